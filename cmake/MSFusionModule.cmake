@@ -1,0 +1,74 @@
+# msf_add_module(<name> [DEPS ...] [PRIVATE_DEPS ...])
+# Builds modules/<name>/src/*.cpp into the library msf_<name> (alias MSFusion::<name>),
+# exported for find_package(MSFusion). Headers live in modules/<name>/include/msf/<name>/.
+# A module without sources yet, or whose msf_ dependencies are not built, is skipped.
+function(msf_add_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp)
+  if(NOT sources)
+    message(STATUS "module ${name}: no sources yet, skipped")
+    return()
+  endif()
+  foreach(dep ${ARG_DEPS})
+    if(dep MATCHES "^msf_" AND NOT TARGET ${dep})
+      message(STATUS "module ${name}: skipped until ${dep} exists")
+      return()
+    endif()
+  endforeach()
+  set(target msf_${name})
+  add_library(${target} ${sources})
+  add_library(MSFusion::${name} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:include>)
+  target_link_libraries(${target} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  msf_set_compiler_options(${target})
+  install(TARGETS ${target} EXPORT MSFusionTargets
+    ARCHIVE DESTINATION lib LIBRARY DESTINATION lib RUNTIME DESTINATION bin)
+  install(DIRECTORY include/ DESTINATION include)
+  set_property(GLOBAL APPEND PROPERTY MSF_MODULE_TARGETS ${target})
+endfunction()
+
+# The msf_* libraries a source file uses, read from its `#include <msf/<module>/...>` lines,
+# so tools, tests and benchmarks link exactly what they include.
+function(msf_modules_used_by out)
+  set(result msf_common)
+  foreach(source ${ARGN})
+    file(STRINGS ${source} lines REGEX "^#include [<\"]msf/[a-z_]+/")
+    foreach(line ${lines})
+      string(REGEX REPLACE "^#include [<\"]msf/([a-z_]+)/.*" "msf_\\1" module ${line})
+      if(TARGET ${module})
+        list(APPEND result ${module})
+      endif()
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES result)
+  set(${out} ${result} PARENT_SCOPE)
+endfunction()
+
+# msf_add_tool(<name>): tools/<name>.cpp into build/bin/<name>.
+function(msf_add_tool name)
+  set(source ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
+  msf_modules_used_by(libs ${source})
+  add_executable(${name} ${source})
+  target_link_libraries(${name} PRIVATE ${libs})
+  msf_set_compiler_options(${name})
+  install(TARGETS ${name} RUNTIME DESTINATION bin)
+endfunction()
+
+# msf_add_test(<name> SOURCES ... [LABELS ...])
+function(msf_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LABELS" ${ARGN})
+  msf_modules_used_by(libs ${ARG_SOURCES})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${libs} msf_test_support)
+  msf_set_compiler_options(${name})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  gtest_discover_tests(${name}
+    WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
+    PROPERTIES ENVIRONMENT "MSF_KITTI_DIR=${MSF_KITTI_DIR};MSF_BIN_DIR=${PROJECT_BINARY_DIR}/bin;MSF_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+               LABELS "${ARG_LABELS}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

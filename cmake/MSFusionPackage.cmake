@@ -1,0 +1,13 @@
+# Installs and exports the CMake package: find_package(MSFusion) gives MSFusion::<module>.
+include(CMakePackageConfigHelpers)
+get_property(MSF_EXPORTED_MODULES GLOBAL PROPERTY MSF_MODULE_TARGETS)
+string(REPLACE "msf_" "" MSF_EXPORTED_MODULES "${MSF_EXPORTED_MODULES}")
+
+install(EXPORT MSFusionTargets NAMESPACE MSFusion:: DESTINATION lib/cmake/MSFusion)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/MSFusionConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/MSFusionConfig.cmake INSTALL_DESTINATION lib/cmake/MSFusion)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/MSFusionConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/MSFusionConfig.cmake
+  ${PROJECT_BINARY_DIR}/MSFusionConfigVersion.cmake DESTINATION lib/cmake/MSFusion)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION share/msfusion/config)

@@ -1,0 +1,25 @@
+#pragma once
+#include <functional>
+#include <string>
+
+namespace msf {
+
+/// Writes `path` through a temporary file in the same folder and a rename, so a reader
+/// never sees a partial file and a failed write leaves nothing behind.
+/// `write` receives the temporary path and must create it (it may throw; the temporary
+/// is then removed). The temporary keeps the extension of `path`, so writers that pick
+/// a format by extension (PCL, OpenCV) still work.
+/// Throws IOError naming the folder if it does not exist or is not writable, and naming
+/// the file if `write` did not produce it.
+void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write);
+
+/// Throws IOError if `path` is not an existing regular file; `what` names its role ("scan").
+void requireFile(const std::string& path, const std::string& what = "file");
+
+/// Throws IOError if `path` is not an existing directory.
+void requireDirectory(const std::string& path, const std::string& what = "folder");
+
+/// Lower-case extension of `path` with its dot (".pcd"), or "" when there is none.
+std::string fileExtension(const std::string& path);
+
+} // namespace msf

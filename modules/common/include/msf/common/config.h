@@ -1,0 +1,32 @@
+#pragma once
+#include <opencv2/core/persistence.hpp>
+
+#include <string>
+
+namespace msf {
+
+/// A YAML configuration file (OpenCV FileStorage), one section per stage:
+///   interpolation: { short_gap_px: 4, max_gap_px: 32 }
+/// Each stage's Config struct has defaults in code and a `read(const cv::FileNode&)`
+/// that overrides only the keys present (see readKey).
+class ConfigFile {
+public:
+  ConfigFile() = default;
+  /// Throws IOError if the file is missing or is not valid YAML.
+  explicit ConfigFile(const std::string& path);
+
+  /// The named section, or an empty node when the file or the section is absent.
+  cv::FileNode section(const std::string& name) const;
+  const std::string& path() const { return path_; }
+
+private:
+  std::string path_;
+  cv::FileStorage storage_;
+};
+
+/// Overrides `value` with `node[key]` when present; throws ConfigError naming the key
+/// when it has the wrong type. T: int, bool, float, double, std::string.
+template <typename T>
+void readKey(const cv::FileNode& node, const char* key, T& value);
+
+} // namespace msf

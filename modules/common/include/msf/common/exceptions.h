@@ -1,0 +1,38 @@
+#pragma once
+#include <stdexcept>
+#include <string>
+
+namespace msf {
+
+/// Base of every exception the library throws; the message names the file, key or value at fault.
+class Error : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A file that cannot be read or written, or whose content is malformed.
+class IOError : public Error {
+public:
+  using Error::Error;
+};
+
+/// A calibration that is missing a key or has a matrix of the wrong size.
+class CalibrationError : public Error {
+public:
+  using Error::Error;
+};
+
+/// A configuration key with a wrong type or an out-of-range value.
+class ConfigError : public Error {
+public:
+  using Error::Error;
+};
+
+/// Input data a stage cannot work on: an unorganized cloud where an organized one is
+/// needed, clouds of different sizes, an empty cloud, NaN where a value is required.
+class InvalidInputError : public Error {
+public:
+  using Error::Error;
+};
+
+} // namespace msf

@@ -1,0 +1,30 @@
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+/// Small helpers shared by the msf_* command-line tools (tools/*.cpp), which otherwise
+/// follow PCL's tools: printHelp, pcl::console::parse_argument, TicToc done lines.
+namespace msf::tool {
+
+/// Runs `body`; any exception becomes "<name>: error: <message>" on stderr and exit code 1.
+int run(const char* name, const std::function<int()>& body);
+
+/// True when -h, --help or -help is among the arguments.
+bool wantsHelp(int argc, char** argv);
+
+/// Throws msf::InvalidInputError naming the first argument that starts with '-' and is
+/// neither in `value_options` (which consume the next argument) nor in `switches`.
+/// PCL's parser ignores unknown options; a typo should not silently do the default.
+void checkOptions(int argc, char** argv, const std::vector<std::string>& value_options,
+                  const std::vector<std::string>& switches);
+
+/// Positional (non-option) arguments, skipping the values of `value_options`.
+std::vector<std::string> positionalArguments(int argc, char** argv,
+                                             const std::vector<std::string>& value_options);
+
+/// Prints PCL's done line: "[done, 12.3 ms : 465750 points]".
+void printDone(double milliseconds, std::size_t points);
+
+} // namespace msf::tool

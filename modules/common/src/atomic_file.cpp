@@ -1,0 +1,63 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <system_error>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace msf {
+
+std::string fileExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void requireFile(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw IOError(what + " '" + path + "' does not exist");
+  if (!fs::is_regular_file(path, ec))
+    throw IOError(what + " '" + path + "' is not a regular file");
+}
+
+void requireDirectory(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::is_directory(path, ec))
+    throw IOError(what + " '" + path + "' does not exist or is not a directory");
+}
+
+void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+  const fs::path target(path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' is not writable");
+
+  static std::atomic<unsigned> counter{0};
+  const fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
+                              std::to_string(counter++) + target.extension().string());
+  try {
+    write(tmp.string());
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+  if (!fs::is_regular_file(tmp, ec)) {
+    fs::remove(tmp, ec);
+    throw IOError("cannot write '" + path + "': the writer produced no file");
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw IOError("cannot write '" + path + "': rename failed: " + ec.message());
+  }
+}
+
+} // namespace msf

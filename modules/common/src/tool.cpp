@@ -1,0 +1,78 @@
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+
+namespace msf::tool {
+
+int run(const char* name, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", name, e.what());
+  } catch (...) {
+    std::fprintf(stderr, "%s: error: unknown exception\n", name);
+  }
+  return 1;
+}
+
+bool wantsHelp(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (!std::strcmp(argv[i], "-h") || !std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-help"))
+      return true;
+  return false;
+}
+
+namespace {
+bool contains(const std::vector<std::string>& list, const char* arg) {
+  return std::find(list.begin(), list.end(), std::string(arg)) != list.end();
+}
+bool isOption(const char* arg) {
+  // "-5" or "-0.3" are values, not options.
+  return arg[0] == '-' && arg[1] != '\0' && !(arg[1] >= '0' && arg[1] <= '9') && arg[1] != '.';
+}
+} // namespace
+
+void checkOptions(int argc, char** argv, const std::vector<std::string>& value_options,
+                  const std::vector<std::string>& switches) {
+  for (int i = 1; i < argc; ++i) {
+    if (!isOption(argv[i]))
+      continue;
+    if (contains(value_options, argv[i])) {
+      if (i + 1 >= argc)
+        throw InvalidInputError(std::string("option '") + argv[i] + "' needs a value");
+      ++i;
+    } else if (!contains(switches, argv[i])) {
+      throw InvalidInputError(std::string("unknown option '") + argv[i] + "' (see -h)");
+    }
+  }
+}
+
+std::vector<std::string> positionalArguments(int argc, char** argv,
+                                             const std::vector<std::string>& value_options) {
+  std::vector<std::string> out;
+  for (int i = 1; i < argc; ++i) {
+    if (isOption(argv[i])) {
+      if (contains(value_options, argv[i]))
+        ++i;
+      continue;
+    }
+    out.emplace_back(argv[i]);
+  }
+  return out;
+}
+
+void printDone(double milliseconds, std::size_t points) {
+  pcl::console::print_info("[done, ");
+  pcl::console::print_value("%g", milliseconds);
+  pcl::console::print_info(" ms : ");
+  pcl::console::print_value("%zu", points);
+  pcl::console::print_info(" points]\n");
+}
+
+} // namespace msf::tool

@@ -1,0 +1,61 @@
+#pragma once
+#include <Eigen/Geometry>
+#include <opencv2/core/types.hpp>
+
+#include <array>
+#include <string>
+
+namespace msf {
+
+/// The camera model that travels beside the clouds: four rectified cameras (KITTI 0, 1 grey
+/// left/right; 2, 3 colour left/right) sharing one rectified image plane, and the LiDAR.
+/// All projection matrices map points in the rectified frame of camera 0 to pixels, so a
+/// point in camera 0 projects into camera i as P[i] * [x y z 1]^T.
+struct Calibration {
+  using Projection = Eigen::Matrix<double, 3, 4>;
+
+  std::array<Projection, 4> P;              ///< P_rect_0X (raw) or PX (odometry, object)
+  cv::Size image_size{0, 0};                ///< rectified image size; 0x0 when unknown
+  Eigen::Isometry3d T_cam0_velo = Eigen::Isometry3d::Identity(); ///< velodyne -> rectified cam 0
+  Eigen::Isometry3d T_velo_imu = Eigen::Isometry3d::Identity();  ///< IMU -> velodyne (raw only)
+  bool has_imu = false;                     ///< true when T_velo_imu was read
+  std::string source;                       ///< where it was read from, for messages
+
+  double fx(int camera = 0) const { return P[camera](0, 0); }
+  double fy(int camera = 0) const { return P[camera](1, 1); }
+  double cx(int camera = 0) const { return P[camera](0, 2); }
+  double cy(int camera = 0) const { return P[camera](1, 2); }
+  /// Intrinsic matrix of a rectified camera.
+  Eigen::Matrix3d K(int camera = 0) const { return P[camera].leftCols<3>(); }
+  /// Optical centre of a camera in the rectified frame of camera 0.
+  Eigen::Vector3d cameraCenter(int camera) const;
+  /// Distance between two optical centres in metres.
+  double baseline(int camera_a, int camera_b) const;
+  double baselineGrey() const { return baseline(0, 1); }
+  double baselineColor() const { return baseline(2, 3); }
+  /// f * B of the grey pair, so that depth = focalBaseline() / disparity.
+  double focalBaseline() const { return fx(0) * baselineGrey(); }
+  /// Throws CalibrationError naming `source` when the image size is unknown.
+  cv::Size requireImageSize() const;
+};
+
+/// Reads a calibration, the format detected from `path`:
+///  - a KITTI odometry `calib.txt` (P0..P3, Tr), or a sequence folder holding one;
+///  - a KITTI raw date folder (calib_cam_to_cam.txt with P_rect_0X, R_rect_00, S_rect_0X,
+///    plus calib_velo_to_cam.txt and, when present, calib_imu_to_velo.txt), a drive folder
+///    inside it, or calib_cam_to_cam.txt itself;
+///  - a KITTI object `calib/NNNNNN.txt` (P0..P3, R0_rect, Tr_velo_to_cam);
+///  - the project's OpenCV YAML camera file (.yaml/.yml, see saveCalibrationYaml).
+/// For odometry and object files, the image size is read from the first image beside the
+/// calibration when there is one. A missing key or a matrix with the wrong number of values
+/// throws CalibrationError naming key and file; a missing path throws IOError.
+Calibration loadCalibration(const std::string& path);
+
+/// Writes the project's YAML camera file (keys P0..P3 as 3x4, image_width, image_height,
+/// T_cam0_velo as 4x4). Atomic: nothing is left behind on failure.
+void saveCalibrationYaml(const Calibration& calibration, const std::string& path);
+
+/// Writes a KITTI odometry calib.txt (P0..P3, Tr). Atomic.
+void saveOdometryCalibration(const Calibration& calibration, const std::string& path);
+
+} // namespace msf

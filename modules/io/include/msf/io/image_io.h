@@ -1,0 +1,25 @@
+#pragma once
+#include <opencv2/core/mat.hpp>
+
+#include <string>
+
+namespace msf {
+
+/// cv::imread that throws IOError naming the file when it is missing or not an image.
+/// flags: cv::ImreadModes (default: as stored).
+cv::Mat readImage(const std::string& path, int flags = -1);
+
+/// cv::imwrite through a temporary file and a rename; throws IOError on failure.
+void writeImage(const std::string& path, const cv::Mat& image);
+
+/// KITTI 16-bit PNG (value = metres or pixels x 256, 0 = none) to CV_32F (0 = none).
+/// Throws IOError when the file is not a single-channel 16-bit image.
+cv::Mat readKittiDepthPng(const std::string& path);
+cv::Mat readKittiDisparityPng(const std::string& path);
+
+/// CV_32F (0, NaN or negative = none) to a KITTI 16-bit PNG; values are clamped to the
+/// largest that fits (255.996). Atomic.
+void writeKittiDepthPng(const std::string& path, const cv::Mat& depth);
+void writeKittiDisparityPng(const std::string& path, const cv::Mat& disparity);
+
+} // namespace msf

@@ -1,0 +1,56 @@
+#pragma once
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/io/cloud_io.h>
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+
+#include <algorithm>
+#include <string>
+
+namespace msf {
+
+namespace detail {
+/// Reads a .pcd or .ply file into a PCLPointCloud2; throws IOError naming the file.
+void readCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob);
+} // namespace detail
+
+template <typename PointT>
+void loadCloud(const std::string& path, pcl::PointCloud<PointT>& cloud) {
+  pcl::PCLPointCloud2 blob;
+  detail::readCloudBlob(path, blob);
+  std::vector<pcl::PCLPointField> wanted;
+  pcl::for_each_type<typename pcl::traits::fieldList<PointT>::type>(pcl::detail::FieldAdder<PointT>(wanted));
+  for (const auto& field : wanted) {
+    // PCL's rgb and rgba are interchangeable; anything else must be present.
+    const bool found = std::any_of(blob.fields.begin(), blob.fields.end(), [&](const pcl::PCLPointField& f) {
+      return f.name == field.name || ((f.name == "rgb" || f.name == "rgba") && (field.name == "rgb" || field.name == "rgba"));
+    });
+    if (!found)
+      throw IOError("cloud '" + path + "' has no field '" + field.name + "'");
+  }
+  pcl::fromPCLPointCloud2(blob, cloud);
+}
+
+template <typename PointT>
+void saveCloud(const std::string& path, const pcl::PointCloud<PointT>& cloud) {
+  const std::string ext = fileExtension(path);
+  if (ext != ".pcd" && ext != ".ply")
+    throw IOError("cannot write '" + path + "': a cloud is written as .pcd or .ply");
+  if (cloud.empty())
+    throw InvalidInputError("cannot write '" + path + "': the cloud is empty");
+  writeAtomically(path, [&](const std::string& tmp) {
+    int result = -1;
+    if (ext == ".pcd")
+      result = pcl::PCDWriter().writeBinaryCompressed(tmp, cloud);
+    else
+      result = pcl::PLYWriter().write(tmp, cloud, true, false);
+    if (result != 0)
+      throw IOError("cannot write cloud '" + path + "'");
+  });
+}
+
+} // namespace msf

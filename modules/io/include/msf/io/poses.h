@@ -1,0 +1,34 @@
+#pragma once
+#include <msf/io/calibration.h>
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace msf {
+
+using PoseList = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
+
+/// KITTI odometry poses/XX.txt: one 3x4 row-major T_world_cam0 a line.
+/// Throws IOError naming file and line for a line that is not 12 numbers.
+PoseList loadOdometryPoses(const std::string& path);
+
+/// Writes poses in the odometry format, atomically.
+void saveOdometryPoses(const std::string& path, const PoseList& T_world_cam0);
+
+/// One OXTS record (the fields the pose needs) of a KITTI raw drive.
+struct OxtsRecord {
+  double lat = 0, lon = 0, alt = 0;     ///< degrees, degrees, metres
+  double roll = 0, pitch = 0, yaw = 0;  ///< radians
+};
+
+/// Reads oxts/data/*.txt of a raw drive folder (sorted by name).
+std::vector<OxtsRecord> loadOxts(const std::string& oxts_data_dir);
+
+/// Converts OXTS records to T_world_cam0 with the KITTI raw devkit's Mercator formulation
+/// (scale from the first latitude), the first frame's camera 0 as the world origin, through
+/// calibration.T_velo_imu (calib_imu_to_velo) and calibration.T_cam0_velo.
+PoseList oxtsToCameraPoses(const std::vector<OxtsRecord>& oxts, const Calibration& calibration);
+
+} // namespace msf

@@ -1,0 +1,313 @@
+#include <msf/common/atomic_file.h>
+#include <opencv2/core.hpp>
+#include <msf/common/exceptions.h>
+#include <msf/io/calibration.h>
+#include <msf/io/image_io.h>
+
+#include <opencv2/core/persistence.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace msf {
+
+Eigen::Vector3d Calibration::cameraCenter(int camera) const {
+  // P = K [R | t] with R = I for rectified cameras: centre = -K^-1 * P.col(3).
+  return -(K(camera).inverse() * P[camera].col(3));
+}
+
+double Calibration::baseline(int camera_a, int camera_b) const {
+  return (cameraCenter(camera_a) - cameraCenter(camera_b)).norm();
+}
+
+cv::Size Calibration::requireImageSize() const {
+  if (image_size.width <= 0 || image_size.height <= 0)
+    throw CalibrationError("calibration '" + source +
+                           "' has no image size (no S_rect_00 key and no image beside it)");
+  return image_size;
+}
+
+namespace {
+
+/// "KEY: v1 v2 ..." lines of a KITTI calibration text file.
+class KeyValueFile {
+public:
+  explicit KeyValueFile(const std::string& path) : path_(path) {
+    requireFile(path, "calibration");
+    std::ifstream in(path);
+    if (!in)
+      throw IOError("calibration '" + path + "' cannot be read");
+    std::string line;
+    while (std::getline(in, line)) {
+      const auto colon = line.find(':');
+      if (colon == std::string::npos)
+        continue;
+      std::string key = line.substr(0, colon);
+      key.erase(0, key.find_first_not_of(" \t"));
+      key.erase(key.find_last_not_of(" \t\r") + 1);
+      std::istringstream values(line.substr(colon + 1));
+      std::vector<double> numbers;
+      std::string token;
+      bool numeric = true;
+      while (values >> token) {
+        try {
+          std::size_t used = 0;
+          numbers.push_back(std::stod(token, &used));
+          numeric = numeric && used == token.size();
+        } catch (const std::exception&) {
+          numeric = false;
+        }
+      }
+      if (numeric)
+        entries_[key] = numbers;
+    }
+  }
+
+  bool has(const std::string& key) const { return entries_.count(key) > 0; }
+
+  std::vector<double> get(const std::string& key, std::size_t count) const {
+    const auto it = entries_.find(key);
+    if (it == entries_.end())
+      throw CalibrationError("calibration '" + path_ + "' has no key '" + key + "'");
+    if (it->second.size() != count)
+      throw CalibrationError("calibration '" + path_ + "': key '" + key + "' has " +
+                             std::to_string(it->second.size()) + " values, expected " +
+                             std::to_string(count));
+    return it->second;
+  }
+
+  Calibration::Projection projection(const std::string& key) const {
+    const auto v = get(key, 12);
+    Calibration::Projection P;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        P(r, c) = v[r * 4 + c];
+    return P;
+  }
+
+  Eigen::Isometry3d transform3x4(const std::string& key) const {
+    const auto v = get(key, 12);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        T.matrix()(r, c) = v[r * 4 + c];
+    return T;
+  }
+
+  Eigen::Matrix3d rotation(const std::string& key) const {
+    const auto v = get(key, 9);
+    Eigen::Matrix3d R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        R(r, c) = v[r * 3 + c];
+    return R;
+  }
+
+  /// The devkit's R + T files (calib_velo_to_cam.txt, calib_imu_to_velo.txt).
+  Eigen::Isometry3d rigid() const {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = rotation("R");
+    const auto t = get("T", 3);
+    T.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+    return T;
+  }
+
+  const std::string& path() const { return path_; }
+
+private:
+  std::string path_;
+  std::map<std::string, std::vector<double>> entries_;
+};
+
+cv::Size imageSizeOf(const fs::path& image) {
+  std::error_code ec;
+  if (!fs::is_regular_file(image, ec))
+    return {0, 0};
+  return readImage(image.string()).size();
+}
+
+fs::path firstFile(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    return {};
+  fs::path first;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && (first.empty() || e.path() < first))
+      first = e.path();
+  return first;
+}
+
+Calibration fromOdometry(const KeyValueFile& f) {
+  Calibration c;
+  c.source = f.path();
+  for (int i = 0; i < 4; ++i)
+    c.P[i] = f.projection("P" + std::to_string(i));
+  c.T_cam0_velo = f.transform3x4("Tr");
+  c.image_size = imageSizeOf(firstFile(fs::path(f.path()).parent_path() / "image_0"));
+  return c;
+}
+
+Calibration fromObject(const KeyValueFile& f) {
+  Calibration c;
+  c.source = f.path();
+  for (int i = 0; i < 4; ++i)
+    c.P[i] = f.projection("P" + std::to_string(i));
+  Eigen::Isometry3d R0 = Eigen::Isometry3d::Identity();
+  R0.linear() = f.rotation("R0_rect");
+  c.T_cam0_velo = R0 * f.transform3x4("Tr_velo_to_cam");
+  // calib/NNNNNN.txt -> image_2/NNNNNN.png
+  const fs::path p(f.path());
+  c.image_size = imageSizeOf(p.parent_path().parent_path() / "image_2" / (p.stem().string() + ".png"));
+  return c;
+}
+
+Calibration fromRawDateFolder(const fs::path& date_dir) {
+  const KeyValueFile cam((date_dir / "calib_cam_to_cam.txt").string());
+  const KeyValueFile velo((date_dir / "calib_velo_to_cam.txt").string());
+  Calibration c;
+  c.source = date_dir.string();
+  for (int i = 0; i < 4; ++i)
+    c.P[i] = cam.projection("P_rect_0" + std::to_string(i));
+  const auto size = cam.get("S_rect_00", 2);
+  c.image_size = cv::Size(static_cast<int>(size[0]), static_cast<int>(size[1]));
+  Eigen::Isometry3d R_rect = Eigen::Isometry3d::Identity();
+  R_rect.linear() = cam.rotation("R_rect_00");
+  c.T_cam0_velo = R_rect * velo.rigid();
+  const fs::path imu = date_dir / "calib_imu_to_velo.txt";
+  if (fs::exists(imu)) {
+    c.T_velo_imu = KeyValueFile(imu.string()).rigid();
+    c.has_imu = true;
+  }
+  return c;
+}
+
+Calibration::Projection readProjectionYaml(const cv::FileStorage& fs_in, const std::string& key,
+                                           const std::string& path) {
+  cv::Mat m;
+  fs_in[key] >> m;
+  if (m.empty())
+    throw CalibrationError("calibration '" + path + "' has no key '" + key + "'");
+  if (m.rows != 3 || m.cols != 4)
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' is " + std::to_string(m.rows) +
+                           "x" + std::to_string(m.cols) + ", expected 3x4");
+  m.convertTo(m, CV_64F);
+  Calibration::Projection P;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c)
+      P(r, c) = m.at<double>(r, c);
+  return P;
+}
+
+Calibration fromYaml(const std::string& path) {
+  cv::FileStorage in;
+  try {
+    in.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw IOError("calibration '" + path + "' is not valid YAML: " + e.err);
+  }
+  if (!in.isOpened())
+    throw IOError("calibration '" + path + "' cannot be opened");
+  Calibration c;
+  c.source = path;
+  for (int i = 0; i < 4; ++i)
+    c.P[i] = readProjectionYaml(in, "P" + std::to_string(i), path);
+  for (const char* key : {"image_width", "image_height"})
+    if (in[key].empty() || !in[key].isInt())
+      throw CalibrationError("calibration '" + path + "' has no integer key '" + key + "'");
+  c.image_size = cv::Size(static_cast<int>(in["image_width"]), static_cast<int>(in["image_height"]));
+  cv::Mat T;
+  in["T_cam0_velo"] >> T;
+  if (T.empty())
+    throw CalibrationError("calibration '" + path + "' has no key 'T_cam0_velo'");
+  if (T.rows != 4 || T.cols != 4)
+    throw CalibrationError("calibration '" + path + "': key 'T_cam0_velo' is " + std::to_string(T.rows) +
+                           "x" + std::to_string(T.cols) + ", expected 4x4");
+  T.convertTo(T, CV_64F);
+  for (int r = 0; r < 4; ++r)
+    for (int col = 0; col < 4; ++col)
+      c.T_cam0_velo.matrix()(r, col) = T.at<double>(r, col);
+  return c;
+}
+
+} // namespace
+
+Calibration loadCalibration(const std::string& path) {
+  std::error_code ec;
+  const fs::path p(path);
+  if (!fs::exists(p, ec))
+    throw IOError("calibration '" + path + "' does not exist");
+  if (fs::is_directory(p, ec)) {
+    if (fs::exists(p / "calib_cam_to_cam.txt"))
+      return fromRawDateFolder(p);
+    if (fs::exists(p.parent_path() / "calib_cam_to_cam.txt")) // a drive folder
+      return fromRawDateFolder(p.parent_path());
+    if (fs::exists(p / "calib.txt"))
+      return fromOdometry(KeyValueFile((p / "calib.txt").string()));
+    throw IOError("calibration folder '" + path +
+                  "' has neither calib_cam_to_cam.txt (KITTI raw) nor calib.txt (KITTI odometry)");
+  }
+  const std::string ext = fileExtension(path);
+  if (ext == ".yaml" || ext == ".yml" || ext == ".xml")
+    return fromYaml(path);
+  if (p.filename() == "calib_cam_to_cam.txt")
+    return fromRawDateFolder(p.has_parent_path() ? p.parent_path() : fs::path("."));
+  const KeyValueFile f(path);
+  if (f.has("Tr_velo_to_cam") || f.has("R0_rect"))
+    return fromObject(f);
+  if (f.has("P_rect_00"))
+    return fromRawDateFolder(p.has_parent_path() ? p.parent_path() : fs::path("."));
+  if (f.has("P0"))
+    return fromOdometry(f);
+  throw CalibrationError("calibration '" + path +
+                         "' is not a KITTI odometry, raw or object calibration (no key P0, P_rect_00 or R0_rect)");
+}
+
+void saveCalibrationYaml(const Calibration& calibration, const std::string& path) {
+  writeAtomically(path, [&](const std::string& tmp) {
+    cv::FileStorage out(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
+    if (!out.isOpened())
+      throw IOError("cannot write calibration '" + path + "'");
+    for (int i = 0; i < 4; ++i) {
+      cv::Mat P(3, 4, CV_64F);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c)
+          P.at<double>(r, c) = calibration.P[i](r, c);
+      out << "P" + std::to_string(i) << P;
+    }
+    out << "image_width" << calibration.image_size.width;
+    out << "image_height" << calibration.image_size.height;
+    cv::Mat T(4, 4, CV_64F);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
+    out << "T_cam0_velo" << T;
+    out.release();
+  });
+}
+
+void saveOdometryCalibration(const Calibration& calibration, const std::string& path) {
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << std::scientific << std::setprecision(12);
+    auto row = [&](const std::string& key, const Eigen::Matrix<double, 3, 4>& M) {
+      out << key << ":";
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c)
+          out << ' ' << M(r, c);
+      out << '\n';
+    };
+    for (int i = 0; i < 4; ++i)
+      row("P" + std::to_string(i), calibration.P[i]);
+    row("Tr", calibration.T_cam0_velo.matrix().topRows<3>());
+    if (!out)
+      throw IOError("cannot write calibration '" + path + "'");
+  });
+}
+
+} // namespace msf

@@ -1,0 +1,199 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/io/image_io.h>
+#include <msf/io/sequence.h>
+#include <msf/io/velodyne_io.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace msf {
+
+FrameRange FrameRange::parse(const std::string& text) {
+  FrameRange r;
+  auto toInt = [&](const std::string& s, int fallback) {
+    if (s.empty())
+      return fallback;
+    std::size_t used = 0;
+    int v = -1;
+    try {
+      v = std::stoi(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size() || v < 0)
+      throw InvalidInputError("frame range '" + text + "' is not 'a:b' with whole numbers a <= b");
+    return v;
+  };
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) {
+    r.first = r.last = toInt(text, -1);
+    if (r.first < 0)
+      throw InvalidInputError("frame range is empty");
+  } else {
+    r.first = toInt(text.substr(0, colon), 0);
+    r.last = toInt(text.substr(colon + 1), -1);
+  }
+  if (r.last >= 0 && r.last < r.first)
+    throw InvalidInputError("frame range '" + text + "' ends before it starts");
+  return r;
+}
+
+namespace {
+
+std::vector<std::string> stemsIn(const fs::path& dir, const std::string& ext) {
+  std::vector<std::string> stems;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    return stems;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && e.path().extension() == ext)
+      stems.push_back(e.path().stem().string());
+  std::sort(stems.begin(), stems.end());
+  return stems;
+}
+
+/// "2011-09-26 13:08:24.969505176" -> seconds of the day (the date does not change in a drive).
+double parseRawTimestamp(const std::string& line) {
+  int h = 0, m = 0;
+  double s = 0;
+  if (line.size() < 19 || std::sscanf(line.c_str() + 11, "%d:%d:%lf", &h, &m, &s) != 3)
+    return 0.0;
+  return h * 3600.0 + m * 60.0 + s;
+}
+
+std::vector<double> readLines(const fs::path& file, bool raw_format) {
+  std::vector<double> t;
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line))
+    if (!line.empty())
+      t.push_back(raw_format ? parseRawTimestamp(line) : std::atof(line.c_str()));
+  if (!t.empty()) {
+    const double t0 = t.front();
+    for (double& x : t)
+      x -= t0;
+  }
+  return t;
+}
+
+bool isOdometrySequence(const fs::path& p) {
+  return fs::is_regular_file(p / "calib.txt") && fs::is_directory(p / "image_0");
+}
+
+} // namespace
+
+Sequence::Sequence(const std::string& dir) {
+  requireDirectory(dir, "sequence");
+  fs::path p = fs::absolute(dir).lexically_normal();
+  if (p.filename().empty())
+    p = p.parent_path();
+  std::error_code ec;
+
+  if (!isOdometrySequence(p) && fs::is_directory(p / "sequences", ec)) {
+    // A dataset root: accept it when it holds exactly one sequence.
+    std::vector<fs::path> found;
+    for (const auto& e : fs::directory_iterator(p / "sequences"))
+      if (isOdometrySequence(e.path()))
+        found.push_back(e.path());
+    if (found.size() != 1)
+      throw IOError("dataset '" + dir + "' holds " + std::to_string(found.size()) +
+                    " sequences under sequences/; name one of them");
+    p = found.front();
+  }
+
+  if (isOdometrySequence(p)) {
+    layout_ = Layout::Odometry;
+    dir_ = p.string();
+    calibration_ = loadCalibration((p / "calib.txt").string());
+    frame_names_ = stemsIn(p / "image_0", ".png");
+    timestamps_ = readLines(p / "times.txt", false);
+    const fs::path root = p.parent_path().parent_path();
+    const fs::path poses = root / "poses" / (p.filename().string() + ".txt");
+    if (fs::is_regular_file(poses, ec))
+      poses_ = loadOdometryPoses(poses.string());
+    if (fs::is_directory(root / "gt", ec))
+      gt_dir_ = (root / "gt").string();
+  } else if (fs::is_directory(p / "image_00" / "data", ec) &&
+             fs::is_regular_file(p.parent_path() / "calib_cam_to_cam.txt", ec)) {
+    layout_ = Layout::Raw;
+    dir_ = p.string();
+    calibration_ = loadCalibration(p.parent_path().string());
+    frame_names_ = stemsIn(p / "image_00" / "data", ".png");
+    timestamps_ = readLines(p / "image_00" / "timestamps.txt", true);
+    if (fs::is_directory(p / "oxts" / "data", ec) && calibration_.has_imu)
+      poses_ = oxtsToCameraPoses(loadOxts((p / "oxts" / "data").string()), calibration_);
+  } else {
+    throw IOError("'" + dir +
+                  "' is neither a KITTI odometry sequence (calib.txt, image_0/) nor a KITTI raw drive "
+                  "(image_00/data/ with calib_cam_to_cam.txt in the folder above)");
+  }
+  if (frame_names_.empty())
+    throw IOError("sequence '" + dir_ + "' has no frames (no images in camera 0's folder)");
+  if (!poses_.empty() && poses_.size() < frame_names_.size())
+    throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " frames but only " +
+                  std::to_string(poses_.size()) + " poses");
+  if (calibration_.image_size.width <= 0)
+    calibration_.image_size = readImage(imagePath(0, 0), cv::IMREAD_GRAYSCALE).size();
+}
+
+std::string Sequence::scanPath(std::size_t i) const {
+  const fs::path p(dir_);
+  if (layout_ == Layout::Odometry)
+    return (p / "velodyne" / (frameName(i) + ".bin")).string();
+  return (p / "velodyne_points" / "data" / (frameName(i) + ".bin")).string();
+}
+
+std::string Sequence::imagePath(int camera, std::size_t i) const {
+  if (camera < 0 || camera > 3)
+    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  const fs::path p(dir_);
+  if (layout_ == Layout::Odometry)
+    return (p / ("image_" + std::to_string(camera)) / (frameName(i) + ".png")).string();
+  return (p / ("image_0" + std::to_string(camera)) / "data" / (frameName(i) + ".png")).string();
+}
+
+Frame Sequence::load(std::size_t i, bool with_color) const {
+  if (i >= size())
+    throw InvalidInputError("frame " + std::to_string(i) + " is out of range: sequence '" + dir_ + "' has " +
+                            std::to_string(size()) + " frames");
+  Frame f;
+  f.index = i;
+  f.timestamp = i < timestamps_.size() ? timestamps_[i] : 0.1 * static_cast<double>(i);
+  f.scan.reset(new pcl::PointCloud<pcl::PointXYZI>);
+  loadVelodyneBin(scanPath(i), *f.scan);
+  f.left = readImage(imagePath(0, i), cv::IMREAD_GRAYSCALE);
+  f.right = readImage(imagePath(1, i), cv::IMREAD_GRAYSCALE);
+  if (with_color && fs::exists(imagePath(2, i)))
+    f.color = readImage(imagePath(2, i), cv::IMREAD_COLOR);
+  const cv::Size size = calibration_.image_size;
+  if (f.left.size() != size || f.right.size() != size)
+    throw InvalidInputError("frame " + frameName(i) + ": image size " + std::to_string(f.left.cols) + "x" +
+                            std::to_string(f.left.rows) + " does not match the calibration's " +
+                            std::to_string(size.width) + "x" + std::to_string(size.height));
+  if (hasPoses()) {
+    f.has_pose = true;
+    f.T_world_cam0 = poses_[i];
+  }
+  return f;
+}
+
+std::vector<std::size_t> Sequence::indices(const FrameRange& range) const {
+  const int last = range.last < 0 ? static_cast<int>(size()) - 1 : std::min(range.last, static_cast<int>(size()) - 1);
+  std::vector<std::size_t> out;
+  for (int i = range.first; i <= last; ++i)
+    out.push_back(static_cast<std::size_t>(i));
+  if (out.empty())
+    throw InvalidInputError("frame range " + std::to_string(range.first) + ":" +
+                            (range.last < 0 ? std::string() : std::to_string(range.last)) + " selects no frame of '" +
+                            dir_ + "' (" + std::to_string(size()) + " frames)");
+  return out;
+}
+
+} // namespace msf

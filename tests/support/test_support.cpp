@@ -1,0 +1,86 @@
+#include "test_support.h"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace msf::test {
+
+std::string kittiDir() {
+  const char* env = std::getenv("MSF_KITTI_DIR");
+  const std::string dir = env ? env : "../shared/data/kitti";
+  std::error_code ec;
+  if (fs::is_directory(fs::path(dir) / "odometry", ec))
+    return fs::absolute(dir).lexically_normal().string();
+  return "";
+}
+
+bool underCi() {
+  const char* ci = std::getenv("CI");
+  return ci && std::string(ci) == "true";
+}
+
+std::string binDir() {
+  const char* env = std::getenv("MSF_BIN_DIR");
+  return env ? env : "bin";
+}
+
+TempDir::TempDir() {
+  std::random_device rd;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path p = fs::temp_directory_path() / ("msf_test_" + std::to_string(rd()));
+    if (fs::create_directory(p)) {
+      path_ = p.string();
+      return;
+    }
+  }
+  throw std::runtime_error("cannot create a temporary folder");
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+namespace {
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+} // namespace
+
+CommandResult runCommand(const std::string& command_line) {
+  TempDir capture;
+  const std::string out = capture.file("out"), err = capture.file("err");
+  const std::string full = command_line + " >" + out + " 2>" + err + " </dev/null";
+  const int status = std::system(full.c_str());
+  CommandResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+CommandResult runTool(const std::string& tool, const std::string& arguments) {
+  return runCommand(binDir() + "/" + tool + " " + arguments);
+}
+
+bool fileExists(const std::string& path) { return fs::exists(path); }
+
+std::size_t countEntries(const std::string& folder) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(folder))
+    ++n;
+  return n;
+}
+
+} // namespace msf::test

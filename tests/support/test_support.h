@@ -1,0 +1,59 @@
+#pragma once
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace msf::test {
+
+/// Root of the KITTI sample (../shared/data/kitti or $MSF_KITTI_DIR); "" when absent.
+std::string kittiDir();
+
+/// True when running under CI (CI=true), where a missing KITTI sample is a failure.
+bool underCi();
+
+/// Folder of the msf_* tools (build/bin).
+std::string binDir();
+
+/// A fresh empty folder, removed with its contents when the object goes away.
+class TempDir {
+public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+private:
+  std::string path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+/// Runs a shell command line; captures its exit code, stdout and stderr.
+CommandResult runCommand(const std::string& command_line);
+
+/// Runs build/bin/<tool> with `arguments` (already quoted as needed).
+CommandResult runTool(const std::string& tool, const std::string& arguments);
+
+bool fileExists(const std::string& path);
+
+/// Number of entries in a folder (to check that a failed tool left no file behind).
+std::size_t countEntries(const std::string& folder);
+
+} // namespace msf::test
+
+/// Use at the start of a test that needs the real KITTI sample: skips when it is absent,
+/// but fails under CI=true, so CI never passes by skipping.
+#define MSF_REQUIRE_KITTI()                                                                   \
+  do {                                                                                        \
+    if (::msf::test::kittiDir().empty()) {                                                    \
+      if (::msf::test::underCi())                                                             \
+        FAIL() << "KITTI sample not found (set MSF_KITTI_DIR); CI=true requires it";          \
+      GTEST_SKIP() << "KITTI sample not found (set MSF_KITTI_DIR)";                           \
+    }                                                                                         \
+  } while (0)
