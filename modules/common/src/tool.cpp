@@ -14,6 +14,9 @@ int run(const char* name, const std::function<int()>& body) {
   try {
     return body();
   } catch (const std::exception& e) {
+    // End a progress line ("Loading x ") that the failure cut short.
+    std::fputc('\n', stdout);
+    std::fflush(stdout);
     std::fprintf(stderr, "%s: error: %s\n", name, e.what());
   } catch (...) {
     std::fprintf(stderr, "%s: error: unknown exception\n", name);

@@ -7,13 +7,24 @@
 
 namespace msf {
 
-namespace detail {
-void readCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
+void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
   requireFile(path, "cloud");
   const std::string ext = fileExtension(path);
   int result = -1;
-  if (ext == ".pcd")
-    result = pcl::PCDReader().read(path, blob);
+  if (ext == ".pcd") {
+    // PCL 1.13's PCDReader::read crashes on a file without a valid header: check it first.
+    pcl::PCDReader reader;
+    Eigen::Vector4f origin;
+    Eigen::Quaternionf orientation;
+    int version = 0, data_type = 0;
+    unsigned int data_index = 0;
+    if (reader.readHeader(path, blob, origin, orientation, version, data_type, data_index) < 0 ||
+        blob.fields.empty())
+      throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header)");
+    if (static_cast<std::size_t>(blob.width) * blob.height == 0)
+      throw IOError("cloud '" + path + "' has no points");
+    result = reader.read(path, blob);
+  }
   else if (ext == ".ply")
     result = pcl::PLYReader().read(path, blob);
   else
@@ -21,7 +32,6 @@ void readCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
   if (result < 0)
     throw IOError("cloud '" + path + "' cannot be parsed as " + ext.substr(1));
 }
-} // namespace detail
 
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh) {
   const std::string ext = fileExtension(path);

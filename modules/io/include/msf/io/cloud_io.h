@@ -1,10 +1,15 @@
 #pragma once
+#include <pcl/PCLPointCloud2.h>
 #include <pcl/PolygonMesh.h>
 #include <pcl/point_cloud.h>
 
 #include <string>
 
 namespace msf {
+
+/// Reads a .pcd or .ply file with whatever fields it has; throws IOError naming the file
+/// when it is missing, unparsable or has no points.
+void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob);
 
 /// Loads a .pcd (or .ply) cloud; throws IOError naming the file when it is missing or
 /// unreadable, and naming the field when the file lacks one that PointT needs (PCL itself

@@ -13,15 +13,10 @@
 
 namespace msf {
 
-namespace detail {
-/// Reads a .pcd or .ply file into a PCLPointCloud2; throws IOError naming the file.
-void readCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob);
-} // namespace detail
-
 template <typename PointT>
 void loadCloud(const std::string& path, pcl::PointCloud<PointT>& cloud) {
   pcl::PCLPointCloud2 blob;
-  detail::readCloudBlob(path, blob);
+  loadCloudBlob(path, blob);
   std::vector<pcl::PCLPointField> wanted;
   pcl::for_each_type<typename pcl::traits::fieldList<PointT>::type>(pcl::detail::FieldAdder<PointT>(wanted));
   for (const auto& field : wanted) {

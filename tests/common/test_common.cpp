@@ -1,0 +1,118 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
+#include <msf/common/tool.h>
+
+#include "test_support.h"
+
+#include <fstream>
+
+namespace {
+
+void writeText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+TEST(AtomicFile, WritesThroughATemporaryAndRenames) {
+  msf::test::TempDir dir;
+  const std::string target = dir.file("out.txt");
+  msf::writeAtomically(target, [](const std::string& tmp) {
+    EXPECT_EQ(msf::fileExtension(tmp), ".txt");
+    writeText(tmp, "hello");
+  });
+  std::ifstream in(target);
+  std::string content;
+  in >> content;
+  EXPECT_EQ(content, "hello");
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 1u);
+}
+
+TEST(AtomicFile, AFailingWriterLeavesNothing) {
+  msf::test::TempDir dir;
+  EXPECT_THROW(msf::writeAtomically(dir.file("out.txt"),
+                                    [](const std::string& tmp) {
+                                      writeText(tmp, "partial");
+                                      throw msf::IOError("disk full");
+                                    }),
+               msf::IOError);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 0u);
+}
+
+TEST(AtomicFile, MissingFolderIsNamed) {
+  try {
+    msf::writeAtomically("/nonexistent_msf_dir/out.txt", [](const std::string&) {});
+    FAIL() << "expected IOError";
+  } catch (const msf::IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_msf_dir"), std::string::npos) << e.what();
+  }
+}
+
+TEST(AtomicFile, WriterThatProducesNoFileIsAnError) {
+  msf::test::TempDir dir;
+  EXPECT_THROW(msf::writeAtomically(dir.file("out.txt"), [](const std::string&) {}), msf::IOError);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 0u);
+}
+
+TEST(Config, ReadsKeysOfASectionAndKeepsDefaults) {
+  msf::test::TempDir dir;
+  writeText(dir.file("c.yaml"), "%YAML:1.0\nstage:\n  gap_px: 7\n  ratio: 0.25\n  name: cubic\n  on: true\n");
+  const msf::ConfigFile config(dir.file("c.yaml"));
+  const cv::FileNode stage = config.section("stage");
+  int gap = 3, untouched = 42;
+  double ratio = 0;
+  std::string name;
+  bool on = false;
+  msf::readKey(stage, "gap_px", gap);
+  msf::readKey(stage, "ratio", ratio);
+  msf::readKey(stage, "name", name);
+  msf::readKey(stage, "on", on);
+  msf::readKey(stage, "absent", untouched);
+  EXPECT_EQ(gap, 7);
+  EXPECT_DOUBLE_EQ(ratio, 0.25);
+  EXPECT_EQ(name, "cubic");
+  EXPECT_TRUE(on);
+  EXPECT_EQ(untouched, 42);
+  EXPECT_TRUE(config.section("other").empty());
+}
+
+TEST(Config, WrongTypeNamesTheKey) {
+  msf::test::TempDir dir;
+  writeText(dir.file("c.yaml"), "%YAML:1.0\nstage:\n  gap_px: 2.5\n  name: 3\n");
+  const msf::ConfigFile config(dir.file("c.yaml"));
+  int gap = 0;
+  try {
+    msf::readKey(config.section("stage"), "gap_px", gap);
+    FAIL() << "expected ConfigError";
+  } catch (const msf::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("stage.gap_px"), std::string::npos) << e.what();
+  }
+  std::string name;
+  EXPECT_THROW(msf::readKey(config.section("stage"), "name", name), msf::ConfigError);
+}
+
+TEST(Config, MissingFileIsAnError) { EXPECT_THROW(msf::ConfigFile("/nonexistent.yaml"), msf::IOError); }
+
+TEST(Statistics, MedianAndPercentile) {
+  EXPECT_DOUBLE_EQ(msf::median({3, 1, 2}), 2.0);
+  EXPECT_DOUBLE_EQ(msf::median({4, 1, 2, 3}), 2.5);
+  EXPECT_DOUBLE_EQ(msf::percentile({0, 10}, 95), 9.5);
+  EXPECT_DOUBLE_EQ(msf::median({}), 0.0);
+}
+
+TEST(Tool, UnknownOptionIsRejectedAndValuesAreNotOptions) {
+  const char* args[] = {"tool", "a.pcd", "-voxel", "-0.5", "-ascii", "b.pcd"};
+  auto argv = const_cast<char**>(args);
+  EXPECT_NO_THROW(msf::tool::checkOptions(6, argv, {"-voxel"}, {"-ascii"}));
+  const auto positional = msf::tool::positionalArguments(6, argv, {"-voxel"});
+  ASSERT_EQ(positional.size(), 2u);
+  EXPECT_EQ(positional[1], "b.pcd");
+  EXPECT_THROW(msf::tool::checkOptions(6, argv, {"-voxel"}, {}), msf::InvalidInputError);
+  const char* missing[] = {"tool", "-voxel"};
+  EXPECT_THROW(msf::tool::checkOptions(2, const_cast<char**>(missing), {"-voxel"}, {}), msf::InvalidInputError);
+}
+
+TEST(Tool, RunTurnsExceptionsIntoExitCodeOne) {
+  EXPECT_EQ(msf::tool::run("msf_test", [] { return 0; }), 0);
+  EXPECT_EQ(msf::tool::run("msf_test", []() -> int { throw msf::IOError("boom"); }), 1);
+}
+
+} // namespace

@@ -1,0 +1,103 @@
+// Converts KITTI Velodyne .bin scans to PointXYZI .pcd clouds, in file order.
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/velodyne_io.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <pcl/console/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace pcl::console;
+
+namespace {
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <scan.bin> <out.pcd> [options]\n", name);
+  print_error("       or: %s -input_dir DIR -output_dir DIR [options]\n", name);
+  print_info("  Reads KITTI Velodyne scans (float32 x, y, z, reflectance) into pcl::PointXYZI clouds,\n"
+             "  in file order (which carries the ring structure). Records with NaN or Inf are dropped.\n");
+  print_info("  where options are:\n");
+  print_info("    -input_dir DIR   convert every *.bin of DIR ...\n");
+  print_info("    -output_dir DIR  ... into DIR/<name>.pcd (the folder must exist)\n");
+  print_info("    -ascii           write ASCII .pcd instead of binary compressed\n");
+}
+
+std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  TicToc tt;
+  tt.tic();
+  print_highlight("Loading ");
+  print_value("%s ", in.c_str());
+  const auto stats = msf::loadVelodyneBin(in, cloud);
+  msf::tool::printDone(tt.toc(), cloud.size());
+  if (stats.dropped_nonfinite > 0)
+    print_warn("dropped %zu of %zu records with non-finite values\n", stats.dropped_nonfinite, stats.records);
+
+  tt.tic();
+  print_highlight("Saving ");
+  print_value("%s ", out.c_str());
+  if (ascii) {
+    if (cloud.empty())
+      throw msf::InvalidInputError("cannot write '" + out + "': the scan has no finite point");
+    msf::writeAtomically(out, [&](const std::string& tmp) {
+      if (pcl::PCDWriter().writeASCII(tmp, cloud) != 0)
+        throw msf::IOError("cannot write cloud '" + out + "'");
+    });
+  } else {
+    msf::saveCloud(out, cloud);
+  }
+  msf::tool::printDone(tt.toc(), cloud.size());
+  return cloud.size();
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_kitti2pcd", [&] {
+    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return argc < 2 ? 1 : 0;
+    }
+    const std::vector<std::string> value_options{"-input_dir", "-output_dir"};
+    msf::tool::checkOptions(argc, argv, value_options, {"-ascii"});
+    const bool ascii = find_switch(argc, argv, "-ascii");
+    std::string input_dir, output_dir;
+    parse_argument(argc, argv, "-input_dir", input_dir);
+    parse_argument(argc, argv, "-output_dir", output_dir);
+
+    if (!input_dir.empty() || !output_dir.empty()) {
+      if (input_dir.empty() || output_dir.empty())
+        throw msf::InvalidInputError("batch mode needs both -input_dir and -output_dir");
+      msf::requireDirectory(input_dir, "input folder");
+      msf::requireDirectory(output_dir, "output folder");
+      std::vector<fs::path> scans;
+      for (const auto& e : fs::directory_iterator(input_dir))
+        if (e.is_regular_file() && msf::fileExtension(e.path().string()) == ".bin")
+          scans.push_back(e.path());
+      if (scans.empty())
+        throw msf::IOError("input folder '" + input_dir + "' has no .bin scan");
+      std::sort(scans.begin(), scans.end());
+      for (const auto& scan : scans)
+        convert(scan.string(), (fs::path(output_dir) / (scan.stem().string() + ".pcd")).string(), ascii);
+      print_info("converted %zu scans\n", scans.size());
+      return 0;
+    }
+
+    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+    if (files.size() != 2)
+      throw msf::InvalidInputError("expected <scan.bin> <out.pcd> (see -h)");
+    if (msf::fileExtension(files[1]) != ".pcd")
+      throw msf::InvalidInputError("output '" + files[1] + "' must end in .pcd");
+    convert(files[0], files[1], ascii);
+    return 0;
+  });
+}

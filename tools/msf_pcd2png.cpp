@@ -1,0 +1,87 @@
+// Writes the depth of an organized cloud as an image: a KITTI 16-bit depth PNG (default),
+// a KITTI disparity PNG, or a false-colour picture with a legend in metres.
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/io/calibration.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/depth_colormap.h>
+#include <msf/io/image_io.h>
+#include <msf/io/organized_conversion.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+#include <opencv2/core.hpp>
+#include <pcl/point_types.h>
+
+using namespace pcl::console;
+
+namespace {
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <organized.pcd> <out.png> [options]\n", name);
+  print_info("  Writes the z of each pixel of an organized cloud (NaN = no depth) as a picture.\n");
+  print_info("  where options are:\n");
+  print_info("    (default)            KITTI 16-bit depth PNG: metres x 256, 0 = none\n");
+  print_info("    -disparity           KITTI 16-bit disparity PNG (pixels x 256), needs -calib\n");
+  print_info("    -calib PATH          KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
+  print_info("    -color               8-bit false-colour picture with a legend in metres\n");
+  print_info("    -range MIN,MAX       colour range in metres for -color (default: 2nd-98th percentile)\n");
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_pcd2png", [&] {
+    if (argc < 3 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
+    }
+    const std::vector<std::string> value_options{"-calib", "-range"};
+    msf::tool::checkOptions(argc, argv, value_options, {"-disparity", "-color"});
+    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+    if (files.size() != 2)
+      throw msf::InvalidInputError("expected <organized.pcd> <out.png> (see -h)");
+    if (msf::fileExtension(files[1]) != ".png")
+      throw msf::InvalidInputError("output '" + files[1] + "' must end in .png");
+    const bool disparity = find_switch(argc, argv, "-disparity");
+    const bool colour = find_switch(argc, argv, "-color");
+    if (disparity && colour)
+      throw msf::InvalidInputError("-disparity and -color exclude each other");
+    std::string calib_path;
+    parse_argument(argc, argv, "-calib", calib_path);
+    if (disparity && calib_path.empty())
+      throw msf::InvalidInputError("-disparity needs -calib PATH (the focal length and baseline)");
+    double range_min = 0, range_max = 0;
+    if (find_argument(argc, argv, "-range") >= 0 &&
+        (parse_2x_arguments(argc, argv, "-range", range_min, range_max) < 0 || range_max <= range_min))
+      throw msf::InvalidInputError("-range must be MIN,MAX in metres with MIN < MAX");
+
+    TicToc tt;
+    tt.tic();
+    print_highlight("Loading ");
+    print_value("%s ", files[0].c_str());
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    msf::loadCloud(files[0], cloud);
+    msf::tool::printDone(tt.toc(), cloud.size());
+    if (!cloud.isOrganized())
+      throw msf::InvalidInputError("cloud '" + files[0] + "' is not organized (" + std::to_string(cloud.width) + "x" +
+                                   std::to_string(cloud.height) + "): a depth image needs width x height pixels");
+    const cv::Mat depth = msf::cloudToDepthImage(cloud);
+
+    tt.tic();
+    print_highlight("Saving ");
+    print_value("%s ", files[1].c_str());
+    if (disparity) {
+      const msf::Calibration calibration = msf::loadCalibration(calib_path);
+      msf::writeKittiDisparityPng(files[1], msf::depthToDisparity(depth, calibration));
+    } else if (colour) {
+      msf::writeImage(files[1], msf::colorizeDepth(depth, static_cast<float>(range_min), static_cast<float>(range_max)));
+    } else {
+      msf::writeKittiDepthPng(files[1], depth);
+    }
+    msf::tool::printDone(tt.toc(), static_cast<std::size_t>(cv::countNonZero(depth)));
+    return 0;
+  });
+}
