@@ -1,0 +1,62 @@
+#pragma once
+#include <msf/io/calibration.h>
+
+#include <opencv2/core/mat.hpp>
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/point_cloud.h>
+
+#include <string>
+
+namespace msf {
+
+/// Intrinsics of the (rectified) camera a depth image was taken with; pixel (u, v) has its
+/// centre at integer coordinates, as in depthImageToCloud: x = (u - cx) z / fx.
+struct PinholeCamera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  int width = 0, height = 0;
+
+  bool valid() const { return fx > 0 && fy > 0 && width > 0 && height > 0; }
+  /// Camera `camera` of a calibration; throws CalibrationError when it has no image size.
+  static PinholeCamera fromCalibration(const Calibration& calibration, int camera = 0);
+};
+
+/// What TsdfIntegrator consumes: a depth image with its camera, and optionally a colour
+/// image and a per-pixel weight image of the same size (the fusion stage's confidence).
+/// The integrator works on this form whatever the point type of the input cloud, so its
+/// inner loop is compiled once.
+struct DepthFrame {
+  cv::Mat depth;   ///< CV_32FC1, z in metres; 0 or NaN = no depth
+  cv::Mat color;   ///< CV_8UC3 in OpenCV's BGR order, or empty
+  cv::Mat weight;  ///< CV_32FC1 (>= 0), or empty
+  PinholeCamera camera;
+
+  /// Throws InvalidInputError naming the image that has a wrong type or size, or the camera
+  /// when its intrinsics are invalid or its size differs from the depth image.
+  void validate() const;
+};
+
+/// Recovers fx, fy, cx, cy of an organized cloud made by a pinhole camera (x = (u - cx) z / fx)
+/// by least squares over its valid points. Throws InvalidInputError when the cloud is not
+/// organized, has too few valid points, or is not a pinhole projection (residual > 0.05 px).
+template <typename PointT>
+PinholeCamera estimatePinholeCamera(const pcl::PointCloud<PointT>& cloud);
+
+/// Organized cloud (NaN where there is no depth) to a DepthFrame: depth = z; colour from the
+/// rgb field when PointT has one; weight from a float field named `weight` when PointT has
+/// one (pcl::traits::has_field), as the fusion stage's point type does. `camera` = nullptr
+/// recovers the intrinsics from the cloud (estimatePinholeCamera).
+/// Throws InvalidInputError when the cloud is not organized.
+template <typename PointT>
+DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamera* camera = nullptr);
+
+/// Same from a cloud of any point type as read from a file (fields x y z, optional rgb or
+/// rgba, optional weight), so tools accept every organized cloud the other stages write.
+/// `what` names the cloud in messages.
+DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* camera = nullptr,
+                        const std::string& what = "cloud");
+
+} // namespace msf
+
+#ifdef MSF_NO_PRECOMPILE
+#include <msf/reconstruction/impl/depth_frame.hpp>
+#endif

@@ -1,0 +1,84 @@
+#pragma once
+#include <msf/reconstruction/tsdf_volume.h>
+
+#include <Eigen/Core>
+#include <opencv2/core/persistence.hpp>
+#include <pcl/PolygonMesh.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <iosfwd>
+#include <unordered_map>
+#include <vector>
+
+namespace msf {
+
+/// A welded triangle mesh: each vertex is stored once and shared by its triangles.
+struct TriangleMesh {
+  std::vector<Eigen::Vector3f> vertices;          ///< metres, world frame
+  std::vector<std::array<std::uint8_t, 3>> colors; ///< r, g, b per vertex
+  std::vector<std::array<std::uint32_t, 3>> triangles; ///< counter-clockwise seen from outside (sdf > 0)
+
+  /// As a pcl::PolygonMesh whose cloud has fields x y z rgb (what saveMesh writes).
+  void toPolygonMesh(pcl::PolygonMesh& mesh) const;
+};
+
+/// Marching cubes over the voxel centres of a TsdfVolume (Lorensen and Cline, with Paul
+/// Bourke's tables), as Voxblox's MeshIntegrator: meshed block by block, in parallel, and
+/// incrementally — an object remembers the mesh of each block and on the next call meshes
+/// again only the blocks whose voxels changed since (and the blocks whose cubes read them).
+/// Vertices are welded across blocks: a vertex is identified by the grid edge it lies on.
+/// A cube is meshed only when all 8 of its voxels have weight > min_weight.
+class MarchingCubes {
+public:
+  struct Config {
+    float min_weight = 0.f; ///< voxels with weight <= this do not make triangles
+
+    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight.
+    void read(const cv::FileNode& node);
+    void print(std::ostream& out) const;
+  };
+
+  struct Stats {
+    std::size_t blocks_meshed = 0;  ///< blocks meshed again by the last call
+    std::size_t blocks_cached = 0;  ///< blocks whose mesh came from the cache
+    double mesh_ms = 0, assemble_ms = 0;
+  };
+
+  MarchingCubes() = default;
+  explicit MarchingCubes(const Config& config);
+
+  const Config& getConfig() const { return config_; }
+  /// Changing min_weight empties the cache.
+  void setConfig(const Config& config);
+  void setMinWeight(float min_weight);
+  float getMinWeight() const { return config_.min_weight; }
+
+  /// Meshes `volume`, incrementally when the same volume was meshed before by this object.
+  void extract(const TsdfVolume& volume, TriangleMesh& mesh);
+  /// The same as a pcl::PolygonMesh (fields x y z rgb; triangles as pcl::Vertices).
+  void extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh);
+  /// Forgets the cached block meshes: the next call meshes everything.
+  void reset();
+
+  const Stats& lastStats() const { return stats_; }
+
+  /// Per-block part of the mesh, kept between calls.
+  struct BlockMesh {
+    std::vector<Eigen::Vector3f> vertices;
+    std::vector<std::array<std::uint8_t, 3>> colors;
+    std::vector<std::uint64_t> keys; ///< grid edge of a vertex other blocks may also make; kInterior otherwise
+    std::vector<std::array<std::uint32_t, 3>> triangles; ///< indices into this block's vertices
+  };
+  static constexpr std::uint64_t kInterior = ~std::uint64_t(0);
+
+private:
+  Config config_;
+  Stats stats_;
+  std::uint64_t volume_id_ = 0;
+  std::uint64_t generation_ = 0;
+  std::unordered_map<GridIndex, BlockMesh, GridIndexHash> cache_;
+};
+
+} // namespace msf

@@ -1,0 +1,22 @@
+#pragma once
+#include <pcl/point_types.h>
+#include <pcl/register_point_struct.h>
+
+namespace msf {
+
+/// One observed voxel of a TsdfVolume as a point: its centre (x y z, metres), sdf (metres),
+/// weight and colour (rgb). A .pcd of these is the volume on disk (TsdfVolume::save), so
+/// tools chain and pcl_viewer shows it (coloured by rgb, or by the sdf field).
+struct EIGEN_ALIGN16 PointTsdf {
+  PCL_ADD_POINT4D;
+  float sdf;
+  float weight;
+  PCL_ADD_RGB;
+  PCL_MAKE_ALIGNED_OPERATOR_NEW
+};
+
+} // namespace msf
+
+POINT_CLOUD_REGISTER_POINT_STRUCT(msf::PointTsdf,
+                                  (float, x, x)(float, y, y)(float, z, z)(float, sdf, sdf)(float, weight, weight)(
+                                      float, rgb, rgb))

@@ -1,0 +1,50 @@
+#pragma once
+#include <msf/reconstruction/tsdf_voxel.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+namespace msf {
+
+/// Integer coordinates of a block (or of a voxel) on the volume's grid.
+using GridIndex = Eigen::Vector3i;
+
+/// Hash of a GridIndex for the volume's block map (the usual three large primes).
+struct GridIndexHash {
+  std::size_t operator()(const GridIndex& i) const noexcept {
+    return static_cast<std::size_t>(static_cast<std::uint32_t>(i.x()) * 73856093u ^
+                                    static_cast<std::uint32_t>(i.y()) * 19349663u ^
+                                    static_cast<std::uint32_t>(i.z()) * 83492791u);
+  }
+};
+
+/// A dense cube of kSide^3 voxels, the unit of allocation, of parallel work and of
+/// incremental meshing (Voxblox's Block). Voxels are contiguous, x fastest.
+struct TsdfBlock {
+  static constexpr int kSide = 8;
+  static constexpr int kVoxels = kSide * kSide * kSide;
+
+  GridIndex index{0, 0, 0};      ///< block coordinates: voxel v lies in block floor(v / kSide)
+  std::uint64_t stamp = 0;       ///< volume generation of the last change (see TsdfVolume)
+  std::array<TsdfVoxel, kVoxels> voxels{};
+
+  static constexpr int linear(int x, int y, int z) { return x + kSide * (y + kSide * z); }
+  TsdfVoxel& at(int x, int y, int z) { return voxels[linear(x, y, z)]; }
+  const TsdfVoxel& at(int x, int y, int z) const { return voxels[linear(x, y, z)]; }
+  /// Global index of the block's first voxel.
+  GridIndex origin() const { return index * kSide; }
+};
+
+/// floor(a / b) for b > 0, also for negative a.
+inline int floorDiv(int a, int b) { return (a >= 0) ? a / b : -((-a + b - 1) / b); }
+
+/// The block that holds global voxel v.
+inline GridIndex blockOf(const GridIndex& v) {
+  return {floorDiv(v.x(), TsdfBlock::kSide), floorDiv(v.y(), TsdfBlock::kSide), floorDiv(v.z(), TsdfBlock::kSide)};
+}
+
+} // namespace msf

@@ -1,0 +1,89 @@
+#pragma once
+#include <msf/reconstruction/point_types.h>
+#include <msf/reconstruction/tsdf_block.h>
+
+#include <pcl/point_cloud.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace msf {
+
+/// A sparse, boundless truncated signed distance volume (Curless and Levoy): blocks of 8^3
+/// voxels allocated on demand in a hash map, as Voxblox's Layer and VDBFusion's VDBVolume.
+/// Voxel v (integer grid coordinates) has its centre at v * voxelSize(), so the marching
+/// cubes grid is the voxel centres.
+///
+/// The volume holds data only; TsdfIntegrator writes it and MarchingCubes reads it.
+class TsdfVolume {
+public:
+  using Ptr = std::shared_ptr<TsdfVolume>;
+  using ConstPtr = std::shared_ptr<const TsdfVolume>;
+
+  /// Throws ConfigError when voxel_size_m <= 0, truncation_m <= 0 (or either not finite).
+  TsdfVolume(double voxel_size_m, double truncation_m);
+
+  double voxelSize() const { return voxel_size_; }
+  double truncation() const { return truncation_; }
+
+  std::size_t numBlocks() const { return blocks_.size(); }
+  /// Voxels with weight > 0 (a pass over every block).
+  std::size_t numObservedVoxels() const;
+  /// Bytes held by blocks and the hash map.
+  std::size_t memoryBytes() const;
+
+  /// The block at `index`, or nullptr when it is not allocated.
+  TsdfBlock* findBlock(const GridIndex& index);
+  const TsdfBlock* findBlock(const GridIndex& index) const;
+  /// The block at `index`, allocated (all voxels unobserved) when absent. Not thread-safe.
+  TsdfBlock& allocateBlock(const GridIndex& index);
+  /// Every allocated block, in allocation order (stable addresses).
+  const std::vector<std::unique_ptr<TsdfBlock>>& blocks() const { return blocks_; }
+
+  /// The voxel with global index v, or nullptr when its block is not allocated.
+  const TsdfVoxel* findVoxel(const GridIndex& v) const;
+  /// Global index of the voxel whose centre is nearest to p (metres, world frame).
+  GridIndex voxelIndexOf(const Eigen::Vector3d& p) const;
+  /// Centre of global voxel v in metres.
+  Eigen::Vector3d voxelCenter(const GridIndex& v) const { return v.cast<double>() * voxel_size_; }
+
+  /// Change counter: each integration takes a new generation and stamps the blocks it
+  /// changes with it, so MarchingCubes re-meshes only those.
+  std::uint64_t generation() const { return generation_; }
+  std::uint64_t beginGeneration() { return ++generation_; }
+  /// Identity of the volume's content lineage; a new value after clear() or load(), which
+  /// tells an incremental mesher to start over.
+  std::uint64_t id() const { return id_; }
+
+  /// Drops every block.
+  void clear();
+
+  /// Observed voxels (weight > min_weight) as points: centre, sdf, weight, colour.
+  void toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight = 0.f) const;
+  /// Replaces the content with the voxels of `cloud` (centres on this volume's grid).
+  /// Throws InvalidInputError naming the first point that is off the grid or not finite.
+  void fromCloud(const pcl::PointCloud<PointTsdf>& cloud);
+
+  /// Saves the observed voxels as a binary compressed .pcd of PointTsdf (x y z sdf weight
+  /// rgb), with voxel size and truncation in a header comment
+  /// ("# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3"). Atomic. Throws IOError naming
+  /// the file, InvalidInputError when the volume has no observed voxel.
+  void save(const std::string& path) const;
+  /// Loads a volume written by save(). Throws IOError naming the file when it is missing,
+  /// lacks a field or the msfusion header comment.
+  static TsdfVolume load(const std::string& path);
+
+private:
+  double voxel_size_;
+  double truncation_;
+  std::uint64_t generation_ = 0;
+  std::uint64_t id_;
+  std::unordered_map<GridIndex, std::size_t, GridIndexHash> index_;
+  std::vector<std::unique_ptr<TsdfBlock>> blocks_;
+};
+
+} // namespace msf

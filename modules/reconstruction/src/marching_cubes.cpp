@@ -1,0 +1,375 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/marching_cubes.h>
+
+#include "marching_cubes_tables.h"
+
+#include <pcl/PCLPointField.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ostream>
+
+namespace msf {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr int kSide = TsdfBlock::kSide;
+constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +x, +y, +z neighbours
+
+// Bourke's corner numbering and edges (see marching_cubes_tables.cpp).
+constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+
+struct Sample {
+  float sdf;
+  float weight;
+  std::uint8_t rgb[3];
+};
+
+/// A vertex is keyed by the grid element it lies on: the lower voxel of a grid edge and the
+/// edge's axis (0..2), or a voxel itself (3) when its sdf is exactly 0. 20 bits per axis.
+constexpr std::int64_t kKeyBias = 1 << 19;
+std::uint64_t vertexKey(int x, int y, int z, int code) {
+  return (static_cast<std::uint64_t>(x + kKeyBias) << 42) | (static_cast<std::uint64_t>(y + kKeyBias) << 22) |
+         (static_cast<std::uint64_t>(z + kKeyBias) << 2) | static_cast<std::uint64_t>(code);
+}
+
+std::uint64_t blockKey(const GridIndex& b) {
+  constexpr std::int64_t kBias = 1 << 20;
+  return (static_cast<std::uint64_t>(b.x() + kBias) << 42) | (static_cast<std::uint64_t>(b.y() + kBias) << 21) |
+         static_cast<std::uint64_t>(b.z() + kBias);
+}
+
+bool lessIndex(const GridIndex& a, const GridIndex& b) {
+  if (a.x() != b.x()) return a.x() < b.x();
+  if (a.y() != b.y()) return a.y() < b.y();
+  return a.z() < b.z();
+}
+
+/// Per-thread working memory for meshing one block.
+struct Scratch {
+  std::array<Sample, kPad * kPad * kPad> samples;
+  std::array<std::int32_t, kPad * kPad * kPad * 4> slot; // local vertex of (grid point, code), -1 = none
+  std::vector<int> used;
+  Scratch() { slot.fill(-1); }
+};
+
+void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
+               Scratch& s) {
+  out.vertices.clear();
+  out.colors.clear();
+  out.keys.clear();
+  out.triangles.clear();
+  const float vs = static_cast<float>(volume.voxelSize());
+
+  // Gather the 9^3 voxels the block's cubes read (weight 0 where a neighbour is absent).
+  const TsdfBlock* nb[8];
+  for (int i = 0; i < 8; ++i)
+    nb[i] = i == 0 ? &block : volume.findBlock(block.index + GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  bool any_negative = false, any_positive = false;
+  for (int z = 0; z < kPad; ++z)
+    for (int y = 0; y < kPad; ++y)
+      for (int x = 0; x < kPad; ++x) {
+        Sample& out_sample = s.samples[x + kPad * (y + kPad * z)];
+        const TsdfBlock* b = nb[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
+        if (!b) {
+          out_sample.weight = 0.f;
+          continue;
+        }
+        const TsdfVoxel& v = b->at(x & 7, y & 7, z & 7);
+        out_sample.sdf = v.sdf;
+        out_sample.weight = v.weight;
+        out_sample.rgb[0] = v.r;
+        out_sample.rgb[1] = v.g;
+        out_sample.rgb[2] = v.b;
+        if (v.weight > min_weight) {
+          any_negative |= v.sdf < 0.f;
+          any_positive |= v.sdf >= 0.f;
+        }
+      }
+  if (!any_negative || !any_positive)
+    return;
+
+  const GridIndex o = block.origin();
+  auto vertexOf = [&](int px, int py, int pz, int code, float t, const Sample& a, const Sample& b) -> std::uint32_t {
+    const int local = px + kPad * (py + kPad * pz);
+    std::int32_t& slot = s.slot[local * 4 + code];
+    if (slot >= 0)
+      return static_cast<std::uint32_t>(slot);
+    slot = static_cast<std::int32_t>(out.vertices.size());
+    s.used.push_back(local * 4 + code);
+    Eigen::Vector3f p(static_cast<float>(o.x() + px), static_cast<float>(o.y() + py), static_cast<float>(o.z() + pz));
+    if (code < 3)
+      p[code] += t;
+    out.vertices.push_back(p * vs);
+    std::array<std::uint8_t, 3> c;
+    for (int k = 0; k < 3; ++k)
+      c[k] = static_cast<std::uint8_t>(std::lround(a.rgb[k] + t * (static_cast<float>(b.rgb[k]) - a.rgb[k])));
+    out.colors.push_back(c);
+    // Interior: every cube around this edge (or voxel) belongs to this block, so no other
+    // block makes this vertex.
+    const int q[3] = {px, py, pz};
+    bool interior = true;
+    for (int k = 0; k < 3; ++k)
+      if (k != code && (q[k] < 1 || q[k] > kSide - 1))
+        interior = false;
+    out.keys.push_back(interior ? MarchingCubes::kInterior : vertexKey(o.x() + px, o.y() + py, o.z() + pz, code));
+    return static_cast<std::uint32_t>(slot);
+  };
+
+  for (int z = 0; z < kSide; ++z)
+    for (int y = 0; y < kSide; ++y)
+      for (int x = 0; x < kSide; ++x) {
+        const Sample* c[8];
+        int cube = 0;
+        bool valid = true;
+        for (int i = 0; i < 8; ++i) {
+          c[i] = &s.samples[(x + kCorner[i][0]) + kPad * ((y + kCorner[i][1]) + kPad * (z + kCorner[i][2]))];
+          if (!(c[i]->weight > min_weight)) {
+            valid = false;
+            break;
+          }
+          cube |= (c[i]->sdf < 0.f) << i;
+        }
+        if (!valid)
+          continue;
+        const unsigned int edges = detail::kEdgeTable[cube];
+        if (!edges)
+          continue;
+        std::uint32_t vert[12];
+        for (int e = 0; e < 12; ++e) {
+          if (!(edges & (1u << e)))
+            continue;
+          int ia = kEdge[e][0], ib = kEdge[e][1];
+          int axis = 0;
+          while (kCorner[ia][axis] == kCorner[ib][axis])
+            ++axis;
+          if (kCorner[ia][axis] > kCorner[ib][axis])
+            std::swap(ia, ib); // interpolate from the lower end, so every block computes the same vertex
+          const Sample& a = *c[ia];
+          const Sample& b = *c[ib];
+          const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
+          // A voxel with sdf exactly 0 is the vertex of all its edges (no duplicate positions).
+          if (a.sdf == 0.f)
+            vert[e] = vertexOf(px, py, pz, 3, 0.f, a, a);
+          else if (b.sdf == 0.f)
+            vert[e] = vertexOf(px + (axis == 0), py + (axis == 1), pz + (axis == 2), 3, 0.f, b, b);
+          else
+            vert[e] = vertexOf(px, py, pz, axis, a.sdf / (a.sdf - b.sdf), a, b);
+        }
+        const int* tri = detail::kTriTable[cube];
+        for (int t = 0; tri[t] != -1; t += 3) {
+          // Bourke's order is clockwise seen from outside with "inside = sdf < 0": reversed here.
+          const std::array<std::uint32_t, 3> f = {vert[tri[t]], vert[tri[t + 2]], vert[tri[t + 1]]};
+          if (f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+            out.triangles.push_back(f);
+        }
+      }
+  for (const int u : s.used)
+    s.slot[u] = -1;
+  s.used.clear();
+}
+
+/// Open addressing map from a vertex key to its index in the assembled mesh.
+class VertexIndexMap {
+public:
+  explicit VertexIndexMap(std::size_t expected) {
+    std::size_t cap = 16;
+    while (cap < 2 * expected)
+      cap <<= 1;
+    keys_.assign(cap, MarchingCubes::kInterior);
+    values_.resize(cap);
+    mask_ = cap - 1;
+  }
+  /// The index stored for `key`, or `value` after storing it.
+  std::uint32_t findOrInsert(std::uint64_t key, std::uint32_t value, bool& inserted) {
+    std::size_t h = (key * 0x9E3779B97F4A7C15ull) >> 20 & mask_;
+    while (true) {
+      if (keys_[h] == key) {
+        inserted = false;
+        return values_[h];
+      }
+      if (keys_[h] == MarchingCubes::kInterior) {
+        keys_[h] = key;
+        values_[h] = value;
+        inserted = true;
+        return value;
+      }
+      h = (h + 1) & mask_;
+    }
+  }
+
+private:
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> values_;
+  std::size_t mask_;
+};
+
+} // namespace
+
+void MarchingCubes::Config::read(const cv::FileNode& node) {
+  readKey(node, "min_weight", min_weight);
+  if (!(min_weight >= 0.f))
+    throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(min_weight));
+}
+
+void MarchingCubes::Config::print(std::ostream& out) const {
+  out << "marching_cubes:\n  min_weight: " << min_weight << "\n";
+}
+
+MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
+
+void MarchingCubes::setConfig(const Config& config) {
+  if (!(config.min_weight >= 0.f))
+    throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(config.min_weight));
+  if (config.min_weight != config_.min_weight)
+    reset();
+  config_ = config;
+}
+
+void MarchingCubes::setMinWeight(float min_weight) {
+  Config c = config_;
+  c.min_weight = min_weight;
+  setConfig(c);
+}
+
+void MarchingCubes::reset() {
+  cache_.clear();
+  volume_id_ = 0;
+  generation_ = 0;
+}
+
+void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
+  stats_ = Stats();
+  const auto t0 = Clock::now();
+  if (volume.id() != volume_id_) {
+    cache_.clear();
+    volume_id_ = volume.id();
+    generation_ = 0;
+  }
+
+  // Blocks to mesh again: the changed ones and those whose cubes read them (-x, -y, -z side).
+  std::vector<std::uint64_t> dirty_keys;
+  std::vector<const TsdfBlock*> dirty;
+  for (const auto& block : volume.blocks()) {
+    if (block->stamp <= generation_)
+      continue;
+    for (int i = 0; i < 8; ++i) {
+      const GridIndex b = block->index - GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+      if (i == 0 || volume.findBlock(b))
+        dirty_keys.push_back(blockKey(b));
+    }
+  }
+  std::sort(dirty_keys.begin(), dirty_keys.end());
+  dirty_keys.erase(std::unique(dirty_keys.begin(), dirty_keys.end()), dirty_keys.end());
+  std::vector<BlockMesh*> targets;
+  for (const auto& block : volume.blocks())
+    if (std::binary_search(dirty_keys.begin(), dirty_keys.end(), blockKey(block->index))) {
+      dirty.push_back(block.get());
+      targets.push_back(&cache_[block->index]);
+    }
+  const float min_weight = config_.min_weight;
+#pragma omp parallel
+  {
+    Scratch scratch;
+#pragma omp for schedule(dynamic, 4)
+    for (std::size_t i = 0; i < dirty.size(); ++i)
+      meshBlock(volume, *dirty[i], min_weight, *targets[i], scratch);
+  }
+  generation_ = volume.generation();
+  stats_.blocks_meshed = dirty.size();
+  stats_.blocks_cached = cache_.size() - dirty.size();
+  stats_.mesh_ms = msSince(t0);
+
+  // Assemble in block order (not cache order), so incremental and full meshing agree.
+  const auto t1 = Clock::now();
+  std::vector<std::pair<GridIndex, const BlockMesh*>> order;
+  order.reserve(cache_.size());
+  std::size_t total_vertices = 0, total_shared = 0, total_triangles = 0;
+  for (const auto& [index, part] : cache_) {
+    if (part.triangles.empty())
+      continue;
+    order.emplace_back(index, &part);
+    total_vertices += part.vertices.size();
+    total_triangles += part.triangles.size();
+    for (const std::uint64_t k : part.keys)
+      total_shared += k != kInterior;
+  }
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return lessIndex(a.first, b.first); });
+  mesh.vertices.clear();
+  mesh.colors.clear();
+  mesh.triangles.clear();
+  mesh.vertices.reserve(total_vertices);
+  mesh.colors.reserve(total_vertices);
+  mesh.triangles.reserve(total_triangles);
+  VertexIndexMap shared(total_shared);
+  std::vector<std::uint32_t> remap;
+  for (const auto& entry : order) {
+    const BlockMesh& part = *entry.second;
+    remap.resize(part.vertices.size());
+    for (std::size_t v = 0; v < part.vertices.size(); ++v) {
+      const auto next = static_cast<std::uint32_t>(mesh.vertices.size());
+      bool inserted = true;
+      remap[v] = part.keys[v] == kInterior ? next : shared.findOrInsert(part.keys[v], next, inserted);
+      if (inserted) {
+        mesh.vertices.push_back(part.vertices[v]);
+        mesh.colors.push_back(part.colors[v]);
+      }
+    }
+    for (const auto& t : part.triangles)
+      mesh.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+  }
+  stats_.assemble_ms = msSince(t1);
+}
+
+void MarchingCubes::extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh) {
+  TriangleMesh triangles;
+  extract(volume, triangles);
+  const auto t1 = Clock::now();
+  triangles.toPolygonMesh(mesh);
+  stats_.assemble_ms += msSince(t1);
+}
+
+void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
+  pcl::PCLPointCloud2& cloud = mesh.cloud;
+  cloud = pcl::PCLPointCloud2();
+  const char* names[4] = {"x", "y", "z", "rgb"};
+  for (int i = 0; i < 4; ++i) {
+    pcl::PCLPointField f;
+    f.name = names[i];
+    f.offset = static_cast<std::uint32_t>(4 * i);
+    f.datatype = pcl::PCLPointField::FLOAT32;
+    f.count = 1;
+    cloud.fields.push_back(f);
+  }
+  cloud.point_step = 16;
+  cloud.width = static_cast<std::uint32_t>(vertices.size());
+  cloud.height = 1;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = true;
+  cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
+  const auto n = static_cast<std::ptrdiff_t>(vertices.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    std::uint8_t* p = cloud.data.data() + 16 * i;
+    std::memcpy(p, vertices[i].data(), 12);
+    const std::uint32_t rgb = (std::uint32_t(255) << 24) | (std::uint32_t(colors[i][0]) << 16) |
+                              (std::uint32_t(colors[i][1]) << 8) | std::uint32_t(colors[i][2]);
+    std::memcpy(p + 12, &rgb, 4);
+  }
+  mesh.polygons.resize(triangles.size());
+  const auto m = static_cast<std::ptrdiff_t>(triangles.size());
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < m; ++i)
+    mesh.polygons[i].vertices.assign(triangles[i].begin(), triangles[i].end());
+}
+
+} // namespace msf

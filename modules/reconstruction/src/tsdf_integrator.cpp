@@ -1,0 +1,468 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <ostream>
+
+namespace msf {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
+constexpr int kSide = TsdfBlock::kSide;
+
+std::uint64_t packKey(const Eigen::Vector3i& b) {
+  constexpr std::int64_t kBias = 1 << 20; // +-1M blocks per axis: +-800 km at 0.1 m voxels
+  return (static_cast<std::uint64_t>(b.x() + kBias) << 42) | (static_cast<std::uint64_t>(b.y() + kBias) << 21) |
+         static_cast<std::uint64_t>(b.z() + kBias);
+}
+GridIndex unpackKey(std::uint64_t k) {
+  constexpr std::int64_t kBias = 1 << 20;
+  constexpr std::uint64_t kMask = (1u << 21) - 1;
+  return {static_cast<int>(static_cast<std::int64_t>((k >> 42) & kMask) - kBias),
+          static_cast<int>(static_cast<std::int64_t>((k >> 21) & kMask) - kBias),
+          static_cast<int>(static_cast<std::int64_t>(k & kMask) - kBias)};
+}
+
+/// Amanatides-Woo traversal of the unit cells that the segment a -> b crosses.
+template <typename Visit>
+void traverseCells(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Visit&& visit) {
+  Eigen::Vector3i cell(static_cast<int>(std::floor(a.x())), static_cast<int>(std::floor(a.y())),
+                       static_cast<int>(std::floor(a.z())));
+  const Eigen::Vector3i end(static_cast<int>(std::floor(b.x())), static_cast<int>(std::floor(b.y())),
+                            static_cast<int>(std::floor(b.z())));
+  const Eigen::Vector3f d = b - a;
+  Eigen::Vector3i step;
+  Eigen::Vector3f t_max, t_delta;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    step[i] = d[i] > 0 ? 1 : (d[i] < 0 ? -1 : 0);
+    t_delta[i] = step[i] ? 1.f / std::abs(d[i]) : kInf;
+    t_max[i] = step[i] > 0 ? (static_cast<float>(cell[i] + 1) - a[i]) / d[i]
+               : step[i] < 0 ? (static_cast<float>(cell[i]) - a[i]) / d[i]
+                             : kInf;
+  }
+  visit(cell);
+  // The cell count bounds the loop against float round-off near cell boundaries.
+  int remaining = (end - cell).cwiseAbs().sum();
+  while (remaining-- > 0) {
+    int axis = 0;
+    if (t_max[1] < t_max[axis]) axis = 1;
+    if (t_max[2] < t_max[axis]) axis = 2;
+    if (t_max[axis] > 1.f)
+      break;
+    cell[axis] += step[axis];
+    t_max[axis] += t_delta[axis];
+    visit(cell);
+  }
+}
+
+/// Running weighted mean of one observation into a voxel.
+inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight) {
+  const float total = voxel.weight + w;
+  const float inv = 1.f / total;
+  voxel.sdf = (voxel.sdf * voxel.weight + sdf * w) * inv;
+  if (bgr) {
+    voxel.r = static_cast<std::uint8_t>((voxel.r * voxel.weight + bgr[2] * w) * inv + 0.5f);
+    voxel.g = static_cast<std::uint8_t>((voxel.g * voxel.weight + bgr[1] * w) * inv + 0.5f);
+    voxel.b = static_cast<std::uint8_t>((voxel.b * voxel.weight + bgr[0] * w) * inv + 0.5f);
+  }
+  voxel.weight = std::min(total, max_weight);
+}
+
+} // namespace
+
+const char* toString(TsdfIntegrator::Weighting weighting) {
+  switch (weighting) {
+  case TsdfIntegrator::Weighting::Constant: return "constant";
+  case TsdfIntegrator::Weighting::InverseSquare: return "inverse_square";
+  case TsdfIntegrator::Weighting::PerPixel: return "per_pixel";
+  }
+  return "?";
+}
+
+TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
+  if (text == "constant") return TsdfIntegrator::Weighting::Constant;
+  if (text == "inverse_square") return TsdfIntegrator::Weighting::InverseSquare;
+  if (text == "per_pixel") return TsdfIntegrator::Weighting::PerPixel;
+  throw ConfigError("TSDF weighting '" + text + "' is not constant, inverse_square or per_pixel");
+}
+
+void TsdfIntegrator::Config::read(const cv::FileNode& node) {
+  std::string w = toString(weighting);
+  readKey(node, "weighting", w);
+  weighting = parseWeighting(w);
+  readKey(node, "max_weight", max_weight);
+  readKey(node, "space_carving", space_carving);
+  readKey(node, "lambda", lambda);
+  readKey(node, "sweeps", sweeps);
+  readKey(node, "min_depth_m", min_depth_m);
+  readKey(node, "max_depth_m", max_depth_m);
+  readKey(node, "interpolate_depth", interpolate_depth);
+  validate();
+}
+
+void TsdfIntegrator::Config::validate() const {
+  if (!(max_weight > 0.f))
+    throw ConfigError("tsdf_integrator.max_weight must be > 0, got " + std::to_string(max_weight));
+  if (!(lambda >= 0.0) || !std::isfinite(lambda))
+    throw ConfigError("tsdf_integrator.lambda must be >= 0, got " + std::to_string(lambda));
+  if (sweeps < 0)
+    throw ConfigError("tsdf_integrator.sweeps must be >= 0, got " + std::to_string(sweeps));
+  if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
+    throw ConfigError("tsdf_integrator: need 0 <= min_depth_m < max_depth_m, got " + std::to_string(min_depth_m) +
+                      " and " + std::to_string(max_depth_m));
+}
+
+void TsdfIntegrator::Config::print(std::ostream& out) const {
+  out << "tsdf_integrator:\n"
+      << "  weighting: " << toString(weighting) << "\n"
+      << "  max_weight: " << max_weight << "\n"
+      << "  space_carving: " << (space_carving ? "true" : "false") << "\n"
+      << "  lambda: " << lambda << "\n"
+      << "  sweeps: " << sweeps << "\n"
+      << "  min_depth_m: " << min_depth_m << "\n"
+      << "  max_depth_m: " << max_depth_m << "\n"
+      << "  interpolate_depth: " << (interpolate_depth ? "true" : "false") << "\n";
+}
+
+TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : volume_(volume) {}
+
+TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume, const Config& config) : volume_(volume) { setConfig(config); }
+
+void TsdfIntegrator::setConfig(const Config& config) {
+  config.validate();
+  config_ = config;
+}
+
+void TsdfIntegrator::setLambda(double lambda) {
+  Config c = config_;
+  c.lambda = lambda;
+  setConfig(c);
+}
+
+void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
+  frame.validate();
+  if (config_.weighting == Weighting::PerPixel && frame.weight.empty())
+    throw InvalidInputError("TSDF weighting per_pixel needs a weight image (a cloud with a 'weight' field)");
+  if (!T_world_cam.matrix().allFinite())
+    throw InvalidInputError("T_world_cam has a value that is not finite");
+  stats_ = Stats();
+  const auto t_start = Clock::now();
+
+  const PinholeCamera& cam = frame.camera;
+  const int width = cam.width, height = cam.height;
+  const float vs = static_cast<float>(volume_.voxelSize());
+  const float trunc = static_cast<float>(volume_.truncation());
+  const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.max_depth_m);
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+
+  // 1. Blocks that the truncation band of each pixel's ray crosses, found in parallel (block
+  //    coordinates s = (p / vs + 1/2) / 8 so that floor(s) is the block of p's nearest voxel).
+  const Eigen::Matrix3f R_wc = T_world_cam.linear().cast<float>();
+  const float to_block = 1.f / (vs * kSide);
+  const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSide;
+  std::vector<std::uint64_t> keys;
+#pragma omp parallel
+  {
+    std::vector<std::uint64_t> local;
+    std::array<std::uint64_t, 8> recent;
+    recent.fill(~0ull);
+    std::size_t next = 0;
+#pragma omp for schedule(static) nowait
+    for (int v = 0; v < height; ++v) {
+      const float* depth = frame.depth.ptr<float>(v);
+      for (int u = 0; u < width; ++u) {
+        const float d = depth[u];
+        if (!(d >= min_d && d <= max_d))
+          continue;
+        const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_block;
+        const float z0 = std::max(d - trunc, min_d), z1 = d + trunc;
+        traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& b) {
+          const std::uint64_t k = packKey(b);
+          // Neighbouring pixels cross the same few blocks: skip keys seen just before.
+          for (const std::uint64_t r : recent)
+            if (r == k)
+              return;
+          recent[next++ & 7] = k;
+          local.push_back(k);
+        });
+      }
+    }
+#pragma omp critical
+    keys.insert(keys.end(), local.begin(), local.end());
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  const std::size_t blocks_before = volume_.numBlocks();
+  std::vector<TsdfBlock*> blocks;
+  blocks.reserve(keys.size());
+  for (const std::uint64_t k : keys)
+    blocks.push_back(&volume_.allocateBlock(unpackKey(k)));
+  stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
+
+  if (config_.space_carving) {
+    // Existing blocks in the view in front of the observed surface: their voxels become free space.
+    const Eigen::Isometry3f T_cw = T_world_cam.inverse().cast<float>();
+    const std::uint64_t mark = std::numeric_limits<std::uint64_t>::max();
+    for (TsdfBlock* b : blocks)
+      b->stamp = mark; // temporary marker, reset below
+    for (const auto& block : volume_.blocks()) {
+      if (block->stamp == mark)
+        continue;
+      const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
+      if (c.z() < min_d)
+        continue;
+      const int u = static_cast<int>(std::lround(fx * c.x() / c.z() + cx));
+      const int v = static_cast<int>(std::lround(fy * c.y() / c.z() + cy));
+      if (u < 0 || v < 0 || u >= width || v >= height)
+        continue;
+      const float d = frame.depth.at<float>(v, u);
+      if (d > 0.f && c.z() < d)
+        blocks.push_back(block.get());
+    }
+  }
+  stats_.allocate_ms = msSince(t_start);
+
+  // 2. Projective update of every voxel of those blocks, in parallel over blocks.
+  const auto t_update = Clock::now();
+  const std::uint64_t stamp = volume_.beginGeneration();
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
+  const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
+  const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
+  const std::uint8_t flag = regularized ? kUpdated : 0;
+  const Weighting weighting = config_.weighting;
+  const bool bilinear = config_.interpolate_depth;
+  const bool carving = config_.space_carving;
+  const float max_weight = config_.max_weight;
+  const bool has_color = !frame.color.empty();
+  std::vector<char> changed(blocks.size(), 0);
+  std::size_t updated_total = 0;
+
+#pragma omp parallel for schedule(dynamic, 8) reduction(+ : updated_total)
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    TsdfBlock& block = *blocks[i];
+    const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
+    std::size_t updated = 0;
+    for (int z = 0; z < kSide; ++z)
+      for (int y = 0; y < kSide; ++y) {
+        const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
+        TsdfVoxel* voxels = &block.at(0, y, z);
+        for (int x = 0; x < kSide; ++x) {
+          const Eigen::Vector3f p = row + ex * static_cast<float>(x);
+          if (p.z() < min_d)
+            continue;
+          const float inv_z = 1.f / p.z();
+          const float u = fx * p.x() * inv_z + cx, v = fy * p.y() * inv_z + cy;
+          if (!(u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
+            continue;
+          const int ui = static_cast<int>(u + 0.5f), vi = static_cast<int>(v + 0.5f);
+          float d = frame.depth.ptr<float>(vi)[ui];
+          if (bilinear) {
+            const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
+            if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
+              const float* r0 = frame.depth.ptr<float>(v0) + u0;
+              const float* r1 = frame.depth.ptr<float>(v0 + 1) + u0;
+              const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
+              const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
+              const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
+              // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
+              if (lo > 0.f && hi - lo < trunc) {
+                const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
+                d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
+              }
+            }
+          }
+          if (!(d >= min_d && d <= max_d))
+            continue;
+          float sdf = d - p.z();
+          if (sdf < -trunc)
+            continue;
+          const bool in_band = sdf <= trunc;
+          if (!in_band) {
+            if (!carving)
+              continue;
+            sdf = trunc;
+          }
+          float w = 1.f;
+          if (weighting == Weighting::InverseSquare) {
+            w = 1.f / (d * d);
+          } else if (weighting == Weighting::PerPixel) {
+            w = frame.weight.ptr<float>(vi)[ui];
+            if (!(w > 0.f))
+              continue;
+          }
+          const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
+          TsdfVoxel& voxel = voxels[x];
+          updateVoxel(voxel, sdf, w, bgr, max_weight);
+          voxel.flags |= flag;
+          ++updated;
+        }
+      }
+    if (updated) {
+      block.stamp = stamp;
+      changed[i] = 1;
+      updated_total += updated;
+    }
+  }
+  std::vector<TsdfBlock*> touched;
+  touched.reserve(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i)
+    if (changed[i])
+      touched.push_back(blocks[i]);
+    else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())
+      blocks[i]->stamp = stamp;
+  stats_.blocks_touched = touched.size();
+  stats_.voxels_updated = updated_total;
+  stats_.update_ms = msSince(t_update);
+
+  const auto t_reg = Clock::now();
+  if (regularized)
+    regularize(touched);
+  stats_.regularize_ms = msSince(t_reg);
+}
+
+void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_world,
+                                   const std::vector<cv::Vec3b>& colors_bgr, const Eigen::Vector3d& origin_world) {
+  if (!colors_bgr.empty() && colors_bgr.size() != points_world.size())
+    throw InvalidInputError("integrateRays: " + std::to_string(colors_bgr.size()) + " colours for " +
+                            std::to_string(points_world.size()) + " points");
+  if (!origin_world.allFinite())
+    throw InvalidInputError("integrateRays: the sensor origin is not finite");
+  stats_ = Stats();
+  const auto t_start = Clock::now();
+  const std::uint64_t stamp = volume_.beginGeneration();
+  const float vs = static_cast<float>(volume_.voxelSize());
+  const float trunc = static_cast<float>(volume_.truncation());
+  const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.max_depth_m);
+  const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
+  const std::uint8_t flag = regularized ? kUpdated : 0;
+  const Eigen::Vector3f o = origin_world.cast<float>();
+  const std::size_t blocks_before = volume_.numBlocks();
+  std::vector<TsdfBlock*> touched;
+  TsdfBlock* last = nullptr;
+  std::size_t updated = 0;
+
+  // Serial: rays of one scan cross the same voxels, and a scan is small (~120k rays).
+  for (std::size_t i = 0; i < points_world.size(); ++i) {
+    const Eigen::Vector3f& p = points_world[i];
+    if (!p.allFinite())
+      continue;
+    Eigen::Vector3f dir = p - o;
+    const float dist = dir.norm();
+    if (!(dist >= min_d && dist <= max_d))
+      continue;
+    dir /= dist;
+    const float w = config_.weighting == Weighting::InverseSquare ? 1.f / (dist * dist) : 1.f;
+    const float t0 = config_.space_carving ? 0.f : dist - trunc;
+    const Eigen::Vector3f a = (o + dir * t0) / vs + Eigen::Vector3f::Constant(0.5f);
+    const Eigen::Vector3f b = (o + dir * (dist + trunc)) / vs + Eigen::Vector3f::Constant(0.5f);
+    const std::uint8_t* bgr = colors_bgr.empty() ? nullptr : colors_bgr[i].val;
+    traverseCells(a, b, [&](const Eigen::Vector3i& v) {
+      const float sdf_raw = dist - (v.cast<float>() * vs - o).dot(dir);
+      if (sdf_raw < -trunc)
+        return;
+      const bool in_band = sdf_raw <= trunc;
+      const GridIndex bi = blockOf(v);
+      if (!last || last->index != bi) {
+        last = &volume_.allocateBlock(bi);
+        if (last->stamp != stamp) {
+          last->stamp = stamp;
+          touched.push_back(last);
+        }
+      }
+      const GridIndex l = v - bi * kSide;
+      TsdfVoxel& voxel = last->at(l.x(), l.y(), l.z());
+      updateVoxel(voxel, in_band ? sdf_raw : trunc, w, in_band ? bgr : nullptr, config_.max_weight);
+      voxel.flags |= flag;
+      ++updated;
+    });
+  }
+  stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
+  stats_.blocks_touched = touched.size();
+  stats_.voxels_updated = updated;
+  stats_.update_ms = msSince(t_start);
+  const auto t_reg = Clock::now();
+  if (regularized)
+    regularize(touched);
+  stats_.regularize_ms = msSince(t_reg);
+}
+
+void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched) {
+  const std::size_t n = touched.size();
+  const float lambda = static_cast<float>(config_.lambda);
+  data_term_.resize(n * TsdfBlock::kVoxels);
+  // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
+  // map is only read here, so the lookups may run in parallel.
+  std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    const GridIndex b = touched[i]->index;
+    const GridIndex offsets[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+    for (int k = 0; k < 6; ++k)
+      neighbours[i][k] = volume_.findBlock(b + offsets[k]);
+    float* y = &data_term_[i * TsdfBlock::kVoxels];
+    for (int j = 0; j < TsdfBlock::kVoxels; ++j)
+      y[j] = touched[i]->voxels[j].sdf;
+  }
+
+  // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
+  // stationarity condition of eq. 7. Red-black order: a half-sweep writes voxels of one
+  // parity and reads only the other, so blocks run in parallel without races.
+  for (int sweep = 0; sweep < config_.sweeps; ++sweep)
+    for (int parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for schedule(dynamic, 8)
+      for (std::size_t i = 0; i < n; ++i) {
+        TsdfBlock& block = *touched[i];
+        const auto& nb = neighbours[i];
+        const float* y = &data_term_[i * TsdfBlock::kVoxels];
+        const GridIndex o = block.origin();
+        const int base_parity = (o.x() + o.y() + o.z()) & 1;
+        for (int z = 0; z < kSide; ++z)
+          for (int yy = 0; yy < kSide; ++yy) {
+            const int x0 = (parity - base_parity - yy - z) & 1;
+            for (int x = x0; x < kSide; x += 2) {
+              const int j = TsdfBlock::linear(x, yy, z);
+              TsdfVoxel& voxel = block.voxels[j];
+              if (!(voxel.flags & kUpdated))
+                continue;
+              float sum = 0.f;
+              int count = 0;
+              auto add = [&](const TsdfVoxel& q) {
+                if (q.weight > 0.f) {
+                  sum += q.sdf;
+                  ++count;
+                }
+              };
+              if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
+              if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
+              if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
+              if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
+              if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
+              if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
+              if (count)
+                voxel.sdf = (y[j] + lambda * sum) / (1.f + lambda * static_cast<float>(count));
+            }
+          }
+      }
+    }
+
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    for (auto& voxel : touched[i]->voxels)
+      voxel.flags = 0;
+}
+
+} // namespace msf

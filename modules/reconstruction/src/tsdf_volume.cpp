@@ -1,0 +1,224 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/io/impl/cloud_io.hpp>
+#include <msf/reconstruction/tsdf_volume.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+namespace msf {
+
+namespace {
+std::uint64_t newVolumeId() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
+std::string number(double v) {
+  std::ostringstream ss;
+  ss.precision(9);
+  ss << v;
+  return ss.str();
+}
+
+constexpr const char* kHeaderTag = "# msfusion tsdf";
+} // namespace
+
+TsdfVolume::TsdfVolume(double voxel_size_m, double truncation_m)
+    : voxel_size_(voxel_size_m), truncation_(truncation_m), id_(newVolumeId()) {
+  if (!std::isfinite(voxel_size_m) || voxel_size_m <= 0.0)
+    throw ConfigError("TSDF voxel size must be > 0 m, got " + number(voxel_size_m));
+  if (!std::isfinite(truncation_m) || truncation_m <= 0.0)
+    throw ConfigError("TSDF truncation distance must be > 0 m, got " + number(truncation_m));
+}
+
+std::size_t TsdfVolume::numObservedVoxels() const {
+  std::size_t n = 0;
+  for (const auto& block : blocks_)
+    for (const auto& voxel : block->voxels)
+      n += voxel.observed() ? 1 : 0;
+  return n;
+}
+
+std::size_t TsdfVolume::memoryBytes() const {
+  // Blocks, the pointer vector, and the map's buckets and nodes (key, value, next, hash).
+  return blocks_.size() * sizeof(TsdfBlock) + blocks_.capacity() * sizeof(void*) +
+         index_.bucket_count() * sizeof(void*) +
+         index_.size() * (sizeof(GridIndex) + sizeof(std::size_t) + 2 * sizeof(void*));
+}
+
+TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) {
+  const auto it = index_.find(index);
+  return it == index_.end() ? nullptr : blocks_[it->second].get();
+}
+
+const TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) const {
+  const auto it = index_.find(index);
+  return it == index_.end() ? nullptr : blocks_[it->second].get();
+}
+
+TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
+  const auto [it, inserted] = index_.try_emplace(index, blocks_.size());
+  if (inserted) {
+    blocks_.push_back(std::make_unique<TsdfBlock>());
+    blocks_.back()->index = index;
+  }
+  return *blocks_[it->second];
+}
+
+const TsdfVoxel* TsdfVolume::findVoxel(const GridIndex& v) const {
+  const GridIndex b = blockOf(v);
+  const TsdfBlock* block = findBlock(b);
+  if (!block)
+    return nullptr;
+  const GridIndex l = v - b * TsdfBlock::kSide;
+  return &block->at(l.x(), l.y(), l.z());
+}
+
+GridIndex TsdfVolume::voxelIndexOf(const Eigen::Vector3d& p) const {
+  return {static_cast<int>(std::lround(p.x() / voxel_size_)), static_cast<int>(std::lround(p.y() / voxel_size_)),
+          static_cast<int>(std::lround(p.z() / voxel_size_))};
+}
+
+void TsdfVolume::clear() {
+  index_.clear();
+  blocks_.clear();
+  id_ = newVolumeId();
+}
+
+void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) const {
+  cloud.clear();
+  cloud.reserve(numObservedVoxels());
+  const float vs = static_cast<float>(voxel_size_);
+  for (const auto& block : blocks_) {
+    const GridIndex o = block->origin();
+    for (int z = 0; z < TsdfBlock::kSide; ++z)
+      for (int y = 0; y < TsdfBlock::kSide; ++y)
+        for (int x = 0; x < TsdfBlock::kSide; ++x) {
+          const TsdfVoxel& voxel = block->at(x, y, z);
+          if (!voxel.observed() || voxel.weight <= min_weight)
+            continue;
+          PointTsdf p;
+          p.x = static_cast<float>(o.x() + x) * vs;
+          p.y = static_cast<float>(o.y() + y) * vs;
+          p.z = static_cast<float>(o.z() + z) * vs;
+          p.sdf = voxel.sdf;
+          p.weight = voxel.weight;
+          p.r = voxel.r;
+          p.g = voxel.g;
+          p.b = voxel.b;
+          p.a = 255;
+          cloud.push_back(p);
+        }
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+}
+
+void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
+  clear();
+  const double tolerance = 0.01; // of a voxel: float coordinates of far voxels round a little
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const PointTsdf& p = cloud[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.sdf) ||
+        !std::isfinite(p.weight) || p.weight < 0.f)
+      throw InvalidInputError("voxel " + std::to_string(i) + " has a coordinate, sdf or weight that is not a finite value");
+    const Eigen::Vector3d q(p.x, p.y, p.z);
+    const GridIndex v = voxelIndexOf(q);
+    if (((q / voxel_size_) - v.cast<double>()).cwiseAbs().maxCoeff() > tolerance)
+      throw InvalidInputError("voxel " + std::to_string(i) + " at (" + number(p.x) + ", " + number(p.y) + ", " +
+                              number(p.z) + ") is not on the " + number(voxel_size_) + " m grid");
+    const GridIndex b = blockOf(v);
+    TsdfBlock& block = allocateBlock(b);
+    const GridIndex l = v - b * TsdfBlock::kSide;
+    TsdfVoxel& voxel = block.at(l.x(), l.y(), l.z());
+    voxel.sdf = std::max(-static_cast<float>(truncation_), std::min(static_cast<float>(truncation_), p.sdf));
+    voxel.weight = p.weight;
+    voxel.r = p.r;
+    voxel.g = p.g;
+    voxel.b = p.b;
+    voxel.flags = 0;
+  }
+  const std::uint64_t stamp = beginGeneration();
+  for (auto& block : blocks_)
+    block->stamp = stamp;
+}
+
+void TsdfVolume::save(const std::string& path) const {
+  if (fileExtension(path) != ".pcd")
+    throw IOError("cannot write volume '" + path + "': a TSDF volume is written as .pcd");
+  pcl::PointCloud<PointTsdf> cloud;
+  toCloud(cloud);
+  if (cloud.empty())
+    throw InvalidInputError("cannot write volume '" + path + "': it has no observed voxel");
+  writeAtomically(path, [&](const std::string& tmp) {
+    // PCL writes the file; the parameters go into a comment line after its first line,
+    // which PCD readers (pcl_viewer included) skip.
+    const std::string raw = tmp + ".raw.pcd";
+    std::string bytes;
+    try {
+      if (pcl::PCDWriter().writeBinaryCompressed(raw, cloud) != 0)
+        throw IOError("cannot write volume '" + path + "'");
+      std::ifstream in(raw, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      std::remove(raw.c_str());
+    } catch (...) {
+      std::remove(raw.c_str());
+      throw;
+    }
+    const auto eol = bytes.find('\n');
+    if (eol == std::string::npos)
+      throw IOError("cannot write volume '" + path + "': PCL wrote no header");
+    const std::string comment = std::string(kHeaderTag) + " voxel_size_m " + number(voxel_size_) + " truncation_m " +
+                                number(truncation_) + "\n";
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(eol + 1));
+    out.write(comment.data(), static_cast<std::streamsize>(comment.size()));
+    out.write(bytes.data() + eol + 1, static_cast<std::streamsize>(bytes.size() - eol - 1));
+    if (!out.flush())
+      throw IOError("cannot write volume '" + path + "': disk full?");
+  });
+}
+
+TsdfVolume TsdfVolume::load(const std::string& path) {
+  requireFile(path, "volume");
+  double voxel_size = 0.0, truncation = 0.0;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    bool found = false;
+    for (int n = 0; n < 32 && std::getline(in, line); ++n) {
+      if (line.rfind("DATA", 0) == 0)
+        break;
+      if (line.rfind(kHeaderTag, 0) == 0) {
+        std::istringstream ss(line.substr(std::string(kHeaderTag).size()));
+        std::string k1, k2;
+        found = static_cast<bool>(ss >> k1 >> voxel_size >> k2 >> truncation) && k1 == "voxel_size_m" &&
+                k2 == "truncation_m";
+        break;
+      }
+    }
+    if (!found)
+      throw IOError("volume '" + path + "' has no header comment '" + kHeaderTag +
+                    " voxel_size_m V truncation_m T' (not written by msf_integrate?)");
+  }
+  TsdfVolume volume(voxel_size, truncation);
+  pcl::PointCloud<PointTsdf> cloud;
+  loadCloud(path, cloud);
+  try {
+    volume.fromCloud(cloud);
+  } catch (const InvalidInputError& e) {
+    throw IOError("volume '" + path + "': " + e.what());
+  }
+  return volume;
+}
+
+} // namespace msf
