@@ -1,0 +1,52 @@
+#pragma once
+#include <msf/io/calibration.h>
+
+#include <opencv2/core/mat.hpp>
+
+#include <cmath>
+#include <cstdint>
+
+namespace msf {
+
+/// Colour of a point in the rectified frame of camera 0, read by projecting it into a
+/// rectified camera's image (KITTI image_2 with P[2]): nearest pixel, no allocation, so it
+/// can run inside the per-pixel loops of stereo and fusion. An empty image samples nothing.
+class ColorSampler {
+public:
+  ColorSampler() = default;
+  /// `image`: CV_8UC3 (BGR) or CV_8UC1 (grey), of any size; `camera`: 0..3.
+  /// Throws InvalidInputError for another image type or camera index.
+  ColorSampler(const cv::Mat& image, const Calibration& calibration, int camera);
+
+  bool empty() const { return image_.empty(); }
+
+  /// Colour of the point (x, y, z) in camera 0, in metres; false when it projects behind the
+  /// camera or outside the image (r, g, b are then left as they were).
+  bool sample(float x, float y, float z, std::uint8_t& r, std::uint8_t& g, std::uint8_t& b) const {
+    if (image_.empty())
+      return false;
+    const float w = P_[8] * x + P_[9] * y + P_[10] * z + P_[11];
+    if (!(w > 1e-6f))
+      return false;
+    const float u = (P_[0] * x + P_[1] * y + P_[2] * z + P_[3]) / w;
+    const float v = (P_[4] * x + P_[5] * y + P_[6] * z + P_[7]) / w;
+    const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
+    if (iu < 0 || iv < 0 || iu >= image_.cols || iv >= image_.rows)
+      return false;
+    const std::uint8_t* px = image_.ptr<std::uint8_t>(iv) + static_cast<std::ptrdiff_t>(iu) * image_.channels();
+    if (image_.channels() == 3) {
+      b = px[0];
+      g = px[1];
+      r = px[2];
+    } else {
+      r = g = b = px[0];
+    }
+    return true;
+  }
+
+private:
+  cv::Mat image_;
+  float P_[12] = {};
+};
+
+} // namespace msf

@@ -1,0 +1,47 @@
+#pragma once
+#include <msf/stereo/stereo_confidence.h>
+
+#include <opencv2/core/persistence.hpp>
+
+#include <iosfwd>
+#include <string>
+
+namespace msf {
+
+/// Every parameter of SgbmStereo, read from the `stereo` section of a config file.
+/// Defaults: OpenCV's 3-way SGBM on 128 disparities with 5x5 blocks (the setting of the
+/// DESIGN's measured baseline), narrowed by a LiDAR depth prior when one is given.
+struct SgbmConfig {
+  std::string mode = "sgbm_3way";  ///< sgbm_3way | sgbm (5 paths) | hh (8 paths) | hh4
+  int min_disparity_px = 0;
+  int num_disparities_px = 128;    ///< positive multiple of 16; the search range without a prior
+  int block_size_px = 5;           ///< odd, 1..11
+  int p1 = 0;                      ///< smoothness penalty for +-1 px steps; 0: 8 * block^2
+  int p2 = 0;                      ///< penalty for larger steps, > p1; 0: 32 * block^2
+  int pre_filter_cap = 63;
+  int uniqueness_ratio_pct = 10;
+  int speckle_window_size_px = 100; ///< 0 disables the speckle filter
+  int speckle_range_px = 2;
+  int disp12_max_diff_px = -1;     ///< OpenCV's own left-right check; < 0 off
+  bool left_right_check = false;   ///< explicit check against a right-view match (2x the time)
+  float left_right_max_diff_px = 1.f;
+  bool prior_search_range = true;  ///< narrow num_disparities to a depth prior when given
+  int prior_margin_px = 8;         ///< disparities beyond the prior's largest
+  float max_depth_m = 0.f;         ///< drop depths beyond this; 0 keeps all
+  int color_camera = 2;            ///< camera whose image colours the cloud
+  StereoConfidenceConfig confidence;
+
+  /// P1 and P2 with the 0 defaults resolved for single-channel images.
+  int resolvedP1() const { return p1 > 0 ? p1 : 8 * block_size_px * block_size_px; }
+  int resolvedP2() const { return p2 > 0 ? p2 : 32 * block_size_px * block_size_px; }
+  /// OpenCV's cv::StereoSGBM mode constant of `mode`.
+  int opencvMode() const;
+
+  /// Overrides the keys present in `node` (the `stereo` section), then validates.
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the key of the first value out of range.
+  void validate() const;
+  void print(std::ostream& out) const;
+};
+
+} // namespace msf

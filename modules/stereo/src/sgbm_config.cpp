@@ -1,0 +1,110 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/stereo/sgbm_config.h>
+
+#include <opencv2/calib3d.hpp>
+
+#include <ostream>
+
+namespace msf {
+
+namespace {
+[[noreturn]] void bad(const std::string& key, const std::string& why) {
+  throw ConfigError("config key 'stereo." + key + "' " + why);
+}
+} // namespace
+
+int SgbmConfig::opencvMode() const {
+  if (mode == "sgbm_3way")
+    return cv::StereoSGBM::MODE_SGBM_3WAY;
+  if (mode == "sgbm")
+    return cv::StereoSGBM::MODE_SGBM;
+  if (mode == "hh")
+    return cv::StereoSGBM::MODE_HH;
+  if (mode == "hh4")
+    return cv::StereoSGBM::MODE_HH4;
+  bad("mode", "must be sgbm_3way, sgbm, hh or hh4, not '" + mode + "'");
+}
+
+void SgbmConfig::read(const cv::FileNode& node) {
+  readKey(node, "mode", mode);
+  readKey(node, "min_disparity_px", min_disparity_px);
+  readKey(node, "num_disparities_px", num_disparities_px);
+  readKey(node, "block_size_px", block_size_px);
+  readKey(node, "p1", p1);
+  readKey(node, "p2", p2);
+  readKey(node, "pre_filter_cap", pre_filter_cap);
+  readKey(node, "uniqueness_ratio_pct", uniqueness_ratio_pct);
+  readKey(node, "speckle_window_size_px", speckle_window_size_px);
+  readKey(node, "speckle_range_px", speckle_range_px);
+  readKey(node, "disp12_max_diff_px", disp12_max_diff_px);
+  readKey(node, "left_right_check", left_right_check);
+  readKey(node, "left_right_max_diff_px", left_right_max_diff_px);
+  readKey(node, "prior_search_range", prior_search_range);
+  readKey(node, "prior_margin_px", prior_margin_px);
+  readKey(node, "max_depth_m", max_depth_m);
+  readKey(node, "color_camera", color_camera);
+  readKey(node, "confidence_hole_distance_px", confidence.hole_distance_px);
+  readKey(node, "confidence_range_window_px", confidence.range_window_px);
+  readKey(node, "confidence_range_free_px", confidence.range_free_px);
+  readKey(node, "confidence_range_scale_px", confidence.range_scale_px);
+  validate();
+}
+
+void SgbmConfig::validate() const {
+  opencvMode();
+  if (num_disparities_px <= 0 || num_disparities_px % 16 != 0)
+    bad("num_disparities_px", "must be a positive multiple of 16, not " + std::to_string(num_disparities_px));
+  if (block_size_px < 1 || block_size_px > 11 || block_size_px % 2 == 0)
+    bad("block_size_px", "must be odd and in 1..11, not " + std::to_string(block_size_px));
+  if (p1 < 0)
+    bad("p1", "must be >= 0 (0: 8 * block^2), not " + std::to_string(p1));
+  if (p2 < 0)
+    bad("p2", "must be >= 0 (0: 32 * block^2), not " + std::to_string(p2));
+  if (resolvedP2() <= resolvedP1())
+    bad("p2", "must be greater than p1 (" + std::to_string(resolvedP2()) + " <= " + std::to_string(resolvedP1()) + ")");
+  if (pre_filter_cap < 1 || pre_filter_cap > 63)
+    bad("pre_filter_cap", "must be in 1..63, not " + std::to_string(pre_filter_cap));
+  if (uniqueness_ratio_pct < 0 || uniqueness_ratio_pct > 100)
+    bad("uniqueness_ratio_pct", "must be in 0..100, not " + std::to_string(uniqueness_ratio_pct));
+  if (speckle_window_size_px < 0)
+    bad("speckle_window_size_px", "must be >= 0, not " + std::to_string(speckle_window_size_px));
+  if (speckle_range_px < 0)
+    bad("speckle_range_px", "must be >= 0, not " + std::to_string(speckle_range_px));
+  if (!(left_right_max_diff_px >= 0.f))
+    bad("left_right_max_diff_px", "must be >= 0");
+  if (prior_margin_px < 0)
+    bad("prior_margin_px", "must be >= 0, not " + std::to_string(prior_margin_px));
+  if (!(max_depth_m >= 0.f))
+    bad("max_depth_m", "must be >= 0 (0 keeps all depths)");
+  if (color_camera < 0 || color_camera > 3)
+    bad("color_camera", "must be 0..3, not " + std::to_string(color_camera));
+  confidence.validate();
+}
+
+void SgbmConfig::print(std::ostream& out) const {
+  out << "stereo:\n"
+      << "  mode: " << mode << "\n"
+      << "  min_disparity_px: " << min_disparity_px << "\n"
+      << "  num_disparities_px: " << num_disparities_px << "\n"
+      << "  block_size_px: " << block_size_px << "\n"
+      << "  p1: " << p1 << "  # resolved " << resolvedP1() << "\n"
+      << "  p2: " << p2 << "  # resolved " << resolvedP2() << "\n"
+      << "  pre_filter_cap: " << pre_filter_cap << "\n"
+      << "  uniqueness_ratio_pct: " << uniqueness_ratio_pct << "\n"
+      << "  speckle_window_size_px: " << speckle_window_size_px << "\n"
+      << "  speckle_range_px: " << speckle_range_px << "\n"
+      << "  disp12_max_diff_px: " << disp12_max_diff_px << "\n"
+      << "  left_right_check: " << (left_right_check ? "true" : "false") << "\n"
+      << "  left_right_max_diff_px: " << left_right_max_diff_px << "\n"
+      << "  prior_search_range: " << (prior_search_range ? "true" : "false") << "\n"
+      << "  prior_margin_px: " << prior_margin_px << "\n"
+      << "  max_depth_m: " << max_depth_m << "\n"
+      << "  color_camera: " << color_camera << "\n"
+      << "  confidence_hole_distance_px: " << confidence.hole_distance_px << "\n"
+      << "  confidence_range_window_px: " << confidence.range_window_px << "\n"
+      << "  confidence_range_free_px: " << confidence.range_free_px << "\n"
+      << "  confidence_range_scale_px: " << confidence.range_scale_px << "\n";
+}
+
+} // namespace msf

@@ -1,0 +1,153 @@
+#include <msf/common/exceptions.h>
+#include <msf/io/organized_conversion.h>
+#include <msf/stereo/disparity_search_range.h>
+#include <msf/stereo/impl/sgbm_stereo.hpp>
+#include <msf/stereo/point_types.h>
+#include <msf/stereo/stereo_confidence.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <string>
+
+namespace msf {
+
+namespace {
+std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+cv::Mat toGrey(const cv::Mat& image) {
+  if (image.channels() == 1)
+    return image;
+  cv::Mat grey;
+  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return grey;
+}
+} // namespace
+
+void SgbmStereo::setConfig(const Config& config) {
+  config.validate();
+  config_ = config;
+}
+
+void SgbmStereo::setCalibration(const Calibration& calibration) {
+  if (!(calibration.focalBaseline() > 0.0))
+    throw CalibrationError("calibration '" + calibration.source +
+                           "': the grey pair has no baseline (P1 must hold -f B in its last column)");
+  calibration_ = calibration;
+  has_calibration_ = true;
+}
+
+void SgbmStereo::setInputImages(const cv::Mat& left, const cv::Mat& right) {
+  left_ = left;
+  right_ = right;
+}
+
+void SgbmStereo::checkInputs() const {
+  if (left_.empty())
+    throw InvalidInputError("SgbmStereo: the left image is missing or empty");
+  if (right_.empty())
+    throw InvalidInputError("SgbmStereo: the right image is missing or empty");
+  for (const auto* image : {&left_, &right_})
+    if (image->depth() != CV_8U || (image->channels() != 1 && image->channels() != 3))
+      throw InvalidInputError(std::string("SgbmStereo: the ") + (image == &left_ ? "left" : "right") +
+                              " image must be 8-bit grey or BGR");
+  if (left_.size() != right_.size())
+    throw InvalidInputError("SgbmStereo: the left image is " + sizeText(left_) + " but the right image is " +
+                            sizeText(right_));
+  const cv::Size expected = calibration_.image_size;
+  if (has_calibration_ && expected.width > 0 && left_.size() != expected)
+    throw InvalidInputError("SgbmStereo: the images are " + sizeText(left_) + " but calibration '" +
+                            calibration_.source + "' is " + std::to_string(expected.width) + "x" +
+                            std::to_string(expected.height));
+  if (!prior_.empty() && (prior_.type() != CV_32FC1 || prior_.size() != left_.size()))
+    throw InvalidInputError("SgbmStereo: the depth prior must be CV_32FC1 of the images' size " + sizeText(left_) +
+                            ", got " + sizeText(prior_));
+  if (config_.left_right_check && left_.cols <= config_.num_disparities_px)
+    throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
+}
+
+cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_disparities) {
+  if (!matcher_)
+    matcher_ = cv::StereoSGBM::create();
+  matcher_->setMode(config_.opencvMode());
+  matcher_->setMinDisparity(config_.min_disparity_px);
+  matcher_->setNumDisparities(num_disparities);
+  matcher_->setBlockSize(config_.block_size_px);
+  matcher_->setP1(config_.resolvedP1());
+  matcher_->setP2(config_.resolvedP2());
+  matcher_->setPreFilterCap(config_.pre_filter_cap);
+  matcher_->setUniquenessRatio(config_.uniqueness_ratio_pct);
+  matcher_->setSpeckleWindowSize(config_.speckle_window_size_px);
+  matcher_->setSpeckleRange(config_.speckle_range_px);
+  matcher_->setDisp12MaxDiff(config_.disp12_max_diff_px);
+  cv::Mat fixed; // CV_16S, disparity x 16
+  matcher_->compute(left, right, fixed);
+  return fixed;
+}
+
+void SgbmStereo::computeDisparity() {
+  checkInputs();
+  const cv::Mat left = toGrey(left_), right = toGrey(right_);
+
+  int num_disparities = config_.num_disparities_px;
+  if (config_.prior_search_range && !prior_.empty() && has_calibration_)
+    num_disparities = searchRangeFromDepth(prior_, calibration_.focalBaseline(), config_.min_disparity_px,
+                                           config_.prior_margin_px, config_.num_disparities_px);
+  searched_disparities_ = num_disparities;
+
+  const cv::Mat fixed = match(left, right, num_disparities);
+  cv::Mat fixed_right; // disparities of the right view, in right-image columns
+  if (config_.left_right_check) {
+    // A right-view match is the left-view match of the mirrored pair, mirrored back.
+    cv::Mat left_flipped, right_flipped;
+    cv::flip(left, left_flipped, 1);
+    cv::flip(right, right_flipped, 1);
+    cv::flip(match(right_flipped, left_flipped, num_disparities), fixed_right, 1);
+  }
+
+  const int rows = fixed.rows, cols = fixed.cols;
+  const float max_depth = config_.max_depth_m;
+  const float min_disparity = (max_depth > 0.f && has_calibration_)
+                                  ? static_cast<float>(calibration_.focalBaseline()) / max_depth
+                                  : 0.f;
+  const float lr_max = config_.left_right_max_diff_px;
+  disparity_.create(rows, cols, CV_32FC1);
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      const short* in = fixed.ptr<short>(v);
+      const short* in_right = fixed_right.empty() ? nullptr : fixed_right.ptr<short>(v);
+      float* out = disparity_.ptr<float>(v);
+      for (int u = 0; u < cols; ++u) {
+        // OpenCV marks a pixel without a match with (min_disparity - 1) * 16; d <= 0 has no depth.
+        float d = in[u] > 0 ? static_cast<float>(in[u]) * (1.f / 16.f) : 0.f;
+        if (d > 0.f && d < min_disparity)
+          d = 0.f;
+        if (d > 0.f && in_right) {
+          const int ur = static_cast<int>(std::lround(static_cast<float>(u) - d));
+          const float dr = ur >= 0 ? static_cast<float>(in_right[ur]) * (1.f / 16.f) : -1.f;
+          if (!(dr > 0.f) || std::fabs(dr - d) > lr_max)
+            d = 0.f;
+        }
+        out[u] = d;
+      }
+    }
+  });
+  confidence_ = stereoConfidence(disparity_, config_.confidence);
+}
+
+cv::Mat SgbmStereo::getDepth() const {
+  if (!has_calibration_)
+    throw CalibrationError("SgbmStereo: no calibration set (setCalibration)");
+  if (disparity_.empty())
+    return cv::Mat();
+  return disparityToDepth(disparity_, calibration_);
+}
+
+#define MSF_INSTANTIATE_SGBM_STEREO(T) template void SgbmStereo::compute<T>(pcl::PointCloud<T>&);
+MSF_INSTANTIATE_SGBM_STEREO(pcl::PointXYZ)
+MSF_INSTANTIATE_SGBM_STEREO(pcl::PointXYZRGB)
+MSF_INSTANTIATE_SGBM_STEREO(pcl::PointXYZRGBA)
+MSF_INSTANTIATE_SGBM_STEREO(msf::PointXYZRGBConfidence)
+
+} // namespace msf

@@ -1,0 +1,73 @@
+#include <msf/common/exceptions.h>
+#include <msf/stereo/stereo_confidence.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <string>
+
+namespace msf {
+
+void StereoConfidenceConfig::validate() const {
+  if (!(hole_distance_px > 0.f))
+    throw ConfigError("config key 'stereo.confidence_hole_distance_px' must be > 0");
+  if (range_window_px < 1 || range_window_px % 2 == 0)
+    throw ConfigError("config key 'stereo.confidence_range_window_px' must be odd and >= 1, not " +
+                      std::to_string(range_window_px));
+  if (!(range_free_px >= 0.f))
+    throw ConfigError("config key 'stereo.confidence_range_free_px' must be >= 0");
+  if (!(range_scale_px > 0.f))
+    throw ConfigError("config key 'stereo.confidence_range_scale_px' must be > 0");
+}
+
+cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig& config) {
+  if (disparity.type() != CV_32FC1)
+    throw InvalidInputError("stereo confidence: disparity image must be CV_32FC1");
+  config.validate();
+  const int rows = disparity.rows, cols = disparity.cols;
+  cv::Mat valid(disparity.size(), CV_8UC1);
+  // Invalid pixels become 0 for the local max and +inf for the local min, so that both
+  // filters see only valid neighbours.
+  cv::Mat for_max(disparity.size(), CV_32FC1), for_min(disparity.size(), CV_32FC1);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int v = 0; v < rows; ++v) {
+    const float* d = disparity.ptr<float>(v);
+    std::uint8_t* m = valid.ptr<std::uint8_t>(v);
+    float* hi = for_max.ptr<float>(v);
+    float* lo = for_min.ptr<float>(v);
+    for (int u = 0; u < cols; ++u) {
+      const bool ok = d[u] > 0.f && std::isfinite(d[u]);
+      m[u] = ok ? 255 : 0;
+      hi[u] = ok ? d[u] : 0.f;
+      lo[u] = ok ? d[u] : inf;
+    }
+  }
+  cv::Mat hole_distance;
+  cv::distanceTransform(valid, hole_distance, cv::DIST_L1, 3, CV_32F);
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(config.range_window_px, config.range_window_px));
+  cv::dilate(for_max, for_max, kernel);
+  cv::erode(for_min, for_min, kernel);
+
+  cv::Mat confidence(disparity.size(), CV_32FC1);
+  const float inv_hole = 1.f / config.hole_distance_px, inv_scale = 1.f / config.range_scale_px;
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      const std::uint8_t* m = valid.ptr<std::uint8_t>(v);
+      const float* dist = hole_distance.ptr<float>(v);
+      const float* hi = for_max.ptr<float>(v);
+      const float* lo = for_min.ptr<float>(v);
+      float* c = confidence.ptr<float>(v);
+      for (int u = 0; u < cols; ++u) {
+        if (!m[u]) {
+          c[u] = 0.f;
+          continue;
+        }
+        const float excess = std::max(0.f, hi[u] - lo[u] - config.range_free_px);
+        c[u] = (1.f - std::exp(-dist[u] * inv_hole)) * std::exp(-excess * inv_scale);
+      }
+    }
+  });
+  return confidence;
+}
+
+} // namespace msf

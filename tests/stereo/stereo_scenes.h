@@ -1,0 +1,73 @@
+#pragma once
+// Hand-made rectified pairs with known disparity, shared by the stereo tests.
+#include <msf/io/calibration.h>
+
+#include <opencv2/core.hpp>
+
+#include <random>
+
+namespace msf::test {
+
+/// A rectified camera rig: focal length f, principal point at the image centre, grey pair
+/// baseline B, the colour camera (2) at camera 0's place.
+inline Calibration syntheticCalibration(cv::Size size, double f = 500.0, double baseline_m = 0.5) {
+  Calibration c;
+  Calibration::Projection P = Calibration::Projection::Zero();
+  P(0, 0) = P(1, 1) = f;
+  P(0, 2) = size.width / 2.0;
+  P(1, 2) = size.height / 2.0;
+  P(2, 2) = 1.0;
+  for (auto& p : c.P)
+    p = P;
+  c.P[1](0, 3) = -f * baseline_m;
+  c.P[3](0, 3) = -f * baseline_m;
+  c.image_size = size;
+  c.source = "synthetic";
+  return c;
+}
+
+/// Left image: smooth random texture; right image: the left shifted by `disparity(u, v)`
+/// pixels (a fronto-parallel background at `background_px`, a square in front at
+/// `square_px`), so that SGBM should recover the disparity exactly in the interior.
+struct SyntheticPair {
+  cv::Mat left, right;
+  cv::Mat disparity; // CV_32F truth
+  cv::Rect square;
+};
+
+inline SyntheticPair makeSyntheticPair(cv::Size size, float background_px, float square_px, unsigned seed = 7) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> grey(0, 255);
+  // Texture wide enough for the right view to sample to the left of column 0.
+  const int margin = static_cast<int>(square_px) + 8;
+  cv::Mat texture(size.height, size.width + margin, CV_8UC1);
+  for (int v = 0; v < texture.rows; ++v)
+    for (int u = 0; u < texture.cols; ++u)
+      texture.at<std::uint8_t>(v, u) = static_cast<std::uint8_t>(grey(rng));
+  // A second texture for the square, so its edges are real depth edges.
+  cv::Mat texture2 = texture.clone();
+  cv::randu(texture2, 0, 256);
+  SyntheticPair pair;
+  pair.square = cv::Rect(size.width / 2, size.height / 4, size.width / 4, size.height / 2);
+  pair.left.create(size, CV_8UC1);
+  pair.right.create(size, CV_8UC1);
+  pair.disparity.create(size, CV_32FC1);
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u) {
+      const bool in_square = pair.square.contains(cv::Point(u, v));
+      pair.left.at<std::uint8_t>(v, u) = (in_square ? texture2 : texture).at<std::uint8_t>(v, u + margin);
+      pair.disparity.at<float>(v, u) = in_square ? square_px : background_px;
+    }
+  // Right pixel (u, v) sees what the left sees at u + d; the square occludes the background.
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u) {
+      const int u_square = u + static_cast<int>(square_px);
+      const bool square_visible = pair.square.contains(cv::Point(u_square, v));
+      pair.right.at<std::uint8_t>(v, u) = square_visible
+                                              ? texture2.at<std::uint8_t>(v, u_square + margin)
+                                              : texture.at<std::uint8_t>(v, u + static_cast<int>(background_px) + margin);
+    }
+  return pair;
+}
+
+} // namespace msf::test
