@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# make bench: every benchmark of bench/, on the KITTI sample.
+# Usage: bench/run_all.sh BIN_DIR KITTI_DIR
+set -euo pipefail
+bin=${1:-build/bin} kitti=${2:-../shared/data/kitti}
+export MSF_KITTI_DIR="$kitti"
+found=0
+for b in "$bin"/bench_*; do
+  [ -x "$b" ] || continue
+  found=1
+  echo "== $(basename "$b")"
+  "$b" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+done
+[ "$found" = 1 ] || echo "bench: no benchmark built yet"
