@@ -218,18 +218,23 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     const std::uint64_t mark = std::numeric_limits<std::uint64_t>::max();
     for (TsdfBlock* b : blocks)
       b->stamp = mark; // temporary marker, reset below
+    // A block may be partly in view when its centre is not: test its bounding sphere.
+    const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
     for (const auto& block : volume_.blocks()) {
       if (block->stamp == mark)
         continue;
       const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
-      if (c.z() < min_d)
+      if (c.z() + radius < min_d)
         continue;
-      const int u = static_cast<int>(std::lround(fx * c.x() / c.z() + cx));
-      const int v = static_cast<int>(std::lround(fy * c.y() / c.z() + cy));
-      if (u < 0 || v < 0 || u >= width || v >= height)
+      const float z = std::max(c.z(), min_d);
+      const float r_px = std::max(fx, fy) * radius / z;
+      const float u = fx * c.x() / z + cx, v = fy * c.y() / z + cy;
+      if (u < -r_px || v < -r_px || u > width + r_px || v > height + r_px)
         continue;
-      const float d = frame.depth.at<float>(v, u);
-      if (d > 0.f && c.z() < d)
+      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, width - 1);
+      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
+      const float d = frame.depth.at<float>(vi, ui);
+      if (!(d > 0.f) || c.z() - radius < d)
         blocks.push_back(block.get());
     }
   }

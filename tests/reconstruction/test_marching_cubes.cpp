@@ -1,0 +1,174 @@
+#include "scenes.h"
+#include "test_support.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/io/cloud_io.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+using namespace msf;
+
+namespace {
+
+void integrateSphere(TsdfVolume& volume, int first, int count, MarchingCubes* mesher = nullptr,
+                     TriangleMesh* mesh = nullptr) {
+  const AnalyticScene scene = test::makeScene(test::SceneKind::Sphere);
+  TsdfIntegrator integrator(volume);
+  const auto poses = test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 40, 8);
+  for (int i = first; i < first + count; ++i) {
+    DepthFrame frame = test::renderFrame(scene, test::smallCamera(), poses[i]);
+    frame.color = cv::Mat(frame.depth.size(), CV_8UC3, cv::Scalar(30 * i, 20, 255 - 30 * i));
+    integrator.integrate(frame, poses[i]);
+    if (mesher)
+      mesher->extract(volume, *mesh);
+  }
+}
+
+} // namespace
+
+TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
+  // sdf = 0.25 - z on a 0.1 m grid: vertices at z = 0.25 exactly, triangles facing -z
+  // (towards positive sdf, the side the camera would see).
+  TsdfVolume volume(0.1, 0.5);
+  for (int bx = -1; bx <= 0; ++bx)
+    for (int by = -1; by <= 0; ++by) {
+      TsdfBlock& block = volume.allocateBlock(GridIndex(bx, by, 0));
+      for (int z = 0; z < 8; ++z)
+        for (int y = 0; y < 8; ++y)
+          for (int x = 0; x < 8; ++x) {
+            TsdfVoxel& v = block.at(x, y, z);
+            v.sdf = 0.25f - 0.1f * static_cast<float>(z);
+            v.weight = 1.f;
+          }
+      block.stamp = volume.beginGeneration();
+    }
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  // 16 x 16 voxel columns -> 15 x 15 cubes -> 225 squares -> 450 triangles, 256 vertices.
+  EXPECT_EQ(mesh.triangles.size(), 450u);
+  EXPECT_EQ(mesh.vertices.size(), 256u);
+  for (const auto& p : mesh.vertices)
+    EXPECT_NEAR(p.z(), 0.25f, 1e-6);
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    EXPECT_LT(n.z(), 0.f);
+  }
+}
+
+TEST(MarchingCubes, MeshIsWeldedOrientedAndManifold) {
+  TsdfVolume volume(0.04, 0.12);
+  integrateSphere(volume, 0, 8);
+  TriangleMesh mesh;
+  MarchingCubes mesher;
+  mesher.extract(volume, mesh);
+  ASSERT_GT(mesh.triangles.size(), 5000u);
+  // No two vertices at the same position, every vertex used, no degenerate triangle.
+  std::set<std::array<float, 3>> positions;
+  for (const auto& p : mesh.vertices)
+    positions.insert({p.x(), p.y(), p.z()});
+  EXPECT_EQ(positions.size(), mesh.vertices.size());
+  std::vector<int> used(mesh.vertices.size(), 0);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  for (const auto& t : mesh.triangles) {
+    EXPECT_TRUE(t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+    for (int k = 0; k < 3; ++k) {
+      used[t[k]] = 1;
+      const auto a = t[k], b = t[(k + 1) % 3];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0);
+  std::size_t interior = 0;
+  for (const auto& [edge, count] : edges) {
+    EXPECT_LE(count, 2);
+    interior += count == 2;
+  }
+  EXPECT_GT(interior, edges.size() * 9 / 10); // welded: most edges are shared by two triangles
+  // Outward normals on the sphere.
+  std::size_t outward = 0, on_sphere = 0;
+  const Eigen::Vector3f centre(0, 0, 2.5f);
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3f c = (mesh.vertices[t[0]] + mesh.vertices[t[1]] + mesh.vertices[t[2]]) / 3.f;
+    if (std::abs((c - centre).norm() - 0.5f) > 0.02f)
+      continue;
+    ++on_sphere;
+    const Eigen::Vector3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    outward += n.dot(c - centre) > 0.f;
+  }
+  ASSERT_GT(on_sphere, 500u);
+  EXPECT_EQ(outward, on_sphere);
+}
+
+TEST(MarchingCubes, IncrementalMeshingEqualsFullMeshing) {
+  TsdfVolume volume(0.04, 0.12);
+  MarchingCubes incremental;
+  TriangleMesh mesh;
+  integrateSphere(volume, 0, 6, &incremental, &mesh);
+  const std::size_t blocks_last_call = incremental.lastStats().blocks_meshed;
+  EXPECT_GT(incremental.lastStats().blocks_cached, 0u);
+  EXPECT_LT(blocks_last_call, volume.numBlocks());
+
+  TriangleMesh full;
+  MarchingCubes().extract(volume, full);
+  ASSERT_GT(full.triangles.size(), 1000u);
+  EXPECT_EQ(mesh.vertices, full.vertices);
+  EXPECT_EQ(mesh.colors, full.colors);
+  EXPECT_EQ(mesh.triangles, full.triangles);
+
+  // Nothing changed: nothing is meshed again, and the mesh is the same.
+  TriangleMesh again;
+  incremental.extract(volume, again);
+  EXPECT_EQ(incremental.lastStats().blocks_meshed, 0u);
+  EXPECT_EQ(again.triangles, full.triangles);
+
+  // Another volume through the same object: it starts over.
+  TsdfVolume other(0.04, 0.12);
+  integrateSphere(other, 2, 2);
+  TriangleMesh other_incremental, other_full;
+  incremental.extract(other, other_incremental);
+  MarchingCubes().extract(other, other_full);
+  EXPECT_EQ(other_incremental.triangles, other_full.triangles);
+  EXPECT_EQ(other_incremental.vertices, other_full.vertices);
+}
+
+TEST(MarchingCubes, MinimumWeightDropsWeakVoxels) {
+  TsdfVolume volume(0.04, 0.12);
+  integrateSphere(volume, 0, 3);
+  TriangleMesh all, strong, none;
+  MarchingCubes().extract(volume, all);
+  MarchingCubes::Config c;
+  c.min_weight = 2.5f; // only voxels seen by all 3 frames
+  MarchingCubes(c).extract(volume, strong);
+  c.min_weight = 3.f;
+  MarchingCubes(c).extract(volume, none);
+  EXPECT_GT(all.triangles.size(), strong.triangles.size());
+  EXPECT_GT(strong.triangles.size(), 100u);
+  EXPECT_TRUE(none.triangles.empty());
+  MarchingCubes::Config bad;
+  bad.min_weight = -1.f;
+  EXPECT_THROW(MarchingCubes{bad}, ConfigError);
+}
+
+TEST(MarchingCubes, PolygonMeshSavesAsPlyObjAndVtk) {
+  TsdfVolume volume(0.04, 0.12);
+  integrateSphere(volume, 0, 2);
+  MarchingCubes mesher;
+  pcl::PolygonMesh mesh;
+  mesher.extract(volume, mesh);
+  TriangleMesh triangles;
+  mesher.extract(volume, triangles);
+  ASSERT_EQ(mesh.polygons.size(), triangles.triangles.size());
+  ASSERT_EQ(mesh.cloud.width, triangles.vertices.size());
+  test::TempDir dir;
+  for (const char* name : {"mesh.ply", "mesh.obj", "mesh.vtk"}) {
+    saveMesh(dir.file(name), mesh);
+    pcl::PolygonMesh back;
+    loadMesh(dir.file(name), back);
+    EXPECT_EQ(back.polygons.size(), mesh.polygons.size()) << name;
+    EXPECT_EQ(back.cloud.width * back.cloud.height, mesh.cloud.width) << name;
+  }
+}

@@ -1,0 +1,154 @@
+#include "scenes.h"
+#include "test_support.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+#include <msf/reconstruction/tsdf_volume.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <fstream>
+
+using namespace msf;
+
+TEST(TsdfVolume, RejectsNonPositiveSizes) {
+  EXPECT_THROW(TsdfVolume(0.0, 0.3), ConfigError);
+  EXPECT_THROW(TsdfVolume(-0.1, 0.3), ConfigError);
+  EXPECT_THROW(TsdfVolume(0.1, 0.0), ConfigError);
+  try {
+    TsdfVolume(0.0, 0.3);
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("voxel size"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TsdfVolume, BlocksAreSparseAndBoundless) {
+  TsdfVolume volume(0.1, 0.3);
+  EXPECT_EQ(volume.numBlocks(), 0u);
+  EXPECT_EQ(volume.findBlock(GridIndex(0, 0, 0)), nullptr);
+  TsdfBlock& far = volume.allocateBlock(GridIndex(-100000, 3, 250000));
+  EXPECT_EQ(&far, volume.findBlock(GridIndex(-100000, 3, 250000)));
+  EXPECT_EQ(&far, &volume.allocateBlock(GridIndex(-100000, 3, 250000)));
+  EXPECT_EQ(volume.numBlocks(), 1u);
+  EXPECT_GE(volume.memoryBytes(), sizeof(TsdfBlock));
+  const std::size_t one = volume.memoryBytes();
+  volume.allocateBlock(GridIndex(1, 1, 1));
+  EXPECT_GT(volume.memoryBytes(), one);
+  // Voxel -1 is in block -1, voxel -8 too, -9 in block -2.
+  EXPECT_EQ(blockOf(GridIndex(-1, 0, 7)), GridIndex(-1, 0, 0));
+  EXPECT_EQ(blockOf(GridIndex(-8, 8, -9)), GridIndex(-1, 1, -2));
+  EXPECT_EQ(volume.voxelIndexOf(Eigen::Vector3d(-0.149, 0.151, 0.04)), GridIndex(-1, 2, 0));
+  EXPECT_EQ(volume.numObservedVoxels(), 0u);
+}
+
+TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
+  const AnalyticScene scene = test::makeScene(test::SceneKind::Sphere);
+  TsdfVolume volume(0.04, 0.12);
+  TsdfIntegrator integrator(volume);
+  const auto camera = test::smallCamera();
+  for (const auto& pose : test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 10, 3)) {
+    DepthFrame frame = test::renderFrame(scene, camera, pose);
+    frame.color.create(frame.depth.size(), CV_8UC3);
+    frame.color.setTo(cv::Scalar(10, 120, 250));
+    integrator.integrate(frame, pose);
+  }
+  ASSERT_GT(volume.numObservedVoxels(), 1000u);
+
+  test::TempDir dir;
+  volume.save(dir.file("volume.pcd"));
+  const TsdfVolume loaded = TsdfVolume::load(dir.file("volume.pcd"));
+  EXPECT_DOUBLE_EQ(loaded.voxelSize(), 0.04);
+  EXPECT_DOUBLE_EQ(loaded.truncation(), 0.12);
+  EXPECT_EQ(loaded.numObservedVoxels(), volume.numObservedVoxels());
+  std::size_t compared = 0;
+  for (const auto& block : volume.blocks())
+    for (int z = 0; z < 8; ++z)
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const TsdfVoxel& a = block->at(x, y, z);
+          if (!a.observed())
+            continue;
+          const TsdfVoxel* b = loaded.findVoxel(block->origin() + GridIndex(x, y, z));
+          ASSERT_NE(b, nullptr);
+          EXPECT_EQ(a.sdf, b->sdf);
+          EXPECT_EQ(a.weight, b->weight);
+          EXPECT_EQ(a.r, b->r);
+          EXPECT_EQ(a.g, b->g);
+          EXPECT_EQ(a.b, b->b);
+          ++compared;
+        }
+  EXPECT_EQ(compared, volume.numObservedVoxels());
+  const TsdfVoxel* some = nullptr;
+  for (const auto& block : loaded.blocks())
+    for (const auto& v : block->voxels)
+      if (v.observed() && std::abs(v.sdf) < 0.01f)
+        some = &v;
+  ASSERT_NE(some, nullptr);
+  EXPECT_EQ(some->r, 250);
+  EXPECT_EQ(some->g, 120);
+  EXPECT_EQ(some->b, 10);
+
+  TriangleMesh a, b;
+  MarchingCubes().extract(volume, a);
+  MarchingCubes().extract(loaded, b);
+  ASSERT_GT(a.triangles.size(), 100u);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(a.triangles, b.triangles);
+
+  // The file is a PCD that PCL reads as a cloud with the named fields.
+  pcl::PointCloud<PointTsdf> cloud;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir.file("volume.pcd"), cloud), 0);
+  EXPECT_EQ(cloud.size(), volume.numObservedVoxels());
+}
+
+TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
+  test::TempDir dir;
+  TsdfVolume empty(0.1, 0.3);
+  EXPECT_THROW(empty.save(dir.file("empty.pcd")), InvalidInputError);
+  empty.allocateBlock(GridIndex(0, 0, 0)).at(1, 2, 3).weight = 1.f;
+  EXPECT_THROW(empty.save(dir.file("volume.ply")), IOError);
+  EXPECT_EQ(test::countEntries(dir.path()), 0u);
+  EXPECT_THROW(empty.save(dir.path() + "/missing/volume.pcd"), IOError);
+
+  try {
+    TsdfVolume::load(dir.file("absent.pcd"));
+    FAIL();
+  } catch (const IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("absent.pcd"), std::string::npos) << e.what();
+  }
+  // A plain cloud without the volume's header comment.
+  pcl::PointCloud<PointTsdf> cloud;
+  PointTsdf p;
+  p.x = p.y = p.z = 0.f;
+  p.sdf = 0.f;
+  p.weight = 1.f;
+  p.rgba = 0;
+  cloud.push_back(p);
+  pcl::io::savePCDFileBinary(dir.file("plain.pcd"), cloud);
+  try {
+    TsdfVolume::load(dir.file("plain.pcd"));
+    FAIL();
+  } catch (const IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("plain.pcd"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("voxel_size_m"), std::string::npos) << e.what();
+  }
+  // A cloud without the sdf field.
+  empty.save(dir.file("one.pcd"));
+  EXPECT_EQ(TsdfVolume::load(dir.file("one.pcd")).numObservedVoxels(), 1u);
+  pcl::PointCloud<pcl::PointXYZ> xyz;
+  xyz.push_back(pcl::PointXYZ(0, 0, 0));
+  pcl::io::savePCDFileASCII(dir.file("xyz.pcd"), xyz);
+  {
+    std::ifstream in(dir.file("xyz.pcd"));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.insert(text.find('\n') + 1, "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n");
+    std::ofstream(dir.file("xyz.pcd")) << text;
+  }
+  try {
+    TsdfVolume::load(dir.file("xyz.pcd"));
+    FAIL();
+  } catch (const IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("sdf"), std::string::npos) << e.what();
+  }
+}
