@@ -1,0 +1,166 @@
+#include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
+#include <msf/evaluation/mesh_accuracy.h>
+
+#include <pcl/conversions.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace msf {
+
+namespace {
+
+/// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3f closestOnTriangle(const Eigen::Vector3f& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                                  const Eigen::Vector3f& c) {
+  const Eigen::Vector3f ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.f && d2 <= 0.f)
+    return a;
+  const Eigen::Vector3f bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.f && d4 <= d3)
+    return b;
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.f && d1 >= 0.f && d3 <= 0.f)
+    return a + ab * (d1 / (d1 - d3));
+  const Eigen::Vector3f cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.f && d5 <= d6)
+    return c;
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.f && d2 >= 0.f && d6 <= 0.f)
+    return a + ac * (d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.f && (d4 - d3) >= 0.f && (d5 - d6) >= 0.f)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const float denom = 1.f / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+void meshArrays(const pcl::PolygonMesh& mesh, std::vector<Eigen::Vector3f>& vertices,
+                std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::fromPCLPointCloud2(mesh.cloud, cloud);
+  vertices.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    vertices[i] = cloud[i].getVector3fMap();
+  triangles.clear();
+  for (const auto& polygon : mesh.polygons)
+    for (std::size_t k = 2; k < polygon.vertices.size(); ++k)
+      triangles.push_back({static_cast<std::uint32_t>(polygon.vertices[0]),
+                           static_cast<std::uint32_t>(polygon.vertices[k - 1]),
+                           static_cast<std::uint32_t>(polygon.vertices[k])});
+}
+
+} // namespace
+
+SurfaceDistance::SurfaceDistance(std::vector<Eigen::Vector3f> vertices,
+                                 std::vector<std::array<std::uint32_t, 3>> triangles, float cell_size_m)
+    : vertices_(std::move(vertices)), triangles_(std::move(triangles)), cell_size_(cell_size_m) {
+  if (!(cell_size_ > 0.f))
+    throw InvalidInputError("surface distance grid cell must be > 0 m");
+  if (triangles_.empty())
+    throw InvalidInputError("surface has no triangle");
+  for (const auto& t : triangles_)
+    for (std::uint32_t i : t)
+      if (i >= vertices_.size())
+        throw InvalidInputError("surface triangle refers to vertex " + std::to_string(i) + " of " +
+                                std::to_string(vertices_.size()));
+  buildGrid();
+}
+
+SurfaceDistance::SurfaceDistance(const pcl::PolygonMesh& mesh, float cell_size_m) : cell_size_(cell_size_m) {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  meshArrays(mesh, vertices, triangles);
+  *this = SurfaceDistance(std::move(vertices), std::move(triangles), cell_size_m);
+}
+
+SurfaceDistance::Cell SurfaceDistance::cellOf(const Eigen::Vector3f& p) const {
+  return (p / cell_size_).array().floor().cast<int>();
+}
+
+void SurfaceDistance::buildGrid() {
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+    const auto& tri = triangles_[t];
+    Eigen::Vector3f lo = vertices_[tri[0]], hi = lo;
+    for (int k = 1; k < 3; ++k) {
+      lo = lo.cwiseMin(vertices_[tri[k]]);
+      hi = hi.cwiseMax(vertices_[tri[k]]);
+    }
+    if (!lo.allFinite() || !hi.allFinite())
+      continue;
+    const Cell a = cellOf(lo), b = cellOf(hi);
+    for (int x = a.x(); x <= b.x(); ++x)
+      for (int y = a.y(); y <= b.y(); ++y)
+        for (int z = a.z(); z <= b.z(); ++z)
+          grid_[Cell(x, y, z)].push_back(t);
+  }
+}
+
+float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) const {
+  const Cell a = cellOf(p - Eigen::Vector3f::Constant(max_distance_m));
+  const Cell b = cellOf(p + Eigen::Vector3f::Constant(max_distance_m));
+  float best2 = max_distance_m * max_distance_m;
+  for (int x = a.x(); x <= b.x(); ++x)
+    for (int y = a.y(); y <= b.y(); ++y)
+      for (int z = a.z(); z <= b.z(); ++z) {
+        const auto it = grid_.find(Cell(x, y, z));
+        if (it == grid_.end())
+          continue;
+        for (std::uint32_t t : it->second) {
+          const auto& tri = triangles_[t];
+          const float d2 =
+              (closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p).squaredNorm();
+          best2 = std::min(best2, d2);
+        }
+      }
+  return std::sqrt(best2);
+}
+
+MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
+                          const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m) {
+  if (mesh.polygons.empty())
+    throw InvalidInputError("the reconstructed mesh has no triangle");
+  if (truth.polygons.empty())
+    throw InvalidInputError("the true surface has no triangle");
+  const float cap = static_cast<float>(cap_m), threshold = static_cast<float>(threshold_m);
+  MeshAccuracy result;
+  result.threshold_m = threshold_m;
+  result.cap_m = cap_m;
+
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  meshArrays(mesh, vertices, triangles);
+  const SurfaceDistance to_truth(truth, std::max(cap, 0.25f));
+  std::vector<double> distances(vertices.size());
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    distances[i] = to_truth.distance(vertices[i], cap);
+  result.vertices = vertices.size();
+  double sum = 0;
+  std::size_t near = 0;
+  for (double d : distances) {
+    sum += d;
+    near += d <= threshold_m;
+  }
+  result.accuracy_mean_m = vertices.empty() ? 0.0 : sum / static_cast<double>(vertices.size());
+  result.accuracy_median_m = median(distances);
+  result.precision = vertices.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(vertices.size());
+
+  const SurfaceDistance to_mesh(std::move(vertices), std::move(triangles), std::max(threshold, 0.1f));
+  std::size_t covered = 0;
+#pragma omp parallel for reduction(+ : covered) schedule(dynamic, 1024)
+  for (std::size_t i = 0; i < seen_truth.size(); ++i)
+    covered += to_mesh.distance(seen_truth[i], threshold) < threshold;
+  result.truth_samples = seen_truth.size();
+  result.completeness =
+      seen_truth.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(seen_truth.size());
+  return result;
+}
+
+} // namespace msf
