@@ -1,0 +1,54 @@
+#pragma once
+#include <opencv2/core/mat.hpp>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace msf::synthetic {
+
+/// Reads the exact ground truth msf_synth writes beside its KITTI odometry layout:
+///   gt/depth_0/NNNNNN.png    camera 0 depth z, KITTI 16-bit (metres x 256, 0 = none)
+///   gt/disp_0/NNNNNN.png     grey-pair disparity f B / z, KITTI 16-bit (pixels x 256)
+///   gt/obj_map_0/NNNNNN.png  8-bit: 0 background, 1..255 foreground (cars, poles, people),
+///                            KITTI 2015's obj_map convention
+///   gt/scene.ply             the true surface, world = camera 0 at frame 0 (poses/00.txt)
+/// Frames are in file-name order, the same order as msf::Sequence's frames.
+class GroundTruth {
+public:
+  /// `path` is a dataset root holding gt/, a sequence folder inside it (root/sequences/00),
+  /// or the gt folder itself. Throws IOError naming `path` when no ground truth is found.
+  explicit GroundTruth(const std::string& path);
+
+  /// The gt folder for `path` (see the constructor), or "" when there is none.
+  static std::string find(const std::string& path);
+
+  const std::string& directory() const { return dir_; }
+  std::size_t size() const { return names_.size(); }
+  /// File stem of frame i ("000042"); throws InvalidInputError when out of range.
+  const std::string& frameName(std::size_t i) const;
+  /// Index of the frame with this file stem; throws InvalidInputError when absent.
+  std::size_t indexOf(const std::string& frame_name) const;
+
+  std::string depthPath(std::size_t i) const;
+  std::string disparityPath(std::size_t i) const;
+  std::string objectMapPath(std::size_t i) const;
+  std::string sceneMeshPath() const;
+
+  /// CV_32F metres, 0 = none.
+  cv::Mat depth(std::size_t i) const;
+  /// CV_32F pixels, 0 = none.
+  cv::Mat disparity(std::size_t i) const;
+  /// CV_8U, 0 = background.
+  cv::Mat objectMap(std::size_t i) const;
+  /// CV_8U masks (255 = in) of the pixels with ground truth that are foreground
+  /// (objectMap > 0) or background, as the KITTI devkit splits its error.
+  cv::Mat foregroundMask(std::size_t i) const;
+  cv::Mat backgroundMask(std::size_t i) const;
+
+private:
+  std::string dir_;
+  std::vector<std::string> names_;
+};
+
+} // namespace msf::synthetic

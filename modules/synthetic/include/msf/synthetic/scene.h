@@ -1,0 +1,69 @@
+#pragma once
+#include <msf/synthetic/geometry.h>
+#include <msf/synthetic/material.h>
+#include <msf/synthetic/primitive.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace msf::synthetic {
+
+/// Cross-section of the street in world coordinates (the rectified frame of camera 0 at
+/// frame 0: x right, y down, z forward). The street runs along z.
+struct StreetLayout {
+  float ground_y = 1.65f;         ///< road plane; KITTI's camera 0 is 1.65 m above it
+  float road_center_x = -1.625f;  ///< road axis; the car keeps to the right-hand lane
+  float lane_width_m = 3.25f;     ///< each of the two driving lanes
+  float parking_width_m = 2.25f;  ///< a parking lane on each side
+  float kerb_height_m = 0.12f;
+  float sidewalk_width_m = 4.5f;  ///< paving from the kerb to the lawn line
+  float z_begin = 0.f, z_end = 0.f;
+
+  float halfRoadWidth() const { return lane_width_m + parking_width_m; }
+  float sidewalkY() const { return ground_y - kerb_height_m; }
+  /// Distance of world x from the road axis, and which side (+1 right, -1 left).
+  float streetOffset(float x) const { return x - road_center_x; }
+};
+
+/// The street as a union of solids over an infinite road plane, with a bounding volume
+/// hierarchy for the ray caster (binned surface area heuristic). Rays that meet
+/// nothing see the sky, which returns nothing.
+class Scene {
+public:
+  StreetLayout layout;
+  std::uint16_t ground_material = 0;
+  std::vector<Material> materials;
+  std::vector<Primitive> primitives;
+
+  std::uint16_t addMaterial(const Material& material);
+  void add(const Primitive& primitive) { primitives.push_back(primitive); }
+
+  /// Builds the hierarchy; call after the last primitive is added.
+  void buildIndex();
+
+  /// Nearest surface with t in (tmin, tmax); false for the sky.
+  bool intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const;
+
+  /// True when p lies inside a solid, or below the road plane, by more than `inset`.
+  bool occupied(V3 p, float inset) const;
+
+  /// Number of foreground instances (largest object id).
+  std::uint32_t objectCount() const;
+
+private:
+  struct Node {
+    V3 lo, hi;
+    std::int32_t index = 0;  ///< leaf: first entry of order_; inner: right child (left is next)
+    std::uint16_t count = 0; ///< > 0 for a leaf
+    std::uint16_t axis = 0;  ///< split axis of an inner node
+  };
+  std::int32_t build(std::int32_t begin, std::int32_t end, const std::vector<V3>& lo, const std::vector<V3>& hi,
+                     const std::vector<V3>& centroid);
+
+  static constexpr std::int32_t kMaxLeafSize = 8;
+  std::vector<Node> nodes_;
+  std::vector<std::int32_t> order_;
+};
+
+} // namespace msf::synthetic

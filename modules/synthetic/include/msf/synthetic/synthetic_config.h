@@ -1,0 +1,38 @@
+#pragma once
+#include <opencv2/core/persistence.hpp>
+
+#include <iosfwd>
+#include <string>
+
+namespace msf::synthetic {
+
+/// Settings of the synthetic KITTI-format generator: the `synthetic` section of a YAML
+/// config (config/synthetic.yaml), mirrored with defaults in code.
+struct SyntheticConfig {
+  std::string scene = "street";        ///< the only scene so far
+  int frames = 10;                     ///< frames to generate (>= 1)
+  int seed = 1;                        ///< everything random derives from it (>= 0)
+  double speed_mps = 10.0;             ///< along the street
+  double frame_rate_hz = 10.0;         ///< camera and LiDAR rate
+  int supersampling = 2;               ///< samples per pixel along each image axis (1..4)
+  double image_noise_sigma = 2.0;      ///< grey levels, Gaussian, per pixel and channel
+  double lidar_range_noise_m = 0.02;   ///< Gaussian, along the beam
+  double lidar_dropout = 0.02;         ///< probability that a return is lost [0, 1)
+  double lidar_max_range_m = 120.0;
+  double lidar_min_range_m = 1.0;
+  double lidar_azimuth_step_deg = 0.18; ///< KITTI's files: ~2000 points a ring at 10 Hz
+  double lidar_upper_elevation_deg = 2.0;   ///< highest of the 64 lasers
+  double lidar_lower_elevation_deg = -24.9; ///< lowest
+  double textureless_share = 0.2;      ///< share of building lots with blank walls [0, 1]
+  double parked_car_share = 0.6;       ///< share of parking slots taken [0, 1]
+  double mesh_max_edge_m = 1.0;        ///< triangle size of gt/scene.ply's flat faces
+
+  /// Overrides the keys present in `node` (a `synthetic` section), then validates.
+  /// Throws ConfigError naming a key with a wrong type or value.
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the first key with a value out of range.
+  void validate() const;
+  void print(std::ostream& out) const;
+};
+
+} // namespace msf::synthetic

@@ -1,0 +1,70 @@
+#pragma once
+#include <msf/io/calibration.h>
+#include <msf/io/poses.h>
+#include <msf/synthetic/camera_renderer.h>
+#include <msf/synthetic/lidar_simulator.h>
+#include <msf/synthetic/scene.h>
+#include <msf/synthetic/synthetic_config.h>
+
+#include <opencv2/core/mat.hpp>
+#include <pcl/PolygonMesh.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace msf::synthetic {
+
+/// Everything of one synthetic frame, in memory.
+struct SyntheticFrame {
+  cv::Mat images[4];  ///< cameras 0, 1: grey CV_8UC1; 2, 3: BGR CV_8UC3 (rectified)
+  pcl::PointCloud<pcl::PointXYZI> scan; ///< Velodyne frame, ring after ring
+  cv::Mat depth;      ///< camera 0, CV_32F metres, 0 = no ground truth (sky, beyond 255 m)
+  cv::Mat disparity;  ///< grey pair, CV_32F pixels (f B / depth), 0 where depth is 0
+  cv::Mat objects;    ///< camera 0, CV_8U: 0 background, 1..255 foreground instance
+};
+
+/// The synthetic KITTI-format generator: KITTI's rig (kittiRig) driving down a street
+/// (buildStreetScene) along streetTrajectory, rendered by CameraRenderer and
+/// LidarSimulator. Deterministic: one seed, one byte-identical dataset.
+class SyntheticGenerator {
+public:
+  /// Builds the trajectory and the scene; throws ConfigError for an invalid config.
+  explicit SyntheticGenerator(const SyntheticConfig& config);
+
+  const SyntheticConfig& config() const { return config_; }
+  const Calibration& calibration() const { return calibration_; }
+  const PoseList& poses() const { return poses_; }
+  const Scene& scene() const { return scene_; }
+  const LidarSimulator& lidar() const { return lidar_; }
+  std::size_t size() const { return poses_.size(); }
+
+  /// Renders frame i; throws InvalidInputError when i is out of range.
+  SyntheticFrame renderFrame(std::size_t i) const;
+
+  /// The true surface (see sceneMesh in scene_mesh.h).
+  pcl::PolygonMesh mesh() const;
+
+  /// Called after each written frame with its index, the seconds it took (render and
+  /// write) and its number of LiDAR points.
+  using Progress = std::function<void(std::size_t frame, double seconds, std::size_t points)>;
+
+  /// Writes the dataset under `root` (see README: KITTI odometry layout plus gt/). The
+  /// whole tree is written into a hidden folder beside `root` and moved into place at the
+  /// end, so a failure leaves nothing behind. `root` may be absent, empty, or a dataset
+  /// written before (replaced); anything else is refused with an IOError naming it.
+  void writeDataset(const std::string& root, const Progress& progress = {}) const;
+
+private:
+  SyntheticConfig config_;
+  Calibration calibration_;
+  PoseList poses_;
+  Scene scene_;
+  CameraRenderer renderer_;
+  LidarSimulator lidar_;
+};
+
+} // namespace msf::synthetic

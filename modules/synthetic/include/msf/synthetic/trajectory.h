@@ -1,0 +1,17 @@
+#pragma once
+#include <msf/io/poses.h>
+#include <msf/synthetic/synthetic_config.h>
+
+#include <vector>
+
+namespace msf::synthetic {
+
+/// T_world_cam0 of every frame: constant speed along the street (world z), a gentle lateral
+/// sway (0.4 m over 150 m) with the heading following the path, camera height constant.
+/// Frame 0 is the identity, so the world is camera 0's frame at frame 0, as in KITTI.
+PoseList streetTrajectory(const SyntheticConfig& config);
+
+/// Timestamps in seconds, frame i at i / frame_rate_hz.
+std::vector<double> frameTimes(const SyntheticConfig& config);
+
+} // namespace msf::synthetic

@@ -1,0 +1,220 @@
+#include <msf/common/exceptions.h>
+#include <msf/synthetic/camera_renderer.h>
+#include <msf/synthetic/counter_rng.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace msf::synthetic {
+
+namespace {
+
+constexpr float kMaxDepthM = 1000.f;
+constexpr float kExposure = 1.0f;
+constexpr float kAmbient = 0.42f;
+constexpr float kSun = 0.75f;
+
+/// A rectified camera placed in the world: every rectified camera shares camera 0's
+/// orientation, so a pixel's ray is R_world_cam0 * K^-1 (u, v, 1) from its centre, and t
+/// along it is the depth in that camera.
+struct CameraModel {
+  V3 center;
+  float R[9];
+  float fx, fy, cx, cy;
+  int width, height;
+
+  V3 rotate(float x, float y, float z) const {
+    return {R[0] * x + R[1] * y + R[2] * z, R[3] * x + R[4] * y + R[5] * z, R[6] * x + R[7] * y + R[8] * z};
+  }
+  V3 direction(float u, float v) const { return rotate((u - cx) / fx, (v - cy) / fy, 1.f); }
+};
+
+CameraModel cameraModel(const Calibration& calibration, int camera, const Eigen::Isometry3d& T_world_cam0) {
+  if (camera < 0 || camera > 3)
+    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  CameraModel m;
+  const Eigen::Vector3d c = T_world_cam0 * calibration.cameraCenter(camera);
+  m.center = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+  const Eigen::Matrix3d R = T_world_cam0.linear();
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k)
+      m.R[3 * r + k] = static_cast<float>(R(r, k));
+  m.fx = static_cast<float>(calibration.fx(camera));
+  m.fy = static_cast<float>(calibration.fy(camera));
+  m.cx = static_cast<float>(calibration.cx(camera));
+  m.cy = static_cast<float>(calibration.cy(camera));
+  const cv::Size size = calibration.requireImageSize();
+  m.width = size.width;
+  m.height = size.height;
+  return m;
+}
+
+/// Direction towards the sun (world, y down): high, from the front left.
+const V3 kSunDirection = normalized({-0.45f, -0.8f, 0.4f});
+
+struct Radiance {
+  float r = 0.f, g = 0.f, b = 0.f;
+};
+
+Radiance sky(V3 dir) {
+  const float up = std::clamp(-dir.y / norm(dir), 0.f, 1.f);
+  const float t = std::min(1.f, up * 2.5f);
+  return {0.82f - 0.42f * t, 0.86f - 0.30f * t, 0.92f - 0.12f * t};
+}
+
+/// What one ray sees: its radiance, which surface (a key that differs across geometric
+/// edges), and the exact depth and object id for the ground truth.
+struct Sample {
+  Radiance radiance;
+  std::int32_t surface = 0; ///< 0 sky; otherwise 8 * (primitive + 3) + face
+  float depth = 0.f;        ///< 0 for the sky
+  std::int32_t object = 0;
+};
+
+/// Traces one ray; step_x / step_y are the ray's spread for one sample step in the image.
+Sample trace(const Scene& scene, const Ray& ray, V3 step_x, V3 step_y) {
+  Sample out;
+  Hit hit;
+  if (!scene.intersect(ray, 0.f, kMaxDepthM, hit)) {
+    out.radiance = sky(ray.dir);
+    return out;
+  }
+  const V3 world = ray.origin + ray.dir * hit.t;
+  // Ray differentials: how far the hit point moves on the surface for one sample step.
+  const float dn = dot(ray.dir, hit.normal);
+  Footprint fp;
+  if (std::fabs(dn) > 1e-6f) {
+    fp.dx = (step_x - ray.dir * (dot(step_x, hit.normal) / dn)) * hit.t;
+    fp.dy = (step_y - ray.dir * (dot(step_y, hit.normal) / dn)) * hit.t;
+  }
+  const Primitive* prim = hit.primitive >= 0 ? &scene.primitives[static_cast<std::size_t>(hit.primitive)] : nullptr;
+  const Material& mat = scene.materials[prim ? prim->material : scene.ground_material];
+  const SurfaceResponse s = shadeSurface(mat, prim, hit, world, fp, scene.layout);
+  const V3 n = dn > 0.f ? hit.normal * -1.f : hit.normal;
+  const float light = kAmbient + kSun * std::max(0.f, dot(n, kSunDirection));
+  out.radiance = {s.r * light, s.g * light, s.b * light};
+  out.surface = 8 * (hit.primitive + 3) + hit.face;
+  out.depth = hit.t;
+  out.object = prim ? static_cast<std::int32_t>(prim->object) : 0;
+  return out;
+}
+
+/// 255 * x^(1/2.2) tabulated over [0, 1]: pow per pixel and channel is a measurable cost.
+class GammaTable {
+public:
+  GammaTable() {
+    for (int i = 0; i <= kSize; ++i)
+      table_[static_cast<std::size_t>(i)] = 255.f * std::pow(static_cast<float>(i) / kSize, 1.f / 2.2f);
+  }
+  float operator()(float linear) const {
+    const float x = std::clamp(linear * kExposure, 0.f, 1.f) * kSize;
+    const int i = std::min(static_cast<int>(x), kSize - 1);
+    const float t = x - static_cast<float>(i);
+    return table_[static_cast<std::size_t>(i)] + t * (table_[static_cast<std::size_t>(i) + 1] - table_[static_cast<std::size_t>(i)]);
+  }
+
+private:
+  static constexpr int kSize = 4096;
+  std::array<float, kSize + 1> table_;
+};
+
+inline std::uint8_t toByte(const GammaTable& gamma, float linear, float noise) {
+  return static_cast<std::uint8_t>(std::clamp(std::lround(gamma(linear) + noise), 0L, 255L));
+}
+
+} // namespace
+
+CameraRenderer::CameraRenderer(const Calibration& calibration, const SyntheticConfig& config)
+    : calibration_(calibration), config_(config) {
+  calibration_.requireImageSize();
+  config_.validate();
+}
+
+cv::Mat CameraRenderer::render(const Scene& scene, int camera, const Eigen::Isometry3d& T_world_cam0,
+                               std::uint64_t noise_key, cv::Mat* depth, cv::Mat* objects) const {
+  const CameraModel cam = cameraModel(calibration_, camera, T_world_cam0);
+  const int W = cam.width, H = cam.height;
+  const bool color = camera >= 2;
+  cv::Mat image(H, W, color ? CV_8UC3 : CV_8UC1);
+  if (depth)
+    depth->create(H, W, CV_32FC1);
+  if (objects)
+    objects->create(H, W, CV_32SC1);
+  const V3 pixel_x = cam.rotate(1.f / cam.fx, 0.f, 0.f), pixel_y = cam.rotate(0.f, 1.f / cam.fy, 0.f);
+  const int ss = config_.supersampling;
+  const float inv_ss = 1.f / static_cast<float>(ss);
+  const V3 sub_x = pixel_x * inv_ss, sub_y = pixel_y * inv_ss;
+  const float sigma = static_cast<float>(config_.image_noise_sigma);
+  const auto seed = static_cast<std::uint64_t>(config_.seed);
+  static const GammaTable gamma;
+
+  // Pass 1: the ray through each pixel centre, its texture filtered over the whole pixel.
+  std::vector<Radiance> radiance(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
+  std::vector<std::int32_t> surface(radiance.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int v = 0; v < H; ++v) {
+    float* d = depth ? depth->ptr<float>(v) : nullptr;
+    std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
+    for (int u = 0; u < W; ++u) {
+      const Sample s = trace(scene, {cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))}, pixel_x,
+                             pixel_y);
+      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
+      radiance[i] = s.radiance;
+      surface[i] = s.surface;
+      if (d)
+        d[u] = s.depth;
+      if (o)
+        o[u] = s.object;
+    }
+  }
+
+  // Pass 2: pixels on a geometric edge (a neighbour sees another surface) get ss x ss
+  // samples; then gamma, noise and quantization.
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int v = 0; v < H; ++v) {
+    std::uint8_t* row = image.ptr<std::uint8_t>(v);
+    for (int u = 0; u < W; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
+      Radiance r = radiance[i];
+      const std::int32_t k = surface[i];
+      const bool edge = (u > 0 && surface[i - 1] != k) || (u + 1 < W && surface[i + 1] != k) ||
+                        (v > 0 && surface[i - static_cast<std::size_t>(W)] != k) ||
+                        (v + 1 < H && surface[i + static_cast<std::size_t>(W)] != k);
+      if (edge && ss > 1) {
+        r = Radiance();
+        for (int sy = 0; sy < ss; ++sy)
+          for (int sx = 0; sx < ss; ++sx) {
+            // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
+            const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
+            const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
+            const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y).radiance;
+            r.r += q.r;
+            r.g += q.g;
+            r.b += q.b;
+          }
+        const float w = inv_ss * inv_ss;
+        r = {r.r * w, r.g * w, r.b * w};
+      }
+      const auto pixel = static_cast<std::uint64_t>(i);
+      auto noise = [&](std::uint64_t channel) {
+        return sigma > 0.f
+                   ? sigma * gaussianFast(hashKey(seed, noise_key, static_cast<std::uint64_t>(camera), pixel, channel))
+                   : 0.f;
+      };
+      if (color) {
+        // OpenCV's BGR order.
+        row[3 * u + 0] = toByte(gamma, r.b, noise(0));
+        row[3 * u + 1] = toByte(gamma, r.g, noise(1));
+        row[3 * u + 2] = toByte(gamma, r.r, noise(2));
+      } else {
+        row[u] = toByte(gamma, 0.30f * r.r + 0.59f * r.g + 0.11f * r.b, noise(0));
+      }
+    }
+  }
+  return image;
+}
+
+} // namespace msf::synthetic

@@ -1,0 +1,231 @@
+#include <msf/synthetic/scene.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace msf::synthetic {
+
+std::uint16_t Scene::addMaterial(const Material& material) {
+  materials.push_back(material);
+  return static_cast<std::uint16_t>(materials.size() - 1);
+}
+
+void Scene::buildIndex() {
+  const auto n = static_cast<std::int32_t>(primitives.size());
+  std::vector<V3> lo(n), hi(n), centroid(n);
+  for (std::int32_t i = 0; i < n; ++i) {
+    primitives[i].bounds(lo[i], hi[i]);
+    centroid[i] = (lo[i] + hi[i]) * 0.5f;
+  }
+  order_.resize(n);
+  for (std::int32_t i = 0; i < n; ++i)
+    order_[i] = i;
+  nodes_.clear();
+  nodes_.reserve(2 * static_cast<std::size_t>(n) + 1);
+  if (n > 0)
+    build(0, n, lo, hi, centroid);
+}
+
+namespace {
+float surfaceArea(V3 lo, V3 hi) {
+  const V3 e = hi - lo;
+  return 2.f * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+} // namespace
+
+std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vector<V3>& lo, const std::vector<V3>& hi,
+                          const std::vector<V3>& centroid) {
+  const auto id = static_cast<std::int32_t>(nodes_.size());
+  nodes_.emplace_back();
+  V3 box_lo = lo[order_[begin]], box_hi = hi[order_[begin]];
+  V3 c_lo = centroid[order_[begin]], c_hi = c_lo;
+  for (std::int32_t i = begin; i < end; ++i) {
+    box_lo = minV(box_lo, lo[order_[i]]);
+    box_hi = maxV(box_hi, hi[order_[i]]);
+    c_lo = minV(c_lo, centroid[order_[i]]);
+    c_hi = maxV(c_hi, centroid[order_[i]]);
+  }
+  nodes_[id].lo = box_lo;
+  nodes_[id].hi = box_hi;
+  const std::int32_t count = end - begin;
+  auto makeLeaf = [&] {
+    nodes_[id].index = begin;
+    nodes_[id].count = static_cast<std::uint16_t>(count);
+    return id;
+  };
+  if (count <= 2)
+    return makeLeaf();
+
+  // Binned surface area heuristic: the split that minimizes the expected number of
+  // primitive tests for a random ray, (area_left n_left + area_right n_right) / area.
+  constexpr int kBins = 16;
+  int best_axis = -1, best_bin = 0;
+  float best_cost = static_cast<float>(count) * surfaceArea(box_lo, box_hi);
+  for (int axis = 0; axis < 3; ++axis) {
+    const float extent = c_hi[axis] - c_lo[axis];
+    if (extent <= 1e-6f)
+      continue;
+    V3 bin_lo[kBins], bin_hi[kBins];
+    int bin_count[kBins] = {};
+    for (int b = 0; b < kBins; ++b) {
+      bin_lo[b] = {1e30f, 1e30f, 1e30f};
+      bin_hi[b] = {-1e30f, -1e30f, -1e30f};
+    }
+    for (std::int32_t i = begin; i < end; ++i) {
+      const std::int32_t p = order_[i];
+      const int b = std::min(kBins - 1, static_cast<int>(kBins * (centroid[p][axis] - c_lo[axis]) / extent));
+      ++bin_count[b];
+      bin_lo[b] = minV(bin_lo[b], lo[p]);
+      bin_hi[b] = maxV(bin_hi[b], hi[p]);
+    }
+    float right_area[kBins];
+    int right_count[kBins];
+    V3 rl{1e30f, 1e30f, 1e30f}, rh{-1e30f, -1e30f, -1e30f};
+    int rc = 0;
+    for (int b = kBins - 1; b > 0; --b) {
+      rc += bin_count[b];
+      if (bin_count[b] > 0) {
+        rl = minV(rl, bin_lo[b]);
+        rh = maxV(rh, bin_hi[b]);
+      }
+      right_count[b] = rc;
+      right_area[b] = rc > 0 ? surfaceArea(rl, rh) : 0.f;
+    }
+    V3 ll{1e30f, 1e30f, 1e30f}, lh{-1e30f, -1e30f, -1e30f};
+    int lc = 0;
+    for (int b = 1; b < kBins; ++b) { // split between bins b - 1 and b
+      lc += bin_count[b - 1];
+      if (bin_count[b - 1] > 0) {
+        ll = minV(ll, bin_lo[b - 1]);
+        lh = maxV(lh, bin_hi[b - 1]);
+      }
+      if (lc == 0 || right_count[b] == 0)
+        continue;
+      const float cost = static_cast<float>(lc) * surfaceArea(ll, lh) + static_cast<float>(right_count[b]) * right_area[b];
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_axis = axis;
+        best_bin = b;
+      }
+    }
+  }
+  if (best_axis < 0) {
+    if (count <= kMaxLeafSize)
+      return makeLeaf();
+    // No useful split (coincident centroids): halve the list.
+    best_axis = 0;
+    best_bin = -1;
+  }
+  std::int32_t mid = (begin + end) / 2;
+  if (best_bin >= 0) {
+    const float extent = c_hi[best_axis] - c_lo[best_axis];
+    const auto it = std::stable_partition(order_.begin() + begin, order_.begin() + end, [&](std::int32_t p) {
+      return std::min(kBins - 1, static_cast<int>(kBins * (centroid[p][best_axis] - c_lo[best_axis]) / extent)) < best_bin;
+    });
+    mid = static_cast<std::int32_t>(it - order_.begin());
+  }
+  nodes_[id].axis = static_cast<std::uint16_t>(best_axis);
+  build(begin, mid, lo, hi, centroid);
+  const std::int32_t right = build(mid, end, lo, hi, centroid);
+  nodes_[id].index = right;
+  return id;
+}
+
+namespace {
+inline bool slabHit(V3 lo, V3 hi, V3 o, V3 inv, float tmin, float tmax) {
+  float t0 = tmin, t1 = tmax;
+  for (int k = 0; k < 3; ++k) {
+    float ta = (lo[k] - o[k]) * inv[k], tb = (hi[k] - o[k]) * inv[k];
+    if (ta > tb)
+      std::swap(ta, tb);
+    // NaN (0 * inf for a ray in the slab's plane) keeps the current interval.
+    t0 = ta > t0 ? ta : t0;
+    t1 = tb < t1 ? tb : t1;
+    if (t0 > t1)
+      return false;
+  }
+  return true;
+}
+} // namespace
+
+bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
+  hit = Hit();
+  hit.t = tmax;
+  bool found = false;
+  if (ray.dir.y > 0.f) {
+    const float t = (layout.ground_y - ray.origin.y) / ray.dir.y;
+    if (t > tmin && t < hit.t) {
+      hit.t = t;
+      hit.primitive = Hit::kGround;
+      hit.face = 3;
+      hit.local = ray.origin + ray.dir * t;
+      hit.normal = {0.f, -1.f, 0.f};
+      found = true;
+    }
+  }
+  if (nodes_.empty())
+    return found;
+  const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
+  std::int32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!slabHit(node.lo, node.hi, ray.origin, inv, tmin, hit.t))
+      continue;
+    if (node.count > 0) {
+      for (std::int32_t i = node.index; i < node.index + node.count; ++i) {
+        const std::int32_t p = order_[i];
+        if (primitives[p].intersect(ray, tmin, hit)) {
+          hit.primitive = p;
+          found = true;
+        }
+      }
+      continue;
+    }
+    const std::int32_t left = static_cast<std::int32_t>(&node - nodes_.data()) + 1, right = node.index;
+    // Near child last on the stack, so it is visited first and shortens the far one.
+    if (ray.dir[node.axis] > 0.f) {
+      stack[top++] = right;
+      stack[top++] = left;
+    } else {
+      stack[top++] = left;
+      stack[top++] = right;
+    }
+  }
+  return found;
+}
+
+bool Scene::occupied(V3 p, float inset) const {
+  if (p.y > layout.ground_y + inset)
+    return true;
+  if (nodes_.empty())
+    return false;
+  std::int32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (p.x < node.lo.x || p.y < node.lo.y || p.z < node.lo.z || p.x > node.hi.x || p.y > node.hi.y ||
+        p.z > node.hi.z)
+      continue;
+    if (node.count > 0) {
+      for (std::int32_t i = node.index; i < node.index + node.count; ++i)
+        if (primitives[order_[i]].contains(p, inset))
+          return true;
+      continue;
+    }
+    stack[top++] = node.index;
+    stack[top++] = static_cast<std::int32_t>(&node - nodes_.data()) + 1;
+  }
+  return false;
+}
+
+std::uint32_t Scene::objectCount() const {
+  std::uint32_t n = 0;
+  for (const auto& p : primitives)
+    n = std::max(n, p.object);
+  return n;
+}
+
+} // namespace msf::synthetic

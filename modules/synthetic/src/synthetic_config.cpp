@@ -1,0 +1,93 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/synthetic/synthetic_config.h>
+
+#include <ostream>
+#include <sstream>
+
+namespace msf::synthetic {
+
+void SyntheticConfig::read(const cv::FileNode& node) {
+  readKey(node, "scene", scene);
+  readKey(node, "frames", frames);
+  readKey(node, "seed", seed);
+  readKey(node, "speed_mps", speed_mps);
+  readKey(node, "frame_rate_hz", frame_rate_hz);
+  readKey(node, "supersampling", supersampling);
+  readKey(node, "image_noise_sigma", image_noise_sigma);
+  readKey(node, "lidar_range_noise_m", lidar_range_noise_m);
+  readKey(node, "lidar_dropout", lidar_dropout);
+  readKey(node, "lidar_max_range_m", lidar_max_range_m);
+  readKey(node, "lidar_min_range_m", lidar_min_range_m);
+  readKey(node, "lidar_azimuth_step_deg", lidar_azimuth_step_deg);
+  readKey(node, "lidar_upper_elevation_deg", lidar_upper_elevation_deg);
+  readKey(node, "lidar_lower_elevation_deg", lidar_lower_elevation_deg);
+  readKey(node, "textureless_share", textureless_share);
+  readKey(node, "parked_car_share", parked_car_share);
+  readKey(node, "mesh_max_edge_m", mesh_max_edge_m);
+  validate();
+}
+
+namespace {
+template <typename T>
+void require(bool ok, const char* key, T value, const char* rule) {
+  if (ok)
+    return;
+  std::ostringstream msg;
+  msg << "config key 'synthetic." << key << "' = " << value << " " << rule;
+  throw ConfigError(msg.str());
+}
+} // namespace
+
+void SyntheticConfig::validate() const {
+  require(scene == "street", "scene", scene, "is unknown (known scenes: street)");
+  require(frames >= 1 && frames <= 999999, "frames", frames, "must be in 1..999999");
+  require(seed >= 0, "seed", seed, "must be >= 0");
+  require(speed_mps >= 0.0 && speed_mps <= 40.0, "speed_mps", speed_mps, "must be in 0..40");
+  require(frame_rate_hz > 0.0 && frame_rate_hz <= 100.0, "frame_rate_hz", frame_rate_hz, "must be in (0, 100]");
+  require(supersampling >= 1 && supersampling <= 4, "supersampling", supersampling, "must be in 1..4");
+  require(image_noise_sigma >= 0.0 && image_noise_sigma <= 50.0, "image_noise_sigma", image_noise_sigma,
+          "must be in 0..50");
+  require(lidar_range_noise_m >= 0.0 && lidar_range_noise_m <= 1.0, "lidar_range_noise_m", lidar_range_noise_m,
+          "must be in 0..1");
+  require(lidar_dropout >= 0.0 && lidar_dropout < 1.0, "lidar_dropout", lidar_dropout, "must be in [0, 1)");
+  require(lidar_min_range_m > 0.0, "lidar_min_range_m", lidar_min_range_m, "must be > 0");
+  require(lidar_max_range_m > lidar_min_range_m && lidar_max_range_m <= 250.0, "lidar_max_range_m",
+          lidar_max_range_m, "must be above lidar_min_range_m and at most 250 (the depth PNG's limit is 256 m)");
+  require(lidar_azimuth_step_deg >= 0.01 && lidar_azimuth_step_deg <= 5.0, "lidar_azimuth_step_deg",
+          lidar_azimuth_step_deg, "must be in 0.01..5");
+  require(lidar_upper_elevation_deg <= 30.0, "lidar_upper_elevation_deg", lidar_upper_elevation_deg,
+          "must be at most 30");
+  require(lidar_lower_elevation_deg >= -60.0 && lidar_lower_elevation_deg < lidar_upper_elevation_deg - 11.0,
+          "lidar_lower_elevation_deg", lidar_lower_elevation_deg,
+          "must be >= -60 and more than 11 below lidar_upper_elevation_deg (the upper block spans 10.33)");
+  require(textureless_share >= 0.0 && textureless_share <= 1.0, "textureless_share", textureless_share,
+          "must be in 0..1");
+  require(parked_car_share >= 0.0 && parked_car_share <= 1.0, "parked_car_share", parked_car_share,
+          "must be in 0..1");
+  require(mesh_max_edge_m >= 0.05 && mesh_max_edge_m <= 20.0, "mesh_max_edge_m", mesh_max_edge_m,
+          "must be in 0.05..20");
+}
+
+void SyntheticConfig::print(std::ostream& out) const {
+  out << "synthetic:\n"
+      << "  scene: " << scene << "\n"
+      << "  frames: " << frames << "\n"
+      << "  seed: " << seed << "\n"
+      << "  speed_mps: " << speed_mps << "\n"
+      << "  frame_rate_hz: " << frame_rate_hz << "\n"
+      << "  supersampling: " << supersampling << "\n"
+      << "  image_noise_sigma: " << image_noise_sigma << "\n"
+      << "  lidar_range_noise_m: " << lidar_range_noise_m << "\n"
+      << "  lidar_dropout: " << lidar_dropout << "\n"
+      << "  lidar_max_range_m: " << lidar_max_range_m << "\n"
+      << "  lidar_min_range_m: " << lidar_min_range_m << "\n"
+      << "  lidar_azimuth_step_deg: " << lidar_azimuth_step_deg << "\n"
+      << "  lidar_upper_elevation_deg: " << lidar_upper_elevation_deg << "\n"
+      << "  lidar_lower_elevation_deg: " << lidar_lower_elevation_deg << "\n"
+      << "  textureless_share: " << textureless_share << "\n"
+      << "  parked_car_share: " << parked_car_share << "\n"
+      << "  mesh_max_edge_m: " << mesh_max_edge_m << "\n";
+}
+
+} // namespace msf::synthetic

@@ -1,0 +1,221 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/image_io.h>
+#include <msf/io/organized_conversion.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/synthetic/kitti_rig.h>
+#include <msf/synthetic/scene_mesh.h>
+#include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/synthetic_generator.h>
+#include <msf/synthetic/trajectory.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace msf::synthetic {
+
+namespace {
+
+/// The 16-bit KITTI PNGs hold at most 255.996 m; farther pixels get no ground truth.
+constexpr float kMaxGroundTruthDepthM = 255.f;
+
+SyntheticConfig validated(const SyntheticConfig& config) {
+  config.validate();
+  const double path = (config.frames - 1) * config.speed_mps / config.frame_rate_hz;
+  if (path > 5000.0)
+    throw ConfigError("config keys 'synthetic.frames', 'speed_mps', 'frame_rate_hz' make a path of " +
+                      std::to_string(path) + " m; at most 5000 m");
+  return config;
+}
+
+std::string frameName(std::size_t i) {
+  char name[16];
+  std::snprintf(name, sizeof name, "%06zu", i);
+  return name;
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  writeAtomically(path.string(), [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out.flush())
+      throw IOError("cannot write '" + path.string() + "'");
+  });
+}
+
+const char* kGroundTruthReadme =
+    "Ground truth of a synthetic sequence written by msf_synth (msfusion).\n"
+    "depth_0/NNNNNN.png    camera 0 depth z, 16-bit, metres x 256, 0 = none (sky, beyond 255 m)\n"
+    "disp_0/NNNNNN.png     grey-pair disparity f B / z, 16-bit, pixels x 256, 0 = none\n"
+    "obj_map_0/NNNNNN.png  8-bit, 0 = background, 1..255 = foreground instance (cars, poles, people)\n"
+    "scene.ply             the true surface, in the world of poses/00.txt (camera 0 at frame 0)\n"
+    "synthetic.yaml        the generator's configuration\n"
+    "Every pixel is exact: the value of the ray through the pixel centre.\n";
+
+bool looksLikeDataset(const fs::path& root) {
+  std::error_code ec;
+  return fs::is_regular_file(root / "gt" / "scene.ply", ec) && fs::is_directory(root / "sequences", ec);
+}
+
+/// Checks `root` before any work, so a bad output folder fails fast.
+void checkOutput(const fs::path& root) {
+  std::error_code ec;
+  const fs::path parent = root.parent_path();
+  if (!fs::is_directory(parent, ec))
+    throw IOError("output folder '" + root.string() + "': its parent folder '" + parent.string() +
+                  "' does not exist");
+  if (::access(parent.c_str(), W_OK) != 0)
+    throw IOError("output folder '" + root.string() + "': its parent folder '" + parent.string() +
+                  "' is not writable");
+  if (fs::exists(root, ec)) {
+    if (!fs::is_directory(root, ec))
+      throw IOError("output folder '" + root.string() + "' exists and is not a folder");
+    if (!fs::is_empty(root, ec) && !looksLikeDataset(root))
+      throw IOError("output folder '" + root.string() +
+                    "' is not empty and holds no synthetic dataset; refusing to overwrite it");
+    if (::access(root.c_str(), W_OK) != 0)
+      throw IOError("output folder '" + root.string() + "' is not writable");
+  }
+}
+
+/// Runs independent file writes in parallel; rethrows the first failure after all end.
+void runAll(const std::vector<std::function<void()>>& jobs) {
+  std::string error;
+  bool failed = false;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int i = 0; i < static_cast<int>(jobs.size()); ++i) {
+    try {
+      jobs[static_cast<std::size_t>(i)]();
+    } catch (const std::exception& e) {
+#pragma omp critical(msf_synth_error)
+      if (!failed) {
+        failed = true;
+        error = e.what();
+      }
+    }
+  }
+  if (failed)
+    throw IOError(error);
+}
+
+} // namespace
+
+SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
+    : config_(validated(config)),
+      calibration_(kittiRig()),
+      poses_(streetTrajectory(config_)),
+      scene_(buildStreetScene(config_, poses_.back().translation().z())),
+      renderer_(calibration_, config_),
+      lidar_(config_) {}
+
+SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i) const {
+  if (i >= poses_.size())
+    throw InvalidInputError("frame " + std::to_string(i) + " is out of range: the sequence has " +
+                            std::to_string(poses_.size()) + " frames");
+  const Eigen::Isometry3d& T_world_cam0 = poses_[i];
+  SyntheticFrame f;
+  cv::Mat ids;
+  f.images[0] = renderer_.render(scene_, 0, T_world_cam0, i, &f.depth, &ids);
+  for (int camera = 1; camera < 4; ++camera)
+    f.images[camera] = renderer_.render(scene_, camera, T_world_cam0, i);
+  f.scan = lidar_.scan(scene_, T_world_cam0 * calibration_.T_cam0_velo, i);
+
+  f.objects.create(ids.size(), CV_8UC1);
+  for (int v = 0; v < ids.rows; ++v) {
+    float* d = f.depth.ptr<float>(v);
+    const std::int32_t* id = ids.ptr<std::int32_t>(v);
+    std::uint8_t* o = f.objects.ptr<std::uint8_t>(v);
+    for (int u = 0; u < ids.cols; ++u) {
+      if (d[u] > kMaxGroundTruthDepthM)
+        d[u] = 0.f;
+      o[u] = (id[u] > 0 && d[u] > 0.f) ? static_cast<std::uint8_t>((id[u] - 1) % 255 + 1) : 0;
+    }
+  }
+  f.disparity = depthToDisparity(f.depth, calibration_);
+  return f;
+}
+
+pcl::PolygonMesh SyntheticGenerator::mesh() const { return sceneMesh(scene_, config_.mesh_max_edge_m); }
+
+void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progress& progress) const {
+  if (root_arg.empty())
+    throw InvalidInputError("no output folder given");
+  const fs::path root = fs::absolute(root_arg).lexically_normal();
+  const fs::path target = root.filename().empty() ? root.parent_path() : root;
+  checkOutput(target);
+
+  const fs::path staging =
+      target.parent_path() / ("." + target.filename().string() + ".msf_synth." + std::to_string(::getpid()));
+  const fs::path seq = staging / "sequences" / "00", gt = staging / "gt";
+  std::error_code ec;
+  fs::remove_all(staging, ec);
+  try {
+    for (const fs::path& dir : {seq / "image_0", seq / "image_1", seq / "image_2", seq / "image_3",
+                                seq / "velodyne", staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0"})
+      if (!fs::create_directories(dir, ec) || ec)
+        throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
+
+    saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
+    std::ostringstream times;
+    for (int i = 0; i < config_.frames; ++i) {
+      char line[32];
+      std::snprintf(line, sizeof line, "%e\n", i / config_.frame_rate_hz);
+      times << line;
+    }
+    writeText(seq / "times.txt", times.str());
+    saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+    std::ostringstream yaml;
+    yaml << "%YAML:1.0\n";
+    config_.print(yaml);
+    writeText(gt / "synthetic.yaml", yaml.str());
+    writeText(gt / "README.txt", kGroundTruthReadme);
+    saveMesh((gt / "scene.ply").string(), mesh());
+
+    for (std::size_t i = 0; i < poses_.size(); ++i) {
+      const auto start = std::chrono::steady_clock::now();
+      const SyntheticFrame f = renderFrame(i);
+      const std::string png = frameName(i) + ".png";
+      std::vector<std::function<void()>> jobs;
+      for (int c = 0; c < 4; ++c)
+        jobs.emplace_back([&, c] { writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f.images[c]); });
+      jobs.emplace_back([&] { saveVelodyneBin((seq / "velodyne" / (frameName(i) + ".bin")).string(), f.scan); });
+      jobs.emplace_back([&] { writeKittiDepthPng((gt / "depth_0" / png).string(), f.depth); });
+      jobs.emplace_back([&] { writeKittiDisparityPng((gt / "disp_0" / png).string(), f.disparity); });
+      jobs.emplace_back([&] { writeImage((gt / "obj_map_0" / png).string(), f.objects); });
+      runAll(jobs);
+      if (progress)
+        progress(i, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), f.scan.size());
+    }
+
+    // Move into place: the old dataset (if any) aside, the new one in, the old one away.
+    const fs::path old = target.parent_path() / ("." + target.filename().string() + ".msf_synth_old." +
+                                                 std::to_string(::getpid()));
+    const bool replace = fs::exists(target, ec);
+    if (replace) {
+      fs::rename(target, old, ec);
+      if (ec)
+        throw IOError("cannot replace output folder '" + target.string() + "': " + ec.message());
+    }
+    fs::rename(staging, target, ec);
+    if (ec) {
+      const std::string why = ec.message();
+      if (replace)
+        fs::rename(old, target, ec);
+      throw IOError("cannot move the dataset into '" + target.string() + "': " + why);
+    }
+    if (replace)
+      fs::remove_all(old, ec);
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    throw;
+  }
+}
+
+} // namespace msf::synthetic

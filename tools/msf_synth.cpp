@@ -1,0 +1,118 @@
+// Writes a synthetic street in KITTI's odometry layout, with exact ground truth.
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
+#include <msf/common/tool.h>
+#include <msf/synthetic/synthetic_generator.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s -o DIR [options]\n", name);
+  print_info("  Renders a synthetic street with KITTI's sensor rig and writes it in KITTI's odometry\n"
+             "  layout with exact ground truth:\n"
+             "    DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
+             "    DIR/poses/00.txt\n"
+             "    DIR/gt/{depth_0,disp_0,obj_map_0}/NNNNNN.png, scene.ply, synthetic.yaml\n"
+             "  Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.\n");
+  print_info("  where options are:\n");
+  print_info("    -o DIR         output folder (absent, empty, or an earlier synthetic dataset, replaced)\n");
+  print_info("    -frames N      number of frames (default 10)\n");
+  print_info("    -seed S        random seed, a whole number >= 0 (default 1)\n");
+  print_info("    -scene NAME    scene to render: street (default)\n");
+  print_info("    -config FILE   YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)\n");
+  print_info("    -print_config  print the configuration in effect\n");
+}
+
+/// The value of integer option `option`, strictly parsed; `fallback` when absent.
+int intOption(int argc, char** argv, const char* option, int fallback, int lo, int hi) {
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], option) != 0)
+      continue;
+    const std::string text = argv[i + 1];
+    std::size_t used = 0;
+    long value = 0;
+    try {
+      value = std::stol(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != text.size() || text.empty())
+      throw msf::InvalidInputError(std::string("option ") + option + ": '" + text + "' is not a whole number");
+    if (value < lo || value > hi)
+      throw msf::InvalidInputError(std::string("option ") + option + ": " + text + " is out of range " +
+                                   std::to_string(lo) + ".." + std::to_string(hi));
+    return static_cast<int>(value);
+  }
+  return fallback;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_synth", [&] {
+    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return argc < 2 ? 1 : 0;
+    }
+    const std::vector<std::string> value_options{"-o", "-frames", "-seed", "-scene", "-config"};
+    msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
+    const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
+    if (!positional.empty())
+      throw msf::InvalidInputError("unexpected argument '" + positional.front() + "' (the output folder goes after -o)");
+
+    msf::synthetic::SyntheticConfig config;
+    std::string config_path, output;
+    parse_argument(argc, argv, "-config", config_path);
+    parse_argument(argc, argv, "-o", output);
+    if (!config_path.empty())
+      config.read(msf::ConfigFile(config_path).section("synthetic"));
+    config.frames = intOption(argc, argv, "-frames", config.frames, 1, 999999);
+    config.seed = intOption(argc, argv, "-seed", config.seed, 0, 2147483647);
+    parse_argument(argc, argv, "-scene", config.scene);
+    if (config.scene != "street")
+      throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
+    config.validate();
+    if (output.empty())
+      throw msf::InvalidInputError("no output folder: give -o DIR");
+    if (find_switch(argc, argv, "-print_config"))
+      config.print(std::cout);
+
+    TicToc tt;
+    tt.tic();
+    print_highlight("Building the street ");
+    const msf::synthetic::SyntheticGenerator generator(config);
+    msf::tool::printDone(tt.toc(), generator.scene().primitives.size());
+
+    std::vector<double> seconds;
+    tt.tic();
+    print_highlight("Writing ");
+    print_value("%d frames", config.frames);
+    print_info(" to ");
+    print_value("%s\n", output.c_str());
+    generator.writeDataset(output, [&](std::size_t frame, double s, std::size_t points) {
+      seconds.push_back(s);
+      print_info("  frame %06zu ", frame);
+      msf::tool::printDone(1000.0 * s, points);
+    });
+    print_info("Wrote ");
+    print_value("%s", output.c_str());
+    print_info(": %d frames, median ", config.frames);
+    print_value("%.3f", msf::median(seconds));
+    print_info(" s per frame, total ");
+    print_value("%.1f", tt.toc() / 1000.0);
+    print_info(" s\n");
+    return 0;
+  });
+}
