@@ -1,0 +1,120 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
+#include <msf/evaluation/holdout.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace msf {
+
+HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration, const HoldoutConfig& config) {
+  if (config.projection.camera != 0)
+    throw ConfigError("protocol 2 evaluates in camera 0; projection.camera is " +
+                      std::to_string(config.projection.camera));
+  if (!frame.scan)
+    throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan");
+  HoldoutFrame out;
+  auto input = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
+  pcl::PointCloud<pcl::PointXYZI> heldout;
+  out.ring_count = splitRings(*frame.scan, config.rings, *input, heldout);
+  out.heldout_points = heldout.size();
+  LidarProjector(calibration, config.projection).projectToImage(heldout, out.gt_depth);
+  out.input.frame = frame.index;
+  out.input.calibration = &calibration;
+  out.input.scan = input;
+  out.input.left = frame.left;
+  out.input.right = frame.right;
+  out.input.color = frame.color;
+  return out;
+}
+
+HoldoutEvaluation::HoldoutEvaluation(const HoldoutConfig& config) : config_(config) {
+  config_.rings.validate();
+  config_.projection.validate();
+}
+
+void HoldoutEvaluation::addMethod(const std::string& name, HoldoutMethod method) {
+  if (name.empty())
+    throw InvalidInputError("a hold-out method needs a name");
+  for (const auto& m : methods_)
+    if (m.first == name)
+      throw InvalidInputError("hold-out method '" + name + "' is given twice");
+  methods_.emplace_back(name, std::move(method));
+}
+
+std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
+                                                  const std::vector<std::size_t>& frames) const {
+  if (methods_.empty())
+    throw InvalidInputError("no hold-out method to run");
+  const Calibration& calibration = sequence.calibration();
+  const double fB = calibration.focalBaseline();
+  std::vector<DepthErrorAccumulator> errors(methods_.size());
+  std::vector<std::vector<double>> times(methods_.size());
+  std::size_t done = 0;
+  for (const std::size_t i : frames) {
+    const HoldoutFrame split = makeHoldoutFrame(sequence.load(i, load_color_), calibration, config_);
+    for (std::size_t m = 0; m < methods_.size(); ++m) {
+      const auto start = std::chrono::steady_clock::now();
+      const cv::Mat estimate = methods_[m].second(split.input);
+      const auto stop = std::chrono::steady_clock::now();
+      times[m].push_back(std::chrono::duration<double, std::milli>(stop - start).count());
+      if (estimate.type() != CV_32FC1 || estimate.size() != split.gt_depth.size())
+        throw InvalidInputError("hold-out method '" + methods_[m].first + "' returned a " +
+                                std::to_string(estimate.cols) + "x" + std::to_string(estimate.rows) +
+                                " image of type " + std::to_string(estimate.type()) + ", expected CV_32FC1 " +
+                                std::to_string(split.gt_depth.cols) + "x" + std::to_string(split.gt_depth.rows));
+      errors[m].add(split.gt_depth, estimate, fB, cv::Mat(), config_.d1);
+    }
+    if (progress_)
+      progress_(++done, frames.size());
+  }
+  std::vector<HoldoutResult> results;
+  for (std::size_t m = 0; m < methods_.size(); ++m) {
+    HoldoutResult r;
+    r.method = methods_[m].first;
+    r.metrics = errors[m].metrics();
+    r.median_ms = median(times[m]);
+    r.frames = frames.size();
+    results.push_back(r);
+  }
+  return results;
+}
+
+std::string formatHoldoutTable(const std::vector<HoldoutResult>& results) {
+  std::ostringstream out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-20s %9s %9s %9s %10s %9s %9s %9s %9s %10s\n", "method", "coverage", "D1 all",
+                "D1 est", "disp MAE", "MAE m", "RMSE m", "iMAE", "iRMSE", "ms/frame");
+  out << line;
+  for (const auto& r : results) {
+    const DepthMetrics& m = r.metrics;
+    std::snprintf(line, sizeof line, "%-20s %9.4f %8.2f%% %8.2f%% %8.3fpx %9.3f %9.3f %9.3f %9.3f %10.2f\n",
+                  r.method.c_str(), m.coverage, 100.0 * m.d1_all, 100.0 * m.d1_estimated, m.disparity_mae_px, m.mae_m,
+                  m.rmse_m, m.imae_per_km, m.irmse_per_km, r.median_ms);
+    out << line;
+  }
+  return out.str();
+}
+
+void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& results) {
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << "method,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
+           "imae_per_km,irmse_per_km,median_ms\n";
+    out.precision(6);
+    for (const auto& r : results) {
+      const DepthMetrics& m = r.metrics;
+      out << r.method << ',' << r.frames << ',' << m.gt_pixels << ',' << m.estimated << ',' << m.coverage << ','
+          << m.d1_all << ',' << m.d1_estimated << ',' << m.disparity_mae_px << ',' << m.mae_m << ',' << m.rmse_m
+          << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << r.median_ms << '\n';
+    }
+    out.flush();
+    if (!out)
+      throw IOError("cannot write '" + path + "'");
+  });
+}
+
+} // namespace msf

@@ -1,0 +1,49 @@
+#pragma once
+#include <msf/io/pinhole_camera.h>
+
+#include <opencv2/core/mat.hpp>
+#include <pcl/filters/filter.h>
+
+namespace msf {
+
+/// Common shape of the stages that turn a sparse organized cloud (projected LiDAR) into a
+/// dense one of the same size: the input's depth image is completed by `completeDepth`,
+/// then every pixel with an estimate becomes a point on its pixel's ray. Real returns that
+/// keep their depth keep their exact point; a new point takes the other fields (intensity,
+/// colour) of the nearest real return. When PointT has a `distance` field (PointXYZID) it
+/// receives the exact distance in pixels to the nearest real return, also where there is
+/// no estimate (+inf when the input has no return at all).
+template <typename PointT>
+class DepthCompletionFilter : public pcl::Filter<PointT> {
+public:
+  using PointCloud = typename pcl::Filter<PointT>::PointCloud;
+
+  /// Intrinsics of the camera the cloud is organized by. When unset (the default), they
+  /// are recovered from the input's points (estimatePinholeCamera) at every call.
+  void setCamera(const PinholeCamera& camera) { camera_ = camera; }
+  const PinholeCamera& getCamera() const { return camera_; }
+
+  /// The depth images of the last call (CV_32FC1, 0 = none): input and completed.
+  const cv::Mat& sparseDepth() const { return sparse_; }
+  const cv::Mat& denseDepth() const { return dense_; }
+
+protected:
+  /// Throws InvalidInputError when the input is not organized or does not match the camera.
+  void applyFilter(PointCloud& output) override;
+  /// sparse: CV_32FC1 (0 = none) -> dense: CV_32FC1 (0 = none), same size.
+  virtual void completeDepth(const cv::Mat& sparse, cv::Mat& dense) = 0;
+  /// OpenMP threads for the write-back (0 = default).
+  virtual int threads() const { return 0; }
+
+  using pcl::Filter<PointT>::input_;
+  using pcl::Filter<PointT>::filter_name_;
+
+  PinholeCamera camera_;
+  cv::Mat sparse_, dense_, distance_, nearest_;
+};
+
+} // namespace msf
+
+#ifdef MSF_NO_PRECOMPILE
+#include <msf/range_image/impl/depth_completion_filter.hpp>
+#endif

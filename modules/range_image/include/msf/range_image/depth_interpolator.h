@@ -1,0 +1,66 @@
+#pragma once
+#include <msf/range_image/slice_interpolation.h>
+
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/persistence.hpp>
+
+#include <string>
+
+namespace msf {
+
+/// How the row and the column estimate of a pixel are merged when both exist.
+enum class CombineRule {
+  Average,     ///< mean of the two
+  ShorterGap,  ///< the estimate bridged over the shorter gap (the more local one); mean on a tie
+  GapWeighted, ///< weights 1 / (gap + 1)
+  Nearest      ///< the smaller depth: foreground wins
+};
+/// "average", "shorter_gap", "gap_weighted", "nearest"; throws ConfigError otherwise.
+CombineRule parseCombineRule(const std::string& name);
+const char* toString(CombineRule rule);
+
+/// Section `interpolation` of the YAML config (paper step 2, compound interpolation).
+struct InterpolationConfig {
+  SliceParams slice;                        ///< keys method, short_gap_px, max_gap_px, jump_abs_m,
+                                            ///< jump_rel, cubic_alpha, cubic_beta, inverse_depth
+  CombineRule combine = CombineRule::ShorterGap;
+  /// Row estimates bridged over at most this many pixels join the samples that column
+  /// slices see (0: columns see samples only). A scan line is dense along a row but its
+  /// samples share azimuths, so without this, whole columns have no sample at all.
+  int column_seed_gap_px = 0;
+  bool gaussian = true;                     ///< fill the holes left by the slices
+  int gaussian_size_px = 5;                 ///< odd kernel width
+  float gaussian_sigma_px = 1.0f;
+  float gaussian_min_weight = 0.1f;         ///< share of the kernel's mass that must hold estimates
+  bool gaussian_smooth_valid = false;       ///< also smooth interpolated pixels (real returns never)
+  int threads = 0;                          ///< OpenMP threads, 0 = default
+
+  void print() const;
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the first key out of range.
+  void validate() const;
+};
+
+/// The image-level core of CompoundInterpolation: a sparse depth image (CV_32FC1, 0 or
+/// NaN = no sample) to an interpolated one (CV_32FC1, 0 = no estimate). Rows and columns
+/// are slices filled by interpolateSlice, combined by `combine`, then one normalized
+/// Gaussian pass fills the small holes that remain. Samples are never changed. The object
+/// keeps its work buffers between calls (one frame after another); it is not meant to be
+/// shared between threads, but each call is parallel inside and gives the same result
+/// for any number of threads.
+class DepthInterpolator {
+public:
+  explicit DepthInterpolator(const InterpolationConfig& config = {});
+  /// Throws ConfigError for an invalid config.
+  void setConfig(const InterpolationConfig& config);
+  const InterpolationConfig& config() const { return config_; }
+
+  /// Throws InvalidInputError when `depth` is not CV_32FC1 or empty. `out` may not alias `depth`.
+  void interpolate(const cv::Mat& depth, cv::Mat& out);
+
+private:
+  InterpolationConfig config_;
+  cv::Mat rows_, cols_, seeds_, row_gap_, col_gap_, values_, weights_;
+};
+
+} // namespace msf

@@ -1,0 +1,15 @@
+#pragma once
+#include <opencv2/core/mat.hpp>
+
+namespace msf {
+
+/// Exact Euclidean distance, in pixels, from every pixel to the nearest sample (a pixel of
+/// `depth` > 0): the separable lower-envelope algorithm of Felzenszwalb and Huttenlocher,
+/// which is exact and several times faster than cv::distanceTransform with a precise mask.
+/// `distance` is CV_32FC1 (0 on a sample, +inf everywhere when there is none). When
+/// `nearest` is given it receives, as CV_32SC1, the row-major index of a nearest sample
+/// (-1 when there is none). `threads` 0 uses OpenMP's default. The result does not depend
+/// on the number of threads.
+void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest = nullptr, int threads = 0);
+
+} // namespace msf

@@ -1,0 +1,72 @@
+#pragma once
+#include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/persistence.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <vector>
+
+namespace msf {
+
+/// Section `projection` of the YAML config.
+struct ProjectionConfig {
+  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills
+  float min_range_m = 0.f;    ///< returns closer to the LiDAR than this are dropped
+  float max_range_m = 120.f;  ///< returns farther than this are dropped (HDL-64E: 120 m)
+
+  void print() const;
+  /// Overrides the keys present; throws ConfigError naming a key with a bad value.
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the first key out of range.
+  void validate() const;
+};
+
+/// Paper step 1: a Velodyne scan (PointXYZI, velodyne frame) into one camera's image.
+/// Points are moved into the camera's rectified frame and projected with its intrinsics;
+/// points behind the camera, outside the image or outside [min_range, max_range] (distance
+/// from the LiDAR) are dropped, and where several land on one pixel the nearest wins.
+class LidarProjector {
+public:
+  LidarProjector() = default;
+  /// Throws CalibrationError when the calibration has no image size.
+  explicit LidarProjector(const Calibration& calibration, const ProjectionConfig& config = {});
+
+  void setCalibration(const Calibration& calibration);
+  /// Throws ConfigError for an invalid config; keeps the calibration.
+  void setConfig(const ProjectionConfig& config);
+  const ProjectionConfig& config() const { return config_; }
+  /// Intrinsics and image size of the target camera.
+  const PinholeCamera& camera() const { return camera_; }
+
+  /// Depth image (CV_32FC1, metres along the optical axis, 0 = no return) and, when
+  /// `intensity` is given, the reflectance of the winning return (0 elsewhere).
+  /// The matrices are reused when they already have the right size and type.
+  void projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
+                      cv::Mat* intensity = nullptr) const;
+
+  /// Organized cloud of the image's size: each pixel with a return holds that return's
+  /// exact position in the camera's rectified frame (within half a pixel of the pixel's
+  /// ray) and, when PointT has them, its reflectance and distance 0; other pixels are NaN
+  /// (distance +inf). Instantiated for PointXYZ, PointXYZI and PointXYZID.
+  template <typename PointT>
+  void project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const;
+
+private:
+  /// Index of the winning point per pixel (-1 none) and its depth (0 none).
+  void scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth, cv::Mat* winner) const;
+  void requireCalibration() const;
+
+  ProjectionConfig config_;
+  PinholeCamera camera_;
+  Eigen::Matrix<float, 3, 4> T_cam_velo_ = Eigen::Matrix<float, 3, 4>::Zero(); ///< velodyne -> this camera
+  float skew_ = 0.f;
+  bool calibrated_ = false;
+  mutable std::vector<int> pixel_;     ///< per scan point: pixel index or -1 (reused)
+  mutable std::vector<float> depth_;   ///< per scan point: depth in the camera
+};
+
+} // namespace msf

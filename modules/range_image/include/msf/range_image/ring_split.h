@@ -1,0 +1,35 @@
+#pragma once
+#include <opencv2/core/persistence.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <vector>
+
+namespace msf {
+
+/// Section `rings` of the YAML config: which rings of a scan are held out as ground truth
+/// (evaluation protocol 2, DESIGN.md).
+struct RingSplitConfig {
+  int modulo = 4;            ///< rings with id % modulo == heldout_remainder are held out
+  int heldout_remainder = 2;
+
+  void print() const;
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the key out of range.
+  void validate() const;
+  bool isHeldOut(int ring) const { return ring % modulo == heldout_remainder; }
+};
+
+/// Ring id of each point of a scan in file order: the number of azimuth wraps before it, a
+/// wrap being atan2(y, x) dropping by more than pi from one point to the next. On KITTI a
+/// laser's sweep starts and ends straight ahead, so a full scan has 64 wraps (ids 0..64) and
+/// an id holds the left half (azimuth > 0) of one laser and the right half of the one before.
+std::vector<int> ringIds(const pcl::PointCloud<pcl::PointXYZI>& scan);
+
+/// Splits a scan (file order) into the points of input rings and of held-out rings, both in
+/// file order; headers are copied. Returns the number of ring ids (wraps + 1).
+/// Throws ConfigError for an invalid config.
+int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const RingSplitConfig& config,
+               pcl::PointCloud<pcl::PointXYZI>& input, pcl::PointCloud<pcl::PointXYZI>& heldout);
+
+} // namespace msf

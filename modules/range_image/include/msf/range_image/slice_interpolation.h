@@ -1,0 +1,49 @@
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace msf {
+
+/// How a gap between two consecutive samples of a slice is bridged.
+enum class SliceInterpolant {
+  Compound, ///< the paper's rule: cubic up to short_gap_px, linear up to max_gap_px
+  Linear,   ///< linear (paper eq. 2) up to max_gap_px
+  Cubic     ///< zero-slope cubic (paper eq. 3-5) up to max_gap_px
+};
+
+/// "compound", "linear", "cubic"; throws ConfigError naming the text otherwise.
+SliceInterpolant parseSliceInterpolant(const std::string& name);
+const char* toString(SliceInterpolant interpolant);
+
+/// Parameters of one slice pass (a row or a column of a depth image).
+struct SliceParams {
+  SliceInterpolant interpolant = SliceInterpolant::Compound;
+  int short_gap_px = 4;        ///< gaps of at most this many empty pixels take the cubic
+  int max_gap_px = 16;         ///< longer gaps stay empty
+  /// A gap is an object edge when its ends z0, z1 differ by more than all three of:
+  float jump_abs_m = 0.5f;     ///< an absolute jump |z1 - z0| in metres,
+  float jump_rel = 0.f;        ///< a share of the nearer depth,
+  float jump_inv_per_m = 0.03f;///< and a jump in inverse depth |1/z0 - 1/z1| (disparity / (f B))
+  float cubic_alpha = 2.f;     ///< cubic weight beta t^2 - alpha t^3 (paper: 2, 3)
+  float cubic_beta = 3.f;
+  bool inverse_depth = false;  ///< interpolate 1/z, which is linear in the image for a plane
+};
+
+/// True when the ends z0, z1 of a gap are on two sides of an object edge.
+/// Inverse depth is affine in the image along a plane, so the ground's inverse depth
+/// changes little across a gap even far away, where its depth changes a lot.
+inline bool isDepthJump(float z0, float z1, const SliceParams& p) {
+  const float d = z1 > z0 ? z1 - z0 : z0 - z1;
+  const float nearer = z1 < z0 ? z1 : z0;
+  return d > p.jump_abs_m && d > p.jump_rel * nearer && d > p.jump_inv_per_m * z0 * z1;
+}
+
+/// Fills one slice of `n` pixels read at `in[i * stride]` (a sample is > 0; 0 or NaN is
+/// empty) into `out[i * stride]` (0 where there is no estimate) and `gap[i * stride]` (the
+/// number of empty pixels of the gap an estimate was bridged over, saturated at 255; 0 on a
+/// sample and where there is no estimate). `in` and `out` may be the same array.
+void interpolateSlice(const float* in, std::ptrdiff_t stride, int n, const SliceParams& params, float* out,
+                      std::uint8_t* gap);
+
+} // namespace msf

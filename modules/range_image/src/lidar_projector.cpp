@@ -1,0 +1,190 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/point_types.h>
+
+#include <pcl/console/print.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace msf {
+
+void ProjectionConfig::print() const {
+  pcl::console::print_info("projection: camera %d, range %g..%g m\n", camera, min_range_m, max_range_m);
+}
+
+void ProjectionConfig::read(const cv::FileNode& node) {
+  readKey(node, "camera", camera);
+  readKey(node, "min_range_m", min_range_m);
+  readKey(node, "max_range_m", max_range_m);
+  validate();
+}
+
+void ProjectionConfig::validate() const {
+  if (camera < 0 || camera > 3)
+    throw ConfigError("projection.camera must be 0..3, not " + std::to_string(camera));
+  if (!(min_range_m >= 0.f))
+    throw ConfigError("projection.min_range_m must be >= 0, not " + std::to_string(min_range_m));
+  if (!(max_range_m > min_range_m))
+    throw ConfigError("projection.max_range_m (" + std::to_string(max_range_m) +
+                      ") must be greater than projection.min_range_m (" + std::to_string(min_range_m) + ")");
+}
+
+LidarProjector::LidarProjector(const Calibration& calibration, const ProjectionConfig& config) {
+  config.validate();
+  config_ = config;
+  setCalibration(calibration);
+}
+
+void LidarProjector::setCalibration(const Calibration& calibration) {
+  camera_ = PinholeCamera::fromCalibration(calibration, config_.camera);
+  // P_i = K_i [I | t_i] on the rectified frame of camera 0, so the point in camera i's
+  // frame is X_0 + K_i^-1 P_i.col(3) (a translation only: the cameras share one plane).
+  const Eigen::Vector3d t_i = calibration.K(config_.camera).inverse() * calibration.P[config_.camera].col(3);
+  Eigen::Isometry3d T = calibration.T_cam0_velo;
+  T.translation() += t_i;
+  T_cam_velo_ = T.matrix().topRows<3>().cast<float>();
+  skew_ = static_cast<float>(calibration.P[config_.camera](0, 1));
+  calibrated_ = true;
+}
+
+void LidarProjector::setConfig(const ProjectionConfig& config) {
+  config.validate();
+  const bool camera_changed = config.camera != config_.camera;
+  config_ = config;
+  if (camera_changed && calibrated_)
+    throw ConfigError("projection.camera changed after the calibration was set: call setCalibration again");
+}
+
+void LidarProjector::requireCalibration() const {
+  if (!calibrated_)
+    throw InvalidInputError("LidarProjector: no calibration set");
+}
+
+void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth, cv::Mat* winner) const {
+  requireCalibration();
+  const int W = camera_.width, H = camera_.height;
+  const int n = static_cast<int>(scan.size());
+  pixel_.resize(scan.size());
+  depth_.resize(scan.size());
+  const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
+  const float fx = camera_.fx, fy = camera_.fy, cx = camera_.cx, cy = camera_.cy, skew = skew_;
+  const float r2min = config_.min_range_m * config_.min_range_m, r2max = config_.max_range_m * config_.max_range_m;
+  const float umax = static_cast<float>(W) - 0.5f, vmax = static_cast<float>(H) - 0.5f;
+
+  // Transform and project in parallel; the z-buffer below is serial over the few points kept.
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
+    pixel_[i] = -1;
+    const float z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
+    if (!(z > 0.f))
+      continue; // behind the camera (or NaN)
+    const float r2 = p.x * p.x + p.y * p.y + p.z * p.z;
+    if (r2 < r2min || r2 > r2max)
+      continue;
+    const float x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
+    const float y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
+    const float inv_z = 1.f / z;
+    const float u = (fx * x + skew * y) * inv_z + cx;
+    const float v = fy * y * inv_z + cy;
+    if (!(u > -0.5f && u < umax && v > -0.5f && v < vmax))
+      continue;
+    // Pixel centres are integers (as in depthImageToCloud), so round to nearest.
+    pixel_[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
+    depth_[i] = z;
+  }
+
+  depth.create(H, W, CV_32FC1);
+  depth.setTo(0.f);
+  float* d = depth.ptr<float>();
+  int* w = nullptr;
+  if (winner) {
+    winner->create(H, W, CV_32SC1);
+    winner->setTo(-1);
+    w = winner->ptr<int>();
+  }
+  for (int i = 0; i < n; ++i) {
+    const int k = pixel_[i];
+    if (k < 0)
+      continue;
+    if (d[k] == 0.f || depth_[i] < d[k]) {
+      d[k] = depth_[i];
+      if (w)
+        w[k] = i;
+    }
+  }
+}
+
+void LidarProjector::projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
+                                    cv::Mat* intensity) const {
+  if (!intensity) {
+    scatter(scan, depth, nullptr);
+    return;
+  }
+  cv::Mat winner;
+  scatter(scan, depth, &winner);
+  intensity->create(depth.size(), CV_32FC1);
+  const int* w = winner.ptr<int>();
+  float* out = intensity->ptr<float>();
+  const int total = static_cast<int>(depth.total());
+#pragma omp parallel for schedule(static)
+  for (int k = 0; k < total; ++k)
+    out[k] = w[k] >= 0 ? scan[static_cast<std::size_t>(w[k])].intensity : 0.f;
+}
+
+namespace {
+template <typename PointT>
+inline void setReflectance(PointT& p, float value) {
+  if constexpr (pcl::traits::has_intensity_v<PointT>)
+    p.intensity = value;
+}
+template <typename PointT>
+inline void setDistance(PointT& p, float value) {
+  if constexpr (std::is_same_v<PointT, PointXYZID>)
+    p.distance = value;
+}
+} // namespace
+
+template <typename PointT>
+void LidarProjector::project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const {
+  cv::Mat depth, winner;
+  scatter(scan, depth, &winner);
+  const int W = camera_.width, H = camera_.height;
+  cloud.resize(static_cast<std::size_t>(W) * H);
+  cloud.width = static_cast<std::uint32_t>(W);
+  cloud.height = static_cast<std::uint32_t>(H);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
+  const int* w = winner.ptr<int>();
+  bool dense = true;
+#pragma omp parallel for schedule(static) reduction(&& : dense)
+  for (int k = 0; k < W * H; ++k) {
+    PointT& out = cloud[static_cast<std::size_t>(k)];
+    if (w[k] < 0) {
+      out.x = out.y = out.z = nan;
+      setReflectance(out, 0.f);
+      setDistance(out, inf);
+      dense = false;
+      continue;
+    }
+    const pcl::PointXYZI& p = scan[static_cast<std::size_t>(w[k])];
+    out.x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
+    out.y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
+    out.z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
+    setReflectance(out, p.intensity);
+    setDistance(out, 0.f);
+  }
+  cloud.is_dense = dense;
+}
+
+template void LidarProjector::project<pcl::PointXYZ>(const pcl::PointCloud<pcl::PointXYZI>&,
+                                                     pcl::PointCloud<pcl::PointXYZ>&) const;
+template void LidarProjector::project<pcl::PointXYZI>(const pcl::PointCloud<pcl::PointXYZI>&,
+                                                      pcl::PointCloud<pcl::PointXYZI>&) const;
+template void LidarProjector::project<PointXYZID>(const pcl::PointCloud<pcl::PointXYZI>&,
+                                                  pcl::PointCloud<PointXYZID>&) const;
+
+} // namespace msf

@@ -1,0 +1,172 @@
+// Evaluation protocol 2 (DESIGN.md): ring hold-out on real KITTI scans. One row per
+// method: the table a user compares depth methods with.
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/evaluation/holdout.h>
+#include <msf/io/sequence.h>
+#include <msf/range_image/depth_interpolator.h>
+#include <msf/range_image/ip_basic.h>
+#include <msf/range_image/lidar_projector.h>
+
+#include <pcl/common/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+/// A named method: from the config to a function of one frame's input.
+struct MethodEntry {
+  const char* name;
+  const char* description;
+  std::function<msf::HoldoutMethod(const msf::ConfigFile&)> make;
+};
+
+/// LiDAR input rings projected into camera 0 (the first step of every LiDAR method).
+struct Projection {
+  msf::ProjectionConfig config;
+  std::unique_ptr<msf::LidarProjector> projector;
+  cv::Mat sparse;
+  explicit Projection(const msf::ConfigFile& file) { config.read(file.section("projection")); }
+  const cv::Mat& operator()(const msf::HoldoutInput& in) {
+    if (!projector)
+      projector = std::make_unique<msf::LidarProjector>(*in.calibration, config);
+    projector->projectToImage(*in.scan, sparse);
+    return sparse;
+  }
+};
+
+msf::HoldoutMethod interpolation(const msf::ConfigFile& file, const char* forced_interpolant) {
+  msf::InterpolationConfig config;
+  config.read(file.section("interpolation"));
+  if (forced_interpolant)
+    config.slice.interpolant = msf::parseSliceInterpolant(forced_interpolant);
+  auto projection = std::make_shared<Projection>(file);
+  auto interpolator = std::make_shared<msf::DepthInterpolator>(config);
+  return [projection, interpolator](const msf::HoldoutInput& in) {
+    cv::Mat dense;
+    interpolator->interpolate((*projection)(in), dense);
+    return dense;
+  };
+}
+
+msf::HoldoutMethod ipBasic(const msf::ConfigFile& file, msf::IpBasicVariant variant) {
+  msf::IpBasicConfig config;
+  config.read(file.section("ip_basic"));
+  config.variant = variant;
+  auto projection = std::make_shared<Projection>(file);
+  return [projection, config](const msf::HoldoutInput& in) { return msf::ipBasic((*projection)(in), config); };
+}
+
+/// Add a method here (name -> function of the frame input) to get its row in the table.
+const std::vector<MethodEntry>& methodTable() {
+  static const std::vector<MethodEntry> table{
+      {"interpolated", "compound interpolation (section interpolation)",
+       [](const msf::ConfigFile& f) { return interpolation(f, nullptr); }},
+      {"linear", "the same slices, linear only", [](const msf::ConfigFile& f) { return interpolation(f, "linear"); }},
+      {"cubic", "the same slices, zero-slope cubic only",
+       [](const msf::ConfigFile& f) { return interpolation(f, "cubic"); }},
+      {"ipbasic", "IP-Basic fast (Ku et al. 2018, section ip_basic)",
+       [](const msf::ConfigFile& f) { return ipBasic(f, msf::IpBasicVariant::Fast); }},
+      {"ipbasic_multiscale", "IP-Basic multiscale",
+       [](const msf::ConfigFile& f) { return ipBasic(f, msf::IpBasicVariant::Multiscale); }},
+  };
+  return table;
+}
+
+std::string methodNames() {
+  std::string names;
+  for (const auto& m : methodTable())
+    names += (names.empty() ? "" : ",") + std::string(m.name);
+  return names;
+}
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <sequence_dir> [options]\n", name);
+  print_info("  Ring hold-out (evaluation protocol 2): rings with id %% 4 == 2 of each scan are ground truth in\n"
+             "  camera 0, the others are the only LiDAR input. Prints one row per method: coverage, D1 with a\n"
+             "  missing estimate counted as bad, D1 over estimates, mean disparity error, depth MAE, RMSE, iMAE,\n"
+             "  iRMSE (1/km) and the median time of a method per frame (projection included).\n");
+  print_info("  where options are:\n");
+  print_info("    -frames a:b      frames to use (default: all)\n");
+  print_info("    -methods a,b,..  methods, in this order (default: all):\n");
+  for (const auto& m : methodTable())
+    print_info("                       %-19s %s\n", m.name, m.description);
+  print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic)\n");
+  print_info("    -csv FILE        also write the rows as CSV\n");
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty())
+      out.push_back(item);
+  return out;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_holdout", [&] {
+    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return argc < 2 ? 1 : 0;
+    }
+    const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv"};
+    msf::tool::checkOptions(argc, argv, value_options, {});
+    const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
+    if (positional.size() != 1)
+      throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
+    std::string frames_text = "0:", methods_text = methodNames(), config_path, csv_path;
+    parse_argument(argc, argv, "-frames", frames_text);
+    parse_argument(argc, argv, "-methods", methods_text);
+    parse_argument(argc, argv, "-config", config_path);
+    parse_argument(argc, argv, "-csv", csv_path);
+    if (!csv_path.empty() && msf::fileExtension(csv_path) != ".csv")
+      throw msf::InvalidInputError("-csv '" + csv_path + "' must end in .csv");
+
+    const msf::ConfigFile config_file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
+    msf::HoldoutConfig config;
+    config.rings.read(config_file.section("rings"));
+    config.projection.read(config_file.section("projection"));
+    msf::HoldoutEvaluation evaluation(config);
+    const auto names = split(methods_text);
+    if (names.empty())
+      throw msf::InvalidInputError("-methods is empty; known methods: " + methodNames());
+    for (const auto& name : names) {
+      const MethodEntry* entry = nullptr;
+      for (const auto& m : methodTable())
+        if (name == m.name)
+          entry = &m;
+      if (!entry)
+        throw msf::InvalidInputError("unknown method '" + name + "'; known methods: " + methodNames());
+      evaluation.addMethod(name, entry->make(config_file));
+    }
+
+    const msf::Sequence sequence(positional[0]);
+    const auto frames = sequence.indices(msf::FrameRange::parse(frames_text));
+    print_highlight("Evaluating ");
+    print_value("%zu frames ", frames.size());
+    print_info("of %s, %zu methods\n", sequence.directory().c_str(), names.size());
+    pcl::StopWatch watch;
+    const auto results = evaluation.run(sequence, frames);
+    const double ms = watch.getTime();
+    std::printf("%s", msf::formatHoldoutTable(results).c_str());
+    std::fflush(stdout);
+    if (!csv_path.empty())
+      msf::writeHoldoutCsv(csv_path, results);
+    msf::tool::printDone(ms, results.empty() ? 0 : results.front().metrics.gt_pixels);
+    return 0;
+  });
+}
