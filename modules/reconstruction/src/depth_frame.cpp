@@ -9,18 +9,6 @@
 
 namespace msf {
 
-PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int camera) {
-  const cv::Size size = calibration.requireImageSize();
-  PinholeCamera c;
-  c.fx = calibration.fx(camera);
-  c.fy = calibration.fy(camera);
-  c.cx = calibration.cx(camera);
-  c.cy = calibration.cy(camera);
-  c.width = size.width;
-  c.height = size.height;
-  return c;
-}
-
 void DepthFrame::validate() const {
   if (depth.empty() || depth.type() != CV_32FC1)
     throw InvalidInputError("depth frame: the depth image must be a non-empty CV_32FC1 image (metres)");
@@ -43,28 +31,6 @@ void requireOrganized(std::uint32_t width, std::uint32_t height, const std::stri
     throw InvalidInputError(what + " is not organized (" + std::to_string(width) + "x" + std::to_string(height) +
                             "): integrating it as a depth image needs an organized cloud (width x height of the "
                             "camera image); integrate an unorganized scan with integrateScan and its sensor origin");
-}
-
-PinholeCamera PinholeFit::solve(int width, int height, const std::string& what) const {
-  const double du = n * saa - sa * sa, dv = n * sbb - sb * sb;
-  if (n < 10 || du <= 1e-12 * n * n || dv <= 1e-12 * n * n)
-    throw InvalidInputError("cannot recover the camera intrinsics of " + what + ": too few valid points (" +
-                            std::to_string(static_cast<long long>(n)) + "); give the calibration");
-  PinholeCamera c;
-  c.fx = (n * sau - sa * su) / du;
-  c.cx = (su - c.fx * sa) / n;
-  c.fy = (n * sbv - sb * sv) / dv;
-  c.cy = (sv - c.fy * sb) / n;
-  c.width = width;
-  c.height = height;
-  const double ru = suu - 2 * c.fx * sau - 2 * c.cx * su + c.fx * c.fx * saa + 2 * c.fx * c.cx * sa + n * c.cx * c.cx;
-  const double rv = svv - 2 * c.fy * sbv - 2 * c.cy * sv + c.fy * c.fy * sbb + 2 * c.fy * c.cy * sb + n * c.cy * c.cy;
-  const double rms = std::sqrt(std::max(0.0, ru + rv) / (2 * n));
-  if (!(c.fx > 0) || !(c.fy > 0) || !(rms < 0.05))
-    throw InvalidInputError("cannot recover the camera intrinsics of " + what +
-                            ": its points are not a pinhole projection of its pixels (residual " + std::to_string(rms) +
-                            " px); give the calibration");
-  return c;
 }
 
 } // namespace detail
@@ -108,7 +74,7 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
     frame.color.create(rows, cols, CV_8UC3);
   if (fw)
     frame.weight.create(rows, cols, CV_32FC1);
-  detail::PinholeFit fit;
+  PinholeFit fit;
   for (int v = 0; v < rows; ++v) {
     float* depth = frame.depth.ptr<float>(v);
     for (int u = 0; u < cols; ++u) {
@@ -138,7 +104,6 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
 }
 
 #define MSF_INSTANTIATE_DEPTH_FRAME(T)                                                        \
-  template PinholeCamera estimatePinholeCamera<T>(const pcl::PointCloud<T>&);                 \
   template DepthFrame toDepthFrame<T>(const pcl::PointCloud<T>&, const PinholeCamera*);
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZ)
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZI)

@@ -1,5 +1,5 @@
 #pragma once
-#include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
 
 #include <opencv2/core/mat.hpp>
 #include <pcl/PCLPointCloud2.h>
@@ -8,17 +8,6 @@
 #include <string>
 
 namespace msf {
-
-/// Intrinsics of the (rectified) camera a depth image was taken with; pixel (u, v) has its
-/// centre at integer coordinates, as in depthImageToCloud: x = (u - cx) z / fx.
-struct PinholeCamera {
-  double fx = 0, fy = 0, cx = 0, cy = 0;
-  int width = 0, height = 0;
-
-  bool valid() const { return fx > 0 && fy > 0 && width > 0 && height > 0; }
-  /// Camera `camera` of a calibration; throws CalibrationError when it has no image size.
-  static PinholeCamera fromCalibration(const Calibration& calibration, int camera = 0);
-};
 
 /// What TsdfIntegrator consumes: a depth image with its camera, and optionally a colour
 /// image and a per-pixel weight image of the same size (the fusion stage's confidence).
@@ -34,12 +23,6 @@ struct DepthFrame {
   /// when its intrinsics are invalid or its size differs from the depth image.
   void validate() const;
 };
-
-/// Recovers fx, fy, cx, cy of an organized cloud made by a pinhole camera (x = (u - cx) z / fx)
-/// by least squares over its valid points. Throws InvalidInputError when the cloud is not
-/// organized, has too few valid points, or is not a pinhole projection (residual > 0.05 px).
-template <typename PointT>
-PinholeCamera estimatePinholeCamera(const pcl::PointCloud<PointT>& cloud);
 
 /// Organized cloud (NaN where there is no depth) to a DepthFrame: depth = z; colour from the
 /// rgb field when PointT has one; weight from a float field named `weight` when PointT has

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/common/exceptions.h>
+#include <msf/io/impl/pinhole_camera.hpp>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/point_types.h>
 
@@ -13,40 +14,9 @@ namespace msf {
 
 namespace detail {
 
-/// Least-squares fit of u = fx * x/z + cx and v = fy * y/z + cy over valid pixels.
-struct PinholeFit {
-  double n = 0, su = 0, sa = 0, saa = 0, sau = 0, suu = 0;
-  double sv = 0, sb = 0, sbb = 0, sbv = 0, svv = 0;
-  void add(int u, int v, float x, float y, float z) {
-    const double a = x / z, b = y / z;
-    n += 1;
-    su += u; sa += a; saa += a * a; sau += a * u; suu += double(u) * u;
-    sv += v; sb += b; sbb += b * b; sbv += b * v; svv += double(v) * v;
-  }
-  void merge(const PinholeFit& o) {
-    n += o.n; su += o.su; sa += o.sa; saa += o.saa; sau += o.sau; suu += o.suu;
-    sv += o.sv; sb += o.sb; sbb += o.sbb; sbv += o.sbv; svv += o.svv;
-  }
-  /// Throws InvalidInputError (naming `what`) when the fit is impossible or poor.
-  PinholeCamera solve(int width, int height, const std::string& what) const;
-};
-
 void requireOrganized(std::uint32_t width, std::uint32_t height, const std::string& what);
 
 } // namespace detail
-
-template <typename PointT>
-PinholeCamera estimatePinholeCamera(const pcl::PointCloud<PointT>& cloud) {
-  detail::requireOrganized(cloud.width, cloud.height, "cloud");
-  detail::PinholeFit fit;
-  for (int v = 0; v < static_cast<int>(cloud.height); ++v)
-    for (int u = 0; u < static_cast<int>(cloud.width); ++u) {
-      const PointT& p = cloud[static_cast<std::size_t>(v) * cloud.width + u];
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && p.z > 0.f)
-        fit.add(u, v, p.x, p.y, p.z);
-    }
-  return fit.solve(static_cast<int>(cloud.width), static_cast<int>(cloud.height), "cloud");
-}
 
 template <typename PointT>
 DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamera* camera) {

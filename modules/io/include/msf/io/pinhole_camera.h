@@ -1,0 +1,49 @@
+#pragma once
+#include <msf/io/calibration.h>
+
+#include <pcl/point_cloud.h>
+
+#include <string>
+
+namespace msf {
+
+/// The intrinsics of one rectified camera, in float for per-pixel loops: pixel (u, v) with
+/// depth z is the point ((u - cx) z / fx, (v - cy) z / fy, z), as depthImageToCloud makes.
+struct PinholeCamera {
+  float fx = 0.f, fy = 0.f, cx = 0.f, cy = 0.f;
+  int width = 0, height = 0;
+
+  bool valid() const { return fx > 0.f && fy > 0.f && width > 0 && height > 0; }
+  /// Camera `camera` (0..3) of a calibration; throws CalibrationError when the calibration
+  /// has no image size, InvalidInputError for a camera index out of range.
+  static PinholeCamera fromCalibration(const Calibration& calibration, int camera = 0);
+};
+
+/// Least-squares fit of u = fx x/z + cx and v = fy y/z + cy over points and their pixels,
+/// so that a tool can work on an organized .pcd alone, without its calibration.
+class PinholeFit {
+public:
+  void add(double u, double v, double x, double y, double z);
+  void merge(const PinholeFit& other);
+  double count() const { return n_; }
+  /// The camera of a width x height image. Throws InvalidInputError naming `what` when there
+  /// are too few points, or when the RMS residual along u or v exceeds `max_rms_px` (the
+  /// points are not on their pixels' rays: real LiDAR returns are within half a pixel).
+  PinholeCamera solve(int width, int height, const std::string& what, double max_rms_px = 1.0) const;
+
+private:
+  double n_ = 0, sa_ = 0, saa_ = 0, su_ = 0, sau_ = 0, suu_ = 0; // a = x / z against u
+  double sb_ = 0, sbb_ = 0, sv_ = 0, sbv_ = 0, svv_ = 0;          // b = y / z against v
+};
+
+/// The intrinsics of an organized cloud made by a pinhole camera, fitted over its valid
+/// points. Throws InvalidInputError when the cloud is not organized, has too few valid
+/// points, or its points are not on their pixels' rays (see PinholeFit::solve).
+template <typename PointT>
+PinholeCamera estimatePinholeCamera(const pcl::PointCloud<PointT>& cloud, double max_rms_px = 1.0);
+
+} // namespace msf
+
+#ifdef MSF_NO_PRECOMPILE
+#include <msf/io/impl/pinhole_camera.hpp>
+#endif

@@ -1,0 +1,70 @@
+#include <msf/io/impl/pinhole_camera.hpp>
+
+#include <pcl/point_types.h>
+
+#include <algorithm>
+
+namespace msf {
+
+PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int camera) {
+  if (camera < 0 || camera > 3)
+    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  const cv::Size size = calibration.requireImageSize();
+  PinholeCamera c;
+  c.fx = static_cast<float>(calibration.fx(camera));
+  c.fy = static_cast<float>(calibration.fy(camera));
+  c.cx = static_cast<float>(calibration.cx(camera));
+  c.cy = static_cast<float>(calibration.cy(camera));
+  c.width = size.width;
+  c.height = size.height;
+  if (!(c.fx > 0.f && c.fy > 0.f))
+    throw CalibrationError("calibration '" + calibration.source + "': camera " + std::to_string(camera) +
+                           " has a non-positive focal length");
+  return c;
+}
+
+void PinholeFit::add(double u, double v, double x, double y, double z) {
+  const double a = x / z, b = y / z;
+  n_ += 1;
+  sa_ += a, saa_ += a * a, su_ += u, sau_ += a * u, suu_ += u * u;
+  sb_ += b, sbb_ += b * b, sv_ += v, sbv_ += b * v, svv_ += v * v;
+}
+
+void PinholeFit::merge(const PinholeFit& o) {
+  n_ += o.n_;
+  sa_ += o.sa_, saa_ += o.saa_, su_ += o.su_, sau_ += o.sau_, suu_ += o.suu_;
+  sb_ += o.sb_, sbb_ += o.sbb_, sv_ += o.sv_, sbv_ += o.sbv_, svv_ += o.svv_;
+}
+
+PinholeCamera PinholeFit::solve(int width, int height, const std::string& what, double max_rms_px) const {
+  const double du = n_ * saa_ - sa_ * sa_, dv = n_ * sbb_ - sb_ * sb_;
+  if (n_ < 10 || !(du > 1e-12 * n_ * n_) || !(dv > 1e-12 * n_ * n_))
+    throw InvalidInputError(what + " has too few valid points (" + std::to_string(static_cast<long long>(n_)) +
+                            ") spread over the image to recover its camera; give the calibration");
+  const double fx = (n_ * sau_ - sa_ * su_) / du, cx = (su_ - fx * sa_) / n_;
+  const double fy = (n_ * sbv_ - sb_ * sv_) / dv, cy = (sv_ - fy * sb_) / n_;
+  // Residual sums of squares of the two line fits, expanded from the sums.
+  const double ru = suu_ - 2 * fx * sau_ - 2 * cx * su_ + fx * fx * saa_ + 2 * fx * cx * sa_ + n_ * cx * cx;
+  const double rv = svv_ - 2 * fy * sbv_ - 2 * cy * sv_ + fy * fy * sbb_ + 2 * fy * cy * sb_ + n_ * cy * cy;
+  const double rms = std::sqrt(std::max(0.0, std::max(ru, rv)) / n_);
+  if (!(fx > 0) || !(fy > 0) || !(rms <= max_rms_px))
+    throw InvalidInputError(what + " is not a camera image: its points do not lie on their pixels' rays (fit residual " +
+                            std::to_string(rms) + " px); give the calibration");
+  PinholeCamera c;
+  c.fx = static_cast<float>(fx);
+  c.fy = static_cast<float>(fy);
+  c.cx = static_cast<float>(cx);
+  c.cy = static_cast<float>(cy);
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+#define MSF_INSTANTIATE_PINHOLE_CAMERA(T) \
+  template PinholeCamera estimatePinholeCamera<T>(const pcl::PointCloud<T>&, double);
+MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZ)
+MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZI)
+MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZRGB)
+MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZRGBA)
+
+} // namespace msf
