@@ -84,10 +84,16 @@ SurfaceResponse road(const Material& m, V3 w, const Footprint& fp, const StreetL
   const float X = layout.streetOffset(w.x), Z = w.z;
   const float fX = footAlong(fp.dx, fp.dy, 0), fZ = footAlong(fp.dx, fp.dy, 2);
   const float iso = std::sqrt(fX * fZ);
-  const float n = fbm(X, Z, m.seed, 1.2f, 7, iso);
+  // Stains and wear at 0.1-1 m survive the footprint of the road at 10-30 m, where a pixel
+  // spans decimetres along the street; stone grain shows up close.
+  const float n = fbm(X, Z, m.seed, 1.2f, 7, iso, 0.7f);
   const float grain = fbm(X, Z, m.seed + 11u, 0.09f, 3, iso, 0.8f);
   const float patch = valueNoise(X / 7.f, Z / 7.f, m.seed + 23u);
-  const float a = 1.f + 0.22f * n + 0.45f * grain + 0.12f * patch;
+  // Wear streaks along the driving direction (10x longer than wide): they keep contrast
+  // across the image rows where the road is seen at a grazing angle.
+  constexpr float kStretch = 10.f;
+  const float streaks = fbm(X, Z / kStretch, m.seed + 47u, 0.4f, 5, std::sqrt(fX * fZ / kStretch), 0.65f);
+  const float a = 1.f + 0.4f * n + 0.45f * grain + 0.12f * patch + 0.3f * streaks;
   // Dashed centre line (3 m dash, 6 m gap) and solid lines between driving and parking lanes.
   const float lane = layout.lane_width_m;
   float paint = intervalCoverage(X, -0.06, 0.06, fX) * pulseCoverage(Z + 1.3, 9.0, 1.0 / 3.0, fZ);

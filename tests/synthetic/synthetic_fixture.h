@@ -1,0 +1,38 @@
+#pragma once
+#include <msf/synthetic/synthetic_generator.h>
+
+#include <cstddef>
+#include <map>
+#include <memory>
+
+namespace msf::test {
+
+/// One generator and its rendered frames, shared by the tests of this executable:
+/// rendering is the slow part, so each frame is rendered once.
+class SharedStreet {
+public:
+  static SharedStreet& instance() {
+    static SharedStreet street;
+    return street;
+  }
+  const synthetic::SyntheticGenerator& generator() const { return *generator_; }
+  const synthetic::SyntheticFrame& frame(std::size_t i) {
+    auto it = frames_.find(i);
+    if (it == frames_.end())
+      it = frames_.emplace(i, generator_->renderFrame(i)).first;
+    return it->second;
+  }
+  static synthetic::SyntheticConfig config() {
+    synthetic::SyntheticConfig c;
+    c.frames = 12;
+    c.seed = 7;
+    return c;
+  }
+
+private:
+  SharedStreet() : generator_(std::make_unique<synthetic::SyntheticGenerator>(config())) {}
+  std::unique_ptr<synthetic::SyntheticGenerator> generator_;
+  std::map<std::size_t, synthetic::SyntheticFrame> frames_;
+};
+
+} // namespace msf::test

@@ -1,0 +1,89 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/synthetic/synthetic_config.h>
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+using msf::synthetic::SyntheticConfig;
+
+cv::FileNode section(const std::string& yaml, cv::FileStorage& storage) {
+  storage.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  return storage["synthetic"];
+}
+
+TEST(SyntheticConfig, DefaultsAreValidAndKittiLike) {
+  const SyntheticConfig c;
+  EXPECT_NO_THROW(c.validate());
+  EXPECT_EQ(c.frames, 10);
+  EXPECT_DOUBLE_EQ(c.speed_mps / c.frame_rate_hz, 1.0); // 10 m/s at 10 Hz
+  EXPECT_DOUBLE_EQ(c.lidar_max_range_m, 120.0);
+  EXPECT_DOUBLE_EQ(c.lidar_upper_elevation_deg, 2.0);
+  EXPECT_DOUBLE_EQ(c.lidar_lower_elevation_deg, -24.9);
+}
+
+TEST(SyntheticConfig, ReadOverridesOnlyThePresentKeys) {
+  cv::FileStorage fs;
+  SyntheticConfig c;
+  c.read(section("%YAML:1.0\nsynthetic:\n  frames: 3\n  lidar_dropout: 0.1\n", fs));
+  EXPECT_EQ(c.frames, 3);
+  EXPECT_DOUBLE_EQ(c.lidar_dropout, 0.1);
+  EXPECT_EQ(c.seed, SyntheticConfig().seed);
+  // An absent section changes nothing.
+  SyntheticConfig d;
+  d.read(cv::FileNode());
+  EXPECT_EQ(d.frames, 10);
+}
+
+TEST(SyntheticConfig, BadValuesNameTheirKey) {
+  struct Case {
+    const char* yaml;
+    const char* key;
+  };
+  for (const Case& bad : {Case{"frames: 0", "synthetic.frames"}, Case{"supersampling: 9", "synthetic.supersampling"},
+                          Case{"lidar_dropout: 1.0", "synthetic.lidar_dropout"},
+                          Case{"scene: moon", "synthetic.scene"}, Case{"frames: many", "synthetic.frames"},
+                          Case{"lidar_max_range_m: 0.5", "synthetic.lidar_max_range_m"},
+                          Case{"seed: -4", "synthetic.seed"}}) {
+    cv::FileStorage fs;
+    SyntheticConfig c;
+    try {
+      c.read(section(std::string("%YAML:1.0\nsynthetic:\n  ") + bad.yaml + "\n", fs));
+      ADD_FAILURE() << bad.yaml << " was accepted";
+    } catch (const msf::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.key), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SyntheticConfig, PrintIsReadableYaml) {
+  SyntheticConfig c;
+  c.frames = 4;
+  c.image_noise_sigma = 1.5;
+  std::ostringstream out;
+  out << "%YAML:1.0\n";
+  c.print(out);
+  cv::FileStorage fs;
+  SyntheticConfig back;
+  back.read(section(out.str(), fs));
+  EXPECT_EQ(back.frames, 4);
+  EXPECT_DOUBLE_EQ(back.image_noise_sigma, 1.5);
+}
+
+TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {
+  const char* source = std::getenv("MSF_SOURCE_DIR");
+  const std::string path = std::string(source ? source : "..") + "/config/synthetic.yaml";
+  if (!msf::test::fileExists(path))
+    GTEST_SKIP() << "config/synthetic.yaml not found (set MSF_SOURCE_DIR)";
+  SyntheticConfig c;
+  c.read(msf::ConfigFile(path).section("synthetic"));
+  EXPECT_EQ(c.scene, "street");
+}
+
+} // namespace
