@@ -1,0 +1,23 @@
+#pragma once
+#include <msf/reconstruction/marching_cubes.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+
+namespace msf {
+
+/// A small z-buffer rasteriser for previews of a mesh (no display or GPU needed): vertex
+/// colours, shaded by how squarely each triangle faces the viewer; the background is white.
+class MeshRenderer {
+public:
+  /// Perspective view through a pinhole camera at T_world_cam (x right, y down, z forward).
+  static cv::Mat render(const TriangleMesh& mesh, const Eigen::Isometry3d& T_world_cam, double fx, double fy,
+                        double cx, double cy, cv::Size size);
+
+  /// View from above: a camera looking down the world's `up` axis at the mesh's bounding
+  /// box, framing all of it. `up` is the world direction that points to the sky (for KITTI
+  /// camera-0 poses, -y).
+  static cv::Mat renderFromAbove(const TriangleMesh& mesh, const Eigen::Vector3d& up, cv::Size size);
+};
+
+} // namespace msf

@@ -1,0 +1,101 @@
+#pragma once
+#include <msf/fusion/point_types.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/pipeline_config.h>
+#include <msf/range_image/point_types.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+#include <msf/reconstruction/tsdf_volume.h>
+#include <msf/stereo/point_types.h>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+/// Milliseconds each stage spent on one frame. lidar = projection + interpolation; lidar
+/// and stereo run at the same time, so depth_ms (their wall time) is what the frame waited.
+struct StageTimes {
+  double load_ms = 0, lidar_ms = 0, stereo_ms = 0, depth_ms = 0, fusion_ms = 0, integrate_ms = 0;
+};
+
+/// What one frame produced on its way through the stages.
+struct FrameResult {
+  std::size_t index = 0;                    ///< position in the sequence
+  std::string name;                         ///< file stem ("000042")
+  bool has_pose = false;
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
+  cv::Mat left;                             ///< camera 0 grey image
+  pcl::PointCloud<PointXYZID>::Ptr lidar_sparse;        ///< projected scan (paper step 1)
+  pcl::PointCloud<PointXYZID>::Ptr lidar;               ///< interpolated (step 2)
+  pcl::PointCloud<PointXYZRGBConfidence>::Ptr stereo;   ///< SGBM (step 3)
+  pcl::PointCloud<PointXYZRGBWeight>::Ptr fused;        ///< fused (step 4)
+  StageTimes times;
+};
+
+/// The whole method (DESIGN.md data flow) for a sequence: per frame, LiDAR projection and
+/// compound interpolation run at the same time as SGBM, then the two depth images are
+/// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
+/// The stages are the library's classes with the settings of one PipelineConfig, the same
+/// as the msf_project, msf_interpolate, msf_stereo, msf_fuse and msf_integrate tools use,
+/// so the chain of tools and the pipeline give the same fused depth.
+///
+/// run() overlaps frames: loading, depth (LiDAR + stereo + fusion) and integration each
+/// have a thread, joined by bounded queues, so stereo of frame t+1 runs while frame t
+/// integrates and memory is bounded by the map, not by the number of frames.
+class Pipeline {
+public:
+  /// Throws ConfigError for an invalid config, CalibrationError when the calibration has no
+  /// image size.
+  Pipeline(const Calibration& calibration, const PipelineConfig& config);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  /// Depth of one frame, synchronously: steps 1-4. Throws InvalidInputError for images or a
+  /// scan that do not fit the calibration.
+  FrameResult computeDepth(const Frame& frame);
+
+  /// Integrates the fused depth of `result` at its pose (step 5). Throws InvalidInputError
+  /// when the frame has no pose.
+  void integrate(FrameResult& result);
+
+  struct RunStats {
+    std::size_t frames_done = 0;
+    double wall_s = 0;
+    bool interrupted = false;  ///< stopped by the stop flag before the last frame
+  };
+  /// Called on the integration thread after each frame is integrated, in frame order.
+  using FrameCallback = std::function<void(FrameResult&)>;
+
+  /// Runs `frames` of `sequence` through the stages, overlapped. When `stop` becomes true,
+  /// no new frame is loaded and the frames already under way are finished, so the volume
+  /// holds whole frames only. An exception in any stage stops the run and is rethrown.
+  RunStats run(const Sequence& sequence, const std::vector<std::size_t>& frames, const FrameCallback& on_frame,
+               const std::atomic<bool>* stop = nullptr);
+
+  /// The mesh of the volume, re-meshing only the blocks changed since the last call.
+  const TriangleMesh& updateMesh();
+
+  const PipelineConfig& config() const { return config_; }
+  const Calibration& calibration() const { return calibration_; }
+  TsdfVolume& volume() { return *volume_; }
+  const TsdfVolume& volume() const { return *volume_; }
+  const TsdfIntegrator& integrator() const { return *integrator_; }
+
+private:
+  struct Stages;  // the stage objects, which keep their buffers from frame to frame
+
+  Calibration calibration_;
+  PipelineConfig config_;
+  std::unique_ptr<TsdfVolume> volume_;
+  std::unique_ptr<TsdfIntegrator> integrator_;
+  std::unique_ptr<Stages> stages_;
+  MarchingCubes mesher_;
+  TriangleMesh mesh_;
+};
+
+} // namespace msf

@@ -1,0 +1,52 @@
+#pragma once
+#include <msf/fusion/fusion_config.h>
+#include <msf/range_image/depth_interpolator.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+#include <msf/stereo/sgbm_config.h>
+
+#include <iosfwd>
+#include <string>
+
+namespace msf {
+
+/// Section `tsdf_volume`: the grid of the map.
+struct VolumeConfig {
+  double voxel_size_m = 0.1;
+  double truncation_m = 0.3;
+
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the key of a value out of range.
+  void validate() const;
+};
+
+/// Section `pipeline`: how the stages are scheduled and what is kept.
+struct SchedulingConfig {
+  int queue_capacity = 2;        ///< frames waiting between two stages
+  int mesh_every_n_frames = 0;   ///< > 0: refresh the mesh incrementally every n frames
+  void read(const cv::FileNode& node);
+  void validate() const;
+};
+
+/// Every stage's configuration, read from one YAML file (config/kitti.yaml), one section
+/// per stage, with the defaults of each stage's own Config where a key is absent.
+struct PipelineConfig {
+  ProjectionConfig projection;              ///< `projection`
+  InterpolationConfig interpolation;        ///< `interpolation`
+  SgbmConfig stereo;                        ///< `stereo`
+  DepthFusionConfig fusion;                 ///< `fusion`
+  VolumeConfig volume;                      ///< `tsdf_volume`
+  TsdfIntegrator::Config integrator;        ///< `tsdf_integrator`
+  MarchingCubes::Config mesher;             ///< `marching_cubes`
+  SchedulingConfig scheduling;              ///< `pipeline`
+
+  /// Defaults overridden by the sections present in `path` ("" = all defaults).
+  /// Throws IOError for a missing file, ConfigError naming a bad key.
+  static PipelineConfig load(const std::string& path);
+  /// Throws ConfigError naming the first invalid key of any stage.
+  void validate() const;
+  void print(std::ostream& out) const;
+};
+
+} // namespace msf

@@ -1,0 +1,61 @@
+#pragma once
+#include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/mesh_accuracy.h>
+#include <msf/pipeline/pipeline.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+/// What msf_reconstruct tells at the end of a run: per-frame stage times, the map's size,
+/// and, where ground truth exists, the depth and mesh errors. Writes summary.json,
+/// frames.csv, runtime.png (the paper's Figs. 7-8: milliseconds per stage per frame) and
+/// report.md, each atomically.
+class RunReport {
+public:
+  struct FrameRow {
+    std::size_t index = 0;
+    std::string name;
+    StageTimes times;
+    double latency_ms = 0;  ///< from the start of its loading to the end of its integration
+  };
+
+  /// Depth errors of one method over all frames: every pixel with ground truth, and the
+  /// KITTI devkit's split into background and foreground when an object map exists.
+  struct DepthScores {
+    DepthMetrics all, background, foreground;
+    bool has_split = false;
+  };
+
+  std::string dataset;            ///< folder reconstructed
+  std::string layout;             ///< odometry, raw or synthetic
+  std::size_t frames_requested = 0;
+  bool interrupted = false;
+  double wall_s = 0;
+  double mesh_ms = 0;
+  double peak_memory_mb = 0;
+  std::size_t observed_voxels = 0, blocks = 0, vertices = 0, triangles = 0;
+  double volume_memory_mb = 0;
+  double voxel_size_m = 0;
+  double lambda = 0;
+  std::vector<FrameRow> frames;
+  std::map<std::string, DepthScores> depth;  ///< by method: sgbm, interpolated, fused
+  bool has_mesh_accuracy = false;
+  MeshAccuracy mesh_accuracy;
+  std::vector<std::string> depth_panels;      ///< file names of the depth panels written
+  std::string mesh_file = "mesh.ply", volume_file = "volume.pcd", preview_file;
+
+  double framesPerSecond() const;
+
+  void writeFramesCsv(const std::string& path) const;
+  void writeSummaryJson(const std::string& path) const;
+  void writeRuntimePlot(const std::string& path) const;
+  void writeMarkdown(const std::string& path) const;
+};
+
+/// Peak resident memory of this process so far, in MiB (getrusage).
+double peakMemoryMb();
+
+} // namespace msf

@@ -1,0 +1,189 @@
+#include <msf/common/exceptions.h>
+#include <msf/fusion/depth_fusion.h>
+#include <msf/pipeline/bounded_queue.h>
+#include <msf/pipeline/pipeline.h>
+#include <msf/reconstruction/impl/depth_frame.hpp> // toDepthFrame for the fused point type
+#include <msf/range_image/compound_interpolation.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/io/pinhole_camera.h>
+#include <msf/stereo/sgbm_stereo.h>
+
+#include <chrono>
+#include <exception>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+namespace msf {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+} // namespace
+
+/// The stage objects of steps 1-4, configured once; they keep their work buffers.
+struct Pipeline::Stages {
+  LidarProjector projector;
+  CompoundInterpolation<PointXYZID> interpolation;
+  SgbmStereo stereo;
+  DepthFusion<> fusion;
+};
+
+Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
+    : calibration_(calibration), config_(config), stages_(std::make_unique<Stages>()), mesher_(config.mesher) {
+  config_.validate();
+  calibration_.requireImageSize();
+  volume_ = std::make_unique<TsdfVolume>(config_.volume.voxel_size_m, config_.volume.truncation_m);
+  integrator_ = std::make_unique<TsdfIntegrator>(*volume_, config_.integrator);
+
+  stages_->projector.setCalibration(calibration_);
+  stages_->projector.setConfig(config_.projection);
+  stages_->interpolation.setConfig(config_.interpolation);
+  stages_->interpolation.setCamera(PinholeCamera::fromCalibration(calibration_, config_.projection.camera));
+  stages_->stereo.setConfig(config_.stereo);
+  stages_->stereo.setCalibration(calibration_);
+  stages_->fusion.setConfig(config_.fusion);
+  stages_->fusion.setCalibration(calibration_);
+}
+
+Pipeline::~Pipeline() = default;
+
+FrameResult Pipeline::computeDepth(const Frame& frame) {
+  FrameResult result;
+  result.index = frame.index;
+  result.has_pose = frame.has_pose;
+  result.T_world_cam0 = frame.T_world_cam0;
+  result.left = frame.left;
+  result.lidar_sparse.reset(new pcl::PointCloud<PointXYZID>);
+  result.lidar.reset(new pcl::PointCloud<PointXYZID>);
+  result.stereo.reset(new pcl::PointCloud<PointXYZRGBConfidence>);
+  result.fused.reset(new pcl::PointCloud<PointXYZRGBWeight>);
+
+  const auto depth_start = Clock::now();
+  // Steps 1-2 on their own thread while SGBM (step 3) runs here: they share no state.
+  auto lidar = std::async(std::launch::async, [&] {
+    const auto start = Clock::now();
+    stages_->projector.project(*frame.scan, *result.lidar_sparse);
+    stages_->interpolation.setInputCloud(result.lidar_sparse);
+    stages_->interpolation.filter(*result.lidar);
+    return msSince(start);
+  });
+  const auto stereo_start = Clock::now();
+  try {
+    stages_->stereo.setInputImages(frame.left, frame.right);
+    stages_->stereo.setInputColor(frame.color);
+    stages_->stereo.compute(*result.stereo);
+  } catch (...) {
+    lidar.wait(); // never leave the other thread writing into `result`
+    throw;
+  }
+  result.times.stereo_ms = msSince(stereo_start);
+  result.times.lidar_ms = lidar.get();
+  result.times.depth_ms = msSince(depth_start);
+
+  const auto fusion_start = Clock::now();
+  stages_->fusion.setInputLidar(result.lidar);
+  stages_->fusion.setInputStereo(result.stereo);
+  stages_->fusion.fuse(*result.fused);
+  result.times.fusion_ms = msSince(fusion_start);
+  return result;
+}
+
+void Pipeline::integrate(FrameResult& result) {
+  if (!result.has_pose)
+    throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
+                            " has no pose: integration needs the sequence's poses");
+  const auto start = Clock::now();
+  const PinholeCamera camera = PinholeCamera::fromCalibration(calibration_, config_.projection.camera);
+  integrator_->integrate(*result.fused, result.T_world_cam0, &camera);
+  result.times.integrate_ms = msSince(start);
+}
+
+Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std::size_t>& frames,
+                                 const FrameCallback& on_frame, const std::atomic<bool>* stop) {
+  struct Loaded {
+    Frame frame;
+    double load_ms;
+  };
+  const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
+  BoundedQueue<Loaded> loaded(capacity);
+  BoundedQueue<FrameResult> depths(capacity);
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto fail = [&](std::exception_ptr e) {
+    {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure)
+        failure = e;
+    }
+    loaded.close();
+    depths.close();
+  };
+  std::atomic<bool> interrupted{false};
+
+  const auto run_start = Clock::now();
+  std::thread loader([&] {
+    try {
+      for (std::size_t i : frames) {
+        if (stop && stop->load()) {
+          interrupted = true;
+          break;
+        }
+        const auto start = Clock::now();
+        Loaded item{sequence.load(i), 0.0};
+        item.load_ms = msSince(start);
+        if (!loaded.push(std::move(item)))
+          break;
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+    loaded.close();
+  });
+  std::thread depth([&] {
+    try {
+      while (auto item = loaded.pop()) {
+        FrameResult result = computeDepth(item->frame);
+        result.name = sequence.frameName(item->frame.index);
+        result.times.load_ms = item->load_ms;
+        if (!depths.push(std::move(result)))
+          break;
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+    depths.close();
+  });
+
+  RunStats stats;
+  try {
+    while (auto result = depths.pop()) {
+      integrate(*result);
+      if (config_.scheduling.mesh_every_n_frames > 0 &&
+          (stats.frames_done + 1) % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
+        updateMesh();
+      ++stats.frames_done;
+      if (on_frame)
+        on_frame(*result);
+    }
+  } catch (...) {
+    fail(std::current_exception());
+  }
+  loader.join();
+  depth.join();
+  if (failure)
+    std::rethrow_exception(failure);
+  stats.wall_s = msSince(run_start) / 1000.0;
+  stats.interrupted = interrupted;
+  return stats;
+}
+
+const TriangleMesh& Pipeline::updateMesh() {
+  mesher_.extract(*volume_, mesh_);
+  return mesh_;
+}
+
+} // namespace msf

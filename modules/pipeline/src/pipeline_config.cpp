@@ -1,0 +1,73 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/pipeline/pipeline_config.h>
+
+#include <cmath>
+#include <ostream>
+
+namespace msf {
+
+void VolumeConfig::read(const cv::FileNode& node) {
+  readKey(node, "voxel_size_m", voxel_size_m);
+  readKey(node, "truncation_m", truncation_m);
+  validate();
+}
+
+void VolumeConfig::validate() const {
+  if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
+    throw ConfigError("tsdf_volume.voxel_size_m must be > 0, got " + std::to_string(voxel_size_m));
+  if (!(truncation_m > 0.0) || !std::isfinite(truncation_m))
+    throw ConfigError("tsdf_volume.truncation_m must be > 0, got " + std::to_string(truncation_m));
+}
+
+void SchedulingConfig::read(const cv::FileNode& node) {
+  readKey(node, "queue_capacity", queue_capacity);
+  readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
+  validate();
+}
+
+void SchedulingConfig::validate() const {
+  if (queue_capacity < 1)
+    throw ConfigError("pipeline.queue_capacity must be >= 1, got " + std::to_string(queue_capacity));
+  if (mesh_every_n_frames < 0)
+    throw ConfigError("pipeline.mesh_every_n_frames must be >= 0, got " + std::to_string(mesh_every_n_frames));
+}
+
+PipelineConfig PipelineConfig::load(const std::string& path) {
+  PipelineConfig config;
+  if (path.empty())
+    return config;
+  const ConfigFile file(path);
+  config.projection.read(file.section("projection"));
+  config.interpolation.read(file.section("interpolation"));
+  config.stereo.read(file.section("stereo"));
+  config.fusion.read(file.section("fusion"));
+  config.volume.read(file.section("tsdf_volume"));
+  config.integrator.read(file.section("tsdf_integrator"));
+  config.mesher.read(file.section("marching_cubes"));
+  config.scheduling.read(file.section("pipeline"));
+  config.validate();
+  return config;
+}
+
+void PipelineConfig::validate() const {
+  projection.validate();
+  interpolation.validate();
+  stereo.validate();
+  fusion.validate();
+  volume.validate();
+  integrator.validate();
+  scheduling.validate();
+}
+
+void PipelineConfig::print(std::ostream& out) const {
+  out << "tsdf_volume: voxel_size_m " << volume.voxel_size_m << ", truncation_m " << volume.truncation_m << "\n";
+  stereo.print(out);
+  fusion.print(out);
+  integrator.print(out);
+  mesher.print(out);
+  out << "pipeline: queue_capacity " << scheduling.queue_capacity << ", mesh_every_n_frames "
+      << scheduling.mesh_every_n_frames << "\n";
+}
+
+} // namespace msf

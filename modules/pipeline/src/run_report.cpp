@@ -1,0 +1,247 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/line_plot.h>
+#include <msf/common/statistics.h>
+#include <msf/io/image_io.h>
+#include <msf/pipeline/run_report.h>
+
+#include <sys/resource.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <sstream>
+
+namespace msf {
+
+namespace {
+
+/// The stages reported, with how to read each from a frame row.
+struct StageColumn {
+  const char* name;
+  std::function<double(const RunReport::FrameRow&)> get;
+};
+const std::vector<StageColumn>& stageColumns() {
+  static const std::vector<StageColumn> columns = {
+      {"load", [](const RunReport::FrameRow& r) { return r.times.load_ms; }},
+      {"lidar", [](const RunReport::FrameRow& r) { return r.times.lidar_ms; }},
+      {"stereo", [](const RunReport::FrameRow& r) { return r.times.stereo_ms; }},
+      {"depth", [](const RunReport::FrameRow& r) { return r.times.depth_ms; }},
+      {"fusion", [](const RunReport::FrameRow& r) { return r.times.fusion_ms; }},
+      {"integrate", [](const RunReport::FrameRow& r) { return r.times.integrate_ms; }},
+      {"latency", [](const RunReport::FrameRow& r) { return r.latency_ms; }},
+  };
+  return columns;
+}
+
+std::vector<double> column(const std::vector<RunReport::FrameRow>& rows, const StageColumn& c) {
+  std::vector<double> values;
+  values.reserve(rows.size());
+  for (const auto& r : rows)
+    values.push_back(c.get(r));
+  return values;
+}
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\')
+      out += '\\', out += c;
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else
+      out += c;
+  }
+  return out + "\"";
+}
+
+std::string num(double v, int precision = 4) {
+  if (!std::isfinite(v))
+    return "null";
+  std::ostringstream s;
+  s << std::setprecision(precision) << std::fixed << v;
+  std::string text = s.str();
+  text.erase(text.find_last_not_of('0') + 1);
+  if (text.back() == '.')
+    text.pop_back();
+  return text;
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out)
+      throw IOError("cannot write '" + path + "'");
+  });
+}
+
+std::string metricsJson(const DepthMetrics& m, const std::string& indent) {
+  std::ostringstream s;
+  s << "{\n"
+    << indent << "  \"gt_pixels\": " << m.gt_pixels << ",\n"
+    << indent << "  \"coverage\": " << num(m.coverage) << ",\n"
+    << indent << "  \"d1_all\": " << num(m.d1_all) << ",\n"
+    << indent << "  \"d1_estimated\": " << num(m.d1_estimated) << ",\n"
+    << indent << "  \"disparity_mae_px\": " << num(m.disparity_mae_px) << ",\n"
+    << indent << "  \"mae_m\": " << num(m.mae_m) << ",\n"
+    << indent << "  \"rmse_m\": " << num(m.rmse_m) << "\n"
+    << indent << "}";
+  return s.str();
+}
+
+} // namespace
+
+double peakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB on Linux
+}
+
+double RunReport::framesPerSecond() const {
+  return wall_s > 0 ? static_cast<double>(frames.size()) / wall_s : 0.0;
+}
+
+void RunReport::writeFramesCsv(const std::string& path) const {
+  std::ostringstream s;
+  s << "frame,name";
+  for (const auto& c : stageColumns())
+    s << "," << c.name << "_ms";
+  s << "\n";
+  for (const auto& r : frames) {
+    s << r.index << "," << r.name;
+    for (const auto& c : stageColumns())
+      s << "," << num(c.get(r), 3);
+    s << "\n";
+  }
+  writeText(path, s.str());
+}
+
+void RunReport::writeSummaryJson(const std::string& path) const {
+  std::ostringstream s;
+  s << "{\n"
+    << "  \"dataset\": " << jsonString(dataset) << ",\n"
+    << "  \"layout\": " << jsonString(layout) << ",\n"
+    << "  \"frames\": " << frames.size() << ",\n"
+    << "  \"frames_requested\": " << frames_requested << ",\n"
+    << "  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n"
+    << "  \"wall_s\": " << num(wall_s, 3) << ",\n"
+    << "  \"frames_per_second\": " << num(framesPerSecond(), 3) << ",\n"
+    << "  \"peak_memory_mb\": " << num(peakMemoryMb() > peak_memory_mb ? peakMemoryMb() : peak_memory_mb, 1)
+    << ",\n"
+    << "  \"stage_ms\": {\n";
+  const auto& columns = stageColumns();
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const auto values = column(frames, columns[k]);
+    s << "    \"" << columns[k].name << "\": {\"median\": " << num(median(values), 3)
+      << ", \"p95\": " << num(percentile(values, 95), 3) << "}" << (k + 1 < columns.size() ? "," : "") << "\n";
+  }
+  s << "  },\n"
+    << "  \"mesh_ms\": " << num(mesh_ms, 3) << ",\n"
+    << "  \"map\": {\"voxel_size_m\": " << num(voxel_size_m) << ", \"lambda\": " << num(lambda)
+    << ", \"observed_voxels\": " << observed_voxels << ", \"blocks\": " << blocks
+    << ", \"memory_mb\": " << num(volume_memory_mb, 1) << ", \"vertices\": " << vertices
+    << ", \"triangles\": " << triangles << "},\n";
+  s << "  \"depth\": {";
+  std::size_t k = 0;
+  for (const auto& [method, scores] : depth) {
+    s << (k++ ? "," : "") << "\n    " << jsonString(method) << ": {\n      \"all\": " << metricsJson(scores.all, "      ");
+    if (scores.has_split)
+      s << ",\n      \"background\": " << metricsJson(scores.background, "      ")
+        << ",\n      \"foreground\": " << metricsJson(scores.foreground, "      ");
+    s << "\n    }";
+  }
+  s << (depth.empty() ? "" : "\n  ") << "},\n";
+  s << "  \"mesh_accuracy\": ";
+  if (has_mesh_accuracy) {
+    const auto& m = mesh_accuracy;
+    s << "{\"accuracy_mean_m\": " << num(m.accuracy_mean_m) << ", \"accuracy_median_m\": "
+      << num(m.accuracy_median_m) << ", \"precision\": " << num(m.precision) << ", \"completeness\": "
+      << num(m.completeness) << ", \"threshold_m\": " << num(m.threshold_m) << ", \"cap_m\": " << num(m.cap_m)
+      << ", \"mesh_vertices\": " << m.vertices << ", \"truth_samples\": " << m.truth_samples << "}\n";
+  } else {
+    s << "null\n";
+  }
+  s << "}\n";
+  writeText(path, s.str());
+}
+
+void RunReport::writeRuntimePlot(const std::string& path) const {
+  LinePlot plot("Run time per frame (" + std::to_string(frames.size()) + " frames, " + num(framesPerSecond(), 1) +
+                    " fps end to end)",
+                "frame", "milliseconds");
+  std::vector<double> x;
+  for (const auto& r : frames)
+    x.push_back(static_cast<double>(r.index));
+  for (const auto& c : stageColumns())
+    if (std::string(c.name) != "depth")
+      plot.addSeries(c.name, x, column(frames, c));
+  plot.addReferenceLine(100.0, "100 ms = 10 Hz");
+  writeImage(path, plot.render(1000, 520));
+}
+
+void RunReport::writeMarkdown(const std::string& path) const {
+  std::ostringstream s;
+  s << "# msfusion reconstruction\n\n"
+    << "Dataset `" << dataset << "` (" << layout << "), " << frames.size() << " of " << frames_requested
+    << " frames" << (interrupted ? " (interrupted: the map holds the frames integrated before the stop)" : "")
+    << ". Voxel " << num(voxel_size_m) << " m, lambda " << num(lambda) << ".\n\n"
+    << "## Speed\n\n"
+    << num(framesPerSecond(), 2) << " frames per second end to end (" << num(wall_s, 2)
+    << " s), peak memory " << num(std::max(peak_memory_mb, peakMemoryMb()), 0) << " MiB, mesh extraction "
+    << num(mesh_ms, 1) << " ms.\n\n"
+    << "| stage | median ms | p95 ms |\n|---|---|---|\n";
+  for (const auto& c : stageColumns()) {
+    const auto values = column(frames, c);
+    s << "| " << c.name << " | " << num(median(values), 1) << " | " << num(percentile(values, 95), 1) << " |\n";
+  }
+  s << "\nLiDAR and stereo run at the same time (`depth` is their wall time); loading, depth and "
+       "integration of successive frames overlap, so frames per second exceed 1000 / latency.\n\n"
+    << "![run time per frame](runtime.png)\n\n"
+    << "## Map\n\n"
+    << observed_voxels << " observed voxels in " << blocks << " blocks (" << num(volume_memory_mb, 1) << " MiB); mesh "
+    << vertices << " vertices, " << triangles << " triangles: [`" << mesh_file << "`](" << mesh_file << "), volume [`"
+    << volume_file << "`](" << volume_file << ").\n\n";
+  if (!preview_file.empty())
+    s << "![mesh from above and from the first camera](" << preview_file << ")\n\n";
+  if (!depth.empty()) {
+    s << "## Depth against ground truth\n\n"
+      << "| method | pixels | coverage | D1 (missing = bad) | D1 on estimates | disparity MAE px | depth MAE m | "
+         "depth RMSE m |\n|---|---|---|---|---|---|---|---|\n";
+    auto row = [&](const std::string& name, const DepthMetrics& m) {
+      s << "| " << name << " | " << m.gt_pixels << " | " << num(m.coverage, 3) << " | " << num(100 * m.d1_all, 2)
+        << " % | " << num(100 * m.d1_estimated, 2) << " % | " << num(m.disparity_mae_px, 2) << " | "
+        << num(m.mae_m, 3) << " | " << num(m.rmse_m, 3) << " |\n";
+    };
+    for (const auto& [method, scores] : depth) {
+      row(method, scores.all);
+      if (scores.has_split) {
+        row(method + " (background)", scores.background);
+        row(method + " (foreground)", scores.foreground);
+      }
+    }
+    s << "\n";
+  }
+  if (has_mesh_accuracy) {
+    const auto& m = mesh_accuracy;
+    s << "## Mesh against the true surface\n\n"
+      << "Accuracy (mean distance of " << m.vertices << " mesh vertices to the true surface, capped at "
+      << num(m.cap_m) << " m): " << num(m.accuracy_mean_m, 3) << " m (median " << num(m.accuracy_median_m, 3)
+      << " m); " << num(100 * m.precision, 1) << " % of vertices within " << num(m.threshold_m) << " m.\n"
+      << "Completeness (share of " << m.truth_samples << " samples of the seen true surface within "
+      << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n\n";
+  }
+  if (!depth_panels.empty()) {
+    s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
+         " (and the fused depth's error where ground truth exists).\n\n";
+    for (const auto& panel : depth_panels)
+      s << "![" << panel << "](" << panel << ")\n\n";
+  }
+  s << "Per-frame times: [`frames.csv`](frames.csv); all figures: [`summary.json`](summary.json).\n";
+  writeText(path, s.str());
+}
+
+} // namespace msf
