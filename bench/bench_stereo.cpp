@@ -1,0 +1,86 @@
+// SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads):
+// the DESIGN.md baseline (3-way, 128 disparities, block 5), the same narrowed by the
+// interpolated LiDAR depth (stereo.prior_search_range), and with the explicit left-right
+// check. Times are of SgbmStereo::computeDisparity (matching, conversion, confidence).
+//
+//   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
+//   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
+#include <msf/io/sequence.h>
+#include <msf/range_image/depth_interpolator.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/stereo/sgbm_stereo.h>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+namespace {
+
+std::string kittiDir() {
+  const char* env = std::getenv("MSF_KITTI_DIR");
+  return env ? env : MSF_KITTI_DIR;
+}
+
+/// The grey pairs and the interpolated LiDAR depth (all rings) of frames 0-9.
+struct Data {
+  msf::Calibration calibration;
+  std::vector<cv::Mat> left, right, prior;
+  Data() {
+    const msf::Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    calibration = sequence.calibration();
+    msf::LidarProjector projector(calibration);
+    msf::DepthInterpolator interpolator;
+    for (std::size_t i = 0; i < 10 && i < sequence.size(); ++i) {
+      const msf::Frame f = sequence.load(i, false);
+      left.push_back(f.left);
+      right.push_back(f.right);
+      cv::Mat sparse, dense;
+      projector.projectToImage(*f.scan, sparse);
+      interpolator.interpolate(sparse, dense);
+      prior.push_back(dense);
+    }
+  }
+};
+
+const Data& data() {
+  static const Data d;
+  return d;
+}
+
+void run(benchmark::State& state, const msf::SgbmConfig& config, bool with_prior) {
+  const Data& d = data();
+  msf::SgbmStereo stereo(config);
+  stereo.setCalibration(d.calibration);
+  std::size_t i = 0, valid = 0, pixels = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.left.size();
+    stereo.setInputImages(d.left[f], d.right[f]);
+    stereo.setDepthPrior(with_prior ? d.prior[f] : cv::Mat());
+    stereo.computeDisparity();
+    valid += static_cast<std::size_t>(cv::countNonZero(stereo.getDisparity() > 0.f));
+    pixels += stereo.getDisparity().total();
+  }
+  state.counters["disparities"] = stereo.getSearchedDisparities();
+  state.counters["valid_share"] = pixels ? static_cast<double>(valid) / pixels : 0.0;
+}
+
+void BM_Sgbm3Way128(benchmark::State& state) { run(state, msf::SgbmConfig{}, false); }
+
+void BM_Sgbm3WayLidarRange(benchmark::State& state) { run(state, msf::SgbmConfig{}, true); }
+
+void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state) {
+  msf::SgbmConfig config;
+  config.left_right_check = true;
+  run(state, config, true);
+}
+
+} // namespace
+
+BENCHMARK(BM_Sgbm3Way128)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK(BM_Sgbm3WayLidarRange)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK(BM_Sgbm3WayLidarRangeLrCheck)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+
+BENCHMARK_MAIN();

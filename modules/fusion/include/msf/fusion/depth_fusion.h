@@ -1,0 +1,89 @@
+#pragma once
+#include <msf/fusion/fusion_config.h>
+#include <msf/fusion/point_types.h>
+#include <msf/io/calibration.h>
+#include <msf/range_image/point_types.h>
+#include <msf/stereo/point_types.h>
+
+#include <opencv2/core/mat.hpp>
+#include <pcl/point_cloud.h>
+
+namespace msf {
+
+/// Paper step 4: per-pixel fusion of two organized depth clouds of one camera, the
+/// interpolated LiDAR and the stereo depth, into one organized cloud of the same size, in
+/// the shape of PCL's two-input classes (pcl::Registration's setInputSource/Target):
+///
+///   msf::DepthFusion<> fusion;                       // PointXYZID + PointXYZRGBConfidence
+///   fusion.setCalibration(calibration);              // f B of the grey pair
+///   fusion.setInputLidar(interpolated);              // CompoundInterpolation's output
+///   fusion.setInputStereo(stereo);                   // SgbmStereo's output
+///   pcl::PointCloud<msf::PointXYZRGBWeight> fused;
+///   fusion.fuse(fused);
+///
+/// Each pixel is fused by fusePixel (fusion_model.h: eq. 6 or inverse-variance). The LiDAR
+/// type's `distance` field (pixels to the nearest real return) and the stereo type's
+/// `confidence` feed the weights; a type without them counts as real returns (distance 0)
+/// and as fully confident matches. A fused point lies on the ray of its input point
+/// (stereo's where it has one), so no intrinsics are needed; colour comes from the stereo
+/// point, or from the colour image by projection when setInputColor was given; `weight`
+/// is the fused weight. Pixels without depth in both inputs are NaN, and then the cloud is
+/// not dense. The header (frame id, stamp) is the stereo cloud's.
+template <typename PointLidarT = PointXYZID, typename PointStereoT = PointXYZRGBConfidence,
+          typename PointOutT = PointXYZRGBWeight>
+class DepthFusion {
+public:
+  using PointCloudLidar = pcl::PointCloud<PointLidarT>;
+  using PointCloudLidarConstPtr = typename PointCloudLidar::ConstPtr;
+  using PointCloudStereo = pcl::PointCloud<PointStereoT>;
+  using PointCloudStereoConstPtr = typename PointCloudStereo::ConstPtr;
+  using PointCloudOut = pcl::PointCloud<PointOutT>;
+
+  DepthFusion() = default;
+  explicit DepthFusion(const DepthFusionConfig& config) { setConfig(config); }
+
+  /// Throws ConfigError naming the key of a value out of range.
+  void setConfig(const DepthFusionConfig& config) {
+    config.validate();
+    config_ = config;
+  }
+  const DepthFusionConfig& getConfig() const { return config_; }
+  void setMethod(FusionMethod method) { config_.method = method; }
+  FusionMethod getMethod() const { return config_.method; }
+
+  /// Gives f B for the disparity domain, and the colour camera's projection.
+  void setCalibration(const Calibration& calibration);
+  const Calibration& getCalibration() const { return calibration_; }
+
+  void setInputLidar(const PointCloudLidarConstPtr& cloud) { lidar_ = cloud; }
+  const PointCloudLidarConstPtr& getInputLidar() const { return lidar_; }
+  void setInputStereo(const PointCloudStereoConstPtr& cloud) { stereo_ = cloud; }
+  const PointCloudStereoConstPtr& getInputStereo() const { return stereo_; }
+
+  /// Optional image of the colour camera (BGR) to colour every fused point by projection,
+  /// also where only the LiDAR has depth. Empty: colour from the stereo points.
+  void setInputColor(const cv::Mat& image) { color_ = image; }
+  void setColorCamera(int camera) { color_camera_ = camera; }
+  int getColorCamera() const { return color_camera_; }
+
+  /// Fuses the inputs into `output` (resized to their width x height).
+  /// Throws InvalidInputError naming the input that is missing, not organized, or of
+  /// another size than the other; CalibrationError when no calibration was set.
+  void fuse(PointCloudOut& output);
+
+private:
+  DepthFusionConfig config_;
+  Calibration calibration_;
+  bool has_calibration_{false};
+  PointCloudLidarConstPtr lidar_;
+  PointCloudStereoConstPtr stereo_;
+  cv::Mat color_;
+  int color_camera_{2};
+  cv::Mat lidar_depth_, lidar_range_; ///< work buffers, kept between frames
+};
+
+} // namespace msf
+
+#ifdef MSF_NO_PRECOMPILE
+#include <msf/fusion/impl/depth_fusion.hpp>
+#endif

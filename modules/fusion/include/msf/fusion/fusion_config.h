@@ -1,0 +1,49 @@
+#pragma once
+#include <opencv2/core/persistence.hpp>
+
+#include <iosfwd>
+#include <string>
+
+namespace msf {
+
+/// How DepthFusion merges the two samples of a pixel (see fusion_model.h).
+enum class FusionMethod {
+  Paper,       ///< the paper's eq. 6 with dynamic weights
+  Uncertainty  ///< inverse-variance fusion with a k-sigma disagreement test
+};
+
+/// "paper" or "uncertainty"; throws ConfigError naming the text otherwise.
+FusionMethod parseFusionMethod(const std::string& name);
+const char* toString(FusionMethod method);
+
+/// Every parameter of DepthFusion, read from the `fusion` section of a config file.
+/// The defaults were measured on KITTI odometry 04 frames 0-9 under DESIGN.md protocol 2
+/// (msf_holdout; the README has the table).
+struct DepthFusionConfig {
+  FusionMethod method = FusionMethod::Uncertainty;
+
+  // --- paper (eq. 6): w2 = w_L / w_S, see fusion_model.h
+  float paper_lidar_gain = 1.f;               ///< w_L on a real return
+  float paper_lidar_distance_px = 4.f;        ///< w_L halves this far from the nearest real return
+  float paper_stereo_reference_depth_m = 10.f;///< w_S = confidence where z_stereo <= this, falls as 1/z^2 beyond
+  float paper_min_stereo_confidence = 0.05f;  ///< floor of the confidence in w_S
+
+  // --- uncertainty: sigmas of the disparity d = f B / z, in pixels
+  float stereo_sigma_min_px = 0.3f;           ///< sigma of a stereo disparity of confidence 1
+  float stereo_sigma_max_px = 4.f;            ///< ... of confidence 0 (quadratic in 1 - confidence between)
+  float lidar_sigma_px = 0.3f;                ///< sigma of the LiDAR on a smooth surface at a real return
+  float lidar_sigma_per_distance = 0.05f;     ///< growth per pixel of distance to the nearest real return
+  float lidar_sigma_per_range = 0.7f;         ///< growth per pixel of local disparity range (an edge)
+  float disagreement_k_sigma = 3.f;           ///< beyond k sigma the more certain sample wins alone
+  int lidar_range_window_px = 5;              ///< odd window of the LiDAR's local disparity range
+  bool parallax_check = true;                 ///< stereo wins where the LiDAR saw past a foreground edge
+  int parallax_max_rows = 16;                 ///< rows below a pixel searched for that foreground
+
+  /// Overrides the keys present in `node` (the `fusion` section), then validates.
+  void read(const cv::FileNode& node);
+  /// Throws ConfigError naming the key of the first value out of range.
+  void validate() const;
+  void print(std::ostream& out) const;
+};
+
+} // namespace msf

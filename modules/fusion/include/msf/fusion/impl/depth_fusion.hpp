@@ -1,0 +1,115 @@
+#pragma once
+#include <msf/common/exceptions.h>
+#include <msf/fusion/depth_fusion.h>
+#include <msf/fusion/fusion_model.h>
+#include <msf/stereo/color_sampler.h>
+#include <msf/stereo/point_field_traits.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace msf {
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::setCalibration(const Calibration& calibration) {
+  if (!(calibration.focalBaseline() > 0.0))
+    throw CalibrationError("calibration '" + calibration.source +
+                           "': the grey pair has no baseline (P1 must hold -f B in its last column)");
+  calibration_ = calibration;
+  has_calibration_ = true;
+}
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& output) {
+  const auto size = [](const auto& cloud) { return std::to_string(cloud.width) + "x" + std::to_string(cloud.height); };
+  if (!lidar_ || lidar_->empty())
+    throw InvalidInputError("DepthFusion: the LiDAR cloud is missing or empty (setInputLidar)");
+  if (!stereo_ || stereo_->empty())
+    throw InvalidInputError("DepthFusion: the stereo cloud is missing or empty (setInputStereo)");
+  if (!lidar_->isOrganized())
+    throw InvalidInputError("DepthFusion: the LiDAR cloud is not organized (" + size(*lidar_) + ")");
+  if (!stereo_->isOrganized())
+    throw InvalidInputError("DepthFusion: the stereo cloud is not organized (" + size(*stereo_) + ")");
+  if (lidar_->width != stereo_->width || lidar_->height != stereo_->height)
+    throw InvalidInputError("DepthFusion: the LiDAR cloud is " + size(*lidar_) + " but the stereo cloud is " +
+                            size(*stereo_));
+  if (!has_calibration_)
+    throw CalibrationError("DepthFusion: no calibration set (setCalibration)");
+
+  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
+  const float fB = static_cast<float>(calibration_.focalBaseline());
+  lidar_depth_.create(rows, cols, CV_32FC1);
+  for (int v = 0; v < rows; ++v) {
+    const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
+    float* z = lidar_depth_.ptr<float>(v);
+    for (int u = 0; u < cols; ++u)
+      z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
+  }
+  if (config_.method == FusionMethod::Uncertainty)
+    localDisparityRange(lidar_depth_, fB, config_.lidar_range_window_px, lidar_range_);
+
+  const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const DepthFusionConfig config = config_;
+  const LidarParallax parallax = lidarParallax(calibration_, config);
+  const cv::Mat& lidar_depth = lidar_depth_;
+  output.resize(static_cast<std::size_t>(rows) * cols);
+  output.width = static_cast<std::uint32_t>(cols);
+  output.height = static_cast<std::uint32_t>(rows);
+  output.header = stereo_->header;
+  output.sensor_origin_ = stereo_->sensor_origin_;
+  output.sensor_orientation_ = stereo_->sensor_orientation_;
+  bool dense = true;
+#pragma omp parallel for reduction(&& : dense)
+  for (int v = 0; v < rows; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * cols;
+    const float* z_lidar = lidar_depth_.ptr<float>(v);
+    const float* range = config.method == FusionMethod::Uncertainty ? lidar_range_.ptr<float>(v) : nullptr;
+    for (int u = 0; u < cols; ++u) {
+      const PointLidarT& l = (*lidar_)[row + u];
+      const PointStereoT& s = (*stereo_)[row + u];
+      PointOutT& p = output[row + u];
+      FusionInputs in;
+      in.z_lidar = z_lidar[u];
+      if constexpr (detail::has_distance_v<PointLidarT>)
+        in.lidar_distance = l.distance;
+      in.lidar_range_px = range ? range[u] : 0.f;
+      in.z_stereo = detail::validDepth(s.z) ? s.z : 0.f;
+      if constexpr (detail::has_confidence_v<PointStereoT>)
+        in.stereo_confidence = s.confidence;
+      const FusionResult f = fusePixel(in, config, fB, parallax, [&](int k) {
+        return v + k < rows ? lidar_depth.ptr<float>(v + k)[u] : 0.f;
+      });
+      if (f.z > 0.f) {
+        // On the ray of the input point: stereo's lies on the pixel's ray, the LiDAR's
+        // within half a pixel of it.
+        const bool from_stereo = in.z_stereo > 0.f;
+        const float scale = f.z / (from_stereo ? s.z : l.z);
+        p.x = (from_stereo ? s.x : l.x) * scale;
+        p.y = (from_stereo ? s.y : l.y) * scale;
+        p.z = f.z;
+      } else {
+        p.x = p.y = p.z = nan;
+        dense = false;
+      }
+      if constexpr (detail::has_rgb_v<PointOutT>) {
+        if constexpr (detail::has_rgb_v<PointStereoT>) {
+          p.r = s.r;
+          p.g = s.g;
+          p.b = s.b;
+        } else {
+          p.r = p.g = p.b = 0;
+        }
+        p.a = 255;
+        if (f.z > 0.f)
+          sampler.sample(p.x, p.y, p.z, p.r, p.g, p.b);
+      }
+      if constexpr (detail::has_weight_v<PointOutT>)
+        p.weight = f.weight;
+    }
+  }
+  output.is_dense = dense;
+}
+
+} // namespace msf

@@ -1,0 +1,91 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/fusion/fusion_config.h>
+
+#include <ostream>
+
+namespace msf {
+
+FusionMethod parseFusionMethod(const std::string& name) {
+  if (name == "paper")
+    return FusionMethod::Paper;
+  if (name == "uncertainty")
+    return FusionMethod::Uncertainty;
+  throw ConfigError("fusion method must be paper or uncertainty, not '" + name + "'");
+}
+
+const char* toString(FusionMethod method) { return method == FusionMethod::Paper ? "paper" : "uncertainty"; }
+
+namespace {
+void positive(float value, const char* key) {
+  if (!(value > 0.f))
+    throw ConfigError(std::string("config key 'fusion.") + key + "' must be > 0");
+}
+void nonNegative(float value, const char* key) {
+  if (!(value >= 0.f))
+    throw ConfigError(std::string("config key 'fusion.") + key + "' must be >= 0");
+}
+} // namespace
+
+void DepthFusionConfig::read(const cv::FileNode& node) {
+  std::string method_name = toString(method);
+  readKey(node, "method", method_name);
+  try {
+    method = parseFusionMethod(method_name);
+  } catch (const ConfigError&) {
+    throw ConfigError("config key 'fusion.method' must be paper or uncertainty, not '" + method_name + "'");
+  }
+  readKey(node, "paper_lidar_gain", paper_lidar_gain);
+  readKey(node, "paper_lidar_distance_px", paper_lidar_distance_px);
+  readKey(node, "paper_stereo_reference_depth_m", paper_stereo_reference_depth_m);
+  readKey(node, "paper_min_stereo_confidence", paper_min_stereo_confidence);
+  readKey(node, "stereo_sigma_min_px", stereo_sigma_min_px);
+  readKey(node, "stereo_sigma_max_px", stereo_sigma_max_px);
+  readKey(node, "lidar_sigma_px", lidar_sigma_px);
+  readKey(node, "lidar_sigma_per_distance", lidar_sigma_per_distance);
+  readKey(node, "lidar_sigma_per_range", lidar_sigma_per_range);
+  readKey(node, "disagreement_k_sigma", disagreement_k_sigma);
+  readKey(node, "lidar_range_window_px", lidar_range_window_px);
+  readKey(node, "parallax_check", parallax_check);
+  readKey(node, "parallax_max_rows", parallax_max_rows);
+  validate();
+}
+
+void DepthFusionConfig::validate() const {
+  nonNegative(paper_lidar_gain, "paper_lidar_gain");
+  positive(paper_lidar_distance_px, "paper_lidar_distance_px");
+  positive(paper_stereo_reference_depth_m, "paper_stereo_reference_depth_m");
+  positive(paper_min_stereo_confidence, "paper_min_stereo_confidence");
+  positive(stereo_sigma_min_px, "stereo_sigma_min_px");
+  if (!(stereo_sigma_max_px >= stereo_sigma_min_px))
+    throw ConfigError("config key 'fusion.stereo_sigma_max_px' must be >= stereo_sigma_min_px");
+  positive(lidar_sigma_px, "lidar_sigma_px");
+  nonNegative(lidar_sigma_per_distance, "lidar_sigma_per_distance");
+  nonNegative(lidar_sigma_per_range, "lidar_sigma_per_range");
+  positive(disagreement_k_sigma, "disagreement_k_sigma");
+  if (lidar_range_window_px < 1 || lidar_range_window_px % 2 == 0)
+    throw ConfigError("config key 'fusion.lidar_range_window_px' must be odd and >= 1, not " +
+                      std::to_string(lidar_range_window_px));
+  if (parallax_max_rows < 1)
+    throw ConfigError("config key 'fusion.parallax_max_rows' must be >= 1, not " + std::to_string(parallax_max_rows));
+}
+
+void DepthFusionConfig::print(std::ostream& out) const {
+  out << "fusion:\n"
+      << "  method: " << toString(method) << "\n"
+      << "  paper_lidar_gain: " << paper_lidar_gain << "\n"
+      << "  paper_lidar_distance_px: " << paper_lidar_distance_px << "\n"
+      << "  paper_stereo_reference_depth_m: " << paper_stereo_reference_depth_m << "\n"
+      << "  paper_min_stereo_confidence: " << paper_min_stereo_confidence << "\n"
+      << "  stereo_sigma_min_px: " << stereo_sigma_min_px << "\n"
+      << "  stereo_sigma_max_px: " << stereo_sigma_max_px << "\n"
+      << "  lidar_sigma_px: " << lidar_sigma_px << "\n"
+      << "  lidar_sigma_per_distance: " << lidar_sigma_per_distance << "\n"
+      << "  lidar_sigma_per_range: " << lidar_sigma_per_range << "\n"
+      << "  disagreement_k_sigma: " << disagreement_k_sigma << "\n"
+      << "  lidar_range_window_px: " << lidar_range_window_px << "\n"
+      << "  parallax_check: " << (parallax_check ? "true" : "false") << "\n"
+      << "  parallax_max_rows: " << parallax_max_rows << "\n";
+}
+
+} // namespace msf

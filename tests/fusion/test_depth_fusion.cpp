@@ -1,0 +1,422 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/fusion/depth_fusion.h>
+#include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/fusion_model.h>
+#include <msf/fusion/point_types.h>
+
+#include "test_support.h"
+
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace {
+
+using Fusion = msf::DepthFusion<>;
+using LidarCloud = pcl::PointCloud<msf::PointXYZID>;
+using StereoCloud = pcl::PointCloud<msf::PointXYZRGBConfidence>;
+using FusedCloud = pcl::PointCloud<msf::PointXYZRGBWeight>;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr double kFocal = 500.0, kBaseline = 0.5, kFB = kFocal * kBaseline;
+
+msf::Calibration calibration(int width, int height) {
+  msf::Calibration c;
+  Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
+  P(0, 0) = P(1, 1) = kFocal;
+  P(0, 2) = width / 2.0;
+  P(1, 2) = height / 2.0;
+  P(2, 2) = 1.0;
+  for (auto& p : c.P)
+    p = P;
+  c.P[1](0, 3) = -kFB;
+  c.image_size = cv::Size(width, height);
+  c.T_cam0_velo.translation() = Eigen::Vector3d(0.0, -0.08, -0.3); // LiDAR 8 cm above camera 0
+  c.source = "synthetic";
+  return c;
+}
+
+/// A point on the ray of pixel (u, v) at depth z (NaN when z <= 0).
+template <typename PointT>
+PointT onRay(int u, int v, float z, int width, int height) {
+  PointT p;
+  if (z > 0.f) {
+    p.x = (u - width / 2.f) * z / static_cast<float>(kFocal);
+    p.y = (v - height / 2.f) * z / static_cast<float>(kFocal);
+    p.z = z;
+  } else {
+    p.x = p.y = p.z = kNaN;
+  }
+  return p;
+}
+
+/// Clouds of w x h from per-pixel depths (0 = none), LiDAR distances and stereo confidences.
+struct Inputs {
+  LidarCloud::Ptr lidar{new LidarCloud};
+  StereoCloud::Ptr stereo{new StereoCloud};
+  Inputs(int w, int h) {
+    lidar->resize(static_cast<std::size_t>(w) * h);
+    lidar->width = w;
+    lidar->height = h;
+    stereo->resize(static_cast<std::size_t>(w) * h);
+    stereo->width = w;
+    stereo->height = h;
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        setLidar(u, v, 0.f, 0.f);
+        setStereo(u, v, 0.f, 0.f);
+      }
+  }
+  void setLidar(int u, int v, float z, float distance) {
+    auto p = onRay<msf::PointXYZID>(u, v, z, lidar->width, lidar->height);
+    p.distance = distance;
+    lidar->at(u, v) = p;
+  }
+  void setStereo(int u, int v, float z, float confidence) {
+    auto p = onRay<msf::PointXYZRGBConfidence>(u, v, z, stereo->width, stereo->height);
+    p.confidence = z > 0.f ? confidence : 0.f;
+    p.r = 10;
+    p.g = 20;
+    p.b = 30;
+    stereo->at(u, v) = p;
+  }
+};
+
+FusedCloud fuse(const Inputs& in, const msf::DepthFusionConfig& config) {
+  Fusion fusion(config);
+  fusion.setCalibration(calibration(static_cast<int>(in.stereo->width), static_cast<int>(in.stereo->height)));
+  fusion.setInputLidar(in.lidar);
+  fusion.setInputStereo(in.stereo);
+  FusedCloud out;
+  fusion.fuse(out);
+  return out;
+}
+
+// ---- eq. 6 on hand-made pixels --------------------------------------------------------------
+
+TEST(DepthFusionPaper, Eq6OnHandMadePixels) {
+  msf::DepthFusionConfig config;
+  config.method = msf::FusionMethod::Paper;
+  config.paper_lidar_gain = 1.f;
+  config.paper_lidar_distance_px = 4.f;
+  config.paper_stereo_reference_depth_m = 10.f;
+  Inputs in(5, 2);
+  in.setLidar(0, 0, 0.f, 0.f);  in.setStereo(0, 0, 12.f, 0.8f);  // invalid LiDAR: stereo value
+  in.setLidar(1, 0, 10.f, 0.f); in.setStereo(1, 0, 0.f, 0.f);    // invalid stereo: LiDAR value
+  in.setLidar(2, 0, 0.f, 0.f);  in.setStereo(2, 0, 0.f, 0.f);    // neither: NaN
+  in.setLidar(3, 0, 10.f, 4.f); in.setStereo(3, 0, 8.f, 0.5f);   // both valid, near
+  in.setLidar(4, 0, 20.f, 0.f); in.setStereo(4, 0, 22.f, 1.0f);  // both valid, far
+  const FusedCloud out = fuse(in, config);
+
+  EXPECT_FLOAT_EQ(out.at(0, 0).z, 12.f);
+  EXPECT_FLOAT_EQ(out.at(1, 0).z, 10.f);
+  EXPECT_TRUE(std::isnan(out.at(2, 0).z));
+  EXPECT_EQ(out.at(2, 0).weight, 0.f);
+  // Pixel 3: w_L = 1 / (1 + 4/4) = 0.5, w_S = 0.5 * min(1, (10/8)^2) = 0.5: w2 = 1, w1 = 1:
+  // y = (8 * 1 + 10 * 1 * 1) / (1 + 1 * 1) = 9, between the two.
+  EXPECT_NEAR(out.at(3, 0).z, 9.f, 1e-5f);
+  EXPECT_NEAR(out.at(3, 0).weight, 1.f, 1e-6f);
+  // Pixel 4: w_L = 1, w_S = 1 * (10/22)^2 = 0.2066: w2 = 4.84: y = (22 + 20 w2) / (1 + w2).
+  const float w2 = 1.f / (100.f / (22.f * 22.f));
+  EXPECT_NEAR(out.at(4, 0).z, (22.f + 20.f * w2) / (1.f + w2), 1e-4f);
+  EXPECT_GT(out.at(4, 0).z, 20.f);
+  EXPECT_LT(out.at(4, 0).z, 22.f);
+  // Fused points stay on their pixel's ray.
+  const auto ray = onRay<pcl::PointXYZ>(3, 0, 9.f, 5, 2);
+  EXPECT_NEAR(out.at(3, 0).x, ray.x, 1e-5f);
+  EXPECT_NEAR(out.at(3, 0).y, ray.y, 1e-5f);
+}
+
+TEST(DepthFusionPaper, PixelFunctionIsTheWeightedMean) {
+  msf::DepthFusionConfig config;
+  msf::FusionInputs in;
+  in.z_lidar = 30.f;
+  in.lidar_distance = 2.f;
+  in.z_stereo = 25.f;
+  in.stereo_confidence = 0.3f;
+  const float w_L = 1.f / (1.f + 2.f / 4.f), w_S = 0.3f * (10.f / 25.f) * (10.f / 25.f);
+  EXPECT_NEAR(msf::fusePaper(in, config).z, (w_S * 25.f + w_L * 30.f) / (w_S + w_L), 1e-4f);
+  // The stereo confidence has a floor, so a zero-confidence match still counts a little.
+  in.stereo_confidence = 0.f;
+  const float w_S0 = config.paper_min_stereo_confidence * 0.16f;
+  EXPECT_NEAR(msf::fusePaper(in, config).z, (w_S0 * 25.f + w_L * 30.f) / (w_S0 + w_L), 1e-4f);
+}
+
+// ---- uncertainty ---------------------------------------------------------------------------
+
+TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
+  msf::DepthFusionConfig config; // sigma_S(c=1) = 0.3 px, sigma_L = 0.3 + 0.05 d + 0.7 range
+  msf::FusionInputs in;
+  in.z_lidar = static_cast<float>(kFB / 20.0);  // disparity 20
+  in.lidar_distance = 6.f;                        // sigma_L = 0.3 + 0.3 = 0.6
+  in.z_stereo = static_cast<float>(kFB / 21.0); // disparity 21, within 3 sigma
+  in.stereo_confidence = 1.f;                     // sigma_S = 0.3
+  const float vL = 0.36f, vS = 0.09f;
+  const float d = (20.f * vS + 21.f * vL) / (vL + vS); // 20.8
+  const auto f = msf::fuseUncertainty(in, config, static_cast<float>(kFB));
+  EXPECT_NEAR(f.z, kFB / d, 1e-4);
+  EXPECT_NEAR(f.weight, 1.f, 1e-6f); // the fused sigma is below stereo_sigma_min_px
+  // Far apart (4 px > 3 * sqrt(0.45)): not averaged, the more certain (stereo) wins.
+  in.z_stereo = static_cast<float>(kFB / 24.0);
+  EXPECT_FLOAT_EQ(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, in.z_stereo);
+  // A weak stereo match (sigma_S = 0.3 + 3.7 * 0.8^2 = 2.668 px) is within 3 sigma: the mean
+  // leans to the LiDAR.
+  in.stereo_confidence = 0.2f;
+  const float vS2 = 2.668f * 2.668f;
+  EXPECT_NEAR(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, kFB / ((20.f * vS2 + 24.f * vL) / (vL + vS2)),
+              1e-3);
+  // Far apart and the LiDAR more certain: the LiDAR alone.
+  in.stereo_confidence = 0.6f; // sigma_S = 0.3 + 3.7 * 0.16 = 0.892 px
+  in.z_stereo = static_cast<float>(kFB / 26.0);
+  EXPECT_FLOAT_EQ(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, in.z_lidar);
+  // Stereo sigma model: min at confidence 1, max at 0, quadratic between.
+  EXPECT_FLOAT_EQ(msf::stereoSigmaPx(1.f, config), 0.3f);
+  EXPECT_FLOAT_EQ(msf::stereoSigmaPx(0.f, config), 4.f);
+  EXPECT_NEAR(msf::stereoSigmaPx(0.5f, config), 0.3f + 3.7f * 0.25f, 1e-6f);
+}
+
+// A foreground box at 5 m fills the rows >= 10 of the image, a wall at 20 m the rows above.
+// The LiDAR, 8 cm above the camera, sees over the box's top edge onto the wall: its returns
+// in rows 10..15 are the wall's (f h (1/5 - 1/20) = 6 rows), where the camera sees the box.
+// Stereo sees the box, a little less confident near the edge. The wall's LiDAR samples are
+// real returns in every third column (distance 0 there, 1 between).
+TEST(DepthFusionUncertainty, SyntheticEdgeKeepsTheForeground) {
+  const int w = 12, h = 30, edge = 10;
+  Inputs in(w, h);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const bool box = v >= edge;
+      const bool seen_past_edge = box && v < edge + 6;
+      in.setLidar(u, v, box && !seen_past_edge ? 5.f : 20.f, (u % 3 == 0) ? 0.f : 1.f);
+      in.setStereo(u, v, box ? 5.f : 20.f, std::abs(v - edge) <= 2 ? 0.6f : 0.95f);
+    }
+  msf::DepthFusionConfig config;
+  config.method = msf::FusionMethod::Uncertainty;
+  const FusedCloud out = fuse(in, config);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u)
+      EXPECT_NEAR(out.at(u, v).z, v >= edge ? 5.f : 20.f, 0.05f) << "pixel " << u << "," << v;
+  // Without the parallax check the LiDAR's returns from the wall win where no foreground
+  // return is within its 5 x 5 window (rows 10..12), as the LiDAR looks more certain there.
+  config.parallax_check = false;
+  EXPECT_NEAR(fuse(in, config).at(4, edge + 2).z, 20.f, 0.05f);
+  // The paper's weighted mean puts those pixels between foreground and background.
+  config.method = msf::FusionMethod::Paper;
+  EXPECT_GT(fuse(in, config).at(4, edge + 2).z, 5.5f);
+}
+
+// Stereo nearer than a confident LiDAR, but the LiDAR has no such near surface below:
+// no parallax case (a stereo mismatch, e.g. a fattened foreground), the LiDAR wins.
+TEST(DepthFusionUncertainty, StereoNearerWithoutLidarEvidenceLoses) {
+  const int w = 6, h = 20;
+  Inputs in(w, h);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      in.setLidar(u, v, 20.f, 0.f);
+      in.setStereo(u, v, v == 8 ? 5.f : 20.f, 0.7f);
+    }
+  const FusedCloud out = fuse(in, {});
+  EXPECT_NEAR(out.at(2, 8).z, 20.f, 1e-4f);
+}
+
+// ---- organized invariants, colour, types -----------------------------------------------------
+
+TEST(DepthFusion, OrganizedInvariants) {
+  const int w = 7, h = 5;
+  Inputs in(w, h);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      if ((u + v) % 3 != 0)
+        in.setLidar(u, v, 10.f + u, 1.f);
+      if ((u + 2 * v) % 4 != 0)
+        in.setStereo(u, v, 10.f + u, 0.9f);
+    }
+  in.stereo->header.frame_id = "camera_0";
+  in.stereo->header.stamp = 42;
+  for (auto method : {msf::FusionMethod::Paper, msf::FusionMethod::Uncertainty}) {
+    msf::DepthFusionConfig config;
+    config.method = method;
+    const FusedCloud out = fuse(in, config);
+    ASSERT_EQ(out.width, static_cast<std::uint32_t>(w));
+    ASSERT_EQ(out.height, static_cast<std::uint32_t>(h));
+    EXPECT_FALSE(out.is_dense);
+    EXPECT_EQ(out.header.frame_id, "camera_0");
+    EXPECT_EQ(out.header.stamp, 42u);
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        const bool any = (u + v) % 3 != 0 || (u + 2 * v) % 4 != 0;
+        const auto& p = out.at(u, v);
+        EXPECT_EQ(std::isfinite(p.z), any) << u << "," << v;
+        EXPECT_EQ(std::isfinite(p.x), any);
+        if (any) {
+          EXPECT_NEAR(p.z, 10.f + u, 1e-4f);
+          EXPECT_GT(p.weight, 0.f);
+          EXPECT_LE(p.weight, 1.f);
+          EXPECT_EQ(p.r, 10); // colour of the stereo point
+        } else {
+          EXPECT_EQ(p.weight, 0.f);
+        }
+      }
+  }
+  // With depth everywhere the cloud is dense.
+  Inputs full(3, 2);
+  for (int v = 0; v < 2; ++v)
+    for (int u = 0; u < 3; ++u)
+      full.setStereo(u, v, 4.f, 1.f);
+  EXPECT_TRUE(fuse(full, {}).is_dense);
+}
+
+TEST(DepthFusion, ColourImageColoursLidarOnlyPixels) {
+  Inputs in(4, 3);
+  in.setLidar(1, 1, 8.f, 0.f); // no stereo there
+  cv::Mat color(3, 4, CV_8UC3, cv::Scalar(1, 2, 3));
+  Fusion fusion;
+  fusion.setCalibration(calibration(4, 3));
+  fusion.setInputLidar(in.lidar);
+  fusion.setInputStereo(in.stereo);
+  fusion.setInputColor(color);
+  FusedCloud out;
+  fusion.fuse(out);
+  EXPECT_EQ(out.at(1, 1).r, 3);
+  EXPECT_EQ(out.at(1, 1).b, 1);
+}
+
+TEST(DepthFusion, PlainPointTypes) {
+  // PointXYZ inputs: LiDAR points count as real returns, stereo points as confident.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr lidar(new pcl::PointCloud<pcl::PointXYZ>(2, 2)), stereo(new pcl::PointCloud<pcl::PointXYZ>(2, 2));
+  for (int v = 0; v < 2; ++v)
+    for (int u = 0; u < 2; ++u) {
+      lidar->at(u, v) = onRay<pcl::PointXYZ>(u, v, 10.f, 2, 2);
+      stereo->at(u, v) = onRay<pcl::PointXYZ>(u, v, u == 0 ? 10.2f : 0.f, 2, 2);
+    }
+  msf::DepthFusion<pcl::PointXYZ, pcl::PointXYZ, pcl::PointXYZ> fusion;
+  fusion.setCalibration(calibration(2, 2));
+  fusion.setInputLidar(lidar);
+  fusion.setInputStereo(stereo);
+  pcl::PointCloud<pcl::PointXYZ> out;
+  fusion.fuse(out);
+  EXPECT_NEAR(out.at(1, 0).z, 10.f, 1e-6f);
+  EXPECT_GT(out.at(0, 0).z, 10.f);
+  EXPECT_LT(out.at(0, 0).z, 10.2f);
+}
+
+TEST(DepthImageFusion, SameResultAsTheCloudClass) {
+  const int w = 30, h = 8;
+  Inputs in(w, h);
+  cv::Mat zl(h, w, CV_32FC1, cv::Scalar(0)), dist(h, w, CV_32FC1, cv::Scalar(0)), zs(h, w, CV_32FC1, cv::Scalar(0)),
+      conf(h, w, CV_32FC1, cv::Scalar(0));
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const float z_l = (u * 7 + v) % 5 == 0 ? 0.f : 6.f + 0.3f * u + (u > 15 ? 10.f : 0.f);
+      const float z_s = (u * 3 + v) % 7 == 0 ? 0.f : 6.2f + 0.3f * u + (u > 14 ? 10.f : 0.f);
+      const float d = static_cast<float>((u + v) % 4), c = 0.1f * static_cast<float>((u * v) % 10);
+      in.setLidar(u, v, z_l, d);
+      in.setStereo(u, v, z_s, c);
+      zl.at<float>(v, u) = z_l;
+      dist.at<float>(v, u) = d;
+      zs.at<float>(v, u) = z_s;
+      conf.at<float>(v, u) = z_s > 0.f ? c : 0.f;
+    }
+  for (auto method : {msf::FusionMethod::Paper, msf::FusionMethod::Uncertainty}) {
+    msf::DepthFusionConfig config;
+    config.method = method;
+    const FusedCloud cloud = fuse(in, config);
+    cv::Mat fused, weight;
+    msf::fuseDepthImages(zl, dist, zs, conf, calibration(w, h), config, fused, &weight);
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        const float z = cloud.at(u, v).z;
+        EXPECT_NEAR(std::isfinite(z) ? z : 0.f, fused.at<float>(v, u), 1e-5f) << u << "," << v;
+        EXPECT_NEAR(cloud.at(u, v).weight, weight.at<float>(v, u), 1e-6f);
+      }
+  }
+}
+
+TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {
+  cv::Mat depth(3, 5, CV_32FC1, cv::Scalar(0));
+  depth.at<float>(1, 1) = static_cast<float>(kFB / 10.0); // disparity 10
+  depth.at<float>(1, 3) = static_cast<float>(kFB / 4.0);  // disparity 4
+  cv::Mat range;
+  msf::localDisparityRange(depth, kFB, 3, range);
+  EXPECT_NEAR(range.at<float>(1, 2), 6.f, 1e-4f); // sees both
+  EXPECT_NEAR(range.at<float>(1, 0), 0.f, 1e-6f); // sees one
+  EXPECT_NEAR(range.at<float>(0, 4), 0.f, 1e-6f); // sees one
+  EXPECT_THROW(msf::localDisparityRange(depth, kFB, 4, range), msf::InvalidInputError);
+}
+
+// ---- bad input -----------------------------------------------------------------------------
+
+std::string errorOf(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const msf::Error& e) {
+    return e.what();
+  }
+  return "no exception";
+}
+
+TEST(DepthFusion, BadInputNamesWhatIsWrong) {
+  Inputs a(6, 4), b(5, 4);
+  Fusion fusion;
+  FusedCloud out;
+  fusion.setCalibration(calibration(6, 4));
+  // Missing inputs.
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("LiDAR cloud is missing"), std::string::npos);
+  fusion.setInputLidar(a.lidar);
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("stereo cloud is missing"), std::string::npos);
+  // Clouds of different sizes.
+  fusion.setInputStereo(b.stereo);
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("LiDAR cloud is 6x4 but the stereo cloud is 5x4"),
+            std::string::npos);
+  // An unorganized cloud.
+  StereoCloud::Ptr flat(new StereoCloud(*a.stereo));
+  flat->width = 24;
+  flat->height = 1;
+  fusion.setInputStereo(flat);
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("stereo cloud is not organized"), std::string::npos);
+  // No calibration.
+  Fusion uncalibrated;
+  uncalibrated.setInputLidar(a.lidar);
+  uncalibrated.setInputStereo(a.stereo);
+  EXPECT_THROW(uncalibrated.fuse(out), msf::CalibrationError);
+  // Images of different sizes.
+  cv::Mat z6(4, 6, CV_32FC1, cv::Scalar(1)), z5(4, 5, CV_32FC1, cv::Scalar(1)), fused;
+  const msf::Calibration c = calibration(6, 4);
+  EXPECT_NE(errorOf([&] { msf::fuseDepthImages(z6, cv::Mat(), z5, cv::Mat(), c, {}, fused); })
+                .find("stereo depth image is 5x4 but the LiDAR depth is 6x4"),
+            std::string::npos);
+  EXPECT_THROW(msf::fuseDepthImages(z6, cv::Mat(4, 6, CV_8UC1), z6, cv::Mat(), c, {}, fused), msf::InvalidInputError);
+}
+
+TEST(DepthFusionConfig, ReadsTheFusionSectionAndRejectsBadValues) {
+  msf::test::TempDir dir;
+  const std::string path = dir.file("c.yaml");
+  std::ofstream(path) << "%YAML:1.0\nfusion:\n  method: paper\n  paper_lidar_gain: 2.5\n  disagreement_k_sigma: 4\n";
+  msf::DepthFusionConfig config;
+  config.read(msf::ConfigFile(path).section("fusion"));
+  EXPECT_EQ(config.method, msf::FusionMethod::Paper);
+  EXPECT_FLOAT_EQ(config.paper_lidar_gain, 2.5f);
+  EXPECT_FLOAT_EQ(config.disagreement_k_sigma, 4.f);
+  EXPECT_FLOAT_EQ(config.stereo_sigma_min_px, 0.3f); // default kept
+  std::ostringstream printed;
+  config.print(printed);
+  EXPECT_NE(printed.str().find("method: paper"), std::string::npos);
+  auto fails = [&](const std::string& body, const std::string& key) {
+    std::ofstream(path) << "%YAML:1.0\nfusion:\n  " << body << "\n";
+    return errorOf([&] {
+             msf::DepthFusionConfig c;
+             c.read(msf::ConfigFile(path).section("fusion"));
+           }).find(key) != std::string::npos;
+  };
+  EXPECT_TRUE(fails("method: average", "fusion.method"));
+  EXPECT_TRUE(fails("stereo_sigma_min_px: 0", "fusion.stereo_sigma_min_px"));
+  EXPECT_TRUE(fails("stereo_sigma_max_px: 0.1", "fusion.stereo_sigma_max_px"));
+  EXPECT_TRUE(fails("lidar_range_window_px: 4", "fusion.lidar_range_window_px"));
+  EXPECT_TRUE(fails("disagreement_k_sigma: many", "fusion.disagreement_k_sigma"));
+}
+
+} // namespace
