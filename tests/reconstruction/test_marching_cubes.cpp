@@ -45,6 +45,7 @@ TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
             v.weight = 1.f;
           }
       block.stamp = volume.beginGeneration();
+      block.updateSigns();
     }
   TriangleMesh mesh;
   MarchingCubes().extract(volume, mesh);

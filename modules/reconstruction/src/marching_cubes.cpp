@@ -28,6 +28,9 @@ constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
+constexpr int kCornerOffset[8] = {0, 1, 1 + kPad, kPad, kPad * kPad, 1 + kPad * kPad, 1 + kPad + kPad * kPad,
+                                   kPad + kPad * kPad};
+
 struct Sample {
   float sdf;
   float weight;
@@ -57,44 +60,61 @@ bool lessIndex(const GridIndex& a, const GridIndex& b) {
 /// Per-thread working memory for meshing one block.
 struct Scratch {
   std::array<Sample, kPad * kPad * kPad> samples;
+  std::array<std::uint8_t, kPad * kPad * kPad> flags; // bit 0: weight > min_weight, bit 1: sdf < 0
   std::array<std::int32_t, kPad * kPad * kPad * 4> slot; // local vertex of (grid point, code), -1 = none
   std::vector<int> used;
+  MarchingCubes::BlockMesh mesh; // grows once per thread, then copied out at its exact size
   Scratch() { slot.fill(-1); }
 };
 
-void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
-               Scratch& s) {
-  out.vertices.clear();
-  out.colors.clear();
-  out.keys.clear();
-  out.triangles.clear();
+void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
+                   Scratch& s) {
   const float vs = static_cast<float>(volume.voxelSize());
 
   // Gather the 9^3 voxels the block's cubes read (weight 0 where a neighbour is absent).
+  if (block.signs == 0)
+    return; // never observed: every cube has this block's unobserved corner
   const TsdfBlock* nb[8];
-  for (int i = 0; i < 8; ++i)
+  std::uint8_t signs = 0;
+  for (int i = 0; i < 8; ++i) {
     nb[i] = i == 0 ? &block : volume.findBlock(block.index + GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+    signs |= nb[i] ? nb[i]->signs : 0;
+  }
+  if (signs != (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative))
+    return; // no sign change within reach of this block's cubes
   bool any_negative = false, any_positive = false;
   for (int z = 0; z < kPad; ++z)
-    for (int y = 0; y < kPad; ++y)
-      for (int x = 0; x < kPad; ++x) {
-        Sample& out_sample = s.samples[x + kPad * (y + kPad * z)];
-        const TsdfBlock* b = nb[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
+    for (int y = 0; y < kPad; ++y) {
+      // A row is 8 voxels of one block and 1 of its +x neighbour.
+      const int at = kPad * (y + kPad * z);
+      const int sel = ((y >> 3) << 1) | ((z >> 3) << 2);
+      for (int part = 0; part < 2; ++part) {
+        const TsdfBlock* b = nb[sel | part];
+        const int x0 = part ? kSide : 0, x1 = part ? kPad : kSide;
         if (!b) {
-          out_sample.weight = 0.f;
+          for (int x = x0; x < x1; ++x) {
+            s.samples[at + x].weight = 0.f;
+            s.flags[at + x] = 0;
+          }
           continue;
         }
-        const TsdfVoxel& v = b->at(x & 7, y & 7, z & 7);
-        out_sample.sdf = v.sdf;
-        out_sample.weight = v.weight;
-        out_sample.rgb[0] = v.r;
-        out_sample.rgb[1] = v.g;
-        out_sample.rgb[2] = v.b;
-        if (v.weight > min_weight) {
-          any_negative |= v.sdf < 0.f;
-          any_positive |= v.sdf >= 0.f;
+        const TsdfVoxel* src = &b->at(0, y & 7, z & 7);
+        for (int x = x0; x < x1; ++x) {
+          const TsdfVoxel& v = src[x & 7];
+          Sample& out_sample = s.samples[at + x];
+          out_sample.sdf = v.sdf;
+          out_sample.weight = v.weight;
+          out_sample.rgb[0] = v.r;
+          out_sample.rgb[1] = v.g;
+          out_sample.rgb[2] = v.b;
+          const bool valid = v.weight > min_weight;
+          const bool negative = v.sdf < 0.f;
+          s.flags[at + x] = static_cast<std::uint8_t>(valid | (negative << 1));
+          any_negative |= valid & negative;
+          any_positive |= valid & !negative;
         }
       }
+    }
   if (!any_negative || !any_positive)
     return;
 
@@ -112,7 +132,7 @@ void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weigh
     out.vertices.push_back(p * vs);
     std::array<std::uint8_t, 3> c;
     for (int k = 0; k < 3; ++k)
-      c[k] = static_cast<std::uint8_t>(std::lround(a.rgb[k] + t * (static_cast<float>(b.rgb[k]) - a.rgb[k])));
+      c[k] = static_cast<std::uint8_t>(a.rgb[k] + t * (static_cast<float>(b.rgb[k]) - a.rgb[k]) + 0.5f);
     out.colors.push_back(c);
     // Interior: every cube around this edge (or voxel) belongs to this block, so no other
     // block makes this vertex.
@@ -128,22 +148,22 @@ void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weigh
   for (int z = 0; z < kSide; ++z)
     for (int y = 0; y < kSide; ++y)
       for (int x = 0; x < kSide; ++x) {
-        const Sample* c[8];
+        const int at = x + kPad * (y + kPad * z);
+        std::uint8_t all_valid = 1;
         int cube = 0;
-        bool valid = true;
         for (int i = 0; i < 8; ++i) {
-          c[i] = &s.samples[(x + kCorner[i][0]) + kPad * ((y + kCorner[i][1]) + kPad * (z + kCorner[i][2]))];
-          if (!(c[i]->weight > min_weight)) {
-            valid = false;
-            break;
-          }
-          cube |= (c[i]->sdf < 0.f) << i;
+          const std::uint8_t f = s.flags[at + kCornerOffset[i]];
+          all_valid &= f;
+          cube |= ((f >> 1) & 1) << i;
         }
-        if (!valid)
+        if (!all_valid)
           continue;
         const unsigned int edges = detail::kEdgeTable[cube];
         if (!edges)
           continue;
+        const Sample* c[8];
+        for (int i = 0; i < 8; ++i)
+          c[i] = &s.samples[at + kCornerOffset[i]];
         std::uint32_t vert[12];
         for (int e = 0; e < 12; ++e) {
           if (!(edges & (1u << e)))
@@ -176,6 +196,20 @@ void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weigh
   for (const int u : s.used)
     s.slot[u] = -1;
   s.used.clear();
+}
+
+void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
+               Scratch& s) {
+  MarchingCubes::BlockMesh& m = s.mesh;
+  m.vertices.clear();
+  m.colors.clear();
+  m.keys.clear();
+  m.triangles.clear();
+  meshBlockInto(volume, block, min_weight, m, s);
+  out.vertices.assign(m.vertices.begin(), m.vertices.end());
+  out.colors.assign(m.colors.begin(), m.colors.end());
+  out.keys.assign(m.keys.begin(), m.keys.end());
+  out.triangles.assign(m.triangles.begin(), m.triangles.end());
 }
 
 /// Open addressing map from a vertex key to its index in the assembled mesh.
@@ -262,6 +296,10 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   for (const auto& block : volume.blocks()) {
     if (block->stamp <= generation_)
       continue;
+    if (generation_ == 0) { // first call: every block is meshed anyway
+      dirty_keys.push_back(blockKey(block->index));
+      continue;
+    }
     for (int i = 0; i < 8; ++i) {
       const GridIndex b = block->index - GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1);
       if (i == 0 || volume.findBlock(b))
@@ -293,39 +331,71 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   const auto t1 = Clock::now();
   std::vector<std::pair<GridIndex, const BlockMesh*>> order;
   order.reserve(cache_.size());
-  std::size_t total_vertices = 0, total_shared = 0, total_triangles = 0;
+  std::size_t total_shared = 0;
   for (const auto& [index, part] : cache_) {
     if (part.triangles.empty())
       continue;
     order.emplace_back(index, &part);
-    total_vertices += part.vertices.size();
-    total_triangles += part.triangles.size();
     for (const std::uint64_t k : part.keys)
       total_shared += k != kInterior;
   }
   std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return lessIndex(a.first, b.first); });
-  mesh.vertices.clear();
-  mesh.colors.clear();
-  mesh.triangles.clear();
-  mesh.vertices.reserve(total_vertices);
-  mesh.colors.reserve(total_vertices);
-  mesh.triangles.reserve(total_triangles);
+  // Vertices that several blocks may make are numbered first, serially through a hash of
+  // their grid keys; each block's interior vertices follow in block order, copied in parallel.
+  const std::size_t parts = order.size();
+  std::vector<std::size_t> remap_offset(parts + 1, 0), triangle_offset(parts + 1, 0), interior_offset(parts + 1, 0);
+  for (std::size_t i = 0; i < parts; ++i) {
+    remap_offset[i + 1] = remap_offset[i] + order[i].second->vertices.size();
+    triangle_offset[i + 1] = triangle_offset[i] + order[i].second->triangles.size();
+  }
+  std::vector<std::uint32_t> remap(remap_offset[parts]);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_source; // (part, vertex) of each shared vertex
+  shared_source.reserve(total_shared);
   VertexIndexMap shared(total_shared);
-  std::vector<std::uint32_t> remap;
-  for (const auto& entry : order) {
-    const BlockMesh& part = *entry.second;
-    remap.resize(part.vertices.size());
-    for (std::size_t v = 0; v < part.vertices.size(); ++v) {
-      const auto next = static_cast<std::uint32_t>(mesh.vertices.size());
-      bool inserted = true;
-      remap[v] = part.keys[v] == kInterior ? next : shared.findOrInsert(part.keys[v], next, inserted);
-      if (inserted) {
-        mesh.vertices.push_back(part.vertices[v]);
-        mesh.colors.push_back(part.colors[v]);
+  for (std::size_t i = 0; i < parts; ++i) {
+    const BlockMesh& part = *order[i].second;
+    std::size_t interior = 0;
+    for (std::size_t v = 0; v < part.keys.size(); ++v) {
+      if (part.keys[v] == kInterior) {
+        ++interior;
+        continue;
       }
+      bool inserted = false;
+      const auto next = static_cast<std::uint32_t>(shared_source.size());
+      remap[remap_offset[i] + v] = shared.findOrInsert(part.keys[v], next, inserted);
+      if (inserted)
+        shared_source.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(v));
     }
-    for (const auto& t : part.triangles)
-      mesh.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+    interior_offset[i + 1] = interior_offset[i] + interior;
+  }
+  const std::size_t n_shared = shared_source.size();
+  const std::size_t n_vertices = n_shared + interior_offset[parts];
+  mesh.vertices.resize(n_vertices);
+  mesh.colors.resize(n_vertices);
+  mesh.triangles.resize(triangle_offset[parts]);
+  const auto n_parts = static_cast<std::ptrdiff_t>(parts);
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::ptrdiff_t i = 0; i < n_parts; ++i) {
+    const BlockMesh& part = *order[i].second;
+    std::uint32_t* map = &remap[remap_offset[i]];
+    auto next = static_cast<std::uint32_t>(n_shared + interior_offset[i]);
+    for (std::size_t v = 0; v < part.keys.size(); ++v)
+      if (part.keys[v] == kInterior) {
+        map[v] = next;
+        mesh.vertices[next] = part.vertices[v];
+        mesh.colors[next] = part.colors[v];
+        ++next;
+      }
+    std::array<std::uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
+    for (std::size_t t = 0; t < part.triangles.size(); ++t)
+      out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
+  }
+  const auto n_shared_signed = static_cast<std::ptrdiff_t>(n_shared);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t k = 0; k < n_shared_signed; ++k) {
+    const BlockMesh& part = *order[shared_source[k].first].second;
+    mesh.vertices[k] = part.vertices[shared_source[k].second];
+    mesh.colors[k] = part.colors[shared_source[k].second];
   }
   stats_.assemble_ms = msSince(t1);
 }

@@ -109,6 +109,7 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "min_depth_m", min_depth_m);
   readKey(node, "max_depth_m", max_depth_m);
   readKey(node, "interpolate_depth", interpolate_depth);
+  readKey(node, "allocation_stride", allocation_stride);
   validate();
 }
 
@@ -117,6 +118,8 @@ void TsdfIntegrator::Config::validate() const {
     throw ConfigError("tsdf_integrator.max_weight must be > 0, got " + std::to_string(max_weight));
   if (!(lambda >= 0.0) || !std::isfinite(lambda))
     throw ConfigError("tsdf_integrator.lambda must be >= 0, got " + std::to_string(lambda));
+  if (allocation_stride < 1)
+    throw ConfigError("tsdf_integrator.allocation_stride must be >= 1, got " + std::to_string(allocation_stride));
   if (sweeps < 0)
     throw ConfigError("tsdf_integrator.sweeps must be >= 0, got " + std::to_string(sweeps));
   if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
@@ -133,7 +136,8 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  sweeps: " << sweeps << "\n"
       << "  min_depth_m: " << min_depth_m << "\n"
       << "  max_depth_m: " << max_depth_m << "\n"
-      << "  interpolate_depth: " << (interpolate_depth ? "true" : "false") << "\n";
+      << "  interpolate_depth: " << (interpolate_depth ? "true" : "false") << "\n"
+      << "  allocation_stride: " << allocation_stride << "\n";
 }
 
 TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : volume_(volume) {}
@@ -174,6 +178,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float to_block = 1.f / (vs * kSide);
   const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSide;
   std::vector<std::uint64_t> keys;
+  const int stride = config_.allocation_stride;
 #pragma omp parallel
   {
     std::vector<std::uint64_t> local;
@@ -181,9 +186,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     recent.fill(~0ull);
     std::size_t next = 0;
 #pragma omp for schedule(static) nowait
-    for (int v = 0; v < height; ++v) {
+    for (int v = 0; v < height; v += stride) {
       const float* depth = frame.depth.ptr<float>(v);
-      for (int u = 0; u < width; ++u) {
+      for (int u = (v / stride) % stride; u < width; u += stride) {
         const float d = depth[u];
         if (!(d >= min_d && d <= max_d))
           continue;
@@ -261,25 +266,39 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
     std::size_t updated = 0;
+    const float* depth_data = frame.depth.ptr<float>(0);
+    const std::size_t depth_step = frame.depth.step1();
     for (int z = 0; z < kSide; ++z)
       for (int y = 0; y < kSide; ++y) {
+        // A row of 8 voxels: projection first in plain float arrays (the compiler vectorizes
+        // it), then the per-voxel depth lookups.
         const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
+        float pu[kSide], pv[kSide], pz[kSide];
+        for (int x = 0; x < kSide; ++x) {
+          const float X = row.x() + ex.x() * x, Y = row.y() + ex.y() * x, Z = row.z() + ex.z() * x;
+          const float inv_z = 1.f / std::max(Z, 1e-6f);
+          pu[x] = fx * X * inv_z + cx;
+          pv[x] = fy * Y * inv_z + cy;
+          pz[x] = Z;
+        }
         TsdfVoxel* voxels = &block.at(0, y, z);
         for (int x = 0; x < kSide; ++x) {
-          const Eigen::Vector3f p = row + ex * static_cast<float>(x);
-          if (p.z() < min_d)
-            continue;
-          const float inv_z = 1.f / p.z();
-          const float u = fx * p.x() * inv_z + cx, v = fy * p.y() * inv_z + cy;
-          if (!(u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
+          const float u = pu[x], v = pv[x], vz = pz[x];
+          if (!(vz >= min_d && u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
             continue;
           const int ui = static_cast<int>(u + 0.5f), vi = static_cast<int>(v + 0.5f);
-          float d = frame.depth.ptr<float>(vi)[ui];
+          float d = depth_data[vi * depth_step + ui];
+          // Cheap rejection on the nearest pixel first; a bilinear value differs from it by
+          // less than the truncation (the 4 pixels must agree within it).
+          if (!(d >= min_d && d <= max_d))
+            continue;
+          if (d - vz < -2.f * trunc || (!carving && d - vz > 2.f * trunc))
+            continue;
           if (bilinear) {
             const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
             if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
-              const float* r0 = frame.depth.ptr<float>(v0) + u0;
-              const float* r1 = frame.depth.ptr<float>(v0 + 1) + u0;
+              const float* r0 = depth_data + v0 * depth_step + u0;
+              const float* r1 = r0 + depth_step;
               const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
               const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
               const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
@@ -290,9 +309,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
               }
             }
           }
-          if (!(d >= min_d && d <= max_d))
-            continue;
-          float sdf = d - p.z();
+          float sdf = d - vz;
           if (sdf < -trunc)
             continue;
           const bool in_band = sdf <= trunc;
@@ -318,6 +335,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       }
     if (updated) {
       block.stamp = stamp;
+      block.updateSigns();
       changed[i] = 1;
       updated_total += updated;
     }
@@ -395,6 +413,8 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
       ++updated;
     });
   }
+  for (TsdfBlock* block : touched)
+    block->updateSigns();
   stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
   stats_.blocks_touched = touched.size();
   stats_.voxels_updated = updated;
@@ -465,9 +485,11 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched) {
     }
 
 #pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
     for (auto& voxel : touched[i]->voxels)
       voxel.flags = 0;
+    touched[i]->updateSigns();
+  }
 }
 
 } // namespace msf

@@ -49,28 +49,53 @@ std::size_t TsdfVolume::numObservedVoxels() const {
 
 std::size_t TsdfVolume::memoryBytes() const {
   // Blocks, the pointer vector, and the map's buckets and nodes (key, value, next, hash).
-  return blocks_.size() * sizeof(TsdfBlock) + blocks_.capacity() * sizeof(void*) +
-         index_.bucket_count() * sizeof(void*) +
-         index_.size() * (sizeof(GridIndex) + sizeof(std::size_t) + 2 * sizeof(void*));
+  return blocks_.size() * sizeof(TsdfBlock) + blocks_.capacity() * sizeof(void*) + table_.capacity() * sizeof(Slot);
+}
+
+std::size_t TsdfVolume::slotOf(const GridIndex& index) const {
+  std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(index.x())) * 0x9E3779B97F4A7C15ull ^
+                    static_cast<std::uint64_t>(static_cast<std::uint32_t>(index.y())) * 0xC2B2AE3D27D4EB4Full ^
+                    static_cast<std::uint64_t>(static_cast<std::uint32_t>(index.z())) * 0x165667B19E3779F9ull;
+  h ^= h >> 29;
+  std::size_t i = static_cast<std::size_t>(h) & mask_;
+  while (table_[i].block >= 0 && table_[i].key != index)
+    i = (i + 1) & mask_;
+  return i;
+}
+
+void TsdfVolume::grow() {
+  const std::size_t capacity = table_.empty() ? 1024 : 2 * table_.size();
+  table_.assign(capacity, Slot());
+  mask_ = capacity - 1;
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    Slot& slot = table_[slotOf(blocks_[b]->index)];
+    slot.key = blocks_[b]->index;
+    slot.block = static_cast<std::int32_t>(b);
+  }
 }
 
 TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) {
-  const auto it = index_.find(index);
-  return it == index_.end() ? nullptr : blocks_[it->second].get();
+  if (table_.empty())
+    return nullptr;
+  const Slot& slot = table_[slotOf(index)];
+  return slot.block >= 0 ? blocks_[static_cast<std::size_t>(slot.block)].get() : nullptr;
 }
 
 const TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) const {
-  const auto it = index_.find(index);
-  return it == index_.end() ? nullptr : blocks_[it->second].get();
+  return const_cast<TsdfVolume*>(this)->findBlock(index);
 }
 
 TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
-  const auto [it, inserted] = index_.try_emplace(index, blocks_.size());
-  if (inserted) {
+  if (2 * (blocks_.size() + 1) > table_.size())
+    grow();
+  Slot& slot = table_[slotOf(index)];
+  if (slot.block < 0) {
+    slot.key = index;
+    slot.block = static_cast<std::int32_t>(blocks_.size());
     blocks_.push_back(std::make_unique<TsdfBlock>());
     blocks_.back()->index = index;
   }
-  return *blocks_[it->second];
+  return *blocks_[static_cast<std::size_t>(slot.block)];
 }
 
 const TsdfVoxel* TsdfVolume::findVoxel(const GridIndex& v) const {
@@ -88,7 +113,8 @@ GridIndex TsdfVolume::voxelIndexOf(const Eigen::Vector3d& p) const {
 }
 
 void TsdfVolume::clear() {
-  index_.clear();
+  table_.clear();
+  mask_ = 0;
   blocks_.clear();
   id_ = newVolumeId();
 }
@@ -148,8 +174,10 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     voxel.flags = 0;
   }
   const std::uint64_t stamp = beginGeneration();
-  for (auto& block : blocks_)
+  for (auto& block : blocks_) {
     block->stamp = stamp;
+    block->updateSigns();
+  }
 }
 
 void TsdfVolume::save(const std::string& path) const {

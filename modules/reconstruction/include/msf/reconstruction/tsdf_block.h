@@ -30,7 +30,19 @@ struct TsdfBlock {
 
   GridIndex index{0, 0, 0};      ///< block coordinates: voxel v lies in block floor(v / kSide)
   std::uint64_t stamp = 0;       ///< volume generation of the last change (see TsdfVolume)
+  /// Bit 0: an observed voxel has sdf >= 0; bit 1: one has sdf < 0. Whoever changes the
+  /// voxels calls updateSigns(), so that the mesher skips blocks a surface cannot cross.
+  std::uint8_t signs = 0;
   std::array<TsdfVoxel, kVoxels> voxels{};
+
+  static constexpr std::uint8_t kHasPositive = 1, kHasNegative = 2;
+  void updateSigns() {
+    std::uint8_t s = 0;
+    for (const TsdfVoxel& v : voxels)
+      if (v.weight > 0.f)
+        s |= v.sdf < 0.f ? kHasNegative : kHasPositive;
+    signs = s;
+  }
 
   static constexpr int linear(int x, int y, int z) { return x + kSide * (y + kSide * z); }
   TsdfVoxel& at(int x, int y, int z) { return voxels[linear(x, y, z)]; }

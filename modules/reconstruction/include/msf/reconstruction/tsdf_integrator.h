@@ -43,10 +43,14 @@ public:
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 80.0;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
+    /// Blocks are allocated along the rays of every n-th pixel in each direction (rows
+    /// staggered): 2 finds the blocks of a dense depth image at a quarter of the cost (rays
+    /// 2 px apart are 0.11 m apart at 40 m on KITTI, blocks 0.8 m); 1 for sparse depth.
+    int allocation_stride = 2;
 
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
     /// (constant | inverse_square | per_pixel), max_weight, space_carving, lambda, sweeps,
-    /// min_depth_m, max_depth_m, interpolate_depth. Throws ConfigError naming a bad key.
+    /// min_depth_m, max_depth_m, interpolate_depth, allocation_stride. Throws ConfigError naming a bad key.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the first value out of range.
     void validate() const;
