@@ -1,0 +1,117 @@
+// Per-pixel depth fusion per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370):
+// the cloud class DepthFusion<PointXYZID, PointXYZRGBConfidence, PointXYZRGBWeight> and the
+// image-level fuseDepthImages, for both methods. Inputs (interpolated LiDAR with distances,
+// SGBM with confidence) are made once before timing.
+//
+//   bench_fusion [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
+//   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
+#include <msf/fusion/depth_fusion.h>
+#include <msf/fusion/depth_image_fusion.h>
+#include <msf/io/organized_conversion.h>
+#include <msf/io/sequence.h>
+#include <msf/range_image/compound_interpolation.h>
+#include <msf/range_image/depth_interpolator.h>
+#include <msf/range_image/distance_transform.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/stereo/sgbm_stereo.h>
+
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <vector>
+
+namespace {
+
+std::string kittiDir() {
+  const char* env = std::getenv("MSF_KITTI_DIR");
+  return env ? env : MSF_KITTI_DIR;
+}
+
+struct Data {
+  msf::Calibration calibration;
+  std::vector<pcl::PointCloud<msf::PointXYZID>::Ptr> lidar;
+  std::vector<pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr> stereo;
+  std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence;
+  Data() {
+    const msf::Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    calibration = sequence.calibration();
+    msf::LidarProjector projector(calibration);
+    msf::CompoundInterpolation<msf::PointXYZID> interpolation;
+    interpolation.setCamera(msf::PinholeCamera::fromCalibration(calibration));
+    msf::SgbmStereo sgbm;
+    sgbm.setCalibration(calibration);
+    for (std::size_t i = 0; i < 10 && i < sequence.size(); ++i) {
+      const msf::Frame f = sequence.load(i, true);
+      pcl::PointCloud<msf::PointXYZID>::Ptr sparse(new pcl::PointCloud<msf::PointXYZID>);
+      pcl::PointCloud<msf::PointXYZID>::Ptr dense(new pcl::PointCloud<msf::PointXYZID>);
+      projector.project(*f.scan, *sparse);
+      interpolation.setInputCloud(sparse);
+      interpolation.filter(*dense);
+      pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr matched(new pcl::PointCloud<msf::PointXYZRGBConfidence>);
+      sgbm.setInputImages(f.left, f.right);
+      sgbm.setInputColor(f.color);
+      sgbm.setDepthPrior(msf::cloudToDepthImage(*dense));
+      sgbm.compute(*matched);
+      lidar.push_back(dense);
+      stereo.push_back(matched);
+      lidar_depth.push_back(msf::cloudToDepthImage(*dense));
+      cv::Mat distance(lidar_depth.back().size(), CV_32FC1);
+      for (int v = 0; v < distance.rows; ++v)
+        for (int u = 0; u < distance.cols; ++u)
+          distance.at<float>(v, u) = dense->at(u, v).distance;
+      lidar_distance.push_back(distance);
+      stereo_depth.push_back(sgbm.getDepth());
+      stereo_confidence.push_back(sgbm.getConfidence().clone());
+    }
+  }
+};
+
+const Data& data() {
+  static const Data d;
+  return d;
+}
+
+void cloudFusion(benchmark::State& state, msf::FusionMethod method) {
+  const Data& d = data();
+  msf::DepthFusionConfig config;
+  config.method = method;
+  msf::DepthFusion<> fusion(config);
+  fusion.setCalibration(d.calibration);
+  pcl::PointCloud<msf::PointXYZRGBWeight> out;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    fusion.setInputLidar(d.lidar[f]);
+    fusion.setInputStereo(d.stereo[f]);
+    fusion.fuse(out);
+    benchmark::DoNotOptimize(out.points.data());
+  }
+}
+
+void imageFusion(benchmark::State& state, msf::FusionMethod method) {
+  const Data& d = data();
+  msf::DepthFusionConfig config;
+  config.method = method;
+  cv::Mat fused, weight;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    msf::fuseDepthImages(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f],
+                         d.calibration, config, fused, &weight);
+    benchmark::DoNotOptimize(fused.data);
+  }
+}
+
+void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Paper); }
+void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
+void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
+void BM_FusionImageUncertainty(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Uncertainty); }
+
+} // namespace
+
+BENCHMARK(BM_FusionCloudPaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_FusionCloudUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_FusionImagePaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+
+BENCHMARK_MAIN();
