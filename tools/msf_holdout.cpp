@@ -6,9 +6,7 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
 #include <msf/io/sequence.h>
-#include <msf/range_image/depth_interpolator.h>
-#include <msf/range_image/ip_basic.h>
-#include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/lidar_completion.h>
 
 #include <pcl/common/time.h>
 #include <pcl/console/parse.h>
@@ -31,54 +29,37 @@ struct MethodEntry {
   std::function<msf::HoldoutMethod(const msf::ConfigFile&)> make;
 };
 
-/// LiDAR input rings projected into camera 0 (the first step of every LiDAR method).
-struct Projection {
-  msf::ProjectionConfig config;
-  std::unique_ptr<msf::LidarProjector> projector;
-  cv::Mat sparse;
-  explicit Projection(const msf::ConfigFile& file) { config.read(file.section("projection")); }
-  const cv::Mat& operator()(const msf::HoldoutInput& in) {
-    if (!projector)
-      projector = std::make_unique<msf::LidarProjector>(*in.calibration, config);
-    projector->projectToImage(*in.scan, sparse);
-    return sparse;
-  }
-};
-
-msf::HoldoutMethod interpolation(const msf::ConfigFile& file, const char* forced_interpolant) {
-  msf::InterpolationConfig config;
-  config.read(file.section("interpolation"));
-  if (forced_interpolant)
-    config.slice.interpolant = msf::parseSliceInterpolant(forced_interpolant);
-  auto projection = std::make_shared<Projection>(file);
-  auto interpolator = std::make_shared<msf::DepthInterpolator>(config);
-  return [projection, interpolator](const msf::HoldoutInput& in) {
-    cv::Mat dense;
-    interpolator->interpolate((*projection)(in), dense);
-    return dense;
+/// A LiDAR method: the input rings completed by `method` (projection on the canvas included).
+msf::HoldoutMethod lidar(const msf::ConfigFile& file, msf::CompletionMethod method) {
+  msf::ProjectionConfig projection;
+  projection.read(file.section("projection"));
+  msf::InterpolationConfig interpolation;
+  interpolation.read(file.section("interpolation"));
+  msf::IpBasicConfig ip_basic;
+  ip_basic.read(file.section("ip_basic"));
+  std::shared_ptr<msf::LidarCompletion> completion; // made at the first frame, which has the calibration
+  return [=](const msf::HoldoutInput& in) mutable {
+    if (!completion)
+      completion = std::make_shared<msf::LidarCompletion>(*in.calibration, method, projection, interpolation, ip_basic);
+    cv::Mat depth;
+    completion->computeDepth(*in.scan, depth);
+    return depth;
   };
-}
-
-msf::HoldoutMethod ipBasic(const msf::ConfigFile& file, msf::IpBasicVariant variant) {
-  msf::IpBasicConfig config;
-  config.read(file.section("ip_basic"));
-  config.variant = variant;
-  auto projection = std::make_shared<Projection>(file);
-  return [projection, config](const msf::HoldoutInput& in) { return msf::ipBasic((*projection)(in), config); };
 }
 
 /// Add a method here (name -> function of the frame input) to get its row in the table.
 const std::vector<MethodEntry>& methodTable() {
   static const std::vector<MethodEntry> table{
       {"interpolated", "compound interpolation (section interpolation)",
-       [](const msf::ConfigFile& f) { return interpolation(f, nullptr); }},
-      {"linear", "the same slices, linear only", [](const msf::ConfigFile& f) { return interpolation(f, "linear"); }},
+       [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::Compound); }},
+      {"linear", "the same slices, linear only",
+       [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::Linear); }},
       {"cubic", "the same slices, zero-slope cubic only",
-       [](const msf::ConfigFile& f) { return interpolation(f, "cubic"); }},
-      {"ipbasic", "IP-Basic fast (Ku et al. 2018, section ip_basic)",
-       [](const msf::ConfigFile& f) { return ipBasic(f, msf::IpBasicVariant::Fast); }},
-      {"ipbasic_multiscale", "IP-Basic multiscale",
-       [](const msf::ConfigFile& f) { return ipBasic(f, msf::IpBasicVariant::Multiscale); }},
+       [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::Cubic); }},
+      {"ipbasic", "IP-Basic fast (Ku et al. 2018, section ip_basic), same projection",
+       [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicFast); }},
+      {"ipbasic_multiscale", "IP-Basic multiscale, same projection",
+       [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicMultiscale); }},
   };
   return table;
 }

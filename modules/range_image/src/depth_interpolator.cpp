@@ -2,12 +2,13 @@
 #include <msf/common/exceptions.h>
 #include <msf/range_image/depth_interpolator.h>
 
-#include <opencv2/imgproc.hpp>
 #include <pcl/console/print.h>
 
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 namespace msf {
 
@@ -107,22 +108,94 @@ void DepthInterpolator::setConfig(const InterpolationConfig& config) {
 
 namespace {
 
-inline float combine(float r, std::uint8_t gr, float c, std::uint8_t gc, CombineRule rule) {
-  if (!(r > 0.f))
-    return c;
-  if (!(c > 0.f))
-    return r;
+// Hot loops that vectorize get an AVX2 clone chosen at load time where the CPU has it.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+#define MSF_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MSF_VECTOR_CLONES
+#endif
+
+/// Adds w times one row of estimates to the vertical sums: values (empty pixels are 0) and weights.
+MSF_VECTOR_CLONES void accumulateRow(const float* __restrict o, float w, float* __restrict v, float* __restrict m,
+                                     int n) {
+  for (int u = 0; u < n; ++u) {
+    v[u] += w * o[u];
+    m[u] += o[u] > 0.f ? w : 0.f;
+  }
+}
+
+/// One row: estimates into `out`, gap lengths into `gap` (0 on samples and holes).
+/// Returns whether the row has a sample.
+bool rowPass(const float* in, int n, const SliceParams& p, float* out, std::uint8_t* gap) {
+  std::fill(out, out + n, 0.f);
+  std::fill(gap, gap + n, std::uint8_t{0});
+  int last = -1;
+  float z_last = 0.f;
+  for (int i = 0; i < n; ++i) {
+    const float z = in[i];
+    if (!(z > 0.f))
+      continue;
+    out[i] = z;
+    const int empty = i - last - 1;
+    if (last >= 0 && empty > 0 && empty <= p.max_gap_px && !isDepthJump(z_last, z, p)) {
+      const std::uint8_t g = gapCode(empty);
+      float* o = out + last;
+      std::uint8_t* gp = gap + last;
+      bridgeValues(z_last, z, empty, p, [&](int k, float value) {
+        o[k] = value;
+        gp[k] = g;
+      });
+    }
+    last = i;
+    z_last = z;
+  }
+  return last >= 0;
+}
+
+/// The estimate of a pixel that has a row estimate r (gap gr) and a column one c (gap gc).
+inline float combine(float r, int gr, float c, int gc, CombineRule rule) {
   switch (rule) {
   case CombineRule::Average:
     return 0.5f * (r + c);
   case CombineRule::Nearest:
     return std::min(r, c);
   case CombineRule::GapWeighted: {
-    const float wr = 1.f / (1.f + gr), wc = 1.f / (1.f + gc);
+    const float wr = 1.f / static_cast<float>(1 + gr), wc = 1.f / static_cast<float>(1 + gc);
     return (wr * r + wc * c) / (wr + wc);
   }
   default:
     return gr < gc ? r : gc < gr ? c : 0.5f * (r + c);
+  }
+}
+
+/// Columns [c0, c1), in place over the row pass's result. The seeds of a column are its
+/// samples and the row estimates bridged over at most `seed_gap` pixels. The image is
+/// swept row by row, so that reads are contiguous; a bridge writes back into the rows of
+/// its gap (still in cache), merging with their row estimates: each pixel lies in at most
+/// one gap of its column, and rows are read before any bridge reaches them.
+void columnPass(int H, int W, int c0, int c1, const SliceParams& p, int seed_gap, CombineRule rule, float* out,
+                const std::uint8_t* gap, int* last, float* z_last) {
+  std::fill(last + c0, last + c1, -1);
+  for (int r = 0; r < H; ++r) {
+    const float* o = out + static_cast<std::ptrdiff_t>(r) * W;
+    const std::uint8_t* g = gap + static_cast<std::ptrdiff_t>(r) * W;
+    for (int c = c0; c < c1; ++c) {
+      const float z = o[c];
+      if (!(z > 0.f) || g[c] > seed_gap)
+        continue;
+      const int empty = r - last[c] - 1;
+      if (last[c] >= 0 && empty > 0 && empty <= p.max_gap_px && !isDepthJump(z_last[c], z, p)) {
+        const int gc = empty;
+        float* column = out + static_cast<std::ptrdiff_t>(last[c]) * W + c;
+        const std::uint8_t* row_gap = gap + static_cast<std::ptrdiff_t>(last[c]) * W + c;
+        bridgeValues(z_last[c], z, empty, p, [&](int k, float value) {
+          float& e = column[static_cast<std::ptrdiff_t>(k) * W];
+          e = e > 0.f ? combine(e, row_gap[static_cast<std::ptrdiff_t>(k) * W], value, gc, rule) : value;
+        });
+      }
+      last[c] = r;
+      z_last[c] = z;
+    }
   }
 }
 
@@ -131,82 +204,98 @@ inline float combine(float r, std::uint8_t gr, float c, std::uint8_t gc, Combine
 void DepthInterpolator::interpolate(const cv::Mat& depth, cv::Mat& out) {
   if (depth.type() != CV_32FC1 || depth.empty())
     throw InvalidInputError("interpolation: expected a non-empty CV_32FC1 depth image");
+  if (out.data == depth.data)
+    throw InvalidInputError("interpolation: the output may not be the input image");
   const int H = depth.rows, W = depth.cols;
   const int nthreads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
   const SliceParams& slice = config_.slice;
-  rows_.create(H, W, CV_32FC1);
-  cols_.create(H, W, CV_32FC1);
-  row_gap_.create(H, W, CV_8UC1);
-  col_gap_.create(H, W, CV_8UC1);
   out.create(H, W, CV_32FC1);
-  const int seed_gap = config_.column_seed_gap_px;
-  if (seed_gap > 0)
-    seeds_.create(H, W, CV_32FC1);
+  row_gap_.create(H, W, CV_8UC1);
+  last_.resize(static_cast<std::size_t>(W));
+  z_last_.resize(static_cast<std::size_t>(W));
+  row_has_.assign(static_cast<std::size_t>(H), 0);
+  prepareHoleFill(W);
 
-  // Every slice is independent: rows over threads, then columns in bands of whole cache lines.
-  // One stride for the input, the estimates and the gaps of a column.
-  const cv::Mat in = depth.isContinuous() ? depth : depth.clone();
+  // Slices are independent, so every pass splits them over the threads (one parallel
+  // region, few barriers) and the result does not depend on their number.
 #pragma omp parallel num_threads(nthreads)
   {
 #pragma omp for schedule(static)
     for (int r = 0; r < H; ++r)
-      interpolateSlice(in.ptr<float>(r), 1, W, slice, rows_.ptr<float>(r), row_gap_.ptr<std::uint8_t>(r));
-    if (seed_gap > 0) {
+      row_has_[r] = rowPass(depth.ptr<float>(r), W, slice, out.ptr<float>(r), row_gap_.ptr<std::uint8_t>(r));
+    const int bands = omp_get_num_threads();
 #pragma omp for schedule(static)
-      for (int r = 0; r < H; ++r) {
-        const float* R = rows_.ptr<float>(r);
-        const std::uint8_t* G = row_gap_.ptr<std::uint8_t>(r);
-        float* s = seeds_.ptr<float>(r);
-        for (int u = 0; u < W; ++u)
-          s[u] = G[u] <= seed_gap ? R[u] : 0.f;
-      }
+    for (int b = 0; b < bands; ++b) {
+      // Bands of whole cache lines (16 floats) per thread.
+      const int c0 = std::min(W, (W * b / bands + 15) / 16 * 16);
+      const int c1 = b + 1 == bands ? W : std::min(W, (W * (b + 1) / bands + 15) / 16 * 16);
+      columnPass(H, W, c0, c1, slice, config_.column_seed_gap_px, config_.combine, out.ptr<float>(),
+                 row_gap_.ptr<std::uint8_t>(), last_.data(), z_last_.data());
     }
-    const float* column_input = seed_gap > 0 ? seeds_.ptr<float>() : in.ptr<float>();
-#pragma omp for schedule(static)
-    for (int c0 = 0; c0 < W; c0 += 64)
-      for (int c = c0; c < std::min(W, c0 + 64); ++c)
-        interpolateSlice(column_input + c, W, H, slice, cols_.ptr<float>() + c, col_gap_.ptr<std::uint8_t>() + c);
-#pragma omp for schedule(static)
-    for (int r = 0; r < H; ++r) {
-      const float* R = rows_.ptr<float>(r);
-      const float* C = cols_.ptr<float>(r);
-      const std::uint8_t* GR = row_gap_.ptr<std::uint8_t>(r);
-      const std::uint8_t* GC = col_gap_.ptr<std::uint8_t>(r);
-      float* o = out.ptr<float>(r);
-      for (int u = 0; u < W; ++u)
-        o[u] = combine(R[u], GR[u], C[u], GC[u], config_.combine);
-    }
+    if (config_.gaussian)
+      fillHoles(depth, out);
   }
-  if (!config_.gaussian)
-    return;
+}
 
-  // Normalized convolution: blur(values) / blur(mask) is the Gaussian average of the
-  // estimates around a pixel, ignoring empty ones (Knutsson and Westin 1993).
-  cv::Mat& mask = weights_;
-  mask.create(H, W, CV_32FC1);
-#pragma omp parallel for schedule(static) num_threads(nthreads)
-  for (int r = 0; r < H; ++r) {
-    const float* o = out.ptr<float>(r);
-    float* m = mask.ptr<float>(r);
-    for (int u = 0; u < W; ++u)
-      m[u] = o[u] > 0.f ? 1.f : 0.f;
-  }
-  const cv::Size kernel(config_.gaussian_size_px, config_.gaussian_size_px);
-  const double sigma = config_.gaussian_sigma_px;
-  cv::GaussianBlur(out, values_, kernel, sigma, sigma, cv::BORDER_CONSTANT);
-  cv::GaussianBlur(mask, mask, kernel, sigma, sigma, cv::BORDER_CONSTANT);
+void DepthInterpolator::prepareHoleFill(int width) {
+  const int k = config_.gaussian_size_px / 2;
+  kernel_.resize(static_cast<std::size_t>(2 * k + 1));
+  const float s2 = config_.gaussian_sigma_px * config_.gaussian_sigma_px;
+  float total = 0.f;
+  for (int i = -k; i <= k; ++i)
+    total += kernel_[i + k] = std::exp(-0.5f * static_cast<float>(i * i) / s2);
+  for (float& w : kernel_)
+    w /= total;
+  values_.create(static_cast<int>(row_has_.size()), width + 2 * k, CV_32FC1);
+  weights_.create(static_cast<int>(row_has_.size()), width + 2 * k, CV_32FC1);
+}
+
+void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
+  // Normalized convolution (Knutsson and Westin 1993): the Gaussian average of the
+  // estimates around a hole, empty pixels weighing 0. Separable: a vectorized vertical
+  // pass into rows padded by k zeros, then the horizontal pass at the holes.
+  // Called by every thread of the parallel region; rows beyond reach of any sample (the
+  // sky above the top ring) are skipped.
+  const int H = out.rows, W = out.cols, k = config_.gaussian_size_px / 2, Wp = W + 2 * k;
+  int first = H, last = -1;
+  for (int r = 0; r < H; ++r)
+    if (row_has_[r]) {
+      first = std::min(first, r);
+      last = r;
+    }
+  const int r0 = std::max(0, first - k), r1 = std::min(H - 1, last + k);
+  const float* g = kernel_.data();
   const float min_weight = config_.gaussian_min_weight;
   const bool smooth = config_.gaussian_smooth_valid;
-#pragma omp parallel for schedule(static) num_threads(nthreads)
-  for (int r = 0; r < H; ++r) {
+#pragma omp for schedule(static)
+  for (int r = r0; r <= r1; ++r) {
+    float* v = values_.ptr<float>(r);
+    float* m = weights_.ptr<float>(r);
+    std::fill(v, v + Wp, 0.f);
+    std::fill(m, m + Wp, 0.f);
+    v += k;
+    m += k;
+    for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
+      accumulateRow(out.ptr<float>(r + i), g[i + k], v, m, W);
+  }
+  // (The implicit barrier above: every vertical sum is made before any hole is written.)
+#pragma omp for schedule(static)
+  for (int r = r0; r <= r1; ++r) {
+    // The horizontal pass only where the result is used: holes are few within the rings.
+    const float* v = values_.ptr<float>(r);
+    const float* m = weights_.ptr<float>(r);
     const float* d = depth.ptr<float>(r);
-    const float* b = values_.ptr<float>(r);
-    const float* m = mask.ptr<float>(r);
     float* o = out.ptr<float>(r);
     for (int u = 0; u < W; ++u) {
-      const bool hole = !(o[u] > 0.f);
-      if ((hole || (smooth && !(d[u] > 0.f))) && m[u] >= min_weight)
-        o[u] = b[u] / m[u];
+      if (o[u] > 0.f && !(smooth && !(d[u] > 0.f)))
+        continue;
+      float sv = 0.f, sm = 0.f;
+      for (int i = 0; i <= 2 * k; ++i) {
+        sv += g[i] * v[u + i];
+        sm += g[i] * m[u + i];
+      }
+      if (sm >= min_weight)
+        o[u] = sv / sm;
     }
   }
 }

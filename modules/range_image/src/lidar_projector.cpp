@@ -12,13 +12,15 @@
 namespace msf {
 
 void ProjectionConfig::print() const {
-  pcl::console::print_info("projection: camera %d, range %g..%g m\n", camera, min_range_m, max_range_m);
+  pcl::console::print_info("projection: camera %d, range %g..%g m, canvas margin %d px\n", camera, min_range_m,
+                           max_range_m, margin_px);
 }
 
 void ProjectionConfig::read(const cv::FileNode& node) {
   readKey(node, "camera", camera);
   readKey(node, "min_range_m", min_range_m);
   readKey(node, "max_range_m", max_range_m);
+  readKey(node, "margin_px", margin_px);
   validate();
 }
 
@@ -30,6 +32,8 @@ void ProjectionConfig::validate() const {
   if (!(max_range_m > min_range_m))
     throw ConfigError("projection.max_range_m (" + std::to_string(max_range_m) +
                       ") must be greater than projection.min_range_m (" + std::to_string(min_range_m) + ")");
+  if (margin_px < 0 || margin_px > 256)
+    throw ConfigError("projection.margin_px must be 0..256, not " + std::to_string(margin_px));
 }
 
 LidarProjector::LidarProjector(const Calibration& calibration, const ProjectionConfig& config) {
@@ -47,6 +51,7 @@ void LidarProjector::setCalibration(const Calibration& calibration) {
   T.translation() += t_i;
   T_cam_velo_ = T.matrix().topRows<3>().cast<float>();
   skew_ = static_cast<float>(calibration.P[config_.camera](0, 1));
+  calibration_ = calibration;
   calibrated_ = true;
 }
 
@@ -55,26 +60,39 @@ void LidarProjector::setConfig(const ProjectionConfig& config) {
   const bool camera_changed = config.camera != config_.camera;
   config_ = config;
   if (camera_changed && calibrated_)
-    throw ConfigError("projection.camera changed after the calibration was set: call setCalibration again");
+    setCalibration(calibration_);
 }
 
-void LidarProjector::requireCalibration() const {
+PinholeCamera LidarProjector::canvasCamera() const {
+  PinholeCamera c = camera_;
+  const int m = config_.margin_px;
+  c.cx += static_cast<float>(m);
+  c.cy += static_cast<float>(m);
+  c.width += 2 * m;
+  c.height += 2 * m;
+  return c;
+}
+
+cv::Rect LidarProjector::imageInCanvas() const {
+  return {config_.margin_px, config_.margin_px, camera_.width, camera_.height};
+}
+
+void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin, cv::Mat& depth,
+                             cv::Mat* winner) const {
   if (!calibrated_)
     throw InvalidInputError("LidarProjector: no calibration set");
-}
-
-void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth, cv::Mat* winner) const {
-  requireCalibration();
-  const int W = camera_.width, H = camera_.height;
+  const int W = camera_.width + 2 * margin, H = camera_.height + 2 * margin;
   const int n = static_cast<int>(scan.size());
   pixel_.resize(scan.size());
   depth_.resize(scan.size());
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
-  const float fx = camera_.fx, fy = camera_.fy, cx = camera_.cx, cy = camera_.cy, skew = skew_;
+  const float fx = camera_.fx, fy = camera_.fy, skew = skew_;
+  const float cx = camera_.cx + static_cast<float>(margin), cy = camera_.cy + static_cast<float>(margin);
   const float r2min = config_.min_range_m * config_.min_range_m, r2max = config_.max_range_m * config_.max_range_m;
   const float umax = static_cast<float>(W) - 0.5f, vmax = static_cast<float>(H) - 0.5f;
 
-  // Transform and project in parallel; the z-buffer below is serial over the few points kept.
+  // Transform and project in parallel; the z-buffer below is serial over the points kept
+  // (the quarter of the scan in front of the camera).
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < n; ++i) {
     const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
@@ -92,7 +110,7 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Ma
     const float v = fy * y * inv_z + cy;
     if (!(u > -0.5f && u < umax && v > -0.5f && v < vmax))
       continue;
-    // Pixel centres are integers (as in depthImageToCloud), so round to nearest.
+    // Pixel centres are integers (as in depthImageToCloud): round to nearest, u + 0.5 > 0.
     pixel_[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
     depth_[i] = z;
   }
@@ -118,21 +136,30 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Ma
   }
 }
 
-void LidarProjector::projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
-                                    cv::Mat* intensity) const {
+void LidarProjector::projectDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin, cv::Mat& depth,
+                                  cv::Mat* intensity) const {
   if (!intensity) {
-    scatter(scan, depth, nullptr);
+    scatter(scan, margin, depth, nullptr);
     return;
   }
-  cv::Mat winner;
-  scatter(scan, depth, &winner);
+  scatter(scan, margin, depth, &winner_);
   intensity->create(depth.size(), CV_32FC1);
-  const int* w = winner.ptr<int>();
+  const int* w = winner_.ptr<int>();
   float* out = intensity->ptr<float>();
   const int total = static_cast<int>(depth.total());
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < total; ++k)
     out[k] = w[k] >= 0 ? scan[static_cast<std::size_t>(w[k])].intensity : 0.f;
+}
+
+void LidarProjector::projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
+                                    cv::Mat* intensity) const {
+  projectDepth(scan, 0, depth, intensity);
+}
+
+void LidarProjector::projectToCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
+                                     cv::Mat* intensity) const {
+  projectDepth(scan, config_.margin_px, depth, intensity);
 }
 
 namespace {
@@ -149,16 +176,17 @@ inline void setDistance(PointT& p, float value) {
 } // namespace
 
 template <typename PointT>
-void LidarProjector::project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const {
-  cv::Mat depth, winner;
-  scatter(scan, depth, &winner);
-  const int W = camera_.width, H = camera_.height;
+void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin,
+                                  pcl::PointCloud<PointT>& cloud) const {
+  cv::Mat depth;
+  scatter(scan, margin, depth, &winner_);
+  const int W = depth.cols, H = depth.rows;
   cloud.resize(static_cast<std::size_t>(W) * H);
   cloud.width = static_cast<std::uint32_t>(W);
   cloud.height = static_cast<std::uint32_t>(H);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
-  const int* w = winner.ptr<int>();
+  const int* w = winner_.ptr<int>();
   bool dense = true;
 #pragma omp parallel for schedule(static) reduction(&& : dense)
   for (int k = 0; k < W * H; ++k) {
@@ -173,18 +201,28 @@ void LidarProjector::project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::P
     const pcl::PointXYZI& p = scan[static_cast<std::size_t>(w[k])];
     out.x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
     out.y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
-    out.z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
+    out.z = depth.ptr<float>()[k]; // the same float as the z-buffer
     setReflectance(out, p.intensity);
     setDistance(out, 0.f);
   }
   cloud.is_dense = dense;
 }
 
-template void LidarProjector::project<pcl::PointXYZ>(const pcl::PointCloud<pcl::PointXYZI>&,
-                                                     pcl::PointCloud<pcl::PointXYZ>&) const;
-template void LidarProjector::project<pcl::PointXYZI>(const pcl::PointCloud<pcl::PointXYZI>&,
-                                                      pcl::PointCloud<pcl::PointXYZI>&) const;
-template void LidarProjector::project<PointXYZID>(const pcl::PointCloud<pcl::PointXYZI>&,
-                                                  pcl::PointCloud<PointXYZID>&) const;
+template <typename PointT>
+void LidarProjector::project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const {
+  projectCloud(scan, 0, cloud);
+}
+
+template <typename PointT>
+void LidarProjector::projectCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const {
+  projectCloud(scan, config_.margin_px, cloud);
+}
+
+#define MSF_INSTANTIATE_PROJECTOR(T)                                                                    \
+  template void LidarProjector::project<T>(const pcl::PointCloud<pcl::PointXYZI>&, pcl::PointCloud<T>&) const; \
+  template void LidarProjector::projectCanvas<T>(const pcl::PointCloud<pcl::PointXYZI>&, pcl::PointCloud<T>&) const;
+MSF_INSTANTIATE_PROJECTOR(pcl::PointXYZ)
+MSF_INSTANTIATE_PROJECTOR(pcl::PointXYZI)
+MSF_INSTANTIATE_PROJECTOR(PointXYZID)
 
 } // namespace msf

@@ -24,28 +24,6 @@ const char* toString(SliceInterpolant interpolant) {
   }
 }
 
-namespace {
-
-/// Writes the `empty` pixels strictly between two samples z0 (at i0) and z1.
-inline void bridge(float z0, float z1, std::ptrdiff_t i0, int empty, std::ptrdiff_t stride, const SliceParams& p,
-                   float* out, std::uint8_t* gap) {
-  const bool cubic = p.interpolant == SliceInterpolant::Cubic ||
-                     (p.interpolant == SliceInterpolant::Compound && empty <= p.short_gap_px);
-  const float a = p.inverse_depth ? 1.f / z0 : z0;
-  const float delta = (p.inverse_depth ? 1.f / z1 : z1) - a;
-  const float step = 1.f / static_cast<float>(empty + 1);
-  const std::uint8_t g = static_cast<std::uint8_t>(empty < 255 ? empty : 255);
-  for (int k = 1; k <= empty; ++k) {
-    const float t = static_cast<float>(k) * step;
-    const float w = cubic ? t * t * (p.cubic_beta - p.cubic_alpha * t) : t;
-    const float value = a + delta * w;
-    const std::ptrdiff_t i = (i0 + k) * stride;
-    out[i] = p.inverse_depth ? 1.f / value : value;
-    gap[i] = g;
-  }
-}
-
-} // namespace
 
 void interpolateSlice(const float* in, std::ptrdiff_t stride, int n, const SliceParams& params, float* out,
                       std::uint8_t* gap) {
@@ -62,7 +40,10 @@ void interpolateSlice(const float* in, std::ptrdiff_t stride, int n, const Slice
     gap[i * stride] = 0;
     const int empty = static_cast<int>(i - last - 1);
     if (last >= 0 && empty > 0 && empty <= params.max_gap_px && !isDepthJump(z_last, z, params))
-      bridge(z_last, z, last, empty, stride, params, out, gap);
+      bridgeValues(z_last, z, empty, params, [&](int k, float value) {
+        out[(last + k) * stride] = value;
+        gap[(last + k) * stride] = gapCode(empty);
+      });
     last = i;
     z_last = z;
   }

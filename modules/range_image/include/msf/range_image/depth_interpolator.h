@@ -5,6 +5,7 @@
 #include <opencv2/core/persistence.hpp>
 
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -27,10 +28,10 @@ struct InterpolationConfig {
   /// Row estimates bridged over at most this many pixels join the samples that column
   /// slices see (0: columns see samples only). A scan line is dense along a row but its
   /// samples share azimuths, so without this, whole columns have no sample at all.
-  int column_seed_gap_px = 0;
+  int column_seed_gap_px = 3;
   bool gaussian = true;                     ///< fill the holes left by the slices
-  int gaussian_size_px = 5;                 ///< odd kernel width
-  float gaussian_sigma_px = 1.0f;
+  int gaussian_size_px = 9;                 ///< odd kernel width
+  float gaussian_sigma_px = 2.0f;
   float gaussian_min_weight = 0.1f;         ///< share of the kernel's mass that must hold estimates
   bool gaussian_smooth_valid = false;       ///< also smooth interpolated pixels (real returns never)
   int threads = 0;                          ///< OpenMP threads, 0 = default
@@ -59,8 +60,16 @@ public:
   void interpolate(const cv::Mat& depth, cv::Mat& out);
 
 private:
+  void prepareHoleFill(int width);
+  /// The normalized Gaussian pass over the holes of `out`, inside the parallel region.
+  void fillHoles(const cv::Mat& depth, cv::Mat& out);
+
   InterpolationConfig config_;
-  cv::Mat rows_, cols_, seeds_, row_gap_, col_gap_, values_, weights_;
+  cv::Mat row_gap_, values_, weights_;
+  std::vector<int> last_;     ///< column pass: row of the previous seed of each column
+  std::vector<float> z_last_; ///< and its depth
+  std::vector<char> row_has_; ///< rows with a sample
+  std::vector<float> kernel_; ///< normalized 1-D Gaussian
 };
 
 } // namespace msf

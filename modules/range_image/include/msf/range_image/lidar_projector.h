@@ -17,6 +17,11 @@ struct ProjectionConfig {
   int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills
   float min_range_m = 0.f;    ///< returns closer to the LiDAR than this are dropped
   float max_range_m = 120.f;  ///< returns farther than this are dropped (HDL-64E: 120 m)
+  /// Border of the canvas (projectToCanvas): returns up to this many pixels outside the
+  /// image are kept there, so that interpolation bridges the gaps that cross the image's
+  /// edges (the lowest ring of the image has its neighbour below the image) instead of
+  /// leaving them open; results are cropped back to the image.
+  int margin_px = 16;
 
   void print() const;
   /// Overrides the keys present; throws ConfigError naming a key with a bad value.
@@ -26,47 +31,68 @@ struct ProjectionConfig {
 };
 
 /// Paper step 1: a Velodyne scan (PointXYZI, velodyne frame) into one camera's image.
-/// Points are moved into the camera's rectified frame and projected with its intrinsics;
-/// points behind the camera, outside the image or outside [min_range, max_range] (distance
-/// from the LiDAR) are dropped, and where several land on one pixel the nearest wins.
+/// Points are moved into the camera's rectified frame and projected with its intrinsics
+/// (a precomputed 3x4 matrix in float, one pass); points behind the camera, outside the
+/// image or outside [min_range, max_range] (distance from the LiDAR) are dropped, and
+/// where several land on one pixel the nearest wins. Pixel centres are integers.
+/// Not thread-safe: an object keeps per-point work buffers between scans.
 class LidarProjector {
 public:
   LidarProjector() = default;
-  /// Throws CalibrationError when the calibration has no image size.
+  /// Throws CalibrationError when the calibration has no image size, ConfigError for a
+  /// bad config.
   explicit LidarProjector(const Calibration& calibration, const ProjectionConfig& config = {});
 
   void setCalibration(const Calibration& calibration);
-  /// Throws ConfigError for an invalid config; keeps the calibration.
+  /// Throws ConfigError for an invalid config.
   void setConfig(const ProjectionConfig& config);
   const ProjectionConfig& config() const { return config_; }
-  /// Intrinsics and image size of the target camera.
+
+  /// Intrinsics and size of the target camera's image.
   const PinholeCamera& camera() const { return camera_; }
+  /// The canvas: the image grown by margin_px on every side (principal point shifted).
+  PinholeCamera canvasCamera() const;
+  /// Where the image lies in the canvas.
+  cv::Rect imageInCanvas() const;
 
   /// Depth image (CV_32FC1, metres along the optical axis, 0 = no return) and, when
   /// `intensity` is given, the reflectance of the winning return (0 elsewhere).
-  /// The matrices are reused when they already have the right size and type.
+  /// Matrices are reused when they already have the right size and type.
   void projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
                       cv::Mat* intensity = nullptr) const;
+  /// The same on the canvas.
+  void projectToCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
+                       cv::Mat* intensity = nullptr) const;
 
   /// Organized cloud of the image's size: each pixel with a return holds that return's
   /// exact position in the camera's rectified frame (within half a pixel of the pixel's
   /// ray) and, when PointT has them, its reflectance and distance 0; other pixels are NaN
-  /// (distance +inf). Instantiated for PointXYZ, PointXYZI and PointXYZID.
+  /// (distance +inf) and the cloud is not dense. Instantiated for PointXYZ, PointXYZI and
+  /// PointXYZID.
   template <typename PointT>
   void project(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const;
+  /// The same on the canvas.
+  template <typename PointT>
+  void projectCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointT>& cloud) const;
 
 private:
-  /// Index of the winning point per pixel (-1 none) and its depth (0 none).
-  void scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth, cv::Mat* winner) const;
-  void requireCalibration() const;
+  /// Depth (0 none) of the winning return per pixel of an image grown by `margin`, and
+  /// its index in the scan (-1 none) when `winner` is given.
+  void scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin, cv::Mat& depth, cv::Mat* winner) const;
+  void projectDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin, cv::Mat& depth,
+                    cv::Mat* intensity) const;
+  template <typename PointT>
+  void projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin, pcl::PointCloud<PointT>& cloud) const;
 
   ProjectionConfig config_;
+  Calibration calibration_;
   PinholeCamera camera_;
   Eigen::Matrix<float, 3, 4> T_cam_velo_ = Eigen::Matrix<float, 3, 4>::Zero(); ///< velodyne -> this camera
   float skew_ = 0.f;
   bool calibrated_ = false;
-  mutable std::vector<int> pixel_;     ///< per scan point: pixel index or -1 (reused)
-  mutable std::vector<float> depth_;   ///< per scan point: depth in the camera
+  mutable std::vector<int> pixel_;    ///< per scan point: pixel index or -1
+  mutable std::vector<float> depth_;  ///< per scan point: depth in the camera
+  mutable cv::Mat winner_;
 };
 
 } // namespace msf

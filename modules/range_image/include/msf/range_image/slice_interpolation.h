@@ -20,14 +20,15 @@ const char* toString(SliceInterpolant interpolant);
 struct SliceParams {
   SliceInterpolant interpolant = SliceInterpolant::Compound;
   int short_gap_px = 4;        ///< gaps of at most this many empty pixels take the cubic
-  int max_gap_px = 16;         ///< longer gaps stay empty
+  int max_gap_px = 64;         ///< longer gaps stay empty
   /// A gap is an object edge when its ends z0, z1 differ by more than all three of:
   float jump_abs_m = 0.5f;     ///< an absolute jump |z1 - z0| in metres,
   float jump_rel = 0.f;        ///< a share of the nearer depth,
   float jump_inv_per_m = 0.03f;///< and a jump in inverse depth |1/z0 - 1/z1| (disparity / (f B))
   float cubic_alpha = 2.f;     ///< cubic weight beta t^2 - alpha t^3 (paper: 2, 3)
   float cubic_beta = 3.f;
-  bool inverse_depth = false;  ///< interpolate 1/z, which is linear in the image for a plane
+  bool inverse_depth = true;   ///< interpolate 1/z, which is affine in the image along a plane
+                               ///< (false: plain depth, the paper's eq. 2-5 on z)
 };
 
 /// True when the ends z0, z1 of a gap are on two sides of an object edge.
@@ -38,6 +39,28 @@ inline bool isDepthJump(float z0, float z1, const SliceParams& p) {
   const float nearer = z1 < z0 ? z1 : z0;
   return d > p.jump_abs_m && d > p.jump_rel * nearer && d > p.jump_inv_per_m * z0 * z1;
 }
+
+/// Calls emit(k, z) with the estimate z of the k-th (1..empty) of the `empty` pixels
+/// strictly between two samples z0 and z1 of a slice: the zero-slope cubic for short gaps
+/// (compound) or always (cubic), else linear. The caller has checked the gap (its length,
+/// the depth jump across it).
+template <typename Emit>
+inline void bridgeValues(float z0, float z1, int empty, const SliceParams& p, Emit&& emit) {
+  const bool cubic = p.interpolant == SliceInterpolant::Cubic ||
+                     (p.interpolant == SliceInterpolant::Compound && empty <= p.short_gap_px);
+  const float a = p.inverse_depth ? 1.f / z0 : z0;
+  const float delta = (p.inverse_depth ? 1.f / z1 : z1) - a;
+  const float step = 1.f / static_cast<float>(empty + 1);
+  for (int k = 1; k <= empty; ++k) {
+    const float t = static_cast<float>(k) * step;
+    const float w = cubic ? t * t * (p.cubic_beta - p.cubic_alpha * t) : t; // paper eq. 3-5 / eq. 2
+    const float v = a + delta * w;
+    emit(k, p.inverse_depth ? 1.f / v : v);
+  }
+}
+
+/// The number of empty pixels of a gap, saturated to what a gap image holds.
+inline std::uint8_t gapCode(int empty) { return static_cast<std::uint8_t>(empty < 255 ? empty : 255); }
 
 /// Fills one slice of `n` pixels read at `in[i * stride]` (a sample is > 0; 0 or NaN is
 /// empty) into `out[i * stride]` (0 where there is no estimate) and `gap[i * stride]` (the
