@@ -1,0 +1,155 @@
+// Paper step 2: compound interpolation of a projected LiDAR scan (or a baseline).
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/io/calibration.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/pinhole_camera.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/range_image/compound_interpolation.h>
+#include <msf/range_image/ip_basic_completion.h>
+#include <msf/range_image/lidar_completion.h>
+#include <msf/range_image/point_types.h>
+
+#include <pcl/common/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <in.pcd> <out.pcd> [options]\n", name);
+  print_error("       or: %s <scan.bin|scan.pcd> <out.pcd> -calib PATH [options]\n", name);
+  print_info("  Densifies a sparse organized LiDAR cloud (msf_project's output) into an organized\n"
+             "  msf::PointXYZID cloud (x y z intensity distance): every pixel with an estimate is a point on\n"
+             "  its pixel's ray; `distance` is the distance in pixels to the nearest real return. Given a raw\n"
+             "  scan (.bin, or an unorganized .pcd) and -calib, it projects the scan itself, with the returns\n"
+             "  just outside the image (projection.margin_px) that bridge the gaps at the image's edges.\n");
+  print_info("  where options are:\n");
+  print_info("    -method NAME     compound (default, paper step 2) | linear | cubic | ipbasic | ipbasic_multiscale\n");
+  print_info("    -config FILE     YAML config, sections interpolation, projection, ip_basic\n");
+  print_info("    -calib PATH      calibration: camera of the cloud (else recovered from its points); needed for a scan\n");
+  print_info("    -camera N        rectified camera 0..3 of -calib (default 0)\n");
+  print_info("    -short_gap N     gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)\n");
+  print_info("    -max_gap N       longer gaps stay empty (interpolation.max_gap_px)\n");
+  print_info("    -no_gaussian     no Gaussian hole filling after the slices (interpolation.gaussian: false)\n");
+  print_info("    -threads N       OpenMP threads (0: all)\n");
+}
+
+std::size_t countValid(const pcl::PointCloud<msf::PointXYZID>& cloud) {
+  std::size_t n = 0;
+  for (const auto& p : cloud)
+    n += std::isfinite(p.z);
+  return n;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_interpolate", [&] {
+    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return argc < 2 ? 1 : 0;
+    }
+    const std::vector<std::string> value_options{"-method", "-config", "-calib", "-camera",
+                                                 "-short_gap", "-max_gap", "-threads"};
+    msf::tool::checkOptions(argc, argv, value_options, {"-no_gaussian"});
+    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+    if (files.size() != 2)
+      throw msf::InvalidInputError("expected <in.pcd> <out.pcd> (see -h)");
+    const std::string in = files[0], out = files[1];
+    const std::string in_ext = msf::fileExtension(in);
+    if (in_ext != ".pcd" && in_ext != ".bin")
+      throw msf::InvalidInputError("input '" + in + "' must be a .pcd cloud or a KITTI .bin scan");
+    if (msf::fileExtension(out) != ".pcd")
+      throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
+
+    std::string method_name = "compound", config_path, calib_path;
+    parse_argument(argc, argv, "-method", method_name);
+    const msf::CompletionMethod method = msf::parseCompletionMethod(method_name);
+    parse_argument(argc, argv, "-config", config_path);
+    parse_argument(argc, argv, "-calib", calib_path);
+    const msf::ConfigFile file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
+    msf::ProjectionConfig projection;
+    projection.read(file.section("projection"));
+    parse_argument(argc, argv, "-camera", projection.camera);
+    projection.validate();
+    msf::InterpolationConfig interpolation;
+    interpolation.read(file.section("interpolation"));
+    parse_argument(argc, argv, "-short_gap", interpolation.slice.short_gap_px);
+    parse_argument(argc, argv, "-max_gap", interpolation.slice.max_gap_px);
+    parse_argument(argc, argv, "-threads", interpolation.threads);
+    if (find_switch(argc, argv, "-no_gaussian"))
+      interpolation.gaussian = false;
+    if (method == msf::CompletionMethod::Linear)
+      interpolation.slice.interpolant = msf::SliceInterpolant::Linear;
+    else if (method == msf::CompletionMethod::Cubic)
+      interpolation.slice.interpolant = msf::SliceInterpolant::Cubic;
+    interpolation.validate();
+    msf::IpBasicConfig ip_basic;
+    ip_basic.read(file.section("ip_basic"));
+    ip_basic.variant = method == msf::CompletionMethod::IpBasicFast ? msf::IpBasicVariant::Fast
+                                                                    : msf::IpBasicVariant::Multiscale;
+
+    // A .bin is a scan; a .pcd is a scan when it is not organized.
+    pcl::StopWatch watch;
+    print_highlight("Loading ");
+    print_value("%s ", in.c_str());
+    pcl::PointCloud<pcl::PointXYZI>::Ptr input(new pcl::PointCloud<pcl::PointXYZI>);
+    if (in_ext == ".bin")
+      msf::loadVelodyneBin(in, *input);
+    else
+      msf::loadCloud(in, *input);
+    msf::tool::printDone(watch.getTime(), input->size());
+    const bool is_scan = !input->isOrganized();
+    const bool ip = method == msf::CompletionMethod::IpBasicFast || method == msf::CompletionMethod::IpBasicMultiscale;
+
+    pcl::PointCloud<msf::PointXYZID> dense;
+    watch.reset();
+    print_highlight("Interpolating ");
+    print_info("(%s%s) ", msf::toString(method), is_scan ? ", from the scan" : "");
+    if (is_scan) {
+      if (calib_path.empty())
+        throw msf::InvalidInputError("'" + in + "' is a scan (not an organized cloud): give -calib to project it, "
+                                     "or project it first with msf_project");
+      msf::LidarCompletion completion(msf::loadCalibration(calib_path), method, projection, interpolation, ip_basic);
+      completion.compute(*input, dense);
+    } else {
+      pcl::PointCloud<msf::PointXYZID>::Ptr sparse(new pcl::PointCloud<msf::PointXYZID>);
+      pcl::copyPointCloud(*input, *sparse);
+      for (auto& p : *sparse)
+        p.distance = std::isfinite(p.z) ? 0.f : std::numeric_limits<float>::infinity();
+      msf::PinholeCamera camera;
+      if (!calib_path.empty())
+        camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib_path), projection.camera);
+      if (ip) {
+        msf::IpBasicCompletion<msf::PointXYZID> filter;
+        filter.setConfig(ip_basic);
+        filter.setCamera(camera);
+        filter.setInputCloud(sparse);
+        filter.filter(dense);
+      } else {
+        msf::CompoundInterpolation<msf::PointXYZID> filter;
+        filter.setConfig(interpolation);
+        filter.setCamera(camera);
+        filter.setInputCloud(sparse);
+        filter.filter(dense);
+      }
+    }
+    msf::tool::printDone(watch.getTime(), countValid(dense));
+
+    watch.reset();
+    print_highlight("Saving ");
+    print_value("%s ", out.c_str());
+    msf::saveCloud(out, dense);
+    msf::tool::printDone(watch.getTime(), dense.size());
+    return 0;
+  });
+}
