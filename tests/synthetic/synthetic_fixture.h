@@ -7,8 +7,8 @@
 
 namespace msf::test {
 
-/// One generator and its rendered frames, shared by the tests of this executable:
-/// rendering is the slow part, so each frame is rendered once.
+/// One generator and its rendered frames (grey cameras, LiDAR, ground truth), shared by the
+/// tests of this executable: rendering is the slow part, so each frame is rendered once.
 class SharedStreet {
 public:
   static SharedStreet& instance() {
@@ -19,7 +19,7 @@ public:
   const synthetic::SyntheticFrame& frame(std::size_t i) {
     auto it = frames_.find(i);
     if (it == frames_.end())
-      it = frames_.emplace(i, generator_->renderFrame(i)).first;
+      it = frames_.emplace(i, generator_->renderFrame(i, false)).first;
     return it->second;
   }
   static synthetic::SyntheticConfig config() {

@@ -6,6 +6,7 @@
 #include <msf/synthetic/procedural_noise.h>
 #include <msf/synthetic/scene.h>
 #include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/trajectory.h>
 
 #include <gtest/gtest.h>
 
@@ -157,6 +158,28 @@ TEST(SyntheticScene, StreetHasEveryKindOfObjectAndIsDeterministic) {
   EXPECT_GT(hit.t, 100.f);
   EXPECT_TRUE(a.occupied({0.f, 1.7f, 0.f}, 0.f));  // below the road
   EXPECT_FALSE(a.occupied({0.f, 1.6f, 0.f}, 0.f)); // above it
+}
+
+TEST(SyntheticTrajectory, DrivesTenMetresASecondFromTheWorldOrigin) {
+  SyntheticConfig config;
+  config.frames = 101;
+  const msf::PoseList poses = streetTrajectory(config);
+  ASSERT_EQ(poses.size(), 101u);
+  EXPECT_TRUE(poses[0].isApprox(Eigen::Isometry3d::Identity(), 1e-12)); // the world is camera 0 at frame 0
+  EXPECT_NEAR(poses[1].translation().z(), 1.0, 1e-9);                  // 10 m/s at 10 Hz
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Eigen::Vector3d step = poses[i].translation() - poses[i - 1].translation();
+    EXPECT_NEAR(step.norm(), 1.0, 0.002);
+    EXPECT_NEAR(poses[i].translation().y(), 0.0, 1e-12); // constant height over the flat road
+    // The heading follows the path, turning about the vertical axis only.
+    const Eigen::Vector3d forward = poses[i].linear() * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(forward.y(), 0.0, 1e-12);
+    EXPECT_NEAR(std::atan2(forward.x(), forward.z()), std::atan2(step.x(), step.z()), 0.002);
+    EXPECT_LE(std::fabs(poses[i].translation().x()), 0.8 + 1e-9); // stays in its lane
+  }
+  const auto times = frameTimes(config);
+  EXPECT_DOUBLE_EQ(times[0], 0.0);
+  EXPECT_DOUBLE_EQ(times[10], 1.0);
 }
 
 TEST(SyntheticTextures, PulseCoverageIsTheExactBoxFilter) {

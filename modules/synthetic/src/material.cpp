@@ -154,7 +154,7 @@ SurfaceResponse facade(const Material& m, const Primitive& p, const Hit& hit, co
     wall = mix(base(m) * (brick * (1.f + 0.1f * fbm(f.u, f.v, m.seed + 7u, 0.8f, 6, iso))), {0.5f, 0.48f, 0.45f},
                mortar * 0.8f);
   } else {
-    const float n = fbm(f.u, f.v, m.seed, 1.5f, 8, iso);
+    const float n = fbm(f.u, f.v, m.seed, 1.5f, 7, iso);
     const float streak = valueNoise(f.u / 0.3f, f.v / 3.f, m.seed + 13u);
     wall = base(m) * (1.f + 0.16f * n + 0.05f * streak);
   }

@@ -132,19 +132,22 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
 }
 
 namespace {
-inline bool slabHit(V3 lo, V3 hi, V3 o, V3 inv, float tmin, float tmax) {
+/// Entry distance of the ray into the box if it meets it within [tmin, tmax]. A NaN from
+/// 0 * inf (a ray in a slab's plane) fails both comparisons and keeps the interval.
+inline void slab(float lo, float hi, float o, float inv, float& t0, float& t1) {
+  float a = (lo - o) * inv, b = (hi - o) * inv;
+  if (a > b)
+    std::swap(a, b);
+  t0 = a > t0 ? a : t0;
+  t1 = b < t1 ? b : t1;
+}
+inline bool slabEntry(const V3& lo, const V3& hi, const V3& o, const V3& inv, float tmin, float tmax, float& entry) {
   float t0 = tmin, t1 = tmax;
-  for (int k = 0; k < 3; ++k) {
-    float ta = (lo[k] - o[k]) * inv[k], tb = (hi[k] - o[k]) * inv[k];
-    if (ta > tb)
-      std::swap(ta, tb);
-    // NaN (0 * inf for a ray in the slab's plane) keeps the current interval.
-    t0 = ta > t0 ? ta : t0;
-    t1 = tb < t1 ? tb : t1;
-    if (t0 > t1)
-      return false;
-  }
-  return true;
+  slab(lo.x, hi.x, o.x, inv.x, t0, t1);
+  slab(lo.y, hi.y, o.y, inv.y, t0, t1);
+  slab(lo.z, hi.z, o.z, inv.z, t0, t1);
+  entry = t0;
+  return t0 <= t1;
 }
 } // namespace
 
@@ -163,40 +166,58 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
       found = true;
     }
   }
-  if (nodes_.empty())
+  float entry = 0.f;
+  if (nodes_.empty() || !slabEntry(nodes_[0].lo, nodes_[0].hi, ray.origin, {1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z}, tmin, hit.t, entry))
     return found;
   const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
-  std::int32_t stack[64];
+  // Nodes whose box the ray enters, with the entry distance: a node is skipped when a hit
+  // found meanwhile lies before it; of two children the nearer is visited first.
+  struct Entry {
+    std::int32_t node;
+    float t;
+  };
+  Entry stack[64];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, entry};
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!slabHit(node.lo, node.hi, ray.origin, inv, tmin, hit.t))
+    const Entry e = stack[--top];
+    if (e.t > hit.t)
       continue;
+    const Node& node = nodes_[static_cast<std::size_t>(e.node)];
     if (node.count > 0) {
       for (std::int32_t i = node.index; i < node.index + node.count; ++i) {
-        const std::int32_t p = order_[i];
-        if (primitives[p].intersect(ray, tmin, hit)) {
+        const std::int32_t p = order_[static_cast<std::size_t>(i)];
+        if (primitives[static_cast<std::size_t>(p)].intersect(ray, tmin, hit)) {
           hit.primitive = p;
           found = true;
         }
       }
       continue;
     }
-    const std::int32_t left = static_cast<std::int32_t>(&node - nodes_.data()) + 1, right = node.index;
-    // Near child last on the stack, so it is visited first and shortens the far one.
-    if (ray.dir[node.axis] > 0.f) {
-      stack[top++] = right;
-      stack[top++] = left;
-    } else {
-      stack[top++] = left;
-      stack[top++] = right;
+    const std::int32_t left = e.node + 1, right = node.index;
+    float t_left = 0.f, t_right = 0.f;
+    const bool hit_left = slabEntry(nodes_[static_cast<std::size_t>(left)].lo, nodes_[static_cast<std::size_t>(left)].hi,
+                                    ray.origin, inv, tmin, hit.t, t_left);
+    const bool hit_right = slabEntry(nodes_[static_cast<std::size_t>(right)].lo,
+                                     nodes_[static_cast<std::size_t>(right)].hi, ray.origin, inv, tmin, hit.t, t_right);
+    if (hit_left && hit_right) {
+      if (t_left <= t_right) {
+        stack[top++] = {right, t_right};
+        stack[top++] = {left, t_left};
+      } else {
+        stack[top++] = {left, t_left};
+        stack[top++] = {right, t_right};
+      }
+    } else if (hit_left) {
+      stack[top++] = {left, t_left};
+    } else if (hit_right) {
+      stack[top++] = {right, t_right};
     }
   }
   return found;
 }
 
-bool Scene::occupied(V3 p, float inset) const {
+bool Scene::occupied(V3 p, float inset, std::int32_t skip) const {
   if (p.y > layout.ground_y + inset)
     return true;
   if (nodes_.empty())
@@ -211,7 +232,7 @@ bool Scene::occupied(V3 p, float inset) const {
       continue;
     if (node.count > 0) {
       for (std::int32_t i = node.index; i < node.index + node.count; ++i)
-        if (primitives[order_[i]].contains(p, inset))
+        if (order_[i] != skip && primitives[order_[i]].contains(p, inset))
           return true;
       continue;
     }

@@ -19,6 +19,9 @@ class MeshBuilder {
 public:
   MeshBuilder(const Scene& scene, float max_edge) : scene_(scene), max_edge_(max_edge) {}
 
+  /// The primitive being tessellated (-1: the road plane).
+  void setCurrent(std::int32_t index) { current_ = index; }
+
   void setColor(const Material& m) {
     auto to8 = [](float linear) {
       return static_cast<std::uint8_t>(std::lround(255.f * std::pow(std::clamp(linear, 0.f, 1.f), 1.f / 2.2f)));
@@ -42,7 +45,7 @@ public:
     for (int j = 0; j < nv; ++j)
       for (int i = 0; i < nu; ++i) {
         const V3 centre = (point(i, j) + point(i + 1, j + 1)) * 0.5f;
-        if (scene_.occupied(centre + n * kHiddenProbe, 0.f))
+        if (scene_.occupied(centre + n * kHiddenProbe, 0.f, current_))
           continue;
         const std::uint32_t a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
         triangles_.push_back({a, b, c});
@@ -53,7 +56,8 @@ public:
   /// One triangle, wound so that its normal agrees with `outward`; skipped when hidden.
   void triangle(V3 a, V3 b, V3 c, V3 outward) {
     const V3 centre = (a + b + c) * (1.f / 3.f);
-    if (scene_.occupied(centre + normalized(outward) * kHiddenProbe, 0.f))
+    // The solid itself does not hide its own faces: a chord of a curved face lies inside it.
+    if (scene_.occupied(centre + normalized(outward) * kHiddenProbe, 0.f, current_))
       return;
     if (dot(cross(b - a, c - a), outward) < 0.f)
       std::swap(b, c);
@@ -165,6 +169,7 @@ private:
 
   const Scene& scene_;
   float max_edge_;
+  std::int32_t current_ = -1;
   std::array<std::uint8_t, 3> color_{{128, 128, 128}};
   pcl::PointCloud<pcl::PointXYZRGB> cloud_;
   std::vector<std::array<std::uint32_t, 3>> triangles_;
@@ -176,7 +181,9 @@ pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m) {
   MeshBuilder builder(scene, static_cast<float>(max_edge_m));
   builder.setColor(scene.materials[scene.ground_material]);
   builder.road();
-  for (const Primitive& p : scene.primitives) {
+  for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
+    const Primitive& p = scene.primitives[i];
+    builder.setCurrent(static_cast<std::int32_t>(i));
     builder.setColor(scene.materials[p.material]);
     switch (p.shape) {
     case Shape::Box:

@@ -115,7 +115,7 @@ SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
       renderer_(calibration_, config_),
       lidar_(config_) {}
 
-SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i) const {
+SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i, bool with_color) const {
   if (i >= poses_.size())
     throw InvalidInputError("frame " + std::to_string(i) + " is out of range: the sequence has " +
                             std::to_string(poses_.size()) + " frames");
@@ -123,7 +123,7 @@ SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i) const {
   SyntheticFrame f;
   cv::Mat ids;
   f.images[0] = renderer_.render(scene_, 0, T_world_cam0, i, &f.depth, &ids);
-  for (int camera = 1; camera < 4; ++camera)
+  for (int camera = 1; camera < (with_color ? 4 : 2); ++camera)
     f.images[camera] = renderer_.render(scene_, camera, T_world_cam0, i);
   f.scan = lidar_.scan(scene_, T_world_cam0 * calibration_.T_cam0_velo, i);
 

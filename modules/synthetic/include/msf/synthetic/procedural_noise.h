@@ -35,8 +35,15 @@ inline float valueNoise(float x, float y, std::uint32_t seed) {
   const float tx = x - fx, ty = y - fy;
   const float sx = tx * tx * tx * (tx * (tx * 6.f - 15.f) + 10.f);
   const float sy = ty * ty * ty * (ty * (ty * 6.f - 15.f) + 10.f);
-  const float a = cellRandom(ix, iy, seed), b = cellRandom(ix + 1, iy, seed);
-  const float c = cellRandom(ix, iy + 1, seed), d = cellRandom(ix + 1, iy + 1, seed);
+  // hashCell with the row hash shared by the two cells of a row.
+  const std::uint32_t row0 = hash32(static_cast<std::uint32_t>(iy) + seed);
+  const std::uint32_t row1 = hash32(static_cast<std::uint32_t>(iy + 1) + seed);
+  const auto ux = static_cast<std::uint32_t>(ix) * 0x9e3779b1U, ux1 = ux + 0x9e3779b1U;
+  constexpr float kScale = 1.0f / 16777216.0f;
+  const float a = static_cast<float>(hash32(ux ^ row0) >> 8) * kScale;
+  const float b = static_cast<float>(hash32(ux1 ^ row0) >> 8) * kScale;
+  const float c = static_cast<float>(hash32(ux ^ row1) >> 8) * kScale;
+  const float d = static_cast<float>(hash32(ux1 ^ row1) >> 8) * kScale;
   const float top = a + (b - a) * sx, bottom = c + (d - c) * sx;
   return 2.f * (top + (bottom - top) * sy) - 1.f;
 }

@@ -45,8 +45,9 @@ public:
   /// Nearest surface with t in (tmin, tmax); false for the sky.
   bool intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const;
 
-  /// True when p lies inside a solid, or below the road plane, by more than `inset`.
-  bool occupied(V3 p, float inset) const;
+  /// True when p lies inside a solid other than primitives[skip], or below the road plane,
+  /// by more than `inset`.
+  bool occupied(V3 p, float inset, std::int32_t skip = -1) const;
 
   /// Number of foreground instances (largest object id).
   std::uint32_t objectCount() const;

@@ -20,7 +20,7 @@ namespace msf::synthetic {
 
 /// Everything of one synthetic frame, in memory.
 struct SyntheticFrame {
-  cv::Mat images[4];  ///< cameras 0, 1: grey CV_8UC1; 2, 3: BGR CV_8UC3 (rectified)
+  cv::Mat images[4];  ///< cameras 0, 1: grey CV_8UC1; 2, 3: BGR CV_8UC3 (rectified) or empty
   pcl::PointCloud<pcl::PointXYZI> scan; ///< Velodyne frame, ring after ring
   cv::Mat depth;      ///< camera 0, CV_32F metres, 0 = no ground truth (sky, beyond 255 m)
   cv::Mat disparity;  ///< grey pair, CV_32F pixels (f B / depth), 0 where depth is 0
@@ -42,8 +42,9 @@ public:
   const LidarSimulator& lidar() const { return lidar_; }
   std::size_t size() const { return poses_.size(); }
 
-  /// Renders frame i; throws InvalidInputError when i is out of range.
-  SyntheticFrame renderFrame(std::size_t i) const;
+  /// Renders frame i; `with_color` false skips cameras 2 and 3 (left empty). Throws
+  /// InvalidInputError when i is out of range.
+  SyntheticFrame renderFrame(std::size_t i, bool with_color = true) const;
 
   /// The true surface (see sceneMesh in scene_mesh.h).
   pcl::PolygonMesh mesh() const;

@@ -1,0 +1,298 @@
+// The written dataset: KITTI's odometry layout that the project's readers open unchanged,
+// ground truth that matches the renderer, byte-identical output for a seed, no partial output.
+#include <msf/common/exceptions.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/image_io.h>
+#include <msf/io/sequence.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/synthetic/ground_truth.h>
+#include <msf/synthetic/synthetic_generator.h>
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <pcl/conversions.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using msf::synthetic::GroundTruth;
+using msf::synthetic::SyntheticConfig;
+using msf::synthetic::SyntheticGenerator;
+
+SyntheticConfig smallConfig(int frames, int seed) {
+  SyntheticConfig c;
+  c.frames = frames;
+  c.seed = seed;
+  return c;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::vector<fs::path> filesUnder(const fs::path& root) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.is_regular_file())
+      files.push_back(fs::relative(e.path(), root));
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// A dataset of one frame, written once for the tests of this file (rendering is the slow
+/// part; the trajectory over many frames is tested on its own).
+class SyntheticDataset : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    dir_ = new msf::test::TempDir;
+    generator_ = new SyntheticGenerator(smallConfig(1, 3));
+    generator_->writeDataset(root());
+  }
+  static void TearDownTestSuite() {
+    delete generator_;
+    delete dir_;
+  }
+  static std::string root() { return dir_->file("street"); }
+  static msf::test::TempDir* dir_;
+  static SyntheticGenerator* generator_;
+};
+msf::test::TempDir* SyntheticDataset::dir_ = nullptr;
+SyntheticGenerator* SyntheticDataset::generator_ = nullptr;
+
+TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutWithGroundTruth) {
+  const fs::path r(root());
+  for (const char* f : {"sequences/00/calib.txt", "sequences/00/times.txt", "poses/00.txt", "gt/scene.ply",
+                        "gt/README.txt", "gt/synthetic.yaml", "sequences/00/velodyne/000000.bin",
+                        "gt/depth_0/000000.png", "gt/disp_0/000000.png", "gt/obj_map_0/000000.png"})
+    EXPECT_TRUE(fs::is_regular_file(r / f)) << f;
+  for (int c = 0; c < 4; ++c)
+    EXPECT_TRUE(fs::is_regular_file(r / "sequences/00" / ("image_" + std::to_string(c)) / "000000.png")) << c;
+  EXPECT_EQ(slurp(r / "sequences/00/times.txt"), "0.000000e+00\n");
+  // Nothing else is left beside the dataset (no staging folders).
+  EXPECT_EQ(msf::test::countEntries(dir_->path()), 1u);
+}
+
+TEST_F(SyntheticDataset, SequenceOpensItUnchanged) {
+  for (const std::string& path : {root(), root() + "/sequences/00"}) {
+    const msf::Sequence seq(path);
+    EXPECT_EQ(seq.layout(), msf::Sequence::Layout::Odometry);
+    ASSERT_EQ(seq.size(), 1u);
+    EXPECT_EQ(seq.frameName(0), "000000");
+    const msf::Calibration& calib = seq.calibration();
+    EXPECT_EQ(calib.image_size, cv::Size(1242, 375));
+    EXPECT_NEAR(calib.fx(), 721.5377, 1e-4);
+    EXPECT_NEAR(calib.cx(), 609.5593, 1e-4);
+    EXPECT_NEAR(calib.cy(), 172.854, 1e-4);
+    EXPECT_NEAR(calib.baselineGrey(), 0.537, 0.001);
+    EXPECT_NEAR(calib.baselineColor(), 0.532, 0.002);
+    // The Velodyne sits about 8 cm above and 27 cm behind camera 0.
+    const Eigen::Vector3d velo = calib.T_cam0_velo.translation(); // its origin in camera 0
+    EXPECT_NEAR(velo.x(), 0.0, 0.02);
+    EXPECT_NEAR(velo.y(), -0.08, 0.02);
+    EXPECT_NEAR(velo.z(), -0.27, 0.02);
+    ASSERT_TRUE(seq.hasPoses());
+    EXPECT_TRUE(seq.poses()[0].isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+    EXPECT_EQ(fs::path(seq.groundTruthDir()), fs::path(root()) / "gt");
+    const msf::Frame f = seq.load(0);
+    EXPECT_EQ(f.left.type(), CV_8UC1);
+    EXPECT_EQ(f.color.type(), CV_8UC3);
+    EXPECT_GT(f.scan->size(), 90000u);
+  }
+}
+
+TEST_F(SyntheticDataset, FilesHoldWhatTheGeneratorRendered) {
+  const SyntheticGenerator& gen = *generator_;
+  const msf::synthetic::SyntheticFrame frame = gen.renderFrame(0, false);
+  const fs::path seq = fs::path(root()) / "sequences/00";
+  for (int c = 0; c < 4; ++c) {
+    const cv::Mat image = msf::readImage((seq / ("image_" + std::to_string(c)) / "000000.png").string(), -1);
+    EXPECT_EQ(image.size(), cv::Size(1242, 375));
+    EXPECT_EQ(image.type(), c < 2 ? CV_8UC1 : CV_8UC3);
+    if (c < 2) {
+      EXPECT_EQ(cv::norm(image, frame.images[c], cv::NORM_INF), 0.0) << "camera " << c;
+    }
+  }
+  EXPECT_TRUE(frame.images[2].empty());
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  msf::loadVelodyneBin((seq / "velodyne/000000.bin").string(), scan);
+  ASSERT_EQ(scan.size(), frame.scan.size());
+  for (std::size_t i = 0; i < scan.size(); i += 997) {
+    EXPECT_EQ(scan[i].x, frame.scan[i].x);
+    EXPECT_EQ(scan[i].intensity, frame.scan[i].intensity);
+  }
+
+  for (const std::string& path : {root(), (seq).string(), root() + "/gt"}) {
+    const GroundTruth gt(path);
+    ASSERT_EQ(gt.size(), 1u);
+    const cv::Mat depth = gt.depth(0), disparity = gt.disparity(0), objects = gt.objectMap(0);
+    // 16-bit PNGs hold 1/256 steps.
+    cv::Mat diff = cv::abs(depth - frame.depth);
+    EXPECT_LE(cv::norm(diff, cv::NORM_INF), 0.5 / 256 + 1e-6);
+    diff = cv::abs(disparity - frame.disparity);
+    EXPECT_LE(cv::norm(diff, cv::NORM_INF), 0.5 / 256 + 1e-6);
+    EXPECT_EQ(cv::norm(objects, frame.objects, cv::NORM_INF), 0.0);
+    // Disparity is f B / z where depth exists, and absent exactly where depth is.
+    const double fB = gen.calibration().focalBaseline();
+    for (int v = 0; v < depth.rows; v += 7)
+      for (int u = 0; u < depth.cols; u += 7) {
+        const float z = frame.depth.at<float>(v, u);
+        ASSERT_EQ(z > 0.f, disparity.at<float>(v, u) > 0.f) << u << "," << v;
+        if (z > 0.f) {
+          ASSERT_NEAR(disparity.at<float>(v, u), fB / z, 0.5 / 256 + 1e-4);
+        }
+      }
+    const int fg = cv::countNonZero(gt.foregroundMask(0)), bg = cv::countNonZero(gt.backgroundMask(0));
+    EXPECT_GT(fg, 1000);
+    EXPECT_EQ(fg + bg, cv::countNonZero(depth > 0.f));
+    EXPECT_TRUE(fs::is_regular_file(gt.sceneMeshPath()));
+    EXPECT_EQ(gt.indexOf("000000"), 0u);
+    EXPECT_THROW(gt.depth(1), msf::InvalidInputError);
+  }
+  EXPECT_THROW(GroundTruth(dir_->path() + "/nothing"), msf::IOError);
+  EXPECT_EQ(GroundTruth::find("/"), "");
+}
+
+/// Distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5).
+double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                             const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0)
+    return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3)
+    return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0)
+    return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6)
+    return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0)
+    return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+TEST_F(SyntheticDataset, SceneMeshIsTheSurfaceTheCamerasSee) {
+  pcl::PolygonMesh mesh;
+  msf::loadMesh(GroundTruth(root()).sceneMeshPath(), mesh);
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  pcl::fromPCLPointCloud2(mesh.cloud, vertices);
+  ASSERT_GT(mesh.polygons.size(), 10000u);
+  // Back-project ground-truth pixels of frame 0 into the world (poses/00.txt's frame) and
+  // measure their distance to the mesh: only tessellation of curved solids may differ.
+  const msf::Sequence seq(root());
+  const GroundTruth gt(root());
+  const cv::Mat depth = gt.depth(0);
+  const msf::Calibration& calib = seq.calibration();
+  std::vector<Eigen::Vector3d> points;
+  for (int v = 5; v < depth.rows; v += 37)
+    for (int u = 5; u < depth.cols; u += 61) {
+      const double z = depth.at<float>(v, u);
+      if (z <= 0.0 || z > 60.0)
+        continue;
+      const Eigen::Vector3d cam((u - calib.cx()) * z / calib.fx(), (v - calib.cy()) * z / calib.fy(), z);
+      points.push_back(seq.poses()[0] * cam);
+    }
+  ASSERT_GT(points.size(), 100u);
+  std::vector<double> distances;
+  for (const Eigen::Vector3d& p : points) {
+    double best = 1e9;
+    for (const auto& poly : mesh.polygons) {
+      const auto& a = vertices[poly.vertices[0]], &b = vertices[poly.vertices[1]], &c = vertices[poly.vertices[2]];
+      // Quick reject by the bounding box grown by the best distance so far.
+      const double lo_x = std::min({a.x, b.x, c.x}) - best, hi_x = std::max({a.x, b.x, c.x}) + best;
+      const double lo_z = std::min({a.z, b.z, c.z}) - best, hi_z = std::max({a.z, b.z, c.z}) + best;
+      if (p.x() < lo_x || p.x() > hi_x || p.z() < lo_z || p.z() > hi_z)
+        continue;
+      best = std::min(best, pointTriangleDistance(p, a.getVector3fMap().cast<double>(),
+                                                  b.getVector3fMap().cast<double>(), c.getVector3fMap().cast<double>()));
+    }
+    distances.push_back(best);
+    if (best > 0.1)
+      std::printf("far: %.3f %.3f %.3f -> %.3f\n", p.x(), p.y(), p.z(), best);
+  }
+  std::sort(distances.begin(), distances.end());
+  const double median = distances[distances.size() / 2], p95 = distances[distances.size() * 95 / 100];
+  std::printf("scene.ply: %zu triangles; distance of %zu true surface points to it: median %.4f m, 95th %.4f m\n",
+              mesh.polygons.size(), distances.size(), median, p95);
+  EXPECT_LT(median, 0.005);
+  EXPECT_LT(p95, 0.03);
+}
+
+TEST_F(SyntheticDataset, SameSeedGivesByteIdenticalFilesAndAnotherSeedDoesNot) {
+  msf::test::TempDir other;
+  const std::string again = other.file("again");
+  SyntheticGenerator(smallConfig(1, 3)).writeDataset(again);
+  const auto files = filesUnder(root());
+  ASSERT_EQ(files, filesUnder(again));
+  for (const auto& f : files)
+    EXPECT_TRUE(slurp(fs::path(root()) / f) == slurp(fs::path(again) / f)) << f;
+
+  // Another seed: another street, other noise.
+  const SyntheticGenerator different(smallConfig(1, 4));
+  const cv::Mat image = msf::readImage((fs::path(root()) / "sequences/00/image_0/000000.png").string(), -1);
+  EXPECT_GT(cv::norm(image, different.renderFrame(0, false).images[0], cv::NORM_L1), 10.0 * image.total());
+}
+
+TEST(SyntheticDatasetOutput, ReplacesAnEarlierDatasetAndRefusesAForeignFolder) {
+  msf::test::TempDir dir;
+  // An earlier dataset (gt/scene.ply and sequences/) is replaced as a whole, not merged.
+  const std::string root = dir.file("ds");
+  fs::create_directories(root + "/gt");
+  fs::create_directories(root + "/sequences/00/image_0");
+  std::ofstream(root + "/gt/scene.ply") << "old";
+  std::ofstream(root + "/sequences/00/image_0/000005.png") << "old";
+  SyntheticGenerator(smallConfig(1, 1)).writeDataset(root);
+  EXPECT_EQ(msf::Sequence(root).size(), 1u);
+  EXPECT_FALSE(fs::exists(root + "/sequences/00/image_0/000005.png"));
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 1u);
+
+  const std::string foreign = dir.file("photos");
+  fs::create_directory(foreign);
+  std::ofstream(foreign + "/keep.jpg") << "x";
+  try {
+    SyntheticGenerator(smallConfig(1, 1)).writeDataset(foreign);
+    ADD_FAILURE() << "a non-empty foreign folder was overwritten";
+  } catch (const msf::IOError& e) {
+    EXPECT_NE(std::string(e.what()).find(foreign), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(msf::test::countEntries(foreign), 1u);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 2u);
+
+  std::ofstream(dir.file("plain_file")) << "x";
+  EXPECT_THROW(SyntheticGenerator(smallConfig(1, 1)).writeDataset(dir.file("plain_file") + "/ds"), msf::IOError);
+  EXPECT_THROW(SyntheticGenerator(smallConfig(1, 1)).writeDataset(dir.file("missing/ds")), msf::IOError);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 3u);
+}
+
+TEST(SyntheticDatasetOutput, AFailureMidwayLeavesNothing) {
+  msf::test::TempDir dir;
+  const SyntheticGenerator gen(smallConfig(2, 1));
+  EXPECT_THROW(gen.writeDataset(dir.file("ds"),
+                                [](std::size_t frame, double, std::size_t) {
+                                  if (frame == 0)
+                                    throw msf::IOError("disk full (simulated)");
+                                }),
+               msf::IOError);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 0u);
+  EXPECT_THROW(gen.renderFrame(2), msf::InvalidInputError);
+}
+
+} // namespace
