@@ -103,27 +103,40 @@ void SurfaceDistance::buildGrid() {
 }
 
 float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) const {
+  float best2 = max_distance_m * max_distance_m;
+  auto scan = [&](const Cell& cell) {
+    const auto it = grid_.find(cell);
+    if (it == grid_.end())
+      return;
+    for (std::uint32_t t : it->second) {
+      const auto& tri = triangles_[t];
+      best2 = std::min(best2, (closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p)
+                                  .squaredNorm());
+    }
+  };
+  // The point's own cell first: near the surface it bounds the search, and the other cells
+  // are visited only when their box is nearer than the best distance so far.
+  const Cell home = cellOf(p);
+  scan(home);
   const Cell a = cellOf(p - Eigen::Vector3f::Constant(max_distance_m));
   const Cell b = cellOf(p + Eigen::Vector3f::Constant(max_distance_m));
-  float best2 = max_distance_m * max_distance_m;
   for (int x = a.x(); x <= b.x(); ++x)
     for (int y = a.y(); y <= b.y(); ++y)
       for (int z = a.z(); z <= b.z(); ++z) {
-        const auto it = grid_.find(Cell(x, y, z));
-        if (it == grid_.end())
+        const Cell cell(x, y, z);
+        if (cell == home)
           continue;
-        for (std::uint32_t t : it->second) {
-          const auto& tri = triangles_[t];
-          const float d2 =
-              (closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p).squaredNorm();
-          best2 = std::min(best2, d2);
-        }
+        const Eigen::Vector3f lo = cell.cast<float>() * cell_size_, hi = lo.array() + cell_size_;
+        const float box2 = (p.cwiseMax(lo).cwiseMin(hi) - p).squaredNorm();
+        if (box2 < best2)
+          scan(cell);
       }
   return std::sqrt(best2);
 }
 
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
-                          const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m) {
+                          const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m,
+                          std::size_t max_samples) {
   if (mesh.polygons.empty())
     throw InvalidInputError("the reconstructed mesh has no triangle");
   if (truth.polygons.empty())
@@ -137,29 +150,32 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   std::vector<std::array<std::uint32_t, 3>> triangles;
   meshArrays(mesh, vertices, triangles);
   const SurfaceDistance to_truth(truth, std::max(cap, 0.25f));
-  std::vector<double> distances(vertices.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (std::size_t i = 0; i < vertices.size(); ++i)
-    distances[i] = to_truth.distance(vertices[i], cap);
-  result.vertices = vertices.size();
+  // A regular stride over large inputs: deterministic, and the statistics barely move.
+  const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
+  std::vector<double> distances((vertices.size() + vertex_step - 1) / vertex_step);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::size_t i = 0; i < distances.size(); ++i)
+    distances[i] = to_truth.distance(vertices[i * vertex_step], cap);
+  result.vertices = distances.size();
   double sum = 0;
   std::size_t near = 0;
   for (double d : distances) {
     sum += d;
     near += d <= threshold_m;
   }
-  result.accuracy_mean_m = vertices.empty() ? 0.0 : sum / static_cast<double>(vertices.size());
+  result.accuracy_mean_m = distances.empty() ? 0.0 : sum / static_cast<double>(distances.size());
   result.accuracy_median_m = median(distances);
-  result.precision = vertices.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(vertices.size());
+  result.precision = distances.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(distances.size());
 
   const SurfaceDistance to_mesh(std::move(vertices), std::move(triangles), std::max(threshold, 0.1f));
+  const std::size_t truth_step = std::max<std::size_t>(1, (seen_truth.size() + max_samples - 1) / max_samples);
+  const std::size_t samples = (seen_truth.size() + truth_step - 1) / truth_step;
   std::size_t covered = 0;
-#pragma omp parallel for reduction(+ : covered) schedule(dynamic, 1024)
-  for (std::size_t i = 0; i < seen_truth.size(); ++i)
-    covered += to_mesh.distance(seen_truth[i], threshold) < threshold;
-  result.truth_samples = seen_truth.size();
-  result.completeness =
-      seen_truth.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(seen_truth.size());
+#pragma omp parallel for reduction(+ : covered) schedule(dynamic, 256)
+  for (std::size_t i = 0; i < samples; ++i)
+    covered += to_mesh.distance(seen_truth[i * truth_step], threshold) < threshold;
+  result.truth_samples = samples;
+  result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);
   return result;
 }
 

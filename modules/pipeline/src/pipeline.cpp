@@ -146,6 +146,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   std::thread depth([&] {
     try {
       while (auto item = loaded.pop()) {
+        if (stop && stop->load())
+          break; // a frame not started is dropped: a stop should be prompt
         FrameResult result = computeDepth(item->frame);
         result.name = sequence.frameName(item->frame.index);
         result.times.load_ms = item->load_ms;
@@ -168,10 +170,16 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
       ++stats.frames_done;
       if (on_frame)
         on_frame(*result);
+      if (stop && stop->load()) {
+        interrupted = stats.frames_done < frames.size();
+        break;
+      }
     }
   } catch (...) {
     fail(std::current_exception());
   }
+  loaded.close(); // wakes the other stages when the loop ended early
+  depths.close();
   loader.join();
   depth.join();
   if (failure)

@@ -47,7 +47,7 @@ private:
 
 /// Mesh quality against the true surface (DESIGN.md protocol 3).
 struct MeshAccuracy {
-  std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated
+  std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated (sampled)
   double accuracy_mean_m = 0;          ///< mean distance of mesh vertices to the truth (capped)
   double accuracy_median_m = 0;
   double precision = 0;                ///< share of mesh vertices within `threshold_m` of the truth
@@ -60,8 +60,10 @@ struct MeshAccuracy {
 /// Accuracy of `mesh` against `truth` (every vertex), and completeness of the seen true
 /// surface `seen_truth` (points on the truth, e.g. ground-truth depth pixels back-projected
 /// into the world) against `mesh`. Distances are exact point-to-triangle distances,
-/// capped at `cap_m`. Throws InvalidInputError when `mesh` or `truth` has no triangle.
+/// capped at `cap_m`. Inputs larger than `max_samples` are taken at a regular stride.
+/// Throws InvalidInputError when `mesh` or `truth` has no triangle.
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
-                          const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m = 1.0);
+                          const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m = 1.0,
+                          std::size_t max_samples = 200000);
 
 } // namespace msf

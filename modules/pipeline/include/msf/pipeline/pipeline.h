@@ -72,8 +72,9 @@ public:
   using FrameCallback = std::function<void(FrameResult&)>;
 
   /// Runs `frames` of `sequence` through the stages, overlapped. When `stop` becomes true,
-  /// no new frame is loaded and the frames already under way are finished, so the volume
-  /// holds whole frames only. An exception in any stage stops the run and is rethrown.
+  /// the frame being integrated is finished and the frames behind it are dropped, so the
+  /// stop is prompt and the volume holds whole frames only. An exception in any stage
+  /// stops the run and is rethrown.
   RunStats run(const Sequence& sequence, const std::vector<std::size_t>& frames, const FrameCallback& on_frame,
                const std::atomic<bool>* stop = nullptr);
 

@@ -1,0 +1,241 @@
+// The pipeline on a small synthetic sequence: same depth as the chain of tools, a sane
+// summary, a clean stop, and clear errors.
+#include <msf/common/exceptions.h>
+#include <msf/fusion/point_types.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/organized_conversion.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/bounded_queue.h>
+#include <msf/pipeline/pipeline.h>
+#include <msf/synthetic/synthetic_generator.h>
+
+#include "test_support.h"
+
+#include <opencv2/core.hpp>
+
+#include <csignal>
+#include <cstring>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace {
+
+/// A 4-frame synthetic street, generated once for the whole suite.
+class PipelineTest : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    dir_ = new msf::test::TempDir;
+    msf::synthetic::SyntheticConfig config;
+    config.frames = 4;
+    config.seed = 7;
+    msf::synthetic::SyntheticGenerator(config).writeDataset(dataset());
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static std::string dataset() { return dir_->file("street"); }
+  static msf::test::TempDir* dir_;
+};
+msf::test::TempDir* PipelineTest::dir_ = nullptr;
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The number after "key": in a JSON text (the first occurrence after `after`).
+double jsonNumber(const std::string& json, const std::string& key, const std::string& after = "") {
+  const std::size_t from = after.empty() ? 0 : json.find("\"" + after + "\"");
+  std::smatch m;
+  const std::string rest = json.substr(from == std::string::npos ? 0 : from);
+  if (!std::regex_search(rest, m, std::regex("\"" + key + "\": (-?[0-9.eE+-]+)")))
+    return std::nan("");
+  return std::stod(m[1]);
+}
+
+TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
+  const msf::Sequence sequence(dataset());
+  const msf::Frame frame = sequence.load(1);
+  msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+  const msf::FrameResult result = pipeline.computeDepth(frame);
+
+  msf::test::TempDir out;
+  const std::string calib = sequence.directory() + "/calib.txt";
+  const std::string steps[][2] = {
+      {"msf_project", sequence.scanPath(1) + " " + out.file("sparse.pcd") + " -calib " + calib},
+      {"msf_interpolate", out.file("sparse.pcd") + " " + out.file("lidar.pcd")},
+      {"msf_stereo", sequence.imagePath(0, 1) + " " + sequence.imagePath(1, 1) + " " + out.file("stereo.pcd") +
+                         " -calib " + calib + " -color " + sequence.imagePath(2, 1)},
+      {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + " -calib " + calib},
+  };
+  for (const auto& step : steps) {
+    const auto r = msf::test::runTool(step[0], step[1]);
+    ASSERT_EQ(r.exit_code, 0) << step[0] << ": " << r.err;
+  }
+  pcl::PointCloud<msf::PointXYZRGBWeight> chained;
+  msf::loadCloud(out.file("fused.pcd"), chained);
+  const cv::Mat a = msf::cloudToDepthImage(*result.fused), b = msf::cloudToDepthImage(chained);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(cv::countNonZero(a), a.total() / 2);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << "fused depth differs between the pipeline and the tools";
+}
+
+TEST_F(PipelineTest, RunIntegratesEveryFrameInOrderAndStopsCleanly) {
+  const msf::Sequence sequence(dataset());
+  const auto frames = sequence.indices(msf::FrameRange::parse("0:"));
+  {
+    msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+    std::vector<std::size_t> seen;
+    const auto stats = pipeline.run(sequence, frames, [&](msf::FrameResult& r) {
+      seen.push_back(r.index);
+      EXPECT_GT(r.times.integrate_ms, 0.0);
+      EXPECT_EQ(r.name, sequence.frameName(r.index));
+    });
+    EXPECT_EQ(seen, frames);
+    EXPECT_EQ(stats.frames_done, frames.size());
+    EXPECT_FALSE(stats.interrupted);
+    EXPECT_GT(pipeline.updateMesh().triangles.size(), 1000u);
+  }
+  {
+    // A stop during the first frame: it is finished, the frames behind it are dropped.
+    msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+    std::atomic<bool> stop{false};
+    const auto stats = pipeline.run(sequence, frames, [&](msf::FrameResult&) { stop = true; }, &stop);
+    EXPECT_TRUE(stats.interrupted);
+    EXPECT_EQ(stats.frames_done, 1u);
+    EXPECT_GT(pipeline.updateMesh().triangles.size(), 100u);
+  }
+}
+
+TEST_F(PipelineTest, AFailingStageStopsTheRunWithItsError) {
+  const msf::Sequence sequence(dataset());
+  msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+  EXPECT_THROW(pipeline.run(sequence, {0, 1, 99}, nullptr), msf::InvalidInputError); // frame 99 does not exist
+}
+
+TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
+  msf::test::TempDir out;
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -o " + out.path() + " -panels 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* file : {"mesh.ply", "volume.pcd", "summary.json", "frames.csv", "runtime.png", "mesh_preview.png",
+                           "report.md", "depth_000000.png", "depth_000003.png"})
+    EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
+  const std::string json = readFile(out.file("summary.json"));
+  EXPECT_EQ(jsonNumber(json, "frames"), 4);
+  EXPECT_GT(jsonNumber(json, "frames_per_second"), 0.0);
+  EXPECT_GT(jsonNumber(json, "peak_memory_mb"), 10.0);
+  EXPECT_LT(jsonNumber(json, "peak_memory_mb"), 4096.0);
+  EXPECT_GT(jsonNumber(json, "median", "stereo"), 0.0);
+  EXPECT_GE(jsonNumber(json, "p95", "integrate"), jsonNumber(json, "median", "integrate"));
+  EXPECT_GT(jsonNumber(json, "triangles"), 1000);
+  // Synthetic ground truth: each depth method is scored; fusion is at least as good as
+  // each input on D1 with missing estimates counted as bad.
+  const double d1_sgbm = jsonNumber(json, "d1_all", "sgbm");
+  const double d1_lidar = jsonNumber(json, "d1_all", "interpolated");
+  const double d1_fused = jsonNumber(json, "d1_all", "fused");
+  for (double d1 : {d1_sgbm, d1_lidar, d1_fused}) {
+    EXPECT_GE(d1, 0.0);
+    EXPECT_LE(d1, 1.0);
+  }
+  EXPECT_LT(d1_fused, d1_sgbm);
+  EXPECT_LT(jsonNumber(json, "accuracy_mean_m"), 0.3);
+  EXPECT_GT(jsonNumber(json, "completeness"), 0.3);
+  // frames.csv: a header and one row per frame.
+  std::istringstream csv(readFile(out.file("frames.csv")));
+  std::string line;
+  int rows = 0;
+  while (std::getline(csv, line))
+    ++rows;
+  EXPECT_EQ(rows, 5);
+  pcl::PolygonMesh mesh;
+  msf::loadMesh(out.file("mesh.ply"), mesh);
+  EXPECT_GT(mesh.polygons.size(), 1000u);
+}
+
+TEST_F(PipelineTest, CtrlCStillWritesTheMeshAndTheSummary) {
+  msf::test::TempDir out;
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const std::string tool = msf::test::binDir() + "/msf_reconstruct";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::close(pipe_fds[0]);
+    ::execl(tool.c_str(), tool.c_str(), dataset().c_str(), "-o", out.path().c_str(), "-panels", "0",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(pipe_fds[1]);
+  // Interrupt as soon as the first frame is integrated.
+  FILE* child_out = ::fdopen(pipe_fds[0], "r");
+  char line[1024];
+  bool interrupted = false;
+  while (std::fgets(line, sizeof line, child_out))
+    if (!interrupted && std::strstr(line, "(1/4)")) {
+      ::kill(pid, SIGINT);
+      interrupted = true;
+    }
+  std::fclose(child_out);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(interrupted) << "the tool printed no progress line";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const std::string json = readFile(out.file("summary.json"));
+  EXPECT_NE(json.find("\"interrupted\": true"), std::string::npos) << json;
+  EXPECT_GE(jsonNumber(json, "frames"), 1);
+  EXPECT_LE(jsonNumber(json, "frames"), 3);
+  pcl::PolygonMesh mesh;
+  msf::loadMesh(out.file("mesh.ply"), mesh);
+  EXPECT_GT(mesh.polygons.size(), 100u);
+}
+
+TEST(Reconstruct, BadInputIsAClearError) {
+  msf::test::TempDir dir;
+  auto r = msf::test::runTool("msf_reconstruct", dir.path() + " -o " + dir.file("out"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("msf_reconstruct: error: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("neither a KITTI odometry sequence"), std::string::npos) << r.err;
+  r = msf::test::runTool("msf_reconstruct", dir.path() + " -o /nonexistent/out");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("/nonexistent"), std::string::npos) << r.err;
+  std::ofstream(dir.file("bad.yaml")) << "%YAML:1.0\ntsdf_volume:\n  voxel_size_m: -1\n";
+  r = msf::test::runTool("msf_reconstruct", dir.path() + " -config " + dir.file("bad.yaml"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("tsdf_volume.voxel_size_m"), std::string::npos) << r.err;
+  r = msf::test::runTool("msf_reconstruct", "-frames 3:1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_FALSE(msf::test::fileExists("msf_out/summary.json"));
+}
+
+TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {
+  msf::BoundedQueue<int> queue(2);
+  EXPECT_TRUE(queue.push(1));
+  EXPECT_TRUE(queue.push(2));
+  std::atomic<bool> third_pushed{false};
+  std::thread producer([&] {
+    queue.push(3);
+    third_pushed = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(third_pushed); // full: the producer waits
+  EXPECT_EQ(queue.pop().value(), 1);
+  producer.join();
+  EXPECT_TRUE(third_pushed);
+  queue.close();
+  EXPECT_FALSE(queue.push(4));
+  EXPECT_EQ(queue.pop().value(), 2);
+  EXPECT_EQ(queue.pop().value(), 3);
+  EXPECT_FALSE(queue.pop().has_value());
+}
+
+} // namespace
