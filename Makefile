@@ -45,7 +45,7 @@ test: deps
 
 demo: deps
 	$(MAKE) build
-	bash scripts/demo.sh $(BUILD_DIR)/bin $(DEMO_OUT) $(KITTI_DIR)
+	bash scripts/demo.sh $(BUILD_DIR)/bin $(DEMO_OUT)
 
 bench: deps-bench
 	$(MAKE) build
