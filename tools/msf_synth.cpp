@@ -93,7 +93,13 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Building the street ");
     const msf::synthetic::SyntheticGenerator generator(config);
-    msf::tool::printDone(tt.toc(), generator.scene().primitives.size());
+    print_info("[done, ");
+    print_value("%g", tt.toc());
+    print_info(" ms : ");
+    print_value("%zu", generator.scene().primitives.size());
+    print_info(" solids, ");
+    print_value("%u", generator.scene().objectCount());
+    print_info(" foreground objects]\n");
 
     std::vector<double> seconds;
     tt.tic();

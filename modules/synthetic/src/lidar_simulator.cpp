@@ -67,7 +67,9 @@ pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const Scene& scene, const E
       if (range <= 0.0)
         continue;
       const float incidence = std::fabs(dot(ray.dir, hit.normal));
-      const double intensity = s.reflectivity * (0.35 + 0.65 * incidence) + 0.02 * gaussian(mix64(key ^ 3));
+      // KITTI's intensities depend little on incidence: the road at grazing angles still
+      // returns ~0.3.
+      const double intensity = s.reflectivity * (0.6 + 0.4 * incidence) + 0.02 * gaussian(mix64(key ^ 3));
       out.x = static_cast<float>(d_velo.x() * range);
       out.y = static_cast<float>(d_velo.y() * range);
       out.z = static_cast<float>(d_velo.z() * range);

@@ -100,7 +100,7 @@ SurfaceResponse road(const Material& m, V3 w, const Footprint& fp, const StreetL
   paint += intervalCoverage(X, lane - 0.06, lane + 0.06, fX) + intervalCoverage(X, -lane - 0.06, -lane + 0.06, fX);
   paint = std::min(paint, 1.f) * (0.8f + 0.2f * fbm(X, Z, m.seed + 31u, 0.5f, 3, iso));
   const Rgb asphalt = base(m) * a;
-  return make(mix(asphalt, {0.72f, 0.72f, 0.70f}, paint), mixf(m.reflectivity * (1.f + 0.3f * n), 0.6f, paint));
+  return make(mix(asphalt, {0.72f, 0.72f, 0.70f}, paint), mixf(m.reflectivity * (1.f + 0.3f * n), 0.75f, paint));
 }
 
 SurfaceResponse sidewalk(const Material& m, const Primitive& p, const Hit& hit, V3 w, const Footprint& fp,

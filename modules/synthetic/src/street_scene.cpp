@@ -35,7 +35,7 @@ public:
     road.r = road.g = 0.16f;
     road.b = 0.17f;
     road.seed = rng_.seed32();
-    road.reflectivity = 0.12f;
+    road.reflectivity = 0.3f;
     scene_.ground_material = scene_.addMaterial(road);
     for (int side : {-1, 1}) {
       addPlateau(side);

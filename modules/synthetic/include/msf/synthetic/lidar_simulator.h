@@ -20,7 +20,8 @@ namespace msf::synthetic {
 /// atan2(y, x): the ring split of DESIGN.md protocol 2 finds exactly 64 rings.
 /// Each return: range + Gaussian noise, lost with probability lidar_dropout (and half the
 /// time on glass), none from the sky or beyond lidar_max_range_m; intensity from the
-/// surface's infrared reflectivity and incidence angle, in KITTI's 0..1 with 0.01 steps.
+/// surface's infrared reflectivity and incidence angle, in KITTI's 0..1 with 0.01 steps
+/// (median ~0.3 as on KITTI's scans: road 0.3, markings 0.75, number plates 0.95).
 class LidarSimulator {
 public:
   explicit LidarSimulator(const SyntheticConfig& config);
