@@ -133,6 +133,9 @@ TEST(DepthFusionPaper, Eq6OnHandMadePixels) {
 
 TEST(DepthFusionPaper, PixelFunctionIsTheWeightedMean) {
   msf::DepthFusionConfig config;
+  config.paper_lidar_gain = 1.f;
+  config.paper_lidar_distance_px = 4.f;
+  config.paper_stereo_reference_depth_m = 10.f;
   msf::FusionInputs in;
   in.z_lidar = 30.f;
   in.lidar_distance = 2.f;
@@ -148,8 +151,20 @@ TEST(DepthFusionPaper, PixelFunctionIsTheWeightedMean) {
 
 // ---- uncertainty ---------------------------------------------------------------------------
 
+/// sigma_S = 0.3 + 3.7 (1 - c)^2 px, sigma_L = 0.3 + 0.05 distance + 0.7 range px.
+msf::DepthFusionConfig handMadeSigmas() {
+  msf::DepthFusionConfig config;
+  config.stereo_sigma_min_px = 0.3f;
+  config.stereo_sigma_max_px = 4.f;
+  config.lidar_sigma_px = 0.3f;
+  config.lidar_sigma_per_distance = 0.05f;
+  config.lidar_sigma_per_range = 0.7f;
+  config.disagreement_k_sigma = 3.f;
+  return config;
+}
+
 TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
-  msf::DepthFusionConfig config; // sigma_S(c=1) = 0.3 px, sigma_L = 0.3 + 0.05 d + 0.7 range
+  const msf::DepthFusionConfig config = handMadeSigmas();
   msf::FusionInputs in;
   in.z_lidar = static_cast<float>(kFB / 20.0);  // disparity 20
   in.lidar_distance = 6.f;                        // sigma_L = 0.3 + 0.3 = 0.6
@@ -194,12 +209,17 @@ TEST(DepthFusionUncertainty, SyntheticEdgeKeepsTheForeground) {
       in.setLidar(u, v, box && !seen_past_edge ? 5.f : 20.f, (u % 3 == 0) ? 0.f : 1.f);
       in.setStereo(u, v, box ? 5.f : 20.f, std::abs(v - edge) <= 2 ? 0.6f : 0.95f);
     }
-  msf::DepthFusionConfig config;
+  msf::DepthFusionConfig config = handMadeSigmas();
   config.method = msf::FusionMethod::Uncertainty;
   const FusedCloud out = fuse(in, config);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u)
       EXPECT_NEAR(out.at(u, v).z, v >= edge ? 5.f : 20.f, 0.05f) << "pixel " << u << "," << v;
+  // The same with the defaults measured on KITTI.
+  const FusedCloud measured = fuse(in, msf::DepthFusionConfig{});
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u)
+      EXPECT_NEAR(measured.at(u, v).z, v >= edge ? 5.f : 20.f, 0.05f) << "pixel " << u << "," << v;
   // Without the parallax check the LiDAR's returns from the wall win where no foreground
   // return is within its 5 x 5 window (rows 10..12), as the LiDAR looks more certain there.
   config.parallax_check = false;
@@ -219,8 +239,8 @@ TEST(DepthFusionUncertainty, StereoNearerWithoutLidarEvidenceLoses) {
       in.setLidar(u, v, 20.f, 0.f);
       in.setStereo(u, v, v == 8 ? 5.f : 20.f, 0.7f);
     }
-  const FusedCloud out = fuse(in, {});
-  EXPECT_NEAR(out.at(2, 8).z, 20.f, 1e-4f);
+  EXPECT_NEAR(fuse(in, handMadeSigmas()).at(2, 8).z, 20.f, 1e-4f);
+  EXPECT_NEAR(fuse(in, {}).at(2, 8).z, 20.f, 1e-4f);
 }
 
 // ---- organized invariants, colour, types -----------------------------------------------------
@@ -401,7 +421,7 @@ TEST(DepthFusionConfig, ReadsTheFusionSectionAndRejectsBadValues) {
   EXPECT_EQ(config.method, msf::FusionMethod::Paper);
   EXPECT_FLOAT_EQ(config.paper_lidar_gain, 2.5f);
   EXPECT_FLOAT_EQ(config.disagreement_k_sigma, 4.f);
-  EXPECT_FLOAT_EQ(config.stereo_sigma_min_px, 0.3f); // default kept
+  EXPECT_FLOAT_EQ(config.stereo_sigma_min_px, msf::DepthFusionConfig{}.stereo_sigma_min_px); // default kept
   std::ostringstream printed;
   config.print(printed);
   EXPECT_NE(printed.str().find("method: paper"), std::string::npos);

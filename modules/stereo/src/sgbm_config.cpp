@@ -40,6 +40,7 @@ void SgbmConfig::read(const cv::FileNode& node) {
   readKey(node, "disp12_max_diff_px", disp12_max_diff_px);
   readKey(node, "left_right_check", left_right_check);
   readKey(node, "left_right_max_diff_px", left_right_max_diff_px);
+  readKey(node, "match_left_border", match_left_border);
   readKey(node, "prior_search_range", prior_search_range);
   readKey(node, "prior_margin_px", prior_margin_px);
   readKey(node, "max_depth_m", max_depth_m);
@@ -97,6 +98,7 @@ void SgbmConfig::print(std::ostream& out) const {
       << "  disp12_max_diff_px: " << disp12_max_diff_px << "\n"
       << "  left_right_check: " << (left_right_check ? "true" : "false") << "\n"
       << "  left_right_max_diff_px: " << left_right_max_diff_px << "\n"
+      << "  match_left_border: " << (match_left_border ? "true" : "false") << "\n"
       << "  prior_search_range: " << (prior_search_range ? "true" : "false") << "\n"
       << "  prior_margin_px: " << prior_margin_px << "\n"
       << "  max_depth_m: " << max_depth_m << "\n"

@@ -82,8 +82,16 @@ cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_dis
   matcher_->setSpeckleRange(config_.speckle_range_px);
   matcher_->setDisp12MaxDiff(config_.disp12_max_diff_px);
   cv::Mat fixed; // CV_16S, disparity x 16
-  matcher_->compute(left, right, fixed);
-  return fixed;
+  const int border = config_.match_left_border ? std::max(0, config_.min_disparity_px + num_disparities) : 0;
+  if (border == 0) {
+    matcher_->compute(left, right, fixed);
+    return fixed;
+  }
+  cv::Mat left_padded, right_padded;
+  cv::copyMakeBorder(left, left_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
+  cv::copyMakeBorder(right, right_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
+  matcher_->compute(left_padded, right_padded, fixed);
+  return fixed.colRange(border, border + left.cols);
 }
 
 void SgbmStereo::computeDisparity() {
@@ -121,11 +129,12 @@ void SgbmStereo::computeDisparity() {
       for (int u = 0; u < cols; ++u) {
         // OpenCV marks a pixel without a match with (min_disparity - 1) * 16; d <= 0 has no depth.
         float d = in[u] > 0 ? static_cast<float>(in[u]) * (1.f / 16.f) : 0.f;
-        if (d > 0.f && d < min_disparity)
+        // Too far, or matched in the replicated border left of the right image.
+        if (d > 0.f && (d < min_disparity || d > static_cast<float>(u)))
           d = 0.f;
         if (d > 0.f && in_right) {
           const int ur = static_cast<int>(std::lround(static_cast<float>(u) - d));
-          const float dr = ur >= 0 ? static_cast<float>(in_right[ur]) * (1.f / 16.f) : -1.f;
+          const float dr = ur >= 0 && ur < cols ? static_cast<float>(in_right[ur]) * (1.f / 16.f) : -1.f;
           if (!(dr > 0.f) || std::fabs(dr - d) > lr_max)
             d = 0.f;
         }

@@ -23,17 +23,17 @@ struct DepthFusionConfig {
   FusionMethod method = FusionMethod::Uncertainty;
 
   // --- paper (eq. 6): w2 = w_L / w_S, see fusion_model.h
-  float paper_lidar_gain = 1.f;               ///< w_L on a real return
-  float paper_lidar_distance_px = 4.f;        ///< w_L halves this far from the nearest real return
-  float paper_stereo_reference_depth_m = 10.f;///< w_S = confidence where z_stereo <= this, falls as 1/z^2 beyond
+  float paper_lidar_gain = 4.f;               ///< w_L on a real return
+  float paper_lidar_distance_px = 8.f;        ///< w_L halves this far from the nearest real return
+  float paper_stereo_reference_depth_m = 20.f;///< w_S = confidence where z_stereo <= this, falls as 1/z^2 beyond
   float paper_min_stereo_confidence = 0.05f;  ///< floor of the confidence in w_S
 
   // --- uncertainty: sigmas of the disparity d = f B / z, in pixels
-  float stereo_sigma_min_px = 0.3f;           ///< sigma of a stereo disparity of confidence 1
-  float stereo_sigma_max_px = 4.f;            ///< ... of confidence 0 (quadratic in 1 - confidence between)
-  float lidar_sigma_px = 0.3f;                ///< sigma of the LiDAR on a smooth surface at a real return
-  float lidar_sigma_per_distance = 0.05f;     ///< growth per pixel of distance to the nearest real return
-  float lidar_sigma_per_range = 0.7f;         ///< growth per pixel of local disparity range (an edge)
+  float stereo_sigma_min_px = 0.5f;           ///< sigma of a stereo disparity of confidence 1
+  float stereo_sigma_max_px = 2.5f;           ///< ... of confidence 0 (quadratic in 1 - confidence between)
+  float lidar_sigma_px = 0.1f;                ///< sigma of the LiDAR on a smooth surface at a real return
+  float lidar_sigma_per_distance = 0.02f;     ///< growth per pixel of distance to the nearest real return
+  float lidar_sigma_per_range = 0.3f;         ///< growth per pixel of local disparity range (an edge)
   float disagreement_k_sigma = 3.f;           ///< beyond k sigma the more certain sample wins alone
   int lidar_range_window_px = 5;              ///< odd window of the LiDAR's local disparity range
   bool parallax_check = true;                 ///< stereo wins where the LiDAR saw past a foreground edge

@@ -25,6 +25,10 @@ struct SgbmConfig {
   int disp12_max_diff_px = -1;     ///< OpenCV's own left-right check; < 0 off
   bool left_right_check = false;   ///< explicit check against a right-view match (2x the time)
   float left_right_max_diff_px = 1.f;
+  /// Match the first min_disparity + num_disparities columns too (OpenCV leaves them empty):
+  /// the pair is padded on the left by replicating its first column, and a disparity that
+  /// points outside the right image (d > u) is dropped.
+  bool match_left_border = true;
   bool prior_search_range = true;  ///< narrow num_disparities to a depth prior when given
   int prior_margin_px = 8;         ///< disparities beyond the prior's largest
   float max_depth_m = 0.f;         ///< drop depths beyond this; 0 keeps all
