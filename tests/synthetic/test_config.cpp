@@ -66,6 +66,8 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   SyntheticConfig c;
   c.frames = 4;
   c.image_noise_sigma = 1.5;
+  c.lidar_range_noise_m = 0.1 + 0.2; // not a short decimal: must still read back exactly
+  c.speed_mps = 12;
   std::ostringstream out;
   out << "%YAML:1.0\n";
   c.print(out);
@@ -73,7 +75,9 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   SyntheticConfig back;
   back.read(section(out.str(), fs));
   EXPECT_EQ(back.frames, 4);
-  EXPECT_DOUBLE_EQ(back.image_noise_sigma, 1.5);
+  EXPECT_EQ(back.image_noise_sigma, 1.5);
+  EXPECT_EQ(back.lidar_range_noise_m, 0.1 + 0.2);
+  EXPECT_EQ(back.speed_mps, 12.0);
 }
 
 TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {

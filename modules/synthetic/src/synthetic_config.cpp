@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/synthetic_config.h>
 
+#include <charconv>
 #include <ostream>
 #include <sstream>
 
@@ -69,25 +70,37 @@ void SyntheticConfig::validate() const {
           "must be in 0.05..20");
 }
 
+namespace {
+/// Shortest text that reads back to the same double, so a printed config reproduces a dataset.
+std::string exact(double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
+  if (text.find_first_of(".en") == std::string::npos)
+    text += ".0"; // keep it a real number for YAML
+  return text;
+}
+} // namespace
+
 void SyntheticConfig::print(std::ostream& out) const {
   out << "synthetic:\n"
       << "  scene: " << scene << "\n"
       << "  frames: " << frames << "\n"
       << "  seed: " << seed << "\n"
-      << "  speed_mps: " << speed_mps << "\n"
-      << "  frame_rate_hz: " << frame_rate_hz << "\n"
+      << "  speed_mps: " << exact(speed_mps) << "\n"
+      << "  frame_rate_hz: " << exact(frame_rate_hz) << "\n"
       << "  supersampling: " << supersampling << "\n"
-      << "  image_noise_sigma: " << image_noise_sigma << "\n"
-      << "  lidar_range_noise_m: " << lidar_range_noise_m << "\n"
-      << "  lidar_dropout: " << lidar_dropout << "\n"
-      << "  lidar_max_range_m: " << lidar_max_range_m << "\n"
-      << "  lidar_min_range_m: " << lidar_min_range_m << "\n"
-      << "  lidar_azimuth_step_deg: " << lidar_azimuth_step_deg << "\n"
-      << "  lidar_upper_elevation_deg: " << lidar_upper_elevation_deg << "\n"
-      << "  lidar_lower_elevation_deg: " << lidar_lower_elevation_deg << "\n"
-      << "  textureless_share: " << textureless_share << "\n"
-      << "  parked_car_share: " << parked_car_share << "\n"
-      << "  mesh_max_edge_m: " << mesh_max_edge_m << "\n";
+      << "  image_noise_sigma: " << exact(image_noise_sigma) << "\n"
+      << "  lidar_range_noise_m: " << exact(lidar_range_noise_m) << "\n"
+      << "  lidar_dropout: " << exact(lidar_dropout) << "\n"
+      << "  lidar_max_range_m: " << exact(lidar_max_range_m) << "\n"
+      << "  lidar_min_range_m: " << exact(lidar_min_range_m) << "\n"
+      << "  lidar_azimuth_step_deg: " << exact(lidar_azimuth_step_deg) << "\n"
+      << "  lidar_upper_elevation_deg: " << exact(lidar_upper_elevation_deg) << "\n"
+      << "  lidar_lower_elevation_deg: " << exact(lidar_lower_elevation_deg) << "\n"
+      << "  textureless_share: " << exact(textureless_share) << "\n"
+      << "  parked_car_share: " << exact(parked_car_share) << "\n"
+      << "  mesh_max_edge_m: " << exact(mesh_max_edge_m) << "\n";
 }
 
 } // namespace msf::synthetic
