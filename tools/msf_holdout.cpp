@@ -5,8 +5,10 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
+#include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/lidar_completion.h>
+#include <msf/stereo/sgbm_stereo.h>
 
 #include <pcl/common/time.h>
 #include <pcl/console/parse.h>
@@ -47,6 +49,52 @@ msf::HoldoutMethod lidar(const msf::ConfigFile& file, msf::CompletionMethod meth
   };
 }
 
+/// SGBM on the grey pair (section stereo); with `prior`, its search narrowed by the compound
+/// interpolation of the input rings, whose time then counts too.
+msf::HoldoutMethod stereo(const msf::ConfigFile& file, bool prior) {
+  msf::SgbmConfig config;
+  config.read(file.section("stereo"));
+  auto completion = lidar(file, msf::CompletionMethod::Compound);
+  auto sgbm = std::make_shared<msf::SgbmStereo>(config);
+  return [=](const msf::HoldoutInput& in) {
+    sgbm->setCalibration(*in.calibration);
+    sgbm->setInputImages(in.left, in.right);
+    sgbm->setDepthPrior(prior ? completion(in) : cv::Mat());
+    sgbm->computeDisparity();
+    return sgbm->getDepth();
+  };
+}
+
+/// Paper steps 1-4: compound interpolation of the input rings, SGBM narrowed by it, and the
+/// per-pixel fusion of the two (section fusion, its method forced to `method`).
+msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) {
+  msf::ProjectionConfig projection;
+  projection.read(file.section("projection"));
+  msf::InterpolationConfig interpolation;
+  interpolation.read(file.section("interpolation"));
+  msf::SgbmConfig stereo_config;
+  stereo_config.read(file.section("stereo"));
+  msf::DepthFusionConfig fusion;
+  fusion.read(file.section("fusion"));
+  fusion.method = method;
+  std::shared_ptr<msf::LidarCompletion> completion;
+  auto sgbm = std::make_shared<msf::SgbmStereo>(stereo_config);
+  return [=](const msf::HoldoutInput& in) mutable {
+    if (!completion)
+      completion = std::make_shared<msf::LidarCompletion>(*in.calibration, msf::CompletionMethod::Compound,
+                                                          projection, interpolation);
+    cv::Mat lidar_depth, distance, depth;
+    completion->computeDepth(*in.scan, lidar_depth, &distance);
+    sgbm->setCalibration(*in.calibration);
+    sgbm->setInputImages(in.left, in.right);
+    sgbm->setDepthPrior(lidar_depth);
+    sgbm->computeDisparity();
+    msf::fuseDepthImages(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), *in.calibration, fusion,
+                         depth);
+    return depth;
+  };
+}
+
 /// Add a method here (name -> function of the frame input) to get its row in the table.
 const std::vector<MethodEntry>& methodTable() {
   static const std::vector<MethodEntry> table{
@@ -60,6 +108,14 @@ const std::vector<MethodEntry>& methodTable() {
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicFast); }},
       {"ipbasic_multiscale", "IP-Basic multiscale, same projection",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicMultiscale); }},
+      {"sgbm", "OpenCV SGBM on the grey pair (section stereo), no LiDAR",
+       [](const msf::ConfigFile& f) { return stereo(f, false); }},
+      {"sgbm_prior", "the same, its search narrowed by the interpolated input rings",
+       [](const msf::ConfigFile& f) { return stereo(f, true); }},
+      {"fused_paper", "interpolated + sgbm_prior fused by eq. 6 (section fusion)",
+       [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Paper); }},
+      {"fused_uncertainty", "interpolated + sgbm_prior fused by inverse variance",
+       [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Uncertainty); }},
   };
   return table;
 }
@@ -82,7 +138,8 @@ void printHelp(const char* name) {
   print_info("    -methods a,b,..  methods, in this order (default: all):\n");
   for (const auto& m : methodTable())
     print_info("                       %-19s %s\n", m.name, m.description);
-  print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic)\n");
+  print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic, stereo,\n"
+             "                     fusion)\n");
   print_info("    -csv FILE        also write the rows as CSV\n");
 }
 
