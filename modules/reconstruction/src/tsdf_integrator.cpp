@@ -252,14 +252,39 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
   const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
   const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
-  const std::uint8_t flag = regularized ? kUpdated : 0;
   const Weighting weighting = config_.weighting;
+  // Changed voxels of each block (local indices), for the regularization.
+  if (regularized)
+    changed_index_.resize(blocks.size() * TsdfBlock::kVoxels);
+  std::vector<std::uint16_t> changed_count(blocks.size(), 0);
   const bool bilinear = config_.interpolate_depth;
   const bool carving = config_.space_carving;
   const float max_weight = config_.max_weight;
   const bool has_color = !frame.color.empty();
   std::vector<char> changed(blocks.size(), 0);
   std::size_t updated_total = 0;
+
+  // Min and max valid depth of 8x8-pixel tiles: a sub-block of 4^3 voxels whose footprint
+  // sees only depth far in front of or behind it is skipped without projecting its voxels
+  // (on KITTI most voxels of the allocated blocks are such, as the road is seen grazing).
+  constexpr int kTile = 8;
+  const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
+  tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
+  tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
+#pragma omp parallel for schedule(static)
+  for (int ty = 0; ty < tiles_y; ++ty)
+    for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
+      const float* row = frame.depth.ptr<float>(v);
+      for (int u = 0; u < width; ++u) {
+        const float d = row[u];
+        if (d >= min_d && d <= max_d) {
+          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + u / kTile;
+          tile_min_[t] = std::min(tile_min_[t], d);
+          tile_max_[t] = std::max(tile_max_[t], d);
+        }
+      }
+    }
+  const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
 
 #pragma omp parallel for schedule(dynamic, 8) reduction(+ : updated_total)
   for (std::size_t i = 0; i < blocks.size(); ++i) {
@@ -268,22 +293,56 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     std::size_t updated = 0;
     const float* depth_data = frame.depth.ptr<float>(0);
     const std::size_t depth_step = frame.depth.step1();
-    for (int z = 0; z < kSide; ++z)
-      for (int y = 0; y < kSide; ++y) {
-        // A row of 8 voxels: projection first in plain float arrays (the compiler vectorizes
+    for (int sub = 0; sub < 8; ++sub) {
+      const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
+      {
+        const Eigen::Vector3f c = base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f));
+        if (c.z() + sub_radius < min_d)
+          continue;
+        if (c.z() - sub_radius > 0.5f * min_d + 1e-3f) {
+          // Pixel footprint of the bounding sphere: |u(p) - u(c)| <= fx r (1 + |x/z|) / (z - r),
+          // +1 px for rounding and bilinear lookups.
+          const float inv = sub_radius / (c.z() - sub_radius);
+          const float ru = fx * inv * (1.f + std::abs(c.x() / c.z())) + 1.f;
+          const float rv = fy * inv * (1.f + std::abs(c.y() / c.z())) + 1.f;
+          const float uc = fx * c.x() / c.z() + cx, vc = fy * c.y() / c.z() + cy;
+          const int u0 = std::max(0, static_cast<int>(std::floor(uc - ru))), u1 = std::min(width - 1, static_cast<int>(uc + ru));
+          const int v0 = std::max(0, static_cast<int>(std::floor(vc - rv))), v1 = std::min(height - 1, static_cast<int>(vc + rv));
+          if (u0 > u1 || v0 > v1)
+            continue; // outside the image
+          const int tx0 = u0 / kTile, tx1 = u1 / kTile, ty0 = v0 / kTile, ty1 = v1 / kTile;
+          if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= 64) {
+            float dmin = std::numeric_limits<float>::infinity(), dmax = -dmin;
+            for (int ty = ty0; ty <= ty1; ++ty)
+              for (int tx = tx0; tx <= tx1; ++tx) {
+                dmin = std::min(dmin, tile_min_[static_cast<std::size_t>(ty) * tiles_x + tx]);
+                dmax = std::max(dmax, tile_max_[static_cast<std::size_t>(ty) * tiles_x + tx]);
+              }
+            if (dmax < c.z() - sub_radius - trunc)
+              continue; // every depth is in front: the voxels are hidden behind the surface
+            if (!carving && dmin > c.z() + sub_radius + trunc)
+              continue; // every depth is beyond: the voxels are free space, outside the band
+          }
+        }
+      }
+      for (int z = sz; z < sz + 4; ++z)
+      for (int y = sy; y < sy + 4; ++y) {
+        // A row of 4 voxels: projection first in plain float arrays (the compiler vectorizes
         // it), then the per-voxel depth lookups.
         const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
-        float pu[kSide], pv[kSide], pz[kSide];
-        for (int x = 0; x < kSide; ++x) {
+        float pu[4], pv[4], pz[4];
+        for (int k = 0; k < 4; ++k) {
+          const int x = sx + k;
           const float X = row.x() + ex.x() * x, Y = row.y() + ex.y() * x, Z = row.z() + ex.z() * x;
           const float inv_z = 1.f / std::max(Z, 1e-6f);
-          pu[x] = fx * X * inv_z + cx;
-          pv[x] = fy * Y * inv_z + cy;
-          pz[x] = Z;
+          pu[k] = fx * X * inv_z + cx;
+          pv[k] = fy * Y * inv_z + cy;
+          pz[k] = Z;
         }
         TsdfVoxel* voxels = &block.at(0, y, z);
-        for (int x = 0; x < kSide; ++x) {
-          const float u = pu[x], v = pv[x], vz = pz[x];
+        for (int k = 0; k < 4; ++k) {
+          const int x = sx + k;
+          const float u = pu[k], v = pv[k], vz = pz[k];
           if (!(vz >= min_d && u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
             continue;
           const int ui = static_cast<int>(u + 0.5f), vi = static_cast<int>(v + 0.5f);
@@ -329,23 +388,33 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
           TsdfVoxel& voxel = voxels[x];
           updateVoxel(voxel, sdf, w, bgr, max_weight);
-          voxel.flags |= flag;
+          if (regularized)
+            changed_index_[i * TsdfBlock::kVoxels + updated] = static_cast<std::uint16_t>(TsdfBlock::linear(x, y, z));
           ++updated;
         }
       }
+    }
+    changed_count[i] = static_cast<std::uint16_t>(updated);
     if (updated) {
       block.stamp = stamp;
-      block.updateSigns();
+      if (!regularized)
+        block.updateSigns(); // else after the regularization
       changed[i] = 1;
       updated_total += updated;
     }
   }
   std::vector<TsdfBlock*> touched;
   touched.reserve(blocks.size());
+  std::vector<std::size_t> offsets{0};
   for (std::size_t i = 0; i < blocks.size(); ++i)
-    if (changed[i])
+    if (changed[i]) {
       touched.push_back(blocks[i]);
-    else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())
+      if (regularized) {
+        // Compact the lists in place: the source is at or after the destination.
+        std::copy_n(&changed_index_[i * TsdfBlock::kVoxels], changed_count[i], &changed_index_[offsets.back()]);
+        offsets.push_back(offsets.back() + changed_count[i]);
+      }
+    } else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())
       blocks[i]->stamp = stamp;
   stats_.blocks_touched = touched.size();
   stats_.voxels_updated = updated_total;
@@ -353,7 +422,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
 
   const auto t_reg = Clock::now();
   if (regularized)
-    regularize(touched);
+    regularize(touched, offsets);
   stats_.regularize_ms = msSince(t_reg);
 }
 
@@ -420,76 +489,82 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
   stats_.voxels_updated = updated;
   stats_.update_ms = msSince(t_start);
   const auto t_reg = Clock::now();
-  if (regularized)
-    regularize(touched);
+  if (regularized) {
+    std::vector<std::size_t> offsets{0};
+    changed_index_.clear();
+    for (TsdfBlock* block : touched) {
+      for (int j = 0; j < TsdfBlock::kVoxels; ++j)
+        if (block->voxels[j].flags & kUpdated) {
+          block->voxels[j].flags = 0;
+          changed_index_.push_back(static_cast<std::uint16_t>(j));
+        }
+      offsets.push_back(changed_index_.size());
+    }
+    regularize(touched, offsets);
+  }
   stats_.regularize_ms = msSince(t_reg);
 }
 
-void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched) {
+void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets) {
   const std::size_t n = touched.size();
   const float lambda = static_cast<float>(config_.lambda);
-  data_term_.resize(n * TsdfBlock::kVoxels);
+  data_term_.resize(offsets.back());
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     const GridIndex b = touched[i]->index;
-    const GridIndex offsets[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+    const GridIndex steps[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
     for (int k = 0; k < 6; ++k)
-      neighbours[i][k] = volume_.findBlock(b + offsets[k]);
-    float* y = &data_term_[i * TsdfBlock::kVoxels];
-    for (int j = 0; j < TsdfBlock::kVoxels; ++j)
-      y[j] = touched[i]->voxels[j].sdf;
+      neighbours[i][k] = volume_.findBlock(b + steps[k]);
+    for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k)
+      data_term_[k] = touched[i]->voxels[changed_index_[k]].sdf;
   }
 
   // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
-  // stationarity condition of eq. 7. Red-black order: a half-sweep writes voxels of one
-  // parity and reads only the other, so blocks run in parallel without races.
+  // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
+  // fixed). Gauss-Seidel in place, block by block; blocks of one of 8 colours (parities of
+  // the block coordinates) share no face, so each colour's blocks run in parallel without races.
+  std::array<std::vector<std::size_t>, 8> colour;
+  for (std::size_t i = 0; i < n; ++i) {
+    const GridIndex& b = touched[i]->index;
+    colour[(b.x() & 1) | ((b.y() & 1) << 1) | ((b.z() & 1) << 2)].push_back(i);
+  }
   for (int sweep = 0; sweep < config_.sweeps; ++sweep)
-    for (int parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(dynamic, 8)
-      for (std::size_t i = 0; i < n; ++i) {
+    for (const auto& group : colour) {
+      const auto m = static_cast<std::ptrdiff_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 16)
+      for (std::ptrdiff_t g = 0; g < m; ++g) {
+        const std::size_t i = group[static_cast<std::size_t>(g)];
         TsdfBlock& block = *touched[i];
         const auto& nb = neighbours[i];
-        const float* y = &data_term_[i * TsdfBlock::kVoxels];
-        const GridIndex o = block.origin();
-        const int base_parity = (o.x() + o.y() + o.z()) & 1;
-        for (int z = 0; z < kSide; ++z)
-          for (int yy = 0; yy < kSide; ++yy) {
-            const int x0 = (parity - base_parity - yy - z) & 1;
-            for (int x = x0; x < kSide; x += 2) {
-              const int j = TsdfBlock::linear(x, yy, z);
-              TsdfVoxel& voxel = block.voxels[j];
-              if (!(voxel.flags & kUpdated))
-                continue;
-              float sum = 0.f;
-              int count = 0;
-              auto add = [&](const TsdfVoxel& q) {
-                if (q.weight > 0.f) {
-                  sum += q.sdf;
-                  ++count;
-                }
-              };
-              if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
-              if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
-              if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
-              if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
-              if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
-              if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
-              if (count)
-                voxel.sdf = (y[j] + lambda * sum) / (1.f + lambda * static_cast<float>(count));
+        for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+          const int j = changed_index_[k];
+          const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
+          float sum = 0.f;
+          int count = 0;
+          auto add = [&](const TsdfVoxel& q) {
+            if (q.weight > 0.f) {
+              sum += q.sdf;
+              ++count;
             }
-          }
+          };
+          if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
+          if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
+          if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
+          if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
+          if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
+          if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
+          if (count)
+            block.voxels[j].sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * static_cast<float>(count));
+        }
       }
     }
 
 #pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    for (auto& voxel : touched[i]->voxels)
-      voxel.flags = 0;
+  for (std::size_t i = 0; i < n; ++i)
     touched[i]->updateSigns();
-  }
 }
 
 } // namespace msf

@@ -18,7 +18,7 @@ namespace msf {
 /// (Curless and Levoy) per voxel, then the regularized update of eq. 7,
 ///   x = argmin ||x - y||^2 + lambda ||g(x)||^2,
 /// with y the mean just computed and g the differences between 6-neighbouring observed
-/// voxels. It is solved by red-black Gauss-Seidel sweeps over the voxels this frame changed,
+/// voxels. It is solved by Gauss-Seidel sweeps over the voxels this frame changed,
 /// warm-started from y, with the voxels around them held fixed; lambda = 0 is the plain mean.
 ///
 /// Organized input (a depth image as an organized cloud or a DepthFrame) is integrated
@@ -39,7 +39,10 @@ public:
     float max_weight = 100.f;       ///< a voxel's weight saturates here, so it can still change
     bool space_carving = false;     ///< also update voxels seen in front of the band (sdf = +truncation)
     double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
-    int sweeps = 2;                 ///< Gauss-Seidel sweeps per frame (each = red + black half-sweep)
+    /// Gauss-Seidel sweeps per frame over the changed voxels. 1: the solution is warm-started
+    /// from the last frame, so it is refined over frames; solving each frame to convergence
+    /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
+    int sweeps = 1;
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 80.0;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
@@ -101,12 +104,15 @@ public:
                      const Eigen::Vector3d& origin_world);
 
 private:
-  void regularize(const std::vector<TsdfBlock*>& touched);
+  /// Eq. 7 over the voxels changed_index_[offsets[i] .. offsets[i + 1]) of touched[i].
+  void regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets);
 
   TsdfVolume& volume_;
   Config config_;
   Stats stats_;
-  std::vector<float> data_term_;  // y of eq. 7 for the touched blocks, reused across frames
+  std::vector<float> data_term_;  // y of eq. 7 for the changed voxels, reused across frames
+  std::vector<std::uint16_t> changed_index_; // local indices of the changed voxels, per block
+  std::vector<float> tile_min_, tile_max_; // depth range of 8x8-pixel tiles, reused
 };
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.
