@@ -1,4 +1,5 @@
 #include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/cloud_io.hpp>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <sstream>
 
 namespace msf {
@@ -30,6 +32,19 @@ std::string number(double v) {
 
 constexpr const char* kHeaderTag = "# msfusion tsdf";
 } // namespace
+
+void TsdfVolume::Config::read(const cv::FileNode& node) {
+  readKey(node, "voxel_size_m", voxel_size_m);
+  readKey(node, "truncation_m", truncation_m);
+  if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
+    throw ConfigError("tsdf_volume.voxel_size_m must be > 0, got " + number(voxel_size_m));
+  if (!(truncation_m > 0.0) || !std::isfinite(truncation_m))
+    throw ConfigError("tsdf_volume.truncation_m must be > 0, got " + number(truncation_m));
+}
+
+void TsdfVolume::Config::print(std::ostream& out) const {
+  out << "tsdf_volume:\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m << "\n";
+}
 
 TsdfVolume::TsdfVolume(double voxel_size_m, double truncation_m)
     : voxel_size_(voxel_size_m), truncation_(truncation_m), id_(newVolumeId()) {

@@ -2,10 +2,12 @@
 #include <msf/reconstruction/point_types.h>
 #include <msf/reconstruction/tsdf_block.h>
 
+#include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,8 +25,18 @@ public:
   using Ptr = std::shared_ptr<TsdfVolume>;
   using ConstPtr = std::shared_ptr<const TsdfVolume>;
 
+  /// The YAML section `tsdf_volume`.
+  struct Config {
+    double voxel_size_m = 0.1;  ///< edge of a voxel
+    double truncation_m = 0.3;  ///< |sdf| is clamped here; observations update voxels within it
+    /// Overrides the keys present (voxel_size_m, truncation_m); throws ConfigError naming a bad one.
+    void read(const cv::FileNode& node);
+    void print(std::ostream& out) const;
+  };
+
   /// Throws ConfigError when voxel_size_m <= 0, truncation_m <= 0 (or either not finite).
   TsdfVolume(double voxel_size_m, double truncation_m);
+  explicit TsdfVolume(const Config& config) : TsdfVolume(config.voxel_size_m, config.truncation_m) {}
 
   double voxelSize() const { return voxel_size_; }
   double truncation() const { return truncation_; }

@@ -1,0 +1,89 @@
+// msf_mesh: marching cubes over a TSDF volume written by msf_integrate; a welded, coloured
+// mesh saved as binary PLY, OBJ or VTK by the output's extension.
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/io/cloud_io.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_volume.h>
+
+#include <pcl/console/time.h>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+const std::vector<std::string> kValueOptions = {"-min_weight", "-config"};
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <volume.pcd> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
+  print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. Options:\n");
+  print_info("    -min_weight W   voxels with weight <= W make no triangles (default "); print_value("0"); print_info(")\n");
+  print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
+}
+
+int run(int argc, char** argv) {
+  msf::tool::checkOptions(argc, argv, kValueOptions, {});
+  const auto files = msf::tool::positionalArguments(argc, argv, kValueOptions);
+  if (files.size() != 2) {
+    printHelp(argv[0]);
+    throw msf::InvalidInputError("need one input volume and one output mesh, got " + std::to_string(files.size()) +
+                                 " file arguments");
+  }
+  const std::string ext = msf::fileExtension(files[1]);
+  if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
+    throw msf::InvalidInputError("output mesh '" + files[1] + "' must end in .ply, .obj or .vtk");
+  msf::MarchingCubes::Config config;
+  std::string config_path;
+  if (parse_argument(argc, argv, "-config", config_path) >= 0)
+    config.read(msf::ConfigFile(config_path).section("marching_cubes"));
+  parse_argument(argc, argv, "-min_weight", config.min_weight);
+  msf::MarchingCubes mesher(config);
+
+  pcl::console::TicToc tt;
+  print_highlight("Loading ");
+  print_value("%s ", files[0].c_str());
+  tt.tic();
+  const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0]);
+  msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
+
+  print_highlight("Meshing ");
+  tt.tic();
+  pcl::PolygonMesh mesh;
+  mesher.extract(volume, mesh);
+  const double ms = tt.toc();
+  print_info("[done, ");
+  print_value("%g", ms);
+  print_info(" ms : ");
+  print_value("%u", mesh.cloud.width);
+  print_info(" vertices, ");
+  print_value("%zu", mesh.polygons.size());
+  print_info(" triangles]\n");
+  if (mesh.polygons.empty())
+    throw msf::InvalidInputError("volume '" + files[0] + "' has no surface above weight " +
+                                 std::to_string(config.min_weight) + ": no mesh written");
+
+  print_highlight("Saving ");
+  print_value("%s ", files[1].c_str());
+  tt.tic();
+  msf::saveMesh(files[1], mesh);
+  msf::tool::printDone(tt.toc(), mesh.cloud.width);
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  if (msf::tool::wantsHelp(argc, argv) || argc < 2) {
+    printHelp(argv[0]);
+    return argc < 2 ? 1 : 0;
+  }
+  return msf::tool::run("msf_mesh", [&] { return run(argc, argv); });
+}
