@@ -253,10 +253,11 @@ void DepthInterpolator::prepareHoleFill(int width) {
 void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
   // Normalized convolution (Knutsson and Westin 1993): the Gaussian average of the
   // estimates around a hole, empty pixels weighing 0. Separable: a vectorized vertical
-  // pass into rows padded by k zeros, then the horizontal pass at the holes.
+  // pass into rows padded by k zeros, around the holes only, then the horizontal pass at
+  // the holes.
   // Called by every thread of the parallel region; rows beyond reach of any sample (the
   // sky above the top ring) are skipped.
-  const int H = out.rows, W = out.cols, k = config_.gaussian_size_px / 2, Wp = W + 2 * k;
+  const int H = out.rows, W = out.cols, k = config_.gaussian_size_px / 2;
   int first = H, last = -1;
   for (int r = 0; r < H; ++r)
     if (row_has_[r]) {
@@ -269,14 +270,34 @@ void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
   const bool smooth = config_.gaussian_smooth_valid;
 #pragma omp for schedule(static)
   for (int r = r0; r <= r1; ++r) {
-    float* v = values_.ptr<float>(r);
-    float* m = weights_.ptr<float>(r);
-    std::fill(v, v + Wp, 0.f);
-    std::fill(m, m + Wp, 0.f);
-    v += k;
-    m += k;
-    for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
-      accumulateRow(out.ptr<float>(r + i), g[i + k], v, m, W);
+    // Vertical sums only where a target of this row will read them: its targets +- k,
+    // gathered as spans (most of a row within the rings is already estimated).
+    const float* own = out.ptr<float>(r);
+    const float* d = depth.ptr<float>(r);
+    float* v = values_.ptr<float>(r) + k;
+    float* m = weights_.ptr<float>(r) + k;
+    std::fill(v - k, v, 0.f); // the padding beyond the image's sides reads as empty
+    std::fill(m - k, m, 0.f);
+    std::fill(v + W, v + W + k, 0.f);
+    std::fill(m + W, m + W + k, 0.f);
+    int u = 0;
+    while (u < W) {
+      if (own[u] > 0.f && !(smooth && !(d[u] > 0.f))) {
+        ++u;
+        continue;
+      }
+      const int a = std::max(0, u - k);
+      int last_target = u;
+      for (int x = u + 1; x < W && x <= last_target + 2 * k + 1; ++x)
+        if (!(own[x] > 0.f) || (smooth && !(d[x] > 0.f)))
+          last_target = x;
+      const int b = std::min(W, last_target + k + 1);
+      std::fill(v + a, v + b, 0.f);
+      std::fill(m + a, m + b, 0.f);
+      for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
+        accumulateRow(out.ptr<float>(r + i) + a, g[i + k], v + a, m + a, b - a);
+      u = last_target + 1;
+    }
   }
   // (The implicit barrier above: every vertical sum is made before any hole is written.)
 #pragma omp for schedule(static)
