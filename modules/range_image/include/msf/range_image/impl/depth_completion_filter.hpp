@@ -67,7 +67,7 @@ void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
       if (s[u] > 0.f && z[u] == s[u]) {
         p = in[row + u]; // a real return keeps its exact point
       } else if (z[u] > 0.f) {
-        p = in[static_cast<std::size_t>(near[u])]; // other fields from the nearest return
+        p = in[near[u] >= 0 ? static_cast<std::size_t>(near[u]) : row + u]; // other fields: nearest return's
         p.x = (static_cast<float>(u) - camera.cx) * inv_fx * z[u];
         p.y = ry * z[u];
         p.z = z[u];
