@@ -135,11 +135,10 @@ namespace {
 /// Entry distance of the ray into the box if it meets it within [tmin, tmax]. A NaN from
 /// 0 * inf (a ray in a slab's plane) fails both comparisons and keeps the interval.
 inline void slab(float lo, float hi, float o, float inv, float& t0, float& t1) {
-  float a = (lo - o) * inv, b = (hi - o) * inv;
-  if (a > b)
-    std::swap(a, b);
-  t0 = a > t0 ? a : t0;
-  t1 = b < t1 ? b : t1;
+  const float a = (lo - o) * inv, b = (hi - o) * inv;
+  const float near = a < b ? a : b, far = a < b ? b : a;
+  t0 = near > t0 ? near : t0;
+  t1 = far < t1 ? far : t1;
 }
 inline bool slabEntry(const V3& lo, const V3& hi, const V3& o, const V3& inv, float tmin, float tmax, float& entry) {
   float t0 = tmin, t1 = tmax;

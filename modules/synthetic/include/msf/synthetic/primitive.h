@@ -87,35 +87,32 @@ struct Primitive {
 
 private:
   bool intersectBox(V3 o, V3 d, float tmin, Hit& hit) const {
-    float t0 = -std::numeric_limits<float>::infinity(), t1 = std::numeric_limits<float>::infinity();
-    int face = -1;
-    for (int k = 0; k < 3; ++k) {
-      const float ok = o[k], dk = d[k], hk = half[k];
-      if (dk == 0.f) {
-        if (ok < -hk || ok > hk)
-          return false;
-        continue;
-      }
-      const float inv = 1.f / dk;
-      float ta = (-hk - ok) * inv, tb = (hk - ok) * inv;
-      int entry_face = 2 * k + 1; // entering through the negative side (dk > 0)
-      if (ta > tb) {
-        std::swap(ta, tb);
-        entry_face = 2 * k;
-      }
-      if (ta > t0) {
-        t0 = ta;
-        face = entry_face;
-      }
-      t1 = std::fmin(t1, tb);
+    // Slabs without branches; a zero direction component gives infinite slab distances,
+    // which select or reject the box correctly.
+    const float ix = 1.f / d.x, iy = 1.f / d.y, iz = 1.f / d.z;
+    const float ax = (-half.x - o.x) * ix, bx = (half.x - o.x) * ix;
+    const float ay = (-half.y - o.y) * iy, by = (half.y - o.y) * iy;
+    const float az = (-half.z - o.z) * iz, bz = (half.z - o.z) * iz;
+    const float nx = ax < bx ? ax : bx, ny = ay < by ? ay : by, nz = az < bz ? az : bz;
+    const float fx = ax < bx ? bx : ax, fy = ay < by ? by : ay, fz = az < bz ? bz : az;
+    int k = 0;
+    float t0 = nx;
+    if (ny > t0) {
+      t0 = ny;
+      k = 1;
     }
-    if (face < 0 || t0 > t1 || t0 <= tmin || t0 >= hit.t)
+    if (nz > t0) {
+      t0 = nz;
+      k = 2;
+    }
+    const float fxy = fx < fy ? fx : fy, t1 = fxy < fz ? fxy : fz;
+    if (!(t0 <= t1) || t0 <= tmin || t0 >= hit.t)
       return false;
     hit.t = t0;
-    hit.face = face;
+    hit.face = 2 * k + (d[k] > 0.f ? 1 : 0); // entering through the negative side when d > 0
     hit.local = o + d * t0;
     float n[3] = {0.f, 0.f, 0.f};
-    n[face >> 1] = (face & 1) ? -1.f : 1.f;
+    n[k] = (hit.face & 1) ? -1.f : 1.f;
     hit.normal = dirToWorld({n[0], n[1], n[2]});
     return true;
   }
