@@ -7,6 +7,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <vector>
 
@@ -122,6 +123,34 @@ MSF_VECTOR_CLONES void accumulateRow(const float* __restrict o, float w, float* 
     v[u] += w * o[u];
     m[u] += o[u] > 0.f ? w : 0.f;
   }
+}
+
+/// 1 where the hole fill must compute a value: no estimate, or (smooth) no sample.
+MSF_VECTOR_CLONES void markTargets(const float* __restrict o, const float* __restrict d, bool smooth,
+                                   std::uint8_t* __restrict mask, int n) {
+  for (int u = 0; u < n; ++u)
+    mask[u] = static_cast<std::uint8_t>((o[u] > 0.f ? 0 : 1) | (smooth && !(d[u] > 0.f) ? 1 : 0));
+}
+
+/// The first u in [from, n) with mask[u] != 0, else n; skips eight zero bytes at a time.
+/// mask[n .. n + 7] must be 0.
+inline int nextTarget(const std::uint8_t* mask, int from, int n) {
+  int u = from;
+  while (u < n && (u & 7))
+    if (mask[u])
+      return u;
+    else
+      ++u;
+  while (u < n) {
+    std::uint64_t word;
+    std::memcpy(&word, mask + u, 8);
+    if (word)
+      break;
+    u += 8;
+  }
+  while (u < n && !mask[u])
+    ++u;
+  return std::min(u, n);
 }
 
 /// One row: estimates into `out`, gap lengths into `gap` (0 on samples and holes).
@@ -247,6 +276,7 @@ void DepthInterpolator::prepareHoleFill(int width) {
   for (float& w : kernel_)
     w /= total;
   values_.create(static_cast<int>(row_has_.size()), width + 2 * k, CV_32FC1);
+  targets_.create(static_cast<int>(row_has_.size()), width + 8, CV_8UC1);
   weights_.create(static_cast<int>(row_has_.size()), width + 2 * k, CV_32FC1);
 }
 
@@ -270,46 +300,43 @@ void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
   const bool smooth = config_.gaussian_smooth_valid;
 #pragma omp for schedule(static)
   for (int r = r0; r <= r1; ++r) {
-    // Vertical sums only where a target of this row will read them: its targets +- k,
-    // gathered as spans (most of a row within the rings is already estimated).
-    const float* own = out.ptr<float>(r);
-    const float* d = depth.ptr<float>(r);
+    // The targets of this row (holes; with smooth_valid, every pixel but the samples), as
+    // a byte mask made by a vectorized loop, then gathered into spans of targets +- k:
+    // vertical sums are made only there (most of a row within the rings is estimated).
+    std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
+    markTargets(out.ptr<float>(r), depth.ptr<float>(r), smooth, mask, W);
+    std::fill(mask + W, mask + W + 8, std::uint8_t{0}); // stops the word scan below
     float* v = values_.ptr<float>(r) + k;
     float* m = weights_.ptr<float>(r) + k;
     std::fill(v - k, v, 0.f); // the padding beyond the image's sides reads as empty
     std::fill(m - k, m, 0.f);
     std::fill(v + W, v + W + k, 0.f);
     std::fill(m + W, m + W + k, 0.f);
-    int u = 0;
+    int u = nextTarget(mask, 0, W);
     while (u < W) {
-      if (own[u] > 0.f && !(smooth && !(d[u] > 0.f))) {
-        ++u;
-        continue;
-      }
       const int a = std::max(0, u - k);
-      int last_target = u;
-      for (int x = u + 1; x < W && x <= last_target + 2 * k + 1; ++x)
-        if (!(own[x] > 0.f) || (smooth && !(d[x] > 0.f)))
-          last_target = x;
+      int last_target = u, next = nextTarget(mask, u + 1, W);
+      while (next < W && next <= last_target + 2 * k + 1) {
+        last_target = next;
+        next = nextTarget(mask, next + 1, W);
+      }
       const int b = std::min(W, last_target + k + 1);
       std::fill(v + a, v + b, 0.f);
       std::fill(m + a, m + b, 0.f);
       for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
         accumulateRow(out.ptr<float>(r + i) + a, g[i + k], v + a, m + a, b - a);
-      u = last_target + 1;
+      u = next;
     }
   }
   // (The implicit barrier above: every vertical sum is made before any hole is written.)
 #pragma omp for schedule(static)
   for (int r = r0; r <= r1; ++r) {
-    // The horizontal pass only where the result is used: holes are few within the rings.
+    // The horizontal pass at the targets only.
+    const std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
     const float* v = values_.ptr<float>(r);
     const float* m = weights_.ptr<float>(r);
-    const float* d = depth.ptr<float>(r);
     float* o = out.ptr<float>(r);
-    for (int u = 0; u < W; ++u) {
-      if (o[u] > 0.f && !(smooth && !(d[u] > 0.f)))
-        continue;
+    for (int u = nextTarget(mask, 0, W); u < W; u = nextTarget(mask, u + 1, W)) {
       float sv = 0.f, sm = 0.f;
       for (int i = 0; i <= 2 * k; ++i) {
         sv += g[i] * v[u + i];

@@ -65,7 +65,7 @@ private:
   void fillHoles(const cv::Mat& depth, cv::Mat& out);
 
   InterpolationConfig config_;
-  cv::Mat row_gap_, values_, weights_;
+  cv::Mat row_gap_, values_, weights_, targets_;
   std::vector<int> last_;     ///< column pass: row of the previous seed of each column
   std::vector<float> z_last_; ///< and its depth
   std::vector<char> row_has_; ///< rows with a sample

@@ -51,12 +51,19 @@ inline void bridgeValues(float z0, float z1, int empty, const SliceParams& p, Em
   const float a = p.inverse_depth ? 1.f / z0 : z0;
   const float delta = (p.inverse_depth ? 1.f / z1 : z1) - a;
   const float step = 1.f / static_cast<float>(empty + 1);
-  for (int k = 1; k <= empty; ++k) {
-    const float t = static_cast<float>(k) * step;
-    const float w = cubic ? t * t * (p.cubic_beta - p.cubic_alpha * t) : t; // paper eq. 3-5 / eq. 2
-    const float v = a + delta * w;
-    emit(k, p.inverse_depth ? 1.f / v : v);
-  }
+  // One loop per case, so that none branches inside (the common case: linear, 1/z).
+  auto run = [&](auto weight, auto finish) {
+    for (int k = 1; k <= empty; ++k)
+      emit(k, finish(a + delta * weight(static_cast<float>(k) * step)));
+  };
+  auto linear = [](float t) { return t; };
+  auto cubicWeight = [&](float t) { return t * t * (p.cubic_beta - p.cubic_alpha * t); }; // paper eq. 3-5
+  auto inverse = [](float v) { return 1.f / v; };
+  auto plain = [](float v) { return v; };
+  if (cubic)
+    p.inverse_depth ? run(cubicWeight, inverse) : run(cubicWeight, plain);
+  else
+    p.inverse_depth ? run(linear, inverse) : run(linear, plain);
 }
 
 /// The number of empty pixels of a gap, saturated to what a gap image holds.
