@@ -98,7 +98,9 @@ SurfaceResponse road(const Material& m, V3 w, const Footprint& fp, const StreetL
   const float lane = layout.lane_width_m;
   float paint = intervalCoverage(X, -0.06, 0.06, fX) * pulseCoverage(Z + 1.3, 9.0, 1.0 / 3.0, fZ);
   paint += intervalCoverage(X, lane - 0.06, lane + 0.06, fX) + intervalCoverage(X, -lane - 0.06, -lane + 0.06, fX);
-  paint = std::min(paint, 1.f) * (0.8f + 0.2f * fbm(X, Z, m.seed + 31u, 0.5f, 3, iso));
+  paint = std::min(paint, 1.f);
+  if (paint > 0.f) // worn paint
+    paint *= 0.8f + 0.2f * fbm(X, Z, m.seed + 31u, 0.5f, 3, iso);
   const Rgb asphalt = base(m) * a;
   return make(mix(asphalt, {0.72f, 0.72f, 0.70f}, paint), mixf(m.reflectivity * (1.f + 0.3f * n), 0.75f, paint));
 }
@@ -169,12 +171,14 @@ SurfaceResponse facade(const Material& m, const Primitive& p, const Hit& hit, co
   const float glass = inside * pulseCoverage(u, pitch, ww / pitch, f.fu) * pulseCoverage(v, storey, wh / storey, f.fv);
   const float framed = inside * pulseCoverage(u + frame, pitch, (ww + 2 * frame) / pitch, f.fu) *
                        pulseCoverage(v + frame, storey, (wh + 2 * frame) / storey, f.fv);
-  // Glass reflects the sky: brighter towards the top of each pane, with blurred clouds.
-  const float in_pane = static_cast<float>(std::fmod(std::fmod(v, storey) + storey, storey) / wh);
-  const float reflection = 0.05f * std::clamp(in_pane, 0.f, 1.f) + 0.04f * fbm(f.u, f.v, m.seed + 17u, 2.0f, 3, iso);
-  const Rgb pane{0.05f + reflection, 0.065f + reflection, 0.08f + 1.2f * reflection};
   Rgb c = mix(wall, {0.75f, 0.74f, 0.72f}, std::max(framed - glass, 0.f));
-  c = mix(c, pane, glass);
+  if (glass > 0.f) {
+    // Glass reflects the sky: brighter towards the top of each pane, with blurred clouds.
+    const float in_pane = static_cast<float>(std::fmod(std::fmod(v, storey) + storey, storey) / wh);
+    const float reflection = 0.05f * std::clamp(in_pane, 0.f, 1.f) + 0.04f * fbm(f.u, f.v, m.seed + 17u, 2.0f, 3, iso);
+    const Rgb pane{0.05f + reflection, 0.065f + reflection, 0.08f + 1.2f * reflection};
+    c = mix(c, pane, glass);
+  }
   return make(c, mixf(m.reflectivity, 0.05f, glass), glass);
 }
 

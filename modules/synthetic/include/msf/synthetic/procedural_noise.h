@@ -54,14 +54,16 @@ inline float valueNoise(float x, float y, std::uint32_t seed) {
 /// Roughly in [-1, 1].
 inline float fbm(float x, float y, std::uint32_t seed, float wavelength_m, int octaves, float footprint_m,
                  float gain = 0.55f) {
-  float sum = 0.f, amplitude = 1.f, total = 0.f, lambda = wavelength_m;
-  for (int i = 0; i < octaves; ++i) {
+  float total = 0.f, amplitude = 1.f;
+  for (int i = 0; i < octaves; ++i, amplitude *= gain)
     total += amplitude;
+  float sum = 0.f, lambda = wavelength_m;
+  amplitude = 1.f;
+  for (int i = 0; i < octaves; ++i, amplitude *= gain, lambda *= 0.5f) {
     const float keep = std::clamp(lambda / (2.f * footprint_m) - 1.f, 0.f, 1.f);
-    if (keep > 0.f)
-      sum += amplitude * keep * valueNoise(x / lambda, y / lambda, seed + 977u * static_cast<std::uint32_t>(i));
-    amplitude *= gain;
-    lambda *= 0.5f;
+    if (keep <= 0.f)
+      break; // every finer octave is faded out too
+    sum += amplitude * keep * valueNoise(x / lambda, y / lambda, seed + 977u * static_cast<std::uint32_t>(i));
   }
   return sum / total;
 }
