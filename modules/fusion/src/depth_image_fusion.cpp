@@ -1,6 +1,5 @@
 #include <msf/common/exceptions.h>
 #include <msf/fusion/depth_image_fusion.h>
-#include <msf/fusion/fusion_model.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -21,10 +20,23 @@ void check(const cv::Mat& image, const char* name, const cv::Size& size, bool op
 }
 } // namespace
 
-void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
-                     const cv::Mat& stereo_confidence, const Calibration& calibration,
-                     const DepthFusionConfig& config, cv::Mat& fused_depth, cv::Mat* fused_weight) {
+void DepthImageFusion::setConfig(const DepthFusionConfig& config) {
   config.validate();
+  config_ = config;
+  parallax_ = lidarParallax(calibration_, config_);
+}
+
+void DepthImageFusion::setCalibration(const Calibration& calibration) {
+  if (!(calibration.focalBaseline() > 0.0))
+    throw CalibrationError("calibration '" + calibration.source +
+                           "': the grey pair has no baseline (P1 must hold -f B in its last column)");
+  calibration_ = calibration;
+  focal_baseline_ = calibration.focalBaseline();
+  parallax_ = lidarParallax(calibration, config_);
+}
+
+void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
+                            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight) {
   if (lidar_depth.empty())
     throw InvalidInputError("depth fusion: the LiDAR depth image is empty");
   const cv::Size size = lidar_depth.size();
@@ -32,44 +44,42 @@ void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, 
   check(lidar_distance, "the LiDAR distance image", size, true);
   check(stereo_depth, "the stereo depth image", size, false);
   check(stereo_confidence, "the stereo confidence image", size, true);
-  const double focal_baseline = calibration.focalBaseline();
-  if (!(focal_baseline > 0.0))
-    throw CalibrationError("calibration '" + calibration.source +
-                           "': the grey pair has no baseline (P1 must hold -f B in its last column)");
-  const LidarParallax parallax = lidarParallax(calibration, config);
+  if (!(focal_baseline_ > 0.0))
+    throw CalibrationError("depth fusion: no calibration set (setCalibration)");
 
-  cv::Mat range;
-  if (config.method == FusionMethod::Uncertainty)
-    localDisparityRange(lidar_depth, focal_baseline, config.lidar_range_window_px, range);
+  const bool uncertainty = config_.method == FusionMethod::Uncertainty;
+  const auto filled = [&](const cv::Mat& image, cv::Mat& buffer, float value) -> const cv::Mat& {
+    if (!image.empty())
+      return image;
+    if (buffer.size() != size || buffer.type() != CV_32FC1 || buffer.at<float>(0, 0) != value)
+      buffer = cv::Mat(size, CV_32FC1, cv::Scalar(value));
+    return buffer;
+  };
+  const cv::Mat& distance = filled(lidar_distance, zeros_, 0.f);
+  const cv::Mat& confidence = filled(stereo_confidence, ones_, 1.f);
+  // The row kernel treats every depth that is not > 0 (0, negative, NaN) as none.
+  const cv::Mat& lidar = lidar_depth;
+  const cv::Mat& stereo = stereo_depth;
+  if (uncertainty)
+    localDisparityExtremes(lidar, focal_baseline_, config_.lidar_range_window_px, largest_, smallest_);
   fused_depth.create(size, CV_32FC1);
-  if (fused_weight)
-    fused_weight->create(size, CV_32FC1);
-  const float fB = static_cast<float>(focal_baseline);
+  cv::Mat& weight = fused_weight ? *fused_weight : weight_;
+  weight.create(size, CV_32FC1);
+  const float fB = static_cast<float>(focal_baseline_);
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& r) {
-    for (int v = r.start; v < r.end; ++v) {
-      const float* zl = lidar_depth.ptr<float>(v);
-      const float* dist = lidar_distance.empty() ? nullptr : lidar_distance.ptr<float>(v);
-      const float* rng = range.empty() ? nullptr : range.ptr<float>(v);
-      const float* zs = stereo_depth.ptr<float>(v);
-      const float* conf = stereo_confidence.empty() ? nullptr : stereo_confidence.ptr<float>(v);
-      float* out = fused_depth.ptr<float>(v);
-      float* weight = fused_weight ? fused_weight->ptr<float>(v) : nullptr;
-      for (int u = 0; u < size.width; ++u) {
-        FusionInputs in;
-        in.z_lidar = detail::validDepth(zl[u]) ? zl[u] : 0.f;
-        in.lidar_distance = dist ? dist[u] : 0.f;
-        in.lidar_range_px = rng ? rng[u] : 0.f;
-        in.z_stereo = detail::validDepth(zs[u]) ? zs[u] : 0.f;
-        in.stereo_confidence = conf ? conf[u] : 1.f;
-        const FusionResult f = fusePixel(in, config, fB, parallax, [&](int k) {
-          return v + k < size.height ? lidar_depth.ptr<float>(v + k)[u] : 0.f;
-        });
-        out[u] = f.z;
-        if (weight)
-          weight[u] = f.weight;
-      }
-    }
+    for (int v = r.start; v < r.end; ++v)
+      fuseRow(config_, fB, parallax_, lidar, v, distance.ptr<float>(v),
+              uncertainty ? largest_.ptr<float>(v) : nullptr, uncertainty ? smallest_.ptr<float>(v) : nullptr,
+              stereo.ptr<float>(v), confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v));
   });
+}
+
+void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
+                     const cv::Mat& stereo_confidence, const Calibration& calibration,
+                     const DepthFusionConfig& config, cv::Mat& fused_depth, cv::Mat* fused_weight) {
+  DepthImageFusion fusion(config);
+  fusion.setCalibration(calibration);
+  fusion.fuse(lidar_depth, lidar_distance, stereo_depth, stereo_confidence, fused_depth, fused_weight);
 }
 
 } // namespace msf

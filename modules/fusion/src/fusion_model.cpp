@@ -8,7 +8,8 @@
 
 namespace msf {
 
-void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& range) {
+void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& largest,
+                            cv::Mat& smallest) {
   if (depth.type() != CV_32FC1)
     throw InvalidInputError("LiDAR depth image must be CV_32FC1 (metres)");
   if (window < 1 || window % 2 == 0)
@@ -16,33 +17,91 @@ void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window
   const int rows = depth.rows, cols = depth.cols;
   const float fB = static_cast<float>(focal_baseline), inf = std::numeric_limits<float>::infinity();
   // Missing pixels are 0 for the maximum and +inf for the minimum, so both see only values.
-  cv::Mat hi(rows, cols, CV_32FC1), lo(rows, cols, CV_32FC1);
+  largest.create(rows, cols, CV_32FC1);
+  smallest.create(rows, cols, CV_32FC1);
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v) {
-      const float* z = depth.ptr<float>(v);
-      float* h = hi.ptr<float>(v);
-      float* l = lo.ptr<float>(v);
+      const float* __restrict__ z = depth.ptr<float>(v);
+      float* __restrict__ h = largest.ptr<float>(v);
+      float* __restrict__ l = smallest.ptr<float>(v);
       for (int u = 0; u < cols; ++u) {
-        const bool ok = z[u] > 0.f && z[u] < inf;
-        const float d = ok ? fB / z[u] : 0.f;
-        h[u] = d;
+        const bool ok = (z[u] > 0.f) & (z[u] < inf);
+        const float d = fB / (ok ? z[u] : 1.f);
+        h[u] = ok ? d : 0.f;
         l[u] = ok ? d : inf;
       }
     }
   });
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(window, window));
-  cv::dilate(hi, hi, kernel);
-  cv::erode(lo, lo, kernel);
-  range.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
-    for (int v = r.start; v < r.end; ++v) {
-      const float* h = hi.ptr<float>(v);
-      const float* l = lo.ptr<float>(v);
-      float* out = range.ptr<float>(v);
-      for (int u = 0; u < cols; ++u)
-        out[u] = l[u] < inf ? h[u] - l[u] : 0.f;
+  cv::dilate(largest, largest, kernel);
+  cv::erode(smallest, smallest, kernel);
+}
+
+void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& range) {
+  cv::Mat largest, smallest;
+  localDisparityExtremes(depth, focal_baseline, window, largest, smallest);
+  range.create(depth.rows, depth.cols, CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* __restrict__ h = largest.ptr<float>(v);
+    const float* __restrict__ l = smallest.ptr<float>(v);
+    float* __restrict__ out = range.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u)
+      out[u] = disparityRangeAt(h, l, u);
+  }
+}
+
+void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
+             const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
+             const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
+             const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
+             float* __restrict__ fused_z, float* __restrict__ fused_weight) {
+  const int width = lidar_depth.cols, rows = lidar_depth.rows;
+  const float* __restrict__ z_lidar = lidar_depth.ptr<float>(v);
+  const DepthFusionConfig config = c; // a local copy: the compiler may keep it in registers
+  if (config.method == FusionMethod::Paper) {
+    for (int u = 0; u < width; ++u) {
+      FusionInputs in;
+      in.z_lidar = z_lidar[u];
+      in.lidar_distance = lidar_distance[u];
+      in.z_stereo = z_stereo[u];
+      in.stereo_confidence = stereo_confidence[u];
+      const FusionResult r = fusePaper(in, config);
+      fused_z[u] = r.z;
+      fused_weight[u] = r.weight;
     }
-  });
+    return;
+  }
+  const float inf = std::numeric_limits<float>::infinity();
+  int candidates = 0; // pixels for the parallax check below
+  for (int u = 0; u < width; ++u) {
+    FusionInputs in;
+    in.z_lidar = z_lidar[u];
+    in.lidar_distance = lidar_distance[u];
+    const float range = lidar_max[u] - lidar_min[u];
+    in.lidar_range_px = lidar_min[u] < inf ? range : 0.f;
+    in.z_stereo = z_stereo[u];
+    in.stereo_confidence = stereo_confidence[u];
+    const FusionResult r = fuseUncertainty(in, config, focal_baseline);
+    fused_z[u] = r.z;
+    fused_weight[u] = r.weight;
+    candidates += (in.z_stereo > 0.f) & (r.z == in.z_lidar) & (in.z_stereo < in.z_lidar);
+  }
+  if (candidates == 0 || !(parallax.rows_per_px > 0.f))
+    return;
+  // The LiDAR kept although stereo saw a nearer surface: was it seen past a foreground edge?
+  for (int u = 0; u < width; ++u) {
+    if (!(z_stereo[u] > 0.f && fused_z[u] == z_lidar[u] && z_stereo[u] < z_lidar[u]))
+      continue;
+    const float s_S = stereoSigmaPx(stereo_confidence[u], config);
+    const bool past = lidarSeesPastForeground(
+        focal_baseline / z_lidar[u], focal_baseline / z_stereo[u], config.disagreement_k_sigma * s_S, focal_baseline,
+        parallax.rows_per_px, parallax.max_rows,
+        [&](int k) { return v + k < rows ? lidar_depth.ptr<float>(v + k)[u] : 0.f; });
+    if (past) {
+      fused_z[u] = z_stereo[u];
+      fused_weight[u] = std::min(1.f, config.stereo_sigma_min_px * config.stereo_sigma_min_px / (s_S * s_S));
+    }
+  }
 }
 
 LidarParallax lidarParallax(const Calibration& calibration, const DepthFusionConfig& config) {

@@ -79,7 +79,7 @@ private:
   PointCloudStereoConstPtr stereo_;
   cv::Mat color_;
   int color_camera_{2};
-  cv::Mat lidar_depth_, lidar_range_; ///< work buffers, kept between frames
+  cv::Mat lidar_depth_, lidar_max_, lidar_min_; ///< work buffers, kept between frames
 };
 
 } // namespace msf

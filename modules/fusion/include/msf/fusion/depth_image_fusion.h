@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/fusion/fusion_config.h>
+#include <msf/fusion/fusion_model.h>
 #include <msf/io/calibration.h>
 
 #include <opencv2/core/mat.hpp>
@@ -7,14 +8,42 @@
 namespace msf {
 
 /// DepthFusion on images, for pipelines that keep depth images between stages (the
-/// evaluation, the TSDF integrator): the same per-pixel model (fusion_model.h), without
-/// clouds. lidar_depth, stereo_depth: CV_32FC1 metres (0 or NaN = none); lidar_distance:
-/// CV_32FC1 pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1
-/// in [0, 1] (empty: all 1); all of one size. `calibration` gives f B and the LiDAR's
-/// mounting over the camera. Writes fused_depth (CV_32FC1, 0 = none) and, when given,
-/// fused_weight (CV_32FC1). Throws InvalidInputError naming the image whose type or size is
-/// wrong, CalibrationError when the calibration has no baseline, ConfigError for an invalid
-/// config.
+/// evaluation, the TSDF integrator): the same per-pixel model (fusion_model.h) without
+/// clouds, so a frame moves a quarter of the memory. Keeps its work buffers between frames;
+/// one object per thread.
+///
+///   msf::DepthImageFusion fusion(config);
+///   fusion.setCalibration(calibration);
+///   fusion.fuse(lidar_depth, lidar_distance, stereo_depth, stereo_confidence, fused_depth);
+class DepthImageFusion {
+public:
+  /// Throws ConfigError for an invalid config.
+  explicit DepthImageFusion(const DepthFusionConfig& config = {}) { setConfig(config); }
+  /// Throws ConfigError for an invalid config.
+  void setConfig(const DepthFusionConfig& config);
+  const DepthFusionConfig& getConfig() const { return config_; }
+  /// f B and the LiDAR's mounting over the camera. Throws CalibrationError without a baseline.
+  void setCalibration(const Calibration& calibration);
+
+  /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
+  /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]
+  /// (empty: all 1); all of one size. Writes fused_depth (CV_32FC1, 0 = none) and, when
+  /// given, fused_weight (CV_32FC1). Throws InvalidInputError naming the image whose type or
+  /// size is wrong, CalibrationError when no calibration was set.
+  void fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
+            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr);
+
+private:
+  DepthFusionConfig config_;
+  double focal_baseline_{0.0};
+  Calibration calibration_;
+  LidarParallax parallax_;
+  cv::Mat largest_, smallest_;          ///< local LiDAR disparity extremes, kept between frames
+  cv::Mat weight_;                      ///< weights when the caller wants none
+  cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none
+};
+
+/// One-call form of DepthImageFusion (buffers are allocated for the call).
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
                      const cv::Mat& stereo_confidence, const Calibration& calibration,
                      const DepthFusionConfig& config, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr);

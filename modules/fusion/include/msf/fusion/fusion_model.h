@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace msf {
 
@@ -28,6 +29,9 @@ namespace detail {
 inline bool validDepth(float z) { return z > 0.f && std::isfinite(z); }
 } // namespace detail
 
+// The per-pixel functions below are written with selects rather than branches, so that the
+// row loops (fuseRow) vectorise. A depth that is not > 0 (0, negative, NaN) is none.
+
 /// The paper's eq. 6 (DESIGN.md step 4), y = (y1 w1 + y2 w2 w1) / (w1 + w2 w1), with
 /// y1 the stereo depth, y2 the LiDAR depth and the dynamic weights
 ///   w_L = paper_lidar_gain / (1 + distance / paper_lidar_distance_px)   (0 without LiDAR)
@@ -41,16 +45,19 @@ inline bool validDepth(float z) { return z > 0.f && std::isfinite(z); }
 /// weighted w_S : w_L. Where stereo has no depth (w1 = 0, eq. 6 is 0/0) the LiDAR depth is
 /// used. weight = min(1, w_L + w_S).
 inline FusionResult fusePaper(const FusionInputs& in, const DepthFusionConfig& c) {
-  const bool lidar = detail::validDepth(in.z_lidar), stereo = detail::validDepth(in.z_stereo);
-  const float w_L = lidar ? c.paper_lidar_gain / (1.f + in.lidar_distance / c.paper_lidar_distance_px) : 0.f;
-  if (!stereo)
-    return lidar ? FusionResult{in.z_lidar, std::min(1.f, w_L)} : FusionResult{};
-  const float ratio = c.paper_stereo_reference_depth_m / in.z_stereo;
+  const bool lidar = in.z_lidar > 0.f, stereo = in.z_stereo > 0.f;
+  const float w_L_any = c.paper_lidar_gain / (1.f + in.lidar_distance / c.paper_lidar_distance_px);
+  const float w_L = lidar ? w_L_any : 0.f;
+  const float ratio = c.paper_stereo_reference_depth_m / (stereo ? in.z_stereo : 1.f);
   const float w_S = std::max(in.stereo_confidence, c.paper_min_stereo_confidence) * std::min(1.f, ratio * ratio);
   const float w1 = 1.f;
   const float w2 = w_L / w_S;
   const float y1 = in.z_stereo, y2 = lidar ? in.z_lidar : 0.f;
-  return {(y1 * w1 + y2 * w2 * w1) / (w1 + w2 * w1), std::min(1.f, w_L + w_S)};
+  const float y = (y1 * w1 + y2 * w2 * w1) / (w1 + w2 * w1);
+  FusionResult r;
+  r.z = stereo ? y : (lidar ? in.z_lidar : 0.f);
+  r.weight = std::min(1.f, stereo ? w_L + w_S : w_L);
+  return r;
 }
 
 /// Sigma of a stereo disparity (pixels): stereo_sigma_min_px at confidence 1, rising
@@ -67,6 +74,40 @@ inline float stereoSigmaPx(float confidence, const DepthFusionConfig& c) {
 /// and the camera does not, sits next to the foreground's returns).
 inline float lidarSigmaPx(float distance, float range_px, const DepthFusionConfig& c) {
   return c.lidar_sigma_px + c.lidar_sigma_per_distance * distance + c.lidar_sigma_per_range * range_px;
+}
+
+/// Inverse-variance fusion in disparity d = f B / z, where both sensors' errors are
+/// measured: stereo sigma_z = z^2 sigma_d / (f B) is sigma_d in disparity, and the LiDAR's
+/// interpolation error is a few tenths of a pixel there. Two samples further apart than
+/// disagreement_k_sigma * sqrt(sigma_L^2 + sigma_S^2) are not averaged (that would put a
+/// point between foreground and background): the one with the smaller sigma is kept. When
+/// that is the LiDAR while stereo sees a nearer surface (z = z_lidar > z_stereo > 0),
+/// callers check lidarSeesPastForeground, and then stereo wins (fusePixel, fuseRow).
+/// weight = min(1, stereo_sigma_min_px^2 / sigma^2), 1 for a stereo match of confidence 1.
+inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline) {
+  // Bitwise & and | on the flags, and every division done unconditionally: no branches.
+  const bool lidar = in.z_lidar > 0.f, stereo = in.z_stereo > 0.f;
+  const float s_L = lidarSigmaPx(in.lidar_distance, in.lidar_range_px, c);
+  const float s_S = stereoSigmaPx(in.stereo_confidence, c);
+  const float v_L = s_L * s_L, v_S = s_S * s_S, v_sum = v_L + v_S;
+  const float d_L = focal_baseline / (lidar ? in.z_lidar : 1.f);
+  const float d_S = focal_baseline / (stereo ? in.z_stereo : 1.f);
+  const float diff = d_L - d_S, k = c.disagreement_k_sigma;
+  const bool both = lidar & stereo;
+  const bool agree = diff * diff <= k * k * v_sum;
+  const bool lidar_more_certain = s_L <= s_S;
+  // Where both agree: the inverse-variance mean, of variance v_L v_S / (v_L + v_S).
+  const float z_mean = focal_baseline * v_sum / (d_L * v_S + d_S * v_L);
+  const bool no_lidar = !lidar, no_stereo = !stereo, disagree = !agree, stereo_more_certain = !lidar_more_certain;
+  const bool take_lidar = lidar & (no_stereo | (disagree & lidar_more_certain));
+  const bool take_stereo = stereo & (no_lidar | (disagree & stereo_more_certain));
+  const float s_min2 = c.stereo_sigma_min_px * c.stereo_sigma_min_px;
+  const float inv_v_L = 1.f / v_L, inv_v_S = 1.f / v_S, inv_v_mean = inv_v_L + inv_v_S;
+  FusionResult r;
+  r.z = take_lidar ? in.z_lidar : (take_stereo ? in.z_stereo : (both ? z_mean : 0.f));
+  const float inv_var = take_lidar ? inv_v_L : (take_stereo ? inv_v_S : (both ? inv_v_mean : 0.f));
+  r.weight = std::min(1.f, s_min2 * inv_var);
+  return r;
 }
 
 /// True when the LiDAR sample of a pixel is likely a return from behind a foreground edge:
@@ -97,64 +138,57 @@ struct LidarParallax {
   int max_rows = 0;        ///< rows read at most
 };
 
-/// Inverse-variance fusion in disparity d = f B / z, where both sensors' errors are
-/// measured: stereo sigma_z = z^2 sigma_d / (f B) is sigma_d in disparity, and the LiDAR's
-/// interpolation error is a few tenths of a pixel there. Two samples further apart than
-/// disagreement_k_sigma * sqrt(sigma_L^2 + sigma_S^2) are not averaged (that would put a
-/// point between foreground and background): the one with the smaller sigma is kept, except
-/// that stereo wins where the LiDAR sample was seen past a foreground edge
-/// (lidarSeesPastForeground; `lidar_below` reads the LiDAR depth image below the pixel).
-/// weight = min(1, (stereo_sigma_min_px / sigma)^2), 1 for a stereo match of confidence 1.
-template <typename LidarBelow>
-inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline,
-                                    const LidarParallax& parallax, LidarBelow&& lidar_below) {
-  const bool lidar = detail::validDepth(in.z_lidar), stereo = detail::validDepth(in.z_stereo);
-  if (!lidar && !stereo)
-    return {};
-  const auto weightOf = [&](float sigma) {
-    const float r = c.stereo_sigma_min_px / sigma;
-    return std::min(1.f, r * r);
-  };
-  const float s_L = lidar ? lidarSigmaPx(in.lidar_distance, in.lidar_range_px, c) : 0.f;
-  const float s_S = stereo ? stereoSigmaPx(in.stereo_confidence, c) : 0.f;
-  if (!stereo)
-    return {in.z_lidar, weightOf(s_L)};
-  if (!lidar)
-    return {in.z_stereo, weightOf(s_S)};
-  const float d_L = focal_baseline / in.z_lidar, d_S = focal_baseline / in.z_stereo;
-  const float v_L = s_L * s_L, v_S = s_S * s_S;
-  const float diff = d_L - d_S, k = c.disagreement_k_sigma;
-  if (diff * diff > k * k * (v_L + v_S)) {
-    const bool stereo_wins =
-        s_S < s_L || lidarSeesPastForeground(d_L, d_S, k * s_S, focal_baseline, parallax.rows_per_px,
-                                             parallax.max_rows, lidar_below);
-    return stereo_wins ? FusionResult{in.z_stereo, weightOf(s_S)} : FusionResult{in.z_lidar, weightOf(s_L)};
-  }
-  const float d = (d_L * v_S + d_S * v_L) / (v_L + v_S);
-  return {focal_baseline / d, weightOf(std::sqrt(v_L * v_S / (v_L + v_S)))};
-}
-
-/// Without the image below the pixel: no parallax check.
-inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline) {
-  return fuseUncertainty(in, c, focal_baseline, LidarParallax{}, [](int) { return 0.f; });
-}
-
-/// Both methods of `c.method`.
-template <typename LidarBelow>
-inline FusionResult fusePixel(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline,
-                              const LidarParallax& parallax, LidarBelow&& lidar_below) {
-  return c.method == FusionMethod::Paper ? fusePaper(in, c)
-                                         : fuseUncertainty(in, c, focal_baseline, parallax, lidar_below);
-}
-
 /// The parallax of `calibration`'s LiDAR over camera 0 (none when the LiDAR is not above it),
 /// with config.parallax_check.
 LidarParallax lidarParallax(const Calibration& calibration, const DepthFusionConfig& config);
+
+/// Both methods of `c.method` for one pixel, the parallax check included: `lidar_below(k)`
+/// reads the LiDAR depth k rows below the pixel.
+template <typename LidarBelow>
+inline FusionResult fusePixel(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline,
+                              const LidarParallax& parallax, LidarBelow&& lidar_below) {
+  if (c.method == FusionMethod::Paper)
+    return fusePaper(in, c);
+  FusionResult r = fuseUncertainty(in, c, focal_baseline);
+  if (in.z_stereo > 0.f && r.z == in.z_lidar && in.z_stereo < in.z_lidar) {
+    const float s_S = stereoSigmaPx(in.stereo_confidence, c);
+    if (lidarSeesPastForeground(focal_baseline / in.z_lidar, focal_baseline / in.z_stereo,
+                                c.disagreement_k_sigma * s_S, focal_baseline, parallax.rows_per_px,
+                                parallax.max_rows, lidar_below)) {
+      r.z = in.z_stereo;
+      r.weight = std::min(1.f, c.stereo_sigma_min_px * c.stereo_sigma_min_px / (s_S * s_S));
+    }
+  }
+  return r;
+}
+
+/// One image row of the fusion, the loop both DepthFusion and DepthImageFusion run: `width`
+/// pixels of row `v` of `lidar_depth` (CV_32FC1, not > 0 = none), with the row's LiDAR
+/// distances and local disparity extremes (localDisparityExtremes; read by the uncertainty
+/// method only), stereo depths (not > 0 = none) and confidences; no pointer may be null. Writes
+/// fused depth (0 = none) and weight. The per-pixel pass vectorises; the rare parallax
+/// checks follow it.
+void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
+             const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
+             const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
+             const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
+             float* __restrict__ fused_z, float* __restrict__ fused_weight);
 
 /// Local disparity range of a depth image (CV_32F metres, 0 = none): at each pixel, the
 /// largest minus the smallest disparity f B / z over the valid pixels of the odd `window`
 /// (0 where the window holds at most one value). Reuses `range` when it has the right size.
 /// Throws InvalidInputError for a wrong type.
 void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& range);
+
+/// The two halves of localDisparityRange, for loops that take the difference themselves:
+/// the largest (0 where none) and the smallest (+inf where none) disparity in the window.
+/// Reuses the matrices when they have the right size.
+void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& largest,
+                            cv::Mat& smallest);
+
+/// localDisparityRange at one pixel from localDisparityExtremes' rows.
+inline float disparityRangeAt(const float* largest, const float* smallest, int u) {
+  return smallest[u] < std::numeric_limits<float>::infinity() ? largest[u] - smallest[u] : 0.f;
+}
 
 } // namespace msf

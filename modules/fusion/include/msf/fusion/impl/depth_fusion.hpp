@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -40,20 +41,21 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
   const float fB = static_cast<float>(calibration_.focalBaseline());
   lidar_depth_.create(rows, cols, CV_32FC1);
+#pragma omp parallel for
   for (int v = 0; v < rows; ++v) {
     const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
     float* z = lidar_depth_.ptr<float>(v);
     for (int u = 0; u < cols; ++u)
       z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
   }
-  if (config_.method == FusionMethod::Uncertainty)
-    localDisparityRange(lidar_depth_, fB, config_.lidar_range_window_px, lidar_range_);
+  const bool uncertainty = config_.method == FusionMethod::Uncertainty;
+  if (uncertainty)
+    localDisparityExtremes(lidar_depth_, fB, config_.lidar_range_window_px, lidar_max_, lidar_min_);
 
   const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const DepthFusionConfig config = config_;
   const LidarParallax parallax = lidarParallax(calibration_, config);
-  const cv::Mat& lidar_depth = lidar_depth_;
   output.resize(static_cast<std::size_t>(rows) * cols);
   output.width = static_cast<std::uint32_t>(cols);
   output.height = static_cast<std::uint32_t>(rows);
@@ -61,52 +63,61 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   output.sensor_origin_ = stereo_->sensor_origin_;
   output.sensor_orientation_ = stereo_->sensor_orientation_;
   bool dense = true;
-#pragma omp parallel for reduction(&& : dense)
-  for (int v = 0; v < rows; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v) * cols;
-    const float* z_lidar = lidar_depth_.ptr<float>(v);
-    const float* range = config.method == FusionMethod::Uncertainty ? lidar_range_.ptr<float>(v) : nullptr;
-    for (int u = 0; u < cols; ++u) {
-      const PointLidarT& l = (*lidar_)[row + u];
-      const PointStereoT& s = (*stereo_)[row + u];
-      PointOutT& p = output[row + u];
-      FusionInputs in;
-      in.z_lidar = z_lidar[u];
-      if constexpr (detail::has_distance_v<PointLidarT>)
-        in.lidar_distance = l.distance;
-      in.lidar_range_px = range ? range[u] : 0.f;
-      in.z_stereo = detail::validDepth(s.z) ? s.z : 0.f;
-      if constexpr (detail::has_confidence_v<PointStereoT>)
-        in.stereo_confidence = s.confidence;
-      const FusionResult f = fusePixel(in, config, fB, parallax, [&](int k) {
-        return v + k < rows ? lidar_depth.ptr<float>(v + k)[u] : 0.f;
-      });
-      if (f.z > 0.f) {
-        // On the ray of the input point: stereo's lies on the pixel's ray, the LiDAR's
-        // within half a pixel of it.
-        const bool from_stereo = in.z_stereo > 0.f;
-        const float scale = f.z / (from_stereo ? s.z : l.z);
-        p.x = (from_stereo ? s.x : l.x) * scale;
-        p.y = (from_stereo ? s.y : l.y) * scale;
-        p.z = f.z;
-      } else {
-        p.x = p.y = p.z = nan;
-        dense = false;
+#pragma omp parallel reduction(&& : dense)
+  {
+    // One row of each input at a time, in contiguous arrays for fuseRow.
+    std::vector<float> distance(static_cast<std::size_t>(cols)), z_stereo(distance), confidence(distance),
+        fused_z(distance), fused_weight(distance);
+#pragma omp for
+    for (int v = 0; v < rows; ++v) {
+      const std::size_t row = static_cast<std::size_t>(v) * cols;
+      for (int u = 0; u < cols; ++u) {
+        const PointStereoT& s = (*stereo_)[row + u];
+        z_stereo[u] = detail::validDepth(s.z) ? s.z : 0.f;
+        if constexpr (detail::has_confidence_v<PointStereoT>)
+          confidence[u] = s.confidence;
+        else
+          confidence[u] = 1.f;
+        if constexpr (detail::has_distance_v<PointLidarT>)
+          distance[u] = (*lidar_)[row + u].distance;
+        else
+          distance[u] = 0.f;
       }
-      if constexpr (detail::has_rgb_v<PointOutT>) {
-        if constexpr (detail::has_rgb_v<PointStereoT>) {
-          p.r = s.r;
-          p.g = s.g;
-          p.b = s.b;
+      fuseRow(config, fB, parallax, lidar_depth_, v, distance.data(), uncertainty ? lidar_max_.ptr<float>(v) : nullptr,
+              uncertainty ? lidar_min_.ptr<float>(v) : nullptr, z_stereo.data(), confidence.data(), fused_z.data(),
+              fused_weight.data());
+      for (int u = 0; u < cols; ++u) {
+        const PointStereoT& s = (*stereo_)[row + u];
+        PointOutT& p = output[row + u];
+        const float z = fused_z[u];
+        if (z > 0.f) {
+          // On the ray of the input point: stereo's lies on the pixel's ray, the LiDAR's
+          // within half a pixel of it.
+          const bool from_stereo = z_stereo[u] > 0.f;
+          const PointLidarT& l = (*lidar_)[row + u];
+          const float scale = z / (from_stereo ? s.z : l.z);
+          p.x = (from_stereo ? s.x : l.x) * scale;
+          p.y = (from_stereo ? s.y : l.y) * scale;
+          p.z = z;
         } else {
-          p.r = p.g = p.b = 0;
+          p.x = p.y = p.z = nan;
+          dense = false;
         }
-        p.a = 255;
-        if (f.z > 0.f)
-          sampler.sample(p.x, p.y, p.z, p.r, p.g, p.b);
+        if constexpr (detail::has_rgb_v<PointOutT>) {
+          if constexpr (detail::has_rgb_v<PointStereoT>) {
+            p.r = s.r;
+            p.g = s.g;
+            p.b = s.b;
+          } else {
+            p.r = p.g = p.b = 0;
+          }
+          p.a = 255;
+          if (z > 0.f)
+            sampler.sample(p.x, p.y, p.z, p.r, p.g, p.b);
+        }
+        if constexpr (detail::has_weight_v<PointOutT>)
+          p.weight = fused_weight[u];
       }
-      if constexpr (detail::has_weight_v<PointOutT>)
-        p.weight = f.weight;
     }
   }
   output.is_dense = dense;
