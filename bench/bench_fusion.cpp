@@ -1,6 +1,6 @@
 // Per-pixel depth fusion per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370):
 // the cloud class DepthFusion<PointXYZID, PointXYZRGBConfidence, PointXYZRGBWeight> and the
-// image-level fuseDepthImages, for both methods. Inputs (interpolated LiDAR with distances,
+// image-level DepthImageFusion, for both methods. Inputs (interpolated LiDAR with distances,
 // SGBM with confidence) are made once before timing.
 //
 //   bench_fusion [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
@@ -92,12 +92,13 @@ void imageFusion(benchmark::State& state, msf::FusionMethod method) {
   const Data& d = data();
   msf::DepthFusionConfig config;
   config.method = method;
+  msf::DepthImageFusion fusion(config);
+  fusion.setCalibration(d.calibration);
   cv::Mat fused, weight;
   std::size_t i = 0;
   for (auto _ : state) {
     const std::size_t f = i++ % d.lidar.size();
-    msf::fuseDepthImages(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f],
-                         d.calibration, config, fused, &weight);
+    fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], fused, &weight);
     benchmark::DoNotOptimize(fused.data);
   }
 }

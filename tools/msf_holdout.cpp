@@ -79,6 +79,7 @@ msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) 
   fusion.method = method;
   std::shared_ptr<msf::LidarCompletion> completion;
   auto sgbm = std::make_shared<msf::SgbmStereo>(stereo_config);
+  auto fuser = std::make_shared<msf::DepthImageFusion>(fusion);
   return [=](const msf::HoldoutInput& in) mutable {
     if (!completion)
       completion = std::make_shared<msf::LidarCompletion>(*in.calibration, msf::CompletionMethod::Compound,
@@ -89,8 +90,8 @@ msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) 
     sgbm->setInputImages(in.left, in.right);
     sgbm->setDepthPrior(lidar_depth);
     sgbm->computeDisparity();
-    msf::fuseDepthImages(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), *in.calibration, fusion,
-                         depth);
+    fuser->setCalibration(*in.calibration);
+    fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
     return depth;
   };
 }
