@@ -9,7 +9,10 @@
 
 namespace msf {
 
-/// How the row and the column estimate of a pixel are merged when both exist.
+/// How the row and the column estimate of a pixel are merged when both exist. Measured
+/// under protocol 2 (odometry 04, frames 0-9, D1 with missing = bad): shorter_gap 4.26 %,
+/// nearest 4.40 %, gap_weighted 4.44 %, average 4.64 %. The shorter gap wins because its
+/// ends are nearer the pixel: between two scan lines that is the column, along one the row.
 enum class CombineRule {
   Average,     ///< mean of the two
   ShorterGap,  ///< the estimate bridged over the shorter gap (the more local one); mean on a tie
@@ -23,7 +26,8 @@ const char* toString(CombineRule rule);
 /// Section `interpolation` of the YAML config (paper step 2, compound interpolation).
 struct InterpolationConfig {
   SliceParams slice;                        ///< keys method, short_gap_px, max_gap_px, jump_abs_m,
-                                            ///< jump_rel, cubic_alpha, cubic_beta, inverse_depth
+                                            ///< jump_rel, jump_inv_per_m, cubic_alpha, cubic_beta,
+                                            ///< inverse_depth
   CombineRule combine = CombineRule::ShorterGap;
   /// Row estimates bridged over at most this many pixels join the samples that column
   /// slices see (0: columns see samples only). A scan line is dense along a row but its
@@ -43,9 +47,10 @@ struct InterpolationConfig {
 };
 
 /// The image-level core of CompoundInterpolation: a sparse depth image (CV_32FC1, 0 or
-/// NaN = no sample) to an interpolated one (CV_32FC1, 0 = no estimate). Rows and columns
-/// are slices filled by interpolateSlice, combined by `combine`, then one normalized
-/// Gaussian pass fills the small holes that remain. Samples are never changed. The object
+/// NaN = no sample) to an interpolated one (CV_32FC1, 0 = no estimate). Rows are slices
+/// first; then columns, whose seeds are the samples and the short row bridges; a pixel
+/// with both estimates takes `combine`'s; then one normalized Gaussian pass fills the
+/// small holes that remain. Samples are never changed. The object
 /// keeps its work buffers between calls (one frame after another); it is not meant to be
 /// shared between threads, but each call is parallel inside and gives the same result
 /// for any number of threads.
