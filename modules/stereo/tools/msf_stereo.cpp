@@ -1,0 +1,130 @@
+// Paper step 3: OpenCV SGBM on a rectified grey pair to an organized cloud in camera 0
+// (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
+// KITTI 16-bit PNG.
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/tool.h>
+#include <msf/io/calibration.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/image_io.h>
+#include <msf/io/organized_conversion.h>
+#include <msf/stereo/point_types.h>
+#include <msf/stereo/sgbm_stereo.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <iostream>
+
+using namespace pcl::console;
+
+namespace {
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s <left.png> <right.png> <out.pcd> -calib PATH [options]\n", name);
+  print_info("  Matches a rectified pair (KITTI image_0, image_1) with OpenCV's StereoSGBM and writes the\n"
+             "  organized cloud of camera 0 (fields x y z rgb confidence; NaN where there is no match).\n");
+  print_info("  where options are:\n");
+  print_info("    -calib PATH            KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
+  print_info("    -color PATH            colour camera image (image_2), projected for each point's colour;\n");
+  print_info("                           without it the colour is the left image's grey\n");
+  print_info("    -disparity_png PATH    also write the disparity as a KITTI 16-bit PNG (pixels x 256)\n");
+  print_info("    -prior PATH            organized depth cloud (the interpolated LiDAR) that narrows the search\n");
+  print_info("    -config FILE           YAML config, section stereo (every SGBM parameter)\n");
+  print_info("    -num_disparities N     search range without a prior (multiple of 16; default 128)\n");
+  print_info("    -block_size N          odd block size (default 5)\n");
+  print_info("    -mode NAME             sgbm_3way (default) | sgbm | hh | hh4\n");
+  print_info("    -lr_check              drop matches that fail a left-right check (twice the time)\n");
+  print_info("    -print_config          print the stereo settings in use\n");
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::run("msf_stereo", [&] {
+    if (argc < 4 || msf::tool::wantsHelp(argc, argv)) {
+      printHelp(argv[0]);
+      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
+    }
+    const std::vector<std::string> value_options{"-calib", "-color", "-disparity_png", "-prior", "-config",
+                                                 "-num_disparities", "-block_size", "-mode"};
+    msf::tool::checkOptions(argc, argv, value_options, {"-lr_check", "-print_config"});
+    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+    if (files.size() != 3)
+      throw msf::InvalidInputError("expected <left.png> <right.png> <out.pcd> (see -h)");
+    const std::string ext = msf::fileExtension(files[2]);
+    if (ext != ".pcd" && ext != ".ply")
+      throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
+    std::string calib_path, color_path, disparity_path, prior_path, config_path, mode;
+    parse_argument(argc, argv, "-calib", calib_path);
+    parse_argument(argc, argv, "-color", color_path);
+    parse_argument(argc, argv, "-disparity_png", disparity_path);
+    parse_argument(argc, argv, "-prior", prior_path);
+    parse_argument(argc, argv, "-config", config_path);
+    parse_argument(argc, argv, "-mode", mode);
+    if (calib_path.empty())
+      throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
+    if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
+      throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
+
+    msf::SgbmConfig config;
+    if (!config_path.empty())
+      config.read(msf::ConfigFile(config_path).section("stereo"));
+    parse_argument(argc, argv, "-num_disparities", config.num_disparities_px);
+    parse_argument(argc, argv, "-block_size", config.block_size_px);
+    if (!mode.empty())
+      config.mode = mode;
+    if (find_switch(argc, argv, "-lr_check"))
+      config.left_right_check = true;
+    config.validate();
+    if (find_switch(argc, argv, "-print_config"))
+      config.print(std::cout);
+
+    TicToc tt;
+    tt.tic();
+    print_highlight("Loading ");
+    print_value("%s %s ", files[0].c_str(), files[1].c_str());
+    const msf::Calibration calibration = msf::loadCalibration(calib_path);
+    const cv::Mat left = msf::readImage(files[0], cv::IMREAD_GRAYSCALE);
+    const cv::Mat right = msf::readImage(files[1], cv::IMREAD_GRAYSCALE);
+    cv::Mat color;
+    if (!color_path.empty())
+      color = msf::readImage(color_path, cv::IMREAD_COLOR);
+    cv::Mat prior;
+    if (!prior_path.empty()) {
+      pcl::PointCloud<pcl::PointXYZ> prior_cloud;
+      msf::loadCloud(prior_path, prior_cloud);
+      prior = msf::cloudToDepthImage(prior_cloud);
+    }
+    msf::tool::printDone(tt.toc(), static_cast<std::size_t>(left.total()));
+
+    tt.tic();
+    print_highlight("Matching ");
+    msf::SgbmStereo stereo(config);
+    stereo.setCalibration(calibration);
+    stereo.setInputImages(left, right);
+    stereo.setInputColor(color);
+    stereo.setDepthPrior(prior);
+    pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
+    stereo.compute(cloud);
+    std::size_t valid = 0;
+    for (const auto& p : cloud)
+      valid += std::isfinite(p.z);
+    print_value("(%d disparities) ", stereo.getSearchedDisparities());
+    msf::tool::printDone(tt.toc(), valid);
+
+    tt.tic();
+    print_highlight("Saving ");
+    print_value("%s ", files[2].c_str());
+    if (!disparity_path.empty())
+      msf::writeKittiDisparityPng(disparity_path, stereo.getDisparity());
+    msf::saveCloud(files[2], cloud);
+    msf::tool::printDone(tt.toc(), cloud.size());
+    return 0;
+  });
+}
