@@ -18,6 +18,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
+#include <cstring>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -179,29 +181,72 @@ void BM_MarchingCubesIncremental(benchmark::State& state) {
 }
 BENCHMARK(BM_MarchingCubesIncremental)->Unit(benchmark::kMillisecond);
 
-/// Keeps the median of each benchmark's repetitions for the side-by-side table.
-class MedianReporter : public benchmark::ConsoleReporter {
-public:
-  std::map<std::string, double> median_ms;
-  std::map<std::string, double> last_ms;
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      const double ms = r.GetAdjustedRealTime() * (r.time_unit == benchmark::kMillisecond ? 1.0 : 1e-6);
-      if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "median")
-        median_ms[r.run_name.str()] = ms;
-      else if (r.run_type == Run::RT_Iteration)
-        last_ms[r.run_name.str()] = ms;
-    }
-    ConsoleReporter::ReportRuns(runs);
+/// Full extraction into a TriangleMesh (what Open3D's extract_triangle_mesh returns).
+void BM_MarchingCubesFullTriangleMesh(benchmark::State& state) {
+  const TsdfVolume& volume = tenFrameMap();
+  TriangleMesh mesh;
+  for (auto _ : state) {
+    MarchingCubes mesher;
+    mesher.extract(volume, mesh);
+    benchmark::DoNotOptimize(mesh.triangles.data());
   }
-  double get(const std::string& name) const {
-    const auto it = median_ms.find(name);
-    if (it != median_ms.end())
-      return it->second;
-    const auto jt = last_ms.find(name);
-    return jt != last_ms.end() ? jt->second : -1.0;
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+BENCHMARK(BM_MarchingCubesFullTriangleMesh)->Unit(benchmark::kMillisecond);
+
+double cpuMs() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+double wallMs() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Wall and process CPU time (all threads) of one measured thing, medians over repetitions.
+struct Timing {
+  std::vector<double> wall, cpu;
+  void add(double w, double c) {
+    wall.push_back(w);
+    cpu.push_back(c);
   }
+  double medianWall() const { return median(wall); }
+  double medianCpu() const { return median(cpu); }
 };
+
+/// The side-by-side protocol, the same as bench/open3d_tsdf.py: a fresh volume, the 10 frames
+/// integrated (time per frame), then one extraction of the 10-frame map.
+struct Ours {
+  Timing integrate0, integrate5, mesh, polygon_mesh;
+  std::size_t vertices = 0, triangles = 0;
+};
+
+Ours measureOurs(int repetitions) {
+  Data& d = data();
+  Ours ours;
+  for (int r = 0; r < repetitions; ++r)
+    for (const double lambda : {0.0, 5.0}) {
+      TsdfVolume volume(kVoxel, kTrunc);
+      TsdfIntegrator integrator(volume, integratorConfig(lambda));
+      double w = wallMs(), c = cpuMs();
+      for (int i = 0; i < kFrames; ++i)
+        integrator.integrate(d.frames[i], d.poses[i]);
+      (lambda == 0 ? ours.integrate0 : ours.integrate5).add((wallMs() - w) / kFrames, (cpuMs() - c) / kFrames);
+      if (lambda != 0)
+        continue;
+      TriangleMesh mesh;
+      w = wallMs(), c = cpuMs();
+      MarchingCubes().extract(volume, mesh);
+      ours.mesh.add(wallMs() - w, cpuMs() - c);
+      pcl::PolygonMesh polygon_mesh;
+      w = wallMs(), c = cpuMs();
+      MarchingCubes().extract(volume, polygon_mesh);
+      ours.polygon_mesh.add(wallMs() - w, cpuMs() - c);
+      ours.vertices = mesh.vertices.size();
+      ours.triangles = mesh.triangles.size();
+    }
+  return ours;
+}
 
 std::map<std::string, double> runOpen3d(int repetitions) {
   const char* env = std::getenv("MSF_OPEN3D_PYTHON");
@@ -216,7 +261,8 @@ std::map<std::string, double> runOpen3d(int repetitions) {
     return result;
   std::ifstream in(out);
   std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const char* key : {"integrate_ms_per_frame", "extract_ms", "vertices", "triangles"}) {
+  for (const char* key : {"integrate_ms_per_frame", "extract_ms", "integrate_cpu_ms_per_frame", "extract_cpu_ms",
+                          "vertices", "triangles"}) {
     const auto at = json.find(std::string("\"") + key + "\": ");
     if (at != std::string::npos)
       result[key] = std::atof(json.c_str() + at + std::strlen(key) + 4);
@@ -235,28 +281,39 @@ int main(int argc, char** argv) {
     return 1;
   }
   data(); // SGBM once, before any timing
-  MedianReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::RunSpecifiedBenchmarks();
 
-  const double ours_int = reporter.get("BM_TsdfIntegrate/lambda:0/manual_time");
-  const double ours_int5 = reporter.get("BM_TsdfIntegrate/lambda:5/manual_time");
-  const double ours_mesh = reporter.get("BM_MarchingCubesFull");
-  std::printf("\nSide by side, KITTI odometry 04 frames 0-%d, SGBM depth, %.1f m voxels, %.1f m truncation, "
-              "depth <= %.0f m (medians; the machine's 2 cores may be shared):\n",
-              kFrames - 1, kVoxel, kTrunc, kMaxDepth);
-  std::printf("  msfusion integrate, lambda 0: %8.1f ms/frame\n", ours_int);
-  std::printf("  msfusion integrate, lambda 5: %8.1f ms/frame  (%.2fx lambda 0)\n", ours_int5, ours_int5 / ours_int);
-  std::printf("  msfusion mesh (10-frame map): %8.1f ms\n", ours_mesh);
-  const auto o3d = runOpen3d(5);
-  if (o3d.count("integrate_ms_per_frame") && o3d.count("extract_ms")) {
-    std::printf("  Open3D   integrate:           %8.1f ms/frame  -> msfusion %.1fx faster\n",
-                o3d.at("integrate_ms_per_frame"), o3d.at("integrate_ms_per_frame") / ours_int);
-    std::printf("  Open3D   mesh (10-frame map): %8.1f ms        -> msfusion %.1fx faster (%.0f vertices, %.0f triangles)\n",
-                o3d.at("extract_ms"), o3d.at("extract_ms") / ours_mesh, o3d.count("vertices") ? o3d.at("vertices") : 0.0,
+  constexpr int kRepetitions = 5;
+  const Ours ours = measureOurs(kRepetitions);
+  const auto o3d = runOpen3d(kRepetitions);
+  std::printf("\nSide by side: KITTI odometry 04 frames 0-%d, SGBM depth (3-way, 128 disparities, block 5), "
+              "%.1f m voxels, %.1f m truncation, depth <= %.0f m;\nmedians of %d runs, wall time and process CPU "
+              "time over all threads (the 2 cores may be shared: CPU time is the steadier figure).\n\n",
+              kFrames - 1, kVoxel, kTrunc, kMaxDepth, kRepetitions);
+  std::printf("  %-38s %10s %10s %12s %12s\n", "", "wall ms", "CPU ms", "Open3D wall", "Open3D CPU");
+  const bool have = o3d.count("integrate_ms_per_frame") && o3d.count("extract_ms") &&
+                    o3d.count("integrate_cpu_ms_per_frame") && o3d.count("extract_cpu_ms");
+  auto row = [&](const char* name, const Timing& t, const char* key_wall, const char* key_cpu) {
+    std::printf("  %-38s %10.1f %10.1f", name, t.medianWall(), t.medianCpu());
+    if (have && key_wall)
+      std::printf(" %12.1f %12.1f   -> %.1fx (wall), %.1fx (CPU) faster", o3d.at(key_wall), o3d.at(key_cpu),
+                  o3d.at(key_wall) / t.medianWall(), o3d.at(key_cpu) / t.medianCpu());
+    std::printf("\n");
+  };
+  row("integrate per frame, lambda 0", ours.integrate0, "integrate_ms_per_frame", "integrate_cpu_ms_per_frame");
+  row("integrate per frame, lambda 5", ours.integrate5, nullptr, nullptr);
+  row("mesh, 10-frame map (TriangleMesh)", ours.mesh, "extract_ms", "extract_cpu_ms");
+  row("mesh, 10-frame map (pcl::PolygonMesh)", ours.polygon_mesh, "extract_ms", "extract_cpu_ms");
+  std::printf("  lambda 5 / lambda 0 integration: %.2fx (wall), %.2fx (CPU)\n",
+              ours.integrate5.medianWall() / ours.integrate0.medianWall(),
+              ours.integrate5.medianCpu() / ours.integrate0.medianCpu());
+  std::printf("  mesh size: msfusion %zu vertices, %zu triangles", ours.vertices, ours.triangles);
+  if (have)
+    std::printf("; Open3D %.0f vertices, %.0f triangles", o3d.count("vertices") ? o3d.at("vertices") : 0.0,
                 o3d.count("triangles") ? o3d.at("triangles") : 0.0);
-  } else {
-    std::printf("  Open3D: not run (needs Debian's python3-open3d: make deps-bench)\n");
-  }
+  std::printf("\n");
+  if (!have)
+    std::printf("  Open3D: not run (needs Debian's python3-open3d and python3-numpy: make deps-bench)\n");
   benchmark::Shutdown();
   return 0;
 }
