@@ -22,6 +22,11 @@ public:
       it = frames_.emplace(i, generator_->renderFrame(i, false)).first;
     return it->second;
   }
+  /// Only the LiDAR scan of frame i (cheap).
+  pcl::PointCloud<pcl::PointXYZI> scan(std::size_t i) const {
+    const auto& g = *generator_;
+    return g.lidar().scan(g.scene(), g.poses()[i] * g.calibration().T_cam0_velo, i);
+  }
   static synthetic::SyntheticConfig config() {
     synthetic::SyntheticConfig c;
     c.frames = 12;

@@ -68,7 +68,7 @@ protected:
 msf::test::TempDir* SyntheticDataset::dir_ = nullptr;
 SyntheticGenerator* SyntheticDataset::generator_ = nullptr;
 
-TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutWithGroundTruth) {
+TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutThatSequenceOpensUnchanged) {
   const fs::path r(root());
   for (const char* f : {"sequences/00/calib.txt", "sequences/00/times.txt", "poses/00.txt", "gt/scene.ply",
                         "gt/README.txt", "gt/synthetic.yaml", "sequences/00/velodyne/000000.bin",
@@ -79,9 +79,8 @@ TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutWithGroundTruth) {
   EXPECT_EQ(slurp(r / "sequences/00/times.txt"), "0.000000e+00\n");
   // Nothing else is left beside the dataset (no staging folders).
   EXPECT_EQ(msf::test::countEntries(dir_->path()), 1u);
-}
 
-TEST_F(SyntheticDataset, SequenceOpensItUnchanged) {
+  // msf::Sequence opens the root (one sequence inside) and the sequence folder alike.
   for (const std::string& path : {root(), root() + "/sequences/00"}) {
     const msf::Sequence seq(path);
     EXPECT_EQ(seq.layout(), msf::Sequence::Layout::Odometry);

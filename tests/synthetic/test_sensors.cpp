@@ -3,6 +3,7 @@
 #include "synthetic_fixture.h"
 
 #include <msf/common/statistics.h>
+#include <msf/io/organized_conversion.h>
 #include <msf/range_image/ring_split.h>
 #include <msf/synthetic/kitti_rig.h>
 
@@ -81,7 +82,7 @@ TEST(SyntheticSensors, NoiselessLidarHitsTheSurfaceExactly) {
 TEST(SyntheticSensors, ScanHas64RingsOfOneSweepEach) {
   auto& street = SharedStreet::instance();
   const auto& gen = street.generator();
-  const auto& scan = street.frame(0).scan;
+  const auto scan = street.scan(0);
   pcl::PointCloud<pcl::PointXYZI> input, heldout;
   const int rings = msf::splitRings(scan, msf::RingSplitConfig(), input, heldout);
   EXPECT_EQ(rings, 64);
@@ -168,8 +169,13 @@ TEST(SyntheticSensors, SgbmOnTheRenderedPairAgreesWithDisparityGroundTruth) {
 
 TEST(SyntheticSensors, DepthGroundTruthOfTheRoadIsExact) {
   auto& street = SharedStreet::instance();
-  const auto& f = street.frame(0);
-  const auto& calib = street.generator().calibration();
+  const auto& gen = street.generator();
+  const auto& calib = gen.calibration();
+  msf::synthetic::SyntheticFrame f;
+  cv::Mat ids;
+  msf::synthetic::CameraRenderer(calib, gen.config()).render(gen.scene(), 0, gen.poses()[0], 0, &f.depth, &ids);
+  ids.convertTo(f.objects, CV_8U); // saturating: only zero or not matters here
+  f.disparity = msf::depthToDisparity(f.depth, calib);
   // Frame 0 is the world origin: the road plane is y = 1.65 m, so below the horizon a road
   // pixel (u, v) sees depth f h / (v - cy). The ego lane is free of objects ahead.
   for (int v : {300, 340, 374}) {
