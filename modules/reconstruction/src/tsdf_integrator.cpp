@@ -21,16 +21,18 @@ double msSince(Clock::time_point t0) {
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
 
+// 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
 std::uint64_t packKey(const Eigen::Vector3i& b) {
-  constexpr std::int64_t kBias = 1 << 20; // +-1M blocks per axis: +-800 km at 0.1 m voxels
-  return (static_cast<std::uint64_t>(b.x() + kBias) << 42) | (static_cast<std::uint64_t>(b.y() + kBias) << 21) |
-         static_cast<std::uint64_t>(b.z() + kBias);
+  constexpr std::int64_t kBias = 1 << 19;
+  constexpr std::uint64_t kMask = (1u << 20) - 1;
+  return ((static_cast<std::uint64_t>(b.x() + kBias) & kMask) << 40) |
+         ((static_cast<std::uint64_t>(b.y() + kBias) & kMask) << 20) | (static_cast<std::uint64_t>(b.z() + kBias) & kMask);
 }
 GridIndex unpackKey(std::uint64_t k) {
-  constexpr std::int64_t kBias = 1 << 20;
-  constexpr std::uint64_t kMask = (1u << 21) - 1;
-  return {static_cast<int>(static_cast<std::int64_t>((k >> 42) & kMask) - kBias),
-          static_cast<int>(static_cast<std::int64_t>((k >> 21) & kMask) - kBias),
+  constexpr std::int64_t kBias = 1 << 19;
+  constexpr std::uint64_t kMask = (1u << 20) - 1;
+  return {static_cast<int>(static_cast<std::int64_t>((k >> 40) & kMask) - kBias),
+          static_cast<int>(static_cast<std::int64_t>((k >> 20) & kMask) - kBias),
           static_cast<int>(static_cast<std::int64_t>(k & kMask) - kBias)};
 }
 
@@ -172,11 +174,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
 
-  // 1. Blocks that the truncation band of each pixel's ray crosses, found in parallel (block
-  //    coordinates s = (p / vs + 1/2) / 8 so that floor(s) is the block of p's nearest voxel).
+  // 1. Sub-blocks (4^3 voxels) that the truncation band of each pixel's ray crosses, found in
+  //    parallel: only those are projected below, which on KITTI's grazing road is a fraction
+  //    of their blocks. Sub-block coordinates s = (p / vs + 1/2) / 4, so that floor(s) holds
+  //    p's nearest voxel. A key is the block (20 bits per axis) and the sub-block's 3 bits.
   const Eigen::Matrix3f R_wc = T_world_cam.linear().cast<float>();
-  const float to_block = 1.f / (vs * kSide);
-  const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSide;
+  constexpr int kSub = kSide / 2;
+  const float to_sub = 1.f / (vs * kSub);
+  const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSub;
   std::vector<std::uint64_t> keys;
   const int stride = config_.allocation_stride;
 #pragma omp parallel
@@ -192,11 +197,13 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         const float d = depth[u];
         if (!(d >= min_d && d <= max_d))
           continue;
-        const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_block;
+        const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
         const float z0 = std::max(d - trunc, min_d), z1 = d + trunc;
-        traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& b) {
-          const std::uint64_t k = packKey(b);
-          // Neighbouring pixels cross the same few blocks: skip keys seen just before.
+        traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
+          const GridIndex b(floorDiv(c.x(), 2), floorDiv(c.y(), 2), floorDiv(c.z(), 2));
+          const std::uint64_t k =
+              (packKey(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
+          // Neighbouring pixels cross the same few sub-blocks: skip keys seen just before.
           for (const std::uint64_t r : recent)
             if (r == k)
               return;
@@ -212,9 +219,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   const std::size_t blocks_before = volume_.numBlocks();
   std::vector<TsdfBlock*> blocks;
-  blocks.reserve(keys.size());
-  for (const std::uint64_t k : keys)
-    blocks.push_back(&volume_.allocateBlock(unpackKey(k)));
+  std::vector<std::uint8_t> masks; // sub-blocks to project, bit x | y << 1 | z << 2
+  for (const std::uint64_t k : keys) {
+    if (blocks.empty() || (k >> 3) != (packKey(blocks.back()->index))) {
+      blocks.push_back(&volume_.allocateBlock(unpackKey(k >> 3)));
+      masks.push_back(0);
+    }
+    masks.back() |= static_cast<std::uint8_t>(1u << (k & 7));
+  }
   stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
 
   if (config_.space_carving) {
@@ -239,8 +251,10 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, width - 1);
       const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
       const float d = frame.depth.at<float>(vi, ui);
-      if (!(d > 0.f) || c.z() - radius < d)
+      if (!(d > 0.f) || c.z() - radius < d) {
         blocks.push_back(block.get());
+        masks.push_back(0xff);
+      }
     }
   }
   stats_.allocate_ms = msSince(t_start);
@@ -286,7 +300,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     }
   const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
 
-#pragma omp parallel for schedule(dynamic, 8) reduction(+ : updated_total)
+  std::size_t projected_total = 0;
+#pragma omp parallel for schedule(dynamic, 8) reduction(+ : updated_total, projected_total)
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
@@ -294,6 +309,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     const float* depth_data = frame.depth.ptr<float>(0);
     const std::size_t depth_step = frame.depth.step1();
     for (int sub = 0; sub < 8; ++sub) {
+      if (!(masks[i] & (1u << sub)))
+        continue; // no sampled ray's band crosses this sub-block
       const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
       {
         const Eigen::Vector3f c = base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f));
@@ -325,6 +342,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           }
         }
       }
+      projected_total += 64;
       for (int z = sz; z < sz + 4; ++z)
       for (int y = sy; y < sy + 4; ++y) {
         // A row of 4 voxels: projection first in plain float arrays (the compiler vectorizes
@@ -418,6 +436,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       blocks[i]->stamp = stamp;
   stats_.blocks_touched = touched.size();
   stats_.voxels_updated = updated_total;
+  stats_.voxels_projected = projected_total;
   stats_.update_ms = msSince(t_update);
 
   const auto t_reg = Clock::now();
@@ -524,12 +543,13 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
 
   // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
   // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
-  // fixed). Gauss-Seidel in place, block by block; blocks of one of 8 colours (parities of
-  // the block coordinates) share no face, so each colour's blocks run in parallel without races.
-  std::array<std::vector<std::size_t>, 8> colour;
+  // fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
+  // share no face (face neighbours differ by one in one coordinate), so each colour's blocks
+  // run in parallel without races.
+  std::array<std::vector<std::size_t>, 2> colour;
   for (std::size_t i = 0; i < n; ++i) {
     const GridIndex& b = touched[i]->index;
-    colour[(b.x() & 1) | ((b.y() & 1) << 1) | ((b.z() & 1) << 2)].push_back(i);
+    colour[(b.x() + b.y() + b.z()) & 1].push_back(i);
   }
   for (int sweep = 0; sweep < config_.sweeps; ++sweep)
     for (const auto& group : colour) {

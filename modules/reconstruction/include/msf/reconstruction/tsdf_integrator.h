@@ -65,6 +65,7 @@ public:
     std::size_t blocks_touched = 0;
     std::size_t blocks_allocated = 0;
     std::size_t voxels_updated = 0;
+    std::size_t voxels_projected = 0; ///< voxels of sub-blocks (4^3) that the depth range did not rule out
     double allocate_ms = 0, update_ms = 0, regularize_ms = 0;
   };
 
