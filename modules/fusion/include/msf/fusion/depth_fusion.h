@@ -21,7 +21,7 @@ namespace msf {
 ///   pcl::PointCloud<msf::PointXYZRGBWeight> fused;
 ///   fusion.fuse(fused);
 ///
-/// Each pixel is fused by fusePixel (fusion_model.h: eq. 6 or inverse-variance). The LiDAR
+/// Each pixel is fused by fuseRow (fusion_model.h: eq. 6 or inverse-variance). The LiDAR
 /// type's `distance` field (pixels to the nearest real return) and the stereo type's
 /// `confidence` feed the weights; a type without them counts as real returns (distance 0)
 /// and as fully confident matches. A fused point lies on the ray of its input point

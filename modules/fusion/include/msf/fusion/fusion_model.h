@@ -82,7 +82,7 @@ inline float lidarSigmaPx(float distance, float range_px, const DepthFusionConfi
 /// disagreement_k_sigma * sqrt(sigma_L^2 + sigma_S^2) are not averaged (that would put a
 /// point between foreground and background): the one with the smaller sigma is kept. When
 /// that is the LiDAR while stereo sees a nearer surface (z = z_lidar > z_stereo > 0),
-/// callers check lidarSeesPastForeground, and then stereo wins (fusePixel, fuseRow).
+/// fuseRow checks lidarSeesPastForeground, and then stereo wins.
 /// weight = min(1, stereo_sigma_min_px^2 / sigma^2), 1 for a stereo match of confidence 1.
 inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline) {
   // Bitwise & and | on the flags, and every division done unconditionally: no branches.
@@ -111,8 +111,8 @@ inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionCon
 }
 
 /// True when the LiDAR sample of a pixel is likely a return from behind a foreground edge:
-/// the LiDAR, mounted `lidar_height_m` above the camera, sees over the top edge of a near
-/// object onto the background, and such returns land in the camera image up to
+/// the LiDAR, mounted a height h above the camera, sees over the top edge of a near object
+/// onto the background, and such returns land in the camera image up to
 /// f * h * (1/z_near - 1/z_far) = (h / B) * (d_near - d_far) rows below the edge, inside the
 /// object. The evidence: stereo sees a nearer surface here (disparity d_stereo > d_lidar),
 /// and the LiDAR itself has that nearer surface within that many rows below the pixel.
@@ -141,26 +141,6 @@ struct LidarParallax {
 /// The parallax of `calibration`'s LiDAR over camera 0 (none when the LiDAR is not above it),
 /// with config.parallax_check.
 LidarParallax lidarParallax(const Calibration& calibration, const DepthFusionConfig& config);
-
-/// Both methods of `c.method` for one pixel, the parallax check included: `lidar_below(k)`
-/// reads the LiDAR depth k rows below the pixel.
-template <typename LidarBelow>
-inline FusionResult fusePixel(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline,
-                              const LidarParallax& parallax, LidarBelow&& lidar_below) {
-  if (c.method == FusionMethod::Paper)
-    return fusePaper(in, c);
-  FusionResult r = fuseUncertainty(in, c, focal_baseline);
-  if (in.z_stereo > 0.f && r.z == in.z_lidar && in.z_stereo < in.z_lidar) {
-    const float s_S = stereoSigmaPx(in.stereo_confidence, c);
-    if (lidarSeesPastForeground(focal_baseline / in.z_lidar, focal_baseline / in.z_stereo,
-                                c.disagreement_k_sigma * s_S, focal_baseline, parallax.rows_per_px,
-                                parallax.max_rows, lidar_below)) {
-      r.z = in.z_stereo;
-      r.weight = std::min(1.f, c.stereo_sigma_min_px * c.stereo_sigma_min_px / (s_S * s_S));
-    }
-  }
-  return r;
-}
 
 /// One image row of the fusion, the loop both DepthFusion and DepthImageFusion run: `width`
 /// pixels of row `v` of `lidar_depth` (CV_32FC1, not > 0 = none), with the row's LiDAR
