@@ -235,6 +235,7 @@ int main(int argc, char** argv) {
 
     msf::Pipeline pipeline(calibration, config);
     const std::set<std::size_t> panel_frames = spread(frames, panels);
+    pipeline.setKeepSparse(!panel_frames.empty()); // the panels show the projected scan
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     Progress progress(frames.size());
@@ -252,7 +253,8 @@ int main(int argc, char** argv) {
             const cv::Mat fused = msf::cloudToDepthImage(*r.fused);
             msf::DepthPanel panel;
             panel.addImage("left image (camera 0), frame " + r.name, r.left);
-            panel.addDepth("projected LiDAR", msf::cloudToDepthImage(*r.lidar_sparse), 3.f, 60.f, 1);
+            if (!r.lidar_sparse->empty())
+              panel.addDepth("projected LiDAR", msf::cloudToDepthImage(*r.lidar_sparse), 3.f, 60.f, 1);
             panel.addDepth("interpolated LiDAR", msf::cloudToDepthImage(*r.lidar), 3.f, 60.f);
             panel.addDepth("SGBM", msf::cloudToDepthImage(*r.stereo), 3.f, 60.f);
             panel.addDepth("fused", fused, 3.f, 60.f);

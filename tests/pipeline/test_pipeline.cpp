@@ -14,6 +14,9 @@
 #include <opencv2/core.hpp>
 
 #include <csignal>
+#include <fcntl.h>
+#include <filesystem>
+#include <sys/file.h>
 #include <cstring>
 #include <cstdio>
 #include <fstream>
@@ -25,24 +28,32 @@
 
 namespace {
 
-/// A 4-frame synthetic street, generated once for the whole suite.
+/// A 4-frame synthetic street, generated once for all the test processes of a build (ctest
+/// runs each test in its own process): in the build folder, under a file lock, so parallel
+/// tests wait for the first one instead of generating it again.
 class PipelineTest : public ::testing::Test {
 protected:
   static void SetUpTestSuite() {
-    dir_ = new msf::test::TempDir;
-    msf::synthetic::SyntheticConfig config;
-    config.frames = 4;
-    config.seed = 7;
-    msf::synthetic::SyntheticGenerator(config).writeDataset(dataset());
+    namespace fs = std::filesystem;
+    const fs::path root = fs::absolute("test_data");
+    fs::create_directories(root);
+    dataset_ = (root / "street_4_frames_seed_7").string();
+    const int lock = ::open((root / "street.lock").c_str(), O_CREAT | O_RDWR, 0644);
+    ASSERT_GE(lock, 0);
+    ::flock(lock, LOCK_EX);
+    if (!fs::exists(fs::path(dataset_) / "gt" / "scene.ply")) {
+      msf::synthetic::SyntheticConfig config;
+      config.frames = 4;
+      config.seed = 7;
+      msf::synthetic::SyntheticGenerator(config).writeDataset(dataset_);
+    }
+    ::flock(lock, LOCK_UN);
+    ::close(lock);
   }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  static std::string dataset() { return dir_->file("street"); }
-  static msf::test::TempDir* dir_;
+  static const std::string& dataset() { return dataset_; }
+  static std::string dataset_;
 };
-msf::test::TempDir* PipelineTest::dir_ = nullptr;
+std::string PipelineTest::dataset_;
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);
@@ -70,8 +81,7 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   msf::test::TempDir out;
   const std::string calib = sequence.directory() + "/calib.txt";
   const std::string steps[][2] = {
-      {"msf_project", sequence.scanPath(1) + " " + out.file("sparse.pcd") + " -calib " + calib},
-      {"msf_interpolate", out.file("sparse.pcd") + " " + out.file("lidar.pcd")},
+      {"msf_interpolate", sequence.scanPath(1) + " " + out.file("lidar.pcd") + " -calib " + calib},
       {"msf_stereo", sequence.imagePath(0, 1) + " " + sequence.imagePath(1, 1) + " " + out.file("stereo.pcd") +
                          " -calib " + calib + " -color " + sequence.imagePath(2, 1)},
       {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + " -calib " + calib},

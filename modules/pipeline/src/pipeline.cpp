@@ -3,8 +3,7 @@
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
 #include <msf/reconstruction/impl/depth_frame.hpp> // toDepthFrame for the fused point type
-#include <msf/range_image/compound_interpolation.h>
-#include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/lidar_completion.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/stereo/sgbm_stereo.h>
 
@@ -26,23 +25,21 @@ double msSince(Clock::time_point start) {
 
 /// The stage objects of steps 1-4, configured once; they keep their work buffers.
 struct Pipeline::Stages {
-  LidarProjector projector;
-  CompoundInterpolation<PointXYZID> interpolation;
+  explicit Stages(const Calibration& calibration, const PipelineConfig& config)
+      : lidar(calibration, CompletionMethod::Compound, config.projection, config.interpolation) {}
+  LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
   SgbmStereo stereo;
   DepthFusion<> fusion;
 };
 
 Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
-    : calibration_(calibration), config_(config), stages_(std::make_unique<Stages>()), mesher_(config.mesher) {
+    : calibration_(calibration), config_(config), mesher_(config.mesher) {
   config_.validate();
   calibration_.requireImageSize();
+  stages_ = std::make_unique<Stages>(calibration_, config_);
   volume_ = std::make_unique<TsdfVolume>(config_.volume.voxel_size_m, config_.volume.truncation_m);
   integrator_ = std::make_unique<TsdfIntegrator>(*volume_, config_.integrator);
 
-  stages_->projector.setCalibration(calibration_);
-  stages_->projector.setConfig(config_.projection);
-  stages_->interpolation.setConfig(config_.interpolation);
-  stages_->interpolation.setCamera(PinholeCamera::fromCalibration(calibration_, config_.projection.camera));
   stages_->stereo.setConfig(config_.stereo);
   stages_->stereo.setCalibration(calibration_);
   stages_->fusion.setConfig(config_.fusion);
@@ -66,10 +63,11 @@ FrameResult Pipeline::computeDepth(const Frame& frame) {
   // Steps 1-2 on their own thread while SGBM (step 3) runs here: they share no state.
   auto lidar = std::async(std::launch::async, [&] {
     const auto start = Clock::now();
-    stages_->projector.project(*frame.scan, *result.lidar_sparse);
-    stages_->interpolation.setInputCloud(result.lidar_sparse);
-    stages_->interpolation.filter(*result.lidar);
-    return msSince(start);
+    stages_->lidar.compute(*frame.scan, *result.lidar);
+    const double ms = msSince(start);
+    if (keep_sparse_)
+      stages_->lidar.projector().project(*frame.scan, *result.lidar_sparse);
+    return ms;
   });
   const auto stereo_start = Clock::now();
   try {

@@ -29,7 +29,7 @@ struct FrameResult {
   bool has_pose = false;
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
   cv::Mat left;                             ///< camera 0 grey image
-  pcl::PointCloud<PointXYZID>::Ptr lidar_sparse;        ///< projected scan (paper step 1)
+  pcl::PointCloud<PointXYZID>::Ptr lidar_sparse;        ///< projected scan (step 1), if kept (setKeepSparse)
   pcl::PointCloud<PointXYZID>::Ptr lidar;               ///< interpolated (step 2)
   pcl::PointCloud<PointXYZRGBConfidence>::Ptr stereo;   ///< SGBM (step 3)
   pcl::PointCloud<PointXYZRGBWeight>::Ptr fused;        ///< fused (step 4)
@@ -37,7 +37,8 @@ struct FrameResult {
 };
 
 /// The whole method (DESIGN.md data flow) for a sequence: per frame, LiDAR projection and
-/// compound interpolation run at the same time as SGBM, then the two depth images are
+/// compound interpolation (LidarCompletion: the scan is projected onto the image grown by
+/// a margin, so gaps across the image's border are bridged) run at the same time as SGBM, then the two depth images are
 /// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
 /// The stages are the library's classes with the settings of one PipelineConfig, the same
 /// as the msf_project, msf_interpolate, msf_stereo, msf_fuse and msf_integrate tools use,
@@ -78,6 +79,10 @@ public:
   RunStats run(const Sequence& sequence, const std::vector<std::size_t>& frames, const FrameCallback& on_frame,
                const std::atomic<bool>* stop = nullptr);
 
+  /// Also keep each frame's projected scan (step 1) in FrameResult::lidar_sparse, for
+  /// pictures; off by default, since step 2 projects the scan itself, with a margin.
+  void setKeepSparse(bool keep) { keep_sparse_ = keep; }
+
   /// The mesh of the volume, re-meshing only the blocks changed since the last call.
   const TriangleMesh& updateMesh();
 
@@ -97,6 +102,7 @@ private:
   std::unique_ptr<Stages> stages_;
   MarchingCubes mesher_;
   TriangleMesh mesh_;
+  bool keep_sparse_ = false;
 };
 
 } // namespace msf
