@@ -22,10 +22,13 @@ namespace msf {
 /// warm-started from y, with the voxels around them held fixed; lambda = 0 is the plain mean.
 ///
 /// Organized input (a depth image as an organized cloud or a DepthFrame) is integrated
-/// voxel-centric: blocks along each pixel's ray within the truncation band are allocated
-/// (serially, once per block), then the voxels of those blocks are projected into the image,
-/// in parallel over blocks. An unorganized scan (a raw LiDAR sweep) is integrated by walking
-/// each point's ray from its sensor origin, as VDBFusion does.
+/// voxel-centric: the blocks, and their 4^3 sub-blocks, that the truncation band of each
+/// pixel's ray crosses are found in parallel and allocated serially (once per block); then
+/// the voxels of those sub-blocks are projected into the image, in parallel over blocks.
+/// An unorganized scan (a raw LiDAR sweep) is integrated by walking each point's ray from its
+/// sensor origin, as VDBFusion does.
+///
+/// Not thread-safe: one integrator per volume at a time.
 class TsdfIntegrator {
 public:
   enum class Weighting {
@@ -46,9 +49,10 @@ public:
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 80.0;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
-    /// Blocks are allocated along the rays of every n-th pixel in each direction (rows
-    /// staggered): 2 finds the blocks of a dense depth image at a quarter of the cost (rays
-    /// 2 px apart are 0.11 m apart at 40 m on KITTI, blocks 0.8 m); 1 for sparse depth.
+    /// Blocks and sub-blocks are found along the rays of every n-th pixel in each direction
+    /// (rows staggered): 2 costs a quarter of 1 on a dense depth image (rays 2 px apart are
+    /// 0.11 m apart at 40 m on KITTI, sub-blocks 0.4 m) and misses about 2 % of the voxel
+    /// updates (measured on KITTI 04 with SGBM depth); use 1 for sparse depth.
     int allocation_stride = 2;
 
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
