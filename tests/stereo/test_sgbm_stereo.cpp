@@ -44,7 +44,9 @@ msf::SgbmConfig smallConfig() {
 
 TEST(SgbmStereo, RecoversTheDisparityOfTwoPlanes) {
   const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
-  msf::SgbmStereo stereo(smallConfig());
+  msf::SgbmConfig bordered = smallConfig();
+  bordered.match_left_border = true;
+  msf::SgbmStereo stereo(bordered);
   stereo.setInputImages(pair.left, pair.right);
   stereo.computeDisparity();
   const cv::Mat& d = stereo.getDisparity();

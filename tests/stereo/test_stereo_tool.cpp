@@ -118,7 +118,7 @@ TEST(StereoToolKitti, OdometryFrameWithColour) {
     ++valid;
     coloured += !(p.r == p.g && p.g == p.b); // image_2 is in colour
   }
-  EXPECT_GT(valid, 0.85 * cloud.size());
+  EXPECT_GT(valid, 0.8 * cloud.size()); // 128 disparities: the first 128 columns have no match
   EXPECT_GT(coloured, valid / 2);
 }
 

@@ -27,8 +27,10 @@ struct SgbmConfig {
   float left_right_max_diff_px = 1.f;
   /// Match the first min_disparity + num_disparities columns too (OpenCV leaves them empty):
   /// the pair is padded on the left by replicating its first column, and a disparity that
-  /// points outside the right image (d > u) is dropped.
-  bool match_left_border = true;
+  /// points outside the right image (d > u) is dropped. Stereo alone gains 2-3 % coverage on
+  /// KITTI for about a quarter more time; the fusion, where the LiDAR covers that band,
+  /// gains nothing measurable, hence off.
+  bool match_left_border = false;
   bool prior_search_range = true;  ///< narrow num_disparities to a depth prior when given
   int prior_margin_px = 8;         ///< disparities beyond the prior's largest
   float max_depth_m = 0.f;         ///< drop depths beyond this; 0 keeps all
