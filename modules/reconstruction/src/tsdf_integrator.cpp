@@ -306,6 +306,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
     std::size_t updated = 0;
+    std::uint8_t signs = 0;
     const float* depth_data = frame.depth.ptr<float>(0);
     const std::size_t depth_step = frame.depth.step1();
     for (int sub = 0; sub < 8; ++sub) {
@@ -357,20 +358,35 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           pv[k] = fy * Y * inv_z + cy;
           pz[k] = Z;
         }
+        // Cheap test of the 4 voxels on their nearest pixel, without branches (most voxels
+        // fail it, unpredictably); a bilinear value differs from the nearest by less than the
+        // truncation (the 4 pixels must agree within it), so 2 truncations is a safe bound.
+        int candidates = 0;
+        float nearest[4];
+        int pixel_u[4], pixel_v[4];
+        for (int k = 0; k < 4; ++k) {
+          const float u = pu[k], v = pv[k], vz = pz[k];
+          const bool inside = (vz >= min_d) & (u > -0.5f) & (v > -0.5f) & (u < width - 0.5f) & (v < height - 0.5f);
+          const int ui = std::clamp(static_cast<int>(u + 0.5f), 0, width - 1);
+          const int vi = std::clamp(static_cast<int>(v + 0.5f), 0, height - 1);
+          const float d = depth_data[vi * depth_step + ui];
+          const float diff = d - vz;
+          const bool ok = inside & (d >= min_d) & (d <= max_d) & (diff >= -2.f * trunc) & (carving | (diff <= 2.f * trunc));
+          candidates |= static_cast<int>(ok) << k;
+          nearest[k] = d;
+          pixel_u[k] = ui;
+          pixel_v[k] = vi;
+        }
+        if (!candidates)
+          continue;
         TsdfVoxel* voxels = &block.at(0, y, z);
         for (int k = 0; k < 4; ++k) {
+          if (!(candidates & (1 << k)))
+            continue;
           const int x = sx + k;
           const float u = pu[k], v = pv[k], vz = pz[k];
-          if (!(vz >= min_d && u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
-            continue;
-          const int ui = static_cast<int>(u + 0.5f), vi = static_cast<int>(v + 0.5f);
-          float d = depth_data[vi * depth_step + ui];
-          // Cheap rejection on the nearest pixel first; a bilinear value differs from it by
-          // less than the truncation (the 4 pixels must agree within it).
-          if (!(d >= min_d && d <= max_d))
-            continue;
-          if (d - vz < -2.f * trunc || (!carving && d - vz > 2.f * trunc))
-            continue;
+          const int ui = pixel_u[k], vi = pixel_v[k];
+          float d = nearest[k];
           if (bilinear) {
             const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
             if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
@@ -406,6 +422,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
           TsdfVoxel& voxel = voxels[x];
           updateVoxel(voxel, sdf, w, bgr, max_weight);
+          signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
           if (regularized)
             changed_index_[i * TsdfBlock::kVoxels + updated] = static_cast<std::uint16_t>(TsdfBlock::linear(x, y, z));
           ++updated;
@@ -415,8 +432,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     changed_count[i] = static_cast<std::uint16_t>(updated);
     if (updated) {
       block.stamp = stamp;
-      if (!regularized)
-        block.updateSigns(); // else after the regularization
+      // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
+      block.signs |= signs;
       changed[i] = 1;
       updated_total += updated;
     }
@@ -582,9 +599,14 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
       }
     }
 
+  // The sweeps move values towards their neighbours' and can change signs.
 #pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
-    touched[i]->updateSigns();
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint8_t signs = 0;
+    for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k)
+      signs |= touched[i]->voxels[changed_index_[k]].sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+    touched[i]->signs |= signs;
+  }
 }
 
 } // namespace msf

@@ -30,8 +30,10 @@ struct TsdfBlock {
 
   GridIndex index{0, 0, 0};      ///< block coordinates: voxel v lies in block floor(v / kSide)
   std::uint64_t stamp = 0;       ///< volume generation of the last change (see TsdfVolume)
-  /// Bit 0: an observed voxel has sdf >= 0; bit 1: one has sdf < 0. Whoever changes the
-  /// voxels calls updateSigns(), so that the mesher skips blocks a surface cannot cross.
+  /// Bit 0: an observed voxel has (or had) sdf >= 0; bit 1: one has (or had) sdf < 0, so that
+  /// the mesher skips blocks a surface cannot cross. A bit may stay set after the voxels
+  /// changed (the integrator only sets bits, cheaply): that costs the mesher a look, never a
+  /// triangle. Code that writes voxels directly sets them too, e.g. with updateSigns().
   std::uint8_t signs = 0;
   std::array<TsdfVoxel, kVoxels> voxels{};
 
