@@ -5,6 +5,9 @@
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
 
+#include <opencv2/core/utility.hpp>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -41,13 +44,16 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
   const float fB = static_cast<float>(calibration_.focalBaseline());
   lidar_depth_.create(rows, cols, CV_32FC1);
-#pragma omp parallel for
-  for (int v = 0; v < rows; ++v) {
-    const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
-    float* z = lidar_depth_.ptr<float>(v);
-    for (int u = 0; u < cols; ++u)
-      z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
-  }
+  // cv::parallel_for_ rather than OpenMP: its work stealing keeps both cores busy when the
+  // machine is shared, where a static OpenMP split waits for the slower thread.
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
+      float* z = lidar_depth_.ptr<float>(v);
+      for (int u = 0; u < cols; ++u)
+        z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
+    }
+  });
   const bool uncertainty = config_.method == FusionMethod::Uncertainty;
   if (uncertainty)
     localDisparityExtremes(lidar_depth_, fB, config_.lidar_range_window_px, lidar_max_, lidar_min_);
@@ -62,14 +68,13 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   output.header = stereo_->header;
   output.sensor_origin_ = stereo_->sensor_origin_;
   output.sensor_orientation_ = stereo_->sensor_orientation_;
-  bool dense = true;
-#pragma omp parallel reduction(&& : dense)
-  {
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
     // One row of each input at a time, in contiguous arrays for fuseRow.
     std::vector<float> distance(static_cast<std::size_t>(cols)), z_stereo(distance), confidence(distance),
         fused_z(distance), fused_weight(distance);
-#pragma omp for
-    for (int v = 0; v < rows; ++v) {
+    bool range_dense = true;
+    for (int v = range.start; v < range.end; ++v) {
       const std::size_t row = static_cast<std::size_t>(v) * cols;
       for (int u = 0; u < cols; ++u) {
         const PointStereoT& s = (*stereo_)[row + u];
@@ -101,7 +106,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
           p.z = z;
         } else {
           p.x = p.y = p.z = nan;
-          dense = false;
+          range_dense = false;
         }
         if constexpr (detail::has_rgb_v<PointOutT>) {
           if constexpr (detail::has_rgb_v<PointStereoT>) {
@@ -119,7 +124,9 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
           p.weight = fused_weight[u];
       }
     }
-  }
+    if (!range_dense)
+      dense = false;
+  });
   output.is_dense = dense;
 }
 

@@ -4,6 +4,9 @@
 #include <msf/stereo/point_field_traits.h>
 #include <msf/stereo/sgbm_stereo.h>
 
+#include <opencv2/core/utility.hpp>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -25,44 +28,49 @@ void SgbmStereo::compute(pcl::PointCloud<PointT>& output) {
   output.resize(static_cast<std::size_t>(rows) * cols);
   output.width = static_cast<std::uint32_t>(cols);
   output.height = static_cast<std::uint32_t>(rows);
-  bool dense = true;
-#pragma omp parallel for reduction(&& : dense)
-  for (int v = 0; v < rows; ++v) {
-    const float* d = disparity_.ptr<float>(v);
-    const float* c = confidence_.ptr<float>(v);
-    const std::uint8_t* grey = left_.ptr<std::uint8_t>(v);
-    PointT* out = &output[static_cast<std::size_t>(v) * cols];
-    for (int u = 0; u < cols; ++u) {
-      PointT& p = out[u];
-      if (d[u] > 0.f) {
-        const float z = fB / d[u];
-        p.x = (static_cast<float>(u) - cx) * z / fx;
-        p.y = (static_cast<float>(v) - cy) * z / fy;
-        p.z = z;
-      } else {
-        p.x = p.y = p.z = nan;
-        dense = false;
-      }
-      if constexpr (detail::has_rgb_v<PointT>) {
-        std::uint8_t r, g, b;
-        if (left_.channels() == 3) {
-          b = grey[3 * u];
-          g = grey[3 * u + 1];
-          r = grey[3 * u + 2];
+  // cv::parallel_for_ (work stealing) keeps both cores busy on a shared machine.
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    bool range_dense = true;
+    for (int v = range.start; v < range.end; ++v) {
+      const float* d = disparity_.ptr<float>(v);
+      const float* c = confidence_.ptr<float>(v);
+      const std::uint8_t* grey = left_.ptr<std::uint8_t>(v);
+      PointT* out = &output[static_cast<std::size_t>(v) * cols];
+      for (int u = 0; u < cols; ++u) {
+        PointT& p = out[u];
+        if (d[u] > 0.f) {
+          const float z = fB / d[u];
+          p.x = (static_cast<float>(u) - cx) * z / fx;
+          p.y = (static_cast<float>(v) - cy) * z / fy;
+          p.z = z;
         } else {
-          r = g = b = grey[u];
+          p.x = p.y = p.z = nan;
+          range_dense = false;
         }
-        if (d[u] > 0.f)
-          sampler.sample(p.x, p.y, p.z, r, g, b);
-        p.r = r;
-        p.g = g;
-        p.b = b;
-        p.a = 255;
+        if constexpr (detail::has_rgb_v<PointT>) {
+          std::uint8_t r, g, b;
+          if (left_.channels() == 3) {
+            b = grey[3 * u];
+            g = grey[3 * u + 1];
+            r = grey[3 * u + 2];
+          } else {
+            r = g = b = grey[u];
+          }
+          if (d[u] > 0.f)
+            sampler.sample(p.x, p.y, p.z, r, g, b);
+          p.r = r;
+          p.g = g;
+          p.b = b;
+          p.a = 255;
+        }
+        if constexpr (detail::has_confidence_v<PointT>)
+          p.confidence = c[u];
       }
-      if constexpr (detail::has_confidence_v<PointT>)
-        p.confidence = c[u];
     }
-  }
+    if (!range_dense)
+      dense = false;
+  });
   output.is_dense = dense;
 }
 
