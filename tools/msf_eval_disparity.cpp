@@ -1,5 +1,7 @@
 // The KITTI 2015 devkit's disparity evaluation of one estimate: D1 (3 px and 5 %) for
 // background, foreground and all pixels, the paper's eq. 8 mean absolute error, density.
+// Given two folders, every frame of the estimate folder against its ground truth, summed
+// over the pixels of all frames (a synthetic sequence's gt/disp_0, split by gt/obj_map_0).
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/disparity_metrics.h>
@@ -9,8 +11,11 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 using namespace pcl::console;
 
@@ -18,10 +23,15 @@ namespace {
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <gt.png> <est.png> [options]\n", name);
+  print_error("       or: %s <gt_dir> <est_dir> [options]\n", name);
   print_info("  KITTI 16-bit disparity PNGs (pixels x 256, 0 = none): D1 outliers (error > 3 px and > 5 %%),\n");
   print_info("  mean absolute error (eq. 8) and density, per region when an object map is given.\n");
+  print_info("  With folders: every NNNNNN.png of est_dir against gt_dir/NNNNNN.png (a missing one is an error),\n");
+  print_info("  the pixels of all frames summed into one table. The object maps come from a sibling folder of\n");
+  print_info("  gt_dir named obj_map_0 (synthetic gt/disp_0) or obj_map (KITTI 2015 disp_*), or -obj_map_dir.\n");
   print_info("  where options are:\n");
   print_info("    -obj_map PATH     object map (0 = background, else foreground), e.g. KITTI obj_map/*.png\n");
+  print_info("    -obj_map_dir DIR  folder mode: object maps DIR/NNNNNN.png\n");
   print_info("    -interpolate      fill missing estimates as the devkit does (background interpolation);\n");
   print_info("                      without it a missing estimate counts as bad in D1\n");
   print_info("    -abs_px X         absolute threshold in pixels (default 3)\n");
@@ -33,6 +43,77 @@ void printRow(const char* name, const msf::DisparityRegionErrors& r) {
               100.0 * r.density(), r.meanAbsError(), r.bad, r.gt_pixels);
 }
 
+/// One frame: the disparities and, when `obj_map_path` is not empty, the object map.
+msf::DisparityEvaluation evaluateFiles(const std::string& gt_path, const std::string& est_path,
+                                       const std::string& obj_map_path, const msf::DisparityEvalOptions& options) {
+  const cv::Mat gt = msf::readKittiDisparityPng(gt_path);
+  const cv::Mat est = msf::readKittiDisparityPng(est_path);
+  if (est.size() != gt.size())
+    throw msf::InvalidInputError("estimate '" + est_path + "' is " + std::to_string(est.cols) + "x" +
+                                 std::to_string(est.rows) + " but ground truth '" + gt_path + "' is " +
+                                 std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
+  cv::Mat obj_map;
+  if (!obj_map_path.empty()) {
+    obj_map = msf::readImage(obj_map_path, cv::IMREAD_UNCHANGED);
+    if (obj_map.channels() != 1)
+      throw msf::InvalidInputError("object map '" + obj_map_path + "' must be a single-channel image");
+    if (obj_map.size() != gt.size())
+      throw msf::InvalidInputError("object map '" + obj_map_path + "' is " + std::to_string(obj_map.cols) + "x" +
+                                   std::to_string(obj_map.rows) + " but ground truth '" + gt_path + "' is " +
+                                   std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
+  }
+  return msf::evaluateDisparity(gt, est, obj_map, options);
+}
+
+bool isDirectory(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_directory(path, ec);
+}
+
+/// The object-map folder beside a ground-truth disparity folder, "" when there is none.
+std::string siblingObjectMapDir(const std::string& gt_dir) {
+  namespace fs = std::filesystem;
+  fs::path p = fs::absolute(gt_dir).lexically_normal();
+  if (p.filename().empty())
+    p = p.parent_path();
+  for (const char* name : {"obj_map_0", "obj_map"})
+    if (isDirectory((p.parent_path() / name).string()))
+      return (p.parent_path() / name).string();
+  return "";
+}
+
+/// Folder mode: every *.png of est_dir against gt_dir (and obj_map_dir when not empty).
+msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::string& est_dir,
+                                         const std::string& obj_map_dir, const msf::DisparityEvalOptions& options,
+                                         std::size_t& frames) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(est_dir))
+    if (e.is_regular_file() && e.path().extension() == ".png")
+      names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  if (names.empty())
+    throw msf::InvalidInputError("estimate folder '" + est_dir + "' has no *.png");
+  msf::DisparityEvaluation sum;
+  for (const auto& name : names) {
+    const std::string gt_path = (fs::path(gt_dir) / name).string();
+    const std::string est_path = (fs::path(est_dir) / name).string();
+    if (!fs::is_regular_file(gt_path))
+      throw msf::InvalidInputError("ground truth '" + gt_path + "' for estimate '" + est_path + "' does not exist");
+    std::string obj_map_path;
+    if (!obj_map_dir.empty()) {
+      obj_map_path = (fs::path(obj_map_dir) / name).string();
+      if (!fs::is_regular_file(obj_map_path))
+        throw msf::InvalidInputError("object map '" + obj_map_path + "' for estimate '" + est_path +
+                                     "' does not exist");
+    }
+    const msf::DisparityEvaluation e = evaluateFiles(gt_path, est_path, obj_map_path, options);
+    sum += e;
+  }
+  frames = names.size();
+  return sum;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -41,38 +122,44 @@ int main(int argc, char** argv) {
       printHelp(argv[0]);
       return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
     }
-    const std::vector<std::string> value_options{"-obj_map", "-abs_px", "-rel"};
+    const std::vector<std::string> value_options{"-obj_map", "-obj_map_dir", "-abs_px", "-rel"};
     msf::tool::checkOptions(argc, argv, value_options, {"-interpolate"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);
     if (files.size() != 2)
-      throw msf::InvalidInputError("expected <gt.png> <est.png> (see -h)");
+      throw msf::InvalidInputError("expected <gt.png> <est.png> or <gt_dir> <est_dir> (see -h)");
     msf::DisparityEvalOptions options;
     options.interpolate_background = find_switch(argc, argv, "-interpolate");
     parse_argument(argc, argv, "-abs_px", options.abs_threshold_px);
     parse_argument(argc, argv, "-rel", options.rel_threshold);
     if (!(options.abs_threshold_px >= 0.f) || !(options.rel_threshold >= 0.f))
       throw msf::InvalidInputError("-abs_px and -rel must be >= 0");
-    std::string obj_map_path;
+    std::string obj_map_path, obj_map_dir;
     parse_argument(argc, argv, "-obj_map", obj_map_path);
+    parse_argument(argc, argv, "-obj_map_dir", obj_map_dir);
 
-    const cv::Mat gt = msf::readKittiDisparityPng(files[0]);
-    const cv::Mat est = msf::readKittiDisparityPng(files[1]);
-    if (est.size() != gt.size())
-      throw msf::InvalidInputError("estimate '" + files[1] + "' is " + std::to_string(est.cols) + "x" +
-                                   std::to_string(est.rows) + " but ground truth '" + files[0] + "' is " +
-                                   std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
-    cv::Mat obj_map;
-    if (!obj_map_path.empty()) {
-      obj_map = msf::readImage(obj_map_path, cv::IMREAD_UNCHANGED);
-      if (obj_map.channels() != 1)
-        throw msf::InvalidInputError("object map '" + obj_map_path + "' must be a single-channel image");
-      if (obj_map.size() != gt.size())
-        throw msf::InvalidInputError("object map '" + obj_map_path + "' is " + std::to_string(obj_map.cols) + "x" +
-                                     std::to_string(obj_map.rows) + " but ground truth '" + files[0] + "' is " +
-                                     std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
+    const bool folders = isDirectory(files[0]);
+    if (folders != isDirectory(files[1]))
+      throw msf::InvalidInputError("'" + files[0] + "' and '" + files[1] +
+                                   "' must both be PNG files or both be folders");
+    std::size_t frames = 1;
+    msf::DisparityEvaluation e;
+    if (folders) {
+      if (!obj_map_path.empty())
+        throw msf::InvalidInputError("-obj_map is for one frame; with folders use -obj_map_dir");
+      if (obj_map_dir.empty())
+        obj_map_dir = siblingObjectMapDir(files[0]);
+      else if (!isDirectory(obj_map_dir))
+        throw msf::InvalidInputError("-obj_map_dir '" + obj_map_dir + "' is not a folder");
+      e = evaluateFolders(files[0], files[1], obj_map_dir, options, frames);
+    } else {
+      if (!obj_map_dir.empty())
+        throw msf::InvalidInputError("-obj_map_dir is for folders; with one frame use -obj_map");
+      e = evaluateFiles(files[0], files[1], obj_map_path, options);
     }
-    const msf::DisparityEvaluation e = msf::evaluateDisparity(gt, est, obj_map, options);
 
+    if (folders)
+      std::printf("%zu frames of '%s'%s\n", frames, files[1].c_str(),
+                  obj_map_dir.empty() ? "" : (", object maps '" + obj_map_dir + "'").c_str());
     std::printf("%-11s %10s  %10s  %10s  %8s  %9s  %9s\n", "region", "D1", "D1 (est.)", "density", "MAE px",
                 "bad", "gt pixels");
     if (e.has_object_map) {

@@ -1,19 +1,27 @@
 // Evaluation protocol 2 (DESIGN.md): ring hold-out on real KITTI scans. One row per
-// method: the table a user compares depth methods with.
+// method: the table a user compares depth methods with. On a synthetic sequence (gt/ beside
+// it, protocol 3) the whole scan is the input and every pixel of gt/depth_0 is ground truth,
+// reported for all, background and foreground pixels (the paper's Table 1).
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/stereo/sgbm_stereo.h>
+#include <msf/synthetic/ground_truth.h>
 
 #include <pcl/common/time.h>
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <sstream>
@@ -128,15 +136,23 @@ std::string methodNames() {
   return names;
 }
 
+/// The paper's Table 1 rows, the default methods of full-image (synthetic ground truth) mode.
+const char* const kGroundTruthMethods = "sgbm,interpolated,fused_uncertainty,fused_paper,ipbasic_multiscale";
+
 void printHelp(const char* name) {
   print_error("Syntax is: %s <sequence_dir> [options]\n", name);
   print_info("  Ring hold-out (evaluation protocol 2): rings with id %% 4 == 2 of each scan are ground truth in\n"
              "  camera 0, the others are the only LiDAR input. Prints one row per method: coverage, D1 with a\n"
              "  missing estimate counted as bad, D1 over estimates, mean disparity error, depth MAE, RMSE, iMAE,\n"
              "  iRMSE (1/km) and the median time of a method per frame (projection included).\n");
+  print_info("  Full-image mode (protocol 3), automatic when the sequence has synthetic ground truth (gt/, as\n"
+             "  msf_synth writes): the whole scan is the LiDAR input, every pixel of gt/depth_0 is ground truth,\n"
+             "  and each method has rows for all, background and foreground pixels (gt/obj_map_0).\n");
   print_info("  where options are:\n");
   print_info("    -frames a:b      frames to use (default: all)\n");
-  print_info("    -methods a,b,..  methods, in this order (default: all):\n");
+  print_info("    -gt              full-image mode; an error when the sequence has no gt/\n");
+  print_info("    -holdout         ring hold-out even when the sequence has gt/\n");
+  print_info("    -methods a,b,..  methods, in this order (default: all; with gt/: %s):\n", kGroundTruthMethods);
   for (const auto& m : methodTable())
     print_info("                       %-19s %s\n", m.name, m.description);
   print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic, stereo,\n"
@@ -154,6 +170,103 @@ std::vector<std::string> split(const std::string& text) {
   return out;
 }
 
+/// One method's rows in full-image mode: all, background and foreground pixels.
+struct RegionResults {
+  std::string method;
+  msf::HoldoutResult region[3];
+};
+const char* const kRegionNames[3] = {"all", "background", "foreground"};
+
+/// Full-image evaluation against synthetic ground truth: each method sees the whole scan
+/// and the grey pair of a frame; its depth is compared at every pixel of gt/depth_0.
+std::vector<RegionResults> runFullImage(const msf::Sequence& sequence, const std::vector<std::size_t>& frames,
+                                        const std::vector<std::pair<std::string, msf::HoldoutMethod>>& methods,
+                                        const msf::D1Threshold& d1) {
+  const msf::synthetic::GroundTruth gt(sequence.groundTruthDir());
+  const msf::Calibration& calibration = sequence.calibration();
+  const double fB = calibration.focalBaseline();
+  std::vector<std::array<msf::DepthErrorAccumulator, 3>> errors(methods.size());
+  std::vector<std::vector<double>> times(methods.size());
+  for (const std::size_t i : frames) {
+    const std::size_t g = gt.indexOf(sequence.frameName(i));
+    const cv::Mat gt_depth = gt.depth(g);
+    const cv::Mat masks[3] = {cv::Mat(), gt.backgroundMask(g), gt.foregroundMask(g)};
+    const msf::Frame frame = sequence.load(i, false);
+    msf::HoldoutInput input;
+    input.frame = i;
+    input.calibration = &calibration;
+    input.scan = frame.scan;
+    input.left = frame.left;
+    input.right = frame.right;
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      const auto start = std::chrono::steady_clock::now();
+      const cv::Mat estimate = methods[m].second(input);
+      const auto stop = std::chrono::steady_clock::now();
+      times[m].push_back(std::chrono::duration<double, std::milli>(stop - start).count());
+      if (estimate.type() != CV_32FC1 || estimate.size() != gt_depth.size())
+        throw msf::InvalidInputError("method '" + methods[m].first + "' returned a " + std::to_string(estimate.cols) +
+                                     "x" + std::to_string(estimate.rows) + " image of type " +
+                                     std::to_string(estimate.type()) + ", expected CV_32FC1 " +
+                                     std::to_string(gt_depth.cols) + "x" + std::to_string(gt_depth.rows) + " as '" +
+                                     gt.depthPath(g) + "'");
+      for (int r = 0; r < 3; ++r)
+        errors[m][r].add(gt_depth, estimate, fB, masks[r], d1);
+    }
+  }
+  std::vector<RegionResults> results;
+  for (std::size_t m = 0; m < methods.size(); ++m) {
+    const double median = msf::median(times[m]);
+    RegionResults row;
+    row.method = methods[m].first;
+    for (int r = 0; r < 3; ++r) {
+      row.region[r].method = methods[m].first;
+      row.region[r].metrics = errors[m][r].metrics();
+      row.region[r].median_ms = median;
+      row.region[r].frames = frames.size();
+    }
+    results.push_back(row);
+  }
+  return results;
+}
+
+/// The protocol 2 columns with a region column after the method.
+std::string formatRegionTable(const std::vector<RegionResults>& results) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-20s %-10s %9s %9s %9s %10s %9s %9s %9s %9s %10s\n", "method", "region",
+                "coverage", "D1 all", "D1 est", "disp MAE", "MAE m", "RMSE m", "iMAE", "iRMSE", "ms/frame");
+  out += line;
+  for (const auto& row : results)
+    for (int r = 0; r < 3; ++r) {
+      const msf::DepthMetrics& m = row.region[r].metrics;
+      std::snprintf(line, sizeof line, "%-20s %-10s %9.4f %8.2f%% %8.2f%% %8.3fpx %9.3f %9.3f %9.3f %9.3f %10.2f\n",
+                    row.method.c_str(), kRegionNames[r], m.coverage, 100.0 * m.d1_all, 100.0 * m.d1_estimated,
+                    m.disparity_mae_px, m.mae_m, m.rmse_m, m.imae_per_km, m.irmse_per_km, row.region[r].median_ms);
+      out += line;
+    }
+  return out;
+}
+
+void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& results) {
+  msf::writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << "method,region,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
+           "imae_per_km,irmse_per_km,median_ms\n";
+    out.precision(6);
+    for (const auto& row : results)
+      for (int r = 0; r < 3; ++r) {
+        const msf::HoldoutResult& h = row.region[r];
+        const msf::DepthMetrics& m = h.metrics;
+        out << h.method << ',' << kRegionNames[r] << ',' << h.frames << ',' << m.gt_pixels << ',' << m.estimated << ','
+            << m.coverage << ',' << m.d1_all << ',' << m.d1_estimated << ',' << m.disparity_mae_px << ',' << m.mae_m
+            << ',' << m.rmse_m << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << h.median_ms << '\n';
+      }
+    out.flush();
+    if (!out)
+      throw msf::IOError("cannot write '" + path + "'");
+  });
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -163,11 +276,20 @@ int main(int argc, char** argv) {
       return argc < 2 ? 1 : 0;
     }
     const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv"};
-    msf::tool::checkOptions(argc, argv, value_options, {});
+    msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() != 1)
       throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
-    std::string frames_text = "0:", methods_text = methodNames(), config_path, csv_path;
+    const bool gt_switch = find_switch(argc, argv, "-gt"), holdout_switch = find_switch(argc, argv, "-holdout");
+    if (gt_switch && holdout_switch)
+      throw msf::InvalidInputError("-gt and -holdout exclude each other");
+    const msf::Sequence sequence(positional[0]);
+    if (gt_switch && sequence.groundTruthDir().empty())
+      throw msf::InvalidInputError("-gt: '" + positional[0] +
+                                   "' has no synthetic ground truth (no gt/depth_0 beside its sequences/, as msf_synth "
+                                   "writes); without -gt it is evaluated by ring hold-out");
+    const bool gt_mode = !holdout_switch && !sequence.groundTruthDir().empty();
+    std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path;
     parse_argument(argc, argv, "-frames", frames_text);
     parse_argument(argc, argv, "-methods", methods_text);
     parse_argument(argc, argv, "-config", config_path);
@@ -180,6 +302,7 @@ int main(int argc, char** argv) {
     config.rings.read(config_file.section("rings"));
     config.projection.read(config_file.section("projection"));
     msf::HoldoutEvaluation evaluation(config);
+    std::vector<std::pair<std::string, msf::HoldoutMethod>> methods;
     const auto names = split(methods_text);
     if (names.empty())
       throw msf::InvalidInputError("-methods is empty; known methods: " + methodNames());
@@ -190,15 +313,26 @@ int main(int argc, char** argv) {
           entry = &m;
       if (!entry)
         throw msf::InvalidInputError("unknown method '" + name + "'; known methods: " + methodNames());
-      evaluation.addMethod(name, entry->make(config_file));
+      methods.emplace_back(name, entry->make(config_file));
+      evaluation.addMethod(name, methods.back().second);
     }
 
-    const msf::Sequence sequence(positional[0]);
     const auto frames = sequence.indices(msf::FrameRange::parse(frames_text));
     print_highlight("Evaluating ");
     print_value("%zu frames ", frames.size());
-    print_info("of %s, %zu methods\n", sequence.directory().c_str(), names.size());
+    print_info("of %s, %zu methods%s\n", sequence.directory().c_str(), names.size(),
+               gt_mode ? ", full image against synthetic ground truth" : ", ring hold-out");
     pcl::StopWatch watch;
+    if (gt_mode) {
+      const auto results = runFullImage(sequence, frames, methods, config.d1);
+      const double ms = watch.getTime();
+      std::printf("%s", formatRegionTable(results).c_str());
+      std::fflush(stdout);
+      if (!csv_path.empty())
+        writeRegionCsv(csv_path, results);
+      msf::tool::printDone(ms, results.empty() ? 0 : results.front().region[0].metrics.gt_pixels);
+      return 0;
+    }
     const auto results = evaluation.run(sequence, frames);
     const double ms = watch.getTime();
     std::printf("%s", msf::formatHoldoutTable(results).c_str());
