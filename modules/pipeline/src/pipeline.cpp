@@ -1,5 +1,6 @@
 #include <msf/common/exceptions.h>
 #include <msf/fusion/depth_fusion.h>
+#include <msf/io/organized_conversion.h>
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
 #include <msf/reconstruction/impl/depth_frame.hpp> // toDepthFrame for the fused point type
@@ -48,7 +49,7 @@ Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
 
 Pipeline::~Pipeline() = default;
 
-FrameResult Pipeline::computeDepth(const Frame& frame) {
+FrameResult Pipeline::startFrame(const Frame& frame) const {
   FrameResult result;
   result.index = frame.index;
   result.has_pose = frame.has_pose;
@@ -58,35 +59,54 @@ FrameResult Pipeline::computeDepth(const Frame& frame) {
   result.lidar.reset(new pcl::PointCloud<PointXYZID>);
   result.stereo.reset(new pcl::PointCloud<PointXYZRGBConfidence>);
   result.fused.reset(new pcl::PointCloud<PointXYZRGBWeight>);
+  return result;
+}
 
-  const auto depth_start = Clock::now();
-  // Steps 1-2 on their own thread while SGBM (step 3) runs here: they share no state.
-  auto lidar = std::async(std::launch::async, [&] {
-    const auto start = Clock::now();
-    stages_->lidar.compute(*frame.scan, *result.lidar);
-    const double ms = msSince(start);
-    if (keep_sparse_)
-      stages_->lidar.projector().project(*frame.scan, *result.lidar_sparse);
-    return ms;
-  });
-  const auto stereo_start = Clock::now();
-  try {
-    stages_->stereo.setInputImages(frame.left, frame.right);
-    stages_->stereo.setInputColor(frame.color);
-    stages_->stereo.compute(*result.stereo);
-  } catch (...) {
-    lidar.wait(); // never leave the other thread writing into `result`
-    throw;
-  }
-  result.times.stereo_ms = msSince(stereo_start);
-  result.times.lidar_ms = lidar.get();
-  result.times.depth_ms = msSince(depth_start);
+void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
+  const auto start = Clock::now();
+  stages_->lidar.compute(*frame.scan, *result.lidar);
+  result.times.lidar_ms = msSince(start);
+  if (keep_sparse_)
+    stages_->lidar.projector().project(*frame.scan, *result.lidar_sparse);
+}
 
-  const auto fusion_start = Clock::now();
+void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
+  const auto start = Clock::now();
+  stages_->stereo.setInputImages(frame.left, frame.right);
+  stages_->stereo.setInputColor(frame.color);
+  // With the prior, SGBM searches only the disparities the interpolated LiDAR allows.
+  stages_->stereo.setDepthPrior(config_.scheduling.stereo_prior ? cloudToDepthImage(*result.lidar) : cv::Mat());
+  stages_->stereo.compute(*result.stereo);
+  result.times.stereo_ms = msSince(start);
+}
+
+void Pipeline::computeFusion(FrameResult& result) {
+  const auto start = Clock::now();
   stages_->fusion.setInputLidar(result.lidar);
   stages_->fusion.setInputStereo(result.stereo);
   stages_->fusion.fuse(*result.fused);
-  result.times.fusion_ms = msSince(fusion_start);
+  result.times.fusion_ms = msSince(start);
+}
+
+FrameResult Pipeline::computeDepth(const Frame& frame) {
+  FrameResult result = startFrame(frame);
+  const auto depth_start = Clock::now();
+  if (config_.scheduling.stereo_prior) {
+    computeLidar(frame, result);
+    computeStereo(frame, result);
+  } else {
+    // Steps 1-2 on their own thread while SGBM (step 3) runs here: they share no state.
+    auto lidar = std::async(std::launch::async, [&] { computeLidar(frame, result); });
+    try {
+      computeStereo(frame, result);
+    } catch (...) {
+      lidar.wait(); // never leave the other thread writing into `result`
+      throw;
+    }
+    lidar.get();
+  }
+  result.times.depth_ms = msSince(depth_start);
+  computeFusion(result);
   return result;
 }
 
@@ -104,6 +124,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
                                  const FrameCallback& on_frame, const std::atomic<bool>* stop) {
   struct Loaded {
     Frame frame;
+    FrameResult result;  // with the stereo prior, steps 1-2 are already done
     double load_ms;
   };
   const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
@@ -131,8 +152,12 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
           break;
         }
         const auto start = Clock::now();
-        Loaded item{sequence.load(i), 0.0};
+        Loaded item{sequence.load(i), FrameResult(), 0.0};
         item.load_ms = msSince(start);
+        item.result = startFrame(item.frame);
+        // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior.
+        if (config_.scheduling.stereo_prior)
+          computeLidar(item.frame, item.result);
         if (!loaded.push(std::move(item)))
           break;
       }
@@ -146,7 +171,16 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
       while (auto item = loaded.pop()) {
         if (stop && stop->load())
           break; // a frame not started is dropped: a stop should be prompt
-        FrameResult result = computeDepth(item->frame);
+        FrameResult result;
+        if (config_.scheduling.stereo_prior) {
+          result = std::move(item->result);
+          const auto start = Clock::now();
+          computeStereo(item->frame, result);
+          result.times.depth_ms = msSince(start) + result.times.lidar_ms;
+          computeFusion(result);
+        } else {
+          result = computeDepth(item->frame);
+        }
         result.name = sequence.frameName(item->frame.index);
         result.times.load_ms = item->load_ms;
         if (!depths.push(std::move(result)))

@@ -23,6 +23,7 @@ void VolumeConfig::validate() const {
 void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
+  readKey(node, "stereo_prior", stereo_prior);
   validate();
 }
 
@@ -67,7 +68,7 @@ void PipelineConfig::print(std::ostream& out) const {
   integrator.print(out);
   mesher.print(out);
   out << "pipeline: queue_capacity " << scheduling.queue_capacity << ", mesh_every_n_frames "
-      << scheduling.mesh_every_n_frames << "\n";
+      << scheduling.mesh_every_n_frames << ", stereo_prior " << scheduling.stereo_prior << "\n";
 }
 
 } // namespace msf

@@ -16,8 +16,8 @@
 
 namespace msf {
 
-/// Milliseconds each stage spent on one frame. lidar = projection + interpolation; lidar
-/// and stereo run at the same time, so depth_ms (their wall time) is what the frame waited.
+/// Milliseconds each stage spent on one frame. lidar = projection + interpolation;
+/// depth_ms = steps 1-3 (lidar + stereo, or their wall time when they run side by side).
 struct StageTimes {
   double load_ms = 0, lidar_ms = 0, stereo_ms = 0, depth_ms = 0, fusion_ms = 0, integrate_ms = 0;
 };
@@ -44,9 +44,12 @@ struct FrameResult {
 /// as the msf_project, msf_interpolate, msf_stereo, msf_fuse and msf_integrate tools use,
 /// so the chain of tools and the pipeline give the same fused depth.
 ///
-/// run() overlaps frames: loading, depth (LiDAR + stereo + fusion) and integration each
-/// have a thread, joined by bounded queues, so stereo of frame t+1 runs while frame t
-/// integrates and memory is bounded by the map, not by the number of frames.
+/// With `pipeline.stereo_prior` (the default) SGBM searches only the disparities that the
+/// interpolated LiDAR allows, so steps 1-2 run first; otherwise they run beside SGBM.
+/// run() overlaps frames: loading (with steps 1-2 when they feed the prior), stereo +
+/// fusion, and integration each have a thread, joined by bounded queues, so the LiDAR of
+/// frame t+2 and the stereo of frame t+1 run while frame t integrates, and memory is
+/// bounded by the map, not by the number of frames.
 class Pipeline {
 public:
   /// Throws ConfigError for an invalid config, CalibrationError when the calibration has no
@@ -94,6 +97,11 @@ public:
 
 private:
   struct Stages;  // the stage objects, which keep their buffers from frame to frame
+
+  FrameResult startFrame(const Frame& frame) const;
+  void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
+  void computeStereo(const Frame& frame, FrameResult& result);  // step 3
+  void computeFusion(FrameResult& result);                      // step 4
 
   Calibration calibration_;
   PipelineConfig config_;

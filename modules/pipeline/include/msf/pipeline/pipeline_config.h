@@ -24,6 +24,7 @@ struct VolumeConfig {
 /// Section `pipeline`: how the stages are scheduled and what is kept.
 struct SchedulingConfig {
   int queue_capacity = 2;        ///< frames waiting between two stages
+  bool stereo_prior = true;      ///< SGBM narrowed by the interpolated LiDAR (stereo.prior_search_range)
   int mesh_every_n_frames = 0;   ///< > 0: refresh the mesh incrementally every n frames
   void read(const cv::FileNode& node);
   void validate() const;
