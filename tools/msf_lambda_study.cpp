@@ -45,7 +45,7 @@ int run(int argc, char** argv) {
     printHelp(argv[0]);
     throw msf::InvalidInputError("need -o DIR");
   }
-  msf::requireDirectory(out_dir, "output folder");
+  msf::ensureOutputDirectory(out_dir);
   msf::LambdaStudy::Config config;
   std::string config_path;
   if (parse_argument(argc, argv, "-config", config_path) >= 0)

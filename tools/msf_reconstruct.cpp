@@ -177,15 +177,7 @@ int main(int argc, char** argv) {
     config.validate();
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 
-    // The output folder: created when its parent exists, so a typo does not scatter files.
-    std::error_code ec;
-    if (!fs::is_directory(out, ec)) {
-      const fs::path parent = fs::absolute(out).parent_path();
-      if (!fs::is_directory(parent, ec))
-        throw msf::IOError("output folder '" + out + "': its parent '" + parent.string() + "' does not exist");
-      if (!fs::create_directory(out, ec))
-        throw msf::IOError("cannot create output folder '" + out + "': " + ec.message());
-    }
+    msf::ensureOutputDirectory(out);
     if (save_depth)
       fs::create_directories(fs::path(out) / "depth");
 

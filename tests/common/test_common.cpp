@@ -52,6 +52,21 @@ TEST(AtomicFile, WriterThatProducesNoFileIsAnError) {
   EXPECT_EQ(msf::test::countEntries(dir.path()), 0u);
 }
 
+TEST(AtomicFile, OutputFolderIsCreatedOnlyUnderAnExistingParent) {
+  msf::test::TempDir dir;
+  msf::ensureOutputDirectory(dir.file("out"));
+  EXPECT_TRUE(msf::test::fileExists(dir.file("out")));
+  msf::ensureOutputDirectory(dir.file("out")); // already there: fine
+  try {
+    msf::ensureOutputDirectory(dir.file("missing/out"));
+    FAIL() << "expected IOError";
+  } catch (const msf::IOError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir.file("missing")), std::string::npos) << e.what();
+  }
+  std::ofstream(dir.file("file")) << "x";
+  EXPECT_THROW(msf::ensureOutputDirectory(dir.file("file")), msf::IOError);
+}
+
 TEST(Config, ReadsKeysOfASectionAndKeepsDefaults) {
   msf::test::TempDir dir;
   writeText(dir.file("c.yaml"), "%YAML:1.0\nstage:\n  gap_px: 7\n  ratio: 0.25\n  name: cubic\n  on: true\n");

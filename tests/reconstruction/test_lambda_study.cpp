@@ -65,7 +65,7 @@ TEST(LambdaStudy, ToolWritesTheTableAndThePlot) {
     ++rows;
   EXPECT_EQ(rows, 4);
   EXPECT_TRUE(test::fileExists(dir.file("lambda_study.png")));
-  r = test::runTool("msf_lambda_study", "-o " + dir.file("missing"));
+  r = test::runTool("msf_lambda_study", "-o " + dir.file("missing/out"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("msf_lambda_study: error:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("missing"), std::string::npos) << r.err;

@@ -31,6 +31,19 @@ void requireDirectory(const std::string& path, const std::string& what) {
     throw IOError(what + " '" + path + "' does not exist or is not a directory");
 }
 
+void ensureOutputDirectory(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    return;
+  if (fs::exists(path, ec))
+    throw IOError("output folder '" + path + "' exists and is not a directory");
+  const fs::path parent = fs::absolute(path).lexically_normal().parent_path();
+  if (!fs::is_directory(parent, ec))
+    throw IOError("output folder '" + path + "': its parent '" + parent.string() + "' does not exist");
+  if (!fs::create_directory(path, ec) && !fs::is_directory(path))
+    throw IOError("cannot create output folder '" + path + "': " + ec.message());
+}
+
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");

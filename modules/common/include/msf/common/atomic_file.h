@@ -19,6 +19,10 @@ void requireFile(const std::string& path, const std::string& what = "file");
 /// Throws IOError if `path` is not an existing directory.
 void requireDirectory(const std::string& path, const std::string& what = "folder");
 
+/// An output folder: created when missing, if its parent exists (a typo in the parent
+/// should not scatter new folders). Throws IOError naming the folder or its parent.
+void ensureOutputDirectory(const std::string& path);
+
 /// Lower-case extension of `path` with its dot (".pcd"), or "" when there is none.
 std::string fileExtension(const std::string& path);
 
