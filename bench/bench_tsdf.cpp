@@ -9,6 +9,7 @@
 #include <msf/io/calibration.h>
 #include <msf/io/image_io.h>
 #include <msf/io/poses.h>
+#include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -50,7 +51,6 @@ struct Data {
   Data() {
     const Sequence sequence(kittiDir() + "/odometry/sequences/04");
     const PinholeCamera camera = PinholeCamera::fromCalibration(sequence.calibration());
-    const double fB = sequence.calibration().focalBaseline();
     cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 25, 32 * 25, 1, 63, 10, 100, 2,
                                                           cv::StereoSGBM::MODE_SGBM_3WAY);
     dir = (fs::temp_directory_path() / ("msf_bench_tsdf_" + std::to_string(::getpid()))).string();
@@ -62,12 +62,9 @@ struct Data {
       sgbm->compute(f.left, f.right, disparity16);
       DepthFrame frame;
       frame.camera = camera;
-      frame.depth.create(f.left.size(), CV_32FC1);
-      for (int v = 0; v < f.left.rows; ++v)
-        for (int u = 0; u < f.left.cols; ++u) {
-          const float d = disparity16.at<std::int16_t>(v, u) / 16.f;
-          frame.depth.at<float>(v, u) = d > 0.f ? static_cast<float>(fB / d) : 0.f;
-        }
+      cv::Mat disparity_px; // OpenCV's fixed point, 1/16 px
+      disparity16.convertTo(disparity_px, CV_32F, 1.0 / 16.0);
+      frame.depth = msf::disparityToDepth(disparity_px, sequence.calibration());
       cv::cvtColor(f.left, frame.color, cv::COLOR_GRAY2BGR);
       char name[32];
       std::snprintf(name, sizeof name, "%06d.png", i);

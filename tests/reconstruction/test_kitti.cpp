@@ -2,6 +2,7 @@
 // sensor origin, and SGBM depth images, each checked against LiDAR points.
 #include "test_support.h"
 
+#include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -78,7 +79,6 @@ TEST(KittiReconstruction, StereoDepthWithRegularizationAgreesWithLidar) {
   MSF_REQUIRE_KITTI();
   const Sequence sequence(test::kittiDir() + "/odometry/sequences/04");
   const PinholeCamera camera = PinholeCamera::fromCalibration(sequence.calibration());
-  const double fB = sequence.calibration().focalBaseline();
   cv::Ptr<cv::StereoSGBM> sgbm =
       cv::StereoSGBM::create(0, 128, 5, 8 * 25, 32 * 25, 1, 63, 10, 100, 2, cv::StereoSGBM::MODE_SGBM_3WAY);
   TsdfVolume volume(0.1, 0.3);
@@ -94,12 +94,9 @@ TEST(KittiReconstruction, StereoDepthWithRegularizationAgreesWithLidar) {
     sgbm->compute(f.left, f.right, disparity);
     DepthFrame frame;
     frame.camera = camera;
-    frame.depth.create(f.left.size(), CV_32FC1);
-    for (int v = 0; v < frame.depth.rows; ++v)
-      for (int u = 0; u < frame.depth.cols; ++u) {
-        const float d = disparity.at<std::int16_t>(v, u) / 16.f;
-        frame.depth.at<float>(v, u) = d > 0.f ? static_cast<float>(fB / d) : 0.f;
-      }
+    cv::Mat disparity_px; // OpenCV's fixed point, 1/16 px
+    disparity.convertTo(disparity_px, CV_32F, 1.0 / 16.0);
+    frame.depth = msf::disparityToDepth(disparity_px, sequence.calibration());
     integrator.integrate(frame, f.T_world_cam0);
     mesher.extract(volume, mesh); // incremental, frame by frame
   }
