@@ -5,9 +5,10 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/mesh_accuracy.h>
+#include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
-#include <msf/io/organized_conversion.h>
+#include <msf/io/impl/organized_conversion.hpp> // depthImageToCloud for the fused point type
 #include <msf/io/sequence.h>
 #include <msf/pipeline/depth_panel.h>
 #include <msf/pipeline/mesh_renderer.h>
@@ -75,9 +76,8 @@ struct GroundTruthScores {
     const cv::Mat gt = truth->depth(gt_index);
     const cv::Mat fg = truth->foregroundMask(gt_index), bg = truth->backgroundMask(gt_index);
     const double fb = calibration.focalBaseline();
-    const std::pair<const char*, cv::Mat> methods[] = {{"sgbm", msf::cloudToDepthImage(*r.stereo)},
-                                                       {"interpolated", msf::cloudToDepthImage(*r.lidar)},
-                                                       {"fused", msf::cloudToDepthImage(*r.fused)}};
+    const std::pair<const char*, cv::Mat> methods[] = {
+        {"sgbm", r.stereo_depth}, {"interpolated", r.lidar_depth}, {"fused", r.fused.depth}};
     for (const auto& [name, estimate] : methods) {
       all[name].add(gt, estimate, fb);
       background[name].add(gt, estimate, fb, bg);
@@ -95,6 +95,23 @@ struct GroundTruthScores {
       }
   }
 };
+
+/// The fused depth as msf_fuse writes it: an organized cloud with colour and weight.
+pcl::PointCloud<msf::PointXYZRGBWeight> fusedCloud(const msf::DepthFrame& fused, const msf::Calibration& calibration) {
+  pcl::PointCloud<msf::PointXYZRGBWeight> cloud;
+  msf::depthImageToCloud(fused.depth, calibration, 0, cloud);
+  for (int v = 0; v < fused.depth.rows; ++v)
+    for (int u = 0; u < fused.depth.cols; ++u) {
+      msf::PointXYZRGBWeight& p = cloud.at(u, v);
+      const cv::Vec3b bgr = fused.color.at<cv::Vec3b>(v, u);
+      p.b = bgr[0];
+      p.g = bgr[1];
+      p.r = bgr[2];
+      p.a = 255;
+      p.weight = fused.weight.at<float>(v, u);
+    }
+  return cloud;
+}
 
 class Progress {
 public:
@@ -240,15 +257,15 @@ int main(int argc, char** argv) {
           if (scores.truth)
             scores.add(r, calibration, config.integrator.max_depth_m);
           if (save_depth)
-            msf::saveCloud((fs::path(out) / "depth" / (r.name + ".pcd")).string(), *r.fused);
+            msf::saveCloud((fs::path(out) / "depth" / (r.name + ".pcd")).string(), fusedCloud(r.fused, calibration));
           if (panel_frames.count(r.index)) {
-            const cv::Mat fused = msf::cloudToDepthImage(*r.fused);
+            const cv::Mat& fused = r.fused.depth;
             msf::DepthPanel panel;
             panel.addImage("left image (camera 0), frame " + r.name, r.left);
-            if (!r.lidar_sparse->empty())
-              panel.addDepth("projected LiDAR", msf::cloudToDepthImage(*r.lidar_sparse), 3.f, 60.f, 1);
-            panel.addDepth("interpolated LiDAR", msf::cloudToDepthImage(*r.lidar), 3.f, 60.f);
-            panel.addDepth("SGBM", msf::cloudToDepthImage(*r.stereo), 3.f, 60.f);
+            if (!r.lidar_sparse.empty())
+              panel.addDepth("projected LiDAR", r.lidar_sparse, 3.f, 60.f, 1);
+            panel.addDepth("interpolated LiDAR", r.lidar_depth, 3.f, 60.f);
+            panel.addDepth("SGBM", r.stereo_depth, 3.f, 60.f);
             panel.addDepth("fused", fused, 3.f, 60.f);
             if (scores.truth)
               panel.addError("|fused - ground truth|", fused, scores.truth->depth(scores.truth->indexOf(r.name)), 2.f);

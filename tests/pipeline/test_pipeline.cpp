@@ -92,7 +92,7 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   }
   pcl::PointCloud<msf::PointXYZRGBWeight> chained;
   msf::loadCloud(out.file("fused.pcd"), chained);
-  const cv::Mat a = msf::cloudToDepthImage(*result.fused), b = msf::cloudToDepthImage(chained);
+  const cv::Mat a = result.fused.depth, b = msf::cloudToDepthImage(chained);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_GT(cv::countNonZero(a), a.total() / 2);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << "fused depth differs between the pipeline and the tools";

@@ -1,11 +1,10 @@
 #include <msf/common/exceptions.h>
-#include <msf/fusion/depth_fusion.h>
-#include <msf/io/organized_conversion.h>
+#include <msf/fusion/depth_image_fusion.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
-#include <msf/reconstruction/impl/depth_frame.hpp> // toDepthFrame for the fused point type
 #include <msf/range_image/lidar_completion.h>
-#include <msf/io/pinhole_camera.h>
+#include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <chrono>
@@ -30,7 +29,7 @@ struct Pipeline::Stages {
       : lidar(calibration, CompletionMethod::Compound, config.projection, config.interpolation) {}
   LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
   SgbmStereo stereo;
-  DepthFusion<> fusion;
+  DepthImageFusion fusion;
 };
 
 Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
@@ -45,6 +44,7 @@ Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
   stages_->stereo.setCalibration(calibration_);
   stages_->fusion.setConfig(config_.fusion);
   stages_->fusion.setCalibration(calibration_);
+  camera_ = PinholeCamera::fromCalibration(calibration_, config_.projection.camera);
 }
 
 Pipeline::~Pipeline() = default;
@@ -55,36 +55,39 @@ FrameResult Pipeline::startFrame(const Frame& frame) const {
   result.has_pose = frame.has_pose;
   result.T_world_cam0 = frame.T_world_cam0;
   result.left = frame.left;
-  result.lidar_sparse.reset(new pcl::PointCloud<PointXYZID>);
-  result.lidar.reset(new pcl::PointCloud<PointXYZID>);
-  result.stereo.reset(new pcl::PointCloud<PointXYZRGBConfidence>);
-  result.fused.reset(new pcl::PointCloud<PointXYZRGBWeight>);
   return result;
 }
 
 void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
-  stages_->lidar.compute(*frame.scan, *result.lidar);
+  stages_->lidar.computeDepth(*frame.scan, result.lidar_depth, &result.lidar_distance);
   result.times.lidar_ms = msSince(start);
   if (keep_sparse_)
-    stages_->lidar.projector().project(*frame.scan, *result.lidar_sparse);
+    stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);
 }
 
 void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   stages_->stereo.setInputImages(frame.left, frame.right);
-  stages_->stereo.setInputColor(frame.color);
   // With the prior, SGBM searches only the disparities the interpolated LiDAR allows.
-  stages_->stereo.setDepthPrior(config_.scheduling.stereo_prior ? cloudToDepthImage(*result.lidar) : cv::Mat());
-  stages_->stereo.compute(*result.stereo);
+  stages_->stereo.setDepthPrior(config_.scheduling.stereo_prior ? result.lidar_depth : cv::Mat());
+  stages_->stereo.computeDisparity();
+  result.stereo_depth = stages_->stereo.getDepth();
+  result.stereo_confidence = stages_->stereo.getConfidence().clone(); // the matcher reuses its buffer
   result.times.stereo_ms = msSince(start);
 }
 
-void Pipeline::computeFusion(FrameResult& result) {
+void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
-  stages_->fusion.setInputLidar(result.lidar);
-  stages_->fusion.setInputStereo(result.stereo);
-  stages_->fusion.fuse(*result.fused);
+  DepthFrame& fused = result.fused;
+  stages_->fusion.fuse(result.lidar_depth, result.lidar_distance, result.stereo_depth, result.stereo_confidence,
+                       fused.depth, &fused.weight);
+  // Colour from the colour camera at the fused point, also where only the LiDAR has depth.
+  fused.camera = camera_;
+  const ColorSampler sampler = frame.color.empty()
+                                   ? ColorSampler()
+                                   : ColorSampler(frame.color, calibration_, config_.stereo.color_camera);
+  colorizeDepth(fused.depth, camera_, sampler, frame.left, fused.color);
   result.times.fusion_ms = msSince(start);
 }
 
@@ -106,7 +109,7 @@ FrameResult Pipeline::computeDepth(const Frame& frame) {
     lidar.get();
   }
   result.times.depth_ms = msSince(depth_start);
-  computeFusion(result);
+  computeFusion(frame, result);
   return result;
 }
 
@@ -115,8 +118,7 @@ void Pipeline::integrate(FrameResult& result) {
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
                             " has no pose: integration needs the sequence's poses");
   const auto start = Clock::now();
-  const PinholeCamera camera = PinholeCamera::fromCalibration(calibration_, config_.projection.camera);
-  integrator_->integrate(*result.fused, result.T_world_cam0, &camera);
+  integrator_->integrate(result.fused, result.T_world_cam0);
   result.times.integrate_ms = msSince(start);
 }
 
@@ -177,7 +179,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
           const auto start = Clock::now();
           computeStereo(item->frame, result);
           result.times.depth_ms = msSince(start) + result.times.lidar_ms;
-          computeFusion(result);
+          computeFusion(item->frame, result);
         } else {
           result = computeDepth(item->frame);
         }

@@ -1,12 +1,10 @@
 #pragma once
-#include <msf/fusion/point_types.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
-#include <msf/range_image/point_types.h>
+#include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
-#include <msf/stereo/point_types.h>
 
 #include <atomic>
 #include <functional>
@@ -22,17 +20,23 @@ struct StageTimes {
   double load_ms = 0, lidar_ms = 0, stereo_ms = 0, depth_ms = 0, fusion_ms = 0, integrate_ms = 0;
 };
 
-/// What one frame produced on its way through the stages.
+/// What one frame produced on its way through the stages: depth images of camera 0
+/// (CV_32FC1 metres, 0 = none), which is all the stages exchange, so a frame moves a quarter
+/// of the memory of organized clouds and no stage converts.
 struct FrameResult {
   std::size_t index = 0;                    ///< position in the sequence
   std::string name;                         ///< file stem ("000042")
   bool has_pose = false;
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
   cv::Mat left;                             ///< camera 0 grey image
-  pcl::PointCloud<PointXYZID>::Ptr lidar_sparse;        ///< projected scan (step 1), if kept (setKeepSparse)
-  pcl::PointCloud<PointXYZID>::Ptr lidar;               ///< interpolated (step 2)
-  pcl::PointCloud<PointXYZRGBConfidence>::Ptr stereo;   ///< SGBM (step 3)
-  pcl::PointCloud<PointXYZRGBWeight>::Ptr fused;        ///< fused (step 4)
+  cv::Mat lidar_sparse;       ///< projected scan (step 1), if kept (setKeepSparse)
+  cv::Mat lidar_depth;        ///< interpolated LiDAR (step 2)
+  cv::Mat lidar_distance;     ///< pixels from each pixel to the nearest real return (step 2)
+  cv::Mat stereo_depth;       ///< SGBM (step 3)
+  cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
+  /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
+  /// the integrator (step 5) consumes.
+  DepthFrame fused;
   StageTimes times;
 };
 
@@ -42,7 +46,9 @@ struct FrameResult {
 /// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
 /// The stages are the library's classes with the settings of one PipelineConfig, the same
 /// as the msf_project, msf_interpolate, msf_stereo, msf_fuse and msf_integrate tools use,
-/// so the chain of tools and the pipeline give the same fused depth.
+/// so the chain of tools and the pipeline give the same fused depth. The tools exchange
+/// organized clouds; the pipeline runs the same per-pixel code on depth images
+/// (LidarCompletion::computeDepth, SgbmStereo::getDepth, DepthImageFusion), which is faster.
 ///
 /// With `pipeline.stereo_prior` (the default) SGBM searches only the disparities that the
 /// interpolated LiDAR allows, so steps 1-2 run first; otherwise they run beside SGBM.
@@ -101,10 +107,11 @@ private:
   FrameResult startFrame(const Frame& frame) const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
-  void computeFusion(FrameResult& result);                      // step 4
+  void computeFusion(const Frame& frame, FrameResult& result);  // step 4
 
   Calibration calibration_;
   PipelineConfig config_;
+  PinholeCamera camera_;  // of the depth images
   std::unique_ptr<TsdfVolume> volume_;
   std::unique_ptr<TsdfIntegrator> integrator_;
   std::unique_ptr<Stages> stages_;

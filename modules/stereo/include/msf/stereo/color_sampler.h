@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
 
 #include <opencv2/core/mat.hpp>
 
@@ -48,5 +49,14 @@ private:
   cv::Mat image_;
   float P_[12] = {};
 };
+
+/// The colour of every pixel of a depth image of camera 0 (CV_32FC1 metres, 0 = none), for
+/// integrators that take a colour image: a pixel with a depth takes the colour the sampler
+/// finds at its point, the others (and points the colour camera does not see) keep the pixel
+/// of `fallback` (the left image, CV_8UC1 or CV_8UC3 of the depth's size). Writes CV_8UC3
+/// BGR, reusing `bgr` when it has the right size. Throws InvalidInputError for a fallback of
+/// another type or size.
+void colorizeDepth(const cv::Mat& depth, const PinholeCamera& camera, const ColorSampler& sampler,
+                   const cv::Mat& fallback, cv::Mat& bgr);
 
 } // namespace msf
