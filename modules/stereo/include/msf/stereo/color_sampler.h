@@ -2,9 +2,9 @@
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
 
+#include <opencv2/core/fast_math.hpp>
 #include <opencv2/core/mat.hpp>
 
-#include <cmath>
 #include <cstdint>
 
 namespace msf {
@@ -31,7 +31,7 @@ public:
       return false;
     const float u = (P_[0] * x + P_[1] * y + P_[2] * z + P_[3]) / w;
     const float v = (P_[4] * x + P_[5] * y + P_[6] * z + P_[7]) / w;
-    const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
+    const int iu = cvRound(u), iv = cvRound(v); // one instruction; std::lround is a libm call
     if (iu < 0 || iv < 0 || iu >= image_.cols || iv >= image_.rows)
       return false;
     const std::uint8_t* px = image_.ptr<std::uint8_t>(iv) + static_cast<std::ptrdiff_t>(iu) * image_.channels();
