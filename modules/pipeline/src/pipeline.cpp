@@ -7,6 +7,8 @@
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
+#include <omp.h>
+
 #include <chrono>
 #include <exception>
 #include <future>
@@ -147,6 +149,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
 
   const auto run_start = Clock::now();
   std::thread loader([&] {
+    if (config_.scheduling.lidar_threads > 0)
+      omp_set_num_threads(config_.scheduling.lidar_threads); // this thread's parallel regions only
     try {
       for (std::size_t i : frames) {
         if (stop && stop->load()) {

@@ -24,6 +24,7 @@ void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
   readKey(node, "stereo_prior", stereo_prior);
+  readKey(node, "lidar_threads", lidar_threads);
   validate();
 }
 
@@ -32,6 +33,8 @@ void SchedulingConfig::validate() const {
     throw ConfigError("pipeline.queue_capacity must be >= 1, got " + std::to_string(queue_capacity));
   if (mesh_every_n_frames < 0)
     throw ConfigError("pipeline.mesh_every_n_frames must be >= 0, got " + std::to_string(mesh_every_n_frames));
+  if (lidar_threads < 0)
+    throw ConfigError("pipeline.lidar_threads must be >= 0, got " + std::to_string(lidar_threads));
 }
 
 PipelineConfig PipelineConfig::load(const std::string& path) {
@@ -68,7 +71,8 @@ void PipelineConfig::print(std::ostream& out) const {
   integrator.print(out);
   mesher.print(out);
   out << "pipeline: queue_capacity " << scheduling.queue_capacity << ", mesh_every_n_frames "
-      << scheduling.mesh_every_n_frames << ", stereo_prior " << scheduling.stereo_prior << "\n";
+      << scheduling.mesh_every_n_frames << ", stereo_prior " << scheduling.stereo_prior << ", lidar_threads "
+      << scheduling.lidar_threads << "\n";
 }
 
 } // namespace msf
