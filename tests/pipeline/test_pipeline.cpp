@@ -227,6 +227,26 @@ TEST(Reconstruct, BadInputIsAClearError) {
   EXPECT_FALSE(msf::test::fileExists("msf_out/summary.json"));
 }
 
+TEST(PipelineConfig, ShippedFilesLoadAndBadSchedulingKeysAreNamed) {
+  const char* source = std::getenv("MSF_SOURCE_DIR");
+  ASSERT_NE(source, nullptr) << "MSF_SOURCE_DIR is set by ctest";
+  for (const char* name : {"kitti.yaml", "synthetic.yaml"}) {
+    const msf::PipelineConfig config = msf::PipelineConfig::load(std::string(source) + "/config/" + name);
+    EXPECT_EQ(config.scheduling.lidar_threads, 1) << name;
+    EXPECT_TRUE(config.scheduling.stereo_prior) << name;
+  }
+  msf::test::TempDir dir;
+  for (const std::string key : {"queue_capacity: 0", "lidar_threads: -1", "mesh_every_n_frames: -2"}) {
+    std::ofstream(dir.file("bad.yaml")) << "%YAML:1.0\npipeline:\n  " << key << "\n";
+    try {
+      msf::PipelineConfig::load(dir.file("bad.yaml"));
+      ADD_FAILURE() << key << " was accepted";
+    } catch (const msf::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("pipeline." + key.substr(0, key.find(':'))), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {
   msf::BoundedQueue<int> queue(2);
   EXPECT_TRUE(queue.push(1));
