@@ -12,3 +12,5 @@ for b in "$bin"/bench_*; do
   "$b" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 done
 [ "$found" = 1 ] || echo "bench: no benchmark built yet"
+echo "== bench_pipeline.sh"
+"$(dirname "$0")/bench_pipeline.sh" "$bin" "$kitti" 5
