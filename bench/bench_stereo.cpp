@@ -1,8 +1,9 @@
-// SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads):
-// the DESIGN.md baseline (3-way, 128 disparities, block 5), the same narrowed by the
-// interpolated LiDAR depth (stereo.prior_search_range), and with the explicit left-right
-// check. Times are of SgbmStereo::computeDisparity (matching, conversion, confidence);
-// cpu_ms_all_threads is the process CPU time per frame (all threads).
+// SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads),
+// each with both engines side by side (stereo.engine: native = our AVX2 SemiGlobalMatcher,
+// opencv = cv::StereoSGBM): the DESIGN.md baseline (3-way, 128 disparities, block 5), the
+// same narrowed by the interpolated LiDAR depth (stereo.prior_search_range), and with the
+// explicit left-right check. Times are of SgbmStereo::computeDisparity (matching,
+// conversion, confidence); cpu_ms_all_threads is the process CPU time per frame (all threads).
 //
 //   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 //   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
@@ -52,8 +53,9 @@ const Data& data() {
   return d;
 }
 
-void run(benchmark::State& state, const msf::SgbmConfig& config, bool with_prior) {
+void run(benchmark::State& state, msf::SgbmConfig config, bool with_prior, const char* engine) {
   const Data& d = data();
+  config.engine = engine;
   msf::SgbmStereo stereo(config);
   stereo.setCalibration(d.calibration);
   std::size_t i = 0, valid = 0, pixels = 0;
@@ -72,22 +74,36 @@ void run(benchmark::State& state, const msf::SgbmConfig& config, bool with_prior
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
   state.counters["disparities"] = stereo.getSearchedDisparities();
   state.counters["valid_share"] = pixels ? static_cast<double>(valid) / pixels : 0.0;
+  if (stereo.getEngineUsed() != engine)
+    state.SkipWithError("the native engine needs AVX2; this row ran OpenCV");
 }
 
-void BM_Sgbm3Way128(benchmark::State& state) { run(state, msf::SgbmConfig{}, false); }
+void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, msf::SgbmConfig{}, false, engine); }
 
-void BM_Sgbm3WayLidarRange(benchmark::State& state) { run(state, msf::SgbmConfig{}, true); }
+void BM_Sgbm3WayLidarRange(benchmark::State& state, const char* engine) {
+  run(state, msf::SgbmConfig{}, true, engine);
+}
 
-void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state) {
+void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state, const char* engine) {
   msf::SgbmConfig config;
   config.left_right_check = true;
-  run(state, config, true);
+  run(state, config, true, engine);
 }
 
 } // namespace
 
-BENCHMARK(BM_Sgbm3Way128)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK(BM_Sgbm3WayLidarRange)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK(BM_Sgbm3WayLidarRangeLrCheck)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+// Each case's engines one after the other, so that both see the same machine load.
+BENCHMARK_CAPTURE(BM_Sgbm3Way128, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3Way128, native, "native")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, native, "native")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, opencv, "opencv")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, native, "native")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
 
 BENCHMARK_MAIN();

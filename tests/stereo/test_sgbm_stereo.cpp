@@ -275,11 +275,13 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
   const std::string path = dir.file("c.yaml");
   {
     std::ofstream out(path);
-    out << "%YAML:1.0\nstereo:\n  mode: hh\n  num_disparities_px: 64\n  block_size_px: 7\n  p1: 100\n  p2: 900\n"
+    out << "%YAML:1.0\nstereo:\n  engine: opencv\n  mode: hh\n  num_disparities_px: 64\n  block_size_px: 7\n  p1: 100\n  p2: 900\n"
            "  left_right_check: true\n  confidence_hole_distance_px: 9.5\n";
   }
   msf::SgbmConfig config;
   config.read(msf::ConfigFile(path).section("stereo"));
+  EXPECT_EQ(config.engine, "opencv");
+  EXPECT_FALSE(config.nativeEngine());
   EXPECT_EQ(config.mode, "hh");
   EXPECT_EQ(config.num_disparities_px, 64);
   EXPECT_EQ(config.block_size_px, 7);
@@ -305,6 +307,7 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
   EXPECT_TRUE(fails("num_disparities_px: 100", "stereo.num_disparities_px"));
   EXPECT_TRUE(fails("block_size_px: 4", "stereo.block_size_px"));
   EXPECT_TRUE(fails("mode: fast", "stereo.mode"));
+  EXPECT_TRUE(fails("engine: gpu", "stereo.engine"));
   EXPECT_TRUE(fails("p1: 500\n  p2: 400", "stereo.p2"));
   EXPECT_TRUE(fails("num_disparities_px: many", "stereo.num_disparities_px"));
   EXPECT_TRUE(fails("color_camera: 5", "stereo.color_camera"));

@@ -26,7 +26,16 @@ int SgbmConfig::opencvMode() const {
   bad("mode", "must be sgbm_3way, sgbm, hh or hh4, not '" + mode + "'");
 }
 
+bool SgbmConfig::nativeEngine() const {
+  if (engine == "native")
+    return true;
+  if (engine == "opencv")
+    return false;
+  bad("engine", "must be native or opencv, not '" + engine + "'");
+}
+
 void SgbmConfig::read(const cv::FileNode& node) {
+  readKey(node, "engine", engine);
   readKey(node, "mode", mode);
   readKey(node, "min_disparity_px", min_disparity_px);
   readKey(node, "num_disparities_px", num_disparities_px);
@@ -53,6 +62,7 @@ void SgbmConfig::read(const cv::FileNode& node) {
 }
 
 void SgbmConfig::validate() const {
+  nativeEngine();
   opencvMode();
   if (num_disparities_px <= 0 || num_disparities_px % 16 != 0)
     bad("num_disparities_px", "must be a positive multiple of 16, not " + std::to_string(num_disparities_px));
@@ -85,6 +95,7 @@ void SgbmConfig::validate() const {
 
 void SgbmConfig::print(std::ostream& out) const {
   out << "stereo:\n"
+      << "  engine: " << engine << "\n"
       << "  mode: " << mode << "\n"
       << "  min_disparity_px: " << min_disparity_px << "\n"
       << "  num_disparities_px: " << num_disparities_px << "\n"

@@ -9,6 +9,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <iostream>
+#include <mutex>
 #include <string>
 
 namespace msf {
@@ -67,7 +69,45 @@ void SgbmStereo::checkInputs() const {
     throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
 }
 
-cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_disparities) {
+bool SgbmStereo::nativeRuns() const {
+  if (!config_.nativeEngine())
+    return false;
+  if (config_.mode != "sgbm_3way") {
+    static std::once_flag noted;
+    std::call_once(noted, [&] {
+      std::cerr << "msf: note: stereo.engine native implements mode sgbm_3way; mode " << config_.mode
+                << " runs on OpenCV's StereoSGBM\n";
+    });
+    return false;
+  }
+  if (!SemiGlobalMatcher::isAvailable()) {
+    static std::once_flag noted;
+    std::call_once(noted, [] {
+      std::cerr << "msf: note: stereo.engine native needs AVX2, which this CPU lacks; using OpenCV's StereoSGBM\n";
+    });
+    return false;
+  }
+  return true;
+}
+
+void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed) {
+  if (nativeRuns()) {
+    SemiGlobalMatcher::Params params;
+    params.min_disparity = config_.min_disparity_px;
+    params.num_disparities = num_disparities;
+    params.block_size = config_.block_size_px;
+    params.p1 = config_.resolvedP1();
+    params.p2 = config_.resolvedP2();
+    params.pre_filter_cap = config_.pre_filter_cap;
+    params.uniqueness_ratio = config_.uniqueness_ratio_pct;
+    params.speckle_window_size = config_.speckle_window_size_px;
+    params.speckle_range = config_.speckle_range_px;
+    params.disp12_max_diff = config_.disp12_max_diff_px;
+    native_.setParams(params);
+    native_.compute(left, right, fixed);
+    engine_used_ = "native";
+    return;
+  }
   if (!matcher_)
     matcher_ = cv::StereoSGBM::create();
   matcher_->setMode(config_.opencvMode());
@@ -81,16 +121,21 @@ cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_dis
   matcher_->setSpeckleWindowSize(config_.speckle_window_size_px);
   matcher_->setSpeckleRange(config_.speckle_range_px);
   matcher_->setDisp12MaxDiff(config_.disp12_max_diff_px);
+  matcher_->compute(left, right, fixed);
+  engine_used_ = "opencv";
+}
+
+cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_disparities) {
   cv::Mat fixed; // CV_16S, disparity x 16
   const int border = config_.match_left_border ? std::max(0, config_.min_disparity_px + num_disparities) : 0;
   if (border == 0) {
-    matcher_->compute(left, right, fixed);
+    runMatcher(left, right, num_disparities, fixed);
     return fixed;
   }
   cv::Mat left_padded, right_padded;
   cv::copyMakeBorder(left, left_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
   cv::copyMakeBorder(right, right_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
-  matcher_->compute(left_padded, right_padded, fixed);
+  runMatcher(left_padded, right_padded, num_disparities, fixed);
   return fixed.colRange(border, border + left.cols);
 }
 

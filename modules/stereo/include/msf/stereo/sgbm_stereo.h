@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/io/calibration.h>
+#include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_config.h>
 
 #include <opencv2/core/mat.hpp>
@@ -11,8 +12,8 @@ class StereoSGBM;
 
 namespace msf {
 
-/// Dense stereo depth (paper step 3): OpenCV's StereoSGBM on a rectified grey pair, to a
-/// disparity image, a per-pixel confidence (stereo_confidence.h) and an organized cloud in
+/// Dense stereo depth (paper step 3): semi-global block matching on a rectified grey pair
+/// (config.engine: our AVX2 SemiGlobalMatcher, or OpenCV's StereoSGBM), to a disparity image, a per-pixel confidence (stereo_confidence.h) and an organized cloud in
 /// the rectified frame of camera 0 with z = f B / d, coloured from the colour camera.
 ///
 ///   msf::SgbmStereo stereo;
@@ -69,9 +70,14 @@ public:
   cv::Mat getDepth() const;
   /// Number of disparities searched by the last computeDisparity() (narrowed by the prior).
   int getSearchedDisparities() const { return searched_disparities_; }
+  /// The engine that ran the last computeDisparity(): "native" or "opencv" (the fallback
+  /// where native was asked for but the CPU has no AVX2 or the mode is not sgbm_3way).
+  const std::string& getEngineUsed() const { return engine_used_; }
 
 private:
   cv::Mat match(const cv::Mat& left, const cv::Mat& right, int num_disparities);
+  void runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed);
+  bool nativeRuns() const;
   void checkInputs() const;
 
   Config config_;
@@ -80,7 +86,9 @@ private:
   cv::Mat left_, right_, color_, prior_;
   cv::Mat disparity_, confidence_;
   int searched_disparities_{0};
+  std::string engine_used_;
   cv::Ptr<cv::StereoSGBM> matcher_;
+  SemiGlobalMatcher native_;
 };
 
 } // namespace msf

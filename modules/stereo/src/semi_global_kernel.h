@@ -1,0 +1,40 @@
+#pragma once
+// The vectorised core of SemiGlobalMatcher (private to the stereo module): one horizontal
+// strip of rows of OpenCV's 3-way semi-global block matching. Kept free of OpenCV and of
+// the standard library's templates so that its translation unit can be compiled for AVX2
+// without lending AVX2 copies of inline functions to the rest of the program.
+#include <cstddef>
+#include <cstdint>
+
+namespace msf::detail {
+
+/// One strip: the rows [row_output_begin, row_end) are written to `disparity`; the rows
+/// [row_begin, row_output_begin) before them only warm up the top-to-bottom path.
+struct SgmStrip {
+  const std::uint8_t* left{nullptr};  ///< grey, height rows of `width` bytes
+  const std::uint8_t* right{nullptr};
+  std::size_t left_step{0}, right_step{0}; ///< bytes between rows
+  int width{0}, height{0};
+  int min_disparity{0};
+  int num_disparities{16};            ///< a positive multiple of 16
+  int block_radius{2};                ///< (block_size - 1) / 2
+  int p1{200}, p2{800};               ///< p2 > p1 > 0
+  int prefilter_cap{63};              ///< OpenCV's ftzero: max(pre_filter_cap, 15) | 1
+  int uniqueness_ratio{10};           ///< percent; 0 = off
+  int disp12_max_diff{1};             ///< pseudo left-right check, >= 0
+  int row_begin{0}, row_output_begin{0}, row_end{0};
+  std::int16_t* disparity{nullptr};   ///< CV_16S disparity x 16 of the whole image
+  std::size_t disparity_step{0};      ///< elements between rows
+  std::uint8_t* workspace{nullptr};   ///< sgmWorkspaceBytes() bytes, owned by the caller
+};
+
+/// Bytes of workspace one strip needs for images `width` wide.
+std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius);
+
+/// Runs one strip with AVX2 instructions; call only where the CPU has them.
+void sgmStripAvx2(const SgmStrip& strip);
+
+/// True when this build has the AVX2 kernel and the CPU runs AVX2.
+bool sgmAvx2Available();
+
+} // namespace msf::detail

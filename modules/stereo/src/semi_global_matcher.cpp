@@ -1,0 +1,119 @@
+#include "semi_global_kernel.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/stereo/semi_global_matcher.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+
+namespace msf {
+
+namespace {
+// Fixed, like OpenCV's, so that results do not depend on the number of threads; 4 strips
+// balance 2 threads on a shared machine and cost ~6 % in warm-up rows.
+constexpr int kStrips = 4;
+
+std::atomic<bool> avx2_enabled{true};
+
+[[noreturn]] void bad(const std::string& name, const std::string& why) {
+  throw ConfigError("SemiGlobalMatcher: parameter '" + name + "' " + why);
+}
+} // namespace
+
+bool SemiGlobalMatcher::isAvailable() {
+  static const bool cpu_has_avx2 = detail::sgmAvx2Available();
+  return cpu_has_avx2 && avx2_enabled.load();
+}
+
+void SemiGlobalMatcher::setAvx2Enabled(bool enabled) { avx2_enabled.store(enabled); }
+
+void SemiGlobalMatcher::setParams(const Params& params) {
+  if (params.num_disparities <= 0 || params.num_disparities % 16 != 0)
+    bad("num_disparities", "must be a positive multiple of 16, not " + std::to_string(params.num_disparities));
+  if (params.block_size < 1 || params.block_size > 11 || params.block_size % 2 == 0)
+    bad("block_size", "must be odd and in 1..11, not " + std::to_string(params.block_size));
+  if (params.p1 <= 0 || params.p2 <= params.p1)
+    bad("p2", "must be greater than p1 > 0 (p1 " + std::to_string(params.p1) + ", p2 " + std::to_string(params.p2) + ")");
+  if (params.p2 > 0x7FFF)
+    bad("p2", "must be at most 32767, not " + std::to_string(params.p2));
+  if (params.pre_filter_cap < 1 || params.pre_filter_cap > 63)
+    bad("pre_filter_cap", "must be in 1..63, not " + std::to_string(params.pre_filter_cap));
+  if (params.uniqueness_ratio < 0 || params.uniqueness_ratio > 100)
+    bad("uniqueness_ratio", "must be in 0..100, not " + std::to_string(params.uniqueness_ratio));
+  if (params.speckle_window_size < 0 || params.speckle_range < 0)
+    bad("speckle_window_size", "and speckle_range must be >= 0");
+  params_ = params;
+}
+
+void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity) {
+  if (left.empty() || right.empty())
+    throw InvalidInputError(std::string("SemiGlobalMatcher: the ") + (left.empty() ? "left" : "right") +
+                            " image is empty");
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1)
+    throw InvalidInputError("SemiGlobalMatcher: the images must be 8-bit grey (CV_8UC1)");
+  if (left.size() != right.size())
+    throw InvalidInputError("SemiGlobalMatcher: the left image is " + std::to_string(left.cols) + "x" +
+                            std::to_string(left.rows) + " but the right image is " + std::to_string(right.cols) + "x" +
+                            std::to_string(right.rows));
+  if (!isAvailable())
+    throw InvalidInputError("SemiGlobalMatcher: this CPU has no AVX2 (use OpenCV's StereoSGBM)");
+
+  const Params& p = params_;
+  const int height = left.rows, radius = p.block_size / 2;
+  raw_.create(left.size(), CV_16SC1);
+  const int strips = std::min(kStrips, height);
+  const int strip_rows = (height + strips - 1) / strips;
+  // OpenCV's warm-up: the block's half height plus a tenth of a strip.
+  const int overlap = radius + 1 + static_cast<int>(std::ceil(0.1 * strip_rows));
+  const std::size_t workspace_bytes = detail::sgmWorkspaceBytes(left.cols, p.min_disparity, p.num_disparities, radius);
+  workspaces_.resize(static_cast<std::size_t>(strips));
+  for (auto& workspace : workspaces_)
+    if (workspace.size() < workspace_bytes)
+      workspace.resize(workspace_bytes);
+
+  detail::SgmStrip job;
+  job.left = left.ptr<std::uint8_t>();
+  job.right = right.ptr<std::uint8_t>();
+  job.left_step = left.step[0];
+  job.right_step = right.step[0];
+  job.width = left.cols;
+  job.height = height;
+  job.min_disparity = p.min_disparity;
+  job.num_disparities = p.num_disparities;
+  job.block_radius = radius;
+  job.p1 = p.p1;
+  job.p2 = p.p2;
+  job.prefilter_cap = std::max(p.pre_filter_cap, 15) | 1;
+  job.uniqueness_ratio = p.uniqueness_ratio;
+  job.disp12_max_diff = p.disp12_max_diff > 0 ? p.disp12_max_diff : 1; // as OpenCV 4.6: never off
+  job.disparity = raw_.ptr<std::int16_t>();
+  job.disparity_step = raw_.step[0] / sizeof(std::int16_t);
+  cv::parallel_for_(
+      cv::Range(0, strips),
+      [&](const cv::Range& range) {
+        for (int i = range.start; i < range.end; ++i) {
+          detail::SgmStrip strip = job;
+          strip.row_output_begin = std::min(i * strip_rows, height);
+          strip.row_end = std::min((i + 1) * strip_rows, height);
+          strip.row_begin = std::max(strip.row_output_begin - overlap, 0);
+          strip.workspace = workspaces_[static_cast<std::size_t>(i)].data();
+          if (strip.row_output_begin < strip.row_end)
+            detail::sgmStripAvx2(strip);
+        }
+      },
+      strips);
+
+  // As OpenCV's StereoSGBM::compute: a 3x3 median, then the speckle filter.
+  cv::medianBlur(raw_, disparity, 3);
+  if (p.speckle_window_size > 0)
+    cv::filterSpeckles(disparity, (p.min_disparity - 1) * 16, p.speckle_window_size, 16 * p.speckle_range,
+                       speckle_buffer_);
+}
+
+} // namespace msf
