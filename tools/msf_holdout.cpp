@@ -158,6 +158,9 @@ void printHelp(const char* name) {
   print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic, stereo,\n"
              "                     fusion)\n");
   print_info("    -csv FILE        also write the rows as CSV\n");
+  print_info("    -breakdown       ring hold-out: also each method's rows for the ground truth that camera 0 sees\n"
+             "                     (visible) and cannot see (hidden: an input return within 1 px in front of it),\n"
+             "                     and for the depth bands < 20, 20-40, >= 40 m; 'MAE part' adds up to the MAE\n");
 }
 
 std::vector<std::string> split(const std::string& text) {
@@ -276,7 +279,7 @@ int main(int argc, char** argv) {
       return argc < 2 ? 1 : 0;
     }
     const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout"});
+    msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout", "-breakdown"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() != 1)
       throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
@@ -289,6 +292,10 @@ int main(int argc, char** argv) {
                                    "' has no synthetic ground truth (no gt/depth_0 beside its sequences/, as msf_synth "
                                    "writes); without -gt it is evaluated by ring hold-out");
     const bool gt_mode = !holdout_switch && !sequence.groundTruthDir().empty();
+    const bool breakdown = find_switch(argc, argv, "-breakdown");
+    if (breakdown && gt_mode)
+      throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
+                                   "regions (add -holdout to evaluate '" + positional[0] + "' by ring hold-out)");
     std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path;
     parse_argument(argc, argv, "-frames", frames_text);
     parse_argument(argc, argv, "-methods", methods_text);
@@ -302,6 +309,7 @@ int main(int argc, char** argv) {
     config.rings.read(config_file.section("rings"));
     config.projection.read(config_file.section("projection"));
     msf::HoldoutEvaluation evaluation(config);
+    evaluation.setBreakdown(breakdown);
     std::vector<std::pair<std::string, msf::HoldoutMethod>> methods;
     const auto names = split(methods_text);
     if (names.empty())
@@ -336,6 +344,8 @@ int main(int argc, char** argv) {
     const auto results = evaluation.run(sequence, frames);
     const double ms = watch.getTime();
     std::printf("%s", msf::formatHoldoutTable(results).c_str());
+    if (breakdown)
+      std::printf("\n%s", msf::formatHoldoutBreakdown(results).c_str());
     std::fflush(stdout);
     if (!csv_path.empty())
       msf::writeHoldoutCsv(csv_path, results);

@@ -21,7 +21,9 @@ HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration
   pcl::PointCloud<pcl::PointXYZI> heldout;
   out.ring_count = splitRings(*frame.scan, config.rings, *input, heldout);
   out.heldout_points = heldout.size();
-  LidarProjector(calibration, config.projection).projectToImage(heldout, out.gt_depth);
+  const LidarProjector projector(calibration, config.projection);
+  projector.projectToImage(heldout, out.gt_depth);
+  projector.projectToImage(*input, out.input_depth);
   out.input.frame = frame.index;
   out.input.calibration = &calibration;
   out.input.scan = input;
@@ -52,10 +54,19 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
   const Calibration& calibration = sequence.calibration();
   const double fB = calibration.focalBaseline();
   std::vector<DepthErrorAccumulator> errors(methods_.size());
+  std::vector<std::vector<DepthErrorAccumulator>> region_errors(methods_.size());
+  std::vector<std::string> region_names;
   std::vector<std::vector<double>> times(methods_.size());
   std::size_t done = 0;
   for (const std::size_t i : frames) {
     const HoldoutFrame split = makeHoldoutFrame(sequence.load(i, load_color_), calibration, config_);
+    std::vector<HoldoutRegion> regions;
+    if (breakdown_) {
+      regions = holdoutRegions(split.gt_depth, split.input_depth, fB, config_.d1);
+      region_names.clear();
+      for (const auto& region : regions)
+        region_names.push_back(region.name);
+    }
     for (std::size_t m = 0; m < methods_.size(); ++m) {
       const auto start = std::chrono::steady_clock::now();
       const cv::Mat estimate = methods_[m].second(split.input);
@@ -67,6 +78,9 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
                                 " image of type " + std::to_string(estimate.type()) + ", expected CV_32FC1 " +
                                 std::to_string(split.gt_depth.cols) + "x" + std::to_string(split.gt_depth.rows));
       errors[m].add(split.gt_depth, estimate, fB, cv::Mat(), config_.d1);
+      region_errors[m].resize(regions.size());
+      for (std::size_t r = 0; r < regions.size(); ++r)
+        region_errors[m][r].add(split.gt_depth, estimate, fB, regions[r].mask, config_.d1);
     }
     if (progress_)
       progress_(++done, frames.size());
@@ -78,6 +92,8 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
     r.metrics = errors[m].metrics();
     r.median_ms = median(times[m]);
     r.frames = frames.size();
+    for (std::size_t k = 0; k < region_errors[m].size(); ++k)
+      r.regions.push_back({region_names[k], region_errors[m][k].metrics()});
     results.push_back(r);
   }
   return results;
@@ -96,6 +112,27 @@ std::string formatHoldoutTable(const std::vector<HoldoutResult>& results) {
                   m.rmse_m, m.imae_per_km, m.irmse_per_km, r.median_ms);
     out << line;
   }
+  return out.str();
+}
+
+std::string formatHoldoutBreakdown(const std::vector<HoldoutResult>& results) {
+  std::ostringstream out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-20s %-10s %9s %9s %9s %9s %10s %9s %9s %10s\n", "method", "region", "share",
+                "coverage", "D1 all", "D1 est", "disp MAE", "MAE m", "RMSE m", "MAE part");
+  out << line;
+  for (const auto& r : results)
+    for (const auto& region : r.regions) {
+      const DepthMetrics& m = region.metrics;
+      // share: of the ground-truth pixels; MAE part: the region's errors over all the method's
+      // estimates, so that the parts of a partition add up to the method's MAE.
+      const double share = r.metrics.gt_pixels ? static_cast<double>(m.gt_pixels) / r.metrics.gt_pixels : 0.0;
+      const double part = r.metrics.estimated && m.estimated ? m.mae_m * m.estimated / r.metrics.estimated : 0.0;
+      std::snprintf(line, sizeof line, "%-20s %-10s %8.2f%% %9.4f %8.2f%% %8.2f%% %8.3fpx %9.3f %9.3f %10.3f\n",
+                    r.method.c_str(), region.region.c_str(), 100.0 * share, m.coverage, 100.0 * m.d1_all,
+                    100.0 * m.d1_estimated, m.disparity_mae_px, m.mae_m, m.rmse_m, part);
+      out << line;
+    }
   return out.str();
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/holdout_breakdown.h>
 #include <msf/io/calibration.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/lidar_projector.h>
@@ -39,6 +40,7 @@ struct HoldoutInput {
 struct HoldoutFrame {
   HoldoutInput input;
   cv::Mat gt_depth;            ///< CV_32FC1, camera 0, held-out returns (0 = none)
+  cv::Mat input_depth;         ///< CV_32FC1, camera 0, the input rings' returns (0 = none)
   std::size_t heldout_points = 0;
   int ring_count = 0;          ///< ring ids in the scan (wraps + 1)
 };
@@ -56,6 +58,7 @@ struct HoldoutResult {
   DepthMetrics metrics;        ///< pooled over the pixels of all frames
   double median_ms = 0;        ///< median time of one call, over the frames
   std::size_t frames = 0;
+  std::vector<RegionMetrics> regions; ///< holdoutRegions' metrics, with setBreakdown(true)
 };
 
 /// Runs named methods over frames of a sequence under protocol 2.
@@ -67,6 +70,8 @@ public:
   void addMethod(const std::string& name, HoldoutMethod method);
   /// Load camera 2 for the methods that need colour (off by default: it costs a decode).
   void setLoadColor(bool load) { load_color_ = load; }
+  /// Also pool the metrics of each of holdoutRegions (HoldoutResult::regions).
+  void setBreakdown(bool breakdown) { breakdown_ = breakdown; }
   /// Called after each frame with (frames done, frames in all); e.g. to print progress.
   void setProgress(std::function<void(std::size_t, std::size_t)> progress) { progress_ = std::move(progress); }
 
@@ -79,11 +84,14 @@ private:
   HoldoutConfig config_;
   std::vector<std::pair<std::string, HoldoutMethod>> methods_;
   bool load_color_ = false;
+  bool breakdown_ = false;
   std::function<void(std::size_t, std::size_t)> progress_;
 };
 
 /// The table a user compares methods with, one row per method (fixed-width text).
 std::string formatHoldoutTable(const std::vector<HoldoutResult>& results);
+/// Rows of every method's regions (HoldoutResult::regions), one per method and region.
+std::string formatHoldoutBreakdown(const std::vector<HoldoutResult>& results);
 /// The same rows as CSV with a header line, written atomically. Throws IOError.
 void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& results);
 

@@ -1,0 +1,75 @@
+#include <msf/common/exceptions.h>
+#include <msf/evaluation/holdout_breakdown.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+namespace msf {
+
+namespace {
+void checkDepth(const cv::Mat& image, const char* name, const cv::Size& size) {
+  if (image.type() != CV_32FC1)
+    throw InvalidInputError(std::string("hold-out breakdown: ") + name + " must be CV_32FC1");
+  if (image.size() != size)
+    throw InvalidInputError(std::string("hold-out breakdown: ") + name + " is " + std::to_string(image.cols) + "x" +
+                            std::to_string(image.rows) + " but the ground truth is " + std::to_string(size.width) +
+                            "x" + std::to_string(size.height));
+}
+inline bool has(float z) { return z > 0.f && z < std::numeric_limits<float>::infinity(); }
+} // namespace
+
+cv::Mat hiddenGroundTruthMask(const cv::Mat& gt_depth, const cv::Mat& input_depth, double focal_baseline,
+                              int radius_px, const D1Threshold& d1) {
+  if (gt_depth.empty())
+    throw InvalidInputError("hold-out breakdown: the ground-truth depth is empty");
+  checkDepth(gt_depth, "the ground-truth depth", gt_depth.size());
+  checkDepth(input_depth, "the input depth", gt_depth.size());
+  if (!(focal_baseline > 0.0))
+    throw InvalidInputError("hold-out breakdown: focal length x baseline must be > 0, not " +
+                            std::to_string(focal_baseline));
+  if (radius_px < 0)
+    throw InvalidInputError("hold-out breakdown: the radius must be >= 0, not " + std::to_string(radius_px));
+  // The largest input disparity around each pixel (0 where there is none).
+  cv::Mat nearest(input_depth.size(), CV_32FC1);
+  const float fB = static_cast<float>(focal_baseline);
+  for (int v = 0; v < input_depth.rows; ++v) {
+    const float* z = input_depth.ptr<float>(v);
+    float* d = nearest.ptr<float>(v);
+    for (int u = 0; u < input_depth.cols; ++u)
+      d[u] = has(z[u]) ? fB / z[u] : 0.f;
+  }
+  cv::dilate(nearest, nearest,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius_px + 1, 2 * radius_px + 1)));
+  cv::Mat hidden(gt_depth.size(), CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < gt_depth.rows; ++v) {
+    const float* g = gt_depth.ptr<float>(v);
+    const float* d = nearest.ptr<float>(v);
+    std::uint8_t* out = hidden.ptr<std::uint8_t>(v);
+    for (int u = 0; u < gt_depth.cols; ++u) {
+      if (!has(g[u]))
+        continue;
+      const double d_gt = focal_baseline / g[u], excess = d[u] - d_gt;
+      if (excess > d1.abs_px && excess > d1.rel * d_gt)
+        out[u] = 255;
+    }
+  }
+  return hidden;
+}
+
+std::vector<HoldoutRegion> holdoutRegions(const cv::Mat& gt_depth, const cv::Mat& input_depth,
+                                          double focal_baseline, const D1Threshold& d1) {
+  const cv::Mat hidden = hiddenGroundTruthMask(gt_depth, input_depth, focal_baseline, 1, d1);
+  std::vector<HoldoutRegion> regions{{"visible", cv::Mat()}, {"hidden", hidden},
+                                     {"z < 20 m", cv::Mat()}, {"z 20-40 m", cv::Mat()}, {"z >= 40 m", cv::Mat()}};
+  cv::Mat has_gt = gt_depth > 0.f;
+  regions[0].mask = has_gt & ~hidden;
+  regions[2].mask = has_gt & (gt_depth < 20.f);
+  regions[3].mask = (gt_depth >= 20.f) & (gt_depth < 40.f);
+  regions[4].mask = (gt_depth >= 40.f) & (gt_depth < std::numeric_limits<float>::infinity());
+  return regions;
+}
+
+} // namespace msf
