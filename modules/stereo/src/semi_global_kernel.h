@@ -8,6 +8,12 @@
 
 namespace msf::detail {
 
+/// Bytes per prepared row array, a compile-time constant so that the kernel addresses its
+/// arrays from one register; it bounds the image width.
+constexpr int kSgmPrepStride = 4096;
+/// Widest image the kernel matches (the rest of a row array pads the 32-byte loads).
+constexpr int kSgmMaxWidth = kSgmPrepStride - 64;
+
 /// One strip: the rows [row_output_begin, row_end) are written to `disparity`; the rows
 /// [row_begin, row_output_begin) before them only warm up the top-to-bottom path.
 struct SgmStrip {

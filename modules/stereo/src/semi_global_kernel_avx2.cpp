@@ -31,7 +31,6 @@ struct Layout {
   int width1{0};       ///< columns that can be matched: [min_x, min_x + width1)
   int min_x{0};
   int num_disparities{0};
-  int prep_stride{0};  ///< bytes per prepared row array
   int ring{0};         ///< prepared rows kept (2r + 2: the row entering and the one leaving)
   std::size_t column_sums{0}, top{0}, sums{0}, top_minima{0}, box{0}, left{0}, right{0}, total{0};
   std::size_t prep{0}, prep_rows{0}, disp2{0}, disp2_cost{0}, bytes{0};
@@ -41,7 +40,6 @@ struct Layout {
     min_x = max_disparity > 0 ? max_disparity : 0;
     const int max_x = width + (min_disparity < 0 ? min_disparity : 0);
     width1 = max_x > min_x ? max_x - min_x : 0;
-    prep_stride = static_cast<int>(alignUp(static_cast<std::size_t>(width) + 64));
     ring = 2 * block_radius + 2;
     const std::size_t volume_row = alignUp(sizeof(std::int16_t) * static_cast<std::size_t>(width1) * num_disparities);
     const std::size_t line = alignUp(sizeof(std::int16_t) * static_cast<std::size_t>(num_disparities));
@@ -59,7 +57,7 @@ struct Layout {
     left = take(line);
     right = take(line);
     total = take(line);
-    prep = take(static_cast<std::size_t>(ring) * kPrepArrays * prep_stride);
+    prep = take(static_cast<std::size_t>(ring) * kPrepArrays * kSgmPrepStride);
     prep_rows = take(sizeof(int) * static_cast<std::size_t>(ring));
     disp2 = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
     disp2_cost = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
@@ -151,12 +149,13 @@ struct Strip {
     y = y < 0 ? 0 : (y >= s.height ? s.height - 1 : y);
     const int slot_index = y % layout.ring;
     int* tags = at<int>(layout.prep_rows);
-    std::uint8_t* slot = at<std::uint8_t>(layout.prep) + static_cast<std::size_t>(slot_index) * Layout::kPrepArrays * layout.prep_stride;
+    std::uint8_t* slot = at<std::uint8_t>(layout.prep) + static_cast<std::size_t>(slot_index) * Layout::kPrepArrays * kSgmPrepStride;
     if (tags[slot_index] == y)
       return slot;
     tags[slot_index] = y;
-    const int stride = layout.prep_stride;
-    std::memset(slot, 0, static_cast<std::size_t>(Layout::kPrepArrays) * stride); // defined padding for wide loads
+    constexpr int stride = kSgmPrepStride;
+    for (int array = 0; array < Layout::kPrepArrays; ++array) // defined padding for the wide loads
+      std::memset(slot + static_cast<std::size_t>(array) * stride + s.width, 0, kSgmPrepStride - kSgmMaxWidth);
     for (int image = 0; image < 2; ++image) {
       const std::uint8_t* first = image == 0 ? s.left : s.right;
       const std::size_t step = image == 0 ? s.left_step : s.right_step;
@@ -192,9 +191,10 @@ MSF_AVX2_INLINE __m256i dissimilarity(__m256i u, __m256i u0, __m256i u1, const s
 struct PixelCost {
   __m256i su, su0, su1, ru, ru0, ru1;
   const std::uint8_t* right; // prefiltered right row (reversed) at the first disparity
-  int stride;
+  /// A constant, so that the six arrays are addressed from one register.
+  static constexpr int stride = kSgmPrepStride;
 
-  MSF_AVX2_INLINE PixelCost(const std::uint8_t* prepared, int stride_, int x, int reversed_first) : stride(stride_) {
+  MSF_AVX2_INLINE PixelCost(const std::uint8_t* prepared, int x, int reversed_first) {
     su = _mm256_set1_epi8(static_cast<char>(prepared[x]));
     su0 = _mm256_set1_epi8(static_cast<char>(prepared[stride + x]));
     su1 = _mm256_set1_epi8(static_cast<char>(prepared[2 * stride + x]));
@@ -219,15 +219,16 @@ struct PixelCost {
 template <bool kSubtract>
 MSF_AVX2_INLINE void updateColumn(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, int xi) {
   const Layout& layout = strip.layout;
-  const int D = layout.num_disparities, stride = layout.prep_stride;
+  const int D = layout.num_disparities;
   const int x = xi + layout.min_x;
   const int reversed_first = strip.s.width - 1 - x + strip.s.min_disparity;
-  const PixelCost cost_add(add, stride, x, reversed_first);
+  const PixelCost cost_add(add, x, reversed_first);
   std::int16_t* column = strip.at<std::int16_t>(layout.column_sums) + static_cast<std::size_t>(xi) * D;
   if constexpr (kSubtract) {
     // (+1, -1) byte pairs: maddubs turns interleaved (add, sub) bytes into add - sub.
     const __m256i plus_minus = _mm256_set1_epi16(static_cast<short>(0xFF01));
-    const PixelCost cost_sub(sub, stride, x, reversed_first);
+    const PixelCost cost_sub(sub, x, reversed_first);
+#pragma GCC unroll 4
     for (int d = 0; d < D; d += 32) {
       // Lanes reordered so that the in-lane unpacks give disparities d..d+15, d+16..d+31.
       const __m256i a = _mm256_permute4x64_epi64(cost_add(d), 0xD8);
@@ -368,6 +369,7 @@ MSF_AVX2_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     PathSweep top_path(top_x, K, top_minima[xi], p2);
     PathSweep left_path(left, K, left_min, p2);
     std::int16_t* sums_x = sums + static_cast<std::size_t>(xi) * D;
+#pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
       const __m256i change = _mm256_sub_epi16(load16(entering + 16 * k), load16(leaving + 16 * k));
       const __m256i cost = _mm256_add_epi16(load16(box + 16 * k), _mm256_and_si256(change, first));
@@ -429,6 +431,7 @@ MSF_AVX2_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
     PathSweep right_path(right, K, right_min, s.p2);
     // Per lane: the smallest total so far and the vector k where it was (the first on ties).
     __m256i best_cost = _mm256_set1_epi16(0x7FFF), best_k = _mm256_setzero_si256();
+#pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
       const __m256i change = _mm256_sub_epi16(load16(entering + 16 * k), load16(leaving + 16 * k));
       const __m256i cost = _mm256_add_epi16(load16(box + 16 * k), _mm256_and_si256(change, first));

@@ -33,6 +33,8 @@ bool SemiGlobalMatcher::isAvailable() {
 
 void SemiGlobalMatcher::setAvx2Enabled(bool enabled) { avx2_enabled.store(enabled); }
 
+int SemiGlobalMatcher::maxWidth() { return detail::kSgmMaxWidth; }
+
 void SemiGlobalMatcher::setParams(const Params& params) {
   if (params.num_disparities <= 0 || params.num_disparities % 16 != 0)
     bad("num_disparities", "must be a positive multiple of 16, not " + std::to_string(params.num_disparities));
@@ -61,6 +63,9 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
     throw InvalidInputError("SemiGlobalMatcher: the left image is " + std::to_string(left.cols) + "x" +
                             std::to_string(left.rows) + " but the right image is " + std::to_string(right.cols) + "x" +
                             std::to_string(right.rows));
+  if (left.cols > maxWidth())
+    throw InvalidInputError("SemiGlobalMatcher: the images are " + std::to_string(left.cols) +
+                            " px wide, more than the " + std::to_string(maxWidth()) + " it matches");
   if (!isAvailable())
     throw InvalidInputError("SemiGlobalMatcher: this CPU has no AVX2 (use OpenCV's StereoSGBM)");
 

@@ -69,9 +69,17 @@ void SgbmStereo::checkInputs() const {
     throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
 }
 
-bool SgbmStereo::nativeRuns() const {
+bool SgbmStereo::nativeRuns(int width) const {
   if (!config_.nativeEngine())
     return false;
+  if (width > SemiGlobalMatcher::maxWidth()) {
+    static std::once_flag noted;
+    std::call_once(noted, [] {
+      std::cerr << "msf: note: stereo.engine native matches images up to " << SemiGlobalMatcher::maxWidth()
+                << " px wide; wider ones run on OpenCV's StereoSGBM\n";
+    });
+    return false;
+  }
   if (config_.mode != "sgbm_3way") {
     static std::once_flag noted;
     std::call_once(noted, [&] {
@@ -91,7 +99,7 @@ bool SgbmStereo::nativeRuns() const {
 }
 
 void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed) {
-  if (nativeRuns()) {
+  if (nativeRuns(left.cols)) {
     SemiGlobalMatcher::Params params;
     params.min_disparity = config_.min_disparity_px;
     params.num_disparities = num_disparities;

@@ -48,14 +48,17 @@ public:
   /// benchmarks can run the OpenCV fallback on a machine with AVX2.
   static void setAvx2Enabled(bool enabled);
 
+  /// Widest image it matches (4032 px).
+  static int maxWidth();
+
   /// Throws ConfigError naming the parameter out of range.
   void setParams(const Params& params);
   const Params& getParams() const { return params_; }
 
   /// Disparity of the left image (CV_16S, disparity x 16, (min_disparity - 1) x 16 where
   /// none; the first min_disparity + num_disparities columns have none, as OpenCV's).
-  /// Throws InvalidInputError for images that are empty, not 8-bit grey or of different
-  /// sizes, and when the CPU has no AVX2.
+  /// Throws InvalidInputError for images that are empty, not 8-bit grey, of different sizes
+  /// or wider than maxWidth(), and when the CPU has no AVX2.
   void compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity);
 
 private:

@@ -71,13 +71,14 @@ public:
   /// Number of disparities searched by the last computeDisparity() (narrowed by the prior).
   int getSearchedDisparities() const { return searched_disparities_; }
   /// The engine that ran the last computeDisparity(): "native" or "opencv" (the fallback
-  /// where native was asked for but the CPU has no AVX2 or the mode is not sgbm_3way).
+  /// where native was asked for but the CPU has no AVX2, the mode is not sgbm_3way or the
+  /// images are wider than SemiGlobalMatcher::maxWidth()).
   const std::string& getEngineUsed() const { return engine_used_; }
 
 private:
   cv::Mat match(const cv::Mat& left, const cv::Mat& right, int num_disparities);
   void runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed);
-  bool nativeRuns() const;
+  bool nativeRuns(int width) const;
   void checkInputs() const;
 
   Config config_;
