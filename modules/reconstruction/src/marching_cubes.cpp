@@ -28,14 +28,6 @@ constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
-constexpr int kCornerOffset[8] = {0, 1, 1 + kPad, kPad, kPad * kPad, 1 + kPad * kPad, 1 + kPad + kPad * kPad,
-                                   kPad + kPad * kPad};
-
-struct Sample {
-  float sdf;
-  float weight;
-  std::uint8_t rgb[3];
-};
 
 /// A vertex is keyed by the grid element it lies on: the lower voxel of a grid edge and the
 /// edge's axis (0..2), or a voxel itself (3) when its sdf is exactly 0. 20 bits per axis.
@@ -59,19 +51,24 @@ bool lessIndex(const GridIndex& a, const GridIndex& b) {
 
 /// Per-thread working memory for meshing one block.
 struct Scratch {
-  std::array<Sample, kPad * kPad * kPad> samples;
-  std::array<std::uint8_t, kPad * kPad * kPad> flags; // bit 0: weight > min_weight, bit 1: sdf < 0
+  // The 9^3 grid points a block's cubes read, as 81 rows of 9 along x (row = y + 9 z): bit x
+  // of a row's mask is voxel x, and each row's voxels are found through two pointers (x < 8
+  // in one block, x = 8 in its +x neighbour), so no voxel is copied.
+  std::array<std::uint16_t, kPad * kPad> valid; // weight > min_weight
+  std::array<std::uint16_t, kPad * kPad> negative; // sdf < 0
+  std::array<std::array<const TsdfVoxel*, 2>, kPad * kPad> row;
   std::array<std::int32_t, kPad * kPad * kPad * 4> slot; // local vertex of (grid point, code), -1 = none
   std::vector<int> used;
   MarchingCubes::BlockMesh mesh; // grows once per thread, then copied out at its exact size
   Scratch() { slot.fill(-1); }
+
+  const TsdfVoxel& voxel(int x, int y, int z) const { return row[y + kPad * z][x >> 3][x & 7]; }
 };
 
 void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
                    Scratch& s) {
   const float vs = static_cast<float>(volume.voxelSize());
 
-  // Gather the 9^3 voxels the block's cubes read (weight 0 where a neighbour is absent).
   if (block.signs == 0)
     return; // never observed: every cube has this block's unobserved corner
   const TsdfBlock* nb[8];
@@ -82,44 +79,36 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
   }
   if (signs != (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative))
     return; // no sign change within reach of this block's cubes
-  bool any_negative = false, any_positive = false;
+
+  // Bit masks of the 9^3 grid points (a missing neighbour block's points are unobserved).
+  std::uint16_t any_negative = 0, any_positive = 0;
   for (int z = 0; z < kPad; ++z)
     for (int y = 0; y < kPad; ++y) {
-      // A row is 8 voxels of one block and 1 of its +x neighbour.
-      const int at = kPad * (y + kPad * z);
+      const int r = y + kPad * z;
       const int sel = ((y >> 3) << 1) | ((z >> 3) << 2);
+      std::uint16_t valid = 0, negative = 0;
       for (int part = 0; part < 2; ++part) {
         const TsdfBlock* b = nb[sel | part];
-        const int x0 = part ? kSide : 0, x1 = part ? kPad : kSide;
-        if (!b) {
-          for (int x = x0; x < x1; ++x) {
-            s.samples[at + x].weight = 0.f;
-            s.flags[at + x] = 0;
-          }
+        s.row[r][part] = b ? &b->at(0, y & 7, z & 7) : nullptr;
+        if (!b)
           continue;
-        }
-        const TsdfVoxel* src = &b->at(0, y & 7, z & 7);
-        for (int x = x0; x < x1; ++x) {
-          const TsdfVoxel& v = src[x & 7];
-          Sample& out_sample = s.samples[at + x];
-          out_sample.sdf = v.sdf;
-          out_sample.weight = v.weight;
-          out_sample.rgb[0] = v.r;
-          out_sample.rgb[1] = v.g;
-          out_sample.rgb[2] = v.b;
-          const bool valid = v.weight > min_weight;
-          const bool negative = v.sdf < 0.f;
-          s.flags[at + x] = static_cast<std::uint8_t>(valid | (negative << 1));
-          any_negative |= valid & negative;
-          any_positive |= valid & !negative;
+        const TsdfVoxel* src = s.row[r][part];
+        for (int x = part * kSide, n = part ? 1 : kSide, k = 0; k < n; ++k, ++x) {
+          valid |= static_cast<std::uint16_t>((src[k].weight > min_weight) << x);
+          negative |= static_cast<std::uint16_t>((src[k].sdf < 0.f) << x);
         }
       }
+      negative &= valid;
+      s.valid[r] = valid;
+      s.negative[r] = negative;
+      any_negative |= negative;
+      any_positive |= valid & ~negative;
     }
   if (!any_negative || !any_positive)
     return;
 
   const GridIndex o = block.origin();
-  auto vertexOf = [&](int px, int py, int pz, int code, float t, const Sample& a, const Sample& b) -> std::uint32_t {
+  auto vertexOf = [&](int px, int py, int pz, int code, float t, const TsdfVoxel& a, const TsdfVoxel& b) -> std::uint32_t {
     const int local = px + kPad * (py + kPad * pz);
     std::int32_t& slot = s.slot[local * 4 + code];
     if (slot >= 0)
@@ -130,9 +119,10 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
     if (code < 3)
       p[code] += t;
     out.vertices.push_back(p * vs);
+    const std::uint8_t ca[3] = {a.r, a.g, a.b}, cb[3] = {b.r, b.g, b.b};
     std::array<std::uint8_t, 3> c;
     for (int k = 0; k < 3; ++k)
-      c[k] = static_cast<std::uint8_t>(a.rgb[k] + t * (static_cast<float>(b.rgb[k]) - a.rgb[k]) + 0.5f);
+      c[k] = static_cast<std::uint8_t>(ca[k] + t * (static_cast<float>(cb[k]) - ca[k]) + 0.5f);
     out.colors.push_back(c);
     // Interior: every cube around this edge (or voxel) belongs to this block, so no other
     // block makes this vertex.
@@ -146,24 +136,25 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
   };
 
   for (int z = 0; z < kSide; ++z)
-    for (int y = 0; y < kSide; ++y)
-      for (int x = 0; x < kSide; ++x) {
-        const int at = x + kPad * (y + kPad * z);
-        std::uint8_t all_valid = 1;
-        int cube = 0;
-        for (int i = 0; i < 8; ++i) {
-          const std::uint8_t f = s.flags[at + kCornerOffset[i]];
-          all_valid &= f;
-          cube |= ((f >> 1) & 1) << i;
-        }
-        if (!all_valid)
-          continue;
+    for (int y = 0; y < kSide; ++y) {
+      // The 8 cubes of a row at once: the 4 rows of grid points around them (y, z), (y + 1, z),
+      // (y, z + 1), (y + 1, z + 1); cube x reads bits x and x + 1 of each.
+      const int r00 = y + kPad * z, r10 = r00 + 1, r01 = r00 + kPad, r11 = r01 + 1;
+      const unsigned valid4 = s.valid[r00] & s.valid[r10] & s.valid[r01] & s.valid[r11];
+      const unsigned n00 = s.negative[r00], n10 = s.negative[r10], n01 = s.negative[r01], n11 = s.negative[r11];
+      const unsigned all_negative = n00 & n10 & n01 & n11, any_neg = n00 | n10 | n01 | n11;
+      // Cubes whose 8 corners are observed and not all of one sign.
+      unsigned active = valid4 & (valid4 >> 1) & (any_neg | (any_neg >> 1)) & ~(all_negative & (all_negative >> 1)) & 0xffu;
+      for (; active; active &= active - 1) {
+        const int x = __builtin_ctz(active);
+        // Bourke's corners 0..7: (0,0,0) (1,0,0) (1,1,0) (0,1,0) (0,0,1) (1,0,1) (1,1,1) (0,1,1).
+        const int cube = static_cast<int>(((n00 >> x) & 1) | ((n00 >> x) & 2) | ((n10 >> x) & 2) << 1 | ((n10 >> x) & 1) << 3 |
+                                          ((n01 >> x) & 1) << 4 | ((n01 >> x) & 2) << 4 | ((n11 >> x) & 2) << 5 |
+                                          ((n11 >> x) & 1) << 7);
         const unsigned int edges = detail::kEdgeTable[cube];
-        if (!edges)
-          continue;
-        const Sample* c[8];
+        const TsdfVoxel* c[8];
         for (int i = 0; i < 8; ++i)
-          c[i] = &s.samples[at + kCornerOffset[i]];
+          c[i] = &s.voxel(x + kCorner[i][0], y + kCorner[i][1], z + kCorner[i][2]);
         std::uint32_t vert[12];
         for (int e = 0; e < 12; ++e) {
           if (!(edges & (1u << e)))
@@ -174,8 +165,8 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
             ++axis;
           if (kCorner[ia][axis] > kCorner[ib][axis])
             std::swap(ia, ib); // interpolate from the lower end, so every block computes the same vertex
-          const Sample& a = *c[ia];
-          const Sample& b = *c[ib];
+          const TsdfVoxel& a = *c[ia];
+          const TsdfVoxel& b = *c[ib];
           const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
           // A voxel with sdf exactly 0 is the vertex of all its edges (no duplicate positions).
           if (a.sdf == 0.f)
@@ -193,6 +184,7 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
             out.triangles.push_back(f);
         }
       }
+    }
   for (const int u : s.used)
     s.slot[u] = -1;
   s.used.clear();

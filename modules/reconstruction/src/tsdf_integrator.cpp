@@ -21,6 +21,25 @@ double msSince(Clock::time_point t0) {
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
 
+// 4 lanes of SIMD (GCC and Clang vector extensions: SSE2 on x86-64, NEON on ARM), for the
+// row of 4 voxels that the update projects at once. Comparisons give 0 or -1 per lane.
+using Float4 = float __attribute__((vector_size(16)));
+using Int4 = std::int32_t __attribute__((vector_size(16)));
+
+inline Float4 clamp4(Float4 v, float lo, float hi) {
+  v = v > lo ? v : lo;
+  return v < hi ? v : hi;
+}
+/// A voxel that passed the nearest-pixel test: its projection, depth and nearest pixel.
+struct Candidate {
+  float u, v, z, nearest;
+  std::int32_t ui, vi;
+  std::uint16_t voxel; ///< index in the block
+};
+
+/// Bit k set when lane k is true (-1).
+inline int laneMask(Int4 m) { return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8); }
+
 // 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
 std::uint64_t packKey(const Eigen::Vector3i& b) {
   constexpr std::int64_t kBias = 1 << 19;
@@ -268,8 +287,10 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
   const Weighting weighting = config_.weighting;
   // Changed voxels of each block (local indices), for the regularization.
-  if (regularized)
+  if (regularized) {
     changed_index_.resize(blocks.size() * TsdfBlock::kVoxels);
+    data_term_.resize(changed_index_.size());
+  }
   std::vector<std::uint16_t> changed_count(blocks.size(), 0);
   const bool bilinear = config_.interpolate_depth;
   const bool carving = config_.space_carving;
@@ -301,14 +322,19 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
 
   std::size_t projected_total = 0;
-#pragma omp parallel for schedule(dynamic, 8) reduction(+ : updated_total, projected_total)
+#pragma omp parallel reduction(+ : updated_total, projected_total)
+  {
+  // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
+  // so that their voxels and colours are prefetched while the rest of the block is tested
+  // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
+  std::vector<Candidate> candidates(TsdfBlock::kVoxels);
+  const float* depth_data = frame.depth.ptr<float>(0);
+  const std::size_t depth_step = frame.depth.step1();
+#pragma omp for schedule(dynamic, 8)
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
-    std::size_t updated = 0;
-    std::uint8_t signs = 0;
-    const float* depth_data = frame.depth.ptr<float>(0);
-    const std::size_t depth_step = frame.depth.step1();
+    std::size_t n_candidates = 0;
     for (int sub = 0; sub < 8; ++sub) {
       if (!(masks[i] & (1u << sub)))
         continue; // no sampled ray's band crosses this sub-block
@@ -346,88 +372,88 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       projected_total += 64;
       for (int z = sz; z < sz + 4; ++z)
       for (int y = sy; y < sy + 4; ++y) {
-        // A row of 4 voxels: projection first in plain float arrays (the compiler vectorizes
-        // it), then the per-voxel depth lookups.
+        // A row of 4 voxels, projected and tested on its nearest pixels in SIMD lanes without
+        // branches (most voxels fail, unpredictably); a bilinear value differs from the nearest
+        // by less than the truncation (the 4 pixels must agree within it), so 2 truncations is
+        // a safe bound. Same float operations as one voxel at a time, so the same results.
         const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
-        float pu[4], pv[4], pz[4];
-        for (int k = 0; k < 4; ++k) {
-          const int x = sx + k;
-          const float X = row.x() + ex.x() * x, Y = row.y() + ex.y() * x, Z = row.z() + ex.z() * x;
-          const float inv_z = 1.f / std::max(Z, 1e-6f);
-          pu[k] = fx * X * inv_z + cx;
-          pv[k] = fy * Y * inv_z + cy;
-          pz[k] = Z;
-        }
-        // Cheap test of the 4 voxels on their nearest pixel, without branches (most voxels
-        // fail it, unpredictably); a bilinear value differs from the nearest by less than the
-        // truncation (the 4 pixels must agree within it), so 2 truncations is a safe bound.
-        int candidates = 0;
-        float nearest[4];
-        int pixel_u[4], pixel_v[4];
-        for (int k = 0; k < 4; ++k) {
-          const float u = pu[k], v = pv[k], vz = pz[k];
-          const bool inside = (vz >= min_d) & (u > -0.5f) & (v > -0.5f) & (u < width - 0.5f) & (v < height - 0.5f);
-          const int ui = std::clamp(static_cast<int>(u + 0.5f), 0, width - 1);
-          const int vi = std::clamp(static_cast<int>(v + 0.5f), 0, height - 1);
-          const float d = depth_data[vi * depth_step + ui];
-          const float diff = d - vz;
-          const bool ok = inside & (d >= min_d) & (d <= max_d) & (diff >= -2.f * trunc) & (carving | (diff <= 2.f * trunc));
-          candidates |= static_cast<int>(ok) << k;
-          nearest[k] = d;
-          pixel_u[k] = ui;
-          pixel_v[k] = vi;
-        }
-        if (!candidates)
+        const Float4 xs = Float4{0.f, 1.f, 2.f, 3.f} + static_cast<float>(sx);
+        const Float4 X = row.x() + ex.x() * xs, Y = row.y() + ex.y() * xs, Z = row.z() + ex.z() * xs;
+        const Float4 inv_z = 1.f / (Z > 1e-6f ? Z : 1e-6f);
+        const Float4 pu = fx * X * inv_z + cx, pv = fy * Y * inv_z + cy;
+        const Int4 inside = (Z >= min_d) & (pu > -0.5f) & (pv > -0.5f) & (pu < width - 0.5f) & (pv < height - 0.5f);
+        // Clamped before the conversion (equal to converting, then clamping, inside the image).
+        const Int4 pixel_u = __builtin_convertvector(clamp4(pu + 0.5f, 0.f, static_cast<float>(width - 1)), Int4);
+        const Int4 pixel_v = __builtin_convertvector(clamp4(pv + 0.5f, 0.f, static_cast<float>(height - 1)), Int4);
+        const Int4 at = pixel_v * static_cast<int>(depth_step) + pixel_u;
+        const Float4 nearest = {depth_data[at[0]], depth_data[at[1]], depth_data[at[2]], depth_data[at[3]]};
+        const Float4 diff = nearest - Z;
+        const Int4 ok = inside & (nearest >= min_d) & (nearest <= max_d) & (diff >= -2.f * trunc) &
+                        ((diff <= 2.f * trunc) | -static_cast<int>(carving));
+        const int lanes = laneMask(ok);
+        if (!lanes)
           continue;
-        TsdfVoxel* voxels = &block.at(0, y, z);
-        for (int k = 0; k < 4; ++k) {
-          if (!(candidates & (1 << k)))
-            continue;
-          const int x = sx + k;
-          const float u = pu[k], v = pv[k], vz = pz[k];
-          const int ui = pixel_u[k], vi = pixel_v[k];
-          float d = nearest[k];
-          if (bilinear) {
-            const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
-            if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
-              const float* r0 = depth_data + v0 * depth_step + u0;
-              const float* r1 = r0 + depth_step;
-              const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
-              const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
-              const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
-              // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
-              if (lo > 0.f && hi - lo < trunc) {
-                const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
-                d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
-              }
-            }
+        const int first = TsdfBlock::linear(sx, y, z);
+        __builtin_prefetch(&block.voxels[first], 1);
+        __builtin_prefetch(&block.voxels[first + 3], 1);
+        for (int k = 0; k < 4; ++k)
+          if (lanes & (1 << k)) {
+            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], pixel_u[k], pixel_v[k],
+                                          static_cast<std::uint16_t>(first + k)};
+            if (has_color)
+              __builtin_prefetch(frame.color.ptr<std::uint8_t>(pixel_v[k]) + 3 * pixel_u[k]);
           }
-          float sdf = d - vz;
-          if (sdf < -trunc)
-            continue;
-          const bool in_band = sdf <= trunc;
-          if (!in_band) {
-            if (!carving)
-              continue;
-            sdf = trunc;
+      }
+    }
+
+    std::size_t updated = 0;
+    std::uint8_t signs = 0;
+    for (std::size_t c = 0; c < n_candidates; ++c) {
+      const Candidate& cand = candidates[c];
+      const float u = cand.u, v = cand.v;
+      const int ui = cand.ui, vi = cand.vi;
+      float d = cand.nearest;
+      if (bilinear) {
+        const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
+        if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
+          const float* r0 = depth_data + v0 * depth_step + u0;
+          const float* r1 = r0 + depth_step;
+          const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
+          const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
+          const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
+          // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
+          if (lo > 0.f && hi - lo < trunc) {
+            const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
+            d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
           }
-          float w = 1.f;
-          if (weighting == Weighting::InverseSquare) {
-            w = 1.f / (d * d);
-          } else if (weighting == Weighting::PerPixel) {
-            w = frame.weight.ptr<float>(vi)[ui];
-            if (!(w > 0.f))
-              continue;
-          }
-          const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
-          TsdfVoxel& voxel = voxels[x];
-          updateVoxel(voxel, sdf, w, bgr, max_weight);
-          signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-          if (regularized)
-            changed_index_[i * TsdfBlock::kVoxels + updated] = static_cast<std::uint16_t>(TsdfBlock::linear(x, y, z));
-          ++updated;
         }
       }
+      float sdf = d - cand.z;
+      if (sdf < -trunc)
+        continue;
+      const bool in_band = sdf <= trunc;
+      if (!in_band) {
+        if (!carving)
+          continue;
+        sdf = trunc;
+      }
+      float w = 1.f;
+      if (weighting == Weighting::InverseSquare) {
+        w = 1.f / (d * d);
+      } else if (weighting == Weighting::PerPixel) {
+        w = frame.weight.ptr<float>(vi)[ui];
+        if (!(w > 0.f))
+          continue;
+      }
+      const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
+      TsdfVoxel& voxel = block.voxels[cand.voxel];
+      updateVoxel(voxel, sdf, w, bgr, max_weight);
+      signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+      if (regularized) {
+        changed_index_[i * TsdfBlock::kVoxels + updated] = cand.voxel;
+        data_term_[i * TsdfBlock::kVoxels + updated] = voxel.sdf;
+      }
+      ++updated;
     }
     changed_count[i] = static_cast<std::uint16_t>(updated);
     if (updated) {
@@ -438,6 +464,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       updated_total += updated;
     }
   }
+  }
   std::vector<TsdfBlock*> touched;
   touched.reserve(blocks.size());
   std::vector<std::size_t> offsets{0};
@@ -447,6 +474,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       if (regularized) {
         // Compact the lists in place: the source is at or after the destination.
         std::copy_n(&changed_index_[i * TsdfBlock::kVoxels], changed_count[i], &changed_index_[offsets.back()]);
+        std::copy_n(&data_term_[i * TsdfBlock::kVoxels], changed_count[i], &data_term_[offsets.back()]);
         offsets.push_back(offsets.back() + changed_count[i]);
       }
     } else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())
@@ -528,11 +556,13 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
   if (regularized) {
     std::vector<std::size_t> offsets{0};
     changed_index_.clear();
+    data_term_.clear();
     for (TsdfBlock* block : touched) {
       for (int j = 0; j < TsdfBlock::kVoxels; ++j)
         if (block->voxels[j].flags & kUpdated) {
           block->voxels[j].flags = 0;
           changed_index_.push_back(static_cast<std::uint16_t>(j));
+          data_term_.push_back(block->voxels[j].sdf);
         }
       offsets.push_back(changed_index_.size());
     }
@@ -544,7 +574,6 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
 void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets) {
   const std::size_t n = touched.size();
   const float lambda = static_cast<float>(config_.lambda);
-  data_term_.resize(offsets.back());
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
@@ -554,8 +583,6 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const GridIndex steps[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
     for (int k = 0; k < 6; ++k)
       neighbours[i][k] = volume_.findBlock(b + steps[k]);
-    for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k)
-      data_term_[k] = touched[i]->voxels[changed_index_[k]].sdf;
   }
 
   // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
@@ -568,24 +595,33 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const GridIndex& b = touched[i]->index;
     colour[(b.x() + b.y() + b.z()) & 1].push_back(i);
   }
-  for (int sweep = 0; sweep < config_.sweeps; ++sweep)
+  for (int sweep = 0; sweep < config_.sweeps; ++sweep) {
+    // The sweeps move values towards their neighbours' and can change signs: the last one
+    // records them.
+    const bool last = sweep + 1 == config_.sweeps;
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
 #pragma omp parallel for schedule(dynamic, 16)
       for (std::ptrdiff_t g = 0; g < m; ++g) {
         const std::size_t i = group[static_cast<std::size_t>(g)];
+        if (g + 1 < m) {
+          // The voxels are in memory, not in a cache: fetch the next block's while this one runs.
+          const std::size_t next = group[static_cast<std::size_t>(g + 1)];
+          for (std::size_t k = offsets[next]; k < offsets[next + 1]; ++k)
+            __builtin_prefetch(&touched[next]->voxels[changed_index_[k]]);
+        }
         TsdfBlock& block = *touched[i];
         const auto& nb = neighbours[i];
+        std::uint8_t signs = 0;
         for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
           const int j = changed_index_[k];
           const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
-          float sum = 0.f;
-          int count = 0;
+          float sum = 0.f, count = 0.f;
+          // Without branches: whether a neighbour was observed is unpredictable.
           auto add = [&](const TsdfVoxel& q) {
-            if (q.weight > 0.f) {
-              sum += q.sdf;
-              ++count;
-            }
+            const bool observed = q.weight > 0.f;
+            sum += observed ? q.sdf : 0.f;
+            count += observed ? 1.f : 0.f;
           };
           if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
           if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
@@ -593,19 +629,15 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
           if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
           if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
-          if (count)
-            block.voxels[j].sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * static_cast<float>(count));
+          float& sdf = block.voxels[j].sdf;
+          if (count > 0.f)
+            sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * count);
+          signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
         }
+        if (last)
+          block.signs |= signs;
       }
     }
-
-  // The sweeps move values towards their neighbours' and can change signs.
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint8_t signs = 0;
-    for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k)
-      signs |= touched[i]->voxels[changed_index_[k]].sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-    touched[i]->signs |= signs;
   }
 }
 
