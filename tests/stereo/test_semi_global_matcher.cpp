@@ -181,6 +181,31 @@ TEST(SemiGlobalMatcher, SameResultWhateverTheThreadCountAndOnReuse) {
   EXPECT_EQ(cv::countNonZero(two != again), 0);
 }
 
+TEST(SemiGlobalMatcher, Avx512AndAvx2KernelsGiveTheSameDisparities) {
+  MSF_REQUIRE_AVX2();
+  if (!msf::SemiGlobalMatcher::usesAvx512())
+    GTEST_SKIP() << "this CPU has no AVX-512BW";
+  // A noisy pair, so that ties and ambiguous pixels occur.
+  auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
+  cv::Mat noise(kSize, CV_8SC1);
+  cv::randn(noise, 0, 8);
+  cv::add(pair.right, noise, pair.right, cv::noArray(), CV_8U);
+  for (const int disparities : {32, 64}) {
+    msf::SemiGlobalMatcher::Params params = smallParams();
+    params.num_disparities = disparities;
+    params.min_disparity = 3;
+    msf::SemiGlobalMatcher matcher(params);
+    cv::Mat wide, narrow;
+    matcher.compute(pair.left, pair.right, wide);
+    msf::SemiGlobalMatcher::setAvx512Enabled(false);
+    EXPECT_FALSE(msf::SemiGlobalMatcher::usesAvx512());
+    matcher.compute(pair.left, pair.right, narrow);
+    msf::SemiGlobalMatcher::setAvx512Enabled(true);
+    EXPECT_EQ(cv::countNonZero(wide != narrow), 0) << disparities;
+    EXPECT_GT(cv::countNonZero(wide > 2 * 16), kSize.area() / 2);
+  }
+}
+
 TEST(SemiGlobalMatcher, BadInputAndParametersAreRejected) {
   const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
   msf::SemiGlobalMatcher matcher(smallParams());

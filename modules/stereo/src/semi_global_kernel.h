@@ -1,8 +1,8 @@
 #pragma once
 // The vectorised core of SemiGlobalMatcher (private to the stereo module): one horizontal
 // strip of rows of OpenCV's 3-way semi-global block matching. Kept free of OpenCV and of
-// the standard library's templates so that its translation unit can be compiled for AVX2
-// without lending AVX2 copies of inline functions to the rest of the program.
+// the standard library's templates so that its kernels can be compiled for AVX2 and
+// AVX-512 without lending such copies of inline functions to the rest of the program.
 #include <cstddef>
 #include <cstdint>
 
@@ -39,8 +39,12 @@ std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities,
 
 /// Runs one strip with AVX2 instructions; call only where the CPU has them.
 void sgmStripAvx2(const SgmStrip& strip);
+/// The same with AVX-512BW (32 disparities per instruction); the same result.
+void sgmStripAvx512(const SgmStrip& strip);
 
 /// True when this build has the AVX2 kernel and the CPU runs AVX2.
 bool sgmAvx2Available();
+/// True when this build has the AVX-512 kernel and the CPU runs AVX-512F and BW.
+bool sgmAvx512Available();
 
 } // namespace msf::detail
