@@ -4,6 +4,7 @@
 
 #include "marching_cubes_tables.h"
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/PCLPointField.h>
 
 #include <algorithm>
@@ -307,13 +308,12 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       targets.push_back(&cache_[block->index]);
     }
   const float min_weight = config_.min_weight;
-#pragma omp parallel
-  {
+  // cv::parallel_for_ (TBB) as the integrator: one pool shared with the other stages.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
     Scratch scratch;
-#pragma omp for schedule(dynamic, 4)
-    for (std::size_t i = 0; i < dirty.size(); ++i)
+    for (int i = range.start; i < range.end; ++i)
       meshBlock(volume, *dirty[i], min_weight, *targets[i], scratch);
-  }
+  }, std::max(1.0, static_cast<double>(dirty.size()) / 16));
   generation_ = volume.generation();
   stats_.blocks_meshed = dirty.size();
   stats_.blocks_cached = cache_.size() - dirty.size();
@@ -365,9 +365,8 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   mesh.vertices.resize(n_vertices);
   mesh.colors.resize(n_vertices);
   mesh.triangles.resize(triangle_offset[parts]);
-  const auto n_parts = static_cast<std::ptrdiff_t>(parts);
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::ptrdiff_t i = 0; i < n_parts; ++i) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
+  for (int i = range.start; i < range.end; ++i) {
     const BlockMesh& part = *order[i].second;
     std::uint32_t* map = &remap[remap_offset[i]];
     auto next = static_cast<std::uint32_t>(n_shared + interior_offset[i]);
@@ -382,13 +381,14 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     for (std::size_t t = 0; t < part.triangles.size(); ++t)
       out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
   }
-  const auto n_shared_signed = static_cast<std::ptrdiff_t>(n_shared);
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t k = 0; k < n_shared_signed; ++k) {
-    const BlockMesh& part = *order[shared_source[k].first].second;
-    mesh.vertices[k] = part.vertices[shared_source[k].second];
-    mesh.colors[k] = part.colors[shared_source[k].second];
-  }
+  }, std::max(1.0, static_cast<double>(parts) / 16));
+  cv::parallel_for_(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      const BlockMesh& part = *order[shared_source[k].first].second;
+      mesh.vertices[k] = part.vertices[shared_source[k].second];
+      mesh.colors[k] = part.colors[shared_source[k].second];
+    }
+  }, 8);
   stats_.assemble_ms = msSince(t1);
 }
 
@@ -418,20 +418,20 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
   cloud.row_step = cloud.point_step * cloud.width;
   cloud.is_dense = true;
   cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
-  const auto n = static_cast<std::ptrdiff_t>(vertices.size());
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    std::uint8_t* p = cloud.data.data() + 16 * i;
-    std::memcpy(p, vertices[i].data(), 12);
-    const std::uint32_t rgb = (std::uint32_t(255) << 24) | (std::uint32_t(colors[i][0]) << 16) |
-                              (std::uint32_t(colors[i][1]) << 8) | std::uint32_t(colors[i][2]);
-    std::memcpy(p + 12, &rgb, 4);
-  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      std::uint8_t* p = cloud.data.data() + 16 * static_cast<std::size_t>(i);
+      std::memcpy(p, vertices[i].data(), 12);
+      const std::uint32_t rgb = (std::uint32_t(255) << 24) | (std::uint32_t(colors[i][0]) << 16) |
+                                (std::uint32_t(colors[i][1]) << 8) | std::uint32_t(colors[i][2]);
+      std::memcpy(p + 12, &rgb, 4);
+    }
+  }, 8);
   mesh.polygons.resize(triangles.size());
-  const auto m = static_cast<std::ptrdiff_t>(triangles.size());
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < m; ++i)
-    mesh.polygons[i].vertices.assign(triangles[i].begin(), triangles[i].end());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(triangles.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i)
+      mesh.polygons[i].vertices.assign(triangles[i].begin(), triangles[i].end());
+  }, 8);
 }
 
 } // namespace msf

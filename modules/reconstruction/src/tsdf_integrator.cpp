@@ -2,11 +2,15 @@
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <atomic>
 #include <limits>
+#include <mutex>
 #include <ostream>
 
 namespace msf {
@@ -202,16 +206,37 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float to_sub = 1.f / (vs * kSub);
   const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSub;
   std::vector<std::uint64_t> keys;
+  std::mutex keys_mutex;
   const int stride = config_.allocation_stride;
-#pragma omp parallel
-  {
+  // Also the min and max valid depth of 8x8-pixel tiles, in the same pass over the rows: a
+  // sub-block of 4^3 voxels whose footprint sees only depth far in front of or behind it is
+  // skipped below without projecting its voxels.
+  constexpr int kTile = 8;
+  const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
+  tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
+  tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
+  // cv::parallel_for_ (TBB's work stealing) rather than OpenMP, as the other stages: in the
+  // pipeline this runs beside SGBM, and one pool of threads shares the 2 cores between them
+  // where two pools would oversubscribe them (and OpenMP's idle threads spin).
+  cv::parallel_for_(cv::Range(0, tiles_y), [&](const cv::Range& range) {
     std::vector<std::uint64_t> local;
     std::array<std::uint64_t, 8> recent;
     recent.fill(~0ull);
     std::size_t next = 0;
-#pragma omp for schedule(static) nowait
-    for (int v = 0; v < height; v += stride) {
+    for (int ty = range.start; ty < range.end; ++ty)
+    for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
       const float* depth = frame.depth.ptr<float>(v);
+      float* t_min = &tile_min_[static_cast<std::size_t>(ty) * tiles_x];
+      float* t_max = &tile_max_[static_cast<std::size_t>(ty) * tiles_x];
+      for (int u = 0; u < width; ++u) {
+        const float d = depth[u];
+        if (d >= min_d && d <= max_d) {
+          t_min[u / kTile] = std::min(t_min[u / kTile], d);
+          t_max[u / kTile] = std::max(t_max[u / kTile], d);
+        }
+      }
+      if (v % stride)
+        continue;
       for (int u = (v / stride) % stride; u < width; u += stride) {
         const float d = depth[u];
         if (!(d >= min_d && d <= max_d))
@@ -231,9 +256,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         });
       }
     }
-#pragma omp critical
+    const std::lock_guard<std::mutex> lock(keys_mutex);
     keys.insert(keys.end(), local.begin(), local.end());
-  }
+  });
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   const std::size_t blocks_before = volume_.numBlocks();
@@ -297,41 +322,20 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float max_weight = config_.max_weight;
   const bool has_color = !frame.color.empty();
   std::vector<char> changed(blocks.size(), 0);
-  std::size_t updated_total = 0;
 
-  // Min and max valid depth of 8x8-pixel tiles: a sub-block of 4^3 voxels whose footprint
-  // sees only depth far in front of or behind it is skipped without projecting its voxels
-  // (on KITTI most voxels of the allocated blocks are such, as the road is seen grazing).
-  constexpr int kTile = 8;
-  const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
-  tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
-  tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
-#pragma omp parallel for schedule(static)
-  for (int ty = 0; ty < tiles_y; ++ty)
-    for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
-      const float* row = frame.depth.ptr<float>(v);
-      for (int u = 0; u < width; ++u) {
-        const float d = row[u];
-        if (d >= min_d && d <= max_d) {
-          const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + u / kTile;
-          tile_min_[t] = std::min(tile_min_[t], d);
-          tile_max_[t] = std::max(tile_max_[t], d);
-        }
-      }
-    }
   const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
 
-  std::size_t projected_total = 0;
-#pragma omp parallel reduction(+ : updated_total, projected_total)
-  {
+  std::atomic<std::size_t> projected_total{0};
+  const float* depth_data = frame.depth.ptr<float>(0);
+  const std::size_t depth_step = frame.depth.step1();
+  cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
   // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
-  std::vector<Candidate> candidates(TsdfBlock::kVoxels);
-  const float* depth_data = frame.depth.ptr<float>(0);
-  const std::size_t depth_step = frame.depth.step1();
-#pragma omp for schedule(dynamic, 8)
-  for (std::size_t i = 0; i < blocks.size(); ++i) {
+  std::array<Candidate, TsdfBlock::kVoxels> candidates;
+  std::size_t projected = 0;
+  for (int n = range.start; n < range.end; ++n) {
+    const auto i = static_cast<std::size_t>(n);
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
     std::size_t n_candidates = 0;
@@ -369,7 +373,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           }
         }
       }
-      projected_total += 64;
+      projected += 64;
       for (int z = sz; z < sz + 4; ++z)
       for (int y = sy; y < sy + 4; ++y) {
         // A row of 4 voxels, projected and tested on its nearest pixels in SIMD lanes without
@@ -461,16 +465,18 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
       block.signs |= signs;
       changed[i] = 1;
-      updated_total += updated;
     }
   }
-  }
+  projected_total += projected;
+  }, std::max(1.0, static_cast<double>(blocks.size()) / 8));
   std::vector<TsdfBlock*> touched;
   touched.reserve(blocks.size());
   std::vector<std::size_t> offsets{0};
+  std::size_t updated_total = 0;
   for (std::size_t i = 0; i < blocks.size(); ++i)
     if (changed[i]) {
       touched.push_back(blocks[i]);
+      updated_total += changed_count[i];
       if (regularized) {
         // Compact the lists in place: the source is at or after the destination.
         std::copy_n(&changed_index_[i * TsdfBlock::kVoxels], changed_count[i], &changed_index_[offsets.back()]);
@@ -577,13 +583,12 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    const GridIndex b = touched[i]->index;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
     const GridIndex steps[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
-    for (int k = 0; k < 6; ++k)
-      neighbours[i][k] = volume_.findBlock(b + steps[k]);
-  }
+    for (int i = range.start; i < range.end; ++i)
+      for (int k = 0; k < 6; ++k)
+        neighbours[i][k] = volume_.findBlock(touched[i]->index + steps[k]);
+  }, 16);
 
   // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
   // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
@@ -601,8 +606,8 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const bool last = sweep + 1 == config_.sweeps;
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
-#pragma omp parallel for schedule(dynamic, 16)
-      for (std::ptrdiff_t g = 0; g < m; ++g) {
+      cv::parallel_for_(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
+      for (std::ptrdiff_t g = range.start; g < range.end; ++g) {
         const std::size_t i = group[static_cast<std::size_t>(g)];
         if (g + 1 < m) {
           // The voxels are in memory, not in a cache: fetch the next block's while this one runs.
@@ -637,6 +642,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         if (last)
           block.signs |= signs;
       }
+      }, std::max(1.0, static_cast<double>(m) / 16));
     }
   }
 }
