@@ -4,16 +4,22 @@
 // same narrowed by the interpolated LiDAR depth (stereo.prior_search_range), and with the
 // explicit left-right check. Times are of SgbmStereo::computeDisparity (matching,
 // conversion, confidence); cpu_ms_all_threads is the process CPU time per frame (all threads).
+// BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
+// SemiGlobalMatcher with its AVX2 and its AVX-512 kernel): per-core cost, steadier than wall
+// time on a machine shared with other work.
 //
 //   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 //   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
 #include <msf/io/sequence.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <benchmark/benchmark.h>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
 
 #include <cstdlib>
 #include <ctime>
@@ -90,7 +96,49 @@ void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state, const char* engine) {
   run(state, config, true, engine);
 }
 
+void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
+  const Data& d = data();
+  const std::string name = kernel;
+  const msf::SgbmConfig config;
+  msf::SemiGlobalMatcher::Params params;
+  params.num_disparities = config.num_disparities_px;
+  params.p1 = config.resolvedP1();
+  params.p2 = config.resolvedP2();
+  msf::SemiGlobalMatcher native(params);
+  const cv::Ptr<cv::StereoSGBM> opencv =
+      cv::StereoSGBM::create(0, params.num_disparities, params.block_size, params.p1, params.p2, params.disp12_max_diff,
+                             params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size,
+                             params.speckle_range, cv::StereoSGBM::MODE_SGBM_3WAY);
+  if (name != "opencv" && !msf::SemiGlobalMatcher::isAvailable()) {
+    state.SkipWithError("this CPU has no AVX2");
+    return;
+  }
+  msf::SemiGlobalMatcher::setAvx512Enabled(name == "avx512");
+  if (name == "avx512" && !msf::SemiGlobalMatcher::usesAvx512()) {
+    msf::SemiGlobalMatcher::setAvx512Enabled(true);
+    state.SkipWithError("this CPU has no AVX-512BW");
+    return;
+  }
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  cv::Mat disparity;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.left.size();
+    if (name == "opencv")
+      opencv->compute(d.left[f], d.right[f], disparity);
+    else
+      native.compute(d.left[f], d.right[f], disparity);
+  }
+  cv::setNumThreads(threads);
+  msf::SemiGlobalMatcher::setAvx512Enabled(true);
+}
+
 } // namespace
+
+BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2, "avx2")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512, "avx512")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
 
 // Each case's engines one after the other, so that both see the same machine load.
 BENCHMARK_CAPTURE(BM_Sgbm3Way128, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
