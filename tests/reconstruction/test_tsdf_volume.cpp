@@ -8,6 +8,7 @@
 
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
 #include <fstream>
 
 using namespace msf;
@@ -32,13 +33,39 @@ TEST(TsdfVolume, BlocksAreSparseAndBoundless) {
   EXPECT_EQ(&far, &volume.allocateBlock(GridIndex(-100000, 3, 250000)));
   EXPECT_EQ(volume.numBlocks(), 1u);
   EXPECT_GE(volume.memoryBytes(), sizeof(TsdfBlock));
-  const std::size_t one = volume.memoryBytes();
   volume.allocateBlock(GridIndex(1, 1, 1));
-  EXPECT_GT(volume.memoryBytes(), one);
+  EXPECT_GE(volume.memoryBytes(), 2 * sizeof(TsdfBlock));
   // Voxel -1 is in block -1, voxel -8 too, -9 in block -2.
   EXPECT_EQ(blockOf(GridIndex(-1, 0, 7)), GridIndex(-1, 0, 0));
   EXPECT_EQ(blockOf(GridIndex(-8, 8, -9)), GridIndex(-1, 1, -2));
   EXPECT_EQ(volume.voxelIndexOf(Eigen::Vector3d(-0.149, 0.151, 0.04)), GridIndex(-1, 2, 0));
+  EXPECT_EQ(volume.numObservedVoxels(), 0u);
+}
+
+TEST(TsdfVolume, BlocksKeepTheirAddressAndStartUnobservedAcrossStorageChunks) {
+  TsdfVolume volume(0.1, 0.3);
+  TsdfBlock* first = &volume.allocateBlock(GridIndex(0, 0, 0));
+  first->at(1, 2, 3).weight = 5.f;
+  std::vector<TsdfBlock*> seen;
+  for (int i = 0; i < 1000; ++i) // blocks are stored ~340 to a 2 MiB chunk: several chunks
+    seen.push_back(&volume.allocateBlock(GridIndex(i, -i, 7)));
+  EXPECT_EQ(volume.numBlocks(), 1001u);
+  EXPECT_EQ(volume.findBlock(GridIndex(0, 0, 0)), first);
+  EXPECT_FLOAT_EQ(first->at(1, 2, 3).weight, 5.f);
+  EXPECT_GE(volume.memoryBytes(), volume.numBlocks() * sizeof(TsdfBlock));
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(std::adjacent_find(seen.begin(), seen.end()), seen.end()); // no two blocks share storage
+  for (int i = 0; i < 1000; ++i)
+    ASSERT_EQ(volume.findBlock(GridIndex(i, -i, 7)), volume.blocks()[static_cast<std::size_t>(i) + 1]);
+
+  // Storage freed by clear() and used again holds fresh, unobserved blocks.
+  for (TsdfBlock* b : volume.blocks())
+    for (TsdfVoxel& v : b->voxels)
+      v.weight = 1.f;
+  volume.clear();
+  EXPECT_EQ(volume.numBlocks(), 0u);
+  for (int i = 0; i < 1000; ++i)
+    volume.allocateBlock(GridIndex(i, 0, 0));
   EXPECT_EQ(volume.numObservedVoxels(), 0u);
 }
 

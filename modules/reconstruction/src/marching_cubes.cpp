@@ -304,7 +304,7 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   std::vector<BlockMesh*> targets;
   for (const auto& block : volume.blocks())
     if (std::binary_search(dirty_keys.begin(), dirty_keys.end(), blockKey(block->index))) {
-      dirty.push_back(block.get());
+      dirty.push_back(block);
       targets.push_back(&cache_[block->index]);
     }
   const float min_weight = config_.min_weight;

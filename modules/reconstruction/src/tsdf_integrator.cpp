@@ -59,13 +59,17 @@ GridIndex unpackKey(std::uint64_t k) {
           static_cast<int>(static_cast<std::int64_t>(k & kMask) - kBias)};
 }
 
+/// floor(x) as an int, inline: without SSE4.1 (not in x86-64's baseline) std::floor is a call.
+inline int floorToInt(float x) {
+  const int i = static_cast<int>(x);
+  return i - (static_cast<float>(i) > x);
+}
+
 /// Amanatides-Woo traversal of the unit cells that the segment a -> b crosses.
 template <typename Visit>
 void traverseCells(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Visit&& visit) {
-  Eigen::Vector3i cell(static_cast<int>(std::floor(a.x())), static_cast<int>(std::floor(a.y())),
-                       static_cast<int>(std::floor(a.z())));
-  const Eigen::Vector3i end(static_cast<int>(std::floor(b.x())), static_cast<int>(std::floor(b.y())),
-                            static_cast<int>(std::floor(b.z())));
+  Eigen::Vector3i cell(floorToInt(a.x()), floorToInt(a.y()), floorToInt(a.z()));
+  const Eigen::Vector3i end(floorToInt(b.x()), floorToInt(b.y()), floorToInt(b.z()));
   const Eigen::Vector3f d = b - a;
   Eigen::Vector3i step;
   Eigen::Vector3f t_max, t_delta;
@@ -228,12 +232,16 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       const float* depth = frame.depth.ptr<float>(v);
       float* t_min = &tile_min_[static_cast<std::size_t>(ty) * tiles_x];
       float* t_max = &tile_max_[static_cast<std::size_t>(ty) * tiles_x];
-      for (int u = 0; u < width; ++u) {
-        const float d = depth[u];
-        if (d >= min_d && d <= max_d) {
-          t_min[u / kTile] = std::min(t_min[u / kTile], d);
-          t_max[u / kTile] = std::max(t_max[u / kTile], d);
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const float* tile = depth + tx * kTile;
+        float lo = t_min[tx], hi = t_max[tx];
+        for (int k = 0, n = std::min(kTile, width - tx * kTile); k < n; ++k) {
+          const bool valid = tile[k] >= min_d && tile[k] <= max_d; // without branches: holes are unpredictable
+          lo = std::min(lo, valid ? tile[k] : std::numeric_limits<float>::infinity());
+          hi = std::max(hi, valid ? tile[k] : -std::numeric_limits<float>::infinity());
         }
+        t_min[tx] = lo;
+        t_max[tx] = hi;
       }
       if (v % stride)
         continue;
@@ -244,7 +252,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
         const float z0 = std::max(d - trunc, min_d), z1 = d + trunc;
         traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
-          const GridIndex b(floorDiv(c.x(), 2), floorDiv(c.y(), 2), floorDiv(c.z(), 2));
+          const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
           const std::uint64_t k =
               (packKey(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
           // Neighbouring pixels cross the same few sub-blocks: skip keys seen just before.
@@ -296,7 +304,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
       const float d = frame.depth.at<float>(vi, ui);
       if (!(d > 0.f) || c.z() - radius < d) {
-        blocks.push_back(block.get());
+        blocks.push_back(block);
         masks.push_back(0xff);
       }
     }
@@ -354,8 +362,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           const float ru = fx * inv * (1.f + std::abs(c.x() / c.z())) + 1.f;
           const float rv = fy * inv * (1.f + std::abs(c.y() / c.z())) + 1.f;
           const float uc = fx * c.x() / c.z() + cx, vc = fy * c.y() / c.z() + cy;
-          const int u0 = std::max(0, static_cast<int>(std::floor(uc - ru))), u1 = std::min(width - 1, static_cast<int>(uc + ru));
-          const int v0 = std::max(0, static_cast<int>(std::floor(vc - rv))), v1 = std::min(height - 1, static_cast<int>(vc + rv));
+          const int u0 = std::max(0, floorToInt(uc - ru)), u1 = std::min(width - 1, static_cast<int>(uc + ru));
+          const int v0 = std::max(0, floorToInt(vc - rv)), v1 = std::min(height - 1, static_cast<int>(vc + rv));
           if (u0 > u1 || v0 > v1)
             continue; // outside the image
           const int tx0 = u0 / kTile, tx1 = u1 / kTile, ty0 = v0 / kTile, ty1 = v1 / kTile;

@@ -6,7 +6,14 @@
 
 #include <pcl/io/pcd_io.h>
 
+#if __has_include(<sys/mman.h>)
+#include <sys/mman.h> // madvise
+#endif
+
 #include <atomic>
+#include <cstdlib>
+#include <new>
+#include <type_traits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +38,11 @@ std::string number(double v) {
 }
 
 constexpr const char* kHeaderTag = "# msfusion tsdf";
+
+// TsdfBlock is trivially destructible: a chunk is freed without destroying its blocks.
+static_assert(std::is_trivially_destructible_v<TsdfBlock>);
+constexpr std::size_t kChunkBytes = std::size_t(2) << 20; // a huge page on x86-64
+constexpr std::size_t kBlocksPerChunk = kChunkBytes / sizeof(TsdfBlock);
 } // namespace
 
 void TsdfVolume::Config::read(const cv::FileNode& node) {
@@ -64,7 +76,7 @@ std::size_t TsdfVolume::numObservedVoxels() const {
 
 std::size_t TsdfVolume::memoryBytes() const {
   // Blocks, the pointer vector, and the map's buckets and nodes (key, value, next, hash).
-  return blocks_.size() * sizeof(TsdfBlock) + blocks_.capacity() * sizeof(void*) + table_.capacity() * sizeof(Slot);
+  return chunks_.size() * kChunkBytes + blocks_.capacity() * sizeof(void*) + table_.capacity() * sizeof(Slot);
 }
 
 std::size_t TsdfVolume::slotOf(const GridIndex& index) const {
@@ -93,7 +105,7 @@ TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) {
   if (table_.empty())
     return nullptr;
   const Slot& slot = table_[slotOf(index)];
-  return slot.block >= 0 ? blocks_[static_cast<std::size_t>(slot.block)].get() : nullptr;
+  return slot.block >= 0 ? blocks_[static_cast<std::size_t>(slot.block)] : nullptr;
 }
 
 const TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) const {
@@ -107,11 +119,24 @@ TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
   if (slot.block < 0) {
     slot.key = index;
     slot.block = static_cast<std::int32_t>(blocks_.size());
-    blocks_.push_back(std::make_unique<TsdfBlock>());
-    blocks_.back()->index = index;
+    if (chunks_.empty() || chunk_used_ == kBlocksPerChunk) {
+      void* chunk = std::aligned_alloc(kChunkBytes, kChunkBytes);
+      if (!chunk)
+        throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+      madvise(chunk, kChunkBytes, MADV_HUGEPAGE); // a hint: without it the chunk has 4 KiB pages
+#endif
+      chunks_.emplace_back(chunk);
+      chunk_used_ = 0;
+    }
+    auto* block = new (static_cast<char*>(chunks_.back().get()) + chunk_used_++ * sizeof(TsdfBlock)) TsdfBlock();
+    block->index = index;
+    blocks_.push_back(block);
   }
   return *blocks_[static_cast<std::size_t>(slot.block)];
 }
+
+void TsdfVolume::ChunkFree::operator()(void* chunk) const noexcept { std::free(chunk); }
 
 const TsdfVoxel* TsdfVolume::findVoxel(const GridIndex& v) const {
   const GridIndex b = blockOf(v);
@@ -131,6 +156,8 @@ void TsdfVolume::clear() {
   table_.clear();
   mask_ = 0;
   blocks_.clear();
+  chunks_.clear();
+  chunk_used_ = 0;
   id_ = newVolumeId();
 }
 

@@ -53,7 +53,7 @@ public:
   /// The block at `index`, allocated (all voxels unobserved) when absent. Not thread-safe.
   TsdfBlock& allocateBlock(const GridIndex& index);
   /// Every allocated block, in allocation order (stable addresses).
-  const std::vector<std::unique_ptr<TsdfBlock>>& blocks() const { return blocks_; }
+  const std::vector<TsdfBlock*>& blocks() const { return blocks_; }
 
   /// The voxel with global index v, or nullptr when its block is not allocated.
   const TsdfVoxel* findVoxel(const GridIndex& v) const;
@@ -104,7 +104,15 @@ private:
 
   std::vector<Slot> table_;
   std::size_t mask_ = 0;
-  std::vector<std::unique_ptr<TsdfBlock>> blocks_;
+  /// Blocks live in chunks of 2 MiB (on huge pages where the system allows): a frame touches
+  /// thousands of blocks across the map, and with one allocation per block each cost a page
+  /// fault and a TLB miss of its own.
+  struct ChunkFree {
+    void operator()(void* chunk) const noexcept;
+  };
+  std::vector<std::unique_ptr<void, ChunkFree>> chunks_;
+  std::size_t chunk_used_ = 0; ///< blocks placed in the last chunk
+  std::vector<TsdfBlock*> blocks_;
 };
 
 } // namespace msf
