@@ -8,8 +8,8 @@ namespace msf {
 
 /// Semi-global block matching of our own, vectorised with AVX2 (and AVX-512BW where the CPU
 /// has it): the algorithm of OpenCV's StereoSGBM in MODE_SGBM_3WAY with the same parameters
-/// and output, about twice as fast per core as the Debian build of OpenCV 4.6 (whose SGBM is
-/// compiled for SSE2 only).
+/// and output, 2.2x (AVX2) to 3x (AVX-512) as fast per core as the Debian build of OpenCV 4.6
+/// (whose SGBM is compiled for SSE2 only) on a KITTI frame at 128 disparities.
 ///
 /// Cost: Birchfield-Tomasi dissimilarity of the Sobel-x prefiltered images (clipped at
 /// pre_filter_cap) plus a quarter of that of the raw images, summed over block_size^2;

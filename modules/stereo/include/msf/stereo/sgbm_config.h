@@ -12,9 +12,9 @@ namespace msf {
 /// Defaults: OpenCV's 3-way SGBM on 128 disparities with 5x5 blocks (the setting of the
 /// DESIGN's measured baseline), narrowed by a LiDAR depth prior when one is given.
 struct SgbmConfig {
-  /// native: our AVX2 matcher (SemiGlobalMatcher), the same algorithm and parameters as
-  /// OpenCV's 3-way SGBM, ~3x faster; on a CPU without AVX2, or for the other modes, it
-  /// falls back to OpenCV with a one-time note. opencv: cv::StereoSGBM.
+  /// native: our AVX2 / AVX-512 matcher (SemiGlobalMatcher), the same algorithm and
+  /// parameters as OpenCV's 3-way SGBM, 2-3x faster per core; on a CPU without AVX2, or for
+  /// the other modes, it falls back to OpenCV with a one-time note. opencv: cv::StereoSGBM.
   std::string engine = "native";
   std::string mode = "sgbm_3way";  ///< sgbm_3way | sgbm (5 paths) | hh (8 paths) | hh4
   int min_disparity_px = 0;
