@@ -117,7 +117,7 @@ const std::vector<MethodEntry>& methodTable() {
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicFast); }},
       {"ipbasic_multiscale", "IP-Basic multiscale, same projection",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicMultiscale); }},
-      {"sgbm", "OpenCV SGBM on the grey pair (section stereo), no LiDAR",
+      {"sgbm", "3-way SGBM on the grey pair (section stereo, stereo.engine), no LiDAR",
        [](const msf::ConfigFile& f) { return stereo(f, false); }},
       {"sgbm_prior", "the same, its search narrowed by the interpolated input rings",
        [](const msf::ConfigFile& f) { return stereo(f, true); }},

@@ -1,4 +1,4 @@
-// Paper step 3: OpenCV SGBM on a rectified grey pair to an organized cloud in camera 0
+// Paper step 3: 3-way SGBM on a rectified grey pair to an organized cloud in camera 0
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
 #include <msf/common/atomic_file.h>
@@ -27,8 +27,9 @@ namespace {
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <left.png> <right.png> <out.pcd> -calib PATH [options]\n", name);
-  print_info("  Matches a rectified pair (KITTI image_0, image_1) with OpenCV's StereoSGBM and writes the\n"
-             "  organized cloud of camera 0 (fields x y z rgb confidence; NaN where there is no match).\n");
+  print_info("  Matches a rectified pair (KITTI image_0, image_1) with 3-way SGBM (stereo.engine: the native\n"
+             "  AVX2 kernel or OpenCV's StereoSGBM) and writes the organized cloud of camera 0\n"
+             "  (fields x y z rgb confidence; NaN where there is no match).\n");
   print_info("  where options are:\n");
   print_info("    -calib PATH            KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
   print_info("    -color PATH            colour camera image (image_2), projected for each point's colour;\n");
