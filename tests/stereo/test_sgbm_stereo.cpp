@@ -223,6 +223,13 @@ TEST(StereoConfidence, HandMadeDisparity) {
   // Within 2 columns of the step, the local range is 6 px: 4 px over the free 2 px.
   EXPECT_NEAR(c.at<float>(0, 29), (1.f - std::exp(-29.f / 15.f)) * std::exp(-2.f), 1e-5f);
   EXPECT_NEAR(c.at<float>(0, 27), 1.f - std::exp(-27.f / 15.f), 1e-5f);
+  // Hole distances beyond the hole term's table (1024 px).
+  cv::Mat wide(1, 2100, CV_32FC1, cv::Scalar(20.f));
+  wide.at<float>(0, 0) = 0.f;
+  config.hole_distance_px = 1000.f;
+  const cv::Mat cw = msf::stereoConfidence(wide, config);
+  EXPECT_NEAR(cw.at<float>(0, 1000), 1.f - std::exp(-1.f), 1e-5f);
+  EXPECT_NEAR(cw.at<float>(0, 1500), 1.f - std::exp(-1.5f), 1e-5f);
   config.range_window_px = 4;
   EXPECT_THROW(msf::stereoConfidence(d, config), msf::ConfigError);
   EXPECT_THROW(msf::stereoConfidence(cv::Mat(3, 3, CV_8UC1), {}), msf::InvalidInputError);

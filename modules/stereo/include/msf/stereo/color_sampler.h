@@ -45,6 +45,12 @@ public:
     return true;
   }
 
+  /// Row `v` of a depth image of camera 0 with intrinsics `camera`: each pixel with a depth
+  /// (z > 0) that the colour camera sees gets its colour in `bgr` (3 bytes a pixel); the
+  /// others are left as they were. The colours sample() finds (up to rounding at pixel
+  /// borders), a row at a time.
+  void sampleRow(const float* z, int cols, int v, const PinholeCamera& camera, std::uint8_t* bgr) const;
+
 private:
   cv::Mat image_;
   float P_[12] = {};
