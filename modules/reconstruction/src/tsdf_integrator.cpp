@@ -42,7 +42,13 @@ struct Candidate {
 };
 
 /// Bit k set when lane k is true (-1).
-inline int laneMask(Int4 m) { return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8); }
+inline int laneMask(Int4 m) {
+#ifdef __SSE__
+  return __builtin_ia32_movmskps(reinterpret_cast<Float4>(m)); // one instruction
+#else
+  return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
+#endif
+}
 
 // 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
 std::uint64_t packKey(const Eigen::Vector3i& b) {
@@ -264,6 +270,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         });
       }
     }
+    // Sorted here, in parallel, so that the merged list is shorter and partly in order.
+    std::sort(local.begin(), local.end());
+    local.erase(std::unique(local.begin(), local.end()), local.end());
     const std::lock_guard<std::mutex> lock(keys_mutex);
     keys.insert(keys.end(), local.begin(), local.end());
   });
