@@ -69,6 +69,31 @@ TEST(TsdfVolume, BlocksKeepTheirAddressAndStartUnobservedAcrossStorageChunks) {
   EXPECT_EQ(volume.numObservedVoxels(), 0u);
 }
 
+TEST(TsdfVolume, AllocatingManyBlocksAtOnceEqualsOneAtATime) {
+  TsdfVolume one(0.1, 0.3), many(0.1, 0.3);
+  std::vector<GridIndex> indices;
+  for (int i = 0; i < 900; ++i)
+    indices.emplace_back(i % 30, -(i / 30), i % 7);
+  indices.push_back(indices[5]); // a repeated index gives the same block
+  one.allocateBlock(indices[10]).at(0, 0, 0).weight = 2.f; // an existing block is kept
+  many.allocateBlock(indices[10]).at(0, 0, 0).weight = 2.f;
+  std::vector<TsdfBlock*> blocks;
+  many.allocateBlocks(indices, blocks);
+  for (const GridIndex& index : indices)
+    one.allocateBlock(index);
+  ASSERT_EQ(blocks.size(), indices.size());
+  EXPECT_EQ(many.numBlocks(), one.numBlocks());
+  EXPECT_EQ(blocks.back(), blocks[5]);
+  EXPECT_FLOAT_EQ(blocks[10]->at(0, 0, 0).weight, 2.f);
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    ASSERT_EQ(blocks[i], many.findBlock(indices[i]));
+    ASSERT_EQ(blocks[i]->index, indices[i]);
+    ASSERT_EQ(many.blocks()[i < 900 ? i : 5]->index, one.blocks()[i < 900 ? i : 5]->index); // the same order
+  }
+  EXPECT_EQ(many.numObservedVoxels(), 1u);
+  EXPECT_GE(many.memoryBytes(), many.numBlocks() * sizeof(TsdfBlock));
+}
+
 TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
   const AnalyticScene scene = test::makeScene(test::SceneKind::Sphere);
   TsdfVolume volume(0.04, 0.12);

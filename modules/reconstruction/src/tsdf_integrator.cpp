@@ -76,6 +76,13 @@ template <typename Visit>
 void traverseCells(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Visit&& visit) {
   Eigen::Vector3i cell(floorToInt(a.x()), floorToInt(a.y()), floorToInt(a.z()));
   const Eigen::Vector3i end(floorToInt(b.x()), floorToInt(b.y()), floorToInt(b.z()));
+  if ((end - cell).cwiseAbs().sum() <= 1) {
+    // In one cell, or in two that share a face (a box, convex): the segment crosses those.
+    visit(cell);
+    if (end != cell)
+      visit(end);
+    return;
+  }
   const Eigen::Vector3f d = b - a;
   Eigen::Vector3i step;
   Eigen::Vector3f t_max, t_delta;
@@ -279,15 +286,17 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   const std::size_t blocks_before = volume_.numBlocks();
-  std::vector<TsdfBlock*> blocks;
+  std::vector<GridIndex> block_indices;
   std::vector<std::uint8_t> masks; // sub-blocks to project, bit x | y << 1 | z << 2
-  for (const std::uint64_t k : keys) {
-    if (blocks.empty() || (k >> 3) != (packKey(blocks.back()->index))) {
-      blocks.push_back(&volume_.allocateBlock(unpackKey(k >> 3)));
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == 0 || (keys[i] >> 3) != (keys[i - 1] >> 3)) {
+      block_indices.push_back(unpackKey(keys[i] >> 3));
       masks.push_back(0);
     }
-    masks.back() |= static_cast<std::uint8_t>(1u << (k & 7));
+    masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
   }
+  std::vector<TsdfBlock*> blocks;
+  volume_.allocateBlocks(block_indices, blocks);
   stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
 
   if (config_.space_carving) {

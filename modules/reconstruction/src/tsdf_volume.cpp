@@ -4,23 +4,25 @@
 #include <msf/io/impl/cloud_io.hpp>
 #include <msf/reconstruction/tsdf_volume.h>
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/io/pcd_io.h>
 
 #if __has_include(<sys/mman.h>)
 #include <sys/mman.h> // madvise
 #endif
 
+#include <algorithm>
 #include <atomic>
-#include <cstdlib>
-#include <new>
-#include <type_traits>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <ostream>
 #include <sstream>
+#include <type_traits>
 
 namespace msf {
 
@@ -91,14 +93,33 @@ std::size_t TsdfVolume::slotOf(const GridIndex& index) const {
 }
 
 void TsdfVolume::grow() {
-  const std::size_t capacity = table_.empty() ? 1024 : 2 * table_.size();
+  // Rehashed from the slots themselves: blocks being allocated may not be constructed yet.
+  std::vector<Slot> old = std::move(table_);
+  const std::size_t capacity = old.empty() ? 1024 : 2 * old.size();
   table_.assign(capacity, Slot());
   mask_ = capacity - 1;
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    Slot& slot = table_[slotOf(blocks_[b]->index)];
-    slot.key = blocks_[b]->index;
-    slot.block = static_cast<std::int32_t>(b);
+  for (const Slot& slot : old)
+    if (slot.block >= 0)
+      table_[slotOf(slot.key)] = slot;
+}
+
+void TsdfVolume::reserve(std::size_t blocks) {
+  while (2 * blocks > table_.size())
+    grow();
+  while (chunks_.size() * kBlocksPerChunk < blocks) {
+    void* chunk = std::aligned_alloc(kChunkBytes, kChunkBytes);
+    if (!chunk)
+      throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+    madvise(chunk, kChunkBytes, MADV_HUGEPAGE); // a hint: without it the chunk has 4 KiB pages
+#endif
+    chunks_.emplace_back(chunk);
   }
+  blocks_.reserve(blocks);
+}
+
+void* TsdfVolume::storage(std::size_t block) const {
+  return static_cast<char*>(chunks_[block / kBlocksPerChunk].get()) + (block % kBlocksPerChunk) * sizeof(TsdfBlock);
 }
 
 TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) {
@@ -113,27 +134,49 @@ const TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) const {
 }
 
 TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
-  if (2 * (blocks_.size() + 1) > table_.size())
-    grow();
+  reserve(blocks_.size() + 1); // may throw: before anything changes
   Slot& slot = table_[slotOf(index)];
   if (slot.block < 0) {
     slot.key = index;
     slot.block = static_cast<std::int32_t>(blocks_.size());
-    if (chunks_.empty() || chunk_used_ == kBlocksPerChunk) {
-      void* chunk = std::aligned_alloc(kChunkBytes, kChunkBytes);
-      if (!chunk)
-        throw std::bad_alloc();
-#ifdef MADV_HUGEPAGE
-      madvise(chunk, kChunkBytes, MADV_HUGEPAGE); // a hint: without it the chunk has 4 KiB pages
-#endif
-      chunks_.emplace_back(chunk);
-      chunk_used_ = 0;
-    }
-    auto* block = new (static_cast<char*>(chunks_.back().get()) + chunk_used_++ * sizeof(TsdfBlock)) TsdfBlock();
+    auto* block = new (storage(blocks_.size())) TsdfBlock();
     block->index = index;
     blocks_.push_back(block);
   }
   return *blocks_[static_cast<std::size_t>(slot.block)];
+}
+
+void TsdfVolume::allocateBlocks(const std::vector<GridIndex>& indices, std::vector<TsdfBlock*>& blocks) {
+  std::size_t missing = 0;
+  for (const GridIndex& index : indices)
+    missing += findBlock(index) == nullptr;
+  reserve(blocks_.size() + missing); // may throw: before anything changes
+  // Serially into the map; the new blocks are constructed (6 KiB of zeros each, and the
+  // first touch of their pages) afterwards, in parallel.
+  std::vector<std::int32_t> position(indices.size());
+  std::vector<std::size_t> fresh; // positions in indices
+  const std::size_t before = blocks_.size();
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    Slot& slot = table_[slotOf(indices[i])];
+    if (slot.block < 0) {
+      slot.key = indices[i];
+      slot.block = static_cast<std::int32_t>(blocks_.size());
+      blocks_.push_back(nullptr);
+      fresh.push_back(i);
+    }
+    position[i] = slot.block;
+  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(fresh.size())), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      const std::size_t b = before + static_cast<std::size_t>(k);
+      auto* block = new (storage(b)) TsdfBlock();
+      block->index = indices[fresh[static_cast<std::size_t>(k)]];
+      blocks_[b] = block;
+    }
+  }, std::max(1.0, static_cast<double>(fresh.size()) / 64));
+  blocks.resize(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    blocks[i] = blocks_[static_cast<std::size_t>(position[i])];
 }
 
 void TsdfVolume::ChunkFree::operator()(void* chunk) const noexcept { std::free(chunk); }
@@ -157,7 +200,6 @@ void TsdfVolume::clear() {
   mask_ = 0;
   blocks_.clear();
   chunks_.clear();
-  chunk_used_ = 0;
   id_ = newVolumeId();
 }
 

@@ -24,7 +24,11 @@ namespace msf {
 /// Organized input (a depth image as an organized cloud or a DepthFrame) is integrated
 /// voxel-centric: the blocks, and their 4^3 sub-blocks, that the truncation band of each
 /// pixel's ray crosses are found in parallel and allocated serially (once per block); then
-/// the voxels of those sub-blocks are projected into the image, in parallel over blocks.
+/// the voxels of those sub-blocks are projected into the image, in parallel over blocks: a
+/// row of 4 voxels at a time in SIMD lanes against its nearest pixels, and the voxels that
+/// pass are updated after the whole block is tested, their memory prefetched meanwhile.
+/// Threads come from cv::parallel_for_ (TBB), the pool the stereo and fusion stages use, so
+/// that in the pipeline integration and SGBM share the cores instead of oversubscribing them.
 /// An unorganized scan (a raw LiDAR sweep) is integrated by walking each point's ray from its
 /// sensor origin, as VDBFusion does.
 ///

@@ -15,7 +15,8 @@
 namespace msf {
 
 /// A sparse, boundless truncated signed distance volume (Curless and Levoy): blocks of 8^3
-/// voxels allocated on demand in a hash map, as Voxblox's Layer and VDBFusion's VDBVolume.
+/// voxels allocated on demand in a hash map, as Voxblox's Layer and VDBFusion's VDBVolume
+/// (stored ~340 to a 2 MiB chunk, so memoryBytes() grows in steps of 2 MiB).
 /// Voxel v (integer grid coordinates) has its centre at v * voxelSize(), so the marching
 /// cubes grid is the voxel centres.
 ///
@@ -52,6 +53,9 @@ public:
   const TsdfBlock* findBlock(const GridIndex& index) const;
   /// The block at `index`, allocated (all voxels unobserved) when absent. Not thread-safe.
   TsdfBlock& allocateBlock(const GridIndex& index);
+  /// allocateBlock for each index, the new blocks constructed in parallel: `blocks[i]` is
+  /// the block at `indices[i]`. Not thread-safe (it runs its own threads).
+  void allocateBlocks(const std::vector<GridIndex>& indices, std::vector<TsdfBlock*>& blocks);
   /// Every allocated block, in allocation order (stable addresses).
   const std::vector<TsdfBlock*>& blocks() const { return blocks_; }
 
@@ -101,6 +105,10 @@ private:
   };
   std::size_t slotOf(const GridIndex& index) const;
   void grow();
+  /// Room in the map and in the chunks for `blocks` blocks in all.
+  void reserve(std::size_t blocks);
+  /// Where block number `block` (position in blocks_) lives.
+  void* storage(std::size_t block) const;
 
   std::vector<Slot> table_;
   std::size_t mask_ = 0;
@@ -110,8 +118,7 @@ private:
   struct ChunkFree {
     void operator()(void* chunk) const noexcept;
   };
-  std::vector<std::unique_ptr<void, ChunkFree>> chunks_;
-  std::size_t chunk_used_ = 0; ///< blocks placed in the last chunk
+  std::vector<std::unique_ptr<void, ChunkFree>> chunks_; ///< block b is in chunk b / (blocks per chunk)
   std::vector<TsdfBlock*> blocks_;
 };
 
