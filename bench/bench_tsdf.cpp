@@ -1,7 +1,7 @@
 // TSDF integration and meshing on KITTI odometry 04 frames 0-9 (SGBM depth, 0.1 m voxels,
 // 0.3 m truncation), side by side with Open3D 0.16's ScalableTSDFVolume on the very same
 // depth images and poses (bench/open3d_tsdf.py, run by this program when Debian's
-// python3-open3d is installed).
+// python3-open3d is installed): once with every core for both, once with one thread each.
 //
 //   bench_tsdf [--benchmark_repetitions=5]   (MSF_KITTI_DIR overrides the compiled-in path,
 //                                             MSF_OPEN3D_PYTHON the interpreter, default /usr/bin/python3)
@@ -16,6 +16,7 @@
 
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
@@ -245,12 +246,15 @@ Ours measureOurs(int repetitions) {
   return ours;
 }
 
-std::map<std::string, double> runOpen3d(int repetitions) {
+/// `threads` 0 = Open3D's default (every core).
+std::map<std::string, double> runOpen3d(int repetitions, int threads) {
   const char* env = std::getenv("MSF_OPEN3D_PYTHON");
   const std::string python = env ? env : "/usr/bin/python3";
   const std::string script = (fs::path(__FILE__).parent_path() / "open3d_tsdf.py").string();
   const std::string out = data().dir + "/open3d.json";
   std::ostringstream cmd;
+  if (threads > 0)
+    cmd << "OMP_NUM_THREADS=" << threads << " ";
   cmd << python << " " << script << " " << data().dir << " --voxel " << kVoxel << " --trunc " << kTrunc
       << " --max-depth " << kMaxDepth << " --repetitions " << repetitions << " > " << out;
   std::map<std::string, double> result;
@@ -280,37 +284,44 @@ int main(int argc, char** argv) {
   data(); // SGBM once, before any timing
   benchmark::RunSpecifiedBenchmarks();
 
+  // Both with every core (2 here), then both on one thread: the CPU time per frame is what
+  // integration takes from the other stages when they share the cores (the pipeline).
   constexpr int kRepetitions = 5;
-  const Ours ours = measureOurs(kRepetitions);
-  const auto o3d = runOpen3d(kRepetitions);
-  std::printf("\nSide by side: KITTI odometry 04 frames 0-%d, SGBM depth (3-way, 128 disparities, block 5), "
-              "%.1f m voxels, %.1f m truncation, depth <= %.0f m;\nmedians of %d runs, wall time and process CPU "
-              "time over all threads (the 2 cores may be shared: CPU time is the steadier figure).\n\n",
-              kFrames - 1, kVoxel, kTrunc, kMaxDepth, kRepetitions);
-  std::printf("  %-38s %10s %10s %12s %12s\n", "", "wall ms", "CPU ms", "Open3D wall", "Open3D CPU");
-  const bool have = o3d.count("integrate_ms_per_frame") && o3d.count("extract_ms") &&
-                    o3d.count("integrate_cpu_ms_per_frame") && o3d.count("extract_cpu_ms");
-  auto row = [&](const char* name, const Timing& t, const char* key_wall, const char* key_cpu) {
-    std::printf("  %-38s %10.1f %10.1f", name, t.medianWall(), t.medianCpu());
-    if (have && key_wall)
-      std::printf(" %12.1f %12.1f   -> %.1fx (wall), %.1fx (CPU) faster", o3d.at(key_wall), o3d.at(key_cpu),
-                  o3d.at(key_wall) / t.medianWall(), o3d.at(key_cpu) / t.medianCpu());
+  const int cores = cv::getNumThreads();
+  for (const int threads : {cores, 1}) {
+    cv::setNumThreads(threads);
+    const Ours ours = measureOurs(kRepetitions);
+    const auto o3d = runOpen3d(kRepetitions, threads == cores ? 0 : threads);
+    std::printf("\nSide by side, %d thread%s: KITTI odometry 04 frames 0-%d, SGBM depth (3-way, 128 disparities, block 5), "
+                "%.1f m voxels, %.1f m truncation, depth <= %.0f m;\nmedians of %d runs, wall time and process CPU "
+                "time over all threads (the cores may be shared: CPU time is the steadier figure).\n\n",
+                threads, threads == 1 ? "" : "s", kFrames - 1, kVoxel, kTrunc, kMaxDepth, kRepetitions);
+    std::printf("  %-38s %10s %10s %12s %12s\n", "", "wall ms", "CPU ms", "Open3D wall", "Open3D CPU");
+    const bool have = o3d.count("integrate_ms_per_frame") && o3d.count("extract_ms") &&
+                      o3d.count("integrate_cpu_ms_per_frame") && o3d.count("extract_cpu_ms");
+    auto row = [&](const char* name, const Timing& t, const char* key_wall, const char* key_cpu) {
+      std::printf("  %-38s %10.1f %10.1f", name, t.medianWall(), t.medianCpu());
+      if (have && key_wall)
+        std::printf(" %12.1f %12.1f   -> %.1fx (wall), %.1fx (CPU) faster", o3d.at(key_wall), o3d.at(key_cpu),
+                    o3d.at(key_wall) / t.medianWall(), o3d.at(key_cpu) / t.medianCpu());
+      std::printf("\n");
+    };
+    row("integrate per frame, lambda 0", ours.integrate0, "integrate_ms_per_frame", "integrate_cpu_ms_per_frame");
+    row("integrate per frame, lambda 5", ours.integrate5, nullptr, nullptr);
+    row("mesh, 10-frame map (TriangleMesh)", ours.mesh, "extract_ms", "extract_cpu_ms");
+    row("mesh, 10-frame map (pcl::PolygonMesh)", ours.polygon_mesh, "extract_ms", "extract_cpu_ms");
+    std::printf("  lambda 5 / lambda 0 integration: %.2fx (wall), %.2fx (CPU)\n",
+                ours.integrate5.medianWall() / ours.integrate0.medianWall(),
+                ours.integrate5.medianCpu() / ours.integrate0.medianCpu());
+    std::printf("  mesh size: msfusion %zu vertices, %zu triangles", ours.vertices, ours.triangles);
+    if (have)
+      std::printf("; Open3D %.0f vertices, %.0f triangles", o3d.count("vertices") ? o3d.at("vertices") : 0.0,
+                  o3d.count("triangles") ? o3d.at("triangles") : 0.0);
     std::printf("\n");
-  };
-  row("integrate per frame, lambda 0", ours.integrate0, "integrate_ms_per_frame", "integrate_cpu_ms_per_frame");
-  row("integrate per frame, lambda 5", ours.integrate5, nullptr, nullptr);
-  row("mesh, 10-frame map (TriangleMesh)", ours.mesh, "extract_ms", "extract_cpu_ms");
-  row("mesh, 10-frame map (pcl::PolygonMesh)", ours.polygon_mesh, "extract_ms", "extract_cpu_ms");
-  std::printf("  lambda 5 / lambda 0 integration: %.2fx (wall), %.2fx (CPU)\n",
-              ours.integrate5.medianWall() / ours.integrate0.medianWall(),
-              ours.integrate5.medianCpu() / ours.integrate0.medianCpu());
-  std::printf("  mesh size: msfusion %zu vertices, %zu triangles", ours.vertices, ours.triangles);
-  if (have)
-    std::printf("; Open3D %.0f vertices, %.0f triangles", o3d.count("vertices") ? o3d.at("vertices") : 0.0,
-                o3d.count("triangles") ? o3d.at("triangles") : 0.0);
-  std::printf("\n");
-  if (!have)
-    std::printf("  Open3D: not run (needs Debian's python3-open3d and python3-numpy: make deps-bench)\n");
+    if (!have)
+      std::printf("  Open3D: not run (needs Debian's python3-open3d and python3-numpy: make deps-bench)\n");
+  }
+  cv::setNumThreads(cores);
   benchmark::Shutdown();
   return 0;
 }

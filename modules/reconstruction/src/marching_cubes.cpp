@@ -212,31 +212,36 @@ public:
     std::size_t cap = 16;
     while (cap < 2 * expected)
       cap <<= 1;
-    keys_.assign(cap, MarchingCubes::kInterior);
-    values_.resize(cap);
+    table_.assign(cap, Entry{MarchingCubes::kInterior, 0});
     mask_ = cap - 1;
   }
   /// The index stored for `key`, or `value` after storing it.
   std::uint32_t findOrInsert(std::uint64_t key, std::uint32_t value, bool& inserted) {
-    std::size_t h = (key * 0x9E3779B97F4A7C15ull) >> 20 & mask_;
-    while (true) {
-      if (keys_[h] == key) {
+    for (std::size_t h = slot(key);; h = (h + 1) & mask_) {
+      Entry& e = table_[h];
+      if (e.key == key) {
         inserted = false;
-        return values_[h];
+        return e.value;
       }
-      if (keys_[h] == MarchingCubes::kInterior) {
-        keys_[h] = key;
-        values_[h] = value;
+      if (e.key == MarchingCubes::kInterior) {
+        e = {key, value};
         inserted = true;
         return value;
       }
-      h = (h + 1) & mask_;
     }
   }
+  /// The table is larger than the caches and the keys are spread over it: fetching a key's
+  /// slot a few keys ahead hides most of the wait.
+  void prefetch(std::uint64_t key) const { __builtin_prefetch(&table_[slot(key)]); }
 
 private:
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::uint32_t> values_;
+  struct Entry {
+    std::uint64_t key;
+    std::uint32_t value;
+  };
+  std::size_t slot(std::uint64_t key) const { return (key * 0x9E3779B97F4A7C15ull) >> 20 & mask_; }
+
+  std::vector<Entry> table_;
   std::size_t mask_;
 };
 
@@ -348,6 +353,9 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     const BlockMesh& part = *order[i].second;
     std::size_t interior = 0;
     for (std::size_t v = 0; v < part.keys.size(); ++v) {
+      constexpr std::size_t kAhead = 8;
+      if (v + kAhead < part.keys.size() && part.keys[v + kAhead] != kInterior)
+        shared.prefetch(part.keys[v + kAhead]);
       if (part.keys[v] == kInterior) {
         ++interior;
         continue;
