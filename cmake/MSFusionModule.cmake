@@ -90,7 +90,9 @@ function(msf_add_test name)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
-    PROPERTIES ENVIRONMENT "MSF_KITTI_DIR=${MSF_KITTI_DIR};MSF_BIN_DIR=${PROJECT_BINARY_DIR}/bin;MSF_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+    # One variable only: gtest_discover_tests keeps only the first item of a list here. The
+    # tests know the source and bin folders from test_support's compile definitions.
+    PROPERTIES ENVIRONMENT "MSF_KITTI_DIR=${MSF_KITTI_DIR}"
                LABELS "${ARG_LABELS}"
     DISCOVERY_TIMEOUT 60)
 endfunction()

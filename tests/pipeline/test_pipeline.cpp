@@ -228,10 +228,8 @@ TEST(Reconstruct, BadInputIsAClearError) {
 }
 
 TEST(PipelineConfig, ShippedFilesLoadAndBadSchedulingKeysAreNamed) {
-  const char* source = std::getenv("MSF_SOURCE_DIR");
-  ASSERT_NE(source, nullptr) << "MSF_SOURCE_DIR is set by ctest";
   for (const char* name : {"kitti.yaml", "synthetic.yaml"}) {
-    const msf::PipelineConfig config = msf::PipelineConfig::load(std::string(source) + "/config/" + name);
+    const msf::PipelineConfig config = msf::PipelineConfig::load(msf::test::sourceDir() + "/config/" + name);
     EXPECT_EQ(config.scheduling.lidar_threads, 1) << name;
     EXPECT_TRUE(config.scheduling.stereo_prior) << name;
   }

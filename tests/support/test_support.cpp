@@ -29,7 +29,12 @@ bool underCi() {
 
 std::string binDir() {
   const char* env = std::getenv("MSF_BIN_DIR");
-  return env ? env : "bin";
+  return env ? env : MSF_TEST_BIN_DIR;
+}
+
+std::string sourceDir() {
+  const char* env = std::getenv("MSF_SOURCE_DIR");
+  return env ? env : MSF_TEST_SOURCE_DIR;
 }
 
 TempDir::TempDir() {

@@ -11,8 +11,11 @@ std::string kittiDir();
 /// True when running under CI (CI=true), where a missing KITTI sample is a failure.
 bool underCi();
 
-/// Folder of the msf_* tools (build/bin).
+/// Folder of the msf_* tools (build/bin, or $MSF_BIN_DIR).
 std::string binDir();
+
+/// Root of the source tree (config/, README.md), or $MSF_SOURCE_DIR.
+std::string sourceDir();
 
 /// A fresh empty folder, removed with its contents when the object goes away.
 class TempDir {

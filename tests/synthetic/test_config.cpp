@@ -81,10 +81,8 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
 }
 
 TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {
-  const char* source = std::getenv("MSF_SOURCE_DIR");
-  const std::string path = std::string(source ? source : "..") + "/config/synthetic.yaml";
-  if (!msf::test::fileExists(path))
-    GTEST_SKIP() << "config/synthetic.yaml not found (set MSF_SOURCE_DIR)";
+  const std::string path = msf::test::sourceDir() + "/config/synthetic.yaml";
+  ASSERT_TRUE(msf::test::fileExists(path)) << path;
   SyntheticConfig c;
   c.read(msf::ConfigFile(path).section("synthetic"));
   EXPECT_EQ(c.scene, "street");
