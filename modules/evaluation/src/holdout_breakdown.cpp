@@ -1,5 +1,6 @@
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/holdout_breakdown.h>
+#include <msf/io/organized_conversion.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -33,14 +34,7 @@ cv::Mat hiddenGroundTruthMask(const cv::Mat& gt_depth, const cv::Mat& input_dept
   if (radius_px < 0)
     throw InvalidInputError("hold-out breakdown: the radius must be >= 0, not " + std::to_string(radius_px));
   // The largest input disparity around each pixel (0 where there is none).
-  cv::Mat nearest(input_depth.size(), CV_32FC1);
-  const float fB = static_cast<float>(focal_baseline);
-  for (int v = 0; v < input_depth.rows; ++v) {
-    const float* z = input_depth.ptr<float>(v);
-    float* d = nearest.ptr<float>(v);
-    for (int u = 0; u < input_depth.cols; ++u)
-      d[u] = has(z[u]) ? fB / z[u] : 0.f;
-  }
+  cv::Mat nearest = depthToDisparity(input_depth, focal_baseline);
   cv::dilate(nearest, nearest,
              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius_px + 1, 2 * radius_px + 1)));
   cv::Mat hidden(gt_depth.size(), CV_8UC1, cv::Scalar(0));

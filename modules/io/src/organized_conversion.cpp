@@ -22,7 +22,11 @@ cv::Mat invertScaled(const cv::Mat& in, double numerator, const char* what) {
 } // namespace
 
 cv::Mat depthToDisparity(const cv::Mat& depth, const Calibration& calibration) {
-  return invertScaled(depth, calibration.focalBaseline(), "depth");
+  return depthToDisparity(depth, calibration.focalBaseline());
+}
+
+cv::Mat depthToDisparity(const cv::Mat& depth, double focal_baseline) {
+  return invertScaled(depth, focal_baseline, "depth");
 }
 
 cv::Mat disparityToDepth(const cv::Mat& disparity, const Calibration& calibration) {

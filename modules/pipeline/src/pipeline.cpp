@@ -75,7 +75,7 @@ void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
   stages_->stereo.setDepthPrior(config_.scheduling.stereo_prior ? result.lidar_depth : cv::Mat());
   stages_->stereo.computeDisparity();
   result.stereo_depth = stages_->stereo.getDepth();
-  result.stereo_confidence = stages_->stereo.getConfidence().clone(); // the matcher reuses its buffer
+  result.stereo_confidence = stages_->stereo.getConfidence(); // a new image each frame
   result.times.stereo_ms = msSince(start);
 }
 

@@ -22,6 +22,8 @@ cv::Mat cloudToDepthImage(const pcl::PointCloud<PointT>& cloud);
 
 /// Disparity (pixels, grey pair) from depth and back: d = f B / z; 0 stays 0.
 cv::Mat depthToDisparity(const cv::Mat& depth, const Calibration& calibration);
+/// The same with f B given (pixels x metres).
+cv::Mat depthToDisparity(const cv::Mat& depth, double focal_baseline);
 cv::Mat disparityToDepth(const cv::Mat& disparity, const Calibration& calibration);
 
 } // namespace msf
