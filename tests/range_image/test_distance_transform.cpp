@@ -65,6 +65,28 @@ TEST(DistanceTransform, ExactAgainstBruteForceWithNearestSamples) {
   }
 }
 
+TEST(DistanceTransform, ExactOnAScanLikePattern) {
+  // Wavy rings a few rows apart below an empty top, as a LiDAR scan projects: the search
+  // over rows goes deep above the first ring and stays shallow between rings.
+  cv::Mat depth(90, 150, CV_32FC1, cv::Scalar(0));
+  cv::RNG rng(7);
+  for (int ring = 0; ring < 12; ++ring)
+    for (int u = 0; u < depth.cols; ++u)
+      if (rng.uniform(0.0, 1.0) < 0.7) {
+        const int v = 30 + 5 * ring + static_cast<int>(std::lround(2.0 * std::sin(0.05 * u + ring)));
+        depth.at<float>(v, u) = 5.f;
+      }
+  const Brute b = bruteForce(depth);
+  cv::Mat distance, nearest;
+  msf::distanceToSamples(depth, distance, &nearest, 2);
+  for (int v = 0; v < depth.rows; ++v)
+    for (int u = 0; u < depth.cols; ++u) {
+      ASSERT_NEAR(distance.at<float>(v, u), b.distance.at<float>(v, u), 1e-4f) << u << "," << v;
+      const int k = nearest.at<int>(v, u);
+      ASSERT_NEAR(std::hypot(k % depth.cols - u, k / depth.cols - v), b.distance.at<float>(v, u), 1e-4);
+    }
+}
+
 TEST(DistanceTransform, ZeroOnSamplesInfinityWithoutAny) {
   cv::Mat depth(5, 7, CV_32FC1, cv::Scalar(0)), distance, nearest;
   msf::distanceToSamples(depth, distance, &nearest);
@@ -95,6 +117,7 @@ TEST(DistanceTransform, RejectsWrongImages) {
   cv::Mat distance;
   EXPECT_THROW(msf::distanceToSamples(cv::Mat(3, 3, CV_8UC1), distance), msf::InvalidInputError);
   EXPECT_THROW(msf::distanceToSamples(cv::Mat(), distance), msf::InvalidInputError);
+  EXPECT_THROW(msf::distanceToSamples(cv::Mat(1, 20000, CV_32FC1, cv::Scalar(0)), distance), msf::InvalidInputError);
 }
 
 } // namespace

@@ -149,10 +149,11 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
 
   const auto run_start = Clock::now();
   std::thread loader([&] {
-    if (config_.scheduling.lidar_threads > 0)
-      omp_set_num_threads(config_.scheduling.lidar_threads); // this thread's parallel regions only
     try {
       for (std::size_t i : frames) {
+        // The first frame has the machine to itself; later ones share it with the other stages.
+        if (i != frames.front() && config_.scheduling.lidar_threads > 0)
+          omp_set_num_threads(config_.scheduling.lidar_threads); // this thread's parallel regions only
         if (stop && stop->load()) {
           interrupted = true;
           break;

@@ -10,22 +10,18 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace msf {
 
 namespace {
 
-/// In place, four at a time where SSE is there (std::sqrt does not vectorize: errno).
-void squareRoots(float* x, int n) {
-  int i = 0;
-#ifdef __SSE2__
-  for (; i + 4 <= n; i += 4)
-    _mm_storeu_ps(x + i, _mm_sqrt_ps(_mm_loadu_ps(x + i)));
-#endif
-  for (; i < n; ++i)
-    x[i] = std::sqrt(x[i]);
-}
+/// A squared distance meaning "no sample": far above any real one (< 2^18 here), and a
+/// real squared row distance added to it stays below 2^31.
+constexpr std::int32_t kNone = 1 << 28;
+/// Longest side handled: (side + kFar)^2 of rowDistances stays below 2^31.
+constexpr int kMaxSide = 1 << 14;
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
 #define MSF_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
@@ -33,75 +29,67 @@ void squareRoots(float* x, int n) {
 #define MSF_VECTOR_CLONES
 #endif
 
-/// Pass 1 downwards, one row: 0 on a sample, else one more than the row above (or none).
-MSF_VECTOR_CLONES void sweepDown(const float* __restrict d, const int* __restrict up, int* __restrict g, int n,
-                                 int none) {
-  for (int c = 0; c < n; ++c) {
-    const int above = up ? std::min(up[c] + 1, none) : none;
-    g[c] = d[c] > 0.f ? 0 : above;
+/// Pass 1 on one row: the squared distance along the row to its nearest sample (kNone
+/// without one) and that sample's column (-1 without one); ties go to the left. Without
+/// branches: where the samples are is unpredictable.
+MSF_VECTOR_CLONES void rowDistances(const float* __restrict d, int W, std::int32_t* __restrict h2,
+                                    std::int32_t* __restrict column) {
+  constexpr std::int32_t kFar = 1 << 14; // beyond any image width the kernel sees
+  std::int32_t last = -kFar;
+  for (int c = 0; c < W; ++c) {
+    last = d[c] > 0.f ? c : last;
+    column[c] = last;
   }
-}
-
-/// Pass 1 upwards, one row: the nearer of its own and the row below's plus one.
-MSF_VECTOR_CLONES void sweepUp(const int* __restrict down, int* __restrict g, int n) {
-  for (int c = 0; c < n; ++c)
-    g[c] = std::min(g[c], down[c] + 1);
-}
-
-/// Work space of one thread for envelopeRow.
-struct Envelope {
-  std::vector<int> v;               ///< columns of the parabolas of the lower envelope
-  std::vector<std::int64_t> h;      ///< their g^2 + q^2
-  std::vector<std::int64_t> num;    ///< left end of each parabola's interval: num / den
-  std::vector<std::int64_t> den;
-  explicit Envelope(int W) : v(W), h(W), num(W + 1), den(W + 1) {}
-};
-
-/// Pass 2 on one row: the lower envelope of the parabolas (x - q)^2 + g(q)^2
-/// (Felzenszwalb and Huttenlocher 2012) gives the squared distance and the nearest
-/// column. Intersections are kept as exact fractions of integers, so there is no
-/// division and no rounding. Columns with g >= none have no sample and no parabola.
-void envelopeRow(const int* g, int W, int none, float* d2, int* column, Envelope& envelope) {
-  // Intersection of parabolas p < q: s = (h_q - h_p) / (2 (q - p)).
-  int* ev = envelope.v.data();
-  std::int64_t* eh = envelope.h.data();
-  std::int64_t* num = envelope.num.data();
-  std::int64_t* den = envelope.den.data();
-  int k = -1;
-  for (int q = 0; q < W; ++q) {
-    if (g[q] >= none)
-      continue;
-    const std::int64_t hq = static_cast<std::int64_t>(g[q]) * g[q] + static_cast<std::int64_t>(q) * q;
-    std::int64_t sn = 0, sd = 1;
-    while (k >= 0) {
-      sn = hq - eh[k];
-      sd = 2 * static_cast<std::int64_t>(q - ev[k]);
-      // s > z[k], with z[0] = -inf.
-      if (k == 0 || sn * den[k] > num[k] * sd)
-        break;
-      --k;
-    }
-    ++k;
-    ev[k] = q;
-    eh[k] = hq;
-    num[k] = sn; // unused for k == 0 (-inf)
-    den[k] = sd;
+  std::int32_t next = W + kFar;
+  for (int c = W - 1; c >= 0; --c) {
+    next = d[c] > 0.f ? c : next;
+    const std::int32_t left = c - column[c], right = next - c;
+    column[c] = right < left ? next : column[c];
+    const std::int32_t h = std::min(left, right);
+    h2[c] = std::min(h * h, kNone);
   }
-  if (k < 0) {
-    std::fill(d2, d2 + W, std::numeric_limits<float>::infinity());
+  if (column[0] < 0 || column[0] >= W) // no sample in the row
     std::fill(column, column + W, -1);
-    return;
+}
+
+/// Squared distances to distances (+inf for kNone); the roots four at a time where SSE is
+/// there (std::sqrt does not vectorize: errno).
+MSF_VECTOR_CLONES void toDistances(const std::int32_t* __restrict d2, float* __restrict out, int n) {
+  for (int c = 0; c < n; ++c)
+    out[c] = d2[c] == kNone ? std::numeric_limits<float>::infinity() : static_cast<float>(d2[c]);
+  int c = 0;
+#ifdef __SSE2__
+  for (; c + 4 <= n; c += 4)
+    _mm_storeu_ps(out + c, _mm_sqrt_ps(_mm_loadu_ps(out + c)));
+#endif
+  for (; c < n; ++c)
+    out[c] = std::sqrt(out[c]);
+}
+
+/// best = min(best, dy2 + h2) over one span of columns; returns the span's largest best.
+MSF_VECTOR_CLONES std::int32_t relax(const std::int32_t* __restrict h2, std::int32_t dy2, std::int32_t* __restrict best,
+                                     int n) {
+  std::int32_t largest = 0;
+  for (int c = 0; c < n; ++c) {
+    best[c] = std::min(best[c], dy2 + h2[c]);
+    largest = std::max(largest, best[c]);
   }
-  int j = 0;
-  for (int q = 0; q < W; ++q) {
-    // Next parabola once its interval starts at or before q: num / den <= q.
-    while (j < k && num[j + 1] <= static_cast<std::int64_t>(q) * den[j + 1])
-      ++j;
-    const int p = ev[j];
-    const std::int64_t dx = q - p;
-    d2[q] = static_cast<float>(dx * dx + eh[j] - static_cast<std::int64_t>(p) * p);
-    column[q] = p;
+  return largest;
+}
+
+/// The same, also keeping the row-major index of the nearest sample (`row` * W + its column).
+MSF_VECTOR_CLONES std::int32_t relaxNearest(const std::int32_t* __restrict h2, const std::int32_t* __restrict column,
+                                            std::int32_t dy2, std::int32_t row_offset, std::int32_t* __restrict best,
+                                            std::int32_t* __restrict nearest, int n) {
+  std::int32_t largest = 0;
+  for (int c = 0; c < n; ++c) {
+    const std::int32_t candidate = dy2 + h2[c];
+    const bool nearer = candidate < best[c];
+    best[c] = nearer ? candidate : best[c];
+    nearest[c] = nearer ? row_offset + column[c] : nearest[c];
+    largest = std::max(largest, best[c]);
   }
+  return largest;
 }
 
 } // namespace
@@ -110,66 +98,55 @@ void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest
   if (depth.type() != CV_32FC1 || depth.empty())
     throw InvalidInputError("distanceToSamples: expected a non-empty CV_32FC1 depth image");
   const int H = depth.rows, W = depth.cols;
-  const int none = H + W + 1; // more than any vertical distance: a column without sample
+  if (H > kMaxSide || W > kMaxSide)
+    throw InvalidInputError("distanceToSamples: the image is " + std::to_string(W) + "x" + std::to_string(H) +
+                            ", more than " + std::to_string(kMaxSide) + " px on a side");
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
-  cv::Mat vertical(H, W, CV_32SC1), near_row;
-  if (nearest) {
-    near_row.create(H, W, CV_32SC1);
-    nearest->create(H, W, CV_32SC1);
-  }
+  cv::Mat h2(H, W, CV_32SC1), column(H, W, CV_32SC1);
+  std::vector<std::uint8_t> row_has_sample(static_cast<std::size_t>(H));
   distance.create(H, W, CV_32FC1);
+  if (nearest)
+    nearest->create(H, W, CV_32SC1);
 
 #pragma omp parallel num_threads(nthreads)
   {
-    // Pass 1, columns: vertical distance to the nearest sample of the column (and its row),
-    // swept down then up a band of columns so that the inner loops are contiguous.
-    const int bands = omp_get_num_threads();
-#pragma omp for schedule(static)
-    for (int b = 0; b < bands; ++b) {
-      const int c0 = std::min(W, (W * b / bands + 15) / 16 * 16);
-      const int c1 = b + 1 == bands ? W : std::min(W, (W * (b + 1) / bands + 15) / 16 * 16);
-      for (int r = 0; r < H; ++r) {
-        const float* d = depth.ptr<float>(r);
-        int* g = vertical.ptr<int>(r);
-        sweepDown(d + c0, r > 0 ? vertical.ptr<int>(r - 1) + c0 : nullptr, g + c0, c1 - c0, none);
-        if (nearest) {
-          int* nr = near_row.ptr<int>(r);
-          const int* nr_up = near_row.ptr<int>(r > 0 ? r - 1 : 0);
-          for (int c = c0; c < c1; ++c)
-            nr[c] = d[c] > 0.f ? r : (r > 0 ? nr_up[c] : -1);
-        }
-      }
-      for (int r = H - 2; r >= 0; --r) {
-        int* g = vertical.ptr<int>(r);
-        const int* down = vertical.ptr<int>(r + 1);
-        if (nearest) {
-          int* nr = near_row.ptr<int>(r);
-          const int* nr_down = near_row.ptr<int>(r + 1);
-          for (int c = c0; c < c1; ++c)
-            if (down[c] + 1 < g[c]) {
-              g[c] = down[c] + 1;
-              nr[c] = nr_down[c];
-            }
-        } else {
-          sweepUp(down + c0, g + c0, c1 - c0);
-        }
-      }
-    }
-
-    // Pass 2, rows.
-    Envelope envelope(W);
-    std::vector<int> column(static_cast<std::size_t>(W));
+    // Pass 1, rows: the distance along each row (LiDAR samples lie on rows).
 #pragma omp for schedule(static)
     for (int r = 0; r < H; ++r) {
-      float* out = distance.ptr<float>(r);
-      envelopeRow(vertical.ptr<int>(r), W, none, out, column.data(), envelope);
-      squareRoots(out, W);
-      if (nearest) {
-        const int* nr = near_row.ptr<int>(r);
-        int* idx = nearest->ptr<int>(r);
-        for (int q = 0; q < W; ++q)
-          idx[q] = column[q] < 0 ? -1 : nr[column[q]] * W + column[q];
+      rowDistances(depth.ptr<float>(r), W, h2.ptr<std::int32_t>(r), column.ptr<std::int32_t>(r));
+      row_has_sample[static_cast<std::size_t>(r)] = column.ptr<std::int32_t>(r)[0] >= 0;
+    }
+
+    // Pass 2: a pixel's squared distance is min over rows r' of (r - r')^2 + h2(r', c). Rows
+    // are visited outwards from r, a span of columns at a time, until (r - r')^2 reaches the
+    // span's largest distance so far: between the rings of a scan that is a few rows, where
+    // the lower envelope of parabolas (exact in any case) branches on every column.
+    constexpr int kSpan = 64;
+    std::vector<std::int32_t> best(static_cast<std::size_t>(W));
+#pragma omp for schedule(static)
+    for (int r = 0; r < H; ++r) {
+      std::int32_t* b = best.data();
+      int* idx = nearest ? nearest->ptr<int>(r) : nullptr;
+      std::copy_n(h2.ptr<std::int32_t>(r), W, b);
+      if (idx) {
+        const std::int32_t* col = column.ptr<std::int32_t>(r);
+        for (int c = 0; c < W; ++c)
+          idx[c] = col[c] < 0 ? -1 : r * W + col[c];
       }
+      for (int c0 = 0; c0 < W; c0 += kSpan) {
+        const int n = std::min(kSpan, W - c0);
+        std::int32_t largest = *std::max_element(b + c0, b + c0 + n);
+        for (int dy = 1; largest > dy * dy && (r - dy >= 0 || r + dy < H); ++dy) {
+          for (const int rr : {r - dy, r + dy}) {
+            if (rr < 0 || rr >= H || !row_has_sample[static_cast<std::size_t>(rr)])
+              continue;
+            const std::int32_t* h = h2.ptr<std::int32_t>(rr) + c0;
+            largest = idx ? relaxNearest(h, column.ptr<std::int32_t>(rr) + c0, dy * dy, rr * W, b + c0, idx + c0, n)
+                          : relax(h, dy * dy, b + c0, n);
+          }
+        }
+      }
+      toDistances(b, distance.ptr<float>(r), W);
     }
   }
 }

@@ -4,8 +4,9 @@
 namespace msf {
 
 /// Exact Euclidean distance, in pixels, from every pixel to the nearest sample (a pixel of
-/// `depth` > 0): the separable lower-envelope algorithm of Felzenszwalb and Huttenlocher,
-/// which is exact and several times faster than cv::distanceTransform with a precise mask.
+/// `depth` > 0): distances along the rows, then for each pixel the nearest of them over the
+/// rows outwards until no farther row can be nearer. On a LiDAR scan's projection (samples
+/// on rows a few pixels apart) that search is a few rows deep and vectorised across columns.
 /// `distance` is CV_32FC1 (0 on a sample, +inf everywhere when there is none). When
 /// `nearest` is given it receives, as CV_32SC1, the row-major index of a nearest sample
 /// (-1 when there is none). `threads` 0 uses OpenMP's default. The result does not depend
