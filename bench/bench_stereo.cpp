@@ -7,23 +7,33 @@
 // BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
 // SemiGlobalMatcher with its AVX2 and its AVX-512 kernel): per-core cost, steadier than wall
 // time on a machine shared with other work.
+// Post-processing, side by side: the native rows again with OpenCV's serial median, speckle
+// filter and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)),
+// and BM_PostFilter, that tail alone (median, speckle filter, conversion to float,
+// confidence) on the matcher's output of the 10 frames, with OpenCV's routines and ours.
 //
 //   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 //   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
 #include <msf/io/sequence.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/stereo/median_blur_3x3.h>
+#include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_stereo.h>
+#include <msf/stereo/speckle_filter.h>
+#include <msf/stereo/stereo_confidence.h>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cstdlib>
 #include <ctime>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace {
@@ -59,9 +69,14 @@ const Data& data() {
   return d;
 }
 
-void run(benchmark::State& state, msf::SgbmConfig config, bool with_prior, const char* engine) {
+/// `engine`: opencv, native, or native_opencv_tail (native with OpenCV's post-processing).
+void run(benchmark::State& state, msf::SgbmConfig config, bool with_prior, const char* engine_row) {
   const Data& d = data();
+  const std::string row = engine_row;
+  const bool opencv_tail = row == "native_opencv_tail";
+  const char* engine = opencv_tail ? "native" : engine_row;
   config.engine = engine;
+  msf::setParallelPostFilterEnabled(!opencv_tail);
   msf::SgbmStereo stereo(config);
   stereo.setCalibration(d.calibration);
   std::size_t i = 0, valid = 0, pixels = 0;
@@ -80,8 +95,48 @@ void run(benchmark::State& state, msf::SgbmConfig config, bool with_prior, const
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
   state.counters["disparities"] = stereo.getSearchedDisparities();
   state.counters["valid_share"] = pixels ? static_cast<double>(valid) / pixels : 0.0;
+  msf::setParallelPostFilterEnabled(true);
   if (stereo.getEngineUsed() != engine)
     state.SkipWithError("the native engine needs AVX2; this row ran OpenCV");
+}
+
+/// The matcher's output of the 10 frames at 128 disparities with the 3x3 median only.
+const std::vector<cv::Mat>& medianOnlyDisparities() {
+  static const std::vector<cv::Mat> fixed = [] {
+    const Data& d = data();
+    std::vector<cv::Mat> out;
+    for (std::size_t f = 0; f < d.left.size(); ++f) {
+      cv::Mat disparity;
+      cv::StereoSGBM::create(0, 128, 5, 200, 800, -1, 63, 10, 0, 2, cv::StereoSGBM::MODE_SGBM_3WAY)
+          ->compute(d.left[f], d.right[f], disparity);
+      out.push_back(disparity);
+    }
+    return out;
+  }();
+  return fixed;
+}
+
+void BM_PostFilter(benchmark::State& state, bool parallel) {
+  const std::vector<cv::Mat>& input = medianOnlyDisparities();
+  msf::setParallelPostFilterEnabled(parallel);
+  cv::Mat median, speckle_buffer, disparity;
+  std::size_t i = 0;
+  const std::clock_t cpu_start = std::clock();
+  for (auto _ : state) {
+    const cv::Mat& raw = input[i++ % input.size()];
+    if (parallel) {
+      msf::medianBlur3x3(raw, median);
+      msf::filterSpecklesParallel(median, -16, 100, 32, speckle_buffer);
+    } else {
+      cv::medianBlur(raw, median, 3);
+      cv::filterSpeckles(median, -16, 100, 32, speckle_buffer);
+    }
+    median.convertTo(disparity, CV_32F, 1.0 / 16);
+    benchmark::DoNotOptimize(msf::stereoConfidence(disparity).data);
+  }
+  state.counters["cpu_ms_all_threads"] =
+      1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
+  msf::setParallelPostFilterEnabled(true);
 }
 
 void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, msf::SgbmConfig{}, false, engine); }
@@ -143,8 +198,16 @@ BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512, "avx512")->Unit(benchmark::kMillise
 // Each case's engines one after the other, so that both see the same machine load.
 BENCHMARK_CAPTURE(BM_Sgbm3Way128, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
 BENCHMARK_CAPTURE(BM_Sgbm3Way128, native, "native")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3Way128, native_opencv_tail, "native_opencv_tail")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
 BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
 BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, native, "native")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, native_opencv_tail, "native_opencv_tail")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
 BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, opencv, "opencv")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
@@ -153,5 +216,8 @@ BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, native, "native")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(10);
+
+BENCHMARK_CAPTURE(BM_PostFilter, opencv, false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
+BENCHMARK_CAPTURE(BM_PostFilter, parallel, true)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
 
 BENCHMARK_MAIN();

@@ -1,7 +1,10 @@
 #include "semi_global_kernel.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/stereo/median_blur_3x3.h>
+#include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/semi_global_matcher.h>
+#include <msf/stereo/speckle_filter.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -125,11 +128,18 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
       },
       strips);
 
-  // As OpenCV's StereoSGBM::compute: a 3x3 median, then the speckle filter.
-  cv::medianBlur(raw_, disparity, 3);
-  if (p.speckle_window_size > 0)
-    cv::filterSpeckles(disparity, (p.min_disparity - 1) * 16, p.speckle_window_size, 16 * p.speckle_range,
-                       speckle_buffer_);
+  // As OpenCV's StereoSGBM::compute: a 3x3 median, then the speckle filter. Ours run on row
+  // bands in parallel with the same results (OpenCV's are serial: 5 ms of a KITTI frame).
+  const int none = (p.min_disparity - 1) * 16;
+  if (parallelPostFilterEnabled()) {
+    medianBlur3x3(raw_, disparity);
+    if (p.speckle_window_size > 0)
+      filterSpecklesParallel(disparity, none, p.speckle_window_size, 16 * p.speckle_range, speckle_buffer_);
+  } else {
+    cv::medianBlur(raw_, disparity, 3);
+    if (p.speckle_window_size > 0)
+      cv::filterSpeckles(disparity, none, p.speckle_window_size, 16 * p.speckle_range, speckle_buffer_);
+  }
 }
 
 } // namespace msf

@@ -1,9 +1,13 @@
 #include <msf/common/exceptions.h>
+#include <msf/stereo/l1_distance_transform.h>
+#include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/stereo_confidence.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,25 +30,39 @@ cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig&
     throw InvalidInputError("stereo confidence: disparity image must be CV_32FC1");
   config.validate();
   const int rows = disparity.rows, cols = disparity.cols;
-  cv::Mat valid(disparity.size(), CV_8UC1);
-  // Invalid pixels become 0 for the local max and +inf for the local min, so that both
-  // filters see only valid neighbours.
+  const bool ours = parallelPostFilterEnabled();
+  // One parallel pass gives the inputs of the local max and min (invalid pixels 0 and +inf,
+  // so that both filters see only valid neighbours) and the holes: each row's distance to
+  // its nearest hole at once (our transform's row pass), or the mask OpenCV's needs.
   cv::Mat for_max(disparity.size(), CV_32FC1), for_min(disparity.size(), CV_32FC1);
+  cv::Mat hole_distance(disparity.size(), CV_16UC1), mask;
+  if (!ours)
+    mask.create(disparity.size(), CV_8UC1);
   const float inf = std::numeric_limits<float>::infinity();
-  for (int v = 0; v < rows; ++v) {
-    const float* d = disparity.ptr<float>(v);
-    std::uint8_t* m = valid.ptr<std::uint8_t>(v);
-    float* hi = for_max.ptr<float>(v);
-    float* lo = for_min.ptr<float>(v);
-    for (int u = 0; u < cols; ++u) {
-      const bool ok = d[u] > 0.f && std::isfinite(d[u]);
-      m[u] = ok ? 255 : 0;
-      hi[u] = ok ? d[u] : 0.f;
-      lo[u] = ok ? d[u] : inf;
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    std::vector<std::uint8_t> valid_row(ours ? static_cast<std::size_t>(cols) : 0);
+    for (int v = range.start; v < range.end; ++v) {
+      const float* d = disparity.ptr<float>(v);
+      std::uint8_t* m = ours ? valid_row.data() : mask.ptr<std::uint8_t>(v);
+      float* hi = for_max.ptr<float>(v);
+      float* lo = for_min.ptr<float>(v);
+      for (int u = 0; u < cols; ++u) {
+        const bool ok = d[u] > 0.f && std::isfinite(d[u]);
+        m[u] = ok ? 255 : 0;
+        hi[u] = ok ? d[u] : 0.f;
+        lo[u] = ok ? d[u] : inf;
+      }
+      if (ours)
+        l1_distance::rowPass(m, cols, hole_distance.ptr<std::uint16_t>(v));
     }
+  });
+  if (ours) {
+    l1_distance::columnPass(hole_distance, hole_distance, CV_16U);
+  } else {
+    cv::Mat distance;
+    cv::distanceTransform(mask, distance, cv::DIST_L1, 3, CV_32F);
+    distance.convertTo(hole_distance, CV_16U); // whole numbers up to 8192: exact
   }
-  cv::Mat hole_distance;
-  cv::distanceTransform(valid, hole_distance, cv::DIST_L1, 3, CV_32F);
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(config.range_window_px, config.range_window_px));
   cv::dilate(for_max, for_max, kernel);
   cv::erode(for_min, for_min, kernel);
@@ -59,19 +77,18 @@ cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig&
     hole_term[k] = 1.f - std::exp(-static_cast<float>(k) * inv_hole);
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
-      const std::uint8_t* m = valid.ptr<std::uint8_t>(v);
-      const float* dist = hole_distance.ptr<float>(v);
+      const std::uint16_t* dist = hole_distance.ptr<std::uint16_t>(v);
       const float* hi = for_max.ptr<float>(v);
       const float* lo = for_min.ptr<float>(v);
       float* c = confidence.ptr<float>(v);
       for (int u = 0; u < cols; ++u) {
-        if (!m[u]) {
+        const int k = dist[u];
+        if (k == 0) { // a hole itself
           c[u] = 0.f;
           continue;
         }
         const float excess = std::max(0.f, hi[u] - lo[u] - config.range_free_px);
-        const int k = static_cast<int>(dist[u]);
-        const float hole = k < kTable ? hole_term[k] : 1.f - std::exp(-dist[u] * inv_hole);
+        const float hole = k < kTable ? hole_term[k] : 1.f - std::exp(-static_cast<float>(k) * inv_hole);
         c[u] = excess > 0.f ? hole * std::exp(-excess * inv_scale) : hole; // most pixels: no excess
       }
     }
