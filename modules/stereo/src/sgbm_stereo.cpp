@@ -179,19 +179,25 @@ void SgbmStereo::computeDisparity() {
       const short* in = fixed.ptr<short>(v);
       const short* in_right = fixed_right.empty() ? nullptr : fixed_right.ptr<short>(v);
       float* out = disparity_.ptr<float>(v);
+      // Branch-free, so that it runs in vectors; the explicit left-right check, rarely on,
+      // follows in a second loop.
       for (int u = 0; u < cols; ++u) {
-        // OpenCV marks a pixel without a match with (min_disparity - 1) * 16; d <= 0 has no depth.
-        float d = in[u] > 0 ? static_cast<float>(in[u]) * (1.f / 16.f) : 0.f;
-        // Too far, or matched in the replicated border left of the right image.
-        if (d > 0.f && (d < min_disparity || d > static_cast<float>(u)))
-          d = 0.f;
-        if (d > 0.f && in_right) {
-          const int ur = static_cast<int>(std::lround(static_cast<float>(u) - d));
-          const float dr = ur >= 0 && ur < cols ? static_cast<float>(in_right[ur]) * (1.f / 16.f) : -1.f;
-          if (!(dr > 0.f) || std::fabs(dr - d) > lr_max)
-            d = 0.f;
-        }
-        out[u] = d;
+        // OpenCV marks a pixel without a match with (min_disparity - 1) * 16; d <= 0 has no
+        // depth, nor has one too far or matched in the replicated border left of the right image.
+        const float d = static_cast<float>(in[u]) * (1.f / 16.f);
+        const bool kept = (d > 0.f) & (d >= min_disparity) & (d <= static_cast<float>(u));
+        out[u] = kept ? d : 0.f;
+      }
+      if (!in_right)
+        continue;
+      for (int u = 0; u < cols; ++u) {
+        const float d = out[u];
+        if (!(d > 0.f))
+          continue;
+        const int ur = static_cast<int>(std::lround(static_cast<float>(u) - d));
+        const float dr = ur >= 0 && ur < cols ? static_cast<float>(in_right[ur]) * (1.f / 16.f) : -1.f;
+        if (!(dr > 0.f) || std::fabs(dr - d) > lr_max)
+          out[u] = 0.f;
       }
     }
   });

@@ -25,33 +25,41 @@ void StereoConfidenceConfig::validate() const {
     throw ConfigError("config key 'stereo.confidence_range_scale_px' must be > 0");
 }
 
+namespace {
+/// A disparity row's validity (> 0 and finite: NaN fails both tests) as 255 or 0, and the
+/// inputs of the local max and min: invalid pixels 0 and +inf, so that both filters see only
+/// valid neighbours. Branch-free over restrict pointers, so that it runs in vectors.
+void splitRow(const float* __restrict d, int cols, std::uint8_t* __restrict valid, float* __restrict for_max,
+              float* __restrict for_min) {
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int u = 0; u < cols; ++u) {
+    const float x = d[u];
+    const bool ok = (x > 0.f) & (x <= std::numeric_limits<float>::max());
+    valid[u] = ok ? 255 : 0;
+    for_max[u] = ok ? x : 0.f;
+    for_min[u] = ok ? x : inf;
+  }
+}
+} // namespace
+
 cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig& config) {
   if (disparity.type() != CV_32FC1)
     throw InvalidInputError("stereo confidence: disparity image must be CV_32FC1");
   config.validate();
   const int rows = disparity.rows, cols = disparity.cols;
   const bool ours = parallelPostFilterEnabled();
-  // One parallel pass gives the inputs of the local max and min (invalid pixels 0 and +inf,
-  // so that both filters see only valid neighbours) and the holes: each row's distance to
-  // its nearest hole at once (our transform's row pass), or the mask OpenCV's needs.
+  // One parallel pass gives the inputs of the local max and min and the holes: each row's
+  // distance to its nearest hole at once (our transform's row pass), or the mask OpenCV's
+  // transform needs.
   cv::Mat for_max(disparity.size(), CV_32FC1), for_min(disparity.size(), CV_32FC1);
   cv::Mat hole_distance(disparity.size(), CV_16UC1), mask;
   if (!ours)
     mask.create(disparity.size(), CV_8UC1);
-  const float inf = std::numeric_limits<float>::infinity();
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
     std::vector<std::uint8_t> valid_row(ours ? static_cast<std::size_t>(cols) : 0);
     for (int v = range.start; v < range.end; ++v) {
-      const float* d = disparity.ptr<float>(v);
       std::uint8_t* m = ours ? valid_row.data() : mask.ptr<std::uint8_t>(v);
-      float* hi = for_max.ptr<float>(v);
-      float* lo = for_min.ptr<float>(v);
-      for (int u = 0; u < cols; ++u) {
-        const bool ok = d[u] > 0.f && std::isfinite(d[u]);
-        m[u] = ok ? 255 : 0;
-        hi[u] = ok ? d[u] : 0.f;
-        lo[u] = ok ? d[u] : inf;
-      }
+      splitRow(disparity.ptr<float>(v), cols, m, for_max.ptr<float>(v), for_min.ptr<float>(v));
       if (ours)
         l1_distance::rowPass(m, cols, hole_distance.ptr<std::uint16_t>(v));
     }
