@@ -29,6 +29,16 @@ struct SgmStrip {
   int uniqueness_ratio{10};           ///< percent; 0 = off
   int disp12_max_diff{1};             ///< pseudo left-right check, >= 0
   int row_begin{0}, row_output_begin{0}, row_end{0};
+  /// Optional guidance (Poggi et al., CVPR 2019, as an additive cost): disparity x 16 of the
+  /// left view per pixel, <= 0 = no hint; where there is one, every disparity d's block cost
+  /// grows by min(guidance_gain * |d - hint|, guidance_max_penalty) before the paths.
+  /// nullptr: no guidance, and exactly the unguided result.
+  const std::int16_t* guidance{nullptr};
+  std::size_t guidance_step{0};       ///< elements between rows
+  /// Cost per pixel of disparity and the largest penalty: 16 x max_penalty + gain < 2^16
+  /// (the penalty is computed in unsigned 16-bit lanes); either 0: no guidance.
+  int guidance_gain{0};
+  int guidance_max_penalty{0};
   std::int16_t* disparity{nullptr};   ///< CV_16S disparity x 16 of the whole image
   std::size_t disparity_step{0};      ///< elements between rows
   std::uint8_t* workspace{nullptr};   ///< sgmWorkspaceBytes() bytes, owned by the caller

@@ -10,7 +10,9 @@
 //  2. block cost: a running sum over 2r+1 rows per column and disparity (the pixel costs of
 //     the row entering and of the row leaving are recomputed rather than stored, so the
 //     buffers of a strip stay within a core's L2 cache), then a sliding sum over 2r+1 columns;
-//  3. paths: left-to-right and top-to-bottom in one pass, right-to-left in a second pass that
+//  3. guidance (optional): at pixels with a disparity hint, a penalty growing with the
+//     distance from the hint is added to the block costs, so that the paths carry the hint on;
+//  4. paths: left-to-right and top-to-bottom in one pass, right-to-left in a second pass that
 //     also picks the disparity (uniqueness, parabolic sub-pixel, pseudo left-right check).
 
 using Reg = typename V::Reg;
@@ -195,6 +197,33 @@ MSF_SIMD_INLINE Reg pathStep(Reg cost, Reg below, Reg above, Reg same, Reg p1, R
   return V::adds16(cost, V::sub16(m, previous_min));
 }
 
+/// The guidance penalty of one row: min(gain |d - hint|, max_penalty) for each disparity
+/// lane of a pixel with a hint, d and the hint in 1/16 px. gain x min(|d - hint|, cap) stays
+/// below 2^16 (cap = the difference at which the penalty reaches its maximum), so the
+/// product is exact as unsigned 16-bit.
+struct Guide {
+  const std::int16_t* hints; ///< the row's hints by image column, nullptr: none in the row
+  Reg first, step, cap, gain, max_penalty;
+
+  MSF_SIMD_INLINE Guide(const SgmStrip& s, const std::int16_t* row_hints) : hints(row_hints) {
+    first = V::add16(V::set16(16 * s.min_disparity), V::mullo16(V::laneIndex(), V::set16(16)));
+    step = V::set16(16 * kLanes);
+    const int g = s.guidance_gain > 0 ? s.guidance_gain : 1;
+    const int reach = (16 * s.guidance_max_penalty + g - 1) / g;
+    cap = V::set16(reach < 0x7FFF ? reach : 0x7FFF);
+    gain = V::set16(s.guidance_gain);
+    max_penalty = V::set16(s.guidance_max_penalty);
+  }
+
+  /// Penalties of vector k at a pixel whose hint is `hint` (disparity x 16).
+  MSF_SIMD_INLINE Reg penalty(Reg hint, int k) const {
+    const Reg d = V::add16(first, V::mullo16(step, V::set16(k)));
+    // Saturated, so that any hint is safe: |-32768| stays 0x8000, above the cap unsigned.
+    const Reg distance = V::minu16(V::abs16(V::subs16(d, hint)), cap);
+    return V::min16(V::sixteenthU16(V::mullo16(distance, gain)), max_penalty);
+  }
+};
+
 /// One path's state while its D disparities are swept a vector at a time, updating `costs`
 /// in place.
 struct PathSweep {
@@ -259,7 +288,8 @@ MSF_SIMD_INLINE Reg nextCost(const Strip& strip, std::int16_t* box, const std::i
 /// With `add` (and `sub`), each column's sums first move down one row: the block row
 /// entering is `add`, the one leaving `sub` (fused here so the sums are read once).
 template <bool kOutput>
-MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const int K) {
+MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub,
+                                    const Guide& guide, const int K) {
   const Layout& layout = strip.layout;
   const int D = kLanes * K, r = strip.s.block_radius, last = layout.width1 - 1;
   const std::int16_t* column_sums = strip.at<std::int16_t>(layout.column_sums);
@@ -289,9 +319,13 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     PathSweep top_path(top_x, K, top_minima[xi], p2);
     PathSweep left_path(left, K, left_min, p2);
     std::int16_t* sums_x = sums + static_cast<std::size_t>(xi) * D;
+    const int hint = guide.hints ? guide.hints[xi + layout.min_x] : 0;
+    const Reg hint_vector = V::set16(hint);
 #pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
-      const Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
+      Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
+      if (hint > 0)
+        cost = V::adds16(cost, guide.penalty(hint_vector, k));
       const Reg t = top_path.step(k, cost, p1);
       if constexpr (kOutput)
         V::store(sums_x + kLanes * k, V::adds16(left_path.step(k, cost, p1), t));
@@ -303,7 +337,7 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
 }
 
 /// Right-to-left path, the total over the three paths, and the disparity of each pixel.
-MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, const int K) {
+MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, const Guide& guide, const int K) {
   const SgmStrip& s = strip.s;
   const Layout& layout = strip.layout;
   const int D = kLanes * K, r = s.block_radius, last = layout.width1 - 1;
@@ -342,9 +376,13 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
     PathSweep right_path(right, K, right_min, s.p2);
     // Per lane: the smallest total so far and the vector k where it was (the first on ties).
     Reg best_cost = V::set16(0x7FFF), best_k = V::set16(0);
+    const int hint = guide.hints ? guide.hints[xi + layout.min_x] : 0;
+    const Reg hint_vector = V::set16(hint);
 #pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
-      const Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
+      Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
+      if (hint > 0)
+        cost = V::adds16(cost, guide.penalty(hint_vector, k));
       const Reg sum = V::adds16(right_path.step(k, cost, p1), V::load(sums_x + kLanes * k));
       V::store(total + kLanes * k, sum);
       best_k = V::whereLess(sum, best_cost, V::set16(k), best_k);
@@ -389,28 +427,29 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
 }
 
 template <bool kOutput, int KC>
-MSF_SIMD void forwardPassK(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub) {
-  forwardPassFor<kOutput>(strip, add, sub, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
+MSF_SIMD void forwardPassK(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide) {
+  forwardPassFor<kOutput>(strip, add, sub, guide, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
 }
 
 template <int KC>
-MSF_SIMD void backwardPassK(const Strip& strip, std::int16_t* out) {
-  backwardPassFor(strip, out, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
+MSF_SIMD void backwardPassK(const Strip& strip, std::int16_t* out, const Guide& guide) {
+  backwardPassFor(strip, out, guide, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
 }
 
 /// `add`, `sub`: the block rows entering and leaving (none at the strip's first row);
-/// `out`: the disparity row, none on warm-up rows.
+/// `out`: the disparity row, none on warm-up rows; `guide`: the row's hints.
 template <int KC>
-MSF_SIMD void matchRow(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, std::int16_t* out) {
+MSF_SIMD void matchRow(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide,
+                       std::int16_t* out) {
   if (!out) {
-    forwardPassK<false, KC>(strip, add, sub);
+    forwardPassK<false, KC>(strip, add, sub, guide);
     return;
   }
-  forwardPassK<true, KC>(strip, add, sub);
-  backwardPassK<KC>(strip, out);
+  forwardPassK<true, KC>(strip, add, sub, guide);
+  backwardPassK<KC>(strip, out, guide);
 }
 
-using RowMatcher = void (*)(const Strip&, const std::uint8_t*, const std::uint8_t*, std::int16_t*);
+using RowMatcher = void (*)(const Strip&, const std::uint8_t*, const std::uint8_t*, const Guide&, std::int16_t*);
 
 /// The passes of one row, unrolled for up to 128 disparities.
 MSF_SIMD RowMatcher rowMatcherFor(int vectors) {
@@ -425,6 +464,16 @@ MSF_SIMD RowMatcher rowMatcherFor(int vectors) {
   case 8: return matchRow<8>;
   default: return matchRow<0>;
   }
+}
+
+/// Row y of the guidance, or nullptr when none of its matched columns has a hint (most rows
+/// between two LiDAR rings), so that such rows cost nothing.
+MSF_SIMD const std::int16_t* rowHints(const SgmStrip& s, int y, const Layout& layout) {
+  const std::int16_t* row = s.guidance + static_cast<std::size_t>(y) * s.guidance_step;
+  for (int x = layout.min_x; x < layout.min_x + layout.width1; ++x)
+    if (row[x] > 0)
+      return row;
+  return nullptr;
 }
 
 MSF_SIMD void runStrip(const SgmStrip& s) {
@@ -454,11 +503,13 @@ MSF_SIMD void runStrip(const SgmStrip& s) {
   std::int16_t* disp2_cost = strip.at<std::int16_t>(layout.disp2_cost);
 
   const RowMatcher match_row = rowMatcherFor(D / kLanes);
+  const bool guided = s.guidance && s.guidance_gain > 0 && s.guidance_max_penalty > 0;
   for (int y = s.row_begin; y < s.row_end; ++y) {
     const std::uint8_t* add = y > s.row_begin ? strip.preparedRow(y + r) : nullptr;
     const std::uint8_t* sub = y > s.row_begin ? strip.preparedRow(y - r - 1) : nullptr;
+    const Guide guide(s, guided ? rowHints(s, y, layout) : nullptr);
     if (y < s.row_output_begin) {
-      match_row(strip, add, sub, nullptr);
+      match_row(strip, add, sub, guide, nullptr);
       continue;
     }
     std::int16_t* out = s.disparity + static_cast<std::size_t>(y) * s.disparity_step;
@@ -467,7 +518,7 @@ MSF_SIMD void runStrip(const SgmStrip& s) {
       disp2[x] = static_cast<std::int16_t>(s.min_disparity - 1);
       disp2_cost[x] = 0x7FFF;
     }
-    match_row(strip, add, sub, out);
+    match_row(strip, add, sub, guide, out);
     // OpenCV's pseudo left-right check: the right view's winners, gathered above from the
     // left view's, must agree with the disparity rounded down or up.
     const int max_diff = s.disp12_max_diff;

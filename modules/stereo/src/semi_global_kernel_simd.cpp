@@ -105,6 +105,11 @@ struct V {
   MSF_SIMD_INLINE static Reg sub16(Reg a, Reg b) { return _mm256_sub_epi16(a, b); }
   MSF_SIMD_INLINE static Reg min16(Reg a, Reg b) { return _mm256_min_epi16(a, b); }
   MSF_SIMD_INLINE static Reg max16(Reg a, Reg b) { return _mm256_max_epi16(a, b); }
+  MSF_SIMD_INLINE static Reg abs16(Reg a) { return _mm256_abs_epi16(a); }
+  MSF_SIMD_INLINE static Reg subs16(Reg a, Reg b) { return _mm256_subs_epi16(a, b); }
+  MSF_SIMD_INLINE static Reg minu16(Reg a, Reg b) { return _mm256_min_epu16(a, b); }
+  /// Unsigned 16-bit lanes divided by 16.
+  MSF_SIMD_INLINE static Reg sixteenthU16(Reg a) { return _mm256_srli_epi16(a, 4); }
   MSF_SIMD_INLINE static Reg mullo16(Reg a, Reg b) { return _mm256_mullo_epi16(a, b); }
   MSF_SIMD_INLINE static Reg and_(Reg a, Reg b) { return _mm256_and_si256(a, b); }
   MSF_SIMD_INLINE static Reg subsu8(Reg a, Reg b) { return _mm256_subs_epu8(a, b); }
@@ -182,6 +187,10 @@ struct V {
   MSF_SIMD_INLINE static Reg sub16(Reg a, Reg b) { return _mm512_sub_epi16(a, b); }
   MSF_SIMD_INLINE static Reg min16(Reg a, Reg b) { return _mm512_min_epi16(a, b); }
   MSF_SIMD_INLINE static Reg max16(Reg a, Reg b) { return _mm512_max_epi16(a, b); }
+  MSF_SIMD_INLINE static Reg abs16(Reg a) { return _mm512_abs_epi16(a); }
+  MSF_SIMD_INLINE static Reg subs16(Reg a, Reg b) { return _mm512_subs_epi16(a, b); }
+  MSF_SIMD_INLINE static Reg minu16(Reg a, Reg b) { return _mm512_min_epu16(a, b); }
+  MSF_SIMD_INLINE static Reg sixteenthU16(Reg a) { return _mm512_srli_epi16(a, 4); }
   MSF_SIMD_INLINE static Reg mullo16(Reg a, Reg b) { return _mm512_mullo_epi16(a, b); }
   MSF_SIMD_INLINE static Reg and_(Reg a, Reg b) { return _mm512_and_si512(a, b); }
   MSF_SIMD_INLINE static Reg subsu8(Reg a, Reg b) { return _mm512_subs_epu8(a, b); }

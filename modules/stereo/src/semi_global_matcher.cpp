@@ -61,10 +61,23 @@ void SemiGlobalMatcher::setParams(const Params& params) {
     bad("uniqueness_ratio", "must be in 0..100, not " + std::to_string(params.uniqueness_ratio));
   if (params.speckle_window_size < 0 || params.speckle_range < 0)
     bad("speckle_window_size", "and speckle_range must be >= 0");
+  if (params.guidance_gain < 0 || params.guidance_gain > kMaxGuidanceGain)
+    bad("guidance_gain", "must be in 0.." + std::to_string(kMaxGuidanceGain) + ", not " +
+                             std::to_string(params.guidance_gain));
+  if (params.guidance_max_penalty < 0 || params.guidance_max_penalty > kMaxGuidancePenalty)
+    bad("guidance_max_penalty", "must be in 0.." + std::to_string(kMaxGuidancePenalty) + ", not " +
+                                    std::to_string(params.guidance_max_penalty));
   params_ = params;
 }
 
+int SemiGlobalMatcher::maxGuidedDisparity() { return 2000; }
+
 void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity) {
+  compute(left, right, disparity, cv::Mat());
+}
+
+void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity,
+                                const cv::Mat& guidance) {
   if (left.empty() || right.empty())
     throw InvalidInputError(std::string("SemiGlobalMatcher: the ") + (left.empty() ? "left" : "right") +
                             " image is empty");
@@ -79,8 +92,19 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
                             " px wide, more than the " + std::to_string(maxWidth()) + " it matches");
   if (!isAvailable())
     throw InvalidInputError("SemiGlobalMatcher: this CPU has no AVX2 (use OpenCV's StereoSGBM)");
-
   const Params& p = params_;
+  if (!guidance.empty()) {
+    if (guidance.type() != CV_16SC1 || guidance.size() != left.size())
+      throw InvalidInputError("SemiGlobalMatcher: the guidance must be CV_16SC1 (disparity x 16) of the images' size " +
+                              std::to_string(left.cols) + "x" + std::to_string(left.rows) + ", got " +
+                              std::to_string(guidance.cols) + "x" + std::to_string(guidance.rows) + " of type " +
+                              std::to_string(guidance.type()));
+    if (p.min_disparity < -maxGuidedDisparity() || p.min_disparity + p.num_disparities > maxGuidedDisparity())
+      throw InvalidInputError("SemiGlobalMatcher: guidance handles disparities within +-" +
+                              std::to_string(maxGuidedDisparity()) + ", not " + std::to_string(p.min_disparity) +
+                              ".." + std::to_string(p.min_disparity + p.num_disparities));
+  }
+
   const int height = left.rows, radius = p.block_size / 2;
   raw_.create(left.size(), CV_16SC1);
   const int strips = std::min(kStrips, height);
@@ -108,6 +132,12 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   job.prefilter_cap = std::max(p.pre_filter_cap, 15) | 1;
   job.uniqueness_ratio = p.uniqueness_ratio;
   job.disp12_max_diff = p.disp12_max_diff > 0 ? p.disp12_max_diff : 1; // as OpenCV 4.6: never off
+  if (!guidance.empty()) {
+    job.guidance = guidance.ptr<std::int16_t>();
+    job.guidance_step = guidance.step[0] / sizeof(std::int16_t);
+    job.guidance_gain = p.guidance_gain;
+    job.guidance_max_penalty = p.guidance_max_penalty;
+  }
   job.disparity = raw_.ptr<std::int16_t>();
   job.disparity_step = raw_.step[0] / sizeof(std::int16_t);
   // AVX-512 where the disparities fill whole 32-lane vectors; with 16 left over its padding

@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_config.h>
 
 #include <opencv2/calib3d.hpp>
@@ -34,6 +35,14 @@ bool SgbmConfig::nativeEngine() const {
   bad("engine", "must be native or opencv, not '" + engine + "'");
 }
 
+bool SgbmConfig::lidarGuidance() const {
+  if (guidance == "lidar")
+    return true;
+  if (guidance == "none")
+    return false;
+  bad("guidance", "must be none or lidar, not '" + guidance + "'");
+}
+
 void SgbmConfig::read(const cv::FileNode& node) {
   readKey(node, "engine", engine);
   readKey(node, "mode", mode);
@@ -52,6 +61,11 @@ void SgbmConfig::read(const cv::FileNode& node) {
   readKey(node, "match_left_border", match_left_border);
   readKey(node, "prior_search_range", prior_search_range);
   readKey(node, "prior_margin_px", prior_margin_px);
+  readKey(node, "guidance", guidance);
+  readKey(node, "guidance_gain", guidance_gain);
+  readKey(node, "guidance_max_penalty", guidance_max_penalty);
+  readKey(node, "guidance_bridge_rows", guidance_bridge_rows);
+  readKey(node, "guidance_bridge_agreement", guidance_bridge_agreement);
   readKey(node, "max_depth_m", max_depth_m);
   readKey(node, "color_camera", color_camera);
   readKey(node, "confidence_hole_distance_px", confidence.hole_distance_px);
@@ -86,6 +100,17 @@ void SgbmConfig::validate() const {
     bad("left_right_max_diff_px", "must be >= 0");
   if (prior_margin_px < 0)
     bad("prior_margin_px", "must be >= 0, not " + std::to_string(prior_margin_px));
+  lidarGuidance();
+  if (guidance_gain < 0 || guidance_gain > SemiGlobalMatcher::kMaxGuidanceGain)
+    bad("guidance_gain", "must be in 0.." + std::to_string(SemiGlobalMatcher::kMaxGuidanceGain) + ", not " +
+                             std::to_string(guidance_gain));
+  if (guidance_max_penalty < 0 || guidance_max_penalty > SemiGlobalMatcher::kMaxGuidancePenalty)
+    bad("guidance_max_penalty", "must be in 0.." + std::to_string(SemiGlobalMatcher::kMaxGuidancePenalty) +
+                                    ", not " + std::to_string(guidance_max_penalty));
+  if (guidance_bridge_rows < 0)
+    bad("guidance_bridge_rows", "must be >= 0, not " + std::to_string(guidance_bridge_rows));
+  if (!(guidance_bridge_agreement >= 0.f))
+    bad("guidance_bridge_agreement", "must be >= 0");
   if (!(max_depth_m >= 0.f))
     bad("max_depth_m", "must be >= 0 (0 keeps all depths)");
   if (color_camera < 0 || color_camera > 3)
@@ -112,6 +137,11 @@ void SgbmConfig::print(std::ostream& out) const {
       << "  match_left_border: " << (match_left_border ? "true" : "false") << "\n"
       << "  prior_search_range: " << (prior_search_range ? "true" : "false") << "\n"
       << "  prior_margin_px: " << prior_margin_px << "\n"
+      << "  guidance: " << guidance << "\n"
+      << "  guidance_gain: " << guidance_gain << "\n"
+      << "  guidance_max_penalty: " << guidance_max_penalty << "\n"
+      << "  guidance_bridge_rows: " << guidance_bridge_rows << "\n"
+      << "  guidance_bridge_agreement: " << guidance_bridge_agreement << "\n"
       << "  max_depth_m: " << max_depth_m << "\n"
       << "  color_camera: " << color_camera << "\n"
       << "  confidence_hole_distance_px: " << confidence.hole_distance_px << "\n"

@@ -1,6 +1,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/stereo/disparity_search_range.h>
+#include <msf/stereo/guidance_hints.h>
 #include <msf/stereo/impl/sgbm_stereo.hpp>
 #include <msf/stereo/point_types.h>
 #include <msf/stereo/stereo_confidence.h>
@@ -9,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <mutex>
 #include <string>
@@ -65,6 +67,13 @@ void SgbmStereo::checkInputs() const {
   if (!prior_.empty() && (prior_.type() != CV_32FC1 || prior_.size() != left_.size()))
     throw InvalidInputError("SgbmStereo: the depth prior must be CV_32FC1 of the images' size " + sizeText(left_) +
                             ", got " + sizeText(prior_));
+  if (config_.lidarGuidance() && !guidance_.empty() &&
+      (guidance_.type() != CV_32FC1 || guidance_.size() != left_.size()))
+    throw InvalidInputError("SgbmStereo: the guidance (sparse depth) must be CV_32FC1 of the images' size " +
+                            sizeText(left_) + ", got " + sizeText(guidance_) + " of type " +
+                            std::to_string(guidance_.type()));
+  if (config_.lidarGuidance() && !guidance_.empty() && !has_calibration_)
+    throw CalibrationError("SgbmStereo: guidance needs the calibration (f B turns its depth into disparity)");
   if (config_.left_right_check && left_.cols <= config_.num_disparities_px)
     throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
 }
@@ -98,7 +107,8 @@ bool SgbmStereo::nativeRuns(int width) const {
   return true;
 }
 
-void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed) {
+void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints,
+                            cv::Mat& fixed) {
   if (nativeRuns(left.cols)) {
     SemiGlobalMatcher::Params params;
     params.min_disparity = config_.min_disparity_px;
@@ -111,10 +121,19 @@ void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_d
     params.speckle_window_size = config_.speckle_window_size_px;
     params.speckle_range = config_.speckle_range_px;
     params.disp12_max_diff = config_.disp12_max_diff_px;
+    params.guidance_gain = config_.guidance_gain;
+    params.guidance_max_penalty = config_.guidance_max_penalty;
     native_.setParams(params);
-    native_.compute(left, right, fixed);
+    native_.compute(left, right, fixed, hints);
     engine_used_ = "native";
     return;
+  }
+  if (!hints.empty()) {
+    static std::once_flag noted;
+    std::call_once(noted, [] {
+      std::cerr << "msf: note: OpenCV's StereoSGBM runs instead of the native matcher and takes no guidance; "
+                   "stereo.guidance is ignored\n";
+    });
   }
   if (!matcher_)
     matcher_ = cv::StereoSGBM::create();
@@ -133,17 +152,19 @@ void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_d
   engine_used_ = "opencv";
 }
 
-cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_disparities) {
+cv::Mat SgbmStereo::match(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints) {
   cv::Mat fixed; // CV_16S, disparity x 16
   const int border = config_.match_left_border ? std::max(0, config_.min_disparity_px + num_disparities) : 0;
   if (border == 0) {
-    runMatcher(left, right, num_disparities, fixed);
+    runMatcher(left, right, num_disparities, hints, fixed);
     return fixed;
   }
-  cv::Mat left_padded, right_padded;
+  cv::Mat left_padded, right_padded, hints_padded;
   cv::copyMakeBorder(left, left_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
   cv::copyMakeBorder(right, right_padded, 0, 0, border, 0, cv::BORDER_REPLICATE);
-  runMatcher(left_padded, right_padded, num_disparities, fixed);
+  if (!hints.empty())
+    cv::copyMakeBorder(hints, hints_padded, 0, 0, border, 0, cv::BORDER_CONSTANT, cv::Scalar(0));
+  runMatcher(left_padded, right_padded, num_disparities, hints_padded, fixed);
   return fixed.colRange(border, border + left.cols);
 }
 
@@ -157,14 +178,19 @@ void SgbmStereo::computeDisparity() {
                                            config_.prior_margin_px, config_.num_disparities_px);
   searched_disparities_ = num_disparities;
 
-  const cv::Mat fixed = match(left, right, num_disparities);
+  const cv::Mat hints = config_.lidarGuidance() && !guidance_.empty()
+                            ? guidanceHints(guidance_, calibration_.focalBaseline(), config_.guidance_bridge_rows,
+                                            config_.guidance_bridge_agreement)
+                            : cv::Mat();
+  const cv::Mat fixed = match(left, right, num_disparities, hints);
   cv::Mat fixed_right; // disparities of the right view, in right-image columns
   if (config_.left_right_check) {
     // A right-view match is the left-view match of the mirrored pair, mirrored back.
     cv::Mat left_flipped, right_flipped;
     cv::flip(left, left_flipped, 1);
     cv::flip(right, right_flipped, 1);
-    cv::flip(match(right_flipped, left_flipped, num_disparities), fixed_right, 1);
+    cv::flip(match(right_flipped, left_flipped, num_disparities, hints.empty() ? hints : rightViewHintsMirrored(hints)),
+             fixed_right, 1);
   }
 
   const int rows = fixed.rows, cols = fixed.cols;

@@ -38,7 +38,18 @@ public:
     int speckle_window_size = 100; ///< 0 = no speckle filter
     int speckle_range = 2;
     int disp12_max_diff = -1;  ///< pseudo left-right check in pixels; <= 0 means 1, as OpenCV 4.6
+    /// Guidance (compute() with a hint image): at a pixel with a hint, each disparity d's
+    /// block cost grows by min(guidance_gain * |d - hint|, guidance_max_penalty) before the
+    /// paths, which carry the hint to the pixels around. 0..kMaxGuidanceGain per pixel of
+    /// disparity and 0..kMaxGuidancePenalty (block costs are 25 x 0..189 at block 5); either
+    /// 0: hints are ignored.
+    int guidance_gain = 0;
+    int guidance_max_penalty = 0;
   };
+
+  /// Bounds of Params::guidance_gain and guidance_max_penalty (16-bit arithmetic).
+  static constexpr int kMaxGuidanceGain = 1000;
+  static constexpr int kMaxGuidancePenalty = 4000;
 
   SemiGlobalMatcher() = default;
   explicit SemiGlobalMatcher(const Params& params) { setParams(params); }
@@ -67,6 +78,16 @@ public:
   /// Throws InvalidInputError for images that are empty, not 8-bit grey, of different sizes
   /// or wider than maxWidth(), and when the CPU has no AVX2.
   void compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity);
+  /// The same, guided by `guidance` (Poggi et al., "Guided Stereo Matching", CVPR 2019):
+  /// CV_16SC1 of the images' size, disparity x 16 of the left view, <= 0 where there is no
+  /// hint (such as projected LiDAR returns). Pixels without a hint have their own costs, but
+  /// the paths bring the hints' costs to them. Empty `guidance`: exactly compute() without
+  /// it. Throws InvalidInputError for a guidance of another type or size, and when
+  /// min_disparity + num_disparities exceeds maxGuidedDisparity().
+  void compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity, const cv::Mat& guidance);
+
+  /// Largest |disparity| that guidance handles (its lanes are 16-bit, in 1/16 px).
+  static int maxGuidedDisparity();
 
 private:
   Params params_;

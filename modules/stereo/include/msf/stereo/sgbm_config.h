@@ -39,6 +39,19 @@ struct SgbmConfig {
   bool match_left_border = false;
   bool prior_search_range = true;  ///< narrow num_disparities to a depth prior when given
   int prior_margin_px = 8;         ///< disparities beyond the prior's largest
+  /// Guided matching (Poggi et al., CVPR 2019): lidar: the projected LiDAR returns given to
+  /// SgbmStereo::setGuidance raise the cost of disparities away from theirs at their pixels
+  /// (and at the rows bridged between them), by min(guidance_gain * |d - d_lidar|,
+  /// guidance_max_penalty), and the paths carry that on to the pixels around; none: ignored.
+  /// The native engine's (where OpenCV runs instead, a one-time note says it is ignored).
+  /// Defaults measured on odometry 04 (protocol 2): fused D1 3.29 -> 3.11 %, MAE 1.088 -> 1.042 m.
+  std::string guidance = "lidar";
+  int guidance_gain = 400;         ///< cost per pixel of disparity, 0..1000
+  int guidance_max_penalty = 1500; ///< 0..4000 (P2 is 800 at block 5)
+  /// Rows between two returns of a column bridged by hints linear between theirs (guidanceHints),
+  /// when their disparities differ by at most guidance_bridge_agreement of the larger; 0: none.
+  int guidance_bridge_rows = 48;
+  float guidance_bridge_agreement = 0.25f;
   float max_depth_m = 0.f;         ///< drop depths beyond this; 0 keeps all
   int color_camera = 2;            ///< camera whose image colours the cloud
   StereoConfidenceConfig confidence;
@@ -50,6 +63,8 @@ struct SgbmConfig {
   int opencvMode() const;
   /// True when engine is native (whether or not the CPU can run it).
   bool nativeEngine() const;
+  /// True when guidance is lidar (false for none).
+  bool lidarGuidance() const;
 
   /// Overrides the keys present in `node` (the `stereo` section), then validates.
   void read(const cv::FileNode& node);

@@ -21,6 +21,7 @@ namespace msf {
 ///   stereo.setInputImages(left, right);          // KITTI image_0, image_1
 ///   stereo.setInputColor(color);                  // image_2, optional
 ///   stereo.setDepthPrior(lidar_depth);            // optional: narrows the search range
+///   stereo.setGuidance(lidar_sparse);             // optional, with config.guidance lidar
 ///   pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
 ///   stereo.compute(cloud);                        // width x height of the images
 ///
@@ -49,6 +50,11 @@ public:
   /// Depth prior (CV_32F metres, 0 = none), such as the interpolated LiDAR depth; with
   /// config.prior_search_range it narrows the disparity search. Empty: no prior.
   void setDepthPrior(const cv::Mat& depth) { prior_ = depth; }
+  /// Sparse depth that guides the matching when config.guidance is lidar (CV_32F metres,
+  /// 0 = none): the projected LiDAR returns (LidarProjector::projectToImage), never an
+  /// interpolation, whose errors the paths would spread. Each return's disparity f B / z
+  /// becomes a hint of SemiGlobalMatcher::compute. Empty, or guidance none: unguided.
+  void setGuidance(const cv::Mat& sparse_depth) { guidance_ = sparse_depth; }
 
   /// Matches the pair: fills getDisparity() and getConfidence().
   /// Throws InvalidInputError naming the image at fault (missing, empty, sizes differ,
@@ -76,15 +82,16 @@ public:
   const std::string& getEngineUsed() const { return engine_used_; }
 
 private:
-  cv::Mat match(const cv::Mat& left, const cv::Mat& right, int num_disparities);
-  void runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, cv::Mat& fixed);
+  cv::Mat match(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints);
+  void runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints,
+                  cv::Mat& fixed);
   bool nativeRuns(int width) const;
   void checkInputs() const;
 
   Config config_;
   Calibration calibration_;
   bool has_calibration_{false};
-  cv::Mat left_, right_, color_, prior_;
+  cv::Mat left_, right_, color_, prior_, guidance_;
   cv::Mat disparity_, confidence_;
   int searched_disparities_{0};
   std::string engine_used_;
