@@ -57,24 +57,42 @@ msf::HoldoutMethod lidar(const msf::ConfigFile& file, msf::CompletionMethod meth
   };
 }
 
-/// SGBM on the grey pair (section stereo); with `prior`, its search narrowed by the compound
-/// interpolation of the input rings, whose time then counts too.
-msf::HoldoutMethod stereo(const msf::ConfigFile& file, bool prior) {
+/// How SGBM uses the input rings.
+enum class StereoInput {
+  None,   ///< the grey pair alone
+  Prior,  ///< its search narrowed by the compound interpolation of the input rings, unguided
+  Guided  ///< the same, and guided by the projected input rings
+};
+
+/// SGBM on the grey pair (section stereo); the time of the LiDAR it uses counts too.
+msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
   msf::SgbmConfig config;
   config.read(file.section("stereo"));
+  config.guidance = input == StereoInput::Guided ? "lidar" : "none";
+  msf::ProjectionConfig projection;
+  projection.read(file.section("projection"));
   auto completion = lidar(file, msf::CompletionMethod::Compound);
   auto sgbm = std::make_shared<msf::SgbmStereo>(config);
-  return [=](const msf::HoldoutInput& in) {
+  std::shared_ptr<msf::LidarProjector> projector;
+  return [=](const msf::HoldoutInput& in) mutable {
     sgbm->setCalibration(*in.calibration);
     sgbm->setInputImages(in.left, in.right);
-    sgbm->setDepthPrior(prior ? completion(in) : cv::Mat());
+    sgbm->setDepthPrior(input != StereoInput::None ? completion(in) : cv::Mat());
+    cv::Mat sparse;
+    if (input == StereoInput::Guided) {
+      if (!projector)
+        projector = std::make_shared<msf::LidarProjector>(*in.calibration, projection);
+      projector->projectToImage(*in.scan, sparse); // the input rings only
+    }
+    sgbm->setGuidance(sparse);
     sgbm->computeDisparity();
     return sgbm->getDepth();
   };
 }
 
-/// Paper steps 1-4: compound interpolation of the input rings, SGBM narrowed by it, and the
-/// per-pixel fusion of the two (section fusion, its method forced to `method`).
+/// Paper steps 1-4: compound interpolation of the input rings, SGBM narrowed by it (and
+/// guided by the projected input rings with stereo.guidance lidar), and the per-pixel
+/// fusion of the two (section fusion, its method forced to `method`).
 msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) {
   msf::ProjectionConfig projection;
   projection.read(file.section("projection"));
@@ -97,6 +115,10 @@ msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) 
     sgbm->setCalibration(*in.calibration);
     sgbm->setInputImages(in.left, in.right);
     sgbm->setDepthPrior(lidar_depth);
+    cv::Mat sparse;
+    if (stereo_config.lidarGuidance())
+      completion->projector().projectToImage(*in.scan, sparse); // the input rings only
+    sgbm->setGuidance(sparse);
     sgbm->computeDisparity();
     fuser->setCalibration(*in.calibration);
     fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
@@ -118,12 +140,14 @@ const std::vector<MethodEntry>& methodTable() {
       {"ipbasic_multiscale", "IP-Basic multiscale, same projection",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicMultiscale); }},
       {"sgbm", "3-way SGBM on the grey pair (section stereo, stereo.engine), no LiDAR",
-       [](const msf::ConfigFile& f) { return stereo(f, false); }},
-      {"sgbm_prior", "the same, its search narrowed by the interpolated input rings",
-       [](const msf::ConfigFile& f) { return stereo(f, true); }},
-      {"fused_paper", "interpolated + sgbm_prior fused by eq. 6 (section fusion)",
+       [](const msf::ConfigFile& f) { return stereo(f, StereoInput::None); }},
+      {"sgbm_prior", "the same, its search narrowed by the interpolated input rings, unguided",
+       [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Prior); }},
+      {"sgbm_guided", "sgbm_prior guided by the projected input rings (stereo.guidance_*)",
+       [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Guided); }},
+      {"fused_paper", "interpolated + SGBM fused by eq. 6 (section fusion; sgbm_guided with stereo.guidance lidar)",
        [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Paper); }},
-      {"fused_uncertainty", "interpolated + sgbm_prior fused by inverse variance",
+      {"fused_uncertainty", "the same fused by inverse variance",
        [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Uncertainty); }},
   };
   return table;
