@@ -9,13 +9,17 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
+#include <msf/range_image/point_types.h>
+#include <msf/range_image/real_returns.h>
 #include <msf/stereo/point_types.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <pcl/common/io.h>
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
+#include <pcl/conversions.h>
 #include <pcl/point_types.h>
 
 #include <cmath>
@@ -35,13 +39,37 @@ void printHelp(const char* name) {
   print_info("    -color PATH            colour camera image (image_2), projected for each point's colour;\n");
   print_info("                           without it the colour is the left image's grey\n");
   print_info("    -disparity_png PATH    also write the disparity as a KITTI 16-bit PNG (pixels x 256)\n");
-  print_info("    -prior PATH            organized depth cloud (the interpolated LiDAR) that narrows the search\n");
+  print_info("    -prior PATH            organized depth cloud (the interpolated LiDAR) that narrows the search;\n");
+  print_info("                           with stereo.guidance lidar its real returns (distance 0) guide it\n");
   print_info("    -config FILE           YAML config, section stereo (every SGBM parameter)\n");
   print_info("    -num_disparities N     search range without a prior (multiple of 16; default 128)\n");
   print_info("    -block_size N          odd block size (default 5)\n");
   print_info("    -mode NAME             sgbm_3way (default) | sgbm | hh | hh4\n");
   print_info("    -lr_check              drop matches that fail a left-right check (twice the time)\n");
   print_info("    -print_config          print the stereo settings in use\n");
+}
+
+/// The prior's depth and, for guided matching, its real returns: the points whose `distance`
+/// to the nearest real return is 0 (msf_interpolate writes that field).
+void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& guidance) {
+  pcl::PCLPointCloud2 blob;
+  msf::loadCloudBlob(path, blob);
+  if (!guided || pcl::getFieldIndex(blob, "distance") < 0) {
+    if (guided)
+      print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    pcl::fromPCLPointCloud2(blob, cloud);
+    prior = msf::cloudToDepthImage(cloud);
+    return;
+  }
+  pcl::PointCloud<msf::PointXYZID> cloud;
+  pcl::fromPCLPointCloud2(blob, cloud);
+  prior = msf::cloudToDepthImage(cloud);
+  cv::Mat distance(prior.size(), CV_32FC1);
+  for (int v = 0; v < distance.rows; ++v)
+    for (int u = 0; u < distance.cols; ++u)
+      distance.at<float>(v, u) = cloud.at(u, v).distance;
+  guidance = msf::realReturns(prior, distance);
 }
 
 } // namespace
@@ -96,12 +124,9 @@ int main(int argc, char** argv) {
     cv::Mat color;
     if (!color_path.empty())
       color = msf::readImage(color_path, cv::IMREAD_COLOR);
-    cv::Mat prior;
-    if (!prior_path.empty()) {
-      pcl::PointCloud<pcl::PointXYZ> prior_cloud;
-      msf::loadCloud(prior_path, prior_cloud);
-      prior = msf::cloudToDepthImage(prior_cloud);
-    }
+    cv::Mat prior, guidance;
+    if (!prior_path.empty())
+      loadPrior(prior_path, config.lidarGuidance(), prior, guidance);
     msf::tool::printDone(tt.toc(), static_cast<std::size_t>(left.total()));
 
     tt.tic();
@@ -111,6 +136,7 @@ int main(int argc, char** argv) {
     stereo.setInputImages(left, right);
     stereo.setInputColor(color);
     stereo.setDepthPrior(prior);
+    stereo.setGuidance(guidance);
     pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
     stereo.compute(cloud);
     std::size_t valid = 0;

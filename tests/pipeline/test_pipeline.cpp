@@ -96,6 +96,12 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   ASSERT_EQ(a.size(), b.size());
   EXPECT_GT(cv::countNonZero(a), a.total() / 2);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << "fused depth differs between the pipeline and the tools";
+  // Both sides were guided by the real returns (stereo.guidance lidar, the default): without
+  // guidance the depth differs.
+  msf::PipelineConfig unguided;
+  unguided.stereo.guidance = "none";
+  msf::Pipeline plain(sequence.calibration(), unguided);
+  EXPECT_GT(cv::norm(a, plain.computeDepth(frame).fused.depth, cv::NORM_INF), 0.0);
 }
 
 TEST_F(PipelineTest, RunIntegratesEveryFrameInOrderAndStopsCleanly) {

@@ -4,6 +4,7 @@
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
 #include <msf/range_image/lidar_completion.h>
+#include <msf/range_image/real_returns.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
@@ -71,8 +72,11 @@ void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
 void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   stages_->stereo.setInputImages(frame.left, frame.right);
-  // With the prior, SGBM searches only the disparities the interpolated LiDAR allows.
+  // With the prior, SGBM searches only the disparities the interpolated LiDAR allows; guided,
+  // the real returns among it steer the matching.
   stages_->stereo.setDepthPrior(config_.scheduling.stereo_prior ? result.lidar_depth : cv::Mat());
+  stages_->stereo.setGuidance(config_.stereo.lidarGuidance() ? realReturns(result.lidar_depth, result.lidar_distance)
+                                                             : cv::Mat());
   stages_->stereo.computeDisparity();
   result.stereo_depth = stages_->stereo.getDepth();
   result.stereo_confidence = stages_->stereo.getConfidence(); // a new image each frame
@@ -93,10 +97,14 @@ void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
   result.times.fusion_ms = msSince(start);
 }
 
+bool Pipeline::lidarBeforeStereo() const {
+  return config_.scheduling.stereo_prior || config_.stereo.lidarGuidance();
+}
+
 FrameResult Pipeline::computeDepth(const Frame& frame) {
   FrameResult result = startFrame(frame);
   const auto depth_start = Clock::now();
-  if (config_.scheduling.stereo_prior) {
+  if (lidarBeforeStereo()) {
     computeLidar(frame, result);
     computeStereo(frame, result);
   } else {
@@ -128,7 +136,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
                                  const FrameCallback& on_frame, const std::atomic<bool>* stop) {
   struct Loaded {
     Frame frame;
-    FrameResult result;  // with the stereo prior, steps 1-2 are already done
+    FrameResult result;  // with the stereo prior or guidance, steps 1-2 are already done
     double load_ms;
   };
   const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
@@ -162,8 +170,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
         Loaded item{sequence.load(i), FrameResult(), 0.0};
         item.load_ms = msSince(start);
         item.result = startFrame(item.frame);
-        // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior.
-        if (config_.scheduling.stereo_prior)
+        // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior or guidance.
+        if (lidarBeforeStereo())
           computeLidar(item.frame, item.result);
         if (!loaded.push(std::move(item)))
           break;
@@ -179,7 +187,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
         if (stop && stop->load())
           break; // a frame not started is dropped: a stop should be prompt
         FrameResult result;
-        if (config_.scheduling.stereo_prior) {
+        if (lidarBeforeStereo()) {
           result = std::move(item->result);
           const auto start = Clock::now();
           computeStereo(item->frame, result);

@@ -105,6 +105,9 @@ private:
   struct Stages;  // the stage objects, which keep their buffers from frame to frame
 
   FrameResult startFrame(const Frame& frame) const;
+  /// Steps 1-2 before SGBM: its search range (stereo prior) or its guidance comes from them;
+  /// otherwise they run beside it.
+  bool lidarBeforeStereo() const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
