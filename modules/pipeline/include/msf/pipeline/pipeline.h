@@ -51,8 +51,9 @@ struct FrameResult {
 /// (LidarCompletion::computeDepth, SgbmStereo::getDepth, DepthImageFusion), which is faster.
 ///
 /// With `pipeline.stereo_prior` (the default) SGBM searches only the disparities that the
-/// interpolated LiDAR allows, so steps 1-2 run first; otherwise they run beside SGBM.
-/// run() overlaps frames: loading (with steps 1-2 when they feed the prior), stereo +
+/// interpolated LiDAR allows, and with `stereo.guidance: lidar` (the default) the LiDAR's
+/// real returns guide it, so steps 1-2 run first; otherwise they run beside SGBM.
+/// run() overlaps frames: loading (with steps 1-2 when they feed SGBM), stereo +
 /// fusion, and integration each have a thread, joined by bounded queues, so the LiDAR of
 /// frame t+2 and the stereo of frame t+1 run while frame t integrates, and memory is
 /// bounded by the map, not by the number of frames.
