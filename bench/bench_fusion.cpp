@@ -6,6 +6,8 @@
 //
 //   bench_fusion [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 //   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
+#include "kitti_sample.h"
+
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/organized_conversion.h>
@@ -24,25 +26,20 @@
 
 namespace {
 
-std::string kittiDir() {
-  const char* env = std::getenv("MSF_KITTI_DIR");
-  return env ? env : MSF_KITTI_DIR;
-}
-
 struct Data {
   msf::Calibration calibration;
   std::vector<pcl::PointCloud<msf::PointXYZID>::Ptr> lidar;
   std::vector<pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr> stereo;
   std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence;
   Data() {
-    const msf::Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
     msf::LidarProjector projector(calibration);
     msf::CompoundInterpolation<msf::PointXYZID> interpolation;
     interpolation.setCamera(msf::PinholeCamera::fromCalibration(calibration));
     msf::SgbmStereo sgbm;
     sgbm.setCalibration(calibration);
-    for (std::size_t i = 0; i < 10 && i < sequence.size(); ++i) {
+    for (std::size_t i = 0; i < msf::bench::kFrames && i < sequence.size(); ++i) {
       const msf::Frame f = sequence.load(i, true);
       pcl::PointCloud<msf::PointXYZID>::Ptr sparse(new pcl::PointCloud<msf::PointXYZID>);
       pcl::PointCloud<msf::PointXYZID>::Ptr dense(new pcl::PointCloud<msf::PointXYZID>);

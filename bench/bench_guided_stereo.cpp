@@ -8,6 +8,8 @@
 //
 //   bench_guided_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 //   (MSF_KITTI_DIR overrides the compiled-in path of the KITTI sample)
+#include "kitti_sample.h"
+
 #include <msf/io/sequence.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/stereo/guidance_hints.h>
@@ -25,20 +27,15 @@
 
 namespace {
 
-std::string kittiDir() {
-  const char* env = std::getenv("MSF_KITTI_DIR");
-  return env ? env : MSF_KITTI_DIR;
-}
-
 /// The grey pairs, the projected scans and their compound interpolation, frames 0-9.
 struct Data {
   msf::Calibration calibration;
   std::vector<cv::Mat> left, right, sparse, prior;
   Data() {
-    const msf::Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
     msf::LidarCompletion completion(calibration);
-    for (std::size_t i = 0; i < 10 && i < sequence.size(); ++i) {
+    for (std::size_t i = 0; i < msf::bench::kFrames && i < sequence.size(); ++i) {
       const msf::Frame f = sequence.load(i, false);
       left.push_back(f.left);
       right.push_back(f.right);

@@ -5,6 +5,8 @@
 // disturbed by other processes on a shared machine). Wall-clock time, all OpenMP threads.
 //
 //   bench_lidar [--benchmark_filter=Compound]   (MSF_KITTI_DIR overrides the compiled-in path)
+#include "kitti_sample.h"
+
 #include <msf/io/pinhole_camera.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
@@ -24,19 +26,14 @@
 
 namespace {
 
-std::string kittiDir() {
-  const char* env = std::getenv("MSF_KITTI_DIR");
-  return env ? env : MSF_KITTI_DIR;
-}
-
 /// Scans of frames 0-9, loaded once.
 struct Data {
   msf::Calibration calibration;
   std::vector<pcl::PointCloud<pcl::PointXYZI>> scans;
   Data() {
-    const msf::Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
-    for (std::size_t i = 0; i < 10 && i < sequence.size(); ++i) {
+    for (std::size_t i = 0; i < msf::bench::kFrames && i < sequence.size(); ++i) {
       scans.emplace_back();
       msf::loadVelodyneBin(sequence.scanPath(i), scans.back());
     }

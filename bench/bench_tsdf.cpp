@@ -5,6 +5,8 @@
 //
 //   bench_tsdf [--benchmark_repetitions=5]   (MSF_KITTI_DIR overrides the compiled-in path,
 //                                             MSF_OPEN3D_PYTHON the interpreter, default /usr/bin/python3)
+#include "kitti_sample.h"
+
 #include <msf/common/statistics.h>
 #include <msf/io/calibration.h>
 #include <msf/io/image_io.h>
@@ -36,12 +38,7 @@ using namespace msf;
 namespace {
 
 constexpr double kVoxel = 0.1, kTrunc = 0.3, kMaxDepth = 40.0;
-constexpr int kFrames = 10;
-
-std::string kittiDir() {
-  const char* env = std::getenv("MSF_KITTI_DIR");
-  return env ? env : MSF_KITTI_DIR;
-}
+constexpr int kFrames = static_cast<int>(msf::bench::kFrames);
 
 /// SGBM depth of the KITTI frames (as DESIGN.md's baseline: 3-way, 128 disparities, block 5),
 /// also written as KITTI depth PNGs for the Open3D script.
@@ -50,7 +47,7 @@ struct Data {
   PoseList poses;
   std::string dir; // depth/, color/, poses.txt, camera.txt
   Data() {
-    const Sequence sequence(kittiDir() + "/odometry/sequences/04");
+    const Sequence sequence = msf::bench::kittiSequence();
     const PinholeCamera camera = PinholeCamera::fromCalibration(sequence.calibration());
     cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 25, 32 * 25, 1, 63, 10, 100, 2,
                                                           cv::StereoSGBM::MODE_SGBM_3WAY);
@@ -277,11 +274,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv))
     return 1;
-  if (!fs::is_directory(kittiDir() + "/odometry/sequences/04")) {
-    std::fprintf(stderr, "bench_tsdf: error: KITTI sample not found in '%s' (set MSF_KITTI_DIR)\n", kittiDir().c_str());
-    return 1;
-  }
-  data(); // SGBM once, before any timing
+  data(); // SGBM once, before any timing (exits with an error without the KITTI sample)
   benchmark::RunSpecifiedBenchmarks();
 
   // Both with every core (2 here), then both on one thread: the CPU time per frame is what

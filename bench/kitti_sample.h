@@ -1,0 +1,33 @@
+#pragma once
+// The KITTI sample the benchmarks time: odometry sequence 04, frames 0-9 (../shared/data/kitti;
+// KITTI data is never copied into the repository).
+#include <msf/io/sequence.h>
+
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+
+namespace msf::bench {
+
+/// The sample's folder: MSF_KITTI_DIR in the environment, else the path CMake compiled in.
+inline std::string kittiDir() {
+  const char* env = std::getenv("MSF_KITTI_DIR");
+  return env ? env : MSF_KITTI_DIR;
+}
+
+/// Odometry sequence 04 of the sample; without it, a clear error and exit code 1.
+inline Sequence kittiSequence() {
+  try {
+    return Sequence(kittiDir() + "/odometry/sequences/04");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: no KITTI sample: %s (set MSF_KITTI_DIR)\n", e.what());
+    std::exit(1);
+  }
+}
+
+/// Frames of it that the benchmarks time.
+constexpr std::size_t kFrames = 10;
+
+} // namespace msf::bench
