@@ -93,15 +93,13 @@ void BM_MatcherOneCore(benchmark::State& state, bool guided) {
     hints.push_back(guided ? msf::guidanceHints(sparse, d.calibration.focalBaseline(), config.guidance_bridge_rows,
                                                 config.guidance_bridge_agreement)
                            : cv::Mat());
-  const int threads = cv::getNumThreads();
-  cv::setNumThreads(1);
+  const msf::bench::OneThread one_thread;
   cv::Mat disparity;
   std::size_t i = 0;
   for (auto _ : state) {
     const std::size_t f = i++ % d.left.size();
     matcher.compute(d.left[f], d.right[f], disparity, hints[f]);
   }
-  cv::setNumThreads(threads);
 }
 
 } // namespace

@@ -171,8 +171,7 @@ void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
     state.SkipWithError("this CPU has no AVX-512BW");
     return;
   }
-  const int threads = cv::getNumThreads();
-  cv::setNumThreads(1);
+  const msf::bench::OneThread one_thread;
   cv::Mat disparity;
   std::size_t i = 0;
   for (auto _ : state) {
@@ -182,7 +181,6 @@ void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
     else
       native.compute(d.left[f], d.right[f], disparity);
   }
-  cv::setNumThreads(threads);
   msf::SemiGlobalMatcher::setAvx512Enabled(true);
 }
 

@@ -3,6 +3,8 @@
 // KITTI data is never copied into the repository).
 #include <msf/io/sequence.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
@@ -29,5 +31,18 @@ inline Sequence kittiSequence() {
 
 /// Frames of it that the benchmarks time.
 constexpr std::size_t kFrames = 10;
+
+/// OpenCV's parallel loops on the calling thread while it lives: per-core costs, steadier
+/// than wall time on a machine shared with other work.
+class OneThread {
+public:
+  OneThread() : threads_(cv::getNumThreads()) { cv::setNumThreads(1); }
+  ~OneThread() { cv::setNumThreads(threads_); }
+  OneThread(const OneThread&) = delete;
+  OneThread& operator=(const OneThread&) = delete;
+
+private:
+  int threads_;
+};
 
 } // namespace msf::bench
