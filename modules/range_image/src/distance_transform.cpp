@@ -17,11 +17,12 @@ namespace msf {
 
 namespace {
 
-/// A squared distance meaning "no sample": far above any real one (< 2^18 here), and a
-/// real squared row distance added to it stays below 2^31.
+/// Longest side handled, so that every real squared distance (at most 2 x 8192^2 = 2^27)
+/// stays below kNone.
+constexpr int kMaxSide = 1 << 13;
+/// A squared distance meaning "no sample": above any real one, and a squared row distance
+/// added to it stays below 2^31.
 constexpr std::int32_t kNone = 1 << 28;
-/// Longest side handled: (side + kFar)^2 of rowDistances stays below 2^31.
-constexpr int kMaxSide = 1 << 14;
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
 #define MSF_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
@@ -34,7 +35,7 @@ constexpr int kMaxSide = 1 << 14;
 /// branches: where the samples are is unpredictable.
 MSF_VECTOR_CLONES void rowDistances(const float* __restrict d, int W, std::int32_t* __restrict h2,
                                     std::int32_t* __restrict column) {
-  constexpr std::int32_t kFar = 1 << 14; // beyond any image width the kernel sees
+  constexpr std::int32_t kFar = 1 << 14; // beyond any width handled; (W + kFar)^2 < 2^31
   std::int32_t last = -kFar;
   for (int c = 0; c < W; ++c) {
     last = d[c] > 0.f ? c : last;
