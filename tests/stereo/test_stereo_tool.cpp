@@ -1,6 +1,7 @@
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
+#include <msf/range_image/point_types.h>
 #include <msf/stereo/point_types.h>
 
 #include "stereo_scenes.h"
@@ -63,6 +64,29 @@ TEST(StereoTool, ConfigSectionAndOverrides) {
                                            config + " -num_disparities 32");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(32 disparities)"), std::string::npos) << r.out;
+}
+
+TEST(StereoTool, APriorGuidesThroughItsRealReturnsOnly) {
+  Scene s;
+  // The prior of msf_interpolate: organized, with `distance` 0 on the real returns.
+  pcl::PointCloud<msf::PointXYZID> with_distance(kSize.width, kSize.height);
+  pcl::PointCloud<pcl::PointXYZ> without(kSize.width, kSize.height);
+  for (int v = 0; v < kSize.height; ++v)
+    for (int u = 0; u < kSize.width; ++u) {
+      const float z = 250.f / 12.f;
+      with_distance.at(u, v) = msf::PointXYZID(0.f, 0.f, z, 0.f, v % 4 == 0 ? 0.f : 1.f);
+      without.at(u, v) = pcl::PointXYZ(0.f, 0.f, z);
+    }
+  const std::string guided = s.dir.file("lidar.pcd"), plain = s.dir.file("xyz.pcd");
+  msf::saveCloud(guided, with_distance);
+  msf::saveCloud(plain, without);
+  auto r = msf::test::runTool("msf_stereo", s.args("-prior " + guided));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("distance"), std::string::npos) << r.err;
+  r = msf::test::runTool("msf_stereo", s.args("-prior " + plain));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("has no field 'distance'"), std::string::npos) << r.err;
+  EXPECT_TRUE(msf::test::fileExists(s.out));
 }
 
 TEST(StereoTool, BadInputFailsAndLeavesNoOutput) {
