@@ -117,11 +117,7 @@ msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::s
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_eval_disparity", [&] {
-    if (argc < 3 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_eval_disparity", 3, printHelp, [&] {
     const std::vector<std::string> value_options{"-obj_map", "-obj_map_dir", "-abs_px", "-rel"};
     msf::tool::checkOptions(argc, argv, value_options, {"-interpolate"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);

@@ -82,11 +82,7 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_fuse", [&] {
-    if (argc < 4 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_fuse", 4, printHelp, [&] {
     const std::vector<std::string> value_options{"-calib", "-method", "-config", "-color"};
     msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);

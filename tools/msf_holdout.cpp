@@ -297,11 +297,7 @@ void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& r
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_holdout", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_holdout", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv"};
     msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout", "-breakdown"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);

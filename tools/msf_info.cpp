@@ -75,11 +75,7 @@ void describe(const std::string& path) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_info", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_info", 2, printHelp, [&] {
     msf::tool::checkOptions(argc, argv, {}, {});
     for (const auto& path : msf::tool::positionalArguments(argc, argv, {}))
       describe(path);

@@ -53,11 +53,7 @@ std::size_t countValid(const pcl::PointCloud<msf::PointXYZID>& cloud) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_interpolate", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_interpolate", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-method", "-config", "-calib", "-camera",
                                                  "-short_gap", "-max_gap", "-threads"};
     msf::tool::checkOptions(argc, argv, value_options, {"-no_gaussian"});

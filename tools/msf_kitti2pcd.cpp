@@ -62,11 +62,7 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_kitti2pcd", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_kitti2pcd", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-input_dir", "-output_dir"};
     msf::tool::checkOptions(argc, argv, value_options, {"-ascii"});
     const bool ascii = find_switch(argc, argv, "-ascii");

@@ -93,9 +93,5 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-  if (msf::tool::wantsHelp(argc, argv) || argc < 2) {
-    printHelp(argv[0]);
-    return argc < 2 ? 1 : 0;
-  }
-  return msf::tool::run("msf_lambda_study", [&] { return run(argc, argv); });
+  return msf::tool::runWithHelp(argc, argv, "msf_lambda_study", 2, printHelp, [&] { return run(argc, argv); });
 }

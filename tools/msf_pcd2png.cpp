@@ -33,11 +33,7 @@ void printHelp(const char* name) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_pcd2png", [&] {
-    if (argc < 3 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_pcd2png", 3, printHelp, [&] {
     const std::vector<std::string> value_options{"-calib", "-range"};
     msf::tool::checkOptions(argc, argv, value_options, {"-disparity", "-color"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);

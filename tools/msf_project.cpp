@@ -35,11 +35,7 @@ void printHelp(const char* name) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_project", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_project", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-calib", "-camera", "-config", "-min_range", "-max_range"};
     msf::tool::checkOptions(argc, argv, value_options, {});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);

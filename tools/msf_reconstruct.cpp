@@ -168,11 +168,7 @@ std::string generateDefaultStreet(const std::string& dir) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_reconstruct", [&] {
-    if (msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
     const std::vector<std::string> value_options{"-o", "-config", "-frames", "-voxel", "-lambda", "-panels"};
     msf::tool::checkOptions(argc, argv, value_options, {"-save_depth"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);

@@ -75,11 +75,7 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_stereo", [&] {
-    if (argc < 4 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return msf::tool::wantsHelp(argc, argv) ? 0 : 1;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_stereo", 4, printHelp, [&] {
     const std::vector<std::string> value_options{"-calib", "-color", "-disparity_png", "-prior", "-config",
                                                  "-num_disparities", "-block_size", "-mode"};
     msf::tool::checkOptions(argc, argv, value_options, {"-lr_check", "-print_config"});

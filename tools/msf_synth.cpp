@@ -61,11 +61,7 @@ int intOption(int argc, char** argv, const char* option, int fallback, int lo, i
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::run("msf_synth", [&] {
-    if (argc < 2 || msf::tool::wantsHelp(argc, argv)) {
-      printHelp(argv[0]);
-      return argc < 2 ? 1 : 0;
-    }
+  return msf::tool::runWithHelp(argc, argv, "msf_synth", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-o", "-frames", "-seed", "-scene", "-config"};
     msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);

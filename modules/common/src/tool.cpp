@@ -31,6 +31,16 @@ bool wantsHelp(int argc, char** argv) {
   return false;
 }
 
+int runWithHelp(int argc, char** argv, const char* name, int min_argc, void (*print_help)(const char*),
+                const std::function<int()>& body) {
+  const bool help = wantsHelp(argc, argv);
+  if (help || argc < min_argc) {
+    print_help(argv[0]);
+    return help ? 0 : 1;
+  }
+  return run(name, body);
+}
+
 namespace {
 bool contains(const std::vector<std::string>& list, const char* arg) {
   return std::find(list.begin(), list.end(), std::string(arg)) != list.end();

@@ -14,6 +14,11 @@ int run(const char* name, const std::function<int()>& body);
 /// True when -h, --help or -help is among the arguments.
 bool wantsHelp(int argc, char** argv);
 
+/// A tool's main: `print_help` and exit code 0 on -h (wantsHelp), `print_help` and 1 with
+/// fewer than `min_argc` arguments (the program's name counts), else `body` under run().
+int runWithHelp(int argc, char** argv, const char* name, int min_argc, void (*print_help)(const char*),
+                const std::function<int()>& body);
+
 /// Throws msf::InvalidInputError naming the first argument that starts with '-' and is
 /// neither in `value_options` (which consume the next argument) nor in `switches`.
 /// PCL's parser ignores unknown options; a typo should not silently do the default.
