@@ -130,4 +130,26 @@ TEST(Tool, RunTurnsExceptionsIntoExitCodeOne) {
   EXPECT_EQ(msf::tool::run("msf_test", []() -> int { throw msf::IOError("boom"); }), 1);
 }
 
+int help_calls = 0;
+void countHelp(const char*) { ++help_calls; }
+
+TEST(Tool, RunWithHelpShowsTheHelpOrRunsTheBody) {
+  const char* help[] = {"tool", "a.pcd", "-h"};
+  const char* few[] = {"tool"};
+  const char* enough[] = {"tool", "a.pcd", "b.pcd"};
+  int ran = 0;
+  const auto body = [&] { return ++ran, 7; };
+  help_calls = 0;
+  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(help), "msf_test", 5, countHelp, body), 0);
+  EXPECT_EQ(msf::tool::runWithHelp(1, const_cast<char**>(few), "msf_test", 3, countHelp, body), 1);
+  EXPECT_EQ(help_calls, 2);
+  EXPECT_EQ(ran, 0);
+  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(enough), "msf_test", 3, countHelp, body), 7);
+  EXPECT_EQ(ran, 1);
+  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(enough), "msf_test", 3, countHelp,
+                                   []() -> int { throw msf::IOError("boom"); }),
+            1);
+  EXPECT_EQ(help_calls, 2);
+}
+
 } // namespace
