@@ -222,6 +222,23 @@ struct Guide {
     const Reg distance = V::minu16(V::abs16(V::subs16(d, hint)), cap);
     return V::min16(V::sixteenthU16(V::mullo16(distance, gain)), max_penalty);
   }
+
+  /// A pixel's hint (0: none) and the hint in every lane.
+  struct Pixel {
+    int hint;
+    Reg lanes;
+  };
+  /// The pixel of image column x.
+  MSF_SIMD_INLINE Pixel at(int x) const {
+    const int hint = hints ? hints[x] : 0;
+    return {hint, V::set16(hint)};
+  }
+  /// The block costs of vector k at `pixel`, with their penalties where it has a hint.
+  MSF_SIMD_INLINE Reg guided(Reg cost, const Pixel& pixel, int k) const {
+    if (pixel.hint > 0)
+      cost = V::adds16(cost, penalty(pixel.lanes, k));
+    return cost;
+  }
 };
 
 /// One path's state while its D disparities are swept a vector at a time, updating `costs`
@@ -319,13 +336,10 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     PathSweep top_path(top_x, K, top_minima[xi], p2);
     PathSweep left_path(left, K, left_min, p2);
     std::int16_t* sums_x = sums + static_cast<std::size_t>(xi) * D;
-    const int hint = guide.hints ? guide.hints[xi + layout.min_x] : 0;
-    const Reg hint_vector = V::set16(hint);
+    const Guide::Pixel pixel = guide.at(xi + layout.min_x);
 #pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
-      Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
-      if (hint > 0)
-        cost = V::adds16(cost, guide.penalty(hint_vector, k));
+      const Reg cost = guide.guided(nextCost(strip, box, entering, leaving, step, k, K), pixel, k);
       const Reg t = top_path.step(k, cost, p1);
       if constexpr (kOutput)
         V::store(sums_x + kLanes * k, V::adds16(left_path.step(k, cost, p1), t));
@@ -376,13 +390,10 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
     PathSweep right_path(right, K, right_min, s.p2);
     // Per lane: the smallest total so far and the vector k where it was (the first on ties).
     Reg best_cost = V::set16(0x7FFF), best_k = V::set16(0);
-    const int hint = guide.hints ? guide.hints[xi + layout.min_x] : 0;
-    const Reg hint_vector = V::set16(hint);
+    const Guide::Pixel pixel = guide.at(xi + layout.min_x);
 #pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
-      Reg cost = nextCost(strip, box, entering, leaving, step, k, K);
-      if (hint > 0)
-        cost = V::adds16(cost, guide.penalty(hint_vector, k));
+      const Reg cost = guide.guided(nextCost(strip, box, entering, leaving, step, k, K), pixel, k);
       const Reg sum = V::adds16(right_path.step(k, cost, p1), V::load(sums_x + kLanes * k));
       V::store(total + kLanes * k, sum);
       best_k = V::whereLess(sum, best_cost, V::set16(k), best_k);
