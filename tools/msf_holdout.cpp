@@ -184,7 +184,8 @@ void printHelp(const char* name) {
   print_info("    -csv FILE        also write the rows as CSV\n");
   print_info("    -breakdown       ring hold-out: also each method's rows for the ground truth that camera 0 sees\n"
              "                     (visible) and cannot see (hidden: an input return within 1 px in front of it),\n"
-             "                     and for the depth bands < 20, 20-40, >= 40 m; 'MAE part' adds up to the MAE\n");
+             "                     and for the depth bands < 20, 20-40, >= 40 m; 'MAE part' adds up to the MAE;\n"
+             "                     and the share of estimates off by >= 10 m (another surface) with their part of it\n");
 }
 
 std::vector<std::string> split(const std::string& text) {

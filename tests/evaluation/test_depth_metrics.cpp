@@ -37,6 +37,24 @@ TEST(DepthMetrics, KnownAnswers) {
   EXPECT_NEAR(m.d1_all, 1.0 / 3.0, 1e-12);
 }
 
+TEST(DepthMetrics, GrossErrorsAreTheEstimatesOnAnotherSurface) {
+  // Errors 1, 9.99, 10 and 30 m: the last two are gross (>= 10 m); the pixel without an
+  // estimate is no error at all.
+  const cv::Mat gt = image({10.f, 20.f, 40.f, 50.f, 8.f}, 5);
+  const cv::Mat est = image({11.f, 29.99f, 30.f, 20.f, 0.f}, 5);
+  const msf::DepthMetrics m = msf::computeDepthMetrics(gt, est, 100.0);
+  ASSERT_EQ(m.estimated, 4u);
+  EXPECT_NEAR(m.gross_share, 0.5, 1e-12);
+  EXPECT_NEAR(m.gross_mae_part_m, (10.0 + 30.0) / 4, 1e-5);
+  EXPECT_LT(m.gross_mae_part_m, m.mae_m); // a part of the MAE
+  // Pooled over frames like the other metrics.
+  msf::DepthErrorAccumulator two;
+  two.add(gt, est, 100.0);
+  two.add(gt, gt, 100.0);
+  EXPECT_NEAR(two.metrics().gross_share, 2.0 / 9, 1e-12); // 4 estimates, then 5 exact ones
+  EXPECT_NEAR(two.metrics().gross_mae_part_m, (10.0 + 30.0) / 9, 1e-5);
+}
+
 TEST(DepthMetrics, D1NeedsBothThreePixelsAndFivePercent) {
   // f B = 100: gt 2 m is d = 50 px, gt 1 m is d = 100 px.
   const cv::Mat gt = image({2.f, 1.f, 2.f}, 3);
@@ -93,6 +111,7 @@ TEST(DepthMetrics, NothingToMeasureGivesNan) {
   EXPECT_EQ(missing.coverage, 0.0);
   EXPECT_EQ(missing.d1_all, 1.0);
   EXPECT_TRUE(std::isnan(missing.mae_m));
+  EXPECT_TRUE(std::isnan(missing.gross_share));
 }
 
 TEST(DepthMetrics, BadInputsNameTheProblem) {

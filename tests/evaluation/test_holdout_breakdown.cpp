@@ -119,7 +119,7 @@ TEST(HoldoutTool, BreakdownPrintsTheRegionsOfEachMethod) {
                                                        "/odometry/sequences/04' -frames 0:0 -methods interpolated "
                                                        "-breakdown");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* region : {"visible", "hidden", "z < 20 m", "z 20-40 m", "z >= 40 m", "MAE part"})
+  for (const char* region : {"visible", "hidden", "z < 20 m", "z 20-40 m", "z >= 40 m", "MAE part", "errors >= 10 m"})
     EXPECT_NE(r.out.find(region), std::string::npos) << region;
 }
 

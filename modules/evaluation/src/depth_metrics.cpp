@@ -40,6 +40,10 @@ void DepthErrorAccumulator::add(const cv::Mat& gt_depth, const cv::Mat& estimate
       const double err = std::abs(ze - zg);
       abs_ += err;
       sq_ += err * err;
+      if (err >= kGrossDepthErrorM) {
+        ++gross_;
+        gross_abs_ += err;
+      }
       const double inv_err = std::abs(1000.0 / ze - 1000.0 / zg); // 1/km
       inv_abs_ += inv_err;
       inv_sq_ += inv_err * inv_err;
@@ -56,6 +60,8 @@ void DepthErrorAccumulator::merge(const DepthErrorAccumulator& o) {
   gt_pixels_ += o.gt_pixels_;
   estimated_ += o.estimated_;
   d1_bad_ += o.d1_bad_;
+  gross_ += o.gross_;
+  gross_abs_ += o.gross_abs_;
   abs_ += o.abs_;
   sq_ += o.sq_;
   inv_abs_ += o.inv_abs_;
@@ -72,6 +78,7 @@ DepthMetrics DepthErrorAccumulator::metrics() const {
   m.d1_all = gt_pixels_ ? static_cast<double>(d1_bad_ + (gt_pixels_ - estimated_)) / gt_pixels_ : nan;
   if (estimated_ == 0) {
     m.mae_m = m.rmse_m = m.imae_per_km = m.irmse_per_km = m.d1_estimated = m.disparity_mae_px = nan;
+    m.gross_share = m.gross_mae_part_m = nan;
     return m;
   }
   const double n = static_cast<double>(estimated_);
@@ -81,6 +88,8 @@ DepthMetrics DepthErrorAccumulator::metrics() const {
   m.irmse_per_km = std::sqrt(inv_sq_ / n);
   m.d1_estimated = static_cast<double>(d1_bad_) / n;
   m.disparity_mae_px = disp_abs_ / n;
+  m.gross_share = static_cast<double>(gross_) / n;
+  m.gross_mae_part_m = gross_abs_ / n;
   return m;
 }
 

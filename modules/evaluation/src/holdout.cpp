@@ -133,6 +133,14 @@ std::string formatHoldoutBreakdown(const std::vector<HoldoutResult>& results) {
                     100.0 * m.d1_estimated, m.disparity_mae_px, m.mae_m, m.rmse_m, part);
       out << line;
     }
+  // Where a method's MAE comes from: a few estimates on the wrong surface, or noise everywhere.
+  std::snprintf(line, sizeof line, "\n%-20s %22s %10s\n", "method", "errors >= 10 m (share)", "MAE part");
+  out << line;
+  for (const auto& r : results) {
+    std::snprintf(line, sizeof line, "%-20s %21.2f%% %10.3f\n", r.method.c_str(), 100.0 * r.metrics.gross_share,
+                  r.metrics.gross_mae_part_m);
+    out << line;
+  }
   return out.str();
 }
 
@@ -140,13 +148,14 @@ void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& 
   writeAtomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp);
     out << "method,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
-           "imae_per_km,irmse_per_km,median_ms\n";
+           "imae_per_km,irmse_per_km,median_ms,gross_share,gross_mae_part_m\n";
     out.precision(6);
     for (const auto& r : results) {
       const DepthMetrics& m = r.metrics;
       out << r.method << ',' << r.frames << ',' << m.gt_pixels << ',' << m.estimated << ',' << m.coverage << ','
           << m.d1_all << ',' << m.d1_estimated << ',' << m.disparity_mae_px << ',' << m.mae_m << ',' << m.rmse_m
-          << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << r.median_ms << '\n';
+          << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << r.median_ms << ',' << m.gross_share << ','
+          << m.gross_mae_part_m << '\n';
     }
     out.flush();
     if (!out)

@@ -26,7 +26,13 @@ struct DepthMetrics {
   double d1_all = 0;           ///< share of ground-truth pixels that are bad or missing
   double d1_estimated = 0;     ///< share of estimated pixels that are bad
   double disparity_mae_px = 0; ///< mean |d_est - d_gt| (eq. 8), d = f B / z
+  /// Gross errors, |z_est - z_gt| >= kGrossDepthErrorM: the estimate is on another surface.
+  double gross_share = 0;      ///< share of estimated pixels with a gross error
+  double gross_mae_part_m = 0; ///< their part of mae_m (their errors over all estimates)
 };
+
+/// An error this large is another surface (an edge, a thin object, foliage), not noise.
+constexpr double kGrossDepthErrorM = 10.0;
 
 /// Sums of errors over one or more frames; pixels of all frames weigh the same.
 class DepthErrorAccumulator {
@@ -42,8 +48,8 @@ public:
   DepthMetrics metrics() const;
 
 private:
-  std::size_t gt_pixels_ = 0, estimated_ = 0, d1_bad_ = 0;
-  double abs_ = 0, sq_ = 0, inv_abs_ = 0, inv_sq_ = 0, disp_abs_ = 0;
+  std::size_t gt_pixels_ = 0, estimated_ = 0, d1_bad_ = 0, gross_ = 0;
+  double abs_ = 0, sq_ = 0, inv_abs_ = 0, inv_sq_ = 0, disp_abs_ = 0, gross_abs_ = 0;
 };
 
 /// The metrics of a single frame.
