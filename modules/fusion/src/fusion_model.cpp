@@ -1,4 +1,5 @@
 #include <msf/common/exceptions.h>
+#include <msf/common/vector_clones.h>
 #include <msf/fusion/fusion_model.h>
 
 #include <opencv2/core/utility.hpp>
@@ -8,6 +9,20 @@
 
 namespace msf {
 
+namespace {
+/// One row's disparities f B / z, as the largest (0 where none) and the smallest (+inf where none).
+MSF_VECTOR_CLONES void disparityBounds(const float* __restrict__ z, int cols, float fB, float* __restrict__ largest,
+                                       float* __restrict__ smallest) {
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int u = 0; u < cols; ++u) {
+    const bool ok = (z[u] > 0.f) & (z[u] < inf);
+    const float d = fB / (ok ? z[u] : 1.f);
+    largest[u] = ok ? d : 0.f;
+    smallest[u] = ok ? d : inf;
+  }
+}
+} // namespace
+
 void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& largest,
                             cv::Mat& smallest) {
   if (depth.type() != CV_32FC1)
@@ -15,22 +30,13 @@ void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int win
   if (window < 1 || window % 2 == 0)
     throw InvalidInputError("local disparity range: window must be odd and >= 1");
   const int rows = depth.rows, cols = depth.cols;
-  const float fB = static_cast<float>(focal_baseline), inf = std::numeric_limits<float>::infinity();
+  const float fB = static_cast<float>(focal_baseline);
   // Missing pixels are 0 for the maximum and +inf for the minimum, so both see only values.
   largest.create(rows, cols, CV_32FC1);
   smallest.create(rows, cols, CV_32FC1);
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
-    for (int v = r.start; v < r.end; ++v) {
-      const float* __restrict__ z = depth.ptr<float>(v);
-      float* __restrict__ h = largest.ptr<float>(v);
-      float* __restrict__ l = smallest.ptr<float>(v);
-      for (int u = 0; u < cols; ++u) {
-        const bool ok = (z[u] > 0.f) & (z[u] < inf);
-        const float d = fB / (ok ? z[u] : 1.f);
-        h[u] = ok ? d : 0.f;
-        l[u] = ok ? d : inf;
-      }
-    }
+    for (int v = r.start; v < r.end; ++v)
+      disparityBounds(depth.ptr<float>(v), cols, fB, largest.ptr<float>(v), smallest.ptr<float>(v));
   });
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(window, window));
   cv::dilate(largest, largest, kernel);
@@ -50,7 +56,7 @@ void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window
   }
 }
 
-void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
+MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
              const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
              const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
              const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,

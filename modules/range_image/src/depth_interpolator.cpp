@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/vector_clones.h>
 #include <msf/range_image/depth_interpolator.h>
 
 #include <pcl/console/print.h>
@@ -108,13 +109,6 @@ void DepthInterpolator::setConfig(const InterpolationConfig& config) {
 }
 
 namespace {
-
-// Hot loops that vectorize get an AVX2 clone chosen at load time where the CPU has it.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-#define MSF_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MSF_VECTOR_CLONES
-#endif
 
 /// Adds w times one row of estimates to the vertical sums: values (empty pixels are 0) and weights.
 MSF_VECTOR_CLONES void accumulateRow(const float* __restrict o, float w, float* __restrict v, float* __restrict m,

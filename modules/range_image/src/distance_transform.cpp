@@ -1,4 +1,5 @@
 #include <msf/common/exceptions.h>
+#include <msf/common/vector_clones.h>
 #include <msf/range_image/distance_transform.h>
 
 #include <omp.h>
@@ -23,12 +24,6 @@ constexpr int kMaxSide = 1 << 13;
 /// A squared distance meaning "no sample": above any real one, and a squared row distance
 /// added to it stays below 2^31.
 constexpr std::int32_t kNone = 1 << 28;
-
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-#define MSF_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MSF_VECTOR_CLONES
-#endif
 
 /// Pass 1 on one row: the squared distance along the row to its nearest sample (kNone
 /// without one) and that sample's column (-1 without one); ties go to the left. Without
