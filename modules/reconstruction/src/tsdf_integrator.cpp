@@ -1,8 +1,8 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/parallel_for.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
-#include <opencv2/core/utility.hpp>
 
 #include <algorithm>
 #include <array>
@@ -232,10 +232,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
   tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
   tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
-  // cv::parallel_for_ (TBB's work stealing) rather than OpenMP, as the other stages: in the
-  // pipeline this runs beside SGBM, and one pool of threads shares the 2 cores between them
-  // where two pools would oversubscribe them (and OpenMP's idle threads spin).
-  cv::parallel_for_(cv::Range(0, tiles_y), [&](const cv::Range& range) {
+  // parallelFor (OpenMP), not cv::parallel_for_: in the pipeline this runs beside SGBM, and
+  // OpenCV would run whichever of the two started second on one core (see parallel_for.h).
+  parallelFor(cv::Range(0, tiles_y), [&](const cv::Range& range) {
     std::vector<std::uint64_t> local;
     std::array<std::uint64_t, 8> recent;
     recent.fill(~0ull);
@@ -354,7 +353,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::atomic<std::size_t> projected_total{0};
   const float* depth_data = frame.depth.ptr<float>(0);
   const std::size_t depth_step = frame.depth.step1();
-  cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
   // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
@@ -609,7 +608,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
     const GridIndex steps[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
     for (int i = range.start; i < range.end; ++i)
       for (int k = 0; k < 6; ++k)
@@ -632,7 +631,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const bool last = sweep + 1 == config_.sweeps;
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
-      cv::parallel_for_(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
+      parallelFor(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
       for (std::ptrdiff_t g = range.start; g < range.end; ++g) {
         const std::size_t i = group[static_cast<std::size_t>(g)];
         if (g + 1 < m) {
