@@ -9,7 +9,7 @@ namespace msf {
 
 cv::Mat MeshRenderer::render(const TriangleMesh& mesh, const Eigen::Isometry3d& T_world_cam, double fx, double fy,
                              double cx, double cy, cv::Size size) {
-  cv::Mat image(size, CV_8UC3, cv::Scalar::all(255));
+  cv::Mat image(size, CV_8UC3, kBackground);
   std::vector<float> zbuffer(static_cast<std::size_t>(size.area()), std::numeric_limits<float>::infinity());
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   constexpr float kNear = 0.3f;
@@ -75,7 +75,7 @@ cv::Mat MeshRenderer::render(const TriangleMesh& mesh, const Eigen::Isometry3d& 
 
 cv::Mat MeshRenderer::renderFromAbove(const TriangleMesh& mesh, const Eigen::Vector3d& up, cv::Size size) {
   if (mesh.vertices.empty())
-    return cv::Mat(size, CV_8UC3, cv::Scalar::all(255));
+    return cv::Mat(size, CV_8UC3, kBackground);
   Eigen::Vector3f lo = mesh.vertices.front(), hi = lo;
   for (const auto& p : mesh.vertices)
     lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);

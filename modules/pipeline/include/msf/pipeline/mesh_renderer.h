@@ -7,9 +7,13 @@
 namespace msf {
 
 /// A small z-buffer rasteriser for previews of a mesh (no display or GPU needed): vertex
-/// colours, shaded by how squarely each triangle faces the viewer; the background is white.
+/// colours, shaded by how squarely each triangle faces the viewer, on a dark background.
 class MeshRenderer {
 public:
+  /// BGR of pixels no triangle covers: dark slate, so that sunlit (near-white) road and the
+  /// sky side of walls stand out, and darker than a scene's shadows only where they are black.
+  static inline const cv::Scalar kBackground{72, 56, 48};
+
   /// Perspective view through a pinhole camera at T_world_cam (x right, y down, z forward).
   static cv::Mat render(const TriangleMesh& mesh, const Eigen::Isometry3d& T_world_cam, double fx, double fy,
                         double cx, double cy, cv::Size size);
