@@ -20,7 +20,6 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
-#include <omp.h>
 
 #include <chrono>
 #include <cstring>
@@ -281,9 +280,9 @@ int main(int argc, char** argv) {
   // Both with every core (2 here), then both on one thread: the CPU time per frame is what
   // integration takes from the other stages when they share the cores (the pipeline).
   constexpr int kRepetitions = 5;
-  const int cores = omp_get_max_threads(); // integration and meshing run on OpenMP (msf::parallelFor)
+  const int cores = cv::getNumThreads();
   for (const int threads : {cores, 1}) {
-    omp_set_num_threads(threads);
+    cv::setNumThreads(threads);
     const Ours ours = measureOurs(kRepetitions);
     const auto o3d = runOpen3d(kRepetitions, threads == cores ? 0 : threads);
     std::printf("\nSide by side, %d thread%s: KITTI odometry 04 frames 0-%d, SGBM depth (3-way, 128 disparities, block 5), "
@@ -315,7 +314,7 @@ int main(int argc, char** argv) {
     if (!have)
       std::printf("  Open3D: not run (needs Debian's python3-open3d and python3-numpy: make deps-bench)\n");
   }
-  omp_set_num_threads(cores);
+  cv::setNumThreads(cores);
   benchmark::Shutdown();
   return 0;
 }

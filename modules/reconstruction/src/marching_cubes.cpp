@@ -1,10 +1,10 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
-#include <msf/common/parallel_for.h>
 #include <msf/reconstruction/marching_cubes.h>
 
 #include "marching_cubes_tables.h"
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/PCLPointField.h>
 
 #include <algorithm>
@@ -313,8 +313,8 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       targets.push_back(&cache_[block->index]);
     }
   const float min_weight = config_.min_weight;
-  // parallelFor (OpenMP) as the integrator, beside the stages on OpenCV's pool.
-  parallelFor(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
+  // cv::parallel_for_ (TBB) as the integrator: one pool shared with the other stages.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
     Scratch scratch;
     for (int i = range.start; i < range.end; ++i)
       meshBlock(volume, *dirty[i], min_weight, *targets[i], scratch);
@@ -373,7 +373,7 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   mesh.vertices.resize(n_vertices);
   mesh.colors.resize(n_vertices);
   mesh.triangles.resize(triangle_offset[parts]);
-  parallelFor(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
   for (int i = range.start; i < range.end; ++i) {
     const BlockMesh& part = *order[i].second;
     std::uint32_t* map = &remap[remap_offset[i]];
@@ -390,7 +390,7 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
   }
   }, std::max(1.0, static_cast<double>(parts) / 16));
-  parallelFor(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const BlockMesh& part = *order[shared_source[k].first].second;
       mesh.vertices[k] = part.vertices[shared_source[k].second];
@@ -426,7 +426,7 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
   cloud.row_step = cloud.point_step * cloud.width;
   cloud.is_dense = true;
   cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
-  parallelFor(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       std::uint8_t* p = cloud.data.data() + 16 * static_cast<std::size_t>(i);
       std::memcpy(p, vertices[i].data(), 12);
@@ -436,7 +436,7 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
     }
   }, 8);
   mesh.polygons.resize(triangles.size());
-  parallelFor(cv::Range(0, static_cast<int>(triangles.size())), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(triangles.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i)
       mesh.polygons[i].vertices.assign(triangles[i].begin(), triangles[i].end());
   }, 8);

@@ -1,10 +1,10 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
-#include <msf/common/parallel_for.h>
 #include <msf/io/impl/cloud_io.hpp>
 #include <msf/reconstruction/tsdf_volume.h>
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/io/pcd_io.h>
 
 #if __has_include(<sys/mman.h>)
@@ -166,7 +166,7 @@ void TsdfVolume::allocateBlocks(const std::vector<GridIndex>& indices, std::vect
     }
     position[i] = slot.block;
   }
-  parallelFor(cv::Range(0, static_cast<int>(fresh.size())), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(fresh.size())), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const std::size_t b = before + static_cast<std::size_t>(k);
       auto* block = new (storage(b)) TsdfBlock();

@@ -27,8 +27,9 @@ namespace msf {
 /// the voxels of those sub-blocks are projected into the image, in parallel over blocks: a
 /// row of 4 voxels at a time in SIMD lanes against its nearest pixels, and the voxels that
 /// pass are updated after the whole block is tested, their memory prefetched meanwhile.
-/// Threads come from this thread's OpenMP team (msf::parallelFor), so that in the pipeline
-/// integration and SGBM (on OpenCV's pool, from another thread) both spread over the cores.
+/// Threads come from cv::parallel_for_, as for the stereo and fusion stages: in the pipeline,
+/// where OpenCV runs one of two concurrent calls serially, integration and SGBM then take a
+/// core each rather than time-sharing both.
 /// An unorganized scan (a raw LiDAR sweep) is integrated by walking each point's ray from its
 /// sensor origin, as VDBFusion does.
 ///
