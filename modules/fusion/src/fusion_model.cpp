@@ -57,10 +57,10 @@ void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window
 }
 
 MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
-             const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
-             const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
-             const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
-             float* __restrict__ fused_z, float* __restrict__ fused_weight) {
+                               const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
+                               const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
+                               const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
+                               float* __restrict__ fused_z, float* __restrict__ fused_weight) {
   const int width = lidar_depth.cols, rows = lidar_depth.rows;
   const float* __restrict__ z_lidar = lidar_depth.ptr<float>(v);
   const DepthFusionConfig config = c; // a local copy: the compiler may keep it in registers

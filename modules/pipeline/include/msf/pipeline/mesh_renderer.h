@@ -10,8 +10,8 @@ namespace msf {
 /// colours, shaded by how squarely each triangle faces the viewer, on a dark background.
 class MeshRenderer {
 public:
-  /// BGR of pixels no triangle covers: dark slate, so that sunlit (near-white) road and the
-  /// sky side of walls stand out, and darker than a scene's shadows only where they are black.
+  /// BGR of pixels no triangle covers: a dark slate, against which bright surfaces (a sunlit
+  /// road) stand out, and a part of the scene that has no mesh is not taken for one.
   static inline const cv::Scalar kBackground{72, 56, 48};
 
   /// Perspective view through a pinhole camera at T_world_cam (x right, y down, z forward).
