@@ -291,6 +291,7 @@ TEST(GuidedMatching, SgbmConfigRejectsBadGuidanceKeysAndOpenCvIgnoresGuidance) {
   };
   config.guidance = "stereo";
   EXPECT_NE(rejected_key(config).find("stereo.guidance'"), std::string::npos);
+  EXPECT_NE(rejected_key(config).find("must be lidar or none, not 'stereo'"), std::string::npos);
   config = guidedConfig();
   config.guidance_bridge_rows = -1;
   EXPECT_NE(rejected_key(config).find("stereo.guidance_bridge_rows'"), std::string::npos);

@@ -13,6 +13,15 @@ namespace {
 [[noreturn]] void bad(const std::string& key, const std::string& why) {
   throw ConfigError("config key 'stereo." + key + "' " + why);
 }
+
+/// A key of two words: true for `yes`, false for `no`, else a ConfigError naming both.
+bool eitherWord(const std::string& key, const std::string& value, const char* yes, const char* no) {
+  if (value == yes)
+    return true;
+  if (value == no)
+    return false;
+  bad(key, std::string("must be ") + yes + " or " + no + ", not '" + value + "'");
+}
 } // namespace
 
 int SgbmConfig::opencvMode() const {
@@ -27,21 +36,9 @@ int SgbmConfig::opencvMode() const {
   bad("mode", "must be sgbm_3way, sgbm, hh or hh4, not '" + mode + "'");
 }
 
-bool SgbmConfig::nativeEngine() const {
-  if (engine == "native")
-    return true;
-  if (engine == "opencv")
-    return false;
-  bad("engine", "must be native or opencv, not '" + engine + "'");
-}
+bool SgbmConfig::nativeEngine() const { return eitherWord("engine", engine, "native", "opencv"); }
 
-bool SgbmConfig::lidarGuidance() const {
-  if (guidance == "lidar")
-    return true;
-  if (guidance == "none")
-    return false;
-  bad("guidance", "must be none or lidar, not '" + guidance + "'");
-}
+bool SgbmConfig::lidarGuidance() const { return eitherWord("guidance", guidance, "lidar", "none"); }
 
 void SgbmConfig::read(const cv::FileNode& node) {
   readKey(node, "engine", engine);
