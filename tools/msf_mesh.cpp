@@ -20,12 +20,15 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-min_weight", "-config"};
+const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <volume.pcd> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
   print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. Options:\n");
   print_info("    -min_weight W   voxels with weight <= W make no triangles (default "); print_value("0"); print_info(")\n");
+  print_info("    -min_component_triangles N\n"
+             "                    remove connected pieces of fewer than N triangles (default ");
+  print_value("0"); print_info(": keep all)\n");
   print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
 }
 
@@ -45,6 +48,7 @@ int run(int argc, char** argv) {
   if (parse_argument(argc, argv, "-config", config_path) >= 0)
     config.read(msf::ConfigFile(config_path).section("marching_cubes"));
   parse_argument(argc, argv, "-min_weight", config.min_weight);
+  parse_argument(argc, argv, "-min_component_triangles", config.min_component_triangles);
   msf::MarchingCubes mesher(config);
 
   pcl::console::TicToc tt;
@@ -65,7 +69,16 @@ int run(int argc, char** argv) {
   print_value("%u", mesh.cloud.width);
   print_info(" vertices, ");
   print_value("%zu", mesh.polygons.size());
-  print_info(" triangles]\n");
+  print_info(" triangles");
+  const msf::MarchingCubes::Stats& stats = mesher.lastStats();
+  if (config.min_component_triangles > 0) {
+    print_info(", ");
+    print_value("%zu", stats.components_removed);
+    print_info(" small pieces of ");
+    print_value("%zu", stats.triangles_removed);
+    print_info(" triangles removed");
+  }
+  print_info("]\n");
   if (mesh.polygons.empty())
     throw msf::InvalidInputError("volume '" + files[0] + "' has no surface above weight " +
                                  std::to_string(config.min_weight) + ": no mesh written");

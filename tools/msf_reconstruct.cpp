@@ -286,6 +286,8 @@ int main(int argc, char** argv) {
     msf::tool::printDone(report.mesh_ms, mesh.triangles.size());
     report.vertices = mesh.vertices.size();
     report.triangles = mesh.triangles.size();
+    report.pieces_removed = pipeline.meshStats().components_removed;
+    report.triangles_removed = pipeline.meshStats().triangles_removed;
     report.observed_voxels = pipeline.volume().numObservedVoxels();
     report.blocks = pipeline.volume().numBlocks();
     report.volume_memory_mb = static_cast<double>(pipeline.volume().memoryBytes()) / (1024.0 * 1024.0);

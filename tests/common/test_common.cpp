@@ -104,6 +104,30 @@ TEST(Config, WrongTypeNamesTheKey) {
   EXPECT_THROW(msf::readKey(config.section("stage"), "name", name), msf::ConfigError);
 }
 
+TEST(Config, RepeatedSectionOrKeyIsAnError) {
+  msf::test::TempDir dir;
+  const auto expectRepeated = [&](const std::string& text, const std::string& name) {
+    writeText(dir.file("c.yaml"), "%YAML:1.0\n" + text);
+    try {
+      msf::ConfigFile config(dir.file("c.yaml"));
+      FAIL() << "no error for " << name;
+    } catch (const msf::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("'" + name + "' appears twice"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("c.yaml"), std::string::npos) << e.what();
+    }
+  };
+  expectRepeated("stage:\n  gap_px: 7\nother:\n  a: 1\nstage:\n  gap_px: 9\n", "stage");
+  expectRepeated("stage:\n  gap_px: 7\n  ratio: 1\n  gap_px: 9\n", "stage.gap_px");
+  // The same key in two sections is fine.
+  writeText(dir.file("c.yaml"), "%YAML:1.0\na:\n  gap_px: 1\nb:\n  gap_px: 2\n");
+  EXPECT_NO_THROW(msf::ConfigFile(dir.file("c.yaml")));
+}
+
+TEST(Config, ProjectConfigFilesHaveNoRepeatedKeys) {
+  for (const char* name : {"kitti.yaml", "synthetic.yaml"})
+    EXPECT_NO_THROW(msf::ConfigFile(msf::test::sourceDir() + "/config/" + name)) << name;
+}
+
 TEST(Config, MissingFileIsAnError) { EXPECT_THROW(msf::ConfigFile("/nonexistent.yaml"), msf::IOError); }
 
 TEST(Statistics, MedianAndPercentile) {

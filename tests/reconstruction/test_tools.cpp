@@ -154,5 +154,8 @@ TEST(Tools, MeshRejectsBadInput) {
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply")), "msf_mesh",
                   "plain.pcd");
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.stl")), "msf_mesh", ".stl");
+  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
+                                                " -min_component_triangles -1"),
+                  "msf_mesh", "marching_cubes.min_component_triangles must be >= 0");
   EXPECT_FALSE(test::fileExists(dir.file("mesh.ply")));
 }

@@ -3,6 +3,9 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 
+#include <algorithm>
+#include <vector>
+
 namespace msf {
 
 ConfigFile::ConfigFile(const std::string& path) : path_(path) {
@@ -14,6 +17,23 @@ ConfigFile::ConfigFile(const std::string& path) : path_(path) {
   }
   if (!storage_.isOpened())
     throw IOError("config '" + path + "' cannot be opened as YAML");
+  rejectRepeatedKeys(storage_.root(), "");
+}
+
+void ConfigFile::rejectRepeatedKeys(const cv::FileNode& map, const std::string& prefix) const {
+  // OpenCV keeps a repeated key and reads only its first value: a section pasted twice
+  // would silently hide the edits made to its second copy.
+  if (!map.isMap())
+    return;
+  std::vector<std::string> names;
+  for (auto it = map.begin(); it != map.end(); ++it) {
+    const cv::FileNode node = *it;
+    const std::string name = prefix + node.name();
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      throw ConfigError("config '" + path_ + "': '" + name + "' appears twice (only the first would be read)");
+    names.push_back(name);
+    rejectRepeatedKeys(node, name + ".");
+  }
 }
 
 cv::FileNode ConfigFile::section(const std::string& name) const {

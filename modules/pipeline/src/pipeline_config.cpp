@@ -61,6 +61,7 @@ void PipelineConfig::validate() const {
   fusion.validate();
   volume.validate();
   integrator.validate();
+  mesher.validate();
   scheduling.validate();
 }
 

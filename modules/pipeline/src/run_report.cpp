@@ -144,7 +144,8 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     << "  \"map\": {\"voxel_size_m\": " << num(voxel_size_m) << ", \"lambda\": " << num(lambda)
     << ", \"observed_voxels\": " << observed_voxels << ", \"blocks\": " << blocks
     << ", \"memory_mb\": " << num(volume_memory_mb, 1) << ", \"vertices\": " << vertices
-    << ", \"triangles\": " << triangles << "},\n";
+    << ", \"triangles\": " << triangles << ", \"pieces_removed\": " << pieces_removed
+    << ", \"triangles_removed\": " << triangles_removed << "},\n";
   s << "  \"depth\": {";
   std::size_t k = 0;
   for (const auto& [method, scores] : depth) {
@@ -204,7 +205,11 @@ void RunReport::writeMarkdown(const std::string& path) const {
     << "## Map\n\n"
     << observed_voxels << " observed voxels in " << blocks << " blocks (" << num(volume_memory_mb, 1) << " MiB); mesh "
     << vertices << " vertices, " << triangles << " triangles: [`" << mesh_file << "`](" << mesh_file << "), volume [`"
-    << volume_file << "`](" << volume_file << ").\n\n";
+    << volume_file << "`](" << volume_file << ").";
+  if (pieces_removed > 0)
+    s << " " << pieces_removed << " pieces of fewer than `marching_cubes.min_component_triangles` triangles ("
+      << triangles_removed << " triangles) were removed.";
+  s << "\n\n";
   if (!preview_file.empty())
     s << "![mesh from above and from the first camera](" << preview_file << ")\n\n";
   if (!depth.empty()) {

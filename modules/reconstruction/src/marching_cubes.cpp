@@ -1,6 +1,7 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/mesh_components.h>
 
 #include "marching_cubes_tables.h"
 
@@ -249,19 +250,27 @@ private:
 
 void MarchingCubes::Config::read(const cv::FileNode& node) {
   readKey(node, "min_weight", min_weight);
+  readKey(node, "min_component_triangles", min_component_triangles);
+  validate();
+}
+
+void MarchingCubes::Config::validate() const {
   if (!(min_weight >= 0.f))
     throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(min_weight));
+  if (min_component_triangles < 0)
+    throw ConfigError("marching_cubes.min_component_triangles must be >= 0, got " +
+                      std::to_string(min_component_triangles));
 }
 
 void MarchingCubes::Config::print(std::ostream& out) const {
-  out << "marching_cubes:\n  min_weight: " << min_weight << "\n";
+  out << "marching_cubes:\n  min_weight: " << min_weight << "\n  min_component_triangles: " << min_component_triangles
+      << "\n";
 }
 
 MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
 
 void MarchingCubes::setConfig(const Config& config) {
-  if (!(config.min_weight >= 0.f))
-    throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(config.min_weight));
+  config.validate();
   if (config.min_weight != config_.min_weight)
     reset();
   config_ = config;
@@ -398,6 +407,15 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     }
   }, 8);
   stats_.assemble_ms = msSince(t1);
+  if (config_.min_component_triangles > 0) {
+    // On the assembled mesh only: a piece may span many blocks, and the cache stays whole.
+    const auto t2 = Clock::now();
+    const ComponentFilterStats removed =
+        removeSmallComponents(mesh, static_cast<std::size_t>(config_.min_component_triangles));
+    stats_.components_removed = removed.components_removed;
+    stats_.triangles_removed = removed.triangles_removed;
+    stats_.filter_ms = msSince(t2);
+  }
 }
 
 void MarchingCubes::extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh) {

@@ -12,7 +12,8 @@ namespace msf {
 class ConfigFile {
 public:
   ConfigFile() = default;
-  /// Throws IOError if the file is missing or is not valid YAML.
+  /// Throws IOError if the file is missing or is not valid YAML, and ConfigError naming a
+  /// section or key that appears twice in the same map.
   explicit ConfigFile(const std::string& path);
 
   /// The named section, or an empty node when the file or the section is absent.
@@ -20,6 +21,8 @@ public:
   const std::string& path() const { return path_; }
 
 private:
+  void rejectRepeatedKeys(const cv::FileNode& map, const std::string& prefix) const;
+
   std::string path_;
   cv::FileStorage storage_;
 };

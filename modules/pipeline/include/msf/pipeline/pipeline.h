@@ -95,6 +95,8 @@ public:
 
   /// The mesh of the volume, re-meshing only the blocks changed since the last call.
   const TriangleMesh& updateMesh();
+  /// What the last updateMesh did (blocks meshed, small pieces removed).
+  const MarchingCubes::Stats& meshStats() const { return mesher_.lastStats(); }
 
   const PipelineConfig& config() const { return config_; }
   const Calibration& calibration() const { return calibration_; }

@@ -37,6 +37,7 @@ public:
   double mesh_ms = 0;
   double peak_memory_mb = 0;
   std::size_t observed_voxels = 0, blocks = 0, vertices = 0, triangles = 0;
+  std::size_t pieces_removed = 0, triangles_removed = 0; ///< marching_cubes.min_component_triangles
   double volume_memory_mb = 0;
   double voxel_size_m = 0;
   double lambda = 0;

@@ -34,16 +34,22 @@ class MarchingCubes {
 public:
   struct Config {
     float min_weight = 0.f; ///< voxels with weight <= this do not make triangles
+    /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents); 0 keeps all.
+    int min_component_triangles = 0;
 
-    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight.
+    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight, min_component_triangles.
     void read(const cv::FileNode& node);
+    /// Throws ConfigError naming the key of a value out of range.
+    void validate() const;
     void print(std::ostream& out) const;
   };
 
   struct Stats {
     std::size_t blocks_meshed = 0;  ///< blocks meshed again by the last call
     std::size_t blocks_cached = 0;  ///< blocks whose mesh came from the cache
-    double mesh_ms = 0, assemble_ms = 0;
+    std::size_t components_removed = 0; ///< pieces below min_component_triangles
+    std::size_t triangles_removed = 0;  ///< their triangles
+    double mesh_ms = 0, assemble_ms = 0, filter_ms = 0;
   };
 
   MarchingCubes() = default;
