@@ -274,6 +274,7 @@ int main(int argc, char** argv) {
         &g_stop);
     progress.end();
     report.wall_s = stats.wall_s;
+    report.first_frame_s = stats.first_frame_s;
     report.interrupted = stats.interrupted;
     if (stats.interrupted)
       print_warn("Interrupted after %zu of %zu frames: writing what was integrated.\n", stats.frames_done, frames.size());
@@ -349,6 +350,8 @@ int main(int argc, char** argv) {
 
     print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
     print_value("%.1f fps", report.framesPerSecond());
+    if (report.frames.size() > 1)
+      print_info(" (%.1f after the first frame)", report.framesPerSecondAfterFirst());
     print_info(", peak memory %.0f MiB, %zu triangles\n", report.peak_memory_mb, report.triangles);
     for (const auto& [name, d] : report.depth)
       print_info("  %-12s D1 %.2f %% (missing = bad), depth MAE %.3f m, coverage %.3f\n", name.c_str(),

@@ -147,6 +147,11 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
   const std::string json = readFile(out.file("summary.json"));
   EXPECT_EQ(jsonNumber(json, "frames"), 4);
   EXPECT_GT(jsonNumber(json, "frames_per_second"), 0.0);
+  // The first frame is done before the run ends, and the three after it take the rest.
+  EXPECT_GT(jsonNumber(json, "first_frame_s"), 0.0);
+  EXPECT_LT(jsonNumber(json, "first_frame_s"), jsonNumber(json, "wall_s"));
+  const double after_first = 3.0 / (jsonNumber(json, "wall_s") - jsonNumber(json, "first_frame_s"));
+  EXPECT_NEAR(jsonNumber(json, "frames_per_second_after_first"), after_first, 0.02 * after_first); // 1 ms rounding
   EXPECT_GT(jsonNumber(json, "peak_memory_mb"), 10.0);
   EXPECT_LT(jsonNumber(json, "peak_memory_mb"), 4096.0);
   EXPECT_GT(jsonNumber(json, "median", "stereo"), 0.0);

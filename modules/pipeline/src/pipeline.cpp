@@ -217,6 +217,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
       ++stats.frames_done;
       if (on_frame)
         on_frame(*result);
+      if (stats.frames_done == 1)
+        stats.first_frame_s = msSince(run_start) / 1000.0;
       if (stop && stop->load()) {
         interrupted = stats.frames_done < frames.size();
         break;

@@ -77,6 +77,9 @@ public:
   struct RunStats {
     std::size_t frames_done = 0;
     double wall_s = 0;
+    /// When the first frame was done (integrated and passed to the callback), from the start:
+    /// the pipeline has filled then, and later frames leave it at its steady rate.
+    double first_frame_s = 0;
     bool interrupted = false;  ///< stopped by the stop flag before the last frame
   };
   /// Called on the integration thread after each frame is integrated, in frame order.

@@ -34,6 +34,7 @@ public:
   std::size_t frames_requested = 0;
   bool interrupted = false;
   double wall_s = 0;
+  double first_frame_s = 0;       ///< when the first frame was done, from the start
   double mesh_ms = 0;
   double peak_memory_mb = 0;
   std::size_t observed_voxels = 0, blocks = 0, vertices = 0, triangles = 0;
@@ -48,7 +49,11 @@ public:
   std::vector<std::string> depth_panels;      ///< file names of the depth panels written
   std::string mesh_file = "mesh.ply", volume_file = "volume.pcd", preview_file;
 
+  /// Frames over the whole run, wall_s: with the first frame's way through the empty pipeline.
   double framesPerSecond() const;
+  /// The rate once the pipeline is full: frames 2..N over the time after the first was done
+  /// (0 with fewer than 2 frames). What keeping up with a sensor needs.
+  double framesPerSecondAfterFirst() const;
 
   void writeFramesCsv(const std::string& path) const;
   void writeSummaryJson(const std::string& path) const;
