@@ -100,8 +100,11 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
 
     msf::DepthFusionConfig config;
-    if (!config_path.empty())
-      config.read(msf::ConfigFile(config_path).section("fusion"));
+    if (!config_path.empty()) {
+      const msf::ConfigFile file(config_path);
+      config.read(file.section("fusion"));
+      file.rejectUnknownKeys();
+    }
     if (!method.empty())
       config.method = msf::parseFusionMethod(method);
     if (find_switch(argc, argv, "-print_config"))

@@ -345,6 +345,7 @@ int main(int argc, char** argv) {
       methods.emplace_back(name, entry->make(config_file));
       evaluation.addMethod(name, methods.back().second);
     }
+    config_file.rejectUnknownKeys(); // the sections the methods read
 
     const auto frames = sequence.indices(msf::FrameRange::parse(frames_text));
     print_highlight("Evaluating ");

@@ -91,6 +91,7 @@ int run(int argc, char** argv) {
     const msf::ConfigFile file(config_path);
     volume_config.read(file.section("tsdf_volume"));
     config.read(file.section("tsdf_integrator"));
+    file.rejectUnknownKeys();
   }
   parse_argument(argc, argv, "-voxel", volume_config.voxel_size_m);
   parse_argument(argc, argv, "-trunc", volume_config.truncation_m);

@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
     interpolation.validate();
     msf::IpBasicConfig ip_basic;
     ip_basic.read(file.section("ip_basic"));
+    file.rejectUnknownKeys();
     ip_basic.variant = method == msf::CompletionMethod::IpBasicFast ? msf::IpBasicVariant::Fast
                                                                     : msf::IpBasicVariant::Multiscale;
 

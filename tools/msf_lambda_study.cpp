@@ -48,8 +48,11 @@ int run(int argc, char** argv) {
   msf::ensureOutputDirectory(out_dir);
   msf::LambdaStudy::Config config;
   std::string config_path;
-  if (parse_argument(argc, argv, "-config", config_path) >= 0)
-    config.read(msf::ConfigFile(config_path).section("lambda_study"));
+  if (parse_argument(argc, argv, "-config", config_path) >= 0) {
+    const msf::ConfigFile file(config_path);
+    config.read(file.section("lambda_study"));
+    file.rejectUnknownKeys();
+  }
   parse_argument(argc, argv, "-frames", config.frames);
   parse_argument(argc, argv, "-voxel", config.voxel_size_m);
   parse_argument(argc, argv, "-trunc", config.truncation_m);

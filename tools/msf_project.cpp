@@ -54,8 +54,11 @@ int main(int argc, char** argv) {
     parse_argument(argc, argv, "-config", config_path);
 
     msf::ProjectionConfig config;
-    if (!config_path.empty())
-      config.read(msf::ConfigFile(config_path).section("projection"));
+    if (!config_path.empty()) {
+      const msf::ConfigFile file(config_path);
+      config.read(file.section("projection"));
+      file.rejectUnknownKeys();
+    }
     parse_argument(argc, argv, "-camera", config.camera);
     parse_argument(argc, argv, "-min_range", config.min_range_m);
     parse_argument(argc, argv, "-max_range", config.max_range_m);

@@ -98,8 +98,11 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
 
     msf::SgbmConfig config;
-    if (!config_path.empty())
-      config.read(msf::ConfigFile(config_path).section("stereo"));
+    if (!config_path.empty()) {
+      const msf::ConfigFile file(config_path);
+      config.read(file.section("stereo"));
+      file.rejectUnknownKeys();
+    }
     parse_argument(argc, argv, "-num_disparities", config.num_disparities_px);
     parse_argument(argc, argv, "-block_size", config.block_size_px);
     if (!mode.empty())

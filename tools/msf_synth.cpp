@@ -72,8 +72,11 @@ int main(int argc, char** argv) {
     std::string config_path, output;
     parse_argument(argc, argv, "-config", config_path);
     parse_argument(argc, argv, "-o", output);
-    if (!config_path.empty())
-      config.read(msf::ConfigFile(config_path).section("synthetic"));
+    if (!config_path.empty()) {
+      const msf::ConfigFile file(config_path);
+      config.read(file.section("synthetic"));
+      file.rejectUnknownKeys();
+    }
     config.frames = intOption(argc, argv, "-frames", config.frames, 1, 999999);
     config.seed = intOption(argc, argv, "-seed", config.seed, 0, 2147483647);
     parse_argument(argc, argv, "-scene", config.scene);

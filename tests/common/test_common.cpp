@@ -123,6 +123,58 @@ TEST(Config, RepeatedSectionOrKeyIsAnError) {
   EXPECT_NO_THROW(msf::ConfigFile(dir.file("c.yaml")));
 }
 
+TEST(Config, ReadsASequenceOfNumbers) {
+  msf::test::TempDir dir;
+  writeText(dir.file("c.yaml"), "%YAML:1.0\nstage:\n  values: [1, 2.5, -3]\n  one: 4\n  words: [a, b]\n");
+  const msf::ConfigFile config(dir.file("c.yaml"));
+  std::vector<double> values{9}, untouched{7};
+  msf::readKey(config.section("stage"), "values", values);
+  EXPECT_EQ(values, (std::vector<double>{1, 2.5, -3}));
+  msf::readKey(config.section("stage"), "absent", untouched);
+  EXPECT_EQ(untouched, std::vector<double>{7});
+  for (const char* key : {"one", "words"}) {
+    try {
+      msf::readKey(config.section("stage"), key, values);
+      FAIL() << key;
+    } catch (const msf::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("stage." + std::string(key) + "' must be a sequence of numbers"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+/// The error of rejectUnknownKeys for a file of `text` whose section `stage` was read for
+/// the key gap_px ("" for none).
+std::string unknownKeyError(const std::string& text) {
+  msf::test::TempDir dir;
+  writeText(dir.file("c.yaml"), "%YAML:1.0\n" + text);
+  const msf::ConfigFile config(dir.file("c.yaml"));
+  int gap = 0;
+  msf::readKey(config.section("stage"), "gap_px", gap);
+  try {
+    config.rejectUnknownKeys();
+  } catch (const msf::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, UnknownKeyOfASectionReadIsAnError) {
+  const std::string what = unknownKeyError("stage:\n  gap_px: 7\n  gap: 9\nunread:\n  anything: 1\n");
+  EXPECT_NE(what.find("'stage.gap' is not a key of section 'stage'"), std::string::npos) << what;
+  EXPECT_NE(what.find("gap_px"), std::string::npos) << what; // the keys it has
+  EXPECT_NE(what.find("c.yaml"), std::string::npos) << what;
+  // Only the sections asked for are checked.
+  EXPECT_EQ(unknownKeyError("stage:\n  gap_px: 7\nunread:\n  anything: 1\n"), "");
+  EXPECT_NO_THROW(msf::ConfigFile().rejectUnknownKeys());
+}
+
+TEST(Config, SectionThatIsNotAMapIsAnError) {
+  const std::string what = unknownKeyError("stage: 3\n");
+  EXPECT_NE(what.find("section 'stage' must hold keys"), std::string::npos) << what;
+}
+
 TEST(Config, ProjectConfigFilesHaveNoRepeatedKeys) {
   for (const char* name : {"kitti.yaml", "synthetic.yaml"})
     EXPECT_NO_THROW(msf::ConfigFile(msf::test::sourceDir() + "/config/" + name)) << name;

@@ -12,6 +12,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 using namespace msf;
 
@@ -157,5 +158,9 @@ TEST(Tools, MeshRejectsBadInput) {
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
                                                 " -min_component_triangles -1"),
                   "msf_mesh", "marching_cubes.min_component_triangles must be >= 0");
+  std::ofstream(dir.file("typo.yaml")) << "%YAML:1.0\nmarching_cubes:\n  min_weigth: 2\n";
+  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " -config " +
+                                                dir.file("typo.yaml")),
+                  "msf_mesh", "'marching_cubes.min_weigth' is not a key of section 'marching_cubes'");
   EXPECT_FALSE(test::fileExists(dir.file("mesh.ply")));
 }

@@ -4,6 +4,8 @@
 #include <msf/common/exceptions.h>
 
 #include <algorithm>
+#include <mutex>
+#include <set>
 #include <vector>
 
 namespace msf {
@@ -36,27 +38,78 @@ void ConfigFile::rejectRepeatedKeys(const cv::FileNode& map, const std::string& 
   }
 }
 
-cv::FileNode ConfigFile::section(const std::string& name) const {
-  if (!storage_.isOpened())
-    return cv::FileNode();
-  return storage_[name];
-}
-
 namespace {
 std::string keyName(const cv::FileNode& node, const char* key) {
   const std::string section = node.name();
   return section.empty() ? std::string(key) : section + "." + key;
 }
+
+/// Every "section.key" a readKey call has asked for in this process: the keys some stage reads.
+struct KnownKeys {
+  std::mutex mutex;
+  std::set<std::string> names;
+};
+KnownKeys& knownKeys() {
+  static KnownKeys keys;
+  return keys;
+}
 } // namespace
+
+cv::FileNode ConfigFile::section(const std::string& name) const {
+  if (!storage_.isOpened())
+    return cv::FileNode();
+  if (std::find(sections_read_.begin(), sections_read_.end(), name) == sections_read_.end())
+    sections_read_.push_back(name);
+  return storage_[name];
+}
+
+void ConfigFile::rejectUnknownKeys() const {
+  if (!storage_.isOpened())
+    return;
+  KnownKeys& known = knownKeys();
+  const std::lock_guard<std::mutex> lock(known.mutex);
+  for (const std::string& name : sections_read_) {
+    const cv::FileNode section = storage_[name];
+    if (section.empty() || section.isNone())
+      continue;
+    if (!section.isMap())
+      throw ConfigError("config '" + path_ + "': section '" + name + "' must hold keys (key: value), one per line");
+    for (auto it = section.begin(); it != section.end(); ++it) {
+      const std::string key = name + "." + (*it).name();
+      if (known.names.count(key))
+        continue;
+      std::string keys;
+      for (auto k = known.names.lower_bound(name + "."); k != known.names.end() && k->rfind(name + ".", 0) == 0; ++k)
+        keys += (keys.empty() ? "" : ", ") + k->substr(name.size() + 1);
+      throw ConfigError("config '" + path_ + "': '" + key + "' is not a key of section '" + name + "' (its keys: " +
+                        keys + ")");
+    }
+  }
+}
 
 template <typename T>
 void readKey(const cv::FileNode& node, const char* key, T& value) {
   if (node.empty() || !node.isMap())
     return;
+  {
+    KnownKeys& known = knownKeys();
+    const std::lock_guard<std::mutex> lock(known.mutex);
+    known.names.insert(keyName(node, key));
+  }
   const cv::FileNode item = node[key];
   if (item.empty() || item.isNone())
     return;
-  if constexpr (std::is_same_v<T, std::string>) {
+  if constexpr (std::is_same_v<T, std::vector<double>>) {
+    if (!item.isSeq())
+      throw ConfigError("config key '" + keyName(node, key) + "' must be a sequence of numbers");
+    std::vector<double> values;
+    for (const auto& v : item) {
+      if (!v.isReal() && !v.isInt())
+        throw ConfigError("config key '" + keyName(node, key) + "' must be a sequence of numbers");
+      values.push_back(v.real());
+    }
+    value = std::move(values);
+  } else if constexpr (std::is_same_v<T, std::string>) {
     if (!item.isString())
       throw ConfigError("config key '" + keyName(node, key) + "' must be a string");
     value = static_cast<std::string>(item);
@@ -90,5 +143,6 @@ template void readKey<bool>(const cv::FileNode&, const char*, bool&);
 template void readKey<float>(const cv::FileNode&, const char*, float&);
 template void readKey<double>(const cv::FileNode&, const char*, double&);
 template void readKey<std::string>(const cv::FileNode&, const char*, std::string&);
+template void readKey<std::vector<double>>(const cv::FileNode&, const char*, std::vector<double>&);
 
 } // namespace msf

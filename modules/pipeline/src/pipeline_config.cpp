@@ -50,6 +50,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.integrator.read(file.section("tsdf_integrator"));
   config.mesher.read(file.section("marching_cubes"));
   config.scheduling.read(file.section("pipeline"));
+  file.rejectUnknownKeys();
   config.validate();
   return config;
 }

@@ -18,20 +18,6 @@ namespace msf {
 
 namespace {
 
-void readList(const cv::FileNode& node, const char* key, std::vector<double>& values) {
-  if (node.empty() || !node.isMap() || node[key].empty())
-    return;
-  const cv::FileNode list = node[key];
-  if (!list.isSeq())
-    throw ConfigError(std::string("config key 'lambda_study.") + key + "' must be a sequence of numbers");
-  values.clear();
-  for (const auto& item : list) {
-    if (!item.isReal() && !item.isInt())
-      throw ConfigError(std::string("config key 'lambda_study.") + key + "' must be a sequence of numbers");
-    values.push_back(item.real());
-  }
-}
-
 /// Camera on an arc of +-15 degrees around the scene, 3 m away, a little above it.
 Eigen::Isometry3d arcPose(int i, int n) {
   const Eigen::Vector3d target(0, 0.1, 3.0);
@@ -50,8 +36,8 @@ Eigen::Isometry3d arcPose(int i, int n) {
 } // namespace
 
 void LambdaStudy::Config::read(const cv::FileNode& node) {
-  readList(node, "noise_mm", noise_mm);
-  readList(node, "lambdas", lambdas);
+  readKey(node, "noise_mm", noise_mm);
+  readKey(node, "lambdas", lambdas);
   readKey(node, "frames", frames);
   readKey(node, "voxel_size_m", voxel_size_m);
   readKey(node, "truncation_m", truncation_m);

@@ -2,6 +2,7 @@
 #include <opencv2/core/persistence.hpp>
 
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -18,6 +19,10 @@ public:
 
   /// The named section, or an empty node when the file or the section is absent.
   cv::FileNode section(const std::string& name) const;
+  /// Throws ConfigError naming the first key, in a section asked for with section(), that
+  /// no readKey call has asked for (OpenCV would let a misspelt key pass unnoticed), and a
+  /// section asked for that is not a map of keys. Call it after every section is read.
+  void rejectUnknownKeys() const;
   const std::string& path() const { return path_; }
 
 private:
@@ -25,10 +30,12 @@ private:
 
   std::string path_;
   cv::FileStorage storage_;
+  mutable std::vector<std::string> sections_read_;
 };
 
 /// Overrides `value` with `node[key]` when present; throws ConfigError naming the key
-/// when it has the wrong type. T: int, bool, float, double, std::string.
+/// when it has the wrong type. T: int, bool, float, double, std::string, std::vector<double>
+/// (a YAML sequence of numbers, [1, 2.5]).
 template <typename T>
 void readKey(const cv::FileNode& node, const char* key, T& value);
 
