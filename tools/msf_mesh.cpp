@@ -82,6 +82,9 @@ int run(int argc, char** argv) {
     print_info(" triangles removed");
   }
   print_info("]\n");
+  if (mesh.polygons.empty() && stats.triangles_removed > 0)
+    throw msf::InvalidInputError("volume '" + files[0] + "': every piece of its surface has fewer than " +
+                                 std::to_string(config.min_component_triangles) + " triangles: no mesh written");
   if (mesh.polygons.empty())
     throw msf::InvalidInputError("volume '" + files[0] + "' has no surface above weight " +
                                  std::to_string(config.min_weight) + ": no mesh written");

@@ -15,7 +15,8 @@ struct ComponentFilterStats {
 
 /// Removes the connected pieces of `mesh` (triangles joined through shared vertices) that have
 /// fewer than `min_triangles` triangles, with the vertices only they use. Such specks come
-/// from depth that no other frame or sensor confirms, above all SGBM's matches in the sky.
+/// from depth that no other frame or sensor confirms, above all SGBM's matches in the sky, but
+/// so do fragments of surfaces seen at grazing angles, such as the far road (README).
 /// The kept vertices and triangles stay in their order. Throws InvalidInputError when a
 /// triangle names a vertex the mesh does not have, or when colors and vertices differ in number.
 ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles);
