@@ -125,13 +125,13 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("expected <gt.png> <est.png> or <gt_dir> <est_dir> (see -h)");
     msf::DisparityEvalOptions options;
     options.interpolate_background = find_switch(argc, argv, "-interpolate");
-    parse_argument(argc, argv, "-abs_px", options.abs_threshold_px);
-    parse_argument(argc, argv, "-rel", options.rel_threshold);
+    msf::tool::parseArgument(argc, argv, "-abs_px", options.abs_threshold_px);
+    msf::tool::parseArgument(argc, argv, "-rel", options.rel_threshold);
     if (!(options.abs_threshold_px >= 0.f) || !(options.rel_threshold >= 0.f))
       throw msf::InvalidInputError("-abs_px and -rel must be >= 0");
     std::string obj_map_path, obj_map_dir;
-    parse_argument(argc, argv, "-obj_map", obj_map_path);
-    parse_argument(argc, argv, "-obj_map_dir", obj_map_dir);
+    msf::tool::parseArgument(argc, argv, "-obj_map", obj_map_path);
+    msf::tool::parseArgument(argc, argv, "-obj_map_dir", obj_map_dir);
 
     const bool folders = isDirectory(files[0]);
     if (folders != isDirectory(files[1]))

@@ -92,19 +92,16 @@ int main(int argc, char** argv) {
     if (ext != ".pcd" && ext != ".ply")
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
     std::string calib_path, method, config_path, color_path;
-    parse_argument(argc, argv, "-calib", calib_path);
-    parse_argument(argc, argv, "-method", method);
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-color", color_path);
+    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    msf::tool::parseArgument(argc, argv, "-method", method);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-color", color_path);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
 
     msf::DepthFusionConfig config;
-    if (!config_path.empty()) {
-      const msf::ConfigFile file(config_path);
-      config.read(file.section("fusion"));
-      file.rejectUnknownKeys();
-    }
+    if (!config_path.empty())
+      msf::readConfigSection(config_path, "fusion", config);
     if (!method.empty())
       config.method = msf::parseFusionMethod(method);
     if (find_switch(argc, argv, "-print_config"))

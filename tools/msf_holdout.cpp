@@ -318,10 +318,10 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
                                    "regions (add -holdout to evaluate '" + positional[0] + "' by ring hold-out)");
     std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path;
-    parse_argument(argc, argv, "-frames", frames_text);
-    parse_argument(argc, argv, "-methods", methods_text);
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-csv", csv_path);
+    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
+    msf::tool::parseArgument(argc, argv, "-methods", methods_text);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-csv", csv_path);
     if (!csv_path.empty() && msf::fileExtension(csv_path) != ".csv")
       throw msf::InvalidInputError("-csv '" + csv_path + "' must end in .csv");
 

@@ -57,7 +57,7 @@ std::vector<std::string> inputClouds(int argc, char** argv) {
   for (const auto& a : msf::tool::positionalArguments(argc, argv, kValueOptions))
     files.push_back(a);
   std::string dir;
-  if (parse_argument(argc, argv, "-input_dir", dir) >= 0) {
+  if (msf::tool::parseArgument(argc, argv, "-input_dir", dir) >= 0) {
     msf::requireDirectory(dir, "input folder");
     std::vector<std::string> found;
     for (const auto& e : fs::directory_iterator(dir))
@@ -75,8 +75,8 @@ int run(int argc, char** argv) {
   msf::tool::checkOptions(argc, argv, kValueOptions, kSwitches);
   const std::vector<std::string> clouds = inputClouds(argc, argv);
   std::string poses_path, output;
-  parse_argument(argc, argv, "-poses", poses_path);
-  parse_argument(argc, argv, "-o", output);
+  msf::tool::parseArgument(argc, argv, "-poses", poses_path);
+  msf::tool::parseArgument(argc, argv, "-o", output);
   if (clouds.empty() || poses_path.empty() || output.empty()) {
     printHelp(argv[0]);
     throw msf::InvalidInputError("need depth clouds, -poses and -o");
@@ -87,20 +87,20 @@ int run(int argc, char** argv) {
   msf::TsdfVolume::Config volume_config;
   msf::TsdfIntegrator::Config config;
   std::string config_path;
-  if (parse_argument(argc, argv, "-config", config_path) >= 0) {
+  if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0) {
     const msf::ConfigFile file(config_path);
     volume_config.read(file.section("tsdf_volume"));
     config.read(file.section("tsdf_integrator"));
     file.rejectUnknownKeys();
   }
-  parse_argument(argc, argv, "-voxel", volume_config.voxel_size_m);
-  parse_argument(argc, argv, "-trunc", volume_config.truncation_m);
-  parse_argument(argc, argv, "-lambda", config.lambda);
-  parse_argument(argc, argv, "-sweeps", config.sweeps);
-  parse_argument(argc, argv, "-max_weight", config.max_weight);
-  parse_argument(argc, argv, "-max_depth", config.max_depth_m);
+  msf::tool::parseArgument(argc, argv, "-voxel", volume_config.voxel_size_m);
+  msf::tool::parseArgument(argc, argv, "-trunc", volume_config.truncation_m);
+  msf::tool::parseArgument(argc, argv, "-lambda", config.lambda);
+  msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
+  msf::tool::parseArgument(argc, argv, "-max_weight", config.max_weight);
+  msf::tool::parseArgument(argc, argv, "-max_depth", config.max_depth_m);
   std::string weighting;
-  if (parse_argument(argc, argv, "-weighting", weighting) >= 0)
+  if (msf::tool::parseArgument(argc, argv, "-weighting", weighting) >= 0)
     config.weighting = msf::parseWeighting(weighting);
   if (find_switch(argc, argv, "-carving"))
     config.space_carving = true;
@@ -113,7 +113,7 @@ int run(int argc, char** argv) {
 
   msf::PoseList poses = msf::loadOdometryPoses(poses_path);
   std::string frames;
-  if (parse_argument(argc, argv, "-frames", frames) >= 0) {
+  if (msf::tool::parseArgument(argc, argv, "-frames", frames) >= 0) {
     const msf::FrameRange range = msf::FrameRange::parse(frames);
     const int last = range.last < 0 ? static_cast<int>(poses.size()) - 1 : range.last;
     if (range.first >= static_cast<int>(poses.size()) || last >= static_cast<int>(poses.size()))
@@ -127,7 +127,7 @@ int run(int argc, char** argv) {
 
   msf::PinholeCamera camera;
   std::string calib;
-  if (parse_argument(argc, argv, "-calib", calib) >= 0)
+  if (msf::tool::parseArgument(argc, argv, "-calib", calib) >= 0)
     camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib));
 
   pcl::console::TicToc tt;

@@ -68,20 +68,20 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
 
     std::string method_name = "compound", config_path, calib_path;
-    parse_argument(argc, argv, "-method", method_name);
+    msf::tool::parseArgument(argc, argv, "-method", method_name);
     const msf::CompletionMethod method = msf::parseCompletionMethod(method_name);
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-calib", calib_path);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
     const msf::ConfigFile file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
     msf::ProjectionConfig projection;
     projection.read(file.section("projection"));
-    parse_argument(argc, argv, "-camera", projection.camera);
+    msf::tool::parseArgument(argc, argv, "-camera", projection.camera);
     projection.validate();
     msf::InterpolationConfig interpolation;
     interpolation.read(file.section("interpolation"));
-    parse_argument(argc, argv, "-short_gap", interpolation.slice.short_gap_px);
-    parse_argument(argc, argv, "-max_gap", interpolation.slice.max_gap_px);
-    parse_argument(argc, argv, "-threads", interpolation.threads);
+    msf::tool::parseArgument(argc, argv, "-short_gap", interpolation.slice.short_gap_px);
+    msf::tool::parseArgument(argc, argv, "-max_gap", interpolation.slice.max_gap_px);
+    msf::tool::parseArgument(argc, argv, "-threads", interpolation.threads);
     if (find_switch(argc, argv, "-no_gaussian"))
       interpolation.gaussian = false;
     if (method == msf::CompletionMethod::Linear)

@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
     msf::tool::checkOptions(argc, argv, value_options, {"-ascii"});
     const bool ascii = find_switch(argc, argv, "-ascii");
     std::string input_dir, output_dir;
-    parse_argument(argc, argv, "-input_dir", input_dir);
-    parse_argument(argc, argv, "-output_dir", output_dir);
+    msf::tool::parseArgument(argc, argv, "-input_dir", input_dir);
+    msf::tool::parseArgument(argc, argv, "-output_dir", output_dir);
 
     if (!input_dir.empty() || !output_dir.empty()) {
       if (input_dir.empty() || output_dir.empty())

@@ -41,22 +41,19 @@ int run(int argc, char** argv) {
     throw msf::InvalidInputError("unexpected argument '" + msf::tool::positionalArguments(argc, argv, kValueOptions)[0] +
                                  "' (see -h)");
   std::string out_dir;
-  if (parse_argument(argc, argv, "-o", out_dir) < 0) {
+  if (msf::tool::parseArgument(argc, argv, "-o", out_dir) < 0) {
     printHelp(argv[0]);
     throw msf::InvalidInputError("need -o DIR");
   }
   msf::ensureOutputDirectory(out_dir);
   msf::LambdaStudy::Config config;
   std::string config_path;
-  if (parse_argument(argc, argv, "-config", config_path) >= 0) {
-    const msf::ConfigFile file(config_path);
-    config.read(file.section("lambda_study"));
-    file.rejectUnknownKeys();
-  }
-  parse_argument(argc, argv, "-frames", config.frames);
-  parse_argument(argc, argv, "-voxel", config.voxel_size_m);
-  parse_argument(argc, argv, "-trunc", config.truncation_m);
-  parse_argument(argc, argv, "-sweeps", config.sweeps);
+  if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0)
+    msf::readConfigSection(config_path, "lambda_study", config);
+  msf::tool::parseArgument(argc, argv, "-frames", config.frames);
+  msf::tool::parseArgument(argc, argv, "-voxel", config.voxel_size_m);
+  msf::tool::parseArgument(argc, argv, "-trunc", config.truncation_m);
+  msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
   const msf::LambdaStudy study(config);
   config.print(std::cout);
 

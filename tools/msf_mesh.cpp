@@ -45,13 +45,10 @@ int run(int argc, char** argv) {
     throw msf::InvalidInputError("output mesh '" + files[1] + "' must end in .ply, .obj or .vtk");
   msf::MarchingCubes::Config config;
   std::string config_path;
-  if (parse_argument(argc, argv, "-config", config_path) >= 0) {
-    const msf::ConfigFile file(config_path);
-    config.read(file.section("marching_cubes"));
-    file.rejectUnknownKeys();
-  }
-  parse_argument(argc, argv, "-min_weight", config.min_weight);
-  parse_argument(argc, argv, "-min_component_triangles", config.min_component_triangles);
+  if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0)
+    msf::readConfigSection(config_path, "marching_cubes", config);
+  msf::tool::parseArgument(argc, argv, "-min_weight", config.min_weight);
+  msf::tool::parseArgument(argc, argv, "-min_component_triangles", config.min_component_triangles);
   msf::MarchingCubes mesher(config);
 
   pcl::console::TicToc tt;

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     if (disparity && colour)
       throw msf::InvalidInputError("-disparity and -color exclude each other");
     std::string calib_path;
-    parse_argument(argc, argv, "-calib", calib_path);
+    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
     if (disparity && calib_path.empty())
       throw msf::InvalidInputError("-disparity needs -calib PATH (the focal length and baseline)");
     double range_min = 0, range_max = 0;

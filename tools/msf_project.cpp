@@ -48,20 +48,17 @@ int main(int argc, char** argv) {
     if (msf::fileExtension(out) != ".pcd")
       throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
     std::string calib_path, config_path;
-    parse_argument(argc, argv, "-calib", calib_path);
+    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required: the projection needs the camera and T_cam0_velo");
-    parse_argument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
 
     msf::ProjectionConfig config;
-    if (!config_path.empty()) {
-      const msf::ConfigFile file(config_path);
-      config.read(file.section("projection"));
-      file.rejectUnknownKeys();
-    }
-    parse_argument(argc, argv, "-camera", config.camera);
-    parse_argument(argc, argv, "-min_range", config.min_range_m);
-    parse_argument(argc, argv, "-max_range", config.max_range_m);
+    if (!config_path.empty())
+      msf::readConfigSection(config_path, "projection", config);
+    msf::tool::parseArgument(argc, argv, "-camera", config.camera);
+    msf::tool::parseArgument(argc, argv, "-min_range", config.min_range_m);
+    msf::tool::parseArgument(argc, argv, "-max_range", config.max_range_m);
     config.validate();
     const msf::Calibration calibration = msf::loadCalibration(calib_path);
     const msf::LidarProjector projector(calibration, config);

@@ -177,16 +177,16 @@ int main(int argc, char** argv) {
 
     std::string out = "msf_out", config_path, frames_text = "0:";
     int panels = 3;
-    parse_argument(argc, argv, "-o", out);
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-frames", frames_text);
-    parse_argument(argc, argv, "-panels", panels);
+    msf::tool::parseArgument(argc, argv, "-o", out);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
+    msf::tool::parseArgument(argc, argv, "-panels", panels);
     const bool save_depth = find_switch(argc, argv, "-save_depth");
     msf::PipelineConfig config = msf::PipelineConfig::load(config_path);
     if (find_argument(argc, argv, "-voxel") >= 0)
-      parse_argument(argc, argv, "-voxel", config.volume.voxel_size_m);
+      msf::tool::parseArgument(argc, argv, "-voxel", config.volume.voxel_size_m);
     if (find_argument(argc, argv, "-lambda") >= 0)
-      parse_argument(argc, argv, "-lambda", config.integrator.lambda);
+      msf::tool::parseArgument(argc, argv, "-lambda", config.integrator.lambda);
     config.validate();
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 

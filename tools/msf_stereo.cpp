@@ -86,25 +86,22 @@ int main(int argc, char** argv) {
     if (ext != ".pcd" && ext != ".ply")
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
     std::string calib_path, color_path, disparity_path, prior_path, config_path, mode;
-    parse_argument(argc, argv, "-calib", calib_path);
-    parse_argument(argc, argv, "-color", color_path);
-    parse_argument(argc, argv, "-disparity_png", disparity_path);
-    parse_argument(argc, argv, "-prior", prior_path);
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-mode", mode);
+    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    msf::tool::parseArgument(argc, argv, "-color", color_path);
+    msf::tool::parseArgument(argc, argv, "-disparity_png", disparity_path);
+    msf::tool::parseArgument(argc, argv, "-prior", prior_path);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-mode", mode);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
     if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
 
     msf::SgbmConfig config;
-    if (!config_path.empty()) {
-      const msf::ConfigFile file(config_path);
-      config.read(file.section("stereo"));
-      file.rejectUnknownKeys();
-    }
-    parse_argument(argc, argv, "-num_disparities", config.num_disparities_px);
-    parse_argument(argc, argv, "-block_size", config.block_size_px);
+    if (!config_path.empty())
+      msf::readConfigSection(config_path, "stereo", config);
+    msf::tool::parseArgument(argc, argv, "-num_disparities", config.num_disparities_px);
+    msf::tool::parseArgument(argc, argv, "-block_size", config.block_size_px);
     if (!mode.empty())
       config.mode = mode;
     if (find_switch(argc, argv, "-lr_check"))

@@ -35,27 +35,13 @@ void printHelp(const char* name) {
   print_info("    -print_config  print the configuration in effect\n");
 }
 
-/// The value of integer option `option`, strictly parsed; `fallback` when absent.
+/// The value of integer option `option` (strictly parsed), within lo..hi; `fallback` when absent.
 int intOption(int argc, char** argv, const char* option, int fallback, int lo, int hi) {
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (std::strcmp(argv[i], option) != 0)
-      continue;
-    const std::string text = argv[i + 1];
-    std::size_t used = 0;
-    long value = 0;
-    try {
-      value = std::stol(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != text.size() || text.empty())
-      throw msf::InvalidInputError(std::string("option ") + option + ": '" + text + "' is not a whole number");
-    if (value < lo || value > hi)
-      throw msf::InvalidInputError(std::string("option ") + option + ": " + text + " is out of range " +
-                                   std::to_string(lo) + ".." + std::to_string(hi));
-    return static_cast<int>(value);
-  }
-  return fallback;
+  int value = fallback;
+  if (msf::tool::parseArgument(argc, argv, option, value) >= 0 && (value < lo || value > hi))
+    throw msf::InvalidInputError(std::string("option ") + option + ": " + std::to_string(value) +
+                                 " is out of range " + std::to_string(lo) + ".." + std::to_string(hi));
+  return value;
 }
 
 } // namespace
@@ -70,16 +56,13 @@ int main(int argc, char** argv) {
 
     msf::synthetic::SyntheticConfig config;
     std::string config_path, output;
-    parse_argument(argc, argv, "-config", config_path);
-    parse_argument(argc, argv, "-o", output);
-    if (!config_path.empty()) {
-      const msf::ConfigFile file(config_path);
-      config.read(file.section("synthetic"));
-      file.rejectUnknownKeys();
-    }
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-o", output);
+    if (!config_path.empty())
+      msf::readConfigSection(config_path, "synthetic", config);
     config.frames = intOption(argc, argv, "-frames", config.frames, 1, 999999);
     config.seed = intOption(argc, argv, "-seed", config.seed, 0, 2147483647);
-    parse_argument(argc, argv, "-scene", config.scene);
+    msf::tool::parseArgument(argc, argv, "-scene", config.scene);
     if (config.scene != "street")
       throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
     config.validate();

@@ -201,6 +201,44 @@ TEST(Tool, UnknownOptionIsRejectedAndValuesAreNotOptions) {
   EXPECT_THROW(msf::tool::checkOptions(2, const_cast<char**>(missing), {"-voxel"}, {}), msf::InvalidInputError);
 }
 
+TEST(Tool, ParseArgumentReadsNumbersStrictly) {
+  const char* args[] = {"tool", "-n", "42", "-x", "2.5e1", "-name", "cubic", "-bad", "2x", "-empty", ""};
+  auto argv = const_cast<char**>(args);
+  const int argc = 11;
+  int n = 0;
+  double x = 0;
+  float xf = 0;
+  std::string name;
+  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-n", n), 1);
+  EXPECT_EQ(n, 42);
+  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-x", x), 3);
+  EXPECT_DOUBLE_EQ(x, 25.0);
+  msf::tool::parseArgument(argc, argv, "-x", xf);
+  EXPECT_FLOAT_EQ(xf, 25.f);
+  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-name", name), 5);
+  EXPECT_EQ(name, "cubic");
+  int untouched = 7;
+  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-absent", untouched), -1);
+  EXPECT_EQ(untouched, 7);
+  const auto expectRejected = [&](const char* option, auto value, const std::string& message) {
+    try {
+      msf::tool::parseArgument(argc, argv, option, value);
+      FAIL() << option;
+    } catch (const msf::InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  expectRejected("-bad", 0.0, "-bad needs a number, not '2x'");
+  expectRejected("-empty", 0.f, "-empty needs a number, not ''");
+  expectRejected("-x", 0, "-x needs a whole number, not '2.5e1'");
+  expectRejected("-name", 0, "-name needs a whole number, not 'cubic'");
+  const char* big[] = {"tool", "-n", "99999999999", "-inf", "inf"};
+  int b = 0;
+  double d = 0;
+  EXPECT_THROW(msf::tool::parseArgument(5, const_cast<char**>(big), "-n", b), msf::InvalidInputError);
+  EXPECT_THROW(msf::tool::parseArgument(5, const_cast<char**>(big), "-inf", d), msf::InvalidInputError);
+}
+
 TEST(Tool, RunTurnsExceptionsIntoExitCodeOne) {
   EXPECT_EQ(msf::tool::run("msf_test", [] { return 0; }), 0);
   EXPECT_EQ(msf::tool::run("msf_test", []() -> int { throw msf::IOError("boom"); }), 1);

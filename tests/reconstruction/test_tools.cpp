@@ -162,6 +162,9 @@ TEST(Tools, MeshRejectsBadInput) {
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
                                                 " -min_component_triangles -1"),
                   "msf_mesh", "marching_cubes.min_component_triangles must be >= 0");
+  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
+                                                " -min_component_triangles 2O"),
+                  "msf_mesh", "-min_component_triangles needs a whole number, not '2O'");
   std::ofstream(dir.file("typo.yaml")) << "%YAML:1.0\nmarching_cubes:\n  min_weigth: 2\n";
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " -config " +
                                                 dir.file("typo.yaml")),

@@ -4,6 +4,11 @@
 #include <pcl/console/print.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <type_traits>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -39,6 +44,59 @@ int runWithHelp(int argc, char** argv, const char* name, int min_argc, void (*pr
     return help ? 0 : 1;
   }
   return run(name, body);
+}
+
+namespace {
+/// Index of the value after the first `option`, or -1.
+int valueIndex(int argc, char** argv, const char* option) {
+  for (int i = 1; i + 1 < argc; ++i)
+    if (!std::strcmp(argv[i], option))
+      return i + 1;
+  return -1;
+}
+
+[[noreturn]] void notANumber(const char* option, const char* text, const char* kind) {
+  throw InvalidInputError(std::string(option) + " needs " + kind + ", not '" + text + "'");
+}
+
+template <typename T>
+int parseNumber(int argc, char** argv, const char* option, T& value) {
+  const int i = valueIndex(argc, argv, option);
+  if (i < 0)
+    return -1;
+  const char* text = argv[i];
+  char* end = nullptr;
+  errno = 0;
+  if constexpr (std::is_same_v<T, int>) {
+    const long v = std::strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX)
+      notANumber(option, text, "a whole number");
+    value = static_cast<int>(v);
+  } else {
+    const double v = std::strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+      notANumber(option, text, "a number");
+    value = static_cast<T>(v);
+  }
+  return i - 1;
+}
+} // namespace
+
+int parseArgument(int argc, char** argv, const char* option, std::string& value) {
+  const int i = valueIndex(argc, argv, option);
+  if (i < 0)
+    return -1;
+  value = argv[i];
+  return i - 1;
+}
+int parseArgument(int argc, char** argv, const char* option, int& value) {
+  return parseNumber(argc, argv, option, value);
+}
+int parseArgument(int argc, char** argv, const char* option, float& value) {
+  return parseNumber(argc, argv, option, value);
+}
+int parseArgument(int argc, char** argv, const char* option, double& value) {
+  return parseNumber(argc, argv, option, value);
 }
 
 namespace {

@@ -33,6 +33,16 @@ private:
   mutable std::vector<std::string> sections_read_;
 };
 
+/// Reads section `section` of the config file at `path` into `config` (its
+/// read(const cv::FileNode&)), then rejects the keys it did not read (rejectUnknownKeys):
+/// what a tool with one section does with -config.
+template <typename Config>
+void readConfigSection(const std::string& path, const std::string& section, Config& config) {
+  const ConfigFile file(path);
+  config.read(file.section(section));
+  file.rejectUnknownKeys();
+}
+
 /// Overrides `value` with `node[key]` when present; throws ConfigError naming the key
 /// when it has the wrong type. T: int, bool, float, double, std::string, std::vector<double>
 /// (a YAML sequence of numbers, [1, 2.5]).

@@ -5,7 +5,7 @@
 #include <vector>
 
 /// Small helpers shared by the msf_* command-line tools (tools/*.cpp), which otherwise
-/// follow PCL's tools: printHelp, pcl::console::parse_argument, TicToc done lines.
+/// follow PCL's tools: printHelp, parse_argument (here strict: parseArgument), TicToc done lines.
 namespace msf::tool {
 
 /// Runs `body`; any exception becomes "<name>: error: <message>" on stderr and exit code 1.
@@ -24,6 +24,15 @@ int runWithHelp(int argc, char** argv, const char* name, int min_argc, void (*pr
 /// PCL's parser ignores unknown options; a typo should not silently do the default.
 void checkOptions(int argc, char** argv, const std::vector<std::string>& value_options,
                   const std::vector<std::string>& switches);
+
+/// pcl::console::parse_argument, strictly: the value after `option` into `value`; returns
+/// the option's index, or -1 when it is absent. PCL reads "abc" or "2x" as 0 or 2; here a
+/// value that is not wholly a number (a whole one for int) throws InvalidInputError naming
+/// the option and the value.
+int parseArgument(int argc, char** argv, const char* option, std::string& value);
+int parseArgument(int argc, char** argv, const char* option, int& value);
+int parseArgument(int argc, char** argv, const char* option, float& value);
+int parseArgument(int argc, char** argv, const char* option, double& value);
 
 /// Positional (non-option) arguments, skipping the values of `value_options`.
 std::vector<std::string> positionalArguments(int argc, char** argv,
