@@ -181,6 +181,10 @@ void printHelp(const char* name) {
     print_info("                       %-19s %s\n", m.name, m.description);
   print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic, stereo,\n"
              "                     fusion)\n");
+  print_info("    -bounds A,B      ring hold-out: also the rows a per-pixel fusion of methods A and B cannot beat, found\n"
+             "                     with the ground truth: bound_select (per pixel the input nearer the truth: the\n"
+             "                     least MAE of choosing one) and bound_blend (the value between the two nearest the\n"
+             "                     truth: the least error of a weighted mean); e.g. -bounds interpolated,sgbm_guided\n");
   print_info("    -csv FILE        also write the rows as CSV\n");
   print_info("    -breakdown       ring hold-out: also each method's rows for the ground truth that camera 0 sees\n"
              "                     (visible) and cannot see (hidden: an input return within 1 px in front of it),\n"
@@ -299,7 +303,7 @@ void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& r
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_holdout", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv"};
+    const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv", "-bounds"};
     msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout", "-breakdown"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() != 1)
@@ -317,7 +321,12 @@ int main(int argc, char** argv) {
     if (breakdown && gt_mode)
       throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
                                    "regions (add -holdout to evaluate '" + positional[0] + "' by ring hold-out)");
-    std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path;
+    std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path,
+                bounds_text;
+    msf::tool::parseArgument(argc, argv, "-bounds", bounds_text);
+    if (!bounds_text.empty() && gt_mode)
+      throw msf::InvalidInputError("-bounds is a ring hold-out option (add -holdout to evaluate '" + positional[0] +
+                                   "' by ring hold-out)");
     msf::tool::parseArgument(argc, argv, "-frames", frames_text);
     msf::tool::parseArgument(argc, argv, "-methods", methods_text);
     msf::tool::parseArgument(argc, argv, "-config", config_path);
@@ -344,6 +353,12 @@ int main(int argc, char** argv) {
         throw msf::InvalidInputError("unknown method '" + name + "'; known methods: " + methodNames());
       methods.emplace_back(name, entry->make(config_file));
       evaluation.addMethod(name, methods.back().second);
+    }
+    if (!bounds_text.empty()) {
+      const auto pair = split(bounds_text);
+      if (pair.size() != 2)
+        throw msf::InvalidInputError("-bounds needs two methods separated by a comma, got '" + bounds_text + "'");
+      evaluation.addFusionBounds(pair[0], pair[1]);
     }
     config_file.rejectUnknownKeys(); // the sections the methods read
 

@@ -134,21 +134,55 @@ TEST(Holdout, PublishedIpBasicFiguresAndTheIssueTargets) {
   EXPECT_LT(ours.d1_all, ip.d1_all);
 }
 
+TEST(Holdout, FusionBoundsOfTwoMethodsAreNoWorseThanEither) {
+  MSF_REQUIRE_KITTI();
+  const msf::Sequence sequence(odometry());
+  msf::HoldoutEvaluation evaluation;
+  evaluation.addMethod("interpolated", lidar(msf::CompletionMethod::Compound));
+  evaluation.addMethod("ipbasic", lidar(msf::CompletionMethod::IpBasicFast));
+  EXPECT_THROW(evaluation.addFusionBounds("interpolated", "interpolated"), msf::InvalidInputError);
+  try {
+    evaluation.addFusionBounds("interpolated", "sgbm");
+    FAIL();
+  } catch (const msf::InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'sgbm' is not a method"), std::string::npos) << e.what();
+  }
+  evaluation.addFusionBounds("interpolated", "ipbasic");
+  const auto results = evaluation.run(sequence, {0, 1});
+  ASSERT_EQ(results.size(), 4u);
+  EXPECT_EQ(results[2].method, "bound_select");
+  EXPECT_EQ(results[3].method, "bound_blend");
+  const msf::DepthMetrics &a = results[0].metrics, &b = results[1].metrics;
+  const msf::DepthMetrics &select = results[2].metrics, &blend = results[3].metrics;
+  // Coverage of one input or the other; errors no larger than the better input's, and blending's no
+  // larger than choosing's. Both inputs err, so the bounds are not the truth itself.
+  EXPECT_GE(select.coverage, std::max(a.coverage, b.coverage));
+  EXPECT_LE(select.coverage, a.coverage + b.coverage);
+  EXPECT_EQ(blend.coverage, select.coverage);
+  EXPECT_LT(select.mae_m, std::min(a.mae_m, b.mae_m));
+  EXPECT_LE(blend.mae_m, select.mae_m);
+  EXPECT_GT(blend.mae_m, 0.0);
+  EXPECT_LE(blend.d1_all, std::min(a.d1_all, b.d1_all));
+  EXPECT_LE(blend.d1_all, select.d1_all);
+}
+
 TEST(HoldoutTool, PrintsOneRowPerMethodAndWritesCsv) {
   MSF_REQUIRE_KITTI();
   msf::test::TempDir tmp;
   const std::string csv = tmp.file("table.csv");
   auto r = msf::test::runTool("msf_holdout", "'" + odometry() + "' -frames 0:1 -methods interpolated,ipbasic -csv '" +
-                                                 csv + "'");
+                                                 csv + "' -bounds ipbasic,interpolated");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("method"), std::string::npos);
   EXPECT_NE(r.out.find("interpolated"), std::string::npos);
   EXPECT_NE(r.out.find("ipbasic"), std::string::npos);
+  EXPECT_NE(r.out.find("bound_select"), std::string::npos);
+  EXPECT_NE(r.out.find("bound_blend"), std::string::npos);
   std::ifstream in(csv);
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string text = ss.str();
-  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 3);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 5); // header, 2 methods, 2 bounds
 }
 
 TEST(HoldoutTool, ErrorsNameTheProblemAndWriteNoCsv) {
@@ -161,6 +195,8 @@ TEST(HoldoutTool, ErrorsNameTheProblemAndWriteNoCsv) {
       {"'" + odometry() + "' -frames 50:60" + csv, "selects no frame"},
       {"/nonexistent/sequence" + csv, "/nonexistent/sequence"},
       {"'" + odometry() + "' -csv '" + tmp.file("t.txt") + "'", ".csv"},
+      {"'" + odometry() + "' -methods interpolated,ipbasic -bounds interpolated" + csv, "-bounds needs two methods"},
+      {"'" + odometry() + "' -methods interpolated,ipbasic -bounds interpolated,sgbm" + csv, "'sgbm' is not a method"},
   };
   for (const auto& [args, message] : cases) {
     const auto r = msf::test::runTool("msf_holdout", args);

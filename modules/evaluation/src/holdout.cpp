@@ -47,14 +47,34 @@ void HoldoutEvaluation::addMethod(const std::string& name, HoldoutMethod method)
   methods_.emplace_back(name, std::move(method));
 }
 
+void HoldoutEvaluation::addFusionBounds(const std::string& first, const std::string& second) {
+  auto index = [&](const std::string& name) {
+    for (std::size_t m = 0; m < methods_.size(); ++m)
+      if (methods_[m].first == name)
+        return m;
+    std::string names;
+    for (const auto& m : methods_)
+      names += (names.empty() ? "" : ", ") + m.first;
+    throw InvalidInputError("fusion bounds: '" + name + "' is not a method of this evaluation (its methods: " +
+                            names + ")");
+  };
+  if (first == second)
+    throw InvalidInputError("fusion bounds need two different methods, got '" + first + "' twice");
+  bound_first_ = index(first);
+  bound_second_ = index(second);
+  bounds_ = true;
+}
+
 std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
                                                   const std::vector<std::size_t>& frames) const {
   if (methods_.empty())
     throw InvalidInputError("no hold-out method to run");
   const Calibration& calibration = sequence.calibration();
   const double fB = calibration.focalBaseline();
-  std::vector<DepthErrorAccumulator> errors(methods_.size());
-  std::vector<std::vector<DepthErrorAccumulator>> region_errors(methods_.size());
+  const FusionBound kBounds[2] = {FusionBound::Select, FusionBound::Blend};
+  const std::size_t rows = methods_.size() + (bounds_ ? 2 : 0); // the methods', then the bounds'
+  std::vector<DepthErrorAccumulator> errors(rows);
+  std::vector<std::vector<DepthErrorAccumulator>> region_errors(rows);
   std::vector<std::string> region_names;
   std::vector<std::vector<double>> times(methods_.size());
   std::size_t done = 0;
@@ -67,6 +87,13 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
       for (const auto& region : regions)
         region_names.push_back(region.name);
     }
+    auto accumulate = [&](std::size_t row, const cv::Mat& estimate) {
+      errors[row].add(split.gt_depth, estimate, fB, cv::Mat(), config_.d1);
+      region_errors[row].resize(regions.size());
+      for (std::size_t r = 0; r < regions.size(); ++r)
+        region_errors[row][r].add(split.gt_depth, estimate, fB, regions[r].mask, config_.d1);
+    };
+    cv::Mat bound_inputs[2];
     for (std::size_t m = 0; m < methods_.size(); ++m) {
       const auto start = std::chrono::steady_clock::now();
       const cv::Mat estimate = methods_[m].second(split.input);
@@ -77,20 +104,22 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
                                 std::to_string(estimate.cols) + "x" + std::to_string(estimate.rows) +
                                 " image of type " + std::to_string(estimate.type()) + ", expected CV_32FC1 " +
                                 std::to_string(split.gt_depth.cols) + "x" + std::to_string(split.gt_depth.rows));
-      errors[m].add(split.gt_depth, estimate, fB, cv::Mat(), config_.d1);
-      region_errors[m].resize(regions.size());
-      for (std::size_t r = 0; r < regions.size(); ++r)
-        region_errors[m][r].add(split.gt_depth, estimate, fB, regions[r].mask, config_.d1);
+      accumulate(m, estimate);
+      if (bounds_ && (m == bound_first_ || m == bound_second_))
+        bound_inputs[m == bound_first_ ? 0 : 1] = estimate;
     }
+    if (bounds_)
+      for (std::size_t k = 0; k < 2; ++k)
+        accumulate(methods_.size() + k, fusionBoundDepth(split.gt_depth, bound_inputs[0], bound_inputs[1], kBounds[k]));
     if (progress_)
       progress_(++done, frames.size());
   }
   std::vector<HoldoutResult> results;
-  for (std::size_t m = 0; m < methods_.size(); ++m) {
+  for (std::size_t m = 0; m < rows; ++m) {
     HoldoutResult r;
-    r.method = methods_[m].first;
+    r.method = m < methods_.size() ? methods_[m].first : fusionBoundName(kBounds[m - methods_.size()]);
     r.metrics = errors[m].metrics();
-    r.median_ms = median(times[m]);
+    r.median_ms = m < methods_.size() ? median(times[m]) : 0.0;
     r.frames = frames.size();
     for (std::size_t k = 0; k < region_errors[m].size(); ++k)
       r.regions.push_back({region_names[k], region_errors[m][k].metrics()});

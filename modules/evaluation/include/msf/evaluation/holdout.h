@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/fusion_bounds.h>
 #include <msf/evaluation/holdout_breakdown.h>
 #include <msf/io/calibration.h>
 #include <msf/io/sequence.h>
@@ -68,6 +69,10 @@ public:
 
   /// Throws InvalidInputError when the name is taken or empty.
   void addMethod(const std::string& name, HoldoutMethod method);
+  /// Also the rows bound_select and bound_blend (FusionBound) of the named methods' depths,
+  /// after the methods' rows; their time is 0. Throws InvalidInputError unless both names
+  /// are methods already added, and different.
+  void addFusionBounds(const std::string& first, const std::string& second);
   /// Load camera 2 for the methods that need colour (off by default: it costs a decode).
   void setLoadColor(bool load) { load_color_ = load; }
   /// Also pool the metrics of each of holdoutRegions (HoldoutResult::regions).
@@ -83,6 +88,8 @@ public:
 private:
   HoldoutConfig config_;
   std::vector<std::pair<std::string, HoldoutMethod>> methods_;
+  std::size_t bound_first_ = 0, bound_second_ = 0; ///< method indices, with bounds_
+  bool bounds_ = false;
   bool load_color_ = false;
   bool breakdown_ = false;
   std::function<void(std::size_t, std::size_t)> progress_;
