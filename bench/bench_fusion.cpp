@@ -90,10 +90,11 @@ void cloudFusion(benchmark::State& state, msf::FusionMethod method) {
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
 }
 
-void imageFusion(benchmark::State& state, msf::FusionMethod method) {
+void imageFusion(benchmark::State& state, msf::FusionMethod method, bool edge_support = true) {
   const Data& d = data();
   msf::DepthFusionConfig config;
   config.method = method;
+  config.edge_support = edge_support;
   msf::DepthImageFusion fusion(config);
   fusion.setCalibration(d.calibration);
   cv::Mat fused, weight;
@@ -112,6 +113,10 @@ void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod
 void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
 void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
 void BM_FusionImageUncertainty(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Uncertainty); }
+// The same without its last step (fusion.edge_support), for that step's cost side by side.
+void BM_FusionImageUncertaintyNoEdgeSupport(benchmark::State& s) {
+  imageFusion(s, msf::FusionMethod::Uncertainty, false);
+}
 
 } // namespace
 
@@ -119,5 +124,6 @@ BENCHMARK(BM_FusionCloudPaper)->Unit(benchmark::kMillisecond)->UseRealTime()->It
 BENCHMARK(BM_FusionCloudUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImagePaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_FusionImageUncertaintyNoEdgeSupport)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 
 BENCHMARK_MAIN();

@@ -104,6 +104,7 @@ TEST(DepthFusionPaper, Eq6OnHandMadePixels) {
   config.paper_lidar_gain = 1.f;
   config.paper_lidar_distance_px = 4.f;
   config.paper_stereo_reference_depth_m = 10.f;
+  config.edge_support = false; // eq. 6 alone: the returns at 10 and 20 m make an edge (test_edge_support)
   Inputs in(5, 2);
   in.setLidar(0, 0, 0.f, 0.f);  in.setStereo(0, 0, 12.f, 0.8f);  // invalid LiDAR: stereo value
   in.setLidar(1, 0, 10.f, 0.f); in.setStereo(1, 0, 0.f, 0.f);    // invalid stereo: LiDAR value

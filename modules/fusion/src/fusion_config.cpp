@@ -48,6 +48,11 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   readKey(node, "lidar_range_window_px", lidar_range_window_px);
   readKey(node, "parallax_check", parallax_check);
   readKey(node, "parallax_max_rows", parallax_max_rows);
+  readKey(node, "edge_support", edge_support);
+  readKey(node, "edge_window_rows", edge_window_rows);
+  readKey(node, "edge_window_cols", edge_window_cols);
+  readKey(node, "edge_jump_px", edge_jump_px);
+  readKey(node, "edge_tolerance_px", edge_tolerance_px);
   validate();
 }
 
@@ -68,6 +73,12 @@ void DepthFusionConfig::validate() const {
                       std::to_string(lidar_range_window_px));
   if (parallax_max_rows < 1)
     throw ConfigError("config key 'fusion.parallax_max_rows' must be >= 1, not " + std::to_string(parallax_max_rows));
+  for (const auto& [key, value] : {std::pair{"edge_window_rows", edge_window_rows}, {"edge_window_cols", edge_window_cols}})
+    if (value < 1 || value % 2 == 0)
+      throw ConfigError(std::string("config key 'fusion.") + key + "' must be odd and >= 1, not " +
+                        std::to_string(value));
+  positive(edge_jump_px, "edge_jump_px");
+  nonNegative(edge_tolerance_px, "edge_tolerance_px");
 }
 
 void DepthFusionConfig::print(std::ostream& out) const {
@@ -85,7 +96,12 @@ void DepthFusionConfig::print(std::ostream& out) const {
       << "  disagreement_k_sigma: " << disagreement_k_sigma << "\n"
       << "  lidar_range_window_px: " << lidar_range_window_px << "\n"
       << "  parallax_check: " << (parallax_check ? "true" : "false") << "\n"
-      << "  parallax_max_rows: " << parallax_max_rows << "\n";
+      << "  parallax_max_rows: " << parallax_max_rows << "\n"
+      << "  edge_support: " << (edge_support ? "true" : "false") << "\n"
+      << "  edge_window_rows: " << edge_window_rows << "\n"
+      << "  edge_window_cols: " << edge_window_cols << "\n"
+      << "  edge_jump_px: " << edge_jump_px << "\n"
+      << "  edge_tolerance_px: " << edge_tolerance_px << "\n";
 }
 
 } // namespace msf

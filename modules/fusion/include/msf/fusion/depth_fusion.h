@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/fusion/edge_support.h>
 #include <msf/fusion/fusion_config.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/calibration.h>
@@ -79,7 +80,9 @@ private:
   PointCloudStereoConstPtr stereo_;
   cv::Mat color_;
   int color_camera_{2};
-  cv::Mat lidar_depth_, lidar_max_, lidar_min_; ///< work buffers, kept between frames
+  cv::Mat lidar_depth_, lidar_distance_, lidar_max_, lidar_min_; ///< work buffers, kept between frames
+  cv::Mat fused_depth_, fused_weight_;
+  EdgeSupportBuffers edge_buffers_;
 };
 
 } // namespace msf

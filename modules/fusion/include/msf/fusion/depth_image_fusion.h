@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/fusion/edge_support.h>
 #include <msf/fusion/fusion_config.h>
 #include <msf/fusion/fusion_model.h>
 #include <msf/io/calibration.h>
@@ -41,6 +42,7 @@ private:
   cv::Mat largest_, smallest_;          ///< local LiDAR disparity extremes, kept between frames
   cv::Mat weight_;                      ///< weights when the caller wants none
   cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none
+  EdgeSupportBuffers edge_buffers_;
 };
 
 /// One-call form of DepthImageFusion (buffers are allocated for the call).

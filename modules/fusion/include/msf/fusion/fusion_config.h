@@ -39,6 +39,14 @@ struct DepthFusionConfig {
   bool parallax_check = true;                 ///< stereo wins where the LiDAR saw past a foreground edge
   int parallax_max_rows = 16;                 ///< rows below a pixel searched for that foreground
 
+  // --- both methods, last: a fused disparity between the two surfaces of a depth edge takes
+  // the nearest real return's (edge_support.h)
+  bool edge_support = true;
+  int edge_window_rows = 13;                  ///< odd window of real returns (two rings above, two below)
+  int edge_window_cols = 7;                   ///< odd
+  float edge_jump_px = 8.f;                   ///< an edge: the window's returns differ by more (disparity)
+  float edge_tolerance_px = 2.f;              ///< a fused disparity this near a return is on its surface
+
   /// Overrides the keys present in `node` (the `fusion` section), then validates.
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the key of the first value out of range.

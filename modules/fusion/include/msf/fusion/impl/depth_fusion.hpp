@@ -44,6 +44,10 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
   const float fB = static_cast<float>(calibration_.focalBaseline());
   lidar_depth_.create(rows, cols, CV_32FC1);
+  if constexpr (detail::has_distance_v<PointLidarT>)
+    lidar_distance_.create(rows, cols, CV_32FC1);
+  else
+    lidar_distance_.release(); // every LiDAR depth counts as a real return
   // cv::parallel_for_ rather than OpenMP: its work stealing keeps both cores busy when the
   // machine is shared, where a static OpenMP split waits for the slower thread.
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
@@ -52,6 +56,11 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
       float* z = lidar_depth_.ptr<float>(v);
       for (int u = 0; u < cols; ++u)
         z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
+      if constexpr (detail::has_distance_v<PointLidarT>) {
+        float* distance = lidar_distance_.ptr<float>(v);
+        for (int u = 0; u < cols; ++u)
+          distance[u] = in[u].distance;
+      }
     }
   });
   const bool uncertainty = config_.method == FusionMethod::Uncertainty;
@@ -68,12 +77,11 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   output.header = stereo_->header;
   output.sensor_origin_ = stereo_->sensor_origin_;
   output.sensor_orientation_ = stereo_->sensor_orientation_;
-  std::atomic<bool> dense{true};
+  // 1. The fused depth and weight images, a row at a time in contiguous arrays for fuseRow.
+  fused_depth_.create(rows, cols, CV_32FC1);
+  fused_weight_.create(rows, cols, CV_32FC1);
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
-    // One row of each input at a time, in contiguous arrays for fuseRow.
-    std::vector<float> distance(static_cast<std::size_t>(cols)), z_stereo(distance), confidence(distance),
-        fused_z(distance), fused_weight(distance);
-    bool range_dense = true;
+    std::vector<float> zeros(static_cast<std::size_t>(cols), 0.f), z_stereo(zeros), confidence(zeros);
     for (int v = range.start; v < range.end; ++v) {
       const std::size_t row = static_cast<std::size_t>(v) * cols;
       for (int u = 0; u < cols; ++u) {
@@ -83,14 +91,23 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
           confidence[u] = s.confidence;
         else
           confidence[u] = 1.f;
-        if constexpr (detail::has_distance_v<PointLidarT>)
-          distance[u] = (*lidar_)[row + u].distance;
-        else
-          distance[u] = 0.f;
       }
-      fuseRow(config, fB, parallax, lidar_depth_, v, distance.data(), uncertainty ? lidar_max_.ptr<float>(v) : nullptr,
-              uncertainty ? lidar_min_.ptr<float>(v) : nullptr, z_stereo.data(), confidence.data(), fused_z.data(),
-              fused_weight.data());
+      fuseRow(config, fB, parallax, lidar_depth_, v, lidar_distance_.empty() ? zeros.data() : lidar_distance_.ptr<float>(v),
+              uncertainty ? lidar_max_.ptr<float>(v) : nullptr, uncertainty ? lidar_min_.ptr<float>(v) : nullptr,
+              z_stereo.data(), confidence.data(), fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v));
+    }
+  });
+  if (config.edge_support)
+    supportAtDepthEdges(lidar_depth_, lidar_distance_, fB, config, fused_depth_, edge_buffers_);
+
+  // 2. The points, on the rays of the input points.
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    bool range_dense = true;
+    for (int v = range.start; v < range.end; ++v) {
+      const std::size_t row = static_cast<std::size_t>(v) * cols;
+      const float* fused_z = fused_depth_.ptr<float>(v);
+      const float* fused_weight = fused_weight_.ptr<float>(v);
       for (int u = 0; u < cols; ++u) {
         const PointStereoT& s = (*stereo_)[row + u];
         PointOutT& p = output[row + u];
@@ -98,7 +115,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
         if (z > 0.f) {
           // On the ray of the input point: stereo's lies on the pixel's ray, the LiDAR's
           // within half a pixel of it.
-          const bool from_stereo = z_stereo[u] > 0.f;
+          const bool from_stereo = detail::validDepth(s.z);
           const PointLidarT& l = (*lidar_)[row + u];
           const float scale = z / (from_stereo ? s.z : l.z);
           p.x = (from_stereo ? s.x : l.x) * scale;
