@@ -25,7 +25,7 @@ TEST(FusionKitti, FusedBeatsEachInputOnHeldOutRings) {
   msf::SgbmStereo stereo;
   stereo.setCalibration(calibration);
   const double fB = calibration.focalBaseline();
-  msf::DepthErrorAccumulator lidar_errors, stereo_errors, paper_errors, uncertainty_errors;
+  msf::DepthErrorAccumulator lidar_errors, stereo_errors, paper_errors, uncertainty_errors, no_edge_errors;
   for (std::size_t i : {0u, 5u}) {
     const msf::HoldoutFrame frame = msf::makeHoldoutFrame(sequence.load(i, false), calibration, {});
     cv::Mat lidar_depth, distance;
@@ -40,6 +40,10 @@ TEST(FusionKitti, FusedBeatsEachInputOnHeldOutRings) {
     msf::fuseDepthImages(lidar_depth, distance, stereo_depth, stereo.getConfidence(), calibration, config, paper);
     config.method = msf::FusionMethod::Uncertainty;
     msf::fuseDepthImages(lidar_depth, distance, stereo_depth, stereo.getConfidence(), calibration, config, uncertainty);
+    cv::Mat no_edge;
+    config.edge_support = false;
+    msf::fuseDepthImages(lidar_depth, distance, stereo_depth, stereo.getConfidence(), calibration, config, no_edge);
+    no_edge_errors.add(frame.gt_depth, no_edge, fB);
     lidar_errors.add(frame.gt_depth, lidar_depth, fB);
     stereo_errors.add(frame.gt_depth, stereo_depth, fB);
     paper_errors.add(frame.gt_depth, paper, fB);
@@ -60,6 +64,8 @@ TEST(FusionKitti, FusedBeatsEachInputOnHeldOutRings) {
   EXPECT_LT(u.disparity_mae_px, std::min(l.disparity_mae_px, s.disparity_mae_px));
   EXPECT_LT(u.mae_m, s.mae_m);
   EXPECT_LT(u.d1_all, 0.045);
+  // Edge support removes outliers between the surfaces of depth edges.
+  EXPECT_LT(u.d1_all, no_edge_errors.metrics().d1_all);
 }
 
 // The cloud class and the image function agree on a real frame.
