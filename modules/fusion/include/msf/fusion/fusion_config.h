@@ -42,7 +42,7 @@ struct DepthFusionConfig {
   // --- both methods, last: a fused disparity between the two surfaces of a depth edge takes
   // the nearest real return's (edge_support.h)
   bool edge_support = true;
-  int edge_window_rows = 13;                  ///< odd window of real returns (two rings above, two below)
+  int edge_window_rows = 13;                  ///< odd window of real returns (KITTI rings are ~5 rows apart)
   int edge_window_cols = 7;                   ///< odd
   float edge_jump_px = 8.f;                   ///< an edge: the window's returns differ by more (disparity)
   float edge_tolerance_px = 2.f;              ///< a fused disparity this near a return is on its surface
