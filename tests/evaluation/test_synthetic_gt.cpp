@@ -103,6 +103,10 @@ TEST_F(SyntheticGtTest, HoldoutGtSwitchWithoutGroundTruthIsAnError) {
   const auto both = msf::test::runTool("msf_holdout", quote(dataset()) + " -gt -holdout");
   EXPECT_NE(both.exit_code, 0);
   EXPECT_NE(both.err.find("msf_holdout: error:"), std::string::npos) << both.err;
+  // -bounds belongs to the ring hold-out, which names the way to it.
+  const auto bounds = msf::test::runTool("msf_holdout", quote(dataset()) + " -bounds interpolated,sgbm");
+  EXPECT_NE(bounds.exit_code, 0);
+  EXPECT_NE(bounds.err.find("-bounds is a ring hold-out option"), std::string::npos) << bounds.err;
 }
 
 TEST_F(SyntheticGtTest, EvalDisparityFoldersGroundTruthAgainstItself) {

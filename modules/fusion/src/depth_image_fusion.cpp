@@ -73,7 +73,7 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
               stereo.ptr<float>(v), confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v));
   });
   if (config_.edge_support)
-    supportAtDepthEdges(lidar, lidar_distance, fB, config_, fused_depth, edge_buffers_);
+    supportAtDepthEdges(lidar, distance, fB, config_, fused_depth, edge_buffers_);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

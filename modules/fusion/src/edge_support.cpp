@@ -19,8 +19,6 @@ namespace {
 // is its return's own.
 constexpr float kSteps = 8.f;
 constexpr std::uint16_t kNone = std::numeric_limits<std::uint16_t>::max();
-// Blocks of rows per parallel loop: a block per row costs more to hand out than its work.
-constexpr double kStripes = 16;
 
 // The loops below are written so that GCC vectorises them (selects of values, no branch;
 // the file is compiled with -fno-trapping-math).
@@ -75,7 +73,7 @@ void supportAtDepthEdges(const cv::Mat& lidar_depth, const cv::Mat& lidar_distan
       returnSteps(lidar_depth.ptr<float>(v),
                   lidar_distance.empty() ? buffers.zeros.ptr<float>(0) : lidar_distance.ptr<float>(v), cols, fB,
                   buffers.returns.ptr<std::uint16_t>(v), buffers.smallest.ptr<std::uint16_t>(v));
-  }, kStripes);
+  });
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {config.edge_window_cols, config.edge_window_rows});
   cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) { // the two at once
     for (int k = range.start; k < range.end; ++k)
@@ -113,7 +111,7 @@ void supportAtDepthEdges(const cv::Mat& lidar_depth, const cv::Mat& lidar_distan
           z[u] = lidar_depth.at<float>(best_row, best_col);
       }
     }
-  }, kStripes);
+  });
 }
 
 } // namespace msf
