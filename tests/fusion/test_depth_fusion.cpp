@@ -175,7 +175,11 @@ TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
   const float d = (20.f * vS + 21.f * vL) / (vL + vS); // 20.8
   const auto f = msf::fuseUncertainty(in, config, static_cast<float>(kFB));
   EXPECT_NEAR(f.z, kFB / d, 1e-4);
-  EXPECT_NEAR(f.weight, 1.f, 1e-6f); // the fused sigma is below stereo_sigma_min_px
+  // The weight is the inverse variance of the fused depth: sigma_z = z^2 sigma_d / (f B) with
+  // 1 / sigma_d^2 = 1 / vL + 1 / vS.
+  const float z = static_cast<float>(kFB / d);
+  const float sigma_z = z * z * std::sqrt(vL * vS / (vL + vS)) / static_cast<float>(kFB);
+  EXPECT_NEAR(f.weight, 1.f / (sigma_z * sigma_z), 1e-3f * f.weight);
   // Far apart (4 px > 3 * sqrt(0.45)): not averaged, the more certain (stereo) wins.
   in.z_stereo = static_cast<float>(kFB / 24.0);
   EXPECT_FLOAT_EQ(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, in.z_stereo);
@@ -193,6 +197,33 @@ TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
   EXPECT_FLOAT_EQ(msf::stereoSigmaPx(1.f, config), 0.3f);
   EXPECT_FLOAT_EQ(msf::stereoSigmaPx(0.f, config), 4.f);
   EXPECT_NEAR(msf::stereoSigmaPx(0.5f, config), 0.3f + 3.7f * 0.25f, 1e-6f);
+}
+
+TEST(DepthFusionUncertainty, WeightsAreInverseDepthVariancesThatTrustTheLidar) {
+  // What the TSDF integrator averages with: 1 / sigma_z^2, sigma_z = z^2 sigma_d / (f B).
+  const msf::DepthFusionConfig config; // the defaults
+  const float fb = static_cast<float>(kFB);
+  auto weight = [&](float z_lidar, float distance, float z_stereo, float confidence) {
+    msf::FusionInputs in;
+    in.z_lidar = z_lidar;
+    in.lidar_distance = distance;
+    in.z_stereo = z_stereo;
+    in.stereo_confidence = confidence;
+    return msf::fuseUncertainty(in, config, fb).weight;
+  };
+  const float lidar = weight(10.f, 0.f, 0.f, 1.f), stereo = weight(0.f, 0.f, 10.f, 1.f);
+  const float sigma_lidar = 100.f * config.lidar_sigma_px / fb;
+  EXPECT_NEAR(lidar, 1.f / (sigma_lidar * sigma_lidar), 1e-3f * lidar);
+  // A real return outweighs the best stereo match at the same depth by (0.5 / 0.1)^2.
+  EXPECT_NEAR(lidar / stereo, std::pow(config.stereo_sigma_min_px / config.lidar_sigma_px, 2.f), 1e-3f);
+  // Both agreeing: more than either alone.
+  EXPECT_GT(weight(10.f, 0.f, 10.f, 1.f), lidar);
+  // Interpolated LiDAR far from a return, and weak stereo, weigh less.
+  EXPECT_LT(weight(10.f, 20.f, 0.f, 1.f), lidar);
+  EXPECT_LT(weight(0.f, 0.f, 10.f, 0.3f), stereo);
+  // Depth error grows as z^2: twice as far, a sixteenth of the weight.
+  EXPECT_NEAR(weight(0.f, 0.f, 20.f, 1.f), stereo / 16.f, 1e-4f * stereo);
+  EXPECT_EQ(weight(0.f, 0.f, 0.f, 1.f), 0.f);
 }
 
 // A foreground box at 5 m fills the rows >= 10 of the image, a wall at 20 m the rows above.
@@ -276,7 +307,9 @@ TEST(DepthFusion, OrganizedInvariants) {
         if (any) {
           EXPECT_NEAR(p.z, 10.f + u, 1e-4f);
           EXPECT_GT(p.weight, 0.f);
-          EXPECT_LE(p.weight, 1.f);
+          if (method == msf::FusionMethod::Paper) {
+            EXPECT_LE(p.weight, 1.f); // the paper's weights; uncertainty's are inverse variances
+          }
           EXPECT_EQ(p.r, 10); // colour of the stereo point
         } else {
           EXPECT_EQ(p.weight, 0.f);

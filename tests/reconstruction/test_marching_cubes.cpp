@@ -7,6 +7,7 @@
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -42,7 +43,7 @@ TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
           for (int x = 0; x < 8; ++x) {
             TsdfVoxel& v = block.at(x, y, z);
             v.sdf = 0.25f - 0.1f * static_cast<float>(z);
-            v.weight = 1.f;
+            v.weight = 100.f; // an inverse variance (m^-2) above the default min_weight
           }
       block.stamp = volume.beginGeneration();
       block.updateSigns();
@@ -139,12 +140,14 @@ TEST(MarchingCubes, IncrementalMeshingEqualsFullMeshing) {
 TEST(MarchingCubes, MinimumWeightDropsWeakVoxels) {
   TsdfVolume volume(0.04, 0.12);
   integrateSphere(volume, 0, 3);
+  // Each frame of exact depth adds 1 / depth_sigma_m^2 to a voxel near the surface.
+  const float frame_weight = static_cast<float>(1.0 / std::pow(TsdfIntegrator::Config().depth_sigma_m, 2));
   TriangleMesh all, strong, none;
   MarchingCubes().extract(volume, all);
   MarchingCubes::Config c;
-  c.min_weight = 2.5f; // only voxels seen by all 3 frames
+  c.min_weight = 2.5f * frame_weight; // only voxels seen by all 3 frames
   MarchingCubes(c).extract(volume, strong);
-  c.min_weight = 3.f;
+  c.min_weight = 3.f * frame_weight;
   MarchingCubes(c).extract(volume, none);
   EXPECT_GT(all.triangles.size(), strong.triangles.size());
   EXPECT_GT(strong.triangles.size(), 100u);

@@ -122,7 +122,7 @@ TEST(MeshComponents, MarchingCubesRemovesSpecksAndReportsThem) {
         for (int x = 0; x < 8; ++x) {
           TsdfVoxel& v = block.at(x, y, z);
           v.sdf = sdf(x, y, z);
-          v.weight = 1.f;
+          v.weight = 100.f; // an inverse variance (m^-2) above the default min_weight
         }
     block.stamp = volume.beginGeneration();
     block.updateSigns();

@@ -105,7 +105,7 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
         [&](int k) { return v + k < rows ? lidar_depth.ptr<float>(v + k)[u] : 0.f; });
     if (past) {
       fused_z[u] = z_stereo[u];
-      fused_weight[u] = std::min(1.f, config.stereo_sigma_min_px * config.stereo_sigma_min_px / (s_S * s_S));
+      fused_weight[u] = depthWeight(z_stereo[u], 1.f / (s_S * s_S), focal_baseline);
     }
   }
 }

@@ -97,7 +97,14 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
   camera.cx = 0.5f * static_cast<float>(config_.width - 1);
   camera.cy = 0.5f * static_cast<float>(config_.height - 1);
   TsdfVolume volume(config_.voxel_size_m, config_.truncation_m);
+  // The paper's TSDF (projective distance, every depth weighing the same, no free-space
+  // updates), so that lambda alone varies: the scene is static and its noise uniform.
   TsdfIntegrator::Config ic;
+  ic.signed_distance = TsdfIntegrator::SignedDistance::Projective;
+  ic.weighting = TsdfIntegrator::Weighting::Constant;
+  ic.truncation_sigmas = 0.0;
+  ic.space_carving = false;
+  ic.weight_dropoff = false;
   ic.lambda = lambda;
   ic.sweeps = config_.sweeps;
   TsdfIntegrator integrator(volume, ic);
@@ -122,7 +129,9 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
     integrate_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   TriangleMesh mesh;
-  MarchingCubes().extract(volume, mesh);
+  MarchingCubes::Config every_voxel;
+  every_voxel.min_weight = 0.f;
+  MarchingCubes(every_voxel).extract(volume, mesh);
   Cell cell;
   cell.noise_mm = noise_mm;
   cell.lambda = lambda;

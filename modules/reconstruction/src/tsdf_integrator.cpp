@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <opencv2/core/utility.hpp>
@@ -36,7 +37,7 @@ inline Float4 clamp4(Float4 v, float lo, float hi) {
 }
 /// A voxel that passed the nearest-pixel test: its projection, depth and nearest pixel.
 struct Candidate {
-  float u, v, z, nearest;
+  float u, v, z, nearest, scale, band;
   std::int32_t ui, vi;
   std::uint16_t voxel; ///< index in the block
 };
@@ -133,6 +134,16 @@ const char* toString(TsdfIntegrator::Weighting weighting) {
   return "?";
 }
 
+const char* toString(TsdfIntegrator::SignedDistance distance) {
+  return distance == TsdfIntegrator::SignedDistance::Plane ? "plane" : "projective";
+}
+
+TsdfIntegrator::SignedDistance parseSignedDistance(const std::string& text) {
+  if (text == "plane") return TsdfIntegrator::SignedDistance::Plane;
+  if (text == "projective") return TsdfIntegrator::SignedDistance::Projective;
+  throw ConfigError("TSDF signed distance '" + text + "' is not plane or projective");
+}
+
 TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
   if (text == "constant") return TsdfIntegrator::Weighting::Constant;
   if (text == "inverse_square") return TsdfIntegrator::Weighting::InverseSquare;
@@ -145,7 +156,18 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "weighting", w);
   weighting = parseWeighting(w);
   readKey(node, "max_weight", max_weight);
+  readKey(node, "depth_sigma_m", depth_sigma_m);
+  readKey(node, "min_pixel_weight", min_pixel_weight);
+  readKey(node, "truncation_sigmas", truncation_sigmas);
   readKey(node, "space_carving", space_carving);
+  readKey(node, "carving_weight", carving_weight);
+  readKey(node, "weight_dropoff", weight_dropoff);
+  std::string distance = toString(signed_distance);
+  readKey(node, "signed_distance", distance);
+  signed_distance = parseSignedDistance(distance);
+  readKey(node, "plane_step_px", plane.step_px);
+  readKey(node, "plane_max_curvature", plane.max_curvature);
+  readKey(node, "plane_min_scale", plane.min_scale);
   readKey(node, "lambda", lambda);
   readKey(node, "sweeps", sweeps);
   readKey(node, "min_depth_m", min_depth_m);
@@ -162,6 +184,20 @@ void TsdfIntegrator::Config::validate() const {
     throw ConfigError("tsdf_integrator.lambda must be >= 0, got " + std::to_string(lambda));
   if (allocation_stride < 1)
     throw ConfigError("tsdf_integrator.allocation_stride must be >= 1, got " + std::to_string(allocation_stride));
+  if (!(depth_sigma_m > 0.0) || !std::isfinite(depth_sigma_m))
+    throw ConfigError("tsdf_integrator.depth_sigma_m must be > 0, got " + std::to_string(depth_sigma_m));
+  if (!(min_pixel_weight >= 0.f) || !std::isfinite(min_pixel_weight))
+    throw ConfigError("tsdf_integrator.min_pixel_weight must be >= 0, got " + std::to_string(min_pixel_weight));
+  if (!(truncation_sigmas >= 0.0) || !std::isfinite(truncation_sigmas))
+    throw ConfigError("tsdf_integrator.truncation_sigmas must be >= 0, got " + std::to_string(truncation_sigmas));
+  if (!(carving_weight >= 0.0) || !std::isfinite(carving_weight))
+    throw ConfigError("tsdf_integrator.carving_weight must be >= 0, got " + std::to_string(carving_weight));
+  if (plane.step_px < 1 || plane.step_px > 64)
+    throw ConfigError("tsdf_integrator.plane_step_px must be in 1..64, got " + std::to_string(plane.step_px));
+  if (!(plane.max_curvature >= 0.f) || !std::isfinite(plane.max_curvature))
+    throw ConfigError("tsdf_integrator.plane_max_curvature must be >= 0, got " + std::to_string(plane.max_curvature));
+  if (!(plane.min_scale > 0.f && plane.min_scale <= 1.f))
+    throw ConfigError("tsdf_integrator.plane_min_scale must be in (0, 1], got " + std::to_string(plane.min_scale));
   if (sweeps < 0)
     throw ConfigError("tsdf_integrator.sweeps must be >= 0, got " + std::to_string(sweeps));
   if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
@@ -173,7 +209,16 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
   out << "tsdf_integrator:\n"
       << "  weighting: " << toString(weighting) << "\n"
       << "  max_weight: " << max_weight << "\n"
+      << "  depth_sigma_m: " << depth_sigma_m << "\n"
+      << "  min_pixel_weight: " << min_pixel_weight << "\n"
+      << "  truncation_sigmas: " << truncation_sigmas << "\n"
       << "  space_carving: " << (space_carving ? "true" : "false") << "\n"
+      << "  carving_weight: " << carving_weight << "\n"
+      << "  weight_dropoff: " << (weight_dropoff ? "true" : "false") << "\n"
+      << "  signed_distance: " << toString(signed_distance) << "\n"
+      << "  plane_step_px: " << plane.step_px << "\n"
+      << "  plane_max_curvature: " << plane.max_curvature << "\n"
+      << "  plane_min_scale: " << plane.min_scale << "\n"
       << "  lambda: " << lambda << "\n"
       << "  sweeps: " << sweeps << "\n"
       << "  min_depth_m: " << min_depth_m << "\n"
@@ -199,12 +244,20 @@ void TsdfIntegrator::setLambda(double lambda) {
 
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
-  if (config_.weighting == Weighting::PerPixel && frame.weight.empty())
-    throw InvalidInputError("TSDF weighting per_pixel needs a weight image (a cloud with a 'weight' field)");
   if (!T_world_cam.matrix().allFinite())
     throw InvalidInputError("T_world_cam has a value that is not finite");
   stats_ = Stats();
   const auto t_start = Clock::now();
+
+  // Each pixel's weight, the inverse variance of its depth (m^-2); pixels weighing less than
+  // min_pixel_weight are no depth, for every step below.
+  pixelWeights(frame, weight_);
+  const bool masked = config_.min_pixel_weight > 0.f;
+  if (masked) {
+    frame.depth.copyTo(masked_depth_);
+    masked_depth_.setTo(0.f, weight_ < config_.min_pixel_weight);
+  }
+  const cv::Mat& depth_image = masked ? masked_depth_ : frame.depth;
 
   const PinholeCamera& cam = frame.camera;
   const int width = cam.width, height = cam.height;
@@ -213,6 +266,40 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.max_depth_m);
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+
+  // 0. Per pixel p of depth d_p, the scale s_p from the projective distance to the distance to
+  //    the surface's plane (a voxel at depth z on p's ray has sdf (d_p - z) s_p), and the bands
+  //    along the ray within which voxels are updated, widened to truncation_sigmas standard
+  //    deviations so that noisy depth is averaged over frames rather than clipped:
+  //    - in front, the plane's: truncation / s_p;
+  //    - behind, the truncation along the ray, or one voxel below the plane (enough for marching
+  //      cubes to see the sign change at a grazing angle) but not the plane's full length:
+  //      beyond the surface's edge the plane is free space, and a box seen edge-on would grow a
+  //      skirt behind it.
+  if (config_.signed_distance == SignedDistance::Plane)
+    planeDistanceScale(depth_image, cam, config_.plane, scale_);
+  else
+    scale_ = cv::Mat(depth_image.size(), CV_32FC1, cv::Scalar(1.f));
+  band_.create(depth_image.size(), CV_32FC1);
+  behind_.create(depth_image.size(), CV_32FC1);
+  const float sigmas = static_cast<float>(config_.truncation_sigmas);
+  const float below_plane = std::min(trunc, vs);
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      const float* s = scale_.ptr<float>(v);
+      const float* w = weight_.ptr<float>(v);
+      float* front = band_.ptr<float>(v);
+      float* back = behind_.ptr<float>(v);
+      for (int u = 0; u < width; ++u) {
+        const float noise = w[u] > 0.f ? sigmas / std::sqrt(w[u]) : 0.f;
+        front[u] = std::max(trunc / s[u], noise);
+        back[u] = std::min(front[u], std::max({trunc, below_plane / s[u], noise}));
+      }
+    }
+  });
+  const float* scale_data = scale_.ptr<float>(0);
+  const float* band_data = band_.ptr<float>(0);
+  const std::size_t scale_step = scale_.step1();
 
   // 1. Sub-blocks (4^3 voxels) that the truncation band of each pixel's ray crosses, found in
   //    parallel: only those are projected below, which on KITTI's grazing road is a fraction
@@ -225,13 +312,15 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::vector<std::uint64_t> keys;
   std::mutex keys_mutex;
   const int stride = config_.allocation_stride;
-  // Also the min and max valid depth of 8x8-pixel tiles, in the same pass over the rows: a
-  // sub-block of 4^3 voxels whose footprint sees only depth far in front of or behind it is
-  // skipped below without projecting its voxels.
+  // Also the depth range of the bands of 8x8-pixel tiles (the least depth less the widest
+  // band, the largest depth plus the widest band), in the same pass over the rows: a sub-block
+  // of 4^3 voxels whose footprint sees only bands far in front of or behind it is skipped
+  // below without projecting its voxels.
   constexpr int kTile = 8;
   const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
   tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
   tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
+  tile_band_.assign(tile_min_.size(), 0.f);
   // cv::parallel_for_, as the other stages. OpenCV runs a call made while another thread's
   // runs serially (one flag per process): in the pipeline, integration and SGBM then take a
   // core each. An OpenMP team of its own was measured too: no faster on KITTI, and 0.85x on
@@ -244,19 +333,24 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     std::size_t next = 0;
     for (int ty = range.start; ty < range.end; ++ty)
     for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
-      const float* depth = frame.depth.ptr<float>(v);
+      const float* depth = depth_image.ptr<float>(v);
+      const float* band_row = band_.ptr<float>(v);
       float* t_min = &tile_min_[static_cast<std::size_t>(ty) * tiles_x];
       float* t_max = &tile_max_[static_cast<std::size_t>(ty) * tiles_x];
+      float* t_band = &tile_band_[static_cast<std::size_t>(ty) * tiles_x];
       for (int tx = 0; tx < tiles_x; ++tx) {
         const float* tile = depth + tx * kTile;
-        float lo = t_min[tx], hi = t_max[tx];
+        const float* tile_band = band_row + tx * kTile;
+        float lo = t_min[tx], hi = t_max[tx], band = t_band[tx];
         for (int k = 0, n = std::min(kTile, width - tx * kTile); k < n; ++k) {
           const bool valid = tile[k] >= min_d && tile[k] <= max_d; // without branches: holes are unpredictable
           lo = std::min(lo, valid ? tile[k] : std::numeric_limits<float>::infinity());
           hi = std::max(hi, valid ? tile[k] : -std::numeric_limits<float>::infinity());
+          band = std::max(band, valid ? tile_band[k] : 0.f);
         }
         t_min[tx] = lo;
         t_max[tx] = hi;
+        t_band[tx] = band;
       }
       if (v % stride)
         continue;
@@ -265,7 +359,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         if (!(d >= min_d && d <= max_d))
           continue;
         const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
-        const float z0 = std::max(d - trunc, min_d), z1 = d + trunc;
+        const float z0 = std::max(d - behind_.ptr<float>(v)[u], min_d), z1 = d + band_row[u];
         traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
           const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
           const std::uint64_t k =
@@ -307,6 +401,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     const std::uint64_t mark = std::numeric_limits<std::uint64_t>::max();
     for (TsdfBlock* b : blocks)
       b->stamp = mark; // temporary marker, reset below
+    // The blocks the bands cross too, whole: a car that moved on by less than a block left
+    // its old rear in the sub-blocks beside its new one.
+    std::fill(masks.begin(), masks.end(), std::uint8_t{0xff});
     // A block may be partly in view when its centre is not: test its bounding sphere.
     const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
     for (const auto& block : volume_.blocks()) {
@@ -322,7 +419,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         continue;
       const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, width - 1);
       const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
-      const float d = frame.depth.at<float>(vi, ui);
+      const float d = depth_image.at<float>(vi, ui);
       if (!(d > 0.f) || c.z() - radius < d) {
         blocks.push_back(block);
         masks.push_back(0xff);
@@ -338,7 +435,6 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
   const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
   const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
-  const Weighting weighting = config_.weighting;
   // Changed voxels of each block (local indices), for the regularization.
   if (regularized) {
     changed_index_.resize(blocks.size() * TsdfBlock::kVoxels);
@@ -347,6 +443,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::vector<std::uint16_t> changed_count(blocks.size(), 0);
   const bool bilinear = config_.interpolate_depth;
   const bool carving = config_.space_carving;
+  const float carving_weight = static_cast<float>(config_.carving_weight);
+  const bool dropoff = config_.weight_dropoff;
   const float max_weight = config_.max_weight;
   const bool has_color = !frame.color.empty();
   std::vector<char> changed(blocks.size(), 0);
@@ -354,8 +452,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
 
   std::atomic<std::size_t> projected_total{0};
-  const float* depth_data = frame.depth.ptr<float>(0);
-  const std::size_t depth_step = frame.depth.step1();
+  const float* depth_data = depth_image.ptr<float>(0);
+  const std::size_t depth_step = depth_image.step1();
   cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
@@ -388,16 +486,19 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
             continue; // outside the image
           const int tx0 = u0 / kTile, tx1 = u1 / kTile, ty0 = v0 / kTile, ty1 = v1 / kTile;
           if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= 64) {
-            float dmin = std::numeric_limits<float>::infinity(), dmax = -dmin;
+            float dmin = std::numeric_limits<float>::infinity(), dmax = -dmin, band = 0.f;
             for (int ty = ty0; ty <= ty1; ++ty)
               for (int tx = tx0; tx <= tx1; ++tx) {
-                dmin = std::min(dmin, tile_min_[static_cast<std::size_t>(ty) * tiles_x + tx]);
-                dmax = std::max(dmax, tile_max_[static_cast<std::size_t>(ty) * tiles_x + tx]);
+                const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+                dmin = std::min(dmin, tile_min_[t]);
+                dmax = std::max(dmax, tile_max_[t]);
+                band = std::max(band, tile_band_[t]);
               }
-            if (dmax < c.z() - sub_radius - trunc)
-              continue; // every depth is in front: the voxels are hidden behind the surface
-            if (!carving && dmin > c.z() + sub_radius + trunc)
-              continue; // every depth is beyond: the voxels are free space, outside the band
+            // A bilinear depth lies between its pixels' depths: within [dmin, dmax].
+            if (dmax + band < c.z() - sub_radius)
+              continue; // every band is in front: the voxels are hidden behind the surface
+            if (!carving && dmin - band > c.z() + sub_radius)
+              continue; // every band is beyond: the voxels are free space
           }
         }
       }
@@ -406,8 +507,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       for (int y = sy; y < sy + 4; ++y) {
         // A row of 4 voxels, projected and tested on its nearest pixels in SIMD lanes without
         // branches (most voxels fail, unpredictably); a bilinear value differs from the nearest
-        // by less than the truncation (the 4 pixels must agree within it), so 2 truncations is
-        // a safe bound. Same float operations as one voxel at a time, so the same results.
+        // by less than the pixel's band (the 4 pixels must agree within it), so 2 bands is a
+        // safe bound. Same float operations as one voxel at a time, so the same results.
         const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
         const Float4 xs = Float4{0.f, 1.f, 2.f, 3.f} + static_cast<float>(sx);
         const Float4 X = row.x() + ex.x() * xs, Y = row.y() + ex.y() * xs, Z = row.z() + ex.z() * xs;
@@ -419,9 +520,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         const Int4 pixel_v = __builtin_convertvector(clamp4(pv + 0.5f, 0.f, static_cast<float>(height - 1)), Int4);
         const Int4 at = pixel_v * static_cast<int>(depth_step) + pixel_u;
         const Float4 nearest = {depth_data[at[0]], depth_data[at[1]], depth_data[at[2]], depth_data[at[3]]};
+        const Int4 at_scale = pixel_v * static_cast<int>(scale_step) + pixel_u;
+        const Float4 scale = {scale_data[at_scale[0]], scale_data[at_scale[1]], scale_data[at_scale[2]],
+                              scale_data[at_scale[3]]};
+        const Float4 band = {band_data[at_scale[0]], band_data[at_scale[1]], band_data[at_scale[2]],
+                             band_data[at_scale[3]]};
         const Float4 diff = nearest - Z;
-        const Int4 ok = inside & (nearest >= min_d) & (nearest <= max_d) & (diff >= -2.f * trunc) &
-                        ((diff <= 2.f * trunc) | -static_cast<int>(carving));
+        const Int4 ok = inside & (nearest >= min_d) & (nearest <= max_d) & (diff >= -2.f * band) &
+                        ((diff <= 2.f * band) | -static_cast<int>(carving));
         const int lanes = laneMask(ok);
         if (!lanes)
           continue;
@@ -430,7 +536,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         __builtin_prefetch(&block.voxels[first + 3], 1);
         for (int k = 0; k < 4; ++k)
           if (lanes & (1 << k)) {
-            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], pixel_u[k], pixel_v[k],
+            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], scale[k], band[k], pixel_u[k], pixel_v[k],
                                           static_cast<std::uint16_t>(first + k)};
             if (has_color)
               __builtin_prefetch(frame.color.ptr<std::uint8_t>(pixel_v[k]) + 3 * pixel_u[k]);
@@ -445,38 +551,46 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       const float u = cand.u, v = cand.v;
       const int ui = cand.ui, vi = cand.vi;
       float d = cand.nearest;
-      if (bilinear) {
-        const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
-        if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
-          const float* r0 = depth_data + v0 * depth_step + u0;
-          const float* r1 = r0 + depth_step;
-          const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
-          const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
-          const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
-          // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
-          if (lo > 0.f && hi - lo < trunc) {
-            const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
-            d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
-          }
+      float quad_min = d; // the least depth of the 4 pixels around the projection
+      const float scale = cand.scale;
+      const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
+      if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
+        const float* r0 = depth_data + v0 * depth_step + u0;
+        const float* r1 = r0 + depth_step;
+        const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
+        const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
+        const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
+        quad_min = lo;
+        // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
+        if (bilinear && lo > 0.f && (hi - lo) * scale < trunc) {
+          const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
+          d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
         }
       }
-      float sdf = d - cand.z;
-      if (sdf < -trunc)
+      const float diff = d - cand.z, band = cand.band, behind = behind_.ptr<float>(vi)[ui];
+      if (diff < -behind)
         continue;
-      const bool in_band = sdf <= trunc;
-      if (!in_band) {
-        if (!carving)
-          continue;
-        sdf = trunc;
-      }
-      float w = 1.f;
-      if (weighting == Weighting::InverseSquare) {
-        w = 1.f / (d * d);
-      } else if (weighting == Weighting::PerPixel) {
-        w = frame.weight.ptr<float>(vi)[ui];
-        if (!(w > 0.f))
-          continue;
-      }
+      const bool in_band = diff <= band;
+      // Free space only where all 4 pixels around the projection see past the band: beside a
+      // depth edge the nearest pixel may see the background through a foreground voxel.
+      if (!in_band && !(carving && quad_min > 0.f && quad_min - cand.z > band))
+        continue;
+      // In front of the band: free space. A band widened for noise reaches beyond the
+      // truncation, the values stay within it (what a truncated distance is).
+      const float sdf = std::clamp((in_band ? diff : band) * scale, -trunc, trunc);
+      // The pixel's inverse variance of the depth along the ray. (The plane distance's is
+      // 1 / scale^2 times larger, but weighting by it let grazing views of noisy far stereo
+      // outweigh the rest: on the synthetic street, 0.145 m mesh accuracy against 0.043 m at
+      // the same min_weight, and a worse accuracy at every completeness.)
+      float w = weight_.ptr<float>(vi)[ui];
+      if (!(w > 0.f))
+        continue;
+      if (!in_band)
+        w *= carving_weight; // free space is weaker evidence than a surface
+      else if (dropoff && sdf < -vs && behind * scale > vs)
+        w *= (behind * scale + sdf) / (behind * scale - vs); // behind the surface the observation is a guess
+      if (!(w > 0.f))
+        continue; // at the band's far end the drop-off leaves nothing
       const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
       TsdfVoxel& voxel = block.voxels[cand.voxel];
       updateVoxel(voxel, sdf, w, bgr, max_weight);
@@ -524,6 +638,26 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   stats_.regularize_ms = msSince(t_reg);
 }
 
+float TsdfIntegrator::depthWeight(float depth) const {
+  const float sigma = static_cast<float>(config_.depth_sigma_m);
+  return config_.weighting == Weighting::InverseSquare ? 1.f / (sigma * sigma * depth * depth) : 1.f / (sigma * sigma);
+}
+
+void TsdfIntegrator::pixelWeights(const DepthFrame& frame, cv::Mat& weight) {
+  if (config_.weighting == Weighting::PerPixel && !frame.weight.empty()) {
+    weight = frame.weight;
+    return;
+  }
+  computed_weight_.create(frame.depth.size(), CV_32FC1); // never the frame's own buffer
+  weight = computed_weight_;
+  for (int v = 0; v < frame.depth.rows; ++v) {
+    const float* d = frame.depth.ptr<float>(v);
+    float* w = weight.ptr<float>(v);
+    for (int u = 0; u < frame.depth.cols; ++u)
+      w[u] = d[u] > 0.f ? depthWeight(d[u]) : 0.f;
+  }
+}
+
 void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_world,
                                    const std::vector<cv::Vec3b>& colors_bgr, const Eigen::Vector3d& origin_world) {
   if (!colors_bgr.empty() && colors_bgr.size() != points_world.size())
@@ -555,7 +689,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
     if (!(dist >= min_d && dist <= max_d))
       continue;
     dir /= dist;
-    const float w = config_.weighting == Weighting::InverseSquare ? 1.f / (dist * dist) : 1.f;
+    const float w = depthWeight(dist);
     const float t0 = config_.space_carving ? 0.f : dist - trunc;
     const Eigen::Vector3f a = (o + dir * t0) / vs + Eigen::Vector3f::Constant(0.5f);
     const Eigen::Vector3f b = (o + dir * (dist + trunc)) / vs + Eigen::Vector3f::Constant(0.5f);

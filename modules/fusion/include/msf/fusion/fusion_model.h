@@ -19,7 +19,8 @@ struct FusionInputs {
   float stereo_confidence = 1.f; ///< in [0, 1], stereo_confidence.h
 };
 
-/// Fused depth (0 = none) and its weight in [0, 1] (0 = none).
+/// Fused depth (0 = none) and its weight (0 = none): the paper method's in [0, 1], the uncertainty
+/// method's the inverse variance of the depth in m^-2 (depthWeight).
 struct FusionResult {
   float z = 0.f;
   float weight = 0.f;
@@ -76,6 +77,16 @@ inline float lidarSigmaPx(float distance, float range_px, const DepthFusionConfi
   return c.lidar_sigma_px + c.lidar_sigma_per_distance * distance + c.lidar_sigma_per_range * range_px;
 }
 
+/// The inverse variance of a depth z, 1 / sigma_z^2 in m^-2, from the inverse variance of its
+/// disparity `inverse_variance_px` (1 / sigma_d^2, px^-2): sigma_z = z^2 sigma_d / (f B). 0 for
+/// no depth. A LiDAR return (0.1 px) at 10 m on KITTI weighs ~1500 (sigma 2.6 cm), the best
+/// stereo match (0.5 px) at 20 m ~3.7 (0.52 m): what the TSDF integrator averages with.
+inline float depthWeight(float z, float inverse_variance_px, float focal_baseline) {
+  const float z_safe = z > 0.f ? z : 1.f;
+  const float k = focal_baseline / (z_safe * z_safe);
+  return z > 0.f ? k * k * inverse_variance_px : 0.f;
+}
+
 /// Inverse-variance fusion in disparity d = f B / z, where both sensors' errors are
 /// measured: stereo sigma_z = z^2 sigma_d / (f B) is sigma_d in disparity, and the LiDAR's
 /// interpolation error is a few tenths of a pixel there. Two samples further apart than
@@ -83,7 +94,7 @@ inline float lidarSigmaPx(float distance, float range_px, const DepthFusionConfi
 /// point between foreground and background): the one with the smaller sigma is kept. When
 /// that is the LiDAR while stereo sees a nearer surface (z = z_lidar > z_stereo > 0),
 /// fuseRow checks lidarSeesPastForeground, and then stereo wins.
-/// weight = min(1, stereo_sigma_min_px^2 / sigma^2), 1 for a stereo match of confidence 1.
+/// weight = depthWeight of the result and its disparity's inverse variance.
 inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline) {
   // Bitwise & and | on the flags, and every division done unconditionally: no branches.
   const bool lidar = in.z_lidar > 0.f, stereo = in.z_stereo > 0.f;
@@ -101,12 +112,11 @@ inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionCon
   const bool no_lidar = !lidar, no_stereo = !stereo, disagree = !agree, stereo_more_certain = !lidar_more_certain;
   const bool take_lidar = lidar & (no_stereo | (disagree & lidar_more_certain));
   const bool take_stereo = stereo & (no_lidar | (disagree & stereo_more_certain));
-  const float s_min2 = c.stereo_sigma_min_px * c.stereo_sigma_min_px;
   const float inv_v_L = 1.f / v_L, inv_v_S = 1.f / v_S, inv_v_mean = inv_v_L + inv_v_S;
   FusionResult r;
   r.z = take_lidar ? in.z_lidar : (take_stereo ? in.z_stereo : (both ? z_mean : 0.f));
   const float inv_var = take_lidar ? inv_v_L : (take_stereo ? inv_v_S : (both ? inv_v_mean : 0.f));
-  r.weight = std::min(1.f, s_min2 * inv_var);
+  r.weight = depthWeight(r.z, inv_var, focal_baseline);
   return r;
 }
 

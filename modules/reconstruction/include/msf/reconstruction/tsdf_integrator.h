@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/reconstruction/depth_frame.h>
+#include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Geometry>
@@ -36,23 +37,48 @@ namespace msf {
 /// Not thread-safe: one integrator per volume at a time.
 class TsdfIntegrator {
 public:
+  /// A voxel's weight is the inverse variance of its signed distance, in m^-2: observations
+  /// add 1 / sigma^2, so that a voxel seen often or closely is both more precise and harder to
+  /// overwrite, and a threshold on it (MarchingCubes min_weight) is a precision.
   enum class Weighting {
-    Constant,      ///< every observation weighs 1
-    InverseSquare, ///< 1 / z^2 (z: observed depth in metres), for depth whose noise grows with range
-    PerPixel       ///< the frame's weight image (the fusion stage's per-pixel weight)
+    Constant,      ///< every depth has sigma = depth_sigma_m
+    InverseSquare, ///< sigma = depth_sigma_m * z / (1 m), for depth whose noise grows with range
+    PerPixel       ///< the frame's weight image, 1 / sigma^2 per pixel (DepthFusion's); as Constant without one
+  };
+
+  /// What a voxel's signed distance measures.
+  enum class SignedDistance {
+    Projective, ///< depth difference along the optical axis (KinectFusion, the paper)
+    Plane       ///< distance to the observed surface's tangent plane (planeDistanceScale)
   };
 
   struct Config {
-    Weighting weighting = Weighting::Constant;
-    float max_weight = 100.f;       ///< a voxel's weight saturates here, so it can still change
-    bool space_carving = false;     ///< also update voxels seen in front of the band (sdf = +truncation)
+    Weighting weighting = Weighting::PerPixel;
+    double depth_sigma_m = 0.05;    ///< sigma of a depth without its own weight (see Weighting)
+    float max_weight = 1e4f;        ///< a voxel's weight saturates here (sigma 1 cm), so it can still change
+    /// Pixels of a smaller weight are not integrated: depth too uncertain to place a surface
+    /// (far stereo, matches in the sky). 0.25 m^-2 = sigma 2 m.
+    float min_pixel_weight = 0.25f;
+    /// The band along a pixel's ray is at least this many of its sigmas, so that noisy depth is
+    /// averaged over frames instead of clipped at the truncation. 0 = the truncation alone.
+    double truncation_sigmas = 2.0;
+    bool space_carving = true;      ///< also update voxels seen in front of the band (sdf = +truncation)
+    /// A free-space update weighs this times the observation's weight: what a ray passed
+    /// through is weaker evidence than the surface it hit, so a surface seen from many frames
+    /// outlasts a few wrong rays while one seen once (a car that drove on) is cleared.
+    double carving_weight = 1.0;
+    /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
+    /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
+    bool weight_dropoff = true;
+    SignedDistance signed_distance = SignedDistance::Plane;
+    PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
     double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
     /// Gauss-Seidel sweeps per frame over the changed voxels. 1: the solution is warm-started
     /// from the last frame, so it is refined over frames; solving each frame to convergence
     /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
     int sweeps = 1;
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
-    double max_depth_m = 80.0;
+    double max_depth_m = 40.0;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
     /// Blocks and sub-blocks are found along the rays of every n-th pixel in each direction
     /// (rows staggered): 2 costs a quarter of 1 on a dense depth image (rays 2 px apart are
@@ -61,8 +87,11 @@ public:
     int allocation_stride = 2;
 
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
-    /// (constant | inverse_square | per_pixel), max_weight, space_carving, lambda, sweeps,
-    /// min_depth_m, max_depth_m, interpolate_depth, allocation_stride. Throws ConfigError naming a bad key.
+    /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
+    /// space_carving, carving_weight,
+    /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
+    /// plane_min_scale, lambda, sweeps, min_depth_m, max_depth_m, interpolate_depth,
+    /// allocation_stride. Throws ConfigError naming a bad key.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the first value out of range.
     void validate() const;
@@ -90,8 +119,7 @@ public:
   const Stats& lastStats() const { return stats_; }
 
   /// Integrates a depth frame seen from T_world_cam (camera to world).
-  /// Throws InvalidInputError (see DepthFrame::validate), also when the weighting is
-  /// PerPixel and the frame has no weight image.
+  /// Throws InvalidInputError (see DepthFrame::validate).
   void integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
@@ -114,6 +142,10 @@ public:
                      const Eigen::Vector3d& origin_world);
 
 private:
+  /// The weight of a depth without its own (Constant, InverseSquare), in m^-2.
+  float depthWeight(float depth) const;
+  /// Per pixel, the weight of the frame's depth (see Weighting); 0 where there is no depth.
+  void pixelWeights(const DepthFrame& frame, cv::Mat& weight);
   /// Eq. 7 over the voxels changed_index_[offsets[i] .. offsets[i + 1]) of touched[i].
   void regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets);
 
@@ -122,12 +154,20 @@ private:
   Stats stats_;
   std::vector<float> data_term_;  // y of eq. 7 for the changed voxels, reused across frames
   std::vector<std::uint16_t> changed_index_; // local indices of the changed voxels, per block
-  std::vector<float> tile_min_, tile_max_; // depth range of 8x8-pixel tiles, reused
+  std::vector<float> tile_min_, tile_max_, tile_band_; // depth range and widest band of 8x8-pixel tiles, reused
+  cv::Mat scale_; // planeDistanceScale of the frame, reused
+  cv::Mat band_, behind_; // per pixel, how far in front of and behind its depth voxels are updated, reused
+  cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
+  cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_
+  cv::Mat computed_weight_;
 };
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.
 const char* toString(TsdfIntegrator::Weighting weighting);
 TsdfIntegrator::Weighting parseWeighting(const std::string& text);
+/// "projective", "plane"; parse throws ConfigError naming the text.
+const char* toString(TsdfIntegrator::SignedDistance distance);
+TsdfIntegrator::SignedDistance parseSignedDistance(const std::string& text);
 
 } // namespace msf
 

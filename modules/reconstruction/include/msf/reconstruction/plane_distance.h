@@ -1,0 +1,36 @@
+#pragma once
+#include <msf/io/pinhole_camera.h>
+
+#include <opencv2/core/mat.hpp>
+
+namespace msf {
+
+/// Settings of planeDistanceScale.
+struct PlaneDistanceConfig {
+  int step_px = 2;           ///< neighbours at +-step_px give the local plane (a wider base averages stereo noise)
+  float max_curvature = 0.05f; ///< |second difference of 1/z| over 1/z above which the pixel is on an edge
+  float min_scale = 0.1f;    ///< the scale never drops below this (bounds the band along the ray)
+};
+
+/// Per pixel of a depth image, the factor s that turns the projective distance d - z of a
+/// point on the pixel's ray (observed depth d, point depth z, both along the optical axis)
+/// into its distance to the tangent plane of the observed surface: (d - z) * s.
+///
+/// On a plane n.P = c seen through the ray r = ((u - cx) / fx, (v - cy) / fy, 1), the inverse
+/// depth is affine in the normalized image coordinates, 1/z = g.r with g = n / c, so the
+/// distance from z r to the plane is |n.(d r - z r)| = (d - z) |n.r| = (d - z) / (d |g|):
+/// s = 1 / (d |g|), from central differences of 1/z. s = 1 facing the camera and small at a
+/// grazing angle (the road 20 m ahead of KITTI's camera: 0.08), where a band of +-truncation
+/// along the ray is only a few centimetres high and marching cubes finds no sign change.
+/// Next to an edge or a fold (the second difference of 1/z, relative to 1/z, exceeds
+/// max_curvature) the slope along that axis is the one-sided difference of the side whose own
+/// samples lie on a line; where neither does, or neighbours are missing, s = 1, the projective
+/// distance.
+/// s is at least min_scale, which bounds the band along the ray to truncation / min_scale.
+///
+/// depth: CV_32FC1 metres (not > 0 = none). Writes `scale` (CV_32FC1, same size, 1 where
+/// there is no depth), reusing its buffer. Rows run in parallel.
+void planeDistanceScale(const cv::Mat& depth, const PinholeCamera& camera, const PlaneDistanceConfig& config,
+                        cv::Mat& scale);
+
+} // namespace msf

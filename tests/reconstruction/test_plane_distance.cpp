@@ -1,0 +1,99 @@
+#include "scenes.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/plane_distance.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace msf;
+
+namespace {
+
+/// Depth of the plane n.P = c (camera frame) at each pixel, 0 where it is behind the camera.
+cv::Mat planeDepth(const PinholeCamera& camera, const Eigen::Vector3f& n, float c) {
+  cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0.f));
+  for (int v = 0; v < camera.height; ++v)
+    for (int u = 0; u < camera.width; ++u) {
+      const Eigen::Vector3f r((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.f);
+      const float z = c / n.dot(r);
+      depth.at<float>(v, u) = z > 0.f ? z : 0.f;
+    }
+  return depth;
+}
+
+/// |n.r|: the exact factor from depth difference to distance to the plane.
+float exactScale(const PinholeCamera& camera, const Eigen::Vector3f& n, int u, int v) {
+  return std::abs(n.dot(Eigen::Vector3f((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.f)));
+}
+
+} // namespace
+
+TEST(PlaneDistance, FrontoParallelPlaneIsTheProjectiveDistance) {
+  const PinholeCamera camera = test::smallCamera();
+  cv::Mat scale;
+  planeDistanceScale(cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(3.f)), camera, {}, scale);
+  ASSERT_EQ(scale.size(), cv::Size(camera.width, camera.height));
+  for (int v = 0; v < camera.height; v += 7)
+    for (int u = 0; u < camera.width; u += 7)
+      ASSERT_NEAR(scale.at<float>(v, u), 1.f, 1e-5f) << u << "," << v;
+}
+
+TEST(PlaneDistance, GroundAtAGrazingAngleGivesTheCosineToItsNormal) {
+  // The road 1.65 m below the camera (y down): n = (0, 1, 0), c = 1.65. Its scale is
+  // (v - cy) / fy, small near the horizon, down to min_scale.
+  const PinholeCamera camera = test::smallCamera();
+  const Eigen::Vector3f n(0.f, 1.f, 0.f);
+  const cv::Mat depth = planeDepth(camera, n, 1.65f);
+  PlaneDistanceConfig config;
+  config.min_scale = 0.05f;
+  cv::Mat scale;
+  planeDistanceScale(depth, camera, config, scale);
+  int checked = 0;
+  // From 5 rows below the horizon, where the neighbours 4 rows above still see the road.
+  for (int v = static_cast<int>(camera.cy) + 5; v < camera.height; ++v)
+    for (int u = 0; u < camera.width; u += 5) {
+      const float exact = std::max(config.min_scale, exactScale(camera, n, u, v));
+      ASSERT_NEAR(scale.at<float>(v, u), exact, 1e-3f * exact + 1e-5f) << u << "," << v;
+      ++checked;
+    }
+  EXPECT_GT(checked, 5000);
+  EXPECT_FLOAT_EQ(scale.at<float>(static_cast<int>(camera.cy) + 6, 160), config.min_scale); // near the horizon
+  EXPECT_NEAR(scale.at<float>(239, 160), (239 - camera.cy) / camera.fy, 1e-4f);
+}
+
+TEST(PlaneDistance, PixelsBesideAnEdgeTakeTheirOwnSurfacesSlope) {
+  // A slanted wall on the left half, a far fronto-parallel wall on the right: next to the step
+  // the central difference straddles both, the one-sided one stays on the pixel's own wall.
+  const PinholeCamera camera = test::smallCamera();
+  const Eigen::Vector3f n = Eigen::Vector3f(0.6f, 0.f, -0.8f);
+  const cv::Mat slanted = planeDepth(camera, n, -2.f);
+  cv::Mat depth = slanted.clone();
+  depth.colRange(160, camera.width).setTo(10.f);
+  cv::Mat scale;
+  planeDistanceScale(depth, camera, {}, scale);
+  for (int u : {150, 156, 158, 159})
+    EXPECT_NEAR(scale.at<float>(100, u), exactScale(camera, n, u, 100), 1e-3f) << u;
+  for (int u : {160, 161, 165, 200})
+    EXPECT_NEAR(scale.at<float>(100, u), 1.f, 1e-5f) << u;
+  // A lone pixel (no neighbour on a line on either side) and a hole keep the projective distance.
+  depth.setTo(0.f);
+  depth.at<float>(50, 50) = 2.f;
+  depth.at<float>(50, 52) = 7.f;
+  depth.at<float>(50, 48) = 3.f;
+  depth.at<float>(52, 50) = 2.f;
+  depth.at<float>(48, 50) = 2.f;
+  planeDistanceScale(depth, camera, {}, scale);
+  EXPECT_FLOAT_EQ(scale.at<float>(50, 50), 1.f);
+  EXPECT_FLOAT_EQ(scale.at<float>(10, 10), 1.f);
+}
+
+TEST(PlaneDistance, RejectsBadInput) {
+  const PinholeCamera camera = test::smallCamera();
+  cv::Mat scale;
+  EXPECT_THROW(planeDistanceScale(cv::Mat(10, 10, CV_16UC1), camera, {}, scale), InvalidInputError);
+  PlaneDistanceConfig bad;
+  bad.min_scale = 0.f;
+  EXPECT_THROW(planeDistanceScale(cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.f)), camera, bad, scale), InvalidInputError);
+}
