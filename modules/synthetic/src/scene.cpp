@@ -228,6 +228,8 @@ std::uint32_t Scene::objectCount() const {
   std::uint32_t n = 0;
   for (const auto& p : primitives)
     n = std::max(n, p.object);
+  for (const auto& m : movers)
+    n = std::max(n, m.object());
   return n;
 }
 

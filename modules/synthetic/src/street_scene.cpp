@@ -2,6 +2,7 @@
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/kitti_rig.h>
 #include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/traffic.h>
 
 #include <algorithm>
 #include <cmath>
@@ -167,7 +168,7 @@ private:
 
   /// Buildings across the street at both ends, so nothing is open to the horizon.
   void addCrossBuildings() {
-    for (const float z : {layout().z_begin - 25.f, layout().z_end + 5.f}) {
+    for (const float z : {layout().openBeginZ() - 20.f, layout().openEndZ()}) {
       const std::uint16_t mat = facadeMaterial(false);
       const float height = uniform(14.0, 20.0);
       scene_.add(boxSolid({layout().road_center_x, yAbove(0.5f * height), z + 10.f},
@@ -279,7 +280,9 @@ private:
 } // namespace
 
 Scene buildStreetScene(const SyntheticConfig& config, double path_end_z) {
-  return StreetBuilder(config, path_end_z).build();
+  Scene scene = StreetBuilder(config, path_end_z).build();
+  addTraffic(config, scene);
+  return scene;
 }
 
 } // namespace msf::synthetic
