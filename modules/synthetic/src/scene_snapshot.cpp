@@ -15,6 +15,8 @@ SceneSnapshot::SceneSnapshot(const Scene& scene, double time_s)
     m.begin = static_cast<std::int32_t>(placed_.size());
     mover.placeAt(time_s, placed_);
     m.end = static_cast<std::int32_t>(placed_.size());
+    movers_lo_ = placed_movers_.empty() ? m.lo : minV(movers_lo_, m.lo);
+    movers_hi_ = placed_movers_.empty() ? m.hi : maxV(movers_hi_, m.hi);
     placed_movers_.push_back(m);
     present_.push_back(&mover);
   }
@@ -25,8 +27,11 @@ bool SceneSnapshot::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) 
   if (placed_movers_.empty())
     return found;
   const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
+  float entry = 0.f;
+  // The movers are cars on the road, below the sensors: most rays pass over all of them.
+  if (!rayEntersBox(movers_lo_, movers_hi_, ray.origin, inv, tmin, hit.t, entry))
+    return found;
   for (const PlacedMover& m : placed_movers_) {
-    float entry = 0.f;
     if (!rayEntersBox(m.lo, m.hi, ray.origin, inv, tmin, hit.t, entry))
       continue;
     for (std::int32_t i = m.begin; i < m.end; ++i)

@@ -12,9 +12,9 @@ namespace msf::synthetic {
 /// The street at one instant: the scene's static solids with their hierarchy, and its
 /// movers placed where they are at that time. A mover is present while its bounds lie in
 /// the street's open stretch (it appears and vanishes inside the buildings across the
-/// street's ends). A ray tests the hierarchy, then each present mover's world bounds and
-/// only then its few solids: movers are a handful, so a flat list beats a hierarchy rebuilt
-/// every frame. Holds a reference to the scene, which must outlive it.
+/// street's ends). A ray tests the hierarchy, then the bounds of all present movers, each
+/// one's bounds, and only then its few solids: movers are a handful, so a flat list beats a
+/// hierarchy rebuilt every frame. Holds a reference to the scene, which must outlive it.
 class SceneSnapshot {
 public:
   SceneSnapshot(const Scene& scene, double time_s);
@@ -55,6 +55,7 @@ private:
   std::size_t static_count_;
   std::vector<Primitive> placed_;
   std::vector<PlacedMover> placed_movers_;
+  V3 movers_lo_, movers_hi_; ///< bounds of all present movers
   std::vector<const MovingObject*> present_;
 };
 
