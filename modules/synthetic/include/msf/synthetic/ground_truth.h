@@ -15,6 +15,7 @@ namespace msf::synthetic {
 ///   gt/obj_map_0/NNNNNN.png  8-bit: 0 background, 1..255 foreground (cars, poles, people),
 ///                            KITTI 2015's obj_map convention
 ///   gt/moving_0/NNNNNN.png   8-bit: 255 where the pixel sees a moving object, 0 elsewhere
+///                            (also beyond 255 m, where depth and obj_map have none)
 ///   gt/moving_objects.txt    the moving objects' oriented boxes at every frame (MovingBox)
 ///   gt/scene.ply             the true static surface (no moving objects), world = camera 0
 ///                            at frame 0 (poses/00.txt)
