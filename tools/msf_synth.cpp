@@ -24,7 +24,8 @@ void printHelp(const char* name) {
              "  layout with exact ground truth:\n"
              "    DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
              "    DIR/poses/00.txt\n"
-             "    DIR/gt/{depth_0,disp_0,obj_map_0}/NNNNNN.png, scene.ply, synthetic.yaml\n"
+             "    DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
+             "      synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
              "  Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.\n");
   print_info("  where options are:\n");
   print_info("    -o DIR         output folder (absent, empty, or an earlier synthetic dataset, replaced)\n");
@@ -81,7 +82,9 @@ int main(int argc, char** argv) {
     print_value("%zu", generator.scene().primitives.size());
     print_info(" solids, ");
     print_value("%u", generator.scene().objectCount());
-    print_info(" foreground objects]\n");
+    print_info(" foreground objects, ");
+    print_value("%zu", generator.scene().movers.size());
+    print_info(" of them moving]\n");
 
     std::vector<double> seconds;
     tt.tic();

@@ -25,7 +25,7 @@ public:
   /// Only the LiDAR scan of frame i (cheap).
   pcl::PointCloud<pcl::PointXYZI> scan(std::size_t i) const {
     const auto& g = *generator_;
-    return g.lidar().scan(g.scene(), g.poses()[i] * g.calibration().T_cam0_velo, i);
+    return g.lidar().scan(g.sceneAt(i), g.poses()[i] * g.calibration().T_cam0_velo, i);
   }
   static synthetic::SyntheticConfig config() {
     synthetic::SyntheticConfig c;

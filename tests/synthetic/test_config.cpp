@@ -26,6 +26,9 @@ TEST(SyntheticConfig, DefaultsAreValidAndKittiLike) {
   EXPECT_DOUBLE_EQ(c.lidar_max_range_m, 120.0);
   EXPECT_DOUBLE_EQ(c.lidar_upper_elevation_deg, 2.0);
   EXPECT_DOUBLE_EQ(c.lidar_lower_elevation_deg, -24.9);
+  // Moving cars are on: one ahead, oncoming ones in pairs.
+  EXPECT_EQ(c.moving_cars_ahead, 1);
+  EXPECT_EQ(c.moving_cars_oncoming, 2);
 }
 
 TEST(SyntheticConfig, ReadOverridesOnlyThePresentKeys) {
@@ -46,11 +49,15 @@ TEST(SyntheticConfig, BadValuesNameTheirKey) {
     const char* yaml;
     const char* key;
   };
-  for (const Case& bad : {Case{"frames: 0", "synthetic.frames"}, Case{"supersampling: 9", "synthetic.supersampling"},
-                          Case{"lidar_dropout: 1.0", "synthetic.lidar_dropout"},
-                          Case{"scene: moon", "synthetic.scene"}, Case{"frames: many", "synthetic.frames"},
-                          Case{"lidar_max_range_m: 0.5", "synthetic.lidar_max_range_m"},
-                          Case{"seed: -4", "synthetic.seed"}}) {
+  for (const Case& bad :
+       {Case{"frames: 0", "synthetic.frames"}, Case{"supersampling: 9", "synthetic.supersampling"},
+        Case{"lidar_dropout: 1.0", "synthetic.lidar_dropout"}, Case{"scene: moon", "synthetic.scene"},
+        Case{"frames: many", "synthetic.frames"}, Case{"lidar_max_range_m: 0.5", "synthetic.lidar_max_range_m"},
+        Case{"seed: -4", "synthetic.seed"}, Case{"moving_cars_ahead: -1", "synthetic.moving_cars_ahead"},
+        Case{"moving_cars_oncoming: -2", "synthetic.moving_cars_oncoming"},
+        Case{"moving_cars_oncoming: 2.5", "synthetic.moving_cars_oncoming"},
+        Case{"oncoming_car_speed_mps: 0", "synthetic.oncoming_car_speed_mps"},
+        Case{"oncoming_group_period_s: 0.5", "synthetic.oncoming_group_period_s"}}) {
     cv::FileStorage fs;
     SyntheticConfig c;
     try {
@@ -68,6 +75,10 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   c.image_noise_sigma = 1.5;
   c.lidar_range_noise_m = 0.1 + 0.2; // not a short decimal: must still read back exactly
   c.speed_mps = 12;
+  c.moving_cars_ahead = 0;
+  c.moving_cars_oncoming = 3;
+  c.oncoming_car_speed_mps = 8.5;
+  c.oncoming_group_period_s = 6;
   std::ostringstream out;
   out << "%YAML:1.0\n";
   c.print(out);
@@ -78,6 +89,10 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   EXPECT_EQ(back.image_noise_sigma, 1.5);
   EXPECT_EQ(back.lidar_range_noise_m, 0.1 + 0.2);
   EXPECT_EQ(back.speed_mps, 12.0);
+  EXPECT_EQ(back.moving_cars_ahead, 0);
+  EXPECT_EQ(back.moving_cars_oncoming, 3);
+  EXPECT_EQ(back.oncoming_car_speed_mps, 8.5);
+  EXPECT_EQ(back.oncoming_group_period_s, 6.0);
 }
 
 TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {

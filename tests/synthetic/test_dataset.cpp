@@ -70,9 +70,10 @@ SyntheticGenerator* SyntheticDataset::generator_ = nullptr;
 
 TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutThatSequenceOpensUnchanged) {
   const fs::path r(root());
-  for (const char* f : {"sequences/00/calib.txt", "sequences/00/times.txt", "poses/00.txt", "gt/scene.ply",
-                        "gt/README.txt", "gt/synthetic.yaml", "sequences/00/velodyne/000000.bin",
-                        "gt/depth_0/000000.png", "gt/disp_0/000000.png", "gt/obj_map_0/000000.png"})
+  for (const char* f :
+       {"sequences/00/calib.txt", "sequences/00/times.txt", "poses/00.txt", "gt/scene.ply", "gt/README.txt",
+        "gt/synthetic.yaml", "sequences/00/velodyne/000000.bin", "gt/depth_0/000000.png", "gt/disp_0/000000.png",
+        "gt/obj_map_0/000000.png", "gt/moving_0/000000.png", "gt/moving_objects.txt"})
     EXPECT_TRUE(fs::is_regular_file(r / f)) << f;
   for (int c = 0; c < 4; ++c)
     EXPECT_TRUE(fs::is_regular_file(r / "sequences/00" / ("image_" + std::to_string(c)) / "000000.png")) << c;
@@ -139,6 +140,18 @@ TEST_F(SyntheticDataset, FilesHoldWhatTheGeneratorRendered) {
     diff = cv::abs(disparity - frame.disparity);
     EXPECT_LE(cv::norm(diff, cv::NORM_INF), 0.5 / 256 + 1e-6);
     EXPECT_EQ(cv::norm(objects, frame.objects, cv::NORM_INF), 0.0);
+    const cv::Mat moving = gt.movingMask(0);
+    EXPECT_EQ(moving.type(), CV_8UC1);
+    EXPECT_EQ(cv::norm(moving, frame.moving, cv::NORM_INF), 0.0);
+    EXPECT_GT(cv::countNonZero(moving), 1000);
+    // The box file holds the generator's boxes (to the float; see test_movers.cpp).
+    const std::vector<msf::synthetic::MovingBox> boxes = gt.movingBoxes(), written = gen.movingBoxes();
+    ASSERT_EQ(boxes.size(), written.size());
+    ASSERT_EQ(boxes.size(), gen.scene().movers.size()); // all on the street at frame 0
+    for (std::size_t k = 0; k < boxes.size(); ++k) {
+      EXPECT_EQ(boxes[k].object, written[k].object);
+      EXPECT_EQ(static_cast<float>(boxes[k].center.z()), static_cast<float>(written[k].center.z()));
+    }
     // Disparity is f B / z where depth exists, and absent exactly where depth is.
     const double fB = gen.calibration().focalBaseline();
     for (int v = 0; v < depth.rows; v += 7)
@@ -194,17 +207,19 @@ TEST_F(SyntheticDataset, SceneMeshIsTheSurfaceTheCamerasSee) {
   pcl::PointCloud<pcl::PointXYZ> vertices;
   pcl::fromPCLPointCloud2(mesh.cloud, vertices);
   ASSERT_GT(mesh.polygons.size(), 10000u);
-  // Back-project ground-truth pixels of frame 0 into the world (poses/00.txt's frame) and
-  // measure their distance to the mesh: only tessellation of curved solids may differ.
+  // Back-project ground-truth pixels of frame 0 that see the static world into the world
+  // (poses/00.txt's frame) and measure their distance to the mesh: only tessellation of
+  // curved solids may differ.
   const msf::Sequence seq(root());
   const GroundTruth gt(root());
-  const cv::Mat depth = gt.depth(0);
+  const cv::Mat depth = gt.depth(0), moving = gt.movingMask(0);
+  ASSERT_GT(cv::countNonZero(moving), 1000); // the cars driving ahead and oncoming
   const msf::Calibration& calib = seq.calibration();
   std::vector<Eigen::Vector3d> points;
   for (int v = 5; v < depth.rows; v += 37)
     for (int u = 5; u < depth.cols; u += 61) {
       const double z = depth.at<float>(v, u);
-      if (z <= 0.0 || z > 60.0)
+      if (z <= 0.0 || z > 60.0 || moving.at<std::uint8_t>(v, u) != 0)
         continue;
       const Eigen::Vector3d cam((u - calib.cx()) * z / calib.fx(), (v - calib.cy()) * z / calib.fy(), z);
       points.push_back(seq.poses()[0] * cam);

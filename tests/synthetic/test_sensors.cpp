@@ -68,10 +68,10 @@ TEST(SyntheticSensors, NoiselessLidarHitsTheSurfaceExactly) {
   config.lidar_dropout = 0.0;
   const msf::synthetic::SyntheticGenerator gen(config);
   const Eigen::Isometry3d& T = gen.poses()[3];
-  const auto scan = gen.lidar().scan(gen.scene(), T * gen.calibration().T_cam0_velo, 3);
+  const auto scan = gen.lidar().scan(gen.sceneAt(3), T * gen.calibration().T_cam0_velo, 3);
   const msf::synthetic::CameraRenderer renderer(gen.calibration(), config);
   cv::Mat depth, objects;
-  renderer.render(gen.scene(), 0, T, 3, &depth, &objects);
+  renderer.render(gen.sceneAt(3), 0, T, 3, &depth, &objects);
   const auto errors = lidarDepthErrors(scan, depth, gen.calibration());
   ASSERT_GT(errors.size(), 10000u);
   const double med = msf::median(errors);
@@ -173,7 +173,11 @@ TEST(SyntheticSensors, DepthGroundTruthOfTheRoadIsExact) {
   const auto& calib = gen.calibration();
   msf::synthetic::SyntheticFrame f;
   cv::Mat ids;
-  msf::synthetic::CameraRenderer(calib, gen.config()).render(gen.scene(), 0, gen.poses()[0], 0, &f.depth, &ids);
+  // The static street: the cars driving ahead in the ego lane are left out.
+  msf::synthetic::Scene static_street = gen.scene();
+  static_street.movers.clear();
+  msf::synthetic::CameraRenderer(calib, gen.config())
+      .render(msf::synthetic::SceneSnapshot(static_street, 0.0), 0, gen.poses()[0], 0, &f.depth, &ids);
   ids.convertTo(f.objects, CV_8U); // saturating: only zero or not matters here
   f.disparity = msf::depthToDisparity(f.depth, calib);
   // Frame 0 is the world origin: the road plane is y = 1.65 m, so below the horizon a road

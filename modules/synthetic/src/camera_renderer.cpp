@@ -75,7 +75,7 @@ struct Sample {
 };
 
 /// Traces one ray; step_x / step_y are the ray's spread for one sample step in the image.
-Sample trace(const Scene& scene, const Ray& ray, V3 step_x, V3 step_y) {
+Sample trace(const SceneSnapshot& scene, const Ray& ray, V3 step_x, V3 step_y) {
   Sample out;
   Hit hit;
   if (!scene.intersect(ray, 0.f, kMaxDepthM, hit)) {
@@ -90,15 +90,14 @@ Sample trace(const Scene& scene, const Ray& ray, V3 step_x, V3 step_y) {
     fp.dx = (step_x - ray.dir * (dot(step_x, hit.normal) / dn)) * hit.t;
     fp.dy = (step_y - ray.dir * (dot(step_y, hit.normal) / dn)) * hit.t;
   }
-  const Primitive* prim = hit.primitive >= 0 ? &scene.primitives[static_cast<std::size_t>(hit.primitive)] : nullptr;
-  const Material& mat = scene.materials[prim ? prim->material : scene.ground_material];
-  const SurfaceResponse s = shadeSurface(mat, prim, hit, world, fp, scene.layout);
+  const SurfaceResponse s = scene.shade(hit, world, fp);
   const V3 n = dn > 0.f ? hit.normal * -1.f : hit.normal;
   const float light = kAmbient + kSun * std::max(0.f, dot(n, kSunDirection));
   out.radiance = {s.r * light, s.g * light, s.b * light};
   out.surface = 8 * (hit.primitive + 3) + hit.face;
   out.depth = hit.t;
-  out.object = prim ? static_cast<std::int32_t>(prim->object) : 0;
+  const Primitive* solid = scene.primitive(hit.primitive);
+  out.object = solid ? static_cast<std::int32_t>(solid->object) : 0;
   return out;
 }
 
@@ -133,7 +132,7 @@ CameraRenderer::CameraRenderer(const Calibration& calibration, const SyntheticCo
   config_.validate();
 }
 
-cv::Mat CameraRenderer::render(const Scene& scene, int camera, const Eigen::Isometry3d& T_world_cam0,
+cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eigen::Isometry3d& T_world_cam0,
                                std::uint64_t noise_key, cv::Mat* depth, cv::Mat* objects) const {
   const CameraModel cam = cameraModel(calibration_, camera, T_world_cam0);
   const int W = cam.width, H = cam.height;

@@ -71,6 +71,10 @@ std::string GroundTruth::disparityPath(std::size_t i) const {
 std::string GroundTruth::objectMapPath(std::size_t i) const {
   return (fs::path(dir_) / "obj_map_0" / (frameName(i) + ".png")).string();
 }
+std::string GroundTruth::movingMaskPath(std::size_t i) const {
+  return (fs::path(dir_) / "moving_0" / (frameName(i) + ".png")).string();
+}
+std::string GroundTruth::movingBoxesPath() const { return (fs::path(dir_) / "moving_objects.txt").string(); }
 std::string GroundTruth::sceneMeshPath() const {
   const std::string path = (fs::path(dir_) / "scene.ply").string();
   requireFile(path, "scene mesh");
@@ -80,13 +84,25 @@ std::string GroundTruth::sceneMeshPath() const {
 cv::Mat GroundTruth::depth(std::size_t i) const { return readKittiDepthPng(depthPath(i)); }
 cv::Mat GroundTruth::disparity(std::size_t i) const { return readKittiDisparityPng(disparityPath(i)); }
 
-cv::Mat GroundTruth::objectMap(std::size_t i) const {
-  const std::string path = objectMapPath(i);
-  const cv::Mat map = readImage(path, cv::IMREAD_UNCHANGED);
-  if (map.type() != CV_8UC1)
-    throw IOError("object map '" + path + "' is not an 8-bit single-channel PNG");
-  return map;
+namespace {
+cv::Mat readByteImage(const std::string& path, const char* what) {
+  const cv::Mat image = readImage(path, cv::IMREAD_UNCHANGED);
+  if (image.type() != CV_8UC1)
+    throw IOError(std::string(what) + " '" + path + "' is not an 8-bit single-channel PNG");
+  return image;
 }
+} // namespace
+
+cv::Mat GroundTruth::objectMap(std::size_t i) const { return readByteImage(objectMapPath(i), "object map"); }
+
+cv::Mat GroundTruth::movingMask(std::size_t i) const {
+  std::error_code ec;
+  if (!fs::is_directory(fs::path(dir_) / "moving_0", ec))
+    return cv::Mat::zeros(depth(i).size(), CV_8UC1);
+  return readByteImage(movingMaskPath(i), "moving mask");
+}
+
+std::vector<MovingBox> GroundTruth::movingBoxes() const { return readMovingBoxes(movingBoxesPath()); }
 
 cv::Mat GroundTruth::foregroundMask(std::size_t i) const {
   const cv::Mat valid = depth(i) > 0.f, objects = objectMap(i);

@@ -30,7 +30,7 @@ LidarSimulator::LidarSimulator(const SyntheticConfig& config) : config_(config) 
   steps_ = static_cast<int>(std::floor(360.0 / config_.lidar_azimuth_step_deg));
 }
 
-pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const Scene& scene, const Eigen::Isometry3d& T_world_velo,
+pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const SceneSnapshot& scene, const Eigen::Isometry3d& T_world_velo,
                                                      std::uint64_t frame_key) const {
   const int rings = ringCount(), steps = steps_;
   std::vector<Sample> samples(static_cast<std::size_t>(rings) * static_cast<std::size_t>(steps));
@@ -57,9 +57,7 @@ pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const Scene& scene, const E
       if (!scene.intersect(ray, 0.f, max_range, hit) || hit.t < min_range)
         continue;
       const auto key = hashKey(seed, frame_key, 0x11da7ULL, static_cast<std::uint64_t>(ring), static_cast<std::uint64_t>(j));
-      const Primitive* prim = hit.primitive >= 0 ? &scene.primitives[static_cast<std::size_t>(hit.primitive)] : nullptr;
-      const Material& mat = scene.materials[prim ? prim->material : scene.ground_material];
-      const SurfaceResponse s = shadeSurface(mat, prim, hit, ray.origin + ray.dir * hit.t, Footprint{}, scene.layout);
+      const SurfaceResponse s = scene.shade(hit, ray.origin + ray.dir * hit.t, Footprint{});
       const double keep = (1.0 - config_.lidar_dropout) * (1.0 - 0.5 * s.glass);
       if (uniform01(mix64(key ^ 1)) >= keep)
         continue;

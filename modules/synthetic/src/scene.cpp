@@ -131,25 +131,6 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
   return id;
 }
 
-namespace {
-/// Entry distance of the ray into the box if it meets it within [tmin, tmax]. A NaN from
-/// 0 * inf (a ray in a slab's plane) fails both comparisons and keeps the interval.
-inline void slab(float lo, float hi, float o, float inv, float& t0, float& t1) {
-  const float a = (lo - o) * inv, b = (hi - o) * inv;
-  const float near = a < b ? a : b, far = a < b ? b : a;
-  t0 = near > t0 ? near : t0;
-  t1 = far < t1 ? far : t1;
-}
-inline bool slabEntry(const V3& lo, const V3& hi, const V3& o, const V3& inv, float tmin, float tmax, float& entry) {
-  float t0 = tmin, t1 = tmax;
-  slab(lo.x, hi.x, o.x, inv.x, t0, t1);
-  slab(lo.y, hi.y, o.y, inv.y, t0, t1);
-  slab(lo.z, hi.z, o.z, inv.z, t0, t1);
-  entry = t0;
-  return t0 <= t1;
-}
-} // namespace
-
 bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
   hit = Hit();
   hit.t = tmax;
@@ -166,7 +147,8 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
     }
   }
   float entry = 0.f;
-  if (nodes_.empty() || !slabEntry(nodes_[0].lo, nodes_[0].hi, ray.origin, {1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z}, tmin, hit.t, entry))
+  if (nodes_.empty() || !rayEntersBox(nodes_[0].lo, nodes_[0].hi, ray.origin,
+                                      {1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z}, tmin, hit.t, entry))
     return found;
   const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
   // Nodes whose box the ray enters, with the entry distance: a node is skipped when a hit
@@ -195,10 +177,11 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
     }
     const std::int32_t left = e.node + 1, right = node.index;
     float t_left = 0.f, t_right = 0.f;
-    const bool hit_left = slabEntry(nodes_[static_cast<std::size_t>(left)].lo, nodes_[static_cast<std::size_t>(left)].hi,
-                                    ray.origin, inv, tmin, hit.t, t_left);
-    const bool hit_right = slabEntry(nodes_[static_cast<std::size_t>(right)].lo,
-                                     nodes_[static_cast<std::size_t>(right)].hi, ray.origin, inv, tmin, hit.t, t_right);
+    const bool hit_left = rayEntersBox(nodes_[static_cast<std::size_t>(left)].lo,
+                                       nodes_[static_cast<std::size_t>(left)].hi, ray.origin, inv, tmin, hit.t, t_left);
+    const bool hit_right =
+        rayEntersBox(nodes_[static_cast<std::size_t>(right)].lo, nodes_[static_cast<std::size_t>(right)].hi, ray.origin,
+                     inv, tmin, hit.t, t_right);
     if (hit_left && hit_right) {
       if (t_left <= t_right) {
         stack[top++] = {right, t_right};
@@ -245,6 +228,8 @@ std::uint32_t Scene::objectCount() const {
   std::uint32_t n = 0;
   for (const auto& p : primitives)
     n = std::max(n, p.object);
+  for (const auto& m : movers)
+    n = std::max(n, m.object());
   return n;
 }
 

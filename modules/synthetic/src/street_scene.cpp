@@ -1,6 +1,8 @@
+#include <msf/synthetic/car.h>
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/kitti_rig.h>
 #include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/traffic.h>
 
 #include <algorithm>
 #include <cmath>
@@ -70,43 +72,6 @@ private:
     return scene_.addMaterial(m);
   }
 
-  Primitive box(V3 center, V3 half, std::uint16_t mat, float yaw = 0.f, std::uint32_t object = 0) {
-    Primitive p;
-    p.shape = Shape::Box;
-    p.center = center;
-    p.half = half;
-    p.material = mat;
-    p.object = object;
-    p.setYaw(yaw);
-    return p;
-  }
-
-  /// A cylinder along local axis `axis` with the given radius and half length.
-  Primitive cylinder(V3 center, int axis, float radius, float half_length, std::uint16_t mat, float yaw = 0.f,
-                     std::uint32_t object = 0) {
-    Primitive p;
-    p.shape = Shape::Cylinder;
-    p.axis = static_cast<std::uint8_t>(axis);
-    p.center = center;
-    float h[3] = {radius, radius, radius};
-    h[axis] = half_length;
-    p.half = {h[0], h[1], h[2]};
-    p.material = mat;
-    p.object = object;
-    p.setYaw(yaw);
-    return p;
-  }
-
-  Primitive ellipsoid(V3 center, V3 radii, std::uint16_t mat, std::uint32_t object = 0) {
-    Primitive p;
-    p.shape = Shape::Ellipsoid;
-    p.center = center;
-    p.half = radii;
-    p.material = mat;
-    p.object = object;
-    return p;
-  }
-
   /// Raised sidewalk and lawn from the kerb to the back row, in 20 m slabs (tight bounds
   /// for the hierarchy); it reaches below the road so only its top and kerb face show.
   void addPlateau(int side) {
@@ -121,8 +86,8 @@ private:
     const float x0 = layout().halfRoadWidth(), x1 = kPlateauOuterX;
     const float top = layout().sidewalkY(), bottom = layout().ground_y + 0.3f;
     for (float z = layout().z_begin - 40.f; z < layout().z_end + 40.f; z += 20.f)
-      scene_.add(box({worldX(side, 0.5f * (x0 + x1)), 0.5f * (top + bottom), z + 10.f},
-                     {0.5f * (x1 - x0), 0.5f * (bottom - top), 10.f}, mat));
+      scene_.add(boxSolid({worldX(side, 0.5f * (x0 + x1)), 0.5f * (top + bottom), z + 10.f},
+                          {0.5f * (x1 - x0), 0.5f * (bottom - top), 10.f}, mat));
   }
 
   std::uint16_t facadeMaterial(bool blank) {
@@ -160,8 +125,8 @@ private:
   /// A building with its front at street offset `front`, `depth` deep, over [z0, z1].
   void addBuilding(int side, float front, float depth, float z0, float z1, float height, bool blank) {
     const std::uint16_t mat = facadeMaterial(blank);
-    scene_.add(box({worldX(side, front + 0.5f * depth), yAboveSidewalk(0.5f * height), 0.5f * (z0 + z1)},
-                   {0.5f * depth, 0.5f * height, 0.5f * (z1 - z0)}, mat));
+    scene_.add(boxSolid({worldX(side, front + 0.5f * depth), yAboveSidewalk(0.5f * height), 0.5f * (z0 + z1)},
+                        {0.5f * depth, 0.5f * height, 0.5f * (z1 - z0)}, mat));
   }
 
   void addBuildings(int side) {
@@ -203,11 +168,11 @@ private:
 
   /// Buildings across the street at both ends, so nothing is open to the horizon.
   void addCrossBuildings() {
-    for (const float z : {layout().z_begin - 25.f, layout().z_end + 5.f}) {
+    for (const float z : {layout().openBeginZ() - 20.f, layout().openEndZ()}) {
       const std::uint16_t mat = facadeMaterial(false);
       const float height = uniform(14.0, 20.0);
-      scene_.add(box({layout().road_center_x, yAbove(0.5f * height), z + 10.f},
-                     {kPlateauOuterX + 2.f, 0.5f * height, 10.f}, mat));
+      scene_.add(boxSolid({layout().road_center_x, yAbove(0.5f * height), z + 10.f},
+                          {kPlateauOuterX + 2.f, 0.5f * height, 10.f}, mat));
     }
   }
 
@@ -217,11 +182,11 @@ private:
     for (float z = layout().z_begin + uniform(0.0, 20.0); z < layout().z_end; z += uniform(22.0, 32.0)) {
       const std::uint32_t id = ++objects_;
       const float x = worldX(side, kerb + 0.45f), height = uniform(6.5, 8.0);
-      scene_.add(cylinder({x, yAboveSidewalk(0.5f * height), z}, 1, 0.07f, 0.5f * height, metal, 0.f, id));
-      scene_.add(cylinder({worldX(side, kerb + 0.45f - 0.8f), yAboveSidewalk(height - 0.1f), z}, 0, 0.04f, 0.8f, metal,
-                          0.f, id));
-      scene_.add(box({worldX(side, kerb + 0.45f - 1.55f), yAboveSidewalk(height - 0.2f), z}, {0.28f, 0.07f, 0.13f},
-                     metal, 0.f, id));
+      scene_.add(cylinderSolid({x, yAboveSidewalk(0.5f * height), z}, 1, 0.07f, 0.5f * height, metal, 0.f, id));
+      scene_.add(cylinderSolid({worldX(side, kerb + 0.45f - 0.8f), yAboveSidewalk(height - 0.1f), z}, 0, 0.04f, 0.8f,
+                               metal, 0.f, id));
+      scene_.add(boxSolid({worldX(side, kerb + 0.45f - 1.55f), yAboveSidewalk(height - 0.2f), z}, {0.28f, 0.07f, 0.13f},
+                          metal, 0.f, id));
       poles_z_[side > 0].push_back(z);
       if (rng_.chance(0.45)) { // a traffic sign half-way to the next lamp
         const float zs = z + uniform(8.0, 14.0);
@@ -229,8 +194,8 @@ private:
         const std::uint16_t plate = material(MaterialType::SignPlate, kSign[rng_.index(2)], 0.9f);
         const std::uint32_t sign = ++objects_;
         const float xs = worldX(side, kerb + 0.35f);
-        scene_.add(cylinder({xs, yAboveSidewalk(1.3f), zs}, 1, 0.035f, 1.3f, metal, 0.f, sign));
-        scene_.add(box({xs, yAboveSidewalk(2.25f), zs - 0.05f}, {0.3f, 0.3f, 0.015f}, plate, 0.f, sign));
+        scene_.add(cylinderSolid({xs, yAboveSidewalk(1.3f), zs}, 1, 0.035f, 1.3f, metal, 0.f, sign));
+        scene_.add(boxSolid({xs, yAboveSidewalk(2.25f), zs - 0.05f}, {0.3f, 0.3f, 0.015f}, plate, 0.f, sign));
         poles_z_[side > 0].push_back(zs);
       }
     }
@@ -252,17 +217,14 @@ private:
       const std::uint16_t leaves =
           material(MaterialType::Foliage, {uniform(0.07, 0.12), uniform(0.15, 0.22), uniform(0.04, 0.07)}, 0.45f);
       const float trunk = uniform(2.6, 3.4), rh = uniform(1.7, 2.6), rv = uniform(2.0, 3.0);
-      scene_.add(cylinder({x, yAboveSidewalk(0.5f * trunk + 0.25f), z}, 1, uniform(0.12, 0.2), 0.5f * trunk + 0.25f,
-                          bark));
-      scene_.add(ellipsoid({x, yAboveSidewalk(trunk + 0.75f * rv), z}, {rh, rv, rh}, leaves));
+      scene_.add(cylinderSolid({x, yAboveSidewalk(0.5f * trunk + 0.25f), z}, 1, uniform(0.12, 0.2),
+                               0.5f * trunk + 0.25f, bark));
+      scene_.add(ellipsoidSolid({x, yAboveSidewalk(trunk + 0.75f * rv), z}, {rh, rv, rh}, leaves));
       trees_z_[side > 0].push_back(z);
     }
   }
 
   void addParkedCars(int side) {
-    static const Rgb3 kPaint[] = {{0.70f, 0.70f, 0.70f}, {0.45f, 0.46f, 0.48f}, {0.04f, 0.04f, 0.045f},
-                                  {0.12f, 0.12f, 0.13f}, {0.05f, 0.08f, 0.20f}, {0.45f, 0.05f, 0.04f},
-                                  {0.10f, 0.20f, 0.45f}, {0.50f, 0.45f, 0.35f}};
     const std::uint16_t rubber = material(MaterialType::Tyre, {0.035f, 0.035f, 0.035f}, 0.08f);
     const float lane_center = layout().halfRoadWidth() - 0.5f * layout().parking_width_m;
     float z = layout().z_begin + 5.f;
@@ -271,25 +233,14 @@ private:
         z += uniform(4.0, 9.0);
         continue;
       }
-      const float length = uniform(3.9, 4.8), width = uniform(1.7, 1.85);
-      const Rgb3 paint = kPaint[rng_.index(8)];
-      const std::uint16_t body = material(MaterialType::CarPaint, paint, 0.3f);
-      const std::uint16_t cabin = material(MaterialType::CarCabin, paint, 0.1f);
+      const CarLook car = drawCarLook(rng_, scene_);
       // Cars face the way their lane drives: +z on the right, -z on the left.
       const float yaw = uniform(-0.03, 0.03) + (side > 0 ? 0.f : kPiF);
-      const V3 base{worldX(side, lane_center + uniform(-0.12, 0.12)), layout().ground_y, z + 0.5f * length};
+      const V3 base{worldX(side, lane_center + uniform(-0.12, 0.12)), layout().ground_y, z + 0.5f * car.length_m};
       const std::uint32_t id = ++objects_;
-      auto at = [&](float lx, float height, float lz) {
-        Primitive frame;
-        frame.setYaw(yaw);
-        return base + frame.dirToWorld({lx, -height, lz});
-      };
-      scene_.add(box(at(0.f, 0.615f, 0.f), {0.5f * width, 0.335f, 0.5f * length}, body, yaw, id));
-      scene_.add(box(at(0.f, 1.19f, -0.06f * length), {0.43f * width, 0.24f, 0.27f * length}, cabin, yaw, id));
-      for (const float lx : {-0.5f * width + 0.13f, 0.5f * width - 0.13f})
-        for (const float lz : {-0.5f * length + 0.85f, 0.5f * length - 0.85f})
-          scene_.add(cylinder(at(lx, 0.31f, lz), 0, 0.31f, 0.1f, rubber, yaw, id));
-      z += length + uniform(0.7, 2.0);
+      for (const Primitive& solid : carSolids(car, rubber, id))
+        scene_.add(solid.placed(base, yaw));
+      z += car.length_m + uniform(0.7, 2.0);
     }
   }
 
@@ -313,9 +264,9 @@ private:
       const std::uint16_t legs = material(MaterialType::Cloth, kClothes[rng_.index(8)], 0.3f);
       const std::uint16_t top = material(MaterialType::Cloth, kClothes[rng_.index(8)], 0.3f);
       const std::uint16_t head = material(MaterialType::Skin, kSkin[rng_.index(3)], 0.3f);
-      scene_.add(cylinder({x, yAboveSidewalk(0.43f * k), z}, 1, 0.13f, 0.43f * k, legs, 0.f, id));
-      scene_.add(cylinder({x, yAboveSidewalk(1.18f * k), z}, 1, 0.19f, 0.32f * k, top, 0.f, id));
-      scene_.add(ellipsoid({x, yAboveSidewalk(1.62f * k), z}, {0.095f * k, 0.12f * k, 0.1f * k}, head, id));
+      scene_.add(cylinderSolid({x, yAboveSidewalk(0.43f * k), z}, 1, 0.13f, 0.43f * k, legs, 0.f, id));
+      scene_.add(cylinderSolid({x, yAboveSidewalk(1.18f * k), z}, 1, 0.19f, 0.32f * k, top, 0.f, id));
+      scene_.add(ellipsoidSolid({x, yAboveSidewalk(1.62f * k), z}, {0.095f * k, 0.12f * k, 0.1f * k}, head, id));
     }
   }
 
@@ -329,7 +280,9 @@ private:
 } // namespace
 
 Scene buildStreetScene(const SyntheticConfig& config, double path_end_z) {
-  return StreetBuilder(config, path_end_z).build();
+  Scene scene = StreetBuilder(config, path_end_z).build();
+  addTraffic(config, scene);
+  return scene;
 }
 
 } // namespace msf::synthetic

@@ -26,6 +26,10 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "textureless_share", textureless_share);
   readKey(node, "parked_car_share", parked_car_share);
   readKey(node, "mesh_max_edge_m", mesh_max_edge_m);
+  readKey(node, "moving_cars_ahead", moving_cars_ahead);
+  readKey(node, "moving_cars_oncoming", moving_cars_oncoming);
+  readKey(node, "oncoming_car_speed_mps", oncoming_car_speed_mps);
+  readKey(node, "oncoming_group_period_s", oncoming_group_period_s);
   validate();
 }
 
@@ -68,6 +72,14 @@ void SyntheticConfig::validate() const {
           "must be in 0..1");
   require(mesh_max_edge_m >= 0.05 && mesh_max_edge_m <= 20.0, "mesh_max_edge_m", mesh_max_edge_m,
           "must be in 0.05..20");
+  require(moving_cars_ahead >= 0 && moving_cars_ahead <= 10, "moving_cars_ahead", moving_cars_ahead,
+          "must be in 0..10");
+  require(moving_cars_oncoming >= 0 && moving_cars_oncoming <= 20, "moving_cars_oncoming", moving_cars_oncoming,
+          "must be in 0..20");
+  require(oncoming_car_speed_mps > 0.0 && oncoming_car_speed_mps <= 40.0, "oncoming_car_speed_mps",
+          oncoming_car_speed_mps, "must be in (0, 40]");
+  require(oncoming_group_period_s >= 1.0 && oncoming_group_period_s <= 3600.0, "oncoming_group_period_s",
+          oncoming_group_period_s, "must be in 1..3600");
 }
 
 namespace {
@@ -100,7 +112,11 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  lidar_lower_elevation_deg: " << exact(lidar_lower_elevation_deg) << "\n"
       << "  textureless_share: " << exact(textureless_share) << "\n"
       << "  parked_car_share: " << exact(parked_car_share) << "\n"
-      << "  mesh_max_edge_m: " << exact(mesh_max_edge_m) << "\n";
+      << "  mesh_max_edge_m: " << exact(mesh_max_edge_m) << "\n"
+      << "  moving_cars_ahead: " << moving_cars_ahead << "\n"
+      << "  moving_cars_oncoming: " << moving_cars_oncoming << "\n"
+      << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
+      << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n";
 }
 
 } // namespace msf::synthetic

@@ -55,7 +55,11 @@ const char* kGroundTruthReadme =
     "depth_0/NNNNNN.png    camera 0 depth z, 16-bit, metres x 256, 0 = none (sky, beyond 255 m)\n"
     "disp_0/NNNNNN.png     grey-pair disparity f B / z, 16-bit, pixels x 256, 0 = none\n"
     "obj_map_0/NNNNNN.png  8-bit, 0 = background, 1..255 = foreground instance (cars, poles, people)\n"
-    "scene.ply             the true surface, in the world of poses/00.txt (camera 0 at frame 0)\n"
+    "moving_0/NNNNNN.png   8-bit, 255 = the pixel sees a moving object (a car driving), 0 = static\n"
+    "moving_objects.txt    the moving objects' oriented boxes at every frame, in the world of poses/00.txt\n"
+    "                      (one line per frame and object; its header names the columns)\n"
+    "scene.ply             the true static surface (no moving objects), in the world of poses/00.txt\n"
+    "                      (camera 0 at frame 0)\n"
     "synthetic.yaml        the generator's configuration\n"
     "Every pixel is exact: the value of the ray through the pixel centre.\n";
 
@@ -115,27 +119,51 @@ SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
       renderer_(calibration_, config_),
       lidar_(config_) {}
 
-SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i, bool with_color) const {
+SceneSnapshot SyntheticGenerator::sceneAt(std::size_t i) const {
   if (i >= poses_.size())
     throw InvalidInputError("frame " + std::to_string(i) + " is out of range: the sequence has " +
                             std::to_string(poses_.size()) + " frames");
+  return SceneSnapshot(scene_, static_cast<double>(i) / config_.frame_rate_hz);
+}
+
+std::vector<MovingBox> SyntheticGenerator::movingBoxes() const {
+  std::vector<MovingBox> boxes;
+  for (std::size_t i = 0; i < poses_.size(); ++i) {
+    const SceneSnapshot snapshot = sceneAt(i);
+    for (const MovingObject* mover : snapshot.movers()) {
+      boxes.push_back(mover->boxAt(snapshot.time()));
+      boxes.back().frame = i;
+    }
+  }
+  return boxes;
+}
+
+SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i, bool with_color) const {
+  const SceneSnapshot snapshot = sceneAt(i);
   const Eigen::Isometry3d& T_world_cam0 = poses_[i];
   SyntheticFrame f;
   cv::Mat ids;
-  f.images[0] = renderer_.render(scene_, 0, T_world_cam0, i, &f.depth, &ids);
+  f.images[0] = renderer_.render(snapshot, 0, T_world_cam0, i, &f.depth, &ids);
   for (int camera = 1; camera < (with_color ? 4 : 2); ++camera)
-    f.images[camera] = renderer_.render(scene_, camera, T_world_cam0, i);
-  f.scan = lidar_.scan(scene_, T_world_cam0 * calibration_.T_cam0_velo, i);
+    f.images[camera] = renderer_.render(snapshot, camera, T_world_cam0, i);
+  f.scan = lidar_.scan(snapshot, T_world_cam0 * calibration_.T_cam0_velo, i);
 
+  std::vector<bool> is_moving(scene_.objectCount() + 1, false);
+  for (const MovingObject& mover : scene_.movers)
+    is_moving[mover.object()] = true;
   f.objects.create(ids.size(), CV_8UC1);
+  f.moving.create(ids.size(), CV_8UC1);
   for (int v = 0; v < ids.rows; ++v) {
     float* d = f.depth.ptr<float>(v);
     const std::int32_t* id = ids.ptr<std::int32_t>(v);
     std::uint8_t* o = f.objects.ptr<std::uint8_t>(v);
+    std::uint8_t* m = f.moving.ptr<std::uint8_t>(v);
     for (int u = 0; u < ids.cols; ++u) {
       if (d[u] > kMaxGroundTruthDepthM)
         d[u] = 0.f;
       o[u] = (id[u] > 0 && d[u] > 0.f) ? static_cast<std::uint8_t>((id[u] - 1) % 255 + 1) : 0;
+      // From the exact id, not the 8-bit map (whose ids repeat on long streets).
+      m[u] = is_moving[static_cast<std::size_t>(id[u])] ? 255 : 0;
     }
   }
   f.disparity = depthToDisparity(f.depth, calibration_);
@@ -157,8 +185,8 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   std::error_code ec;
   fs::remove_all(staging, ec);
   try {
-    for (const fs::path& dir : {seq / "image_0", seq / "image_1", seq / "image_2", seq / "image_3",
-                                seq / "velodyne", staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0"})
+    for (const fs::path& dir : {seq / "image_0", seq / "image_1", seq / "image_2", seq / "image_3", seq / "velodyne",
+                                staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0", gt / "moving_0"})
       if (!fs::create_directories(dir, ec) || ec)
         throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
 
@@ -177,6 +205,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     writeText(gt / "synthetic.yaml", yaml.str());
     writeText(gt / "README.txt", kGroundTruthReadme);
     saveMesh((gt / "scene.ply").string(), mesh());
+    writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
 
     for (std::size_t i = 0; i < poses_.size(); ++i) {
       const auto start = std::chrono::steady_clock::now();
@@ -189,6 +218,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
       jobs.emplace_back([&] { writeKittiDepthPng((gt / "depth_0" / png).string(), f.depth); });
       jobs.emplace_back([&] { writeKittiDisparityPng((gt / "disp_0" / png).string(), f.disparity); });
       jobs.emplace_back([&] { writeImage((gt / "obj_map_0" / png).string(), f.objects); });
+      jobs.emplace_back([&] { writeImage((gt / "moving_0" / png).string(), f.moving); });
       runAll(jobs);
       if (progress)
         progress(i, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), f.scan.size());

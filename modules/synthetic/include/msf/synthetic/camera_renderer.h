@@ -1,6 +1,6 @@
 #pragma once
 #include <msf/io/calibration.h>
-#include <msf/synthetic/scene.h>
+#include <msf/synthetic/scene_snapshot.h>
 #include <msf/synthetic/synthetic_config.h>
 
 #include <opencv2/core/mat.hpp>
@@ -22,12 +22,12 @@ class CameraRenderer {
 public:
   CameraRenderer(const Calibration& calibration, const SyntheticConfig& config);
 
-  /// Image of camera 0..3 with camera 0 at T_world_cam0: CV_8UC1 for the grey cameras
+  /// Image of camera 0..3 with camera 0 at T_world_cam0, seeing `scene` at its time: CV_8UC1 for the grey cameras
   /// 0 and 1, BGR CV_8UC3 for the colour cameras 2 and 3. `noise_key` selects the noise
   /// (use the frame index). When given, `depth` and `objects` receive the exact ground
   /// truth of the ray through each pixel centre: depth z in metres in this camera's frame
   /// (CV_32F, 0 where the sky is seen) and the foreground object id (CV_32S, 0 background).
-  cv::Mat render(const Scene& scene, int camera, const Eigen::Isometry3d& T_world_cam0, std::uint64_t noise_key,
+  cv::Mat render(const SceneSnapshot& scene, int camera, const Eigen::Isometry3d& T_world_cam0, std::uint64_t noise_key,
                  cv::Mat* depth = nullptr, cv::Mat* objects = nullptr) const;
 
 private:

@@ -28,4 +28,23 @@ struct Ray {
   V3 dir;
 };
 
+/// Entry distance of a ray into the axis-aligned box [lo, hi] if it meets it within
+/// [tmin, tmax]; `inv` is 1 / the ray's direction, per axis. A NaN from 0 * inf (a ray in a
+/// slab's plane) fails both comparisons and keeps the interval.
+inline bool rayEntersBox(const V3& lo, const V3& hi, const V3& origin, const V3& inv, float tmin, float tmax,
+                         float& entry) {
+  float t0 = tmin, t1 = tmax;
+  auto slab = [&](float l, float h, float o, float i) {
+    const float a = (l - o) * i, b = (h - o) * i;
+    const float near = a < b ? a : b, far = a < b ? b : a;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+  };
+  slab(lo.x, hi.x, origin.x, inv.x);
+  slab(lo.y, hi.y, origin.y, inv.y);
+  slab(lo.z, hi.z, origin.z, inv.z);
+  entry = t0;
+  return t0 <= t1;
+}
+
 } // namespace msf::synthetic

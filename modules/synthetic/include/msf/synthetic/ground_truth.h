@@ -1,4 +1,6 @@
 #pragma once
+#include <msf/synthetic/moving_box.h>
+
 #include <opencv2/core/mat.hpp>
 
 #include <cstddef>
@@ -12,7 +14,11 @@ namespace msf::synthetic {
 ///   gt/disp_0/NNNNNN.png     grey-pair disparity f B / z, KITTI 16-bit (pixels x 256)
 ///   gt/obj_map_0/NNNNNN.png  8-bit: 0 background, 1..255 foreground (cars, poles, people),
 ///                            KITTI 2015's obj_map convention
-///   gt/scene.ply             the true surface, world = camera 0 at frame 0 (poses/00.txt)
+///   gt/moving_0/NNNNNN.png   8-bit: 255 where the pixel sees a moving object, 0 elsewhere
+///                            (also beyond 255 m, where depth and obj_map have none)
+///   gt/moving_objects.txt    the moving objects' oriented boxes at every frame (MovingBox)
+///   gt/scene.ply             the true static surface (no moving objects), world = camera 0
+///                            at frame 0 (poses/00.txt)
 /// Frames are in file-name order, the same order as msf::Sequence's frames.
 class GroundTruth {
 public:
@@ -33,6 +39,8 @@ public:
   std::string depthPath(std::size_t i) const;
   std::string disparityPath(std::size_t i) const;
   std::string objectMapPath(std::size_t i) const;
+  std::string movingMaskPath(std::size_t i) const;
+  std::string movingBoxesPath() const;
   std::string sceneMeshPath() const;
 
   /// CV_32F metres, 0 = none.
@@ -45,6 +53,14 @@ public:
   /// (objectMap > 0) or background, as the KITTI devkit splits its error.
   cv::Mat foregroundMask(std::size_t i) const;
   cv::Mat backgroundMask(std::size_t i) const;
+  /// CV_8U, 255 where the pixel sees a moving object. A dataset written before moving
+  /// objects existed has no moving_0/: its street was static, and the mask is all zero
+  /// (of the depth's size). Throws IOError when moving_0/ exists and the frame's file does not.
+  cv::Mat movingMask(std::size_t i) const;
+  /// The moving objects' boxes at every frame, in file order (frame by frame). Throws
+  /// IOError naming the file when it is missing (datasets written before moving objects
+  /// have none), and the file and line when a line is garbled.
+  std::vector<MovingBox> movingBoxes() const;
 
 private:
   std::string dir_;

@@ -1,5 +1,5 @@
 #pragma once
-#include <msf/synthetic/scene.h>
+#include <msf/synthetic/scene_snapshot.h>
 #include <msf/synthetic/synthetic_config.h>
 
 #include <Eigen/Geometry>
@@ -14,8 +14,9 @@ namespace msf::synthetic {
 /// A Velodyne HDL-64E: 64 lasers in two blocks as on KITTI's unit (the upper 32 spaced 1/3
 /// degree down from lidar_upper_elevation_deg, the lower 32 evenly down to
 /// lidar_lower_elevation_deg), each sweeping the azimuth from -pi to pi in
-/// lidar_azimuth_step_deg steps. The scan is a snapshot at the frame's pose (no motion
-/// during the sweep), so it agrees exactly with the camera's ground truth.
+/// lidar_azimuth_step_deg steps. The scan is a snapshot at the frame's pose and time (no
+/// motion of the sensor or of moving objects during the sweep), so it agrees exactly with
+/// the camera's ground truth.
 /// Points are written ring after ring, top laser first, each ring one sweep of rising
 /// atan2(y, x): the ring split of DESIGN.md protocol 2 finds exactly 64 rings.
 /// Each return: range + Gaussian noise, lost with probability lidar_dropout (and half the
@@ -31,9 +32,9 @@ public:
   int ringCount() const { return static_cast<int>(elevations_deg_.size()); }
   int pointsPerRing() const { return steps_; }
 
-  /// One scan in the Velodyne frame with the Velodyne at T_world_velo; `frame_key` selects
-  /// the noise (use the frame index).
-  pcl::PointCloud<pcl::PointXYZI> scan(const Scene& scene, const Eigen::Isometry3d& T_world_velo,
+  /// One scan in the Velodyne frame with the Velodyne at T_world_velo, of `scene` at its
+  /// time; `frame_key` selects the noise (use the frame index).
+  pcl::PointCloud<pcl::PointXYZI> scan(const SceneSnapshot& scene, const Eigen::Isometry3d& T_world_velo,
                                        std::uint64_t frame_key) const;
 
 private:

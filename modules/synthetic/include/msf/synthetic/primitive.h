@@ -42,6 +42,18 @@ struct Primitive {
   V3 toLocal(V3 p) const { return dirToLocal(p - center); }
   V3 toWorld(V3 p) const { return center + dirToWorld(p); }
 
+  /// This solid, given in an object's own frame, placed in the world with the object's
+  /// origin at `origin` and its heading `yaw`; the solid's own yaw adds to the heading.
+  Primitive placed(V3 origin, float yaw) const {
+    Primitive frame;
+    frame.setYaw(yaw);
+    Primitive p = *this;
+    p.center = origin + frame.dirToWorld(center);
+    p.cos_yaw = frame.cos_yaw * cos_yaw - frame.sin_yaw * sin_yaw;
+    p.sin_yaw = frame.sin_yaw * cos_yaw + frame.cos_yaw * sin_yaw;
+    return p;
+  }
+
   /// World axis-aligned bounds.
   void bounds(V3& lo, V3& hi) const {
     const float ex = std::fabs(cos_yaw) * half.x + std::fabs(sin_yaw) * half.z;
@@ -183,5 +195,36 @@ private:
     return true;
   }
 };
+
+/// A solid of `shape` with half extents (radii) `half`, turned by `yaw` about the vertical.
+inline Primitive makeSolid(Shape shape, V3 center, V3 half, std::uint16_t material, float yaw = 0.f,
+                           std::uint32_t object = 0) {
+  Primitive p;
+  p.shape = shape;
+  p.center = center;
+  p.half = half;
+  p.material = material;
+  p.object = object;
+  p.setYaw(yaw);
+  return p;
+}
+
+inline Primitive boxSolid(V3 center, V3 half, std::uint16_t material, float yaw = 0.f, std::uint32_t object = 0) {
+  return makeSolid(Shape::Box, center, half, material, yaw, object);
+}
+
+/// A capped cylinder along local axis `axis` (0 x, 1 y, 2 z) with the given radius and half length.
+inline Primitive cylinderSolid(V3 center, int axis, float radius, float half_length, std::uint16_t material,
+                               float yaw = 0.f, std::uint32_t object = 0) {
+  float h[3] = {radius, radius, radius};
+  h[axis] = half_length;
+  Primitive p = makeSolid(Shape::Cylinder, center, {h[0], h[1], h[2]}, material, yaw, object);
+  p.axis = static_cast<std::uint8_t>(axis);
+  return p;
+}
+
+inline Primitive ellipsoidSolid(V3 center, V3 radii, std::uint16_t material, std::uint32_t object = 0) {
+  return makeSolid(Shape::Ellipsoid, center, radii, material, 0.f, object);
+}
 
 } // namespace msf::synthetic

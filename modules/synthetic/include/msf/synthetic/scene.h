@@ -1,6 +1,7 @@
 #pragma once
 #include <msf/synthetic/geometry.h>
 #include <msf/synthetic/material.h>
+#include <msf/synthetic/moving_object.h>
 #include <msf/synthetic/primitive.h>
 
 #include <cstddef>
@@ -19,22 +20,33 @@ struct StreetLayout {
   float kerb_height_m = 0.12f;
   float sidewalk_width_m = 4.5f;  ///< paving from the kerb to the lawn line
   float z_begin = 0.f, z_end = 0.f;
+  float cross_gap_m = 5.f;        ///< open road between z_begin, z_end and the buildings across the street
 
   float halfRoadWidth() const { return lane_width_m + parking_width_m; }
   float sidewalkY() const { return ground_y - kerb_height_m; }
   /// Distance of world x from the road axis, and which side (+1 right, -1 left).
   float streetOffset(float x) const { return x - road_center_x; }
+  /// Centre x of the right-hand driving lane (the cameras' lane, driving +z) and of the left one.
+  float rightLaneX() const { return road_center_x + 0.5f * lane_width_m; }
+  float leftLaneX() const { return road_center_x - 0.5f * lane_width_m; }
+  /// The street's open stretch along z, between the buildings across its ends.
+  float openBeginZ() const { return z_begin - cross_gap_m; }
+  float openEndZ() const { return z_end + cross_gap_m; }
 };
 
 /// The street as a union of solids over an infinite road plane, with a bounding volume
 /// hierarchy for the ray caster (binned surface area heuristic). Rays that meet
-/// nothing see the sky, which returns nothing.
+/// nothing see the sky, which returns nothing. The solids and their hierarchy are the
+/// static world; `movers` drive through it and are placed at a time by SceneSnapshot.
 class Scene {
 public:
   StreetLayout layout;
   std::uint16_t ground_material = 0;
   std::vector<Material> materials;
   std::vector<Primitive> primitives;
+  /// Foreground objects that move (their materials are in `materials`, their ids follow the
+  /// static objects' ids); not in the hierarchy, not in intersect() or occupied().
+  std::vector<MovingObject> movers;
 
   std::uint16_t addMaterial(const Material& material);
   void add(const Primitive& primitive) { primitives.push_back(primitive); }
@@ -42,14 +54,14 @@ public:
   /// Builds the hierarchy; call after the last primitive is added.
   void buildIndex();
 
-  /// Nearest surface with t in (tmin, tmax); false for the sky.
+  /// Nearest static surface with t in (tmin, tmax); false for the sky.
   bool intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const;
 
-  /// True when p lies inside a solid other than primitives[skip], or below the road plane,
-  /// by more than `inset`.
+  /// True when p lies inside a static solid other than primitives[skip], or below the road
+  /// plane, by more than `inset`.
   bool occupied(V3 p, float inset, std::int32_t skip = -1) const;
 
-  /// Number of foreground instances (largest object id).
+  /// Number of foreground instances, static and moving (largest object id).
   std::uint32_t objectCount() const;
 
 private:

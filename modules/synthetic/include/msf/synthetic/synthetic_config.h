@@ -26,6 +26,11 @@ struct SyntheticConfig {
   double textureless_share = 0.2;      ///< share of building lots with blank walls [0, 1]
   double parked_car_share = 0.6;       ///< share of parking slots taken [0, 1]
   double mesh_max_edge_m = 1.0;        ///< triangle size of gt/scene.ply's flat faces
+  // Moving cars (see addTraffic in traffic.h); 0 cars turns them off.
+  int moving_cars_ahead = 1;            ///< cars driving ahead in the cameras' lane (0..10)
+  int moving_cars_oncoming = 2;         ///< oncoming cars met in each group (0..20)
+  double oncoming_car_speed_mps = 10.0; ///< their speed along the street, (0, 40]
+  double oncoming_group_period_s = 4.0; ///< a group is met every this many seconds [1, 3600]
 
   /// Overrides the keys present in `node` (a `synthetic` section), then validates.
   /// Throws ConfigError naming a key with a wrong type or value.

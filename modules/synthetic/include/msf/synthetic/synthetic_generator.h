@@ -3,7 +3,9 @@
 #include <msf/io/poses.h>
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/lidar_simulator.h>
+#include <msf/synthetic/moving_box.h>
 #include <msf/synthetic/scene.h>
+#include <msf/synthetic/scene_snapshot.h>
 #include <msf/synthetic/synthetic_config.h>
 
 #include <opencv2/core/mat.hpp>
@@ -25,11 +27,13 @@ struct SyntheticFrame {
   cv::Mat depth;      ///< camera 0, CV_32F metres, 0 = no ground truth (sky, beyond 255 m)
   cv::Mat disparity;  ///< grey pair, CV_32F pixels (f B / depth), 0 where depth is 0
   cv::Mat objects;    ///< camera 0, CV_8U: 0 background, 1..255 foreground instance
+  cv::Mat moving;     ///< camera 0, CV_8U: 255 where the pixel sees a moving object, else 0
 };
 
 /// The synthetic KITTI-format generator: KITTI's rig (kittiRig) driving down a street
-/// (buildStreetScene) along streetTrajectory, rendered by CameraRenderer and
-/// LidarSimulator. Deterministic: one seed, one byte-identical dataset.
+/// (buildStreetScene, with its moving cars) along streetTrajectory, rendered by
+/// CameraRenderer and LidarSimulator at each frame's time. Deterministic: one seed, one
+/// byte-identical dataset.
 class SyntheticGenerator {
 public:
   /// Builds the trajectory and the scene; throws ConfigError for an invalid config.
@@ -39,6 +43,12 @@ public:
   const Calibration& calibration() const { return calibration_; }
   const PoseList& poses() const { return poses_; }
   const Scene& scene() const { return scene_; }
+  /// The scene at frame i's time, i / frame_rate_hz. Throws InvalidInputError when i is out
+  /// of range.
+  SceneSnapshot sceneAt(std::size_t i) const;
+  /// The oriented boxes of the moving objects present at every frame, frame by frame
+  /// (gt/moving_objects.txt).
+  std::vector<MovingBox> movingBoxes() const;
   const LidarSimulator& lidar() const { return lidar_; }
   std::size_t size() const { return poses_.size(); }
 
@@ -46,7 +56,7 @@ public:
   /// InvalidInputError when i is out of range.
   SyntheticFrame renderFrame(std::size_t i, bool with_color = true) const;
 
-  /// The true surface (see sceneMesh in scene_mesh.h).
+  /// The true static surface (see sceneMesh in scene_mesh.h), without the moving objects.
   pcl::PolygonMesh mesh() const;
 
   /// Called after each written frame with its index, the seconds it took (render and

@@ -1,0 +1,75 @@
+#include <msf/synthetic/car.h>
+#include <msf/synthetic/counter_rng.h>
+#include <msf/synthetic/traffic.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace msf::synthetic {
+
+namespace {
+
+// Keys of the movers' streams, apart from the static street's.
+constexpr std::uint64_t kAheadStream = 0xa4eadULL;
+constexpr std::uint64_t kOncomingStream = 0x0c0a1ULL;
+constexpr float kPiF = 3.14159265f;
+constexpr double kMinGapAheadM = 8.0, kMaxGapAheadM = 40.0;
+// Centre spacing of consecutive oncoming cars: 4.2 m between bumpers at the least.
+constexpr double kMinSpacingOncomingM = 9.0, kMaxSpacingOncomingM = 10.5;
+
+/// Car `id` with its look, tyres and a small offset from the lane's centre drawn from
+/// `rng`, its centre at `z` at time 0.
+void addCar(SequentialRng& rng, Scene& scene, std::uint32_t id, float lane_x, double z, float yaw, double speed_mps) {
+  const CarLook look = drawCarLook(rng, scene);
+  const std::uint16_t tyre = scene.addMaterial({MaterialType::Tyre, 0.035f, 0.035f, 0.035f, rng.seed32(), 0.08f});
+  const float x = lane_x + static_cast<float>(rng.uniform(-0.15, 0.15));
+  scene.movers.emplace_back(id, carSolids(look, tyre, id), V3{x, scene.layout.ground_y, static_cast<float>(z)}, yaw,
+                            static_cast<float>(speed_mps));
+}
+
+} // namespace
+
+void addTraffic(const SyntheticConfig& config, Scene& scene) {
+  const auto seed = static_cast<std::uint64_t>(config.seed);
+  const double v = config.speed_mps;
+  const double duration = (config.frames - 1) / config.frame_rate_hz;
+  std::uint32_t id = scene.objectCount();
+
+  if (config.moving_cars_ahead > 0) {
+    SequentialRng lane(hashKey(seed, kAheadStream));
+    double z = lane.uniform(10.0, 20.0);
+    double speed = v * lane.uniform(0.9, 1.1);
+    if (duration > 0.0)
+      speed = std::clamp(speed, v - (z - kMinGapAheadM) / duration, v + (kMaxGapAheadM - z) / duration);
+    for (int j = 0; j < config.moving_cars_ahead; ++j) {
+      SequentialRng rng(hashKey(seed, kAheadStream, static_cast<std::uint64_t>(j) + 1));
+      if (j > 0)
+        z += rng.uniform(10.0, 16.0);
+      addCar(rng, scene, ++id, scene.layout.rightLaneX(), z, 0.f, speed);
+    }
+  }
+
+  if (config.moving_cars_oncoming > 0) {
+    const double u = config.oncoming_car_speed_mps, closing = v + u;
+    const double period = config.oncoming_group_period_s;
+    const int groups = static_cast<int>(std::floor(duration / period)) + 1;
+    double last_meeting = -1e9;
+    for (int g = 0; g < groups; ++g) {
+      SequentialRng group(hashKey(seed, kOncomingStream, static_cast<std::uint64_t>(g) + 1));
+      double meeting = g * period + group.uniform(0.35, 0.45);
+      for (int j = 0; j < config.moving_cars_oncoming; ++j) {
+        SequentialRng rng(
+            hashKey(seed, kOncomingStream, static_cast<std::uint64_t>(g) + 1, static_cast<std::uint64_t>(j) + 1));
+        if (j > 0)
+          meeting += rng.uniform(kMinSpacingOncomingM, kMaxSpacingOncomingM) / closing;
+        // A long group runs into the next one's time: keep the spacing.
+        meeting = std::max(meeting, last_meeting + kMinSpacingOncomingM / closing);
+        last_meeting = meeting;
+        // Its centre passes the cameras (at z = v t) at `meeting`, driving -z at u.
+        addCar(rng, scene, ++id, scene.layout.leftLaneX(), (v + u) * meeting, kPiF, u);
+      }
+    }
+  }
+}
+
+} // namespace msf::synthetic
