@@ -9,6 +9,7 @@
 #include <msf/pipeline/pipeline.h>
 #include <msf/synthetic/synthetic_generator.h>
 
+#include "pipeline_fixture.h"
 #include "test_support.h"
 
 #include <opencv2/core.hpp>
@@ -27,50 +28,6 @@
 #include <unistd.h>
 
 namespace {
-
-/// A 4-frame synthetic street, generated once for all the test processes of a build (ctest
-/// runs each test in its own process): in the build folder, under a file lock, so parallel
-/// tests wait for the first one instead of generating it again.
-class PipelineTest : public ::testing::Test {
-protected:
-  static void SetUpTestSuite() {
-    namespace fs = std::filesystem;
-    const fs::path root = fs::absolute("test_data");
-    fs::create_directories(root);
-    dataset_ = (root / "street_4_frames_seed_7").string();
-    const int lock = ::open((root / "street.lock").c_str(), O_CREAT | O_RDWR, 0644);
-    ASSERT_GE(lock, 0);
-    ::flock(lock, LOCK_EX);
-    if (!fs::exists(fs::path(dataset_) / "gt" / "scene.ply")) {
-      msf::synthetic::SyntheticConfig config;
-      config.frames = 4;
-      config.seed = 7;
-      msf::synthetic::SyntheticGenerator(config).writeDataset(dataset_);
-    }
-    ::flock(lock, LOCK_UN);
-    ::close(lock);
-  }
-  static const std::string& dataset() { return dataset_; }
-  static std::string dataset_;
-};
-std::string PipelineTest::dataset_;
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// The number after "key": in a JSON text (the first occurrence after `after`).
-double jsonNumber(const std::string& json, const std::string& key, const std::string& after = "") {
-  const std::size_t from = after.empty() ? 0 : json.find("\"" + after + "\"");
-  std::smatch m;
-  const std::string rest = json.substr(from == std::string::npos ? 0 : from);
-  if (!std::regex_search(rest, m, std::regex("\"" + key + "\": (-?[0-9.eE+-]+)")))
-    return std::nan("");
-  return std::stod(m[1]);
-}
 
 TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   const msf::Sequence sequence(dataset());
