@@ -1,5 +1,6 @@
 // The pipeline on a small synthetic sequence: same depth as the chain of tools, a sane
 // summary, a clean stop, and clear errors.
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
@@ -211,6 +212,67 @@ TEST(PipelineConfig, ShippedFilesLoadAndBadSchedulingKeysAreNamed) {
       EXPECT_NE(std::string(e.what()).find("pipeline." + key.substr(0, key.find(':'))), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(PipelineConfig, ThePrintedConfigurationIsCompleteAndReadsBackToTheSame) {
+  msf::test::TempDir dir;
+  auto printed = [](const msf::PipelineConfig& c) {
+    std::ostringstream out;
+    c.print(out);
+    return out.str();
+  };
+  auto reload = [&](const std::string& text) {
+    std::ofstream(dir.file("config.yaml")) << text;
+    return msf::PipelineConfig::load(dir.file("config.yaml"));
+  };
+  // A configuration with values that print with many digits, and words other than the defaults.
+  msf::PipelineConfig edited;
+  edited.volume.voxel_size_m = 0.07;
+  edited.integrator.lambda = 5;
+  edited.fusion.lidar_sigma_px = 0.123456789f;
+  edited.fusion.method = msf::FusionMethod::Paper;
+  edited.fusion.edge_support = false;
+  edited.interpolation.combine = msf::CombineRule::Nearest;
+  edited.interpolation.slice.jump_inv_per_m = 1.f / 3.f;
+  edited.stereo.guidance = "none";
+  edited.stereo.guidance_bridge_agreement = 0.3f;
+  edited.projection.max_range_m = 80.5f;
+  edited.rings.heldout_remainder = 1;
+  edited.mesher.min_weight = 0.25f;
+  edited.scheduling.queue_capacity = 3;
+  std::vector<std::pair<std::string, msf::PipelineConfig>> configs = {{"defaults", msf::PipelineConfig{}},
+                                                                      {"edited", edited}};
+  for (const char* name : {"kitti.yaml", "synthetic.yaml"})
+    configs.emplace_back(name, msf::PipelineConfig::load(msf::test::sourceDir() + "/config/" + name));
+  for (const auto& [name, config] : configs) {
+    const std::string first = printed(config);
+    const msf::PipelineConfig again = reload(first);
+    EXPECT_EQ(printed(again), first) << name;
+    // Every key a stage reads is in the file: the dump is the whole configuration.
+    const msf::ConfigFile file(dir.file("config.yaml"));
+    for (const char* section : {"projection", "interpolation", "rings", "stereo", "fusion", "tsdf_volume",
+                                "tsdf_integrator", "marching_cubes", "pipeline"}) {
+      const std::vector<std::string> keys = msf::knownConfigKeys(section);
+      EXPECT_FALSE(keys.empty()) << section;
+      for (const std::string& key : keys)
+        EXPECT_FALSE(file.section(section)[key].empty()) << name << ": " << section << "." << key << " is not printed";
+    }
+  }
+  // The very same values, not ones near them.
+  const msf::PipelineConfig again = reload(printed(edited));
+  EXPECT_EQ(again.volume.voxel_size_m, 0.07);
+  EXPECT_EQ(again.fusion.lidar_sigma_px, 0.123456789f);
+  EXPECT_EQ(again.fusion.method, msf::FusionMethod::Paper);
+  EXPECT_FALSE(again.fusion.edge_support);
+  EXPECT_EQ(again.interpolation.combine, msf::CombineRule::Nearest);
+  EXPECT_EQ(again.interpolation.slice.jump_inv_per_m, 1.f / 3.f);
+  EXPECT_EQ(again.stereo.guidance, "none");
+  EXPECT_EQ(again.stereo.guidance_bridge_agreement, 0.3f);
+  EXPECT_EQ(again.projection.max_range_m, 80.5f);
+  EXPECT_EQ(again.rings.heldout_remainder, 1);
+  EXPECT_EQ(again.mesher.min_weight, 0.25f);
+  EXPECT_EQ(again.scheduling.queue_capacity, 3);
+  EXPECT_EQ(again.integrator.lambda, 5.0);
 }
 
 TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {
