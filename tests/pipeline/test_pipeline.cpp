@@ -127,6 +127,10 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
   EXPECT_LT(d1_fused, d1_sgbm);
   EXPECT_LT(jsonNumber(json, "accuracy_mean_m"), 0.3);
   EXPECT_GT(jsonNumber(json, "completeness"), 0.3);
+  // Protocol 4 on the exact depth, every pixel static (the street marks no moving object).
+  EXPECT_NE(json.find("\"moving_split\": false"), std::string::npos);
+  EXPECT_EQ(jsonNumber(json, "gt_pixels", "reconstruction_evaluation"), jsonNumber(json, "gt_pixels", "fused"));
+  EXPECT_GT(jsonNumber(json, "coverage", "reconstruction_evaluation"), 0.3); // the mesh's row comes first
   // frames.csv: a header and one row per frame.
   std::istringstream csv(readFile(out.file("frames.csv")));
   std::string line;

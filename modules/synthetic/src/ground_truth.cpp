@@ -77,6 +77,15 @@ std::string GroundTruth::sceneMeshPath() const {
   return path;
 }
 
+std::string GroundTruth::movingMaskPath(std::size_t i) const {
+  return (fs::path(dir_) / "moving_0" / (frameName(i) + ".png")).string();
+}
+
+bool GroundTruth::hasMovingMasks() const {
+  std::error_code ec;
+  return fs::is_directory(fs::path(dir_) / "moving_0", ec);
+}
+
 cv::Mat GroundTruth::depth(std::size_t i) const { return readKittiDepthPng(depthPath(i)); }
 cv::Mat GroundTruth::disparity(std::size_t i) const { return readKittiDisparityPng(disparityPath(i)); }
 
@@ -100,6 +109,19 @@ cv::Mat GroundTruth::backgroundMask(std::size_t i) const {
   if (valid.size() != objects.size())
     throw IOError("object map '" + objectMapPath(i) + "' and depth '" + depthPath(i) + "' differ in size");
   return valid & (objects == 0);
+}
+
+cv::Mat GroundTruth::movingMask(std::size_t i) const {
+  const cv::Mat truth = depth(i);
+  if (!hasMovingMasks())
+    return cv::Mat::zeros(truth.size(), CV_8UC1);
+  const std::string path = movingMaskPath(i);
+  requireFile(path, "moving-object mask");
+  const cv::Mat mask = readImage(path, cv::IMREAD_UNCHANGED);
+  if (mask.type() != CV_8UC1 || mask.size() != truth.size())
+    throw IOError("moving-object mask '" + path + "' is not an 8-bit single-channel PNG of the depth's size " +
+                  std::to_string(truth.cols) + "x" + std::to_string(truth.rows));
+  return mask;
 }
 
 } // namespace msf::synthetic

@@ -13,6 +13,7 @@ namespace msf::synthetic {
 ///   gt/obj_map_0/NNNNNN.png  8-bit: 0 background, 1..255 foreground (cars, poles, people),
 ///                            KITTI 2015's obj_map convention
 ///   gt/scene.ply             the true surface, world = camera 0 at frame 0 (poses/00.txt)
+///   gt/moving_0/NNNNNN.png   8-bit, 255 = a moving object (optional: without it, all is static)
 /// Frames are in file-name order, the same order as msf::Sequence's frames.
 class GroundTruth {
 public:
@@ -34,6 +35,9 @@ public:
   std::string disparityPath(std::size_t i) const;
   std::string objectMapPath(std::size_t i) const;
   std::string sceneMeshPath() const;
+  std::string movingMaskPath(std::size_t i) const;
+  /// True when the dataset marks moving objects (gt/moving_0/ exists).
+  bool hasMovingMasks() const;
 
   /// CV_32F metres, 0 = none.
   cv::Mat depth(std::size_t i) const;
@@ -45,6 +49,9 @@ public:
   /// (objectMap > 0) or background, as the KITTI devkit splits its error.
   cv::Mat foregroundMask(std::size_t i) const;
   cv::Mat backgroundMask(std::size_t i) const;
+  /// CV_8U, non-zero = a moving object; all zeros when the dataset has no gt/moving_0/.
+  /// Throws IOError when gt/moving_0/ exists but lacks the frame or its size is not the depth's.
+  cv::Mat movingMask(std::size_t i) const;
 
 private:
   std::string dir_;
