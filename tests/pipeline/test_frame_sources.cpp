@@ -8,6 +8,7 @@
 #include <msf/range_image/ring_split.h>
 
 #include "pipeline_fixture.h"
+#include "test_support.h"
 
 #include <opencv2/core.hpp>
 
@@ -17,9 +18,11 @@
 
 namespace {
 
-TEST_F(PipelineTest, TheFrameFilterChangesEachFrameBeforeAnyStageSeesIt) {
-  const msf::Sequence sequence(dataset());
-  const auto frames = sequence.indices(msf::FrameRange::parse("0:2"));
+/// Runs frames 0-1 of `dataset` with a frame filter that keeps the input rings of the ring
+/// hold-out, and checks that the pipeline's step 1 saw exactly those.
+void checkTheFilterComesFirst(const std::string& dataset) {
+  const msf::Sequence sequence(dataset);
+  const auto frames = sequence.indices(msf::FrameRange::parse("0:1"));
   const msf::PipelineConfig config;
   msf::Pipeline pipeline(sequence.calibration(), config);
   pipeline.setKeepSparse(true); // the projected scan step 1 worked on
@@ -51,11 +54,19 @@ TEST_F(PipelineTest, TheFrameFilterChangesEachFrameBeforeAnyStageSeesIt) {
     // Step 1 saw exactly the input rings: no pixel of a held-out return that no input
     // return shares.
     EXPECT_EQ(cv::norm(r.lidar_sparse, input_image, cv::NORM_INF), 0.0) << "frame " << r.index;
+    EXPECT_GT(cv::countNonZero((heldout_image > 0) & (input_image == 0)), 1000);
     EXPECT_EQ(cv::countNonZero((heldout_image > 0) & (input_image == 0) & (r.lidar_sparse > 0)), 0);
     ++checked;
   });
   EXPECT_EQ(filtered, frames); // once per frame, in order
   EXPECT_EQ(checked, frames.size());
+}
+
+TEST_F(PipelineTest, TheFrameFilterChangesEachFrameBeforeAnyStageSeesIt) { checkTheFilterComesFirst(dataset()); }
+
+TEST(FrameFilter, NoHeldOutReturnOfARealKittiScanReachesThePipeline) {
+  MSF_REQUIRE_KITTI();
+  checkTheFilterComesFirst(msf::test::kittiDir() + "/odometry/sequences/04");
 }
 
 TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndWeightOneWhereItHasDepth) {
