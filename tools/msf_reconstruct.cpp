@@ -63,7 +63,8 @@ void printHelp(const char* name) {
              "  generates the default synthetic street (20 frames) in a temporary folder and reconstructs it.\n");
   print_info("  where options are:\n");
   print_info("    -o DIR         output folder (default msf_out): mesh.ply, volume.pcd, summary.json,\n"
-             "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md\n");
+             "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md,\n"
+             "                   config.yaml\n");
   print_info("    -config FILE   YAML configuration (config/kitti.yaml); flags below override it\n");
   print_info("    -frames a:b    frame range, inclusive (default: all)\n");
   print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
@@ -110,10 +111,6 @@ struct GroundTruthScores {
       }
   }
 };
-
-/// Ghost figures need the space moving objects occupied; GroundTruth does not read the
-/// boxes of gt/moving_objects.txt yet, so until it does there is none (wire it here).
-msf::MovingSpace movingSpace(const msf::synthetic::GroundTruth&) { return {}; }
 
 /// Why a ghost figure is absent, in words for the report.
 std::string noGhostsReason(const msf::synthetic::GroundTruth* truth) {
@@ -529,7 +526,9 @@ int main(int argc, char** argv) {
       print_value("%s ", scene.c_str());
       pcl::PolygonMesh truth;
       msf::loadMesh(scene, truth);
-      const msf::MovingSpace was_moving = movingSpace(*scores.truth);
+      // Where moving objects were: the boxes of gt/moving_objects.txt, once GroundTruth reads
+      // them. Until then there is no ghost figure (noGhostsReason says why).
+      const msf::MovingSpace was_moving;
       std::unique_ptr<msf::SurfaceDistance> static_surface;
       if (was_moving)
         static_surface = std::make_unique<msf::SurfaceDistance>(truth); // gt/scene.ply: the static scene
