@@ -60,8 +60,8 @@ out = sys.argv[1]
 times = dict(line.strip().split(": ") for line in open(f"{out}/times.txt"))
 titles = {"odometry04": "KITTI odometry 04, frames 0-9", "raw0009": "KITTI raw 2011_09_26_drive_0009, frames 0-4",
           "synthetic": "synthetic street, 40 frames"}
-def pct(x): return "    -  " if x is None else f"{100 * x:6.2f}%"
-def num(x, f="6.3f"): return "    -" if x is None else format(x, f)
+def pct(x): return "      - " if x is None else f"{100 * x:6.2f}%"
+def num(x, f="6.3f"): return format("-", ">" + f.split(".")[0]) if x is None else format(x, f)
 for name, title in titles.items():
     s = json.load(open(f"{out}/{name}/summary.json"))
     e = s["reconstruction_evaluation"]
@@ -71,7 +71,7 @@ for name, title in titles.items():
     synthetic = any("accuracy" in r for r in e["rows"].values())
     if synthetic:
         head += f"   {'mesh vs true surface':>27s}"
-        cols += f"   {'accuracy':>8s} {'complete':>8s} {'ghosts':>8s}"
+        cols += f"   {'accuracy':>8s} {'complete':>8s} {'ghosts':>7s}"
     print(head)
     print(cols)
     for source, r in e["rows"].items():
@@ -79,8 +79,8 @@ for name, title in titles.items():
                 f"   {num(r['all']['coverage'], '8.3f')} {pct(r['all']['d1_all'])}")
         if synthetic:
             a, g = r.get("accuracy"), r.get("ghosts")
-            line += (f"   {num(a and a['accuracy_mean_m'], '7.3f')}m {pct(a and a['completeness'])}"
-                     f"  {pct(g and g['share'])}")
+            line += (f"   {num(a and a['accuracy_mean_m'], '7.3f')}{' m' if a else '  '} {pct(a and a['completeness'])}"
+                     f" {pct(g and g['share'])}")
         print(line)
     if e.get("moving_split"):
         print("  (static pixels; moving objects apart in summary.json)")
