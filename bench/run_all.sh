@@ -14,3 +14,5 @@ done
 [ "$found" = 1 ] || echo "bench: no benchmark built yet"
 echo "== bench_pipeline.sh"
 "$(dirname "$0")/bench_pipeline.sh" "$bin" "$kitti" 5
+echo "== bench_reconstruction.sh"
+"$(dirname "$0")/bench_reconstruction.sh" "$bin" "$kitti"

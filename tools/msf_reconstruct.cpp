@@ -4,7 +4,10 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/ghost_metric.h>
+#include <msf/evaluation/holdout.h>
 #include <msf/evaluation/mesh_accuracy.h>
+#include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
@@ -14,6 +17,7 @@
 #include <msf/pipeline/mesh_renderer.h>
 #include <msf/pipeline/pipeline.h>
 #include <msf/pipeline/run_report.h>
+#include <msf/pipeline/source_depth_frame.h>
 #include <msf/synthetic/ground_truth.h>
 #include <msf/synthetic/synthetic_generator.h>
 
@@ -27,10 +31,14 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -55,13 +63,22 @@ void printHelp(const char* name) {
              "  generates the default synthetic street (20 frames) in a temporary folder and reconstructs it.\n");
   print_info("  where options are:\n");
   print_info("    -o DIR         output folder (default msf_out): mesh.ply, volume.pcd, summary.json,\n"
-             "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md\n");
+             "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md,\n"
+             "                   config.yaml\n");
   print_info("    -config FILE   YAML configuration (config/kitti.yaml); flags below override it\n");
   print_info("    -frames a:b    frame range, inclusive (default: all)\n");
   print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
   print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
   print_info("    -panels N      depth panels to draw, spread over the frames (default 3)\n");
   print_info("    -save_depth    also write each frame's fused depth as OUT/depth/NNNNNN.pcd\n");
+  print_info("    -holdout       evaluation protocol 4: the held-out rings (config section rings) are removed\n"
+             "                   from every scan before the pipeline sees it and become the ground truth; the\n"
+             "                   mesh, rendered at every frame's pose, is scored at them beside the fused depth\n");
+  print_info("    -compare_sources  also integrate the interpolated LiDAR alone and SGBM alone into volumes of\n"
+             "                   their own (mesh_lidar.ply, mesh_stereo.ply), scored as the mesh is\n");
+  print_info("  With ground truth (-holdout, or a synthetic sequence's gt/), summary.json and report.md hold the\n"
+             "  protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo), within the map's depth range and all.\n"
+             "  OUT/config.yaml is the configuration in full; -config OUT/config.yaml repeats the run.\n");
   print_info("  Ctrl-C stops after the frames under way and still writes the mesh and the summary.\n");
 }
 
@@ -71,9 +88,8 @@ struct GroundTruthScores {
   std::map<std::string, msf::DepthErrorAccumulator> all, background, foreground;
   std::vector<Eigen::Vector3f> seen_surface;  // ground-truth depth back-projected to the world
 
-  void add(const msf::FrameResult& r, const msf::Calibration& calibration, double max_depth_m) {
+  void add(const msf::FrameResult& r, const cv::Mat& gt, const msf::Calibration& calibration, double max_depth_m) {
     const std::size_t gt_index = truth->indexOf(r.name);
-    const cv::Mat gt = truth->depth(gt_index);
     const cv::Mat fg = truth->foregroundMask(gt_index), bg = truth->backgroundMask(gt_index);
     const double fb = calibration.focalBaseline();
     const std::pair<const char*, cv::Mat> methods[] = {
@@ -94,6 +110,63 @@ struct GroundTruthScores {
           seen_surface.push_back(T * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
       }
   }
+};
+
+/// Why a ghost figure is absent, in words for the report.
+std::string noGhostsReason(const msf::synthetic::GroundTruth* truth) {
+  if (!truth)
+    return "no synthetic ground truth: the places of moving objects are unknown";
+  return "the dataset has no moving-object boxes (gt/moving_objects.txt)";
+}
+
+/// Ground truth made on the loading thread (the held-out rings of a frame), waiting there
+/// until the integration thread scores the frame: only frames that were integrated are scored.
+class PendingTruth {
+public:
+  void put(std::size_t frame, cv::Mat depth) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    depth_[frame] = std::move(depth);
+  }
+  cv::Mat take(std::size_t frame) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = depth_.find(frame);
+    if (it == depth_.end())
+      throw msf::InvalidInputError("frame " + std::to_string(frame) + " has no held-out ground truth");
+    cv::Mat depth = std::move(it->second);
+    depth_.erase(it);
+    return depth;
+  }
+
+private:
+  std::mutex mutex_;
+  std::map<std::size_t, cv::Mat> depth_;
+};
+
+/// Splits a frame's scan for protocol 4: the input rings replace the scan; the held-out ones,
+/// projected into camera 0, are returned. Throws InvalidInputError naming the frame's scan
+/// when no ring is held out (a scan not in the sensor's order, ring after ring).
+cv::Mat holdOutRings(msf::Frame& frame, const msf::Sequence& sequence, const msf::HoldoutConfig& config) {
+  const msf::HoldoutFrame split = msf::makeHoldoutFrame(frame, sequence.calibration(), config);
+  if (split.heldout_points == 0)
+    throw msf::InvalidInputError("-holdout: scan '" + sequence.scanPath(frame.index) + "' has " +
+                                 std::to_string(split.ring_count) + " ring id(s) and none is held out (rings.modulo " +
+                                 std::to_string(config.rings.modulo) + ", heldout_remainder " +
+                                 std::to_string(config.rings.heldout_remainder) +
+                                 "): the ring hold-out needs a scan in the sensor's order, ring after ring");
+  frame.scan = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>(*split.input.scan);
+  return split.gt_depth;
+}
+
+/// A single-source map of -compare_sources: its own volume and integrator, configured as
+/// the pipeline's.
+struct SourceMap {
+  msf::DepthSource source;
+  msf::TsdfVolume volume;
+  msf::TsdfIntegrator integrator;
+  msf::TriangleMesh mesh;
+  SourceMap(msf::DepthSource s, const msf::PipelineConfig& config)
+      : source(s), volume(config.volume.voxel_size_m, config.volume.truncation_m), integrator(volume, config.integrator) {}
+  std::string name() const { return std::string("mesh_") + msf::toString(source); }
 };
 
 /// The fused depth as msf_fuse writes it: an organized cloud with colour and weight.
@@ -165,15 +238,63 @@ std::string generateDefaultStreet(const std::string& dir) {
   return dir;
 }
 
+/// Removes the output folder when this run created it and did not finish: a failed run
+/// leaves nothing behind.
+class OutputFolder {
+public:
+  explicit OutputFolder(const std::string& path) : path_(path), created_(!fs::exists(path)) {
+    msf::ensureOutputDirectory(path);
+  }
+  ~OutputFolder() {
+    if (created_ && !kept_) {
+      std::error_code e;
+      fs::remove_all(path_, e);
+    }
+  }
+  void keep() { kept_ = true; }
+
+private:
+  std::string path_;
+  bool created_, kept_ = false;
+};
+
+/// The console's protocol 4 table: per source, coverage, D1 (missing = bad) and MAE within
+/// the map's range and over all ground-truth pixels (static ones, when the dataset says which).
+void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
+  print_info("Protocol 4, %s: %zu pixels in %zu frames; within range: true depth <= %g m%s\n", e.truth.c_str(),
+             e.gt_pixels, e.frames, e.range_m, e.moving_split ? "; static pixels" : "");
+  print_info("  %-12s %9s %8s %8s   %9s %8s %8s\n", "source", "coverage", "D1", "MAE m", "coverage", "D1", "MAE m");
+  print_info("  %-12s %27s   %27s\n", "", "---- within range ----", "--------- all ---------");
+  for (const auto& r : e.rows) {
+    const msf::DepthMetrics &a = r.score.within_range, &b = r.score.all;
+    print_info("  %-12s %9.3f %7.2f%% %8.3f   %9.3f %7.2f%% %8.3f", r.score.source.c_str(), a.coverage,
+               100 * a.d1_all, a.mae_m, b.coverage, 100 * b.d1_all, b.mae_m);
+    if (r.has_accuracy)
+      print_info("   accuracy %.3f m, completeness %.1f %%", r.accuracy.accuracy_mean_m, 100 * r.accuracy.completeness);
+    if (r.has_ghosts)
+      print_info(", ghosts %.2f %%", 100 * r.ghosts.share);
+    print_info("\n");
+  }
+  if (!e.no_ghosts.empty())
+    print_info("  no ghost figure: %s\n", e.no_ghosts.c_str());
+}
+
+constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
+
 } // namespace
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
     const std::vector<std::string> value_options{"-o", "-config", "-frames", "-voxel", "-lambda", "-panels"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-save_depth"});
+    msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
-    if (positional.size() > 1)
-      throw msf::InvalidInputError("expected at most one DATASET_DIR (see -h)");
+    if (positional.size() > 1) {
+      std::string extra;
+      for (std::size_t k = 1; k < positional.size(); ++k)
+        extra += (k > 1 ? "', '" : "") + positional[k];
+      throw msf::InvalidInputError("expected at most one DATASET_DIR, got '" + positional.front() + "' and '" + extra +
+                                   "' too (-save_depth, -holdout and -compare_sources take no value; see -h)");
+    }
 
     std::string out = "msf_out", config_path, frames_text = "0:";
     int panels = 3;
@@ -182,6 +303,8 @@ int main(int argc, char** argv) {
     msf::tool::parseArgument(argc, argv, "-frames", frames_text);
     msf::tool::parseArgument(argc, argv, "-panels", panels);
     const bool save_depth = find_switch(argc, argv, "-save_depth");
+    const bool holdout = find_switch(argc, argv, "-holdout");
+    const bool compare_sources = find_switch(argc, argv, "-compare_sources");
     msf::PipelineConfig config = msf::PipelineConfig::load(config_path);
     if (find_argument(argc, argv, "-voxel") >= 0)
       msf::tool::parseArgument(argc, argv, "-voxel", config.volume.voxel_size_m);
@@ -190,9 +313,7 @@ int main(int argc, char** argv) {
     config.validate();
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 
-    msf::ensureOutputDirectory(out);
-    if (save_depth)
-      fs::create_directories(fs::path(out) / "depth");
+    OutputFolder output(out);
 
     // The dataset, or the default synthetic street in a temporary folder removed at the end.
     std::string dataset;
@@ -213,10 +334,18 @@ int main(int argc, char** argv) {
 
     const msf::Sequence sequence(dataset);
     if (!sequence.hasPoses())
-      throw msf::InvalidInputError("sequence '" + sequence.directory() +
-                                   "' has no poses (odometry poses/XX.txt or raw oxts/): the map needs them");
+      throw msf::InvalidInputError("sequence '" + sequence.directory() + "' has no poses (odometry poses/XX.txt or raw " +
+                                   "oxts/): the map needs them" + (holdout ? ", and -holdout renders it at them" : ""));
     const std::vector<std::size_t> frames = sequence.indices(range);
     const msf::Calibration& calibration = sequence.calibration();
+    const msf::HoldoutConfig holdout_config{config.rings, config.projection, {}};
+    if (holdout) {
+      // The first frame's split, before any work: a scan without rings is a clear error at once.
+      msf::Frame first = sequence.load(frames.front(), false);
+      holdOutRings(first, sequence, holdout_config);
+    }
+    if (save_depth)
+      fs::create_directories(fs::path(out) / "depth");
 
     msf::RunReport report;
     report.dataset = sequence.directory();
@@ -226,21 +355,43 @@ int main(int argc, char** argv) {
     report.frames_requested = frames.size();
     report.voxel_size_m = config.volume.voxel_size_m;
     report.lambda = config.integrator.lambda;
+    std::ostringstream config_yaml;
+    config.print(config_yaml);
+    report.config_yaml = config_yaml.str();
+    report.config_file = "config.yaml";
 
     GroundTruthScores scores;
     if (!sequence.groundTruthDir().empty())
       scores.truth = std::make_unique<msf::synthetic::GroundTruth>(sequence.groundTruthDir());
+
+    // Protocol 4: the held-out rings with -holdout, else a synthetic sequence's exact depth.
+    std::unique_ptr<msf::ReconstructionEvaluation> evaluation;
+    if (holdout || scores.truth)
+      evaluation = std::make_unique<msf::ReconstructionEvaluation>(msf::PinholeCamera::fromCalibration(calibration, 0),
+                                                                   calibration.focalBaseline(),
+                                                                   config.integrator.max_depth_m, holdout_config.d1);
+    const bool moving_split = !holdout && scores.truth && scores.truth->hasMovingMasks();
+    std::vector<std::unique_ptr<SourceMap>> source_maps;
+    if (compare_sources)
+      for (const msf::DepthSource source : {msf::DepthSource::Lidar, msf::DepthSource::Stereo})
+        source_maps.push_back(std::make_unique<SourceMap>(source, config));
 
     print_highlight("Reconstructing ");
     print_value("%zu", frames.size());
     print_info(" frames of ");
     print_value("%s", sequence.directory().c_str());
     print_info(" into ");
-    print_value("%s\n", out.c_str());
+    print_value("%s", out.c_str());
+    print_info("%s%s\n", holdout ? ", held-out rings removed from every scan" : "",
+               compare_sources ? ", with a map of each source alone" : "");
 
     msf::Pipeline pipeline(calibration, config);
     const std::set<std::size_t> panel_frames = spread(frames, panels);
     pipeline.setKeepSparse(!panel_frames.empty()); // the panels show the projected scan
+    PendingTruth heldout_truth;
+    if (holdout)
+      pipeline.setFrameFilter(
+          [&](msf::Frame& frame) { heldout_truth.put(frame.index, holdOutRings(frame, sequence, holdout_config)); });
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     Progress progress(frames.size());
@@ -250,8 +401,23 @@ int main(int argc, char** argv) {
         [&](msf::FrameResult& r) {
           report.frames.push_back({r.index, r.name, r.times,
                                    r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms});
-          if (scores.truth)
-            scores.add(r, calibration, config.integrator.max_depth_m);
+          cv::Mat synthetic_depth;
+          if (scores.truth) {
+            synthetic_depth = scores.truth->depth(scores.truth->indexOf(r.name));
+            scores.add(r, synthetic_depth, calibration, config.integrator.max_depth_m);
+          }
+          if (evaluation) {
+            if (holdout)
+              evaluation->addGroundTruth(r.index, r.T_world_cam0, heldout_truth.take(r.index));
+            else
+              evaluation->addGroundTruth(r.index, r.T_world_cam0, synthetic_depth,
+                                         moving_split ? scores.truth->movingMask(scores.truth->indexOf(r.name))
+                                                      : cv::Mat());
+            evaluation->scoreDepth("fused", r.index, r.fused.depth);
+          }
+          for (auto& map : source_maps)
+            map->integrator.integrate(
+                msf::sourceDepthFrame(r, map->source, config.fusion, calibration.focalBaseline()), r.T_world_cam0);
           if (save_depth)
             msf::saveCloud((fs::path(out) / "depth" / (r.name + ".pcd")).string(), fusedCloud(r.fused, calibration));
           if (panel_frames.count(r.index)) {
@@ -259,12 +425,12 @@ int main(int argc, char** argv) {
             msf::DepthPanel panel;
             panel.addImage("left image (camera 0), frame " + r.name, r.left);
             if (!r.lidar_sparse.empty())
-              panel.addDepth("projected LiDAR", r.lidar_sparse, 3.f, 60.f, 1);
+              panel.addDepth(holdout ? "projected LiDAR (input rings)" : "projected LiDAR", r.lidar_sparse, 3.f, 60.f, 1);
             panel.addDepth("interpolated LiDAR", r.lidar_depth, 3.f, 60.f);
             panel.addDepth("SGBM", r.stereo_depth, 3.f, 60.f);
             panel.addDepth("fused", fused, 3.f, 60.f);
             if (scores.truth)
-              panel.addError("|fused - ground truth|", fused, scores.truth->depth(scores.truth->indexOf(r.name)), 2.f);
+              panel.addError("|fused - ground truth|", fused, synthetic_depth, 2.f);
             const std::string name = "depth_" + r.name + ".png";
             msf::writeImage((fs::path(out) / name).string(), panel.render());
             report.depth_panels.push_back(name);
@@ -292,10 +458,16 @@ int main(int argc, char** argv) {
     report.observed_voxels = pipeline.volume().numObservedVoxels();
     report.blocks = pipeline.volume().numBlocks();
     report.volume_memory_mb = static_cast<double>(pipeline.volume().memoryBytes()) / (1024.0 * 1024.0);
+    for (auto& map : source_maps) {
+      tt.tic();
+      print_highlight("Meshing the %s map ", msf::toString(map->source));
+      msf::MarchingCubes(config.mesher).extract(map->volume, map->mesh);
+      msf::tool::printDone(tt.toc(), map->mesh.triangles.size());
+    }
 
     tt.tic();
     print_highlight("Saving ");
-    print_value("%s/{mesh.ply, volume.pcd} ", out.c_str());
+    print_value("%s/{mesh.ply, volume.pcd%s} ", out.c_str(), compare_sources ? ", mesh_lidar.ply, mesh_stereo.ply" : "");
     pcl::PolygonMesh polygon_mesh;
     mesh.toPolygonMesh(polygon_mesh);
     if (!mesh.triangles.empty()) {
@@ -304,6 +476,18 @@ int main(int argc, char** argv) {
     } else {
       print_warn("\nno surface was reconstructed: mesh.ply and volume.pcd are not written\n");
     }
+    std::map<std::string, pcl::PolygonMesh> source_polygons;
+    for (const auto& map : source_maps)
+      if (!map->mesh.triangles.empty()) {
+        map->mesh.toPolygonMesh(source_polygons[map->name()]);
+        msf::saveMesh((fs::path(out) / (map->name() + ".ply")).string(), source_polygons[map->name()]);
+      }
+    msf::writeAtomically((fs::path(out) / report.config_file).string(), [&](const std::string& tmp) {
+      std::ofstream file(tmp);
+      file << report.config_yaml;
+      if (!file)
+        throw msf::IOError("cannot write '" + tmp + "'");
+    });
     msf::tool::printDone(tt.toc(), mesh.vertices.size());
 
     if (!mesh.triangles.empty()) {
@@ -320,6 +504,13 @@ int main(int argc, char** argv) {
       msf::writeImage((fs::path(out) / report.preview_file).string(), preview);
     }
 
+    // The meshes against the true surface (synthetic), each as the fused one.
+    std::map<std::string, std::pair<const msf::TriangleMesh*, const pcl::PolygonMesh*>> meshes{
+        {"mesh", {&mesh, &polygon_mesh}}};
+    for (const auto& map : source_maps)
+      meshes[map->name()] = {&map->mesh, source_polygons.count(map->name()) ? &source_polygons[map->name()] : nullptr};
+    std::map<std::string, msf::MeshAccuracy> accuracy;
+    std::map<std::string, msf::GhostMetrics> ghosts;
     if (scores.truth) {
       for (const auto& [name, acc] : scores.all) {
         auto& d = report.depth[name];
@@ -329,24 +520,81 @@ int main(int argc, char** argv) {
         d.has_split = true;
       }
       const std::string scene = scores.truth->sceneMeshPath();
-      if (!mesh.triangles.empty() && fs::exists(scene)) {
-        tt.tic();
-        print_highlight("Scoring the mesh against ");
-        print_value("%s ", scene.c_str());
-        pcl::PolygonMesh truth;
-        msf::loadMesh(scene, truth);
-        report.mesh_accuracy = msf::evaluateMesh(polygon_mesh, truth, scores.seen_surface,
-                                                 2.0 * config.volume.voxel_size_m, 1.0);
-        report.has_mesh_accuracy = true;
-        msf::tool::printDone(tt.toc(), report.mesh_accuracy.vertices);
+      tt.tic();
+      print_highlight("Scoring the mesh%s against ", source_maps.empty() ? "" : "es");
+      print_value("%s ", scene.c_str());
+      pcl::PolygonMesh truth;
+      msf::loadMesh(scene, truth);
+      // Where moving objects were: inside a box of gt/moving_objects.txt at any frame, grown by
+      // a voxel (a car's surface is meshed up to a voxel off its box).
+      msf::MovingSpace was_moving;
+      if (fs::exists(scores.truth->movingBoxesPath())) {
+        const double margin = config.volume.voxel_size_m;
+        was_moving = [boxes = scores.truth->movingBoxes(), margin](const Eigen::Vector3f& p) {
+          const Eigen::Vector3d q = p.cast<double>();
+          for (const auto& box : boxes)
+            if (box.contains(q, margin))
+              return true;
+          return false;
+        };
       }
+      std::unique_ptr<msf::SurfaceDistance> static_surface;
+      if (was_moving)
+        static_surface = std::make_unique<msf::SurfaceDistance>(truth); // gt/scene.ply: the static scene
+      for (const auto& [name, m] : meshes) {
+        if (!m.second)
+          continue;
+        accuracy[name] =
+            msf::evaluateMesh(*m.second, truth, scores.seen_surface, 2.0 * config.volume.voxel_size_m, 1.0);
+        if (was_moving)
+          ghosts[name] = msf::measureGhosts(m.first->vertices, *static_surface, was_moving, kGhostDistanceM);
+      }
+      if (accuracy.count("mesh")) {
+        report.mesh_accuracy = accuracy["mesh"];
+        report.has_mesh_accuracy = true;
+      }
+      msf::tool::printDone(tt.toc(), accuracy.size());
     }
+
+    if (evaluation) {
+      tt.tic();
+      print_highlight("Rendering the mesh%s at every frame's pose ", source_maps.empty() ? "" : "es");
+      for (const auto& [name, m] : meshes)
+        evaluation->scoreMesh(name, *m.first);
+      msf::tool::printDone(tt.toc(), evaluation->frames() * meshes.size());
+      msf::RunReport::MapEvaluation& e = report.map_evaluation;
+      e.truth = holdout ? "held-out rings (ring id % " + std::to_string(config.rings.modulo) +
+                              " == " + std::to_string(config.rings.heldout_remainder) + ") projected into camera 0"
+                        : "the synthetic sequence's exact depth (gt/depth_0)";
+      e.range_m = config.integrator.max_depth_m;
+      e.frames = evaluation->frames();
+      e.gt_pixels = evaluation->groundTruthPixels();
+      e.moving_split = moving_split;
+      if (ghosts.empty())
+        e.no_ghosts = noGhostsReason(scores.truth.get());
+      const auto rows = evaluation->scores();
+      for (const char* source : {"mesh", "fused", "mesh_lidar", "mesh_stereo"})
+        for (const auto& score : rows)
+          if (score.source == source) {
+            msf::RunReport::MapEvaluation::Row row;
+            row.score = score;
+            row.has_accuracy = accuracy.count(source) > 0;
+            if (row.has_accuracy)
+              row.accuracy = accuracy[source];
+            row.has_ghosts = ghosts.count(source) > 0;
+            if (row.has_ghosts)
+              row.ghosts = ghosts[source];
+            e.rows.push_back(row);
+          }
+    }
+
     report.peak_memory_mb = msf::peakMemoryMb();
     report.writeFramesCsv((fs::path(out) / "frames.csv").string());
     if (!report.frames.empty())
       report.writeRuntimePlot((fs::path(out) / "runtime.png").string());
     report.writeSummaryJson((fs::path(out) / "summary.json").string());
     report.writeMarkdown((fs::path(out) / "report.md").string());
+    output.keep();
 
     print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
     print_value("%.1f fps", report.framesPerSecond());
@@ -359,6 +607,8 @@ int main(int argc, char** argv) {
     if (report.has_mesh_accuracy)
       print_info("  mesh: accuracy %.3f m, completeness %.1f %% within %.2f m\n", report.mesh_accuracy.accuracy_mean_m,
                  100 * report.mesh_accuracy.completeness, report.mesh_accuracy.threshold_m);
+    if (!report.map_evaluation.rows.empty())
+      printMapEvaluation(report.map_evaluation);
     print_info("Report: ");
     print_value("%s/report.md\n", out.c_str());
     return stats.interrupted ? 130 : 0;

@@ -4,6 +4,7 @@
 #include <msf/common/exceptions.h>
 
 #include <algorithm>
+#include <charconv>
 #include <mutex>
 #include <set>
 #include <vector>
@@ -63,29 +64,56 @@ cv::FileNode ConfigFile::section(const std::string& name) const {
   return storage_[name];
 }
 
+std::vector<std::string> knownConfigKeys(const std::string& section) {
+  KnownKeys& known = knownKeys();
+  const std::lock_guard<std::mutex> lock(known.mutex);
+  std::vector<std::string> keys;
+  for (auto k = known.names.lower_bound(section + "."); k != known.names.end() && k->rfind(section + ".", 0) == 0; ++k)
+    keys.push_back(k->substr(section.size() + 1));
+  return keys;
+}
+
 void ConfigFile::rejectUnknownKeys() const {
   if (!storage_.isOpened())
     return;
-  KnownKeys& known = knownKeys();
-  const std::lock_guard<std::mutex> lock(known.mutex);
   for (const std::string& name : sections_read_) {
     const cv::FileNode section = storage_[name];
     if (section.empty() || section.isNone())
       continue;
     if (!section.isMap())
       throw ConfigError("config '" + path_ + "': section '" + name + "' must hold keys (key: value), one per line");
+    const std::vector<std::string> known = knownConfigKeys(name);
     for (auto it = section.begin(); it != section.end(); ++it) {
-      const std::string key = name + "." + (*it).name();
-      if (known.names.count(key))
+      if (std::binary_search(known.begin(), known.end(), (*it).name()))
         continue;
       std::string keys;
-      for (auto k = known.names.lower_bound(name + "."); k != known.names.end() && k->rfind(name + ".", 0) == 0; ++k)
-        keys += (keys.empty() ? "" : ", ") + k->substr(name.size() + 1);
-      throw ConfigError("config '" + path_ + "': '" + key + "' is not a key of section '" + name + "' (its keys: " +
-                        keys + ")");
+      for (const std::string& k : known)
+        keys += (keys.empty() ? "" : ", ") + k;
+      throw ConfigError("config '" + path_ + "': '" + name + "." + (*it).name() + "' is not a key of section '" +
+                        name + "' (its keys: " + keys + ")");
     }
   }
 }
+
+std::string configValue(bool value) { return value ? "true" : "false"; }
+
+std::string configValue(int value) { return std::to_string(value); }
+
+namespace {
+template <typename Real>
+std::string shortestReal(Real value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
+  if (text.find_first_of(".en") == std::string::npos)
+    text += ".0"; // a real number stays one: 5.0, not the integer 5
+  return text;
+}
+} // namespace
+
+std::string configValue(float value) { return shortestReal(value); }
+
+std::string configValue(double value) { return shortestReal(value); }
 
 template <typename T>
 void readKey(const cv::FileNode& node, const char* key, T& value) {

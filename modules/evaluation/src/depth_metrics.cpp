@@ -29,31 +29,33 @@ void DepthErrorAccumulator::add(const cv::Mat& gt_depth, const cv::Mat& estimate
     const float* g = gt_depth.ptr<float>(v);
     const float* e = estimated_depth.ptr<float>(v);
     const std::uint8_t* m = mask.empty() ? nullptr : mask.ptr<std::uint8_t>(v);
-    for (int u = 0; u < gt_depth.cols; ++u) {
-      if (!has(g[u]) || (m && !m[u]))
-        continue;
-      ++gt_pixels_;
-      if (!has(e[u]))
-        continue;
-      ++estimated_;
-      const double zg = g[u], ze = e[u];
-      const double err = std::abs(ze - zg);
-      abs_ += err;
-      sq_ += err * err;
-      if (err >= kGrossDepthErrorM) {
-        ++gross_;
-        gross_abs_ += err;
-      }
-      const double inv_err = std::abs(1000.0 / ze - 1000.0 / zg); // 1/km
-      inv_abs_ += inv_err;
-      inv_sq_ += inv_err * inv_err;
-      const double dg = focal_baseline / zg, de = focal_baseline / ze;
-      const double disp_err = std::abs(de - dg);
-      disp_abs_ += disp_err;
-      if (disp_err > d1.abs_px && disp_err > d1.rel * dg)
-        ++d1_bad_;
-    }
+    for (int u = 0; u < gt_depth.cols; ++u)
+      if (has(g[u]) && (!m || m[u]))
+        addPixel(g[u], e[u], focal_baseline, d1);
   }
+}
+
+void DepthErrorAccumulator::addPixel(float gt_z, float estimated_z, double focal_baseline, const D1Threshold& d1) {
+  ++gt_pixels_;
+  if (!has(estimated_z))
+    return;
+  ++estimated_;
+  const double zg = gt_z, ze = estimated_z;
+  const double err = std::abs(ze - zg);
+  abs_ += err;
+  sq_ += err * err;
+  if (err >= kGrossDepthErrorM) {
+    ++gross_;
+    gross_abs_ += err;
+  }
+  const double inv_err = std::abs(1000.0 / ze - 1000.0 / zg); // 1/km
+  inv_abs_ += inv_err;
+  inv_sq_ += inv_err * inv_err;
+  const double dg = focal_baseline / zg, de = focal_baseline / ze;
+  const double disp_err = std::abs(de - dg);
+  disp_abs_ += disp_err;
+  if (disp_err > d1.abs_px && disp_err > d1.rel * dg)
+    ++d1_bad_;
 }
 
 void DepthErrorAccumulator::merge(const DepthErrorAccumulator& o) {

@@ -1,75 +1,53 @@
 #include <msf/pipeline/mesh_renderer.h>
+#include <msf/reconstruction/mesh_rasterizer.h>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <vector>
 
 namespace msf {
 
 cv::Mat MeshRenderer::render(const TriangleMesh& mesh, const Eigen::Isometry3d& T_world_cam, double fx, double fy,
                              double cx, double cy, cv::Size size) {
   cv::Mat image(size, CV_8UC3, kBackground);
-  std::vector<float> zbuffer(static_cast<std::size_t>(size.area()), std::numeric_limits<float>::infinity());
+  PinholeCamera camera;
+  camera.fx = static_cast<float>(fx), camera.fy = static_cast<float>(fy);
+  camera.cx = static_cast<float>(cx), camera.cy = static_cast<float>(cy);
+  camera.width = size.width, camera.height = size.height;
+  // Visibility from the rasteriser (the surface seen at each pixel), then each pixel shaded.
+  cv::Mat depth, ids;
+  MeshRasterizer().render(mesh, camera, T_world_cam, depth, &ids);
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
-  constexpr float kNear = 0.3f;
-
-  std::vector<Eigen::Vector3f> cam(mesh.vertices.size());
-  for (std::size_t i = 0; i < cam.size(); ++i)
-    cam[i] = T_cam_world * mesh.vertices[i];
   const bool coloured = mesh.colors.size() == mesh.vertices.size();
-
-  for (const auto& tri : mesh.triangles) {
-    const Eigen::Vector3f& a = cam[tri[0]];
-    const Eigen::Vector3f& b = cam[tri[1]];
-    const Eigen::Vector3f& c = cam[tri[2]];
-    if (a.z() < kNear || b.z() < kNear || c.z() < kNear)
-      continue; // no clipping: previews only lose triangles that cross the near plane
-    const Eigen::Vector3f normal = (b - a).cross(c - a);
-    const float n = normal.norm();
-    if (n <= 0.f)
-      continue;
-    // Lambert-like shading toward the viewer, both sides lit.
-    const float shade = 0.35f + 0.65f * std::abs(normal.dot(a.normalized())) / n;
-    float u[3], v[3], z[3];
-    const Eigen::Vector3f* p[3] = {&a, &b, &c};
-    for (int k = 0; k < 3; ++k) {
-      z[k] = p[k]->z();
-      u[k] = static_cast<float>(fx * p[k]->x() / z[k] + cx);
-      v[k] = static_cast<float>(fy * p[k]->y() / z[k] + cy);
-    }
-    const int u0 = std::max(0, static_cast<int>(std::floor(std::min({u[0], u[1], u[2]}))));
-    const int u1 = std::min(size.width - 1, static_cast<int>(std::ceil(std::max({u[0], u[1], u[2]}))));
-    const int v0 = std::max(0, static_cast<int>(std::floor(std::min({v[0], v[1], v[2]}))));
-    const int v1 = std::min(size.height - 1, static_cast<int>(std::ceil(std::max({v[0], v[1], v[2]}))));
-    const float area = (u[1] - u[0]) * (v[2] - v[0]) - (u[2] - u[0]) * (v[1] - v[0]);
-    if (u0 > u1 || v0 > v1 || std::abs(area) < 1e-9f)
-      continue;
-    for (int y = v0; y <= v1; ++y)
-      for (int x = u0; x <= u1; ++x) {
-        const float px = static_cast<float>(x), py = static_cast<float>(y);
-        const float w0 = ((u[1] - px) * (v[2] - py) - (u[2] - px) * (v[1] - py)) / area;
-        const float w1 = ((u[2] - px) * (v[0] - py) - (u[0] - px) * (v[2] - py)) / area;
-        const float w2 = 1.f - w0 - w1;
-        if (w0 < 0.f || w1 < 0.f || w2 < 0.f)
-          continue;
-        const float depth = w0 * z[0] + w1 * z[1] + w2 * z[2];
-        float& zb = zbuffer[static_cast<std::size_t>(y) * size.width + x];
-        if (depth >= zb)
-          continue;
-        zb = depth;
-        float r = 170.f, g = 170.f, bl = 170.f;
-        if (coloured) {
-          const auto &ca = mesh.colors[tri[0]], &cb = mesh.colors[tri[1]], &cc = mesh.colors[tri[2]];
-          r = w0 * ca[0] + w1 * cb[0] + w2 * cc[0];
-          g = w0 * ca[1] + w1 * cb[1] + w2 * cc[1];
-          bl = w0 * ca[2] + w1 * cb[2] + w2 * cc[2];
-        }
-        image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<std::uint8_t>(bl * shade),
-                                              cv::saturate_cast<std::uint8_t>(g * shade),
-                                              cv::saturate_cast<std::uint8_t>(r * shade));
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const std::int32_t id = ids.at<std::int32_t>(y, x);
+      if (id < 0)
+        continue;
+      const auto& tri = mesh.triangles[static_cast<std::size_t>(id)];
+      const Eigen::Vector3f a = T_cam_world * mesh.vertices[tri[0]], b = T_cam_world * mesh.vertices[tri[1]],
+                            c = T_cam_world * mesh.vertices[tri[2]];
+      const Eigen::Vector3f normal = (b - a).cross(c - a);
+      const float n2 = normal.squaredNorm();
+      if (!(n2 > 0.f))
+        continue;
+      const float z = depth.at<float>(y, x);
+      const Eigen::Vector3f p((x - camera.cx) * z / camera.fx, (y - camera.cy) * z / camera.fy, z);
+      // Lambert-like shading toward the viewer, both sides lit.
+      const float shade = 0.35f + 0.65f * std::abs(normal.dot(p.normalized())) / std::sqrt(n2);
+      float r = 170.f, g = 170.f, bl = 170.f;
+      if (coloured) {
+        // Barycentric weights of the point seen, from the areas it makes with the corners.
+        const float wa = (b - p).cross(c - p).dot(normal) / n2, wb = (c - p).cross(a - p).dot(normal) / n2;
+        const float wc = 1.f - wa - wb;
+        const auto &ca = mesh.colors[tri[0]], &cb = mesh.colors[tri[1]], &cc = mesh.colors[tri[2]];
+        r = wa * ca[0] + wb * cb[0] + wc * cc[0];
+        g = wa * ca[1] + wb * cb[1] + wc * cc[1];
+        bl = wa * ca[2] + wb * cb[2] + wc * cc[2];
       }
-  }
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<std::uint8_t>(bl * shade),
+                                            cv::saturate_cast<std::uint8_t>(g * shade),
+                                            cv::saturate_cast<std::uint8_t>(r * shade));
+    }
   return image;
 }
 

@@ -168,6 +168,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
         }
         const auto start = Clock::now();
         Loaded item{sequence.load(i), FrameResult(), 0.0};
+        if (frame_filter_)
+          frame_filter_(item.frame);
         item.load_ms = msSince(start);
         item.result = startFrame(item.frame);
         // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior or guidance.

@@ -20,6 +20,12 @@ void VolumeConfig::validate() const {
     throw ConfigError("tsdf_volume.truncation_m must be > 0, got " + std::to_string(truncation_m));
 }
 
+void VolumeConfig::print(std::ostream& out) const {
+  out << "tsdf_volume:\n"
+      << "  voxel_size_m: " << configValue(voxel_size_m) << "\n"
+      << "  truncation_m: " << configValue(truncation_m) << "\n";
+}
+
 void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
@@ -37,6 +43,14 @@ void SchedulingConfig::validate() const {
     throw ConfigError("pipeline.lidar_threads must be >= 0, got " + std::to_string(lidar_threads));
 }
 
+void SchedulingConfig::print(std::ostream& out) const {
+  out << "pipeline:\n"
+      << "  queue_capacity: " << configValue(queue_capacity) << "\n"
+      << "  stereo_prior: " << configValue(stereo_prior) << "\n"
+      << "  mesh_every_n_frames: " << configValue(mesh_every_n_frames) << "\n"
+      << "  lidar_threads: " << configValue(lidar_threads) << "\n";
+}
+
 PipelineConfig PipelineConfig::load(const std::string& path) {
   PipelineConfig config;
   if (path.empty())
@@ -44,6 +58,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   const ConfigFile file(path);
   config.projection.read(file.section("projection"));
   config.interpolation.read(file.section("interpolation"));
+  config.rings.read(file.section("rings"));
   config.stereo.read(file.section("stereo"));
   config.fusion.read(file.section("fusion"));
   config.volume.read(file.section("tsdf_volume"));
@@ -58,6 +73,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
 void PipelineConfig::validate() const {
   projection.validate();
   interpolation.validate();
+  rings.validate();
   stereo.validate();
   fusion.validate();
   volume.validate();
@@ -67,14 +83,16 @@ void PipelineConfig::validate() const {
 }
 
 void PipelineConfig::print(std::ostream& out) const {
-  out << "tsdf_volume: voxel_size_m " << volume.voxel_size_m << ", truncation_m " << volume.truncation_m << "\n";
+  out << "%YAML:1.0\n";
+  projection.print(out);
+  interpolation.print(out);
+  rings.print(out);
   stereo.print(out);
   fusion.print(out);
+  volume.print(out);
   integrator.print(out);
   mesher.print(out);
-  out << "pipeline: queue_capacity " << scheduling.queue_capacity << ", mesh_every_n_frames "
-      << scheduling.mesh_every_n_frames << ", stereo_prior " << scheduling.stereo_prior << ", lidar_threads "
-      << scheduling.lidar_threads << "\n";
+  scheduling.print(out);
 }
 
 } // namespace msf

@@ -1,10 +1,12 @@
 #include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/line_plot.h>
 #include <msf/common/statistics.h>
 #include <msf/io/image_io.h>
 #include <msf/pipeline/run_report.h>
 
+#include <opencv2/core/persistence.hpp>
 #include <sys/resource.h>
 
 #include <cmath>
@@ -93,6 +95,52 @@ std::string metricsJson(const DepthMetrics& m, const std::string& indent) {
   return s.str();
 }
 
+std::string accuracyJson(const MeshAccuracy& m) {
+  return "{\"accuracy_mean_m\": " + num(m.accuracy_mean_m) + ", \"accuracy_median_m\": " + num(m.accuracy_median_m) +
+         ", \"precision\": " + num(m.precision) + ", \"completeness\": " + num(m.completeness) +
+         ", \"threshold_m\": " + num(m.threshold_m) + ", \"cap_m\": " + num(m.cap_m) +
+         ", \"mesh_vertices\": " + std::to_string(m.vertices) + ", \"truth_samples\": " +
+         std::to_string(m.truth_samples) + "}";
+}
+
+/// A value of a configuration as JSON: numbers as numbers, true / false as booleans, words
+/// as strings, sequences as arrays.
+std::string configValueJson(const cv::FileNode& node) {
+  if (node.isInt())
+    return std::to_string(static_cast<int>(node));
+  if (node.isReal()) {
+    const double v = node.real();
+    return std::isfinite(v) ? configValue(v) : "null";
+  }
+  if (node.isString()) {
+    const std::string word = node;
+    return word == "true" || word == "false" ? word : jsonString(word);
+  }
+  if (node.isSeq()) {
+    std::string out = "[";
+    for (auto it = node.begin(); it != node.end(); ++it)
+      out += (it == node.begin() ? "" : ", ") + configValueJson(*it);
+    return out + "]";
+  }
+  return "null";
+}
+
+/// The configuration file `yaml` (sections of keys, as PipelineConfig::print writes it) as
+/// a JSON object, a section a line.
+std::string configJson(const std::string& yaml) {
+  const cv::FileStorage storage(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  const cv::FileNode root = storage.root();
+  std::string out = "{";
+  for (auto section = root.begin(); section != root.end(); ++section) {
+    out += std::string(section == root.begin() ? "" : ",") + "\n    " + jsonString((*section).name()) + ": {";
+    const cv::FileNode keys = *section;
+    for (auto key = keys.begin(); key != keys.end(); ++key)
+      out += std::string(key == keys.begin() ? "" : ", ") + jsonString((*key).name()) + ": " + configValueJson(*key);
+    out += "}";
+  }
+  return out + "\n  }";
+}
+
 } // namespace
 
 double peakMemoryMb() {
@@ -163,17 +211,35 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     s << "\n    }";
   }
   s << (depth.empty() ? "" : "\n  ") << "},\n";
-  s << "  \"mesh_accuracy\": ";
-  if (has_mesh_accuracy) {
-    const auto& m = mesh_accuracy;
-    s << "{\"accuracy_mean_m\": " << num(m.accuracy_mean_m) << ", \"accuracy_median_m\": "
-      << num(m.accuracy_median_m) << ", \"precision\": " << num(m.precision) << ", \"completeness\": "
-      << num(m.completeness) << ", \"threshold_m\": " << num(m.threshold_m) << ", \"cap_m\": " << num(m.cap_m)
-      << ", \"mesh_vertices\": " << m.vertices << ", \"truth_samples\": " << m.truth_samples << "}\n";
+  s << "  \"mesh_accuracy\": " << (has_mesh_accuracy ? accuracyJson(mesh_accuracy) : "null") << ",\n";
+  s << "  \"reconstruction_evaluation\": ";
+  const MapEvaluation& e = map_evaluation;
+  if (e.rows.empty()) {
+    s << "null";
   } else {
-    s << "null\n";
+    s << "{\n    \"truth\": " << jsonString(e.truth) << ", \"range_m\": " << num(e.range_m) << ", \"frames\": " << e.frames
+      << ", \"gt_pixels\": " << e.gt_pixels << ", \"moving_split\": " << (e.moving_split ? "true" : "false")
+      << ",\n    \"no_ghosts\": " << (e.no_ghosts.empty() ? "null" : jsonString(e.no_ghosts)) << ",\n    \"rows\": {";
+    const std::string in = "        ";
+    for (std::size_t row = 0; row < e.rows.size(); ++row) {
+      const MapEvaluation::Row& r = e.rows[row];
+      s << (row ? "," : "") << "\n      " << jsonString(r.score.source) << ": {\n"
+        << in << "\"within_range\": " << metricsJson(r.score.within_range, in) << ",\n"
+        << in << "\"all\": " << metricsJson(r.score.all, in);
+      if (e.moving_split)
+        s << ",\n" << in << "\"moving_within_range\": " << metricsJson(r.score.moving_within_range, in) << ",\n"
+          << in << "\"moving_all\": " << metricsJson(r.score.moving_all, in);
+      if (r.has_accuracy)
+        s << ",\n" << in << "\"accuracy\": " << accuracyJson(r.accuracy);
+      if (r.has_ghosts)
+        s << ",\n" << in << "\"ghosts\": {\"share\": " << num(r.ghosts.share, 6) << ", \"ghost_vertices\": "
+          << r.ghosts.ghost_vertices << ", \"vertices\": " << r.ghosts.vertices << ", \"distance_m\": "
+          << num(r.ghosts.distance_m) << "}";
+      s << "\n      }";
+    }
+    s << "\n    }\n  }";
   }
-  s << "}\n";
+  s << ",\n  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
   writeText(path, s.str());
 }
 
@@ -247,14 +313,70 @@ void RunReport::writeMarkdown(const std::string& path) const {
       << "Completeness (share of " << m.truth_samples << " samples of the seen true surface within "
       << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n\n";
   }
+  if (!map_evaluation.rows.empty())
+    writeMapEvaluation(s);
   if (!depth_panels.empty()) {
     s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
          " (and the fused depth's error where ground truth exists).\n\n";
     for (const auto& panel : depth_panels)
       s << "![" << panel << "](" << panel << ")\n\n";
   }
-  s << "Per-frame times: [`frames.csv`](frames.csv); all figures: [`summary.json`](summary.json).\n";
+  s << "Per-frame times: [`frames.csv`](frames.csv); all figures: [`summary.json`](summary.json)";
+  if (!config_file.empty())
+    s << "; the configuration in full: [`" << config_file << "`](" << config_file << ")";
+  s << ".\n";
   writeText(path, s.str());
+}
+
+void RunReport::writeMapEvaluation(std::ostream& s) const {
+  const MapEvaluation& e = map_evaluation;
+  s << "## The map against ground truth it never saw (evaluation protocol 4)\n\n"
+    << "Ground truth: " << e.truth << ", " << e.gt_pixels << " pixels in " << e.frames
+    << " frames. Each mesh is rendered into camera 0 at every frame's pose (the first surface along each pixel's ray) "
+       "and scored at the ground-truth pixels beside the per-frame fused depth; a missing estimate counts as bad in "
+       "D1. Within range: true depth at most "
+    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`), the map holds nothing farther."
+    << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
+    << "\n\n";
+  bool accuracy = false, ghosts = false;
+  for (const auto& r : e.rows)
+    accuracy |= r.has_accuracy, ghosts |= r.has_ghosts;
+  auto table = [&](const char* what, auto in_range, auto all) {
+    s << "| " << what << " | pixels in range | coverage | D1 | D1 on estimates | MAE m | pixels | coverage | D1 | MAE m |"
+      << (accuracy ? " accuracy m | completeness |" : "") << (ghosts ? " ghosts |" : "") << "\n|---|---|---|---|---|---|---|---|---|---|"
+      << (accuracy ? "---|---|" : "") << (ghosts ? "---|" : "") << "\n";
+    for (const auto& r : e.rows) {
+      const DepthMetrics &a = in_range(r.score), &b = all(r.score);
+      s << "| " << r.score.source << " | " << a.gt_pixels << " | " << num(a.coverage, 3) << " | "
+        << num(100 * a.d1_all, 2) << " % | " << num(100 * a.d1_estimated, 2) << " % | " << num(a.mae_m, 3) << " | "
+        << b.gt_pixels << " | " << num(b.coverage, 3) << " | " << num(100 * b.d1_all, 2) << " % | " << num(b.mae_m, 3)
+        << " |";
+      if (accuracy)
+        s << (r.has_accuracy ? " " + num(r.accuracy.accuracy_mean_m, 3) + " | " + num(100 * r.accuracy.completeness, 1) +
+                                   " % |"
+                             : " | |");
+      if (ghosts)
+        s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % |" : " |");
+      s << "\n";
+    }
+    s << "\n";
+  };
+  table(e.moving_split ? "source (static pixels)" : "source",
+        [](const ReconstructionScore& r) -> const DepthMetrics& { return r.within_range; },
+        [](const ReconstructionScore& r) -> const DepthMetrics& { return r.all; });
+  if (e.moving_split)
+    table("source (moving objects)",
+          [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_within_range; },
+          [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_all; });
+  if (accuracy)
+    s << "Accuracy: mean distance of the mesh's vertices to the true surface; completeness: share of the seen true "
+         "surface within the threshold of the mesh (as above).\n";
+  if (!e.no_ghosts.empty())
+    s << "No ghost figure: " << e.no_ghosts << ".\n";
+  else if (ghosts)
+    s << "Ghosts: share of the mesh's vertices farther than " << num(e.rows.front().ghosts.distance_m)
+      << " m from the static true surface inside the space a moving object occupied.\n";
+  s << "\n";
 }
 
 } // namespace msf

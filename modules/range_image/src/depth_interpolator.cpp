@@ -3,7 +3,7 @@
 #include <msf/common/vector_clones.h>
 #include <msf/range_image/depth_interpolator.h>
 
-#include <pcl/console/print.h>
+#include <ostream>
 
 #include <omp.h>
 
@@ -39,14 +39,25 @@ const char* toString(CombineRule rule) {
   }
 }
 
-void InterpolationConfig::print() const {
-  pcl::console::print_info(
-      "interpolation: %s, cubic gaps <= %d px, gaps <= %d px, edges: jump > %g m, > %g z, > %g / m in 1/z, "
-      "%s depth, column seeds <= %d px, combine %s, "
-      "gaussian %s (%d px, sigma %g, min weight %g%s)\n",
-      toString(slice.interpolant), slice.short_gap_px, slice.max_gap_px, slice.jump_abs_m, slice.jump_rel,
-      slice.jump_inv_per_m, slice.inverse_depth ? "inverse" : "plain", column_seed_gap_px, toString(combine), gaussian ? "on" : "off", gaussian_size_px,
-      gaussian_sigma_px, gaussian_min_weight, gaussian_smooth_valid ? ", smooths estimates" : "");
+void InterpolationConfig::print(std::ostream& out) const {
+  out << "interpolation:\n"
+      << "  method: " << toString(slice.interpolant) << "\n"
+      << "  short_gap_px: " << configValue(slice.short_gap_px) << "\n"
+      << "  max_gap_px: " << configValue(slice.max_gap_px) << "\n"
+      << "  jump_abs_m: " << configValue(slice.jump_abs_m) << "\n"
+      << "  jump_rel: " << configValue(slice.jump_rel) << "\n"
+      << "  jump_inv_per_m: " << configValue(slice.jump_inv_per_m) << "\n"
+      << "  cubic_alpha: " << configValue(slice.cubic_alpha) << "\n"
+      << "  cubic_beta: " << configValue(slice.cubic_beta) << "\n"
+      << "  inverse_depth: " << configValue(slice.inverse_depth) << "\n"
+      << "  column_seed_gap_px: " << configValue(column_seed_gap_px) << "\n"
+      << "  combine: " << toString(combine) << "\n"
+      << "  gaussian: " << configValue(gaussian) << "\n"
+      << "  gaussian_size_px: " << configValue(gaussian_size_px) << "\n"
+      << "  gaussian_sigma_px: " << configValue(gaussian_sigma_px) << "\n"
+      << "  gaussian_min_weight: " << configValue(gaussian_min_weight) << "\n"
+      << "  gaussian_smooth_valid: " << configValue(gaussian_smooth_valid) << "\n"
+      << "  threads: " << configValue(threads) << "\n";
 }
 
 void InterpolationConfig::read(const cv::FileNode& node) {

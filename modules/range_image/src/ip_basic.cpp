@@ -3,7 +3,7 @@
 #include <msf/range_image/ip_basic.h>
 
 #include <opencv2/imgproc.hpp>
-#include <pcl/console/print.h>
+#include <ostream>
 
 namespace msf {
 
@@ -31,9 +31,12 @@ const char* toString(IpBasicBlur blur) {
   return blur == IpBasicBlur::None ? "none" : blur == IpBasicBlur::Gaussian ? "gaussian" : "bilateral";
 }
 
-void IpBasicConfig::print() const {
-  pcl::console::print_info("ip_basic: %s, max depth %g m, extrapolate %s, blur %s\n", toString(variant), max_depth_m,
-                           extrapolate ? "on" : "off", toString(blur));
+void IpBasicConfig::print(std::ostream& out) const {
+  out << "ip_basic:\n"
+      << "  variant: " << toString(variant) << "\n"
+      << "  max_depth_m: " << configValue(max_depth_m) << "\n"
+      << "  extrapolate: " << configValue(extrapolate) << "\n"
+      << "  blur: " << toString(blur) << "\n";
 }
 
 void IpBasicConfig::read(const cv::FileNode& node) {

@@ -3,7 +3,7 @@
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/point_types.h>
 
-#include <pcl/console/print.h>
+#include <ostream>
 
 #include <cmath>
 #include <limits>
@@ -11,9 +11,12 @@
 
 namespace msf {
 
-void ProjectionConfig::print() const {
-  pcl::console::print_info("projection: camera %d, range %g..%g m, canvas margin %d px\n", camera, min_range_m,
-                           max_range_m, margin_px);
+void ProjectionConfig::print(std::ostream& out) const {
+  out << "projection:\n"
+      << "  camera: " << configValue(camera) << "\n"
+      << "  min_range_m: " << configValue(min_range_m) << "\n"
+      << "  max_range_m: " << configValue(max_range_m) << "\n"
+      << "  margin_px: " << configValue(margin_px) << "\n";
 }
 
 void ProjectionConfig::read(const cv::FileNode& node) {

@@ -2,15 +2,17 @@
 #include <msf/common/exceptions.h>
 #include <msf/range_image/ring_split.h>
 
-#include <pcl/console/print.h>
+#include <ostream>
 
 #include <cmath>
 #include <string>
 
 namespace msf {
 
-void RingSplitConfig::print() const {
-  pcl::console::print_info("rings: held out where id %% %d == %d\n", modulo, heldout_remainder);
+void RingSplitConfig::print(std::ostream& out) const {
+  out << "rings:\n"
+      << "  modulo: " << configValue(modulo) << "\n"
+      << "  heldout_remainder: " << configValue(heldout_remainder) << "\n";
 }
 
 void RingSplitConfig::read(const cv::FileNode& node) {

@@ -263,8 +263,8 @@ void MarchingCubes::Config::validate() const {
 }
 
 void MarchingCubes::Config::print(std::ostream& out) const {
-  out << "marching_cubes:\n  min_weight: " << min_weight << "\n  min_component_triangles: " << min_component_triangles
-      << "\n";
+  out << "marching_cubes:\n  min_weight: " << configValue(min_weight)
+      << "\n  min_component_triangles: " << configValue(min_component_triangles) << "\n";
 }
 
 MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }

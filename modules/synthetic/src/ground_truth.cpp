@@ -81,6 +81,11 @@ std::string GroundTruth::sceneMeshPath() const {
   return path;
 }
 
+bool GroundTruth::hasMovingMasks() const {
+  std::error_code ec;
+  return fs::is_directory(fs::path(dir_) / "moving_0", ec);
+}
+
 cv::Mat GroundTruth::depth(std::size_t i) const { return readKittiDepthPng(depthPath(i)); }
 cv::Mat GroundTruth::disparity(std::size_t i) const { return readKittiDisparityPng(disparityPath(i)); }
 
@@ -94,13 +99,6 @@ cv::Mat readByteImage(const std::string& path, const char* what) {
 } // namespace
 
 cv::Mat GroundTruth::objectMap(std::size_t i) const { return readByteImage(objectMapPath(i), "object map"); }
-
-cv::Mat GroundTruth::movingMask(std::size_t i) const {
-  std::error_code ec;
-  if (!fs::is_directory(fs::path(dir_) / "moving_0", ec))
-    return cv::Mat::zeros(depth(i).size(), CV_8UC1);
-  return readByteImage(movingMaskPath(i), "moving mask");
-}
 
 std::vector<MovingBox> GroundTruth::movingBoxes() const { return readMovingBoxes(movingBoxesPath()); }
 
@@ -116,6 +114,19 @@ cv::Mat GroundTruth::backgroundMask(std::size_t i) const {
   if (valid.size() != objects.size())
     throw IOError("object map '" + objectMapPath(i) + "' and depth '" + depthPath(i) + "' differ in size");
   return valid & (objects == 0);
+}
+
+cv::Mat GroundTruth::movingMask(std::size_t i) const {
+  const cv::Mat truth = depth(i);
+  if (!hasMovingMasks())
+    return cv::Mat::zeros(truth.size(), CV_8UC1);
+  const std::string path = movingMaskPath(i);
+  requireFile(path, "moving-object mask");
+  const cv::Mat mask = readImage(path, cv::IMREAD_UNCHANGED);
+  if (mask.type() != CV_8UC1 || mask.size() != truth.size())
+    throw IOError("moving-object mask '" + path + "' is not an 8-bit single-channel PNG of the depth's size " +
+                  std::to_string(truth.cols) + "x" + std::to_string(truth.rows));
+  return mask;
 }
 
 } // namespace msf::synthetic

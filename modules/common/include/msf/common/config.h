@@ -49,4 +49,17 @@ void readConfigSection(const std::string& path, const std::string& section, Conf
 template <typename T>
 void readKey(const cv::FileNode& node, const char* key, T& value);
 
+/// The keys of `section` that readKey calls have asked for in this process, sorted: the keys
+/// the stages that read the section know (what rejectUnknownKeys lists).
+std::vector<std::string> knownConfigKeys(const std::string& section);
+
+/// A value as a stage's print() writes it, so that readKey reads back the very same value
+/// and a printed configuration reproduces a run: numbers in the fewest digits that do (0.1f
+/// as 0.1, not 0.100000001), real numbers with a decimal point or exponent, booleans as
+/// true / false.
+std::string configValue(bool value);
+std::string configValue(int value);
+std::string configValue(float value);
+std::string configValue(double value);
+
 } // namespace msf

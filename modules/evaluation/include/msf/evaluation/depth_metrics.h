@@ -44,6 +44,10 @@ public:
   /// naming the image at fault.
   void add(const cv::Mat& gt_depth, const cv::Mat& estimated_depth, double focal_baseline,
            const cv::Mat& mask = cv::Mat(), const D1Threshold& d1 = {});
+  /// Adds one pixel, for ground truth kept as a list of pixels: gt_z is its true depth (> 0;
+  /// the caller leaves out pixels without), estimated_z the estimate (missing when not > 0 or
+  /// not finite). focal_baseline > 0 (add checks it; here it is the caller's).
+  void addPixel(float gt_z, float estimated_z, double focal_baseline, const D1Threshold& d1 = {});
   void merge(const DepthErrorAccumulator& other);
   DepthMetrics metrics() const;
 

@@ -6,8 +6,8 @@
 
 namespace msf {
 
-/// A small z-buffer rasteriser for previews of a mesh (no display or GPU needed): vertex
-/// colours, shaded by how squarely each triangle faces the viewer, on a dark background.
+/// Previews of a mesh (no display or GPU needed): the surface MeshRasterizer sees at each
+/// pixel in its vertex colours, shaded by how squarely it faces the viewer, on a dark background.
 class MeshRenderer {
 public:
   /// BGR of pixels no triangle covers: a dark slate, against which bright surfaces (a sunlit

@@ -96,6 +96,14 @@ public:
   /// pictures; off by default, since step 2 projects the scan itself, with a margin.
   void setKeepSparse(bool keep) { keep_sparse_ = keep; }
 
+  /// Changes each frame before any stage sees it: run() calls it on its loading thread right
+  /// after Sequence::load, once per frame in frame order (its time counts as loading). E.g.
+  /// the ring hold-out of evaluation protocol 4 removes the held-out rings from the scan
+  /// there. It runs beside run()'s callback (the integration thread): what the two share
+  /// needs a lock. Set it before run(); computeDepth's caller holds its frame and filters it.
+  using FrameFilter = std::function<void(Frame&)>;
+  void setFrameFilter(FrameFilter filter) { frame_filter_ = std::move(filter); }
+
   /// The mesh of the volume, re-meshing only the blocks changed since the last call.
   const TriangleMesh& updateMesh();
   /// What the last updateMesh did (blocks meshed, small pieces removed).
@@ -127,6 +135,7 @@ private:
   MarchingCubes mesher_;
   TriangleMesh mesh_;
   bool keep_sparse_ = false;
+  FrameFilter frame_filter_;
 };
 
 } // namespace msf

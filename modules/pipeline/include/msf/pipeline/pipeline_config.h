@@ -2,6 +2,7 @@
 #include <msf/fusion/fusion_config.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/ring_split.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/stereo/sgbm_config.h>
@@ -19,6 +20,7 @@ struct VolumeConfig {
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the key of a value out of range.
   void validate() const;
+  void print(std::ostream& out) const;
 };
 
 /// Section `pipeline`: how the stages are scheduled and what is kept.
@@ -32,6 +34,7 @@ struct SchedulingConfig {
   int lidar_threads = 1;
   void read(const cv::FileNode& node);
   void validate() const;
+  void print(std::ostream& out) const;
 };
 
 /// Every stage's configuration, read from one YAML file (config/kitti.yaml), one section
@@ -39,6 +42,8 @@ struct SchedulingConfig {
 struct PipelineConfig {
   ProjectionConfig projection;              ///< `projection`
   InterpolationConfig interpolation;        ///< `interpolation`
+  /// `rings`: not a stage's; the ring hold-out of msf_reconstruct -holdout (protocols 2 and 4)
+  RingSplitConfig rings;
   SgbmConfig stereo;                        ///< `stereo`
   DepthFusionConfig fusion;                 ///< `fusion`
   VolumeConfig volume;                      ///< `tsdf_volume`
@@ -51,6 +56,8 @@ struct PipelineConfig {
   static PipelineConfig load(const std::string& path);
   /// Throws ConfigError naming the first invalid key of any stage.
   void validate() const;
+  /// Every key of every section above, as a YAML config file that load() reads back to the
+  /// same configuration: what a run used, in full (each section's own print()).
   void print(std::ostream& out) const;
 };
 

@@ -1,8 +1,11 @@
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
+#include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/pipeline/pipeline.h>
 
+#include <iosfwd>
 #include <map>
 #include <string>
 #include <vector>
@@ -29,6 +32,24 @@ public:
     bool has_split = false;
   };
 
+  /// Evaluation protocol 4: the map against ground truth it never saw (msf_reconstruct
+  /// -holdout, or a synthetic sequence), one row per depth source.
+  struct MapEvaluation {
+    struct Row {
+      ReconstructionScore score;   ///< source "mesh", "fused", "mesh_lidar" or "mesh_stereo"
+      bool has_accuracy = false;   ///< a mesh against the true surface (synthetic)
+      MeshAccuracy accuracy;
+      bool has_ghosts = false;     ///< a mesh where moving objects were
+      GhostMetrics ghosts;
+    };
+    std::string truth;             ///< what the ground truth is, in words
+    double range_m = 0;            ///< "within range": true depth <= this (tsdf_integrator.max_depth_m)
+    std::size_t frames = 0, gt_pixels = 0;
+    bool moving_split = false;     ///< the dataset marks moving objects (gt/moving_0)
+    std::string no_ghosts;         ///< why there is no ghost figure, when there is none
+    std::vector<Row> rows;         ///< empty without ground truth
+  };
+
   std::string dataset;            ///< folder reconstructed
   std::string layout;             ///< odometry, raw or synthetic
   std::size_t frames_requested = 0;
@@ -46,6 +67,11 @@ public:
   std::map<std::string, DepthScores> depth;  ///< by method: sgbm, interpolated, fused
   bool has_mesh_accuracy = false;
   MeshAccuracy mesh_accuracy;
+  MapEvaluation map_evaluation;
+  /// The effective configuration (PipelineConfig::print: every key of every section, after
+  /// defaults, the file and the flags), written into summary.json; "" leaves it out.
+  std::string config_yaml;
+  std::string config_file;                    ///< its copy beside the report, e.g. config.yaml
   std::vector<std::string> depth_panels;      ///< file names of the depth panels written
   std::string mesh_file = "mesh.ply", volume_file = "volume.pcd", preview_file;
 
@@ -59,6 +85,9 @@ public:
   void writeSummaryJson(const std::string& path) const;
   void writeRuntimePlot(const std::string& path) const;
   void writeMarkdown(const std::string& path) const;
+
+private:
+  void writeMapEvaluation(std::ostream& out) const;
 };
 
 /// Peak resident memory of this process so far, in MiB (getrusage).

@@ -1,4 +1,5 @@
 #pragma once
+#include <iosfwd>
 #include <msf/range_image/slice_interpolation.h>
 
 #include <opencv2/core/mat.hpp>
@@ -40,7 +41,8 @@ struct InterpolationConfig {
   bool gaussian_smooth_valid = false;       ///< also smooth interpolated pixels (real returns never)
   int threads = 0;                          ///< OpenMP threads, 0 = default
 
-  void print() const;
+  /// The section as YAML, every key (configValue).
+  void print(std::ostream& out) const;
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the first key out of range.
   void validate() const;

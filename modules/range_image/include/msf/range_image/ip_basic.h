@@ -1,4 +1,5 @@
 #pragma once
+#include <iosfwd>
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/persistence.hpp>
 
@@ -25,7 +26,8 @@ struct IpBasicConfig {
   bool extrapolate = false;    ///< extend the top pixel of each column to the image top
   IpBasicBlur blur = IpBasicBlur::Bilateral;
 
-  void print() const;
+  /// The section as YAML, every key (configValue).
+  void print(std::ostream& out) const;
   void read(const cv::FileNode& node);
   void validate() const;
 };

@@ -1,4 +1,5 @@
 #pragma once
+#include <iosfwd>
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
 
@@ -23,7 +24,8 @@ struct ProjectionConfig {
   /// leaving them open; results are cropped back to the image.
   int margin_px = 16;
 
-  void print() const;
+  /// The section as YAML, every key (configValue).
+  void print(std::ostream& out) const;
   /// Overrides the keys present; throws ConfigError naming a key with a bad value.
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the first key out of range.

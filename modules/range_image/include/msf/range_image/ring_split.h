@@ -1,4 +1,5 @@
 #pragma once
+#include <iosfwd>
 #include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -13,7 +14,8 @@ struct RingSplitConfig {
   int modulo = 4;            ///< rings with id % modulo == heldout_remainder are held out
   int heldout_remainder = 2;
 
-  void print() const;
+  /// The section as YAML, every key (configValue).
+  void print(std::ostream& out) const;
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the key out of range.
   void validate() const;

@@ -42,6 +42,8 @@ public:
   std::string movingMaskPath(std::size_t i) const;
   std::string movingBoxesPath() const;
   std::string sceneMeshPath() const;
+  /// True when the dataset marks moving objects (gt/moving_0/ exists).
+  bool hasMovingMasks() const;
 
   /// CV_32F metres, 0 = none.
   cv::Mat depth(std::size_t i) const;
@@ -55,7 +57,8 @@ public:
   cv::Mat backgroundMask(std::size_t i) const;
   /// CV_8U, 255 where the pixel sees a moving object. A dataset written before moving
   /// objects existed has no moving_0/: its street was static, and the mask is all zero
-  /// (of the depth's size). Throws IOError when moving_0/ exists and the frame's file does not.
+  /// (of the depth's size). Throws IOError when moving_0/ exists and the frame's file does
+  /// not, or its size is not the depth's.
   cv::Mat movingMask(std::size_t i) const;
   /// The moving objects' boxes at every frame, in file order (frame by frame). Throws
   /// IOError naming the file when it is missing (datasets written before moving objects

@@ -1,0 +1,28 @@
+#pragma once
+#include <msf/fusion/fusion_config.h>
+#include <msf/pipeline/pipeline.h>
+#include <msf/reconstruction/depth_frame.h>
+
+namespace msf {
+
+/// One input of the fusion, integrated alone into a volume of its own (msf_reconstruct
+/// -compare_sources), to see what the fusion adds to the map.
+enum class DepthSource {
+  Lidar,  ///< the interpolated LiDAR (step 2), FrameResult::lidar_depth
+  Stereo  ///< SGBM (step 3), FrameResult::stereo_depth
+};
+
+/// "lidar" or "stereo".
+const char* toString(DepthSource source);
+
+/// What the integrator gets from one source of a frame: the source's depth, the fused
+/// colour (sampled at the fused depth) and, as the fused depth's, the inverse variance of
+/// each depth (depthWeight) by the fusion's own sigma of that source: lidarSigmaPx from the
+/// distance to the nearest real return and the local disparity range, stereoSigmaPx from
+/// SGBM's confidence. So a single-source map is weighed as the fused one is. Throws
+/// InvalidInputError when the frame has no depth of that source, a cue image of another
+/// size, no fused colour, or f B is not > 0.
+DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const DepthFusionConfig& fusion,
+                            double focal_baseline);
+
+} // namespace msf

@@ -1,0 +1,63 @@
+#pragma once
+#include <msf/io/pinhole_camera.h>
+#include <msf/reconstruction/marching_cubes.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace msf {
+
+/// A TriangleMesh seen through a pinhole camera: per pixel, the depth z of the first surface
+/// along the ray through the pixel's centre (pixel (u, v) is centred on the integer
+/// coordinates, as PinholeCamera and LidarProjector have it), with the triangle it lies on.
+/// What evaluation protocol 4 compares with ground-truth depth, and what the colour preview
+/// (MeshRenderer) shades.
+///
+/// Exact at pixel centres: a centre is covered when it is inside or on the triangle's
+/// projection (two triangles sharing an edge get the same edge test with opposite signs, so
+/// no centre falls between them), and its depth is the perspective-correct one (1/z is
+/// affine in the image along a plane). Both faces are drawn: marching cubes' winding is not
+/// guaranteed to face the camera. Triangles crossing the near plane are clipped to it, so a
+/// surface that passes beside the camera is neither dropped nor smeared across the image.
+///
+/// Parallel over bands of image rows: the triangles are first sorted into the bands their
+/// projection may cover (two counting passes over fixed chunks of triangles, so the order
+/// within a band, and the result, do not depend on the threads), then each band is drawn
+/// by one thread into its own rows. The buffers are kept between calls: rendering one mesh
+/// at many poses allocates nothing per frame or per triangle.
+class MeshRasterizer {
+public:
+  /// Surfaces nearer the camera than `near_m` (metres, > 0) are cut away. Throws
+  /// InvalidInputError for a value that is not > 0 and finite.
+  void setNearPlane(float near_m);
+  float getNearPlane() const { return near_m_; }
+
+  /// Renders `mesh` (world frame) through `camera` at `T_world_cam`. depth: CV_32FC1 of the
+  /// camera's size, z in metres, 0 where no triangle covers the pixel centre. triangle_ids,
+  /// when given: CV_32SC1, the index into mesh.triangles of the surface seen, -1 where none.
+  /// Throws InvalidInputError for an invalid camera (or one taller than 65535 rows), a pose
+  /// that is not finite, or a triangle whose vertex index is out of range.
+  void render(const TriangleMesh& mesh, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
+              cv::Mat& depth, cv::Mat* triangle_ids = nullptr);
+
+private:
+  /// Sorts the triangles into bands_ (bin_start_, binned_); returns false on a bad index.
+  bool binTriangles(const TriangleMesh& mesh, const PinholeCamera& camera);
+  /// Draws the triangles of band `band` into its rows.
+  void drawBand(int band, const TriangleMesh& mesh, const PinholeCamera& camera, cv::Mat& depth,
+                cv::Mat* triangle_ids) const;
+
+  float near_m_ = 0.1f;
+  int bands_ = 0;
+  std::vector<Eigen::Vector3f> cam_;        ///< vertices in the camera frame
+  std::vector<Eigen::Vector2f> pixel_;      ///< their projections (those in front of the near plane)
+  std::vector<std::uint32_t> rows_;         ///< per triangle: first row << 16 | last row it may cover
+  std::vector<std::uint32_t> offsets_;      ///< per chunk and band: where its triangles go in binned_
+  std::vector<std::uint32_t> bin_start_;    ///< per band (and one past): its triangles in binned_
+  std::vector<std::uint32_t> binned_;       ///< triangle indices, band after band
+};
+
+} // namespace msf

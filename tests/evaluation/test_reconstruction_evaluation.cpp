@@ -1,0 +1,164 @@
+// Evaluation protocol 4 on analytic scenes with known answers, and the ghost metric on
+// hand-made vertices.
+#include <msf/common/exceptions.h>
+#include <msf/evaluation/ghost_metric.h>
+#include <msf/evaluation/reconstruction_evaluation.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include <cmath>
+
+using namespace msf;
+
+namespace {
+
+PinholeCamera camera() {
+  PinholeCamera c;
+  c.width = 100, c.height = 80;
+  c.fx = c.fy = 100.f;
+  c.cx = 49.5f, c.cy = 39.5f;
+  return c;
+}
+constexpr double kFocalBaseline = 100.0 * 0.5; // f = 100 px, B = 0.5 m
+
+/// A square of side `side` facing the camera at depth z, centred on the world point (x, y).
+TriangleMesh square(float x, float y, float z, float side) {
+  TriangleMesh mesh;
+  const float h = side / 2;
+  mesh.vertices = {{x - h, y - h, z}, {x + h, y - h, z}, {x + h, y + h, z}, {x - h, y + h, z}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return mesh;
+}
+
+cv::Mat constantDepth(float z) { return cv::Mat(80, 100, CV_32FC1, cv::Scalar(z)); }
+
+/// Pixels whose centre sees the world point x in [x0, x1], y in [y0, y1] at depth z, from the origin.
+int footprint(float z, float x0, float x1, float y0, float y1) {
+  const PinholeCamera c = camera();
+  int n = 0;
+  for (int v = 0; v < c.height; ++v)
+    for (int u = 0; u < c.width; ++u) {
+      const double x = (u - c.cx) * z / c.fx, y = (v - c.cy) * z / c.fy;
+      n += x >= x0 && x <= x1 && y >= y0 && y <= y1;
+    }
+  return n;
+}
+
+} // namespace
+
+TEST(ReconstructionEvaluation, AMeshOffsetFromThePlaneHasThatErrorOverItsFootprint) {
+  // Ground truth: a wall at 10 m over the whole image. The mesh: a 4 m square of it, 0.1 m
+  // behind. The fused depth: the wall 0.05 m in front, everywhere.
+  ReconstructionEvaluation evaluation(camera(), kFocalBaseline, 40.0);
+  evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(10.f));
+  evaluation.scoreDepth("fused", 0, constantDepth(9.95f));
+  evaluation.scoreMesh("mesh", square(0.f, 0.f, 10.1f, 4.f));
+  const auto scores = evaluation.scores();
+  ASSERT_EQ(scores.size(), 2u);
+  EXPECT_EQ(scores[0].source, "fused");
+  EXPECT_EQ(scores[1].source, "mesh");
+  const DepthMetrics& fused = scores[0].all;
+  EXPECT_EQ(fused.gt_pixels, 8000u);
+  EXPECT_DOUBLE_EQ(fused.coverage, 1.0);
+  EXPECT_NEAR(fused.mae_m, 0.05, 1e-5);
+  EXPECT_DOUBLE_EQ(fused.d1_all, 0.0);
+  const DepthMetrics& mesh = scores[1].all;
+  // The square covers 4 m / 10.1 m * 100 px ~ 40 px a side.
+  const int covered = footprint(10.1f, -2.f, 2.f, -2.f, 2.f);
+  EXPECT_GT(covered, 1500);
+  EXPECT_EQ(mesh.gt_pixels, 8000u);
+  EXPECT_EQ(mesh.estimated, static_cast<std::size_t>(covered));
+  EXPECT_NEAR(mesh.coverage, covered / 8000.0, 1e-12);
+  EXPECT_NEAR(mesh.mae_m, 0.1, 1e-5);
+  EXPECT_NEAR(mesh.rmse_m, 0.1, 1e-5);
+  EXPECT_NEAR(mesh.d1_all, 1.0 - covered / 8000.0, 1e-12); // missing = bad; 0.05 px off is good
+  EXPECT_DOUBLE_EQ(mesh.d1_estimated, 0.0);
+  // Everything within range: the same figures; nothing moving.
+  EXPECT_EQ(scores[1].within_range.gt_pixels, 8000u);
+  EXPECT_EQ(scores[1].within_range.estimated, mesh.estimated);
+  EXPECT_EQ(scores[1].moving_all.gt_pixels, 0u);
+  EXPECT_EQ(evaluation.frames(), 1u);
+  EXPECT_EQ(evaluation.groundTruthPixels(), 8000u);
+}
+
+TEST(ReconstructionEvaluation, RangeMovingPixelsAndPosesSplitThePixels) {
+  // Two frames seeing the same wall from 10 m and, moved 20 m back, from 30 m; the range is
+  // 20 m. In frame 1, the left half of the image is a moving object.
+  ReconstructionEvaluation evaluation(camera(), kFocalBaseline, 20.0);
+  evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(10.f));
+  Eigen::Isometry3d back = Eigen::Isometry3d::Identity();
+  back.translation().z() = -20.0;
+  cv::Mat moving(80, 100, CV_8UC1, cv::Scalar(0));
+  moving.colRange(0, 50).setTo(255);
+  // Sparse ground truth, as the held-out rings are: every other row.
+  cv::Mat sparse = constantDepth(30.f);
+  for (int v = 1; v < 80; v += 2)
+    sparse.row(v).setTo(0.f);
+  evaluation.addGroundTruth(1, back, sparse, moving);
+  EXPECT_EQ(evaluation.groundTruthPixels(), 8000u + 4000u);
+  // The wall itself, large enough to fill both views.
+  evaluation.scoreMesh("mesh", square(0.f, 0.f, 10.f, 40.f));
+  const ReconstructionScore s = evaluation.scores().at(0);
+  EXPECT_EQ(s.all.gt_pixels, 8000u + 2000u);     // frame 1's right half is static
+  EXPECT_EQ(s.within_range.gt_pixels, 8000u);    // frame 1's wall is 30 m away
+  EXPECT_EQ(s.moving_all.gt_pixels, 2000u);
+  EXPECT_EQ(s.moving_within_range.gt_pixels, 0u);
+  EXPECT_DOUBLE_EQ(s.all.coverage, 1.0);
+  EXPECT_LT(s.all.mae_m, 1e-4); // the mesh is rendered at each frame's own pose
+  EXPECT_DOUBLE_EQ(s.moving_all.coverage, 1.0);
+}
+
+TEST(ReconstructionEvaluation, BadInputIsAClearError) {
+  EXPECT_THROW(ReconstructionEvaluation(PinholeCamera(), kFocalBaseline, 40.0), InvalidInputError);
+  EXPECT_THROW(ReconstructionEvaluation(camera(), 0.0, 40.0), InvalidInputError);
+  EXPECT_THROW(ReconstructionEvaluation(camera(), kFocalBaseline, 0.0), ConfigError);
+  ReconstructionEvaluation evaluation(camera(), kFocalBaseline, 40.0);
+  auto message = [](const auto& call) {
+    try {
+      call();
+    } catch (const InvalidInputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(message([&] { evaluation.scoreDepth("fused", 3, constantDepth(1.f)); })
+                .find("frame 3 has no ground truth"),
+            std::string::npos);
+  EXPECT_NE(message([&] { evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), cv::Mat(10, 10, CV_32FC1)); })
+                .find("ground truth of frame 0 is a 10x10 image"),
+            std::string::npos);
+  evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(5.f));
+  EXPECT_NE(message([&] { evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(5.f)); })
+                .find("given twice"),
+            std::string::npos);
+  EXPECT_NE(message([&] { evaluation.scoreDepth("fused", 0, cv::Mat(80, 100, CV_16UC1)); }).find("fused depth of frame 0"),
+            std::string::npos);
+}
+
+TEST(GhostMetric, CountsVerticesFarFromTheStaticSurfaceWhereAMovingObjectWas) {
+  // The static surface: the ground y = 0. A car drove through the box x in [0, 2],
+  // y in [-2, 0], z in [5, 9] (world y down: the box stands on the ground).
+  const SurfaceDistance ground({{-50.f, 0.f, -50.f}, {50.f, 0.f, -50.f}, {50.f, 0.f, 50.f}, {-50.f, 0.f, 50.f}},
+                               {{0, 1, 2}, {0, 2, 3}});
+  const MovingSpace was_moving = [](const Eigen::Vector3f& p) {
+    return p.x() >= 0.f && p.x() <= 2.f && p.y() >= -2.f && p.y() <= 0.f && p.z() >= 5.f && p.z() <= 9.f;
+  };
+  const std::vector<Eigen::Vector3f> vertices = {
+      {1.f, 0.f, 6.f},     // the road under the car: not a ghost
+      {1.f, -1.f, 6.f},    // the car's side left in the map: a ghost
+      {1.f, -0.15f, 7.f},  // within 0.2 m of the road: not a ghost
+      {1.f, -0.25f, 7.f},  // 0.25 m above it: a ghost
+      {5.f, -1.f, 6.f},    // a floating speck where no car was: not a ghost
+  };
+  const GhostMetrics m = measureGhosts(vertices, ground, was_moving, 0.2);
+  EXPECT_EQ(m.vertices, 5u);
+  EXPECT_EQ(m.ghost_vertices, 2u);
+  EXPECT_DOUBLE_EQ(m.share, 0.4);
+  EXPECT_DOUBLE_EQ(m.distance_m, 0.2);
+  // A larger distance keeps only the side.
+  EXPECT_EQ(measureGhosts(vertices, ground, was_moving, 0.5).ghost_vertices, 1u);
+  EXPECT_THROW(measureGhosts(vertices, ground, MovingSpace(), 0.2), InvalidInputError);
+  EXPECT_THROW(measureGhosts(vertices, ground, was_moving, 0.0), InvalidInputError);
+  EXPECT_EQ(measureGhosts({}, ground, was_moving).share, 0.0);
+}

@@ -1,0 +1,118 @@
+// What the pipeline hands to evaluation protocol 4: frames changed before any stage sees
+// them (the ring hold-out), and each source's depth as a frame to integrate alone.
+#include <msf/common/exceptions.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/source_depth_frame.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/ring_split.h>
+
+#include "pipeline_fixture.h"
+#include "test_support.h"
+
+#include <opencv2/core.hpp>
+
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace {
+
+/// Runs frames 0-1 of `dataset` with a frame filter that keeps the input rings of the ring
+/// hold-out, and checks that the pipeline's step 1 saw exactly those.
+void checkTheFilterComesFirst(const std::string& dataset) {
+  const msf::Sequence sequence(dataset);
+  const auto frames = sequence.indices(msf::FrameRange::parse("0:1"));
+  const msf::PipelineConfig config;
+  msf::Pipeline pipeline(sequence.calibration(), config);
+  pipeline.setKeepSparse(true); // the projected scan step 1 worked on
+  // The filter keeps the input rings and remembers, per frame, what it removed and kept.
+  std::mutex mutex;
+  std::map<std::size_t, pcl::PointCloud<pcl::PointXYZI>> kept, removed;
+  std::vector<std::size_t> filtered;
+  const std::thread::id caller = std::this_thread::get_id();
+  pipeline.setFrameFilter([&](msf::Frame& frame) {
+    EXPECT_NE(std::this_thread::get_id(), caller); // on the loading thread
+    pcl::PointCloud<pcl::PointXYZI> input, heldout;
+    msf::splitRings(*frame.scan, msf::RingSplitConfig{}, input, heldout);
+    *frame.scan = input;
+    const std::lock_guard<std::mutex> lock(mutex);
+    filtered.push_back(frame.index);
+    kept[frame.index] = input;
+    removed[frame.index] = heldout;
+  });
+  msf::LidarProjector projector(sequence.calibration(), config.projection);
+  std::size_t checked = 0;
+  pipeline.run(sequence, frames, [&](msf::FrameResult& r) {
+    cv::Mat input_image, heldout_image;
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      ASSERT_GT(removed[r.index].size(), 1000u) << "no held-out ring in frame " << r.index;
+      projector.projectToImage(kept[r.index], input_image);
+      projector.projectToImage(removed[r.index], heldout_image);
+    }
+    // Step 1 saw exactly the input rings: no pixel of a held-out return that no input
+    // return shares.
+    EXPECT_EQ(cv::norm(r.lidar_sparse, input_image, cv::NORM_INF), 0.0) << "frame " << r.index;
+    EXPECT_GT(cv::countNonZero((heldout_image > 0) & (input_image == 0)), 1000);
+    EXPECT_EQ(cv::countNonZero((heldout_image > 0) & (input_image == 0) & (r.lidar_sparse > 0)), 0);
+    ++checked;
+  });
+  EXPECT_EQ(filtered, frames); // once per frame, in order
+  EXPECT_EQ(checked, frames.size());
+}
+
+TEST_F(PipelineTest, TheFrameFilterChangesEachFrameBeforeAnyStageSeesIt) { checkTheFilterComesFirst(dataset()); }
+
+TEST(FrameFilter, NoHeldOutReturnOfARealKittiScanReachesThePipeline) {
+  MSF_REQUIRE_KITTI();
+  checkTheFilterComesFirst(msf::test::kittiDir() + "/odometry/sequences/04");
+}
+
+TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndTheFusionsWeights) {
+  msf::FrameResult r;
+  r.name = "000007";
+  r.lidar_depth = (cv::Mat_<float>(2, 3) << 5.f, 0.f, std::nanf(""), 5.f, 5.f, -1.f);
+  r.lidar_distance = (cv::Mat_<float>(2, 3) << 0.f, 1.f, 1.f, 0.f, 10.f, 1.f);
+  r.stereo_depth = (cv::Mat_<float>(2, 3) << 0.f, 6.f, 12.f, 0.f, 0.f, 9.f);
+  r.stereo_confidence = (cv::Mat_<float>(2, 3) << 1.f, 1.f, 1.f, 1.f, 1.f, 0.f);
+  r.fused.depth = cv::Mat(2, 3, CV_32FC1, cv::Scalar(4.f));
+  r.fused.weight = cv::Mat(2, 3, CV_32FC1, cv::Scalar(3.f));
+  r.fused.color = cv::Mat(2, 3, CV_8UC3, cv::Scalar(10, 20, 30));
+  r.fused.camera.fx = r.fused.camera.fy = 100.f;
+  r.fused.camera.cx = 1.f, r.fused.camera.cy = 0.5f;
+  r.fused.camera.width = 3, r.fused.camera.height = 2;
+  const msf::DepthFusionConfig fusion;
+  const double fb = 386.0;
+
+  const msf::DepthFrame lidar = msf::sourceDepthFrame(r, msf::DepthSource::Lidar, fusion, fb);
+  EXPECT_EQ(lidar.depth.data, r.lidar_depth.data);
+  EXPECT_EQ(lidar.color.data, r.fused.color.data);
+  EXPECT_EQ(lidar.camera.fx, 100.f);
+  // No depth, no weight; a real return outweighs an interpolated pixel 10 px from one.
+  EXPECT_EQ(lidar.weight.at<float>(0, 1), 0.f);
+  EXPECT_EQ(lidar.weight.at<float>(0, 2), 0.f);
+  EXPECT_EQ(lidar.weight.at<float>(1, 2), 0.f);
+  EXPECT_GT(lidar.weight.at<float>(1, 0), lidar.weight.at<float>(1, 1));
+  EXPECT_GT(lidar.weight.at<float>(1, 1), 0.f);
+
+  const msf::DepthFrame stereo = msf::sourceDepthFrame(r, msf::DepthSource::Stereo, fusion, fb);
+  EXPECT_EQ(stereo.depth.data, r.stereo_depth.data);
+  // The fusion's weight of a stereo-only pixel: 1 / sigma_z^2, sigma_z = z^2 sigma_d / (f B).
+  const float sigma_z = 6.f * 6.f * fusion.stereo_sigma_min_px / static_cast<float>(fb);
+  EXPECT_NEAR(stereo.weight.at<float>(0, 1), 1.f / (sigma_z * sigma_z), 1e-3f);
+  EXPECT_NEAR(stereo.weight.at<float>(0, 2), stereo.weight.at<float>(0, 1) / 16.f, 1e-3f); // twice as far
+  EXPECT_LT(stereo.weight.at<float>(1, 2), stereo.weight.at<float>(0, 1));                  // confidence 0
+  EXPECT_EQ(stereo.weight.at<float>(0, 0), 0.f);
+
+  r.stereo_depth.release();
+  try {
+    msf::sourceDepthFrame(r, msf::DepthSource::Stereo, fusion, fb);
+    ADD_FAILURE() << "a frame without stereo depth was accepted";
+  } catch (const msf::InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 000007 has no stereo depth"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(msf::sourceDepthFrame(r, msf::DepthSource::Lidar, fusion, 0.0), msf::InvalidInputError);
+}
+
+} // namespace

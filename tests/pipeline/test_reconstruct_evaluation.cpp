@@ -1,0 +1,160 @@
+// msf_reconstruct's evaluation protocol 4: -holdout on real KITTI frames, the synthetic
+// ground truth with moving objects marked, -compare_sources, and clear errors that leave no output.
+#include <msf/io/image_io.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/synthetic/ground_truth.h>
+
+#include "pipeline_fixture.h"
+#include "test_support.h"
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// KITTI odometry 04 as a dataset of its own under `root`, its folders linked: without the
+/// poses when `poses` is false; with the scans of frames 0-1 sorted by azimuth (one sweep,
+/// no ring order) when `sorted_scans` is true.
+std::string kittiCopy(const std::string& root, bool poses, bool sorted_scans) {
+  const fs::path kitti = fs::path(msf::test::kittiDir()) / "odometry";
+  const fs::path sequence = fs::path(root) / "sequences" / "04";
+  fs::create_directories(sequence);
+  for (const char* entry : {"image_0", "image_1", "image_2", "calib.txt", "times.txt"})
+    fs::create_symlink(kitti / "sequences" / "04" / entry, sequence / entry);
+  if (poses) {
+    fs::create_directories(fs::path(root) / "poses");
+    fs::create_symlink(kitti / "poses" / "04.txt", fs::path(root) / "poses" / "04.txt");
+  }
+  if (!sorted_scans) {
+    fs::create_symlink(kitti / "sequences" / "04" / "velodyne", sequence / "velodyne");
+  } else {
+    fs::create_directories(sequence / "velodyne");
+    for (const char* name : {"000000.bin", "000001.bin"}) {
+      pcl::PointCloud<pcl::PointXYZI> scan;
+      msf::loadVelodyneBin((kitti / "sequences" / "04" / "velodyne" / name).string(), scan);
+      std::sort(scan.begin(), scan.end(), [](const pcl::PointXYZI& a, const pcl::PointXYZI& b) {
+        return std::atan2(a.y, a.x) < std::atan2(b.y, b.x);
+      });
+      msf::saveVelodyneBin((sequence / "velodyne" / name).string(), scan);
+    }
+  }
+  return sequence.string();
+}
+
+/// The JSON object of one protocol 4 row ("mesh", "fused", ...) with its metrics.
+std::string rowOf(const std::string& json, const std::string& source) {
+  const std::size_t rows = json.find("\"rows\"", json.find("\"reconstruction_evaluation\""));
+  const std::size_t at = json.find("\"" + source + "\": {", rows);
+  return at == std::string::npos ? "" : json.substr(at, json.find("\n      }", at) - at);
+}
+
+} // namespace
+
+TEST(ReconstructEvaluation, HoldoutOnKittiScoresTheMeshesBesideTheFusedDepth) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir out;
+  const std::string sequence = msf::test::kittiDir() + "/odometry/sequences/04";
+  const auto r = msf::test::runTool("msf_reconstruct", sequence + " -frames 0:1 -holdout -compare_sources -panels 0 -o " +
+                                                           out.path() + " -config " + msf::test::sourceDir() +
+                                                           "/config/kitti.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json = readFile(out.file("summary.json"));
+  EXPECT_NE(json.find("\"truth\": \"held-out rings (ring id % 4 == 2)"), std::string::npos);
+  EXPECT_EQ(jsonNumber(json, "frames", "reconstruction_evaluation"), 2);
+  EXPECT_EQ(jsonNumber(json, "range_m", "reconstruction_evaluation"), 40); // kitti.yaml's tsdf_integrator.max_depth_m
+  const double pixels = jsonNumber(json, "gt_pixels", "reconstruction_evaluation");
+  EXPECT_GT(pixels, 8000);
+  for (const char* source : {"mesh", "fused", "mesh_lidar", "mesh_stereo"}) {
+    const std::string row = rowOf(json, source);
+    ASSERT_FALSE(row.empty()) << source << " row missing:\n" << json;
+    // Every row is scored at the same pixels.
+    EXPECT_EQ(jsonNumber(row, "gt_pixels", "all"), pixels) << source;
+    EXPECT_LE(jsonNumber(row, "gt_pixels", "within_range"), pixels) << source;
+    EXPECT_GT(jsonNumber(row, "coverage", "within_range"), 0.05) << source;
+    EXPECT_LE(jsonNumber(row, "d1_all", "within_range"), 1.0) << source;
+  }
+  // The fused depth covers (nearly) every held-out pixel; a two-frame map far fewer, and
+  // its missing pixels count as bad.
+  const double fused_coverage = jsonNumber(rowOf(json, "fused"), "coverage", "within_range");
+  const double mesh_coverage = jsonNumber(rowOf(json, "mesh"), "coverage", "within_range");
+  EXPECT_GT(fused_coverage, 0.99);
+  EXPECT_LT(mesh_coverage, fused_coverage);
+  EXPECT_GT(jsonNumber(rowOf(json, "mesh"), "d1_all", "within_range"),
+            jsonNumber(rowOf(json, "fused"), "d1_all", "within_range"));
+  // Where the mesh has depth, it is the held-out surface most of the time.
+  EXPECT_LT(jsonNumber(rowOf(json, "mesh"), "d1_estimated", "within_range"), 0.2);
+  for (const char* file : {"mesh.ply", "mesh_lidar.ply", "mesh_stereo.ply", "config.yaml", "report.md"})
+    EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
+  EXPECT_NE(readFile(out.file("report.md")).find("evaluation protocol 4"), std::string::npos);
+  EXPECT_NE(r.out.find("mesh_stereo"), std::string::npos) << r.out; // the console's table
+  // The configuration in full, in summary.json and beside it.
+  EXPECT_NE(json.find("\"rings\": {\"modulo\": 4, \"heldout_remainder\": 2}"), std::string::npos);
+  EXPECT_EQ(jsonNumber(json, "max_depth_m", "tsdf_integrator"), 40);
+  EXPECT_NE(readFile(out.file("config.yaml")).find("heldout_remainder: 2"), std::string::npos);
+}
+
+TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
+  // The default street has moving cars: their pixels (gt/moving_0) are scored apart, and the
+  // ghost figure counts the mesh's vertices where a car was (gt/moving_objects.txt).
+  const msf::synthetic::GroundTruth truth(dataset());
+  ASSERT_TRUE(truth.hasMovingMasks());
+  std::size_t expected_moving = 0, expected_all = 0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const cv::Mat depth = truth.depth(i), mask = truth.movingMask(i);
+    expected_all += static_cast<std::size_t>(cv::countNonZero(depth > 0.f));
+    expected_moving += static_cast<std::size_t>(cv::countNonZero((depth > 0.f) & (mask > 0)));
+  }
+  ASSERT_GT(expected_moving, 100u) << "the street's first frames show no moving car";
+  msf::test::TempDir out;
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:1 -panels 0 -o " + out.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json = readFile(out.file("summary.json"));
+  EXPECT_NE(json.find("\"moving_split\": true"), std::string::npos);
+  EXPECT_NE(json.find("\"no_ghosts\": null"), std::string::npos);
+  const std::string mesh = rowOf(json, "mesh"), fused = rowOf(json, "fused");
+  ASSERT_FALSE(mesh.empty()) << json;
+  const double pixels = jsonNumber(json, "gt_pixels", "reconstruction_evaluation");
+  const double static_pixels = jsonNumber(mesh, "gt_pixels", "all");
+  const double moving_pixels = jsonNumber(mesh, "gt_pixels", "moving_all");
+  EXPECT_EQ(pixels, static_cast<double>(expected_all));
+  EXPECT_EQ(moving_pixels, static_cast<double>(expected_moving));
+  EXPECT_EQ(static_pixels + moving_pixels, pixels);
+  EXPECT_EQ(jsonNumber(fused, "gt_pixels", "moving_all"), moving_pixels);
+  EXPECT_GT(jsonNumber(mesh, "completeness", "accuracy"), 0.3); // the mesh's own accuracy row
+  // Two frames: the cars are where the last frame saw them, which the figure counts.
+  const double ghosts = jsonNumber(mesh, "share", "ghosts");
+  EXPECT_GT(ghosts, 0.0);
+  EXPECT_LT(ghosts, 0.5);
+  EXPECT_GT(jsonNumber(mesh, "vertices", "ghosts"), 1000.0);
+  EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
+}
+
+TEST(ReconstructEvaluation, BadInputIsAClearErrorAndLeavesNoOutput) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  auto fails = [&](const std::string& dataset, const std::string& options, const std::string& message) {
+    const std::string out = dir.file("out");
+    const auto r = msf::test::runTool("msf_reconstruct", dataset + " -frames 0:1 -panels 0 -o " + out + " " + options);
+    EXPECT_NE(r.exit_code, 0) << options;
+    EXPECT_NE(r.err.find("msf_reconstruct: error: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << "a failed run left " << out;
+  };
+  const std::string without_poses = kittiCopy(dir.file("no_poses"), false, false);
+  fails(without_poses, "-holdout", "has no poses");
+  const std::string no_rings = kittiCopy(dir.file("no_rings"), true, true);
+  fails(no_rings, "-holdout", "000000.bin' has 1 ring id(s) and none is held out");
+  const std::string kitti = msf::test::kittiDir() + "/odometry/sequences/04";
+  fails(kitti, "-compare_sources garbage", "got '" + kitti + "' and 'garbage' too");
+  fails(kitti, "-compare_sources=lidar", "-compare_sources=lidar");
+  std::ofstream(dir.file("rings.yaml")) << "%YAML:1.0\nrings:\n  modulo: 1\n";
+  fails(kitti, "-holdout -config " + dir.file("rings.yaml"), "rings.modulo");
+  // Without -holdout the sorted scans are only scans: the map is made.
+  const auto r = msf::test::runTool("msf_reconstruct", no_rings + " -frames 0:0 -panels 0 -o " + dir.file("ok"));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
