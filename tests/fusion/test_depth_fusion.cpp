@@ -175,11 +175,14 @@ TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
   const float d = (20.f * vS + 21.f * vL) / (vL + vS); // 20.8
   const auto f = msf::fuseUncertainty(in, config, static_cast<float>(kFB));
   EXPECT_NEAR(f.z, kFB / d, 1e-4);
-  // The weight is the inverse variance of the fused depth: sigma_z = z^2 sigma_d / (f B) with
-  // 1 / sigma_d^2 = 1 / vL + 1 / vS.
-  const float z = static_cast<float>(kFB / d);
-  const float sigma_z = z * z * std::sqrt(vL * vS / (vL + vS)) / static_cast<float>(kFB);
-  EXPECT_NEAR(f.weight, 1.f / (sigma_z * sigma_z), 1e-3f * f.weight);
+  // The weight is the inverse variance of the fused depth, the sum of the two sources':
+  // the LiDAR's range noise and interpolation error (0.05 px a pixel of distance, in depth),
+  // the stereo's 0.3 px in depth.
+  const float fb = static_cast<float>(kFB), z_L = in.z_lidar, z_S = in.z_stereo;
+  const float interpolation = z_L * z_L * 0.05f * 6.f / fb, range = config.lidar_range_sigma_m;
+  const float sigma_S = z_S * z_S * 0.3f / fb;
+  EXPECT_NEAR(f.weight, 1.f / (range * range + interpolation * interpolation) + 1.f / (sigma_S * sigma_S),
+              1e-3f * f.weight);
   // Far apart (4 px > 3 * sqrt(0.45)): not averaged, the more certain (stereo) wins.
   in.z_stereo = static_cast<float>(kFB / 24.0);
   EXPECT_FLOAT_EQ(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, in.z_stereo);
@@ -212,10 +215,13 @@ TEST(DepthFusionUncertainty, WeightsAreInverseDepthVariancesThatTrustTheLidar) {
     return msf::fuseUncertainty(in, config, fb).weight;
   };
   const float lidar = weight(10.f, 0.f, 0.f, 1.f), stereo = weight(0.f, 0.f, 10.f, 1.f);
-  const float sigma_lidar = 100.f * config.lidar_sigma_px / fb;
-  EXPECT_NEAR(lidar, 1.f / (sigma_lidar * sigma_lidar), 1e-3f * lidar);
-  // A real return outweighs the best stereo match at the same depth by (0.5 / 0.1)^2.
-  EXPECT_NEAR(lidar / stereo, std::pow(config.stereo_sigma_min_px / config.lidar_sigma_px, 2.f), 1e-3f);
+  // A real return: the LiDAR's range noise, at any depth.
+  EXPECT_NEAR(lidar, 1.f / (config.lidar_range_sigma_m * config.lidar_range_sigma_m), 1e-3f * lidar);
+  EXPECT_NEAR(weight(40.f, 0.f, 0.f, 1.f), lidar, 1e-3f * lidar);
+  // The best stereo match: its disparity sigma in depth.
+  const float sigma_stereo = 100.f * config.stereo_sigma_min_px / fb;
+  EXPECT_NEAR(stereo, 1.f / (sigma_stereo * sigma_stereo), 1e-3f * stereo);
+  EXPECT_GT(lidar, 10.f * stereo);
   // Both agreeing: more than either alone.
   EXPECT_GT(weight(10.f, 0.f, 10.f, 1.f), lidar);
   // Interpolated LiDAR far from a return, and weak stereo, weigh less.

@@ -218,6 +218,20 @@ TEST(PipelineConfig, ShippedFilesLoadAndBadSchedulingKeysAreNamed) {
   }
 }
 
+TEST(PipelineConfig, ShippedFilesAreTheDefaults) {
+  // One truth: msf_reconstruct without -config (make demo, the README's main command) runs
+  // what the shipped files say, so their figures are the defaults' figures.
+  auto printed = [](const msf::PipelineConfig& c) {
+    std::ostringstream out;
+    c.print(out);
+    return out.str();
+  };
+  for (const char* name : {"kitti.yaml", "synthetic.yaml"})
+    EXPECT_EQ(printed(msf::PipelineConfig::load(msf::test::sourceDir() + "/config/" + name)),
+              printed(msf::PipelineConfig{}))
+        << name;
+}
+
 TEST(PipelineConfig, ThePrintedConfigurationIsCompleteAndReadsBackToTheSame) {
   msf::test::TempDir dir;
   auto printed = [](const msf::PipelineConfig& c) {

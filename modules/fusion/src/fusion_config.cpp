@@ -40,6 +40,7 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   readKey(node, "paper_stereo_reference_depth_m", paper_stereo_reference_depth_m);
   readKey(node, "paper_min_stereo_confidence", paper_min_stereo_confidence);
   readKey(node, "stereo_sigma_min_px", stereo_sigma_min_px);
+  readKey(node, "lidar_range_sigma_m", lidar_range_sigma_m);
   readKey(node, "stereo_sigma_max_px", stereo_sigma_max_px);
   readKey(node, "lidar_sigma_px", lidar_sigma_px);
   readKey(node, "lidar_sigma_per_distance", lidar_sigma_per_distance);
@@ -62,6 +63,7 @@ void DepthFusionConfig::validate() const {
   positive(paper_stereo_reference_depth_m, "paper_stereo_reference_depth_m");
   positive(paper_min_stereo_confidence, "paper_min_stereo_confidence");
   positive(stereo_sigma_min_px, "stereo_sigma_min_px");
+  positive(lidar_range_sigma_m, "lidar_range_sigma_m");
   if (!(stereo_sigma_max_px >= stereo_sigma_min_px))
     throw ConfigError("config key 'fusion.stereo_sigma_max_px' must be >= stereo_sigma_min_px");
   positive(lidar_sigma_px, "lidar_sigma_px");
@@ -93,6 +95,7 @@ void DepthFusionConfig::print(std::ostream& out) const {
       << "  lidar_sigma_px: " << configValue(lidar_sigma_px) << "\n"
       << "  lidar_sigma_per_distance: " << configValue(lidar_sigma_per_distance) << "\n"
       << "  lidar_sigma_per_range: " << configValue(lidar_sigma_per_range) << "\n"
+      << "  lidar_range_sigma_m: " << configValue(lidar_range_sigma_m) << "\n"
       << "  disagreement_k_sigma: " << configValue(disagreement_k_sigma) << "\n"
       << "  lidar_range_window_px: " << configValue(lidar_range_window_px) << "\n"
       << "  parallax_check: " << configValue(parallax_check) << "\n"

@@ -29,7 +29,9 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
   out.depth = depth;
   out.color = result.fused.color;
   out.camera = result.fused.camera;
-  // The LiDAR's disparity range around each pixel, as the fusion measures it for its sigma.
+  // The LiDAR alone has no stereo to settle its edges (returns seen past a foreground edge,
+  // interpolation across one): its weight counts the local disparity range too, as the
+  // fusion's sigma does.
   cv::Mat range;
   if (lidar)
     localDisparityRange(depth, focal_baseline, fusion.lidar_range_window_px, range);
@@ -40,9 +42,12 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
     const float* c = cue.empty() ? nullptr : cue.ptr<float>(v);
     float* w = out.weight.ptr<float>(v);
     for (int u = 0; u < depth.cols; ++u) {
-      const float sigma = lidar ? lidarSigmaPx(c ? c[u] : 0.f, range.ptr<float>(v)[u], fusion)
-                                : stereoSigmaPx(c ? c[u] : 1.f, fusion);
-      w[u] = std::isfinite(z[u]) && z[u] > 0.f ? depthWeight(z[u], 1.f / (sigma * sigma), fb) : 0.f;
+      const bool valid = std::isfinite(z[u]) && z[u] > 0.f;
+      const float sigma = stereoSigmaPx(c ? c[u] : 1.f, fusion);
+      w[u] = !valid ? 0.f
+             : lidar ? lidarDepthWeight(z[u], lidarSigmaPx(c ? c[u] : 0.f, range.ptr<float>(v)[u], fusion) -
+                                                  fusion.lidar_sigma_px, fb, fusion)
+                     : depthWeight(z[u], 1.f / (sigma * sigma), fb);
     }
   }
   out.validate();

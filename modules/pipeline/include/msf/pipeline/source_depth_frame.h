@@ -17,9 +17,9 @@ const char* toString(DepthSource source);
 
 /// What the integrator gets from one source of a frame: the source's depth, the fused
 /// colour (sampled at the fused depth) and, as the fused depth's, the inverse variance of
-/// each depth (depthWeight) by the fusion's own sigma of that source: lidarSigmaPx from the
-/// distance to the nearest real return and the local disparity range, stereoSigmaPx from
-/// SGBM's confidence. So a single-source map is weighed as the fused one is. Throws
+/// each depth by the fusion's own model of that source: lidarDepthWeight of lidarSigmaPx (the
+/// distance to the nearest real return and the local disparity range: the LiDAR alone has no
+/// stereo to settle its edges), depthWeight of stereoSigmaPx from SGBM's confidence. Throws
 /// InvalidInputError when the frame has no depth of that source, a cue image of another
 /// size, no fused colour, or f B is not > 0.
 DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const DepthFusionConfig& fusion,
