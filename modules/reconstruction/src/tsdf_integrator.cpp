@@ -23,6 +23,8 @@ double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+using detail::PixelBand;
+
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
 
@@ -37,7 +39,8 @@ inline Float4 clamp4(Float4 v, float lo, float hi) {
 }
 /// A voxel that passed the nearest-pixel test: its projection, depth and nearest pixel.
 struct Candidate {
-  float u, v, z, nearest, scale, band;
+  float u, v, z, nearest;
+  const PixelBand* pixel;
   std::int32_t ui, vi;
   std::uint16_t voxel; ///< index in the block
 };
@@ -280,26 +283,23 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     planeDistanceScale(depth_image, cam, config_.plane, scale_);
   else
     scale_ = cv::Mat(depth_image.size(), CV_32FC1, cv::Scalar(1.f));
-  band_.create(depth_image.size(), CV_32FC1);
-  behind_.create(depth_image.size(), CV_32FC1);
+  // One record per pixel, so that a voxel's update reads them from one cache line.
+  pixels_.resize(static_cast<std::size_t>(width) * height);
   const float sigmas = static_cast<float>(config_.truncation_sigmas);
   const float below_plane = std::min(trunc, vs);
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
-      float* front = band_.ptr<float>(v);
-      float* back = behind_.ptr<float>(v);
+      PixelBand* out = &pixels_[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
         const float noise = w[u] > 0.f ? sigmas / std::sqrt(w[u]) : 0.f;
-        front[u] = std::max(trunc / s[u], noise);
-        back[u] = std::min(front[u], std::max({trunc, below_plane / s[u], noise}));
+        const float front = std::max(trunc / s[u], noise);
+        out[u] = {s[u], front, std::min(front, std::max({trunc, below_plane / s[u], noise})), w[u]};
       }
     }
   });
-  const float* scale_data = scale_.ptr<float>(0);
-  const float* band_data = band_.ptr<float>(0);
-  const std::size_t scale_step = scale_.step1();
+  const PixelBand* pixel_data = pixels_.data();
 
   // 1. Sub-blocks (4^3 voxels) that the truncation band of each pixel's ray crosses, found in
   //    parallel: only those are projected below, which on KITTI's grazing road is a fraction
@@ -328,25 +328,24 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // lose their cache.
   cv::parallel_for_(cv::Range(0, tiles_y), [&](const cv::Range& range) {
     std::vector<std::uint64_t> local;
-    std::array<std::uint64_t, 8> recent;
+    std::array<std::uint64_t, 256> recent;
     recent.fill(~0ull);
-    std::size_t next = 0;
     for (int ty = range.start; ty < range.end; ++ty)
     for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
       const float* depth = depth_image.ptr<float>(v);
-      const float* band_row = band_.ptr<float>(v);
+      const PixelBand* band_row = &pixels_[static_cast<std::size_t>(v) * width];
       float* t_min = &tile_min_[static_cast<std::size_t>(ty) * tiles_x];
       float* t_max = &tile_max_[static_cast<std::size_t>(ty) * tiles_x];
       float* t_band = &tile_band_[static_cast<std::size_t>(ty) * tiles_x];
       for (int tx = 0; tx < tiles_x; ++tx) {
         const float* tile = depth + tx * kTile;
-        const float* tile_band = band_row + tx * kTile;
+        const PixelBand* tile_band = band_row + tx * kTile;
         float lo = t_min[tx], hi = t_max[tx], band = t_band[tx];
         for (int k = 0, n = std::min(kTile, width - tx * kTile); k < n; ++k) {
           const bool valid = tile[k] >= min_d && tile[k] <= max_d; // without branches: holes are unpredictable
           lo = std::min(lo, valid ? tile[k] : std::numeric_limits<float>::infinity());
           hi = std::max(hi, valid ? tile[k] : -std::numeric_limits<float>::infinity());
-          band = std::max(band, valid ? tile_band[k] : 0.f);
+          band = std::max(band, valid ? tile_band[k].front : 0.f);
         }
         t_min[tx] = lo;
         t_max[tx] = hi;
@@ -359,16 +358,17 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         if (!(d >= min_d && d <= max_d))
           continue;
         const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
-        const float z0 = std::max(d - behind_.ptr<float>(v)[u], min_d), z1 = d + band_row[u];
+        const float z0 = std::max(d - band_row[u].behind, min_d), z1 = d + band_row[u].front;
         traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
           const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
           const std::uint64_t k =
               (packKey(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
-          // Neighbouring pixels cross the same few sub-blocks: skip keys seen just before.
-          for (const std::uint64_t r : recent)
-            if (r == k)
-              return;
-          recent[next++ & 7] = k;
+          // Neighbouring pixels cross the same sub-blocks (a grazing band crosses a dozen):
+          // skip keys seen lately, in a small direct-mapped table.
+          std::uint64_t& slot = recent[(k ^ (k >> 17) ^ (k >> 31)) & (recent.size() - 1)];
+          if (slot == k)
+            return;
+          slot = k;
           local.push_back(k);
         });
       }
@@ -401,13 +401,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     const std::uint64_t mark = std::numeric_limits<std::uint64_t>::max();
     for (TsdfBlock* b : blocks)
       b->stamp = mark; // temporary marker, reset below
-    // The blocks the bands cross too, whole: a car that moved on by less than a block left
-    // its old rear in the sub-blocks beside its new one.
+    // Only sub-blocks that hold a surface (a negative voxel): free space has nothing to carve.
+    // Also in the blocks the bands cross: a car that moved on by less than a block left its
+    // old rear in the sub-blocks beside its new one.
     std::fill(masks.begin(), masks.end(), std::uint8_t{0xff});
     // A block may be partly in view when its centre is not: test its bounding sphere.
     const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
     for (const auto& block : volume_.blocks()) {
-      if (block->stamp == mark)
+      if (block->stamp == mark || !block->negative_subblocks)
         continue;
       const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
       if (c.z() + radius < min_d)
@@ -422,7 +423,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       const float d = depth_image.at<float>(vi, ui);
       if (!(d > 0.f) || c.z() - radius < d) {
         blocks.push_back(block);
-        masks.push_back(0xff);
+        masks.push_back(block->negative_subblocks);
       }
     }
   }
@@ -520,11 +521,10 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         const Int4 pixel_v = __builtin_convertvector(clamp4(pv + 0.5f, 0.f, static_cast<float>(height - 1)), Int4);
         const Int4 at = pixel_v * static_cast<int>(depth_step) + pixel_u;
         const Float4 nearest = {depth_data[at[0]], depth_data[at[1]], depth_data[at[2]], depth_data[at[3]]};
-        const Int4 at_scale = pixel_v * static_cast<int>(scale_step) + pixel_u;
-        const Float4 scale = {scale_data[at_scale[0]], scale_data[at_scale[1]], scale_data[at_scale[2]],
-                              scale_data[at_scale[3]]};
-        const Float4 band = {band_data[at_scale[0]], band_data[at_scale[1]], band_data[at_scale[2]],
-                             band_data[at_scale[3]]};
+        const Int4 at_pixel = pixel_v * width + pixel_u;
+        const PixelBand* p[4] = {&pixel_data[at_pixel[0]], &pixel_data[at_pixel[1]], &pixel_data[at_pixel[2]],
+                                 &pixel_data[at_pixel[3]]};
+        const Float4 band = {p[0]->front, p[1]->front, p[2]->front, p[3]->front};
         const Float4 diff = nearest - Z;
         const Int4 ok = inside & (nearest >= min_d) & (nearest <= max_d) & (diff >= -2.f * band) &
                         ((diff <= 2.f * band) | -static_cast<int>(carving));
@@ -536,7 +536,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         __builtin_prefetch(&block.voxels[first + 3], 1);
         for (int k = 0; k < 4; ++k)
           if (lanes & (1 << k)) {
-            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], scale[k], band[k], pixel_u[k], pixel_v[k],
+            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], p[k], pixel_u[k], pixel_v[k],
                                           static_cast<std::uint16_t>(first + k)};
             if (has_color)
               __builtin_prefetch(frame.color.ptr<std::uint8_t>(pixel_v[k]) + 3 * pixel_u[k]);
@@ -545,14 +545,15 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     }
 
     std::size_t updated = 0;
-    std::uint8_t signs = 0;
+    std::uint8_t signs = 0, negative = 0;
     for (std::size_t c = 0; c < n_candidates; ++c) {
       const Candidate& cand = candidates[c];
       const float u = cand.u, v = cand.v;
       const int ui = cand.ui, vi = cand.vi;
       float d = cand.nearest;
       float quad_min = d; // the least depth of the 4 pixels around the projection
-      const float scale = cand.scale;
+      const PixelBand& pixel = *cand.pixel;
+      const float scale = pixel.scale;
       const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
       if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
         const float* r0 = depth_data + v0 * depth_step + u0;
@@ -567,7 +568,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
         }
       }
-      const float diff = d - cand.z, band = cand.band, behind = behind_.ptr<float>(vi)[ui];
+      const float diff = d - cand.z, band = pixel.front, behind = pixel.behind;
       if (diff < -behind)
         continue;
       const bool in_band = diff <= band;
@@ -582,7 +583,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       // 1 / scale^2 times larger, but weighting by it let grazing views of noisy far stereo
       // outweigh the rest: on the synthetic street, 0.145 m mesh accuracy against 0.043 m at
       // the same min_weight, and a worse accuracy at every completeness.)
-      float w = weight_.ptr<float>(vi)[ui];
+      float w = pixel.weight;
       if (!(w > 0.f))
         continue;
       if (!in_band)
@@ -595,6 +596,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       TsdfVoxel& voxel = block.voxels[cand.voxel];
       updateVoxel(voxel, sdf, w, bgr, max_weight);
       signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+      negative |= voxel.sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(cand.voxel)) : 0;
       if (regularized) {
         changed_index_[i * TsdfBlock::kVoxels + updated] = cand.voxel;
         data_term_[i * TsdfBlock::kVoxels + updated] = voxel.sdf;
@@ -606,6 +608,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       block.stamp = stamp;
       // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
       block.signs |= signs;
+      block.negative_subblocks |= negative;
       changed[i] = 1;
     }
   }
@@ -779,7 +782,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         }
         TsdfBlock& block = *touched[i];
         const auto& nb = neighbours[i];
-        std::uint8_t signs = 0;
+        std::uint8_t signs = 0, negative = 0;
         for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
           const int j = changed_index_[k];
           const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
@@ -800,9 +803,12 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           if (count > 0.f)
             sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * count);
           signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+          negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
         }
-        if (last)
+        if (last) {
           block.signs |= signs;
+          block.negative_subblocks |= negative;
+        }
       }
       }, std::max(1.0, static_cast<double>(m) / 16));
     }

@@ -35,15 +35,26 @@ struct TsdfBlock {
   /// changed (the integrator only sets bits, cheaply): that costs the mesher a look, never a
   /// triangle. Code that writes voxels directly sets them too, e.g. with updateSigns().
   std::uint8_t signs = 0;
+  /// Bit k: sub-block k (the 4^3 voxels at 4 * (k & 1, k >> 1 & 1, k >> 2 & 1)) holds (or held)
+  /// an observed voxel with sdf < 0, a surface that free space may have to carve away; set like
+  /// `signs`.
+  std::uint8_t negative_subblocks = 0;
   std::array<TsdfVoxel, kVoxels> voxels{};
 
   static constexpr std::uint8_t kHasPositive = 1, kHasNegative = 2;
+  /// The sub-block of voxel `linear` (see negative_subblocks).
+  static constexpr int subBlockOf(int linear) {
+    return ((linear >> 2) & 1) | (((linear >> 5) & 1) << 1) | (((linear >> 8) & 1) << 2);
+  }
   void updateSigns() {
-    std::uint8_t s = 0;
-    for (const TsdfVoxel& v : voxels)
-      if (v.weight > 0.f)
-        s |= v.sdf < 0.f ? kHasNegative : kHasPositive;
+    std::uint8_t s = 0, negative = 0;
+    for (int i = 0; i < kVoxels; ++i)
+      if (voxels[i].weight > 0.f) {
+        s |= voxels[i].sdf < 0.f ? kHasNegative : kHasPositive;
+        negative |= voxels[i].sdf < 0.f ? static_cast<std::uint8_t>(1u << subBlockOf(i)) : 0;
+      }
     signs = s;
+    negative_subblocks = negative;
   }
 
   static constexpr int linear(int x, int y, int z) { return x + kSide * (y + kSide * z); }
