@@ -498,3 +498,34 @@ TEST(TsdfIntegrator, CarvingRemovesTheGhostOfACarAheadAndKeepsTheStreet) {
   EXPECT_GT(ghosts[0], 1000u);
   EXPECT_LT(ghosts[1], ghosts[0] / 20);
 }
+
+TEST(TsdfIntegrator, ARoofSeenAtAGrazingAngleIsMeshedWithoutASkirt) {
+  // A box 1.2 m tall 8-12 m ahead, its roof 0.45 m below the camera: seen at 2-3 degrees, the
+  // roof's plane runs metres along the rays, but behind its far edge is free space (then the
+  // road 1.2 m lower): the band below the plane stops where the roof is seen to stop.
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.65);
+  scene.addBox(Eigen::Vector3d(0, 1.65 - 0.6, 10), Eigen::Vector3d(0.9, 0.6, 2));
+  const PinholeCamera camera = streetCamera();
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(0.3 * i, 0, 0); // a little sideways: the box stays ahead
+    DepthFrame frame;
+    frame.camera = camera;
+    frame.depth = scene.renderDepth(camera, pose, 60.0); // the road past the box too: free space over it
+    integrator.integrate(frame, pose);
+  }
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  std::size_t roof = 0, skirt = 0;
+  for (const auto& v : mesh.vertices) {
+    const bool over_box = std::abs(v.x()) < 0.8f;
+    roof += over_box && std::abs(v.y() - 0.45f) < 0.05f && v.z() > 8.2f && v.z() < 11.8f;
+    skirt += over_box && v.y() < 1.5f && v.z() > 12.3f && v.z() < 19.f; // above the road behind the box
+  }
+  std::printf("  roof vertices %zu, skirt vertices %zu\n", roof, skirt);
+  EXPECT_GT(roof, 100u);
+  EXPECT_EQ(skirt, 0u);
+}
