@@ -19,8 +19,9 @@ struct FusionInputs {
   float stereo_confidence = 1.f; ///< in [0, 1], stereo_confidence.h
 };
 
-/// Fused depth (0 = none) and its weight (0 = none): the paper method's in [0, 1], the uncertainty
-/// method's the inverse variance of the depth in m^-2 (depthWeight).
+/// Fused depth (0 = none) and its weight (0 = none): fusePaper's in [0, 1], fuseUncertainty's
+/// the inverse variance of the depth in m^-2 (depthWeight). fuseRow gives both methods' in
+/// m^-2, what the integrator averages with.
 struct FusionResult {
   float z = 0.f;
   float weight = 0.f;
