@@ -40,7 +40,7 @@ struct FrameResult {
   StageTimes times;
 };
 
-/// The whole method (DESIGN.md data flow) for a sequence: per frame, LiDAR projection and
+/// The whole method (the README's data flow) for a sequence: per frame, LiDAR projection and
 /// compound interpolation (LidarCompletion: the scan is projected onto the image grown by
 /// a margin, so gaps across the image's border are bridged) run at the same time as SGBM, then the two depth images are
 /// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
