@@ -28,7 +28,7 @@ namespace {
 
 const std::vector<std::string> kValueOptions = {"-poses", "-o", "-voxel", "-trunc", "-lambda", "-sweeps", "-weighting",
                                                 "-max_weight", "-max_depth", "-calib", "-input_dir", "-frames", "-config"};
-const std::vector<std::string> kSwitches = {"-carving", "-print_config"};
+const std::vector<std::string> kSwitches = {"-carving", "-no_carving", "-print_config"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]\n", name);
@@ -51,7 +51,8 @@ void printHelp(const char* name) {
   print_value("%s", msf::configValue(defaults.max_weight).c_str()); print_info(")\n");
   print_info("    -max_depth M        ignore depth beyond M metres (default ");
   print_value("%s", msf::configValue(defaults.max_depth_m).c_str()); print_info(")\n");
-  print_info("    -carving            space carving: voxels seen in front of the surface become free (default ");
+  print_info("    -carving, -no_carving  space carving on or off: voxels seen in front of the surface become free\n"
+             "                        (default ");
   print_value("%s", defaults.space_carving ? "on" : "off"); print_info("; tsdf_integrator.space_carving)\n");
   print_info("    -config FILE        YAML with sections tsdf_volume and tsdf_integrator; flags override it\n");
   print_info("    -print_config       print the configuration in use\n");
@@ -107,8 +108,12 @@ int run(int argc, char** argv) {
   std::string weighting;
   if (msf::tool::parseArgument(argc, argv, "-weighting", weighting) >= 0)
     config.weighting = msf::parseWeighting(weighting);
+  if (find_switch(argc, argv, "-carving") && find_switch(argc, argv, "-no_carving"))
+    throw msf::InvalidInputError("-carving and -no_carving together: choose one");
   if (find_switch(argc, argv, "-carving"))
     config.space_carving = true;
+  if (find_switch(argc, argv, "-no_carving"))
+    config.space_carving = false;
   msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
   msf::TsdfIntegrator integrator(volume, config);
   if (find_switch(argc, argv, "-print_config")) {
