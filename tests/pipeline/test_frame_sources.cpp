@@ -116,3 +116,52 @@ TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndTheFusionsWeights) {
 }
 
 } // namespace
+
+namespace {
+
+TEST(FusedDepthFrame, TheFusedImageInTheLidarsCanvas) {
+  // A 4x2 image in a canvas grown by 1 pixel: the margin takes the LiDAR's depth and weight,
+  // the image its fused depth and weight, the colours of the image's border repeated.
+  msf::FrameResult r;
+  r.name = "000003";
+  r.fused.depth = cv::Mat(2, 4, CV_32FC1, cv::Scalar(7.f));
+  r.fused.weight = cv::Mat(2, 4, CV_32FC1, cv::Scalar(50.f));
+  r.fused.color = cv::Mat(2, 4, CV_8UC3, cv::Scalar(10, 20, 30));
+  r.fused.camera.fx = r.fused.camera.fy = 100.f;
+  r.fused.camera.cx = 1.5f, r.fused.camera.cy = 0.5f;
+  r.fused.camera.width = 4, r.fused.camera.height = 2;
+  const msf::DepthFusionConfig fusion;
+  const double fb = 386.0;
+  // Without a canvas: the fused frame as it is.
+  EXPECT_EQ(msf::fusedDepthFrame(r, fusion, fb).depth.data, r.fused.depth.data);
+
+  r.lidar_canvas_depth = cv::Mat(4, 6, CV_32FC1, cv::Scalar(9.f));
+  r.lidar_canvas_distance = cv::Mat(4, 6, CV_32FC1, cv::Scalar(0.f));
+  r.lidar_canvas_camera = r.fused.camera;
+  r.lidar_canvas_camera.cx += 1.f, r.lidar_canvas_camera.cy += 1.f;
+  r.lidar_canvas_camera.width = 6, r.lidar_canvas_camera.height = 4;
+  const msf::DepthFrame f = msf::fusedDepthFrame(r, fusion, fb);
+  ASSERT_EQ(f.depth.size(), cv::Size(6, 4));
+  EXPECT_EQ(f.camera.cx, 2.5f);
+  EXPECT_EQ(f.depth.at<float>(0, 0), 9.f);  // margin: the LiDAR
+  EXPECT_EQ(f.depth.at<float>(1, 1), 7.f);  // image: the fused depth
+  EXPECT_EQ(f.weight.at<float>(1, 1), 50.f);
+  // A real return in the margin weighs the LiDAR's range noise.
+  EXPECT_NEAR(f.weight.at<float>(3, 5), 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m), 1e-2f);
+  EXPECT_EQ(f.color.at<cv::Vec3b>(0, 0), cv::Vec3b(10, 20, 30));
+  f.validate();
+  // The LiDAR alone lives on the canvas too.
+  r.lidar_depth = cv::Mat(2, 4, CV_32FC1, cv::Scalar(9.f));
+  r.lidar_distance = cv::Mat(2, 4, CV_32FC1, cv::Scalar(0.f));
+  EXPECT_EQ(msf::sourceDepthFrame(r, msf::DepthSource::Lidar, fusion, fb).depth.size(), cv::Size(6, 4));
+  // A canvas that cannot hold the image is an error naming the frame.
+  r.lidar_canvas_distance = cv::Mat(3, 6, CV_32FC1, cv::Scalar(0.f));
+  try {
+    msf::fusedDepthFrame(r, fusion, fb);
+    ADD_FAILURE() << "a bad canvas was accepted";
+  } catch (const msf::InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 000003's LiDAR canvas"), std::string::npos) << e.what();
+  }
+}
+
+} // namespace
