@@ -455,6 +455,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const bool carving = config_.space_carving;
   const float carving_weight = static_cast<float>(config_.carving_weight);
   const bool dropoff = config_.weight_dropoff;
+  const float colour_band = 1.5f * vs;
   const float max_weight = config_.max_weight;
   const bool has_color = !frame.color.empty();
   std::vector<char> changed(blocks.size(), 0);
@@ -605,7 +606,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         w *= (behind * scale + sdf) / (behind * scale - vs); // behind the surface the observation is a guess
       if (!(w > 0.f))
         continue; // at the band's far end the drop-off leaves nothing
-      const std::uint8_t* bgr = (has_color && in_band) ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
+      // Colour only near the surface: the mesh's vertices take it from the voxels on either side.
+      const bool coloured = has_color && in_band && std::abs(sdf) < colour_band;
+      const std::uint8_t* bgr = coloured ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
       TsdfVoxel& voxel = block.voxels[cand.voxel];
       updateVoxel(voxel, sdf, w, bgr, max_weight, trunc);
       signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
