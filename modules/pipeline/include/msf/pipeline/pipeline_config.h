@@ -4,6 +4,7 @@
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/ring_split.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/stereo/sgbm_config.h>
 
@@ -50,6 +51,7 @@ struct PipelineConfig {
   TsdfIntegrator::Config integrator;        ///< `tsdf_integrator`
   MarchingCubes::Config mesher;             ///< `marching_cubes`
   SchedulingConfig scheduling;              ///< `pipeline`
+  StreamingMap::Config streaming;           ///< `streaming`: the map in bounded memory (off by default)
 
   /// Defaults overridden by the sections present in `path` ("" = all defaults).
   /// Throws IOError for a missing file, ConfigError naming a bad key.
