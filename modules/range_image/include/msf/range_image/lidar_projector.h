@@ -15,7 +15,7 @@ namespace msf {
 
 /// Section `projection` of the YAML config.
 struct ProjectionConfig {
-  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills
+  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills; the pipeline needs 0
   float min_range_m = 0.f;    ///< returns closer to the LiDAR than this are dropped
   float max_range_m = 120.f;  ///< returns farther than this are dropped (HDL-64E: 120 m)
   /// Border of the canvas (projectToCanvas): returns up to this many pixels outside the
