@@ -9,6 +9,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <memory>
 #include <vector>
 
 namespace msf {
@@ -40,6 +41,9 @@ struct ProjectionConfig {
 /// Not thread-safe: an object keeps per-point work buffers between scans.
 class LidarProjector {
 public:
+  using Ptr = std::shared_ptr<LidarProjector>;
+  using ConstPtr = std::shared_ptr<const LidarProjector>;
+
   LidarProjector() = default;
   /// Throws CalibrationError when the calibration has no image size, ConfigError for a
   /// bad config.
