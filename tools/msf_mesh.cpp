@@ -25,7 +25,8 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-region"};
+const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-voxel", "-trunc",
+                                                 "-region"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <volume.pcd | STORE_DIR> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
@@ -39,6 +40,9 @@ void printHelp(const char* name) {
              "                    remove connected pieces of fewer than N triangles (default ");
   print_value("%s", msf::configValue(defaults.min_component_triangles).c_str()); print_info("; 0 keeps all)\n");
   print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
+  print_info("    -voxel V -trunc T\n"
+             "                    voxel size and truncation (m) of a volume whose header comment a PCL\n"
+             "                    rewrite dropped (otherwise read from the file, and checked if given)\n");
   print_info("    -region x0,y0,z0,x1,y1,z1  a store's tiles within this box only (metres, world frame)\n");
 }
 
@@ -49,6 +53,8 @@ int remeshStore(const std::string& store, const std::string& output, const msf::
     throw msf::InvalidInputError("output mesh '" + output + "': a store is meshed into a .ply");
   if (config.min_component_triangles > 0)
     throw msf::InvalidInputError("-min_component_triangles: a store is meshed tile by tile, pieces cross tiles");
+  if (find_argument(argc, argv, "-voxel") >= 0 || find_argument(argc, argv, "-trunc") >= 0)
+    throw msf::InvalidInputError("-voxel and -trunc are for a volume .pcd: a store's index gives them");
   Eigen::Vector3d lo = Eigen::Vector3d::Ones(), hi = Eigen::Vector3d::Zero();
   std::string region;
   if (msf::tool::parseArgument(argc, argv, "-region", region) >= 0) {
@@ -110,7 +116,12 @@ int run(int argc, char** argv) {
   print_highlight("Loading ");
   print_value("%s ", files[0].c_str());
   tt.tic();
-  const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0]);
+  double voxel = 0, trunc = 0;
+  msf::tool::parseArgument(argc, argv, "-voxel", voxel);
+  msf::tool::parseArgument(argc, argv, "-trunc", trunc);
+  if (voxel < 0 || trunc < 0 || !std::isfinite(voxel) || !std::isfinite(trunc))
+    throw msf::InvalidInputError("-voxel and -trunc must be > 0 m");
+  const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0], voxel, trunc);
   msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
 
   print_highlight("Meshing ");
