@@ -92,6 +92,9 @@ struct GroundTruthScores {
   std::unique_ptr<msf::synthetic::GroundTruth> truth;
   std::map<std::string, msf::DepthErrorAccumulator> all, background, foreground;
   std::vector<Eigen::Vector3f> seen_surface;  // ground-truth depth back-projected to the world
+  /// For the mesh's completeness; not for a streamed map (no mesh scores): it grows by ~0.3 MB
+  /// a frame, what a drive in bounded memory cannot keep.
+  bool keep_surface = true;
 
   void add(const msf::FrameResult& r, const cv::Mat& gt, const msf::Calibration& calibration, double max_depth_m) {
     const std::size_t gt_index = truth->indexOf(r.name);
@@ -106,6 +109,8 @@ struct GroundTruthScores {
     }
     // Every 4th pixel of the true static surface in range, for the mesh's completeness against
     // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
+    if (!keep_surface)
+      return;
     const cv::Mat moving = truth->movingMask(gt_index);
     const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
     const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
@@ -377,6 +382,7 @@ int main(int argc, char** argv) {
     GroundTruthScores scores;
     if (!sequence.groundTruthDir().empty())
       scores.truth = std::make_unique<msf::synthetic::GroundTruth>(sequence.groundTruthDir());
+    scores.keep_surface = !streaming;
 
     // Protocol 4: the held-out rings with -holdout, else a synthetic sequence's exact depth.
     std::unique_ptr<msf::ReconstructionEvaluation> evaluation;
