@@ -46,6 +46,7 @@ LidarProjector::LidarProjector(const Calibration& calibration, const ProjectionC
 }
 
 void LidarProjector::setCalibration(const Calibration& calibration) {
+  calibration.requireVelodyne();
   camera_ = PinholeCamera::fromCalibration(calibration, config_.camera);
   // P_i = K_i [I | t_i] on the rectified frame of camera 0, so the point in camera i's
   // frame is X_0 + K_i^-1 P_i.col(3) (a translation only: the cameras share one plane).
