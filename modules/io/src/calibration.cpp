@@ -291,6 +291,8 @@ Calibration loadCalibration(const std::string& path, cv::Size image_size) {
   return c;
 }
 
+std::string cameraFrameId(int camera) { return "camera_" + std::to_string(camera); }
+
 cv::Size parseImageSize(const std::string& text) {
   if (text.empty())
     return {0, 0};

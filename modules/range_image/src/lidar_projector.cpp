@@ -188,6 +188,8 @@ void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   cloud.resize(static_cast<std::size_t>(W) * H);
   cloud.width = static_cast<std::uint32_t>(W);
   cloud.height = static_cast<std::uint32_t>(H);
+  cloud.header = scan.header; // the scan's stamp, in the camera's frame
+  cloud.header.frame_id = cameraFrameId(config_.camera);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
   const int* w = winner_.ptr<int>();

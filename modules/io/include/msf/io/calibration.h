@@ -62,6 +62,11 @@ Calibration loadCalibration(const std::string& path);
 /// throws CalibrationError naming both.
 Calibration loadCalibration(const std::string& path, cv::Size image_size);
 
+/// The frame id of clouds in a rectified camera's frame ("camera_0" .. "camera_3"); scans of
+/// a Sequence are in "velodyne". Stamps are microseconds from the sequence's first frame.
+std::string cameraFrameId(int camera);
+inline constexpr const char* kVelodyneFrameId = "velodyne";
+
 /// "WxH" (e.g. 1242x375) to a size, "" to {0, 0} (none given); throws InvalidInputError
 /// naming the text otherwise.
 cv::Size parseImageSize(const std::string& text);
