@@ -178,6 +178,11 @@ void RunReport::writeSummaryJson(const std::string& path) const {
   s << "{\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
     << "  \"layout\": " << jsonString(layout) << ",\n"
+    << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);
+  if (!pose_ms.empty())
+    s << ", \"estimate_ms\": {\"median\": " << num(median(pose_ms), 3) << ", \"p95\": " << num(percentile(pose_ms, 95), 3)
+      << "}";
+  s << "},\n"
     << "  \"frames\": " << frames.size() << ",\n"
     << "  \"frames_requested\": " << frames_requested << ",\n"
     << "  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n"
@@ -263,6 +268,11 @@ void RunReport::writeMarkdown(const std::string& path) const {
     << "Dataset `" << dataset << "` (" << layout << "), " << frames.size() << " of " << frames_requested
     << " frames" << (interrupted ? " (interrupted: the map holds the frames integrated before the stop)" : "")
     << ". Voxel " << num(voxel_size_m) << " m, lambda " << num(lambda) << ".\n\n"
+    << "Trajectory: " << trajectory << ", [`" << poses_file << "`](" << poses_file << ")";
+  if (!pose_ms.empty())
+    s << "; the odometry took " << num(median(pose_ms), 1) << " ms per frame (median, p95 "
+      << num(percentile(pose_ms, 95), 1) << ") on the loading thread";
+  s << ".\n\n"
     << "## Speed\n\n"
     << num(framesPerSecond(), 2) << " frames per second end to end (" << num(wall_s, 2) << " s; "
     << num(framesPerSecondAfterFirst(), 2) << " after the first frame, done at " << num(first_frame_s, 2)

@@ -52,6 +52,8 @@ public:
 
   std::string dataset;            ///< folder reconstructed
   std::string layout;             ///< odometry, raw or synthetic
+  std::string trajectory;         ///< where the poses came from, in words (PoseSource::description)
+  std::vector<double> pose_ms;    ///< per frame, when the poses were estimated on the loading thread
   std::size_t frames_requested = 0;
   bool interrupted = false;
   double wall_s = 0;
@@ -74,6 +76,7 @@ public:
   std::string config_file;                    ///< its copy beside the report, e.g. config.yaml
   std::vector<std::string> depth_panels;      ///< file names of the depth panels written
   std::string mesh_file = "mesh.ply", volume_file = "volume.pcd", preview_file;
+  std::string poses_file = "poses.txt";        ///< the poses used, T_world_cam0 in KITTI's format
 
   /// Frames over the whole run, wall_s: with the first frame's way through the empty pipeline.
   double framesPerSecond() const;
