@@ -1,6 +1,6 @@
 // SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads),
 // each with both engines side by side (stereo.engine: native = our AVX2 SemiGlobalMatcher,
-// opencv = cv::StereoSGBM): the DESIGN.md baseline (3-way, 128 disparities, block 5), the
+// opencv = cv::StereoSGBM): the baseline docs/results.md quotes (3-way, 128 disparities, block 5), the
 // same narrowed by the interpolated LiDAR depth (stereo.prior_search_range), and with the
 // explicit left-right check. Times are of SgbmStereo::computeDisparity (matching,
 // conversion, confidence); cpu_ms_all_threads is the process CPU time per frame (all threads).

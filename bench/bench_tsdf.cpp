@@ -40,7 +40,7 @@ namespace {
 constexpr double kVoxel = 0.1, kTrunc = 0.3, kMaxDepth = 40.0;
 constexpr int kFrames = static_cast<int>(msf::bench::kFrames);
 
-/// SGBM depth of the KITTI frames (as DESIGN.md's baseline: 3-way, 128 disparities, block 5),
+/// SGBM depth of the KITTI frames (as the baseline docs/results.md quotes: 3-way, 128 disparities, block 5),
 /// also written as KITTI depth PNGs for the Open3D script.
 struct Data {
   std::vector<DepthFrame> frames;

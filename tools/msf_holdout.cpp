@@ -1,4 +1,4 @@
-// Evaluation protocol 2 (DESIGN.md): ring hold-out on real KITTI scans. One row per
+// Evaluation protocol 2 (docs/design.md): ring hold-out on real KITTI scans. One row per
 // method: the table a user compares depth methods with. On a synthetic sequence (gt/ beside
 // it, protocol 3) the whole scan is the input and every pixel of gt/depth_0 is ground truth,
 // reported for all, background and foreground pixels (the paper's Table 1).

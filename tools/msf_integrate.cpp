@@ -28,14 +28,14 @@ namespace {
 
 const std::vector<std::string> kValueOptions = {"-poses", "-o", "-voxel", "-trunc", "-lambda", "-sweeps", "-weighting",
                                                 "-max_weight", "-max_depth", "-calib", "-input_dir", "-frames", "-config"};
-const std::vector<std::string> kSwitches = {"-carving", "-print_config"};
+const std::vector<std::string> kSwitches = {"-carving", "-no_carving", "-print_config"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]\n", name);
   print_info("  Integrates organized depth clouds (rectified camera 0 frame, NaN where there is no depth)\n"
              "  into a sparse TSDF volume, the i-th cloud seen from the i-th pose (T_world_cam, KITTI\n"
-             "  odometry format). A cloud's rgb colours the voxels; a 'weight' field is used with\n"
-             "  -weighting per_pixel. Options:\n");
+             "  odometry format). A cloud's rgb colours the voxels; a 'weight' field (1/sigma^2 of the depth,\n"
+             "  msf_fuse's) is used with -weighting per_pixel. Options:\n");
   print_info("    -input_dir DIR      also every .pcd of DIR, in name order\n");
   print_info("    -frames a:b         the poses of these lines (0-based) only, when the file has more\n");
   print_info("    -calib PATH         camera intrinsics (KITTI calib.txt, raw folder or YAML); default:\n"
@@ -44,10 +44,16 @@ void printHelp(const char* name) {
   print_info("    -trunc M            truncation distance in metres (default "); print_value("0.3"); print_info(")\n");
   print_info("    -lambda L           eq. 7 regularization (default "); print_value("0"); print_info(", the paper's KITTI value is 5)\n");
   print_info("    -sweeps N           Gauss-Seidel sweeps per frame (default "); print_value("1"); print_info(")\n");
-  print_info("    -weighting W        constant | inverse_square | per_pixel (default constant)\n");
-  print_info("    -max_weight W       weight at which a voxel saturates (default "); print_value("100"); print_info(")\n");
-  print_info("    -max_depth M        ignore depth beyond M metres (default "); print_value("80"); print_info(")\n");
-  print_info("    -carving            space carving: voxels seen in front of the surface become free\n");
+  const msf::TsdfIntegrator::Config defaults; // the help says what the code does
+  print_info("    -weighting W        constant | inverse_square | per_pixel (default ");
+  print_value("%s", msf::toString(defaults.weighting)); print_info(")\n");
+  print_info("    -max_weight W       weight (m^-2) at which a voxel saturates (default ");
+  print_value("%s", msf::configValue(defaults.max_weight).c_str()); print_info(")\n");
+  print_info("    -max_depth M        ignore depth beyond M metres (default ");
+  print_value("%s", msf::configValue(defaults.max_depth_m).c_str()); print_info(")\n");
+  print_info("    -carving, -no_carving  space carving on or off: voxels seen in front of the surface become free\n"
+             "                        (default ");
+  print_value("%s", defaults.space_carving ? "on" : "off"); print_info("; tsdf_integrator.space_carving)\n");
   print_info("    -config FILE        YAML with sections tsdf_volume and tsdf_integrator; flags override it\n");
   print_info("    -print_config       print the configuration in use\n");
 }
@@ -102,8 +108,12 @@ int run(int argc, char** argv) {
   std::string weighting;
   if (msf::tool::parseArgument(argc, argv, "-weighting", weighting) >= 0)
     config.weighting = msf::parseWeighting(weighting);
+  if (find_switch(argc, argv, "-carving") && find_switch(argc, argv, "-no_carving"))
+    throw msf::InvalidInputError("-carving and -no_carving together: choose one");
   if (find_switch(argc, argv, "-carving"))
     config.space_carving = true;
+  if (find_switch(argc, argv, "-no_carving"))
+    config.space_carving = false;
   msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
   msf::TsdfIntegrator integrator(volume, config);
   if (find_switch(argc, argv, "-print_config")) {

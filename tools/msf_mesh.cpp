@@ -25,10 +25,12 @@ const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_t
 void printHelp(const char* name) {
   print_error("Syntax is: %s <volume.pcd> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
   print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. Options:\n");
-  print_info("    -min_weight W   voxels with weight <= W make no triangles (default "); print_value("0"); print_info(")\n");
+  const msf::MarchingCubes::Config defaults; // the help says what the code does
+  print_info("    -min_weight W   voxels with weight <= W (m^-2, an inverse variance) make no triangles (default ");
+  print_value("%s", msf::configValue(defaults.min_weight).c_str()); print_info(")\n");
   print_info("    -min_component_triangles N\n"
              "                    remove connected pieces of fewer than N triangles (default ");
-  print_value("0"); print_info(": keep all)\n");
+  print_value("%s", msf::configValue(defaults.min_component_triangles).c_str()); print_info("; 0 keeps all)\n");
   print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
 }
 

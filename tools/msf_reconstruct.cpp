@@ -103,14 +103,16 @@ struct GroundTruthScores {
       background[name].add(gt, estimate, fb, bg);
       foreground[name].add(gt, estimate, fb, fg);
     }
-    // Every 4th pixel of the true surface in range, for the mesh's completeness.
+    // Every 4th pixel of the true static surface in range, for the mesh's completeness against
+    // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
+    const cv::Mat moving = truth->movingMask(gt_index);
     const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
     const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
     const Eigen::Isometry3f T = r.T_world_cam0.cast<float>();
     for (int v = 0; v < gt.rows; v += 4)
       for (int u = 0; u < gt.cols; u += 4) {
         const float z = gt.at<float>(v, u);
-        if (z > 0.f && z <= max_depth_m)
+        if (z > 0.f && z <= max_depth_m && moving.at<std::uint8_t>(v, u) == 0)
           seen_surface.push_back(T * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
       }
   }

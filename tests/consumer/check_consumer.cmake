@@ -1,6 +1,7 @@
 # ctest script: install the build tree into a scratch prefix, then configure, build and run a
-# consumer project whose source is the library example of README.md.
-# In: BUILD_DIR, SOURCE_DIR (this folder), README, WORK_DIR, KITTI_DIR.
+# consumer project made of the README's library example: its C++ block (example.cpp) and its
+# CMake block (CMakeLists.txt), between <!-- example:consumer:begin --> and ...:end -->.
+# In: BUILD_DIR, README, WORK_DIR, KITTI_DIR.
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run step)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -12,14 +13,11 @@ endfunction()
 
 run("install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 
-# The README's example, between its markers, is the consumer's source.
-file(READ ${README} readme)
-string(REGEX MATCH "<!-- example:begin -->[^`]*```cpp\n(.*)```[^`]*<!-- example:end -->" found "${readme}")
-if(NOT found)
-  message(FATAL_ERROR "README.md has no ```cpp block between <!-- example:begin --> and <!-- example:end -->")
-endif()
-file(WRITE ${WORK_DIR}/src/example.cpp "${CMAKE_MATCH_1}")
-file(COPY ${SOURCE_DIR}/CMakeLists.txt DESTINATION ${WORK_DIR}/src)
+include(${CMAKE_CURRENT_LIST_DIR}/../readme_blocks.cmake)
+msf_readme_block(${README} consumer cpp source source_line)
+msf_readme_block(${README} consumer cmake lists lists_line)
+file(WRITE ${WORK_DIR}/src/example.cpp "#line ${source_line} \"${README}\"\n${source}")
+file(WRITE ${WORK_DIR}/src/CMakeLists.txt "${lists}")
 
 run("configure" ${CMAKE_COMMAND} -S ${WORK_DIR}/src -B ${WORK_DIR}/build -DCMAKE_BUILD_TYPE=Release
     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
@@ -34,7 +32,7 @@ if(NOT EXISTS ${scan})
   message(STATUS "KITTI sample not found: the consumer was built but not run")
   return()
 endif()
-run("run" ${WORK_DIR}/build/example ${calib} ${scan})
+run("run" ${WORK_DIR}/build/app ${calib} ${scan})
 if(NOT last_output MATCHES "124231 points")
   message(FATAL_ERROR "unexpected output of the example: ${last_output}")
 endif()

@@ -114,7 +114,7 @@ TEST(DisparityMetrics, BadInputNamesTheImage) {
   EXPECT_THROW(msf::interpolateBackground(cv::Mat(2, 2, CV_8U)), msf::InvalidInputError);
 }
 
-// The devkit's sample: D1 of disp_est against disp_gt is 13.62 % (DESIGN.md protocol 1).
+// The devkit's sample: D1 of disp_est against disp_gt is 13.62 % (protocol 1, docs/design.md).
 TEST(DisparityMetricsKitti, DevkitSampleD1) {
   MSF_REQUIRE_KITTI();
   const std::string dir = msf::test::kittiDir() + "/stereo2015_devkit/";

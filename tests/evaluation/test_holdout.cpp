@@ -112,7 +112,7 @@ TEST(Holdout, MethodsAreNamedOnceAndTheirOutputIsChecked) {
 }
 
 TEST(Holdout, PublishedIpBasicFiguresAndTheIssueTargets) {
-  // DESIGN.md's protocol-2 table: IP-Basic multiscale on the image's own projection has
+  // The brief's protocol-2 baseline (docs/results.md): IP-Basic multiscale on the image's own projection has
   // coverage 0.993, D1 (missing = bad) 6.1 %, depth MAE 1.87 m on odometry 04 frames 0-9.
   // The compound interpolation (defaults) must reach coverage >= 0.99, D1 <= 5 %, MAE <= 1.5 m.
   MSF_REQUIRE_KITTI();

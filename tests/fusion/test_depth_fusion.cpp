@@ -120,7 +120,10 @@ TEST(DepthFusionPaper, Eq6OnHandMadePixels) {
   // Pixel 3: w_L = 1 / (1 + 4/4) = 0.5, w_S = 0.5 * min(1, (10/8)^2) = 0.5: w2 = 1, w1 = 1:
   // y = (8 * 1 + 10 * 1 * 1) / (1 + 1 * 1) = 9, between the two.
   EXPECT_NEAR(out.at(3, 0).z, 9.f, 1e-5f);
-  EXPECT_NEAR(out.at(3, 0).weight, 1.f, 1e-6f);
+  // Its weight, min(1, w_L + w_S) = 1, in the integrator's unit: the inverse variance of the
+  // best stereo match at 9 m.
+  const float sigma_best = 9.f * 9.f * config.stereo_sigma_min_px / static_cast<float>(kFB);
+  EXPECT_NEAR(out.at(3, 0).weight, 1.f / (sigma_best * sigma_best), 1e-3f * out.at(3, 0).weight);
   // Pixel 4: w_L = 1, w_S = 1 * (10/22)^2 = 0.2066: w2 = 4.84: y = (22 + 20 w2) / (1 + w2).
   const float w2 = 1.f / (100.f / (22.f * 22.f));
   EXPECT_NEAR(out.at(4, 0).z, (22.f + 20.f * w2) / (1.f + w2), 1e-4f);
@@ -312,10 +315,7 @@ TEST(DepthFusion, OrganizedInvariants) {
         EXPECT_EQ(std::isfinite(p.x), any);
         if (any) {
           EXPECT_NEAR(p.z, 10.f + u, 1e-4f);
-          EXPECT_GT(p.weight, 0.f);
-          if (method == msf::FusionMethod::Paper) {
-            EXPECT_LE(p.weight, 1.f); // the paper's weights; uncertainty's are inverse variances
-          }
+          EXPECT_GT(p.weight, 0.f); // inverse variances in m^-2, eq. 6's trust scaled by the best stereo's
           EXPECT_EQ(p.r, 10); // colour of the stereo point
         } else {
           EXPECT_EQ(p.weight, 0.f);

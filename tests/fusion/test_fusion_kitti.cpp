@@ -1,4 +1,4 @@
-// Fusion on real KITTI frames under DESIGN.md protocol 2 (ring hold-out): the fused depth
+// Fusion on real KITTI frames under protocol 2 (docs/design.md) (ring hold-out): the fused depth
 // must beat each of its inputs, and the rows of msf_holdout must say so too.
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/holdout.h>

@@ -69,19 +69,26 @@ TEST(FrameFilter, NoHeldOutReturnOfARealKittiScanReachesThePipeline) {
   checkTheFilterComesFirst(msf::test::kittiDir() + "/odometry/sequences/04");
 }
 
-TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndTheFusionsWeights) {
+/// A frame whose fused depth is `width` x `height` of `depth` weighing `weight`, its colour
+/// (10, 20, 30), its camera of focal 100 px centred.
+msf::FrameResult fusedFrame(const std::string& name, int width, int height, float depth, float weight) {
   msf::FrameResult r;
-  r.name = "000007";
+  r.name = name;
+  r.fused.depth = cv::Mat(height, width, CV_32FC1, cv::Scalar(depth));
+  r.fused.weight = cv::Mat(height, width, CV_32FC1, cv::Scalar(weight));
+  r.fused.color = cv::Mat(height, width, CV_8UC3, cv::Scalar(10, 20, 30));
+  r.fused.camera.fx = r.fused.camera.fy = 100.f;
+  r.fused.camera.cx = 0.5f * static_cast<float>(width - 1), r.fused.camera.cy = 0.5f * static_cast<float>(height - 1);
+  r.fused.camera.width = width, r.fused.camera.height = height;
+  return r;
+}
+
+TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndTheFusionsWeights) {
+  msf::FrameResult r = fusedFrame("000007", 3, 2, 4.f, 3.f);
   r.lidar_depth = (cv::Mat_<float>(2, 3) << 5.f, 0.f, std::nanf(""), 5.f, 5.f, -1.f);
   r.lidar_distance = (cv::Mat_<float>(2, 3) << 0.f, 1.f, 1.f, 0.f, 10.f, 1.f);
   r.stereo_depth = (cv::Mat_<float>(2, 3) << 0.f, 6.f, 12.f, 0.f, 0.f, 9.f);
   r.stereo_confidence = (cv::Mat_<float>(2, 3) << 1.f, 1.f, 1.f, 1.f, 1.f, 0.f);
-  r.fused.depth = cv::Mat(2, 3, CV_32FC1, cv::Scalar(4.f));
-  r.fused.weight = cv::Mat(2, 3, CV_32FC1, cv::Scalar(3.f));
-  r.fused.color = cv::Mat(2, 3, CV_8UC3, cv::Scalar(10, 20, 30));
-  r.fused.camera.fx = r.fused.camera.fy = 100.f;
-  r.fused.camera.cx = 1.f, r.fused.camera.cy = 0.5f;
-  r.fused.camera.width = 3, r.fused.camera.height = 2;
   const msf::DepthFusionConfig fusion;
   const double fb = 386.0;
 
@@ -113,6 +120,44 @@ TEST(SourceDepthFrame, TakesTheSourcesDepthTheFusedColourAndTheFusionsWeights) {
     EXPECT_NE(std::string(e.what()).find("frame 000007 has no stereo depth"), std::string::npos) << e.what();
   }
   EXPECT_THROW(msf::sourceDepthFrame(r, msf::DepthSource::Lidar, fusion, 0.0), msf::InvalidInputError);
+}
+
+TEST(FusedDepthFrame, TheFusedImageInTheLidarsCanvas) {
+  // A 4x2 image in a canvas grown by 1 pixel: the margin takes the LiDAR's depth and weight,
+  // the image its fused depth and weight, the colours of the image's border repeated.
+  msf::FrameResult r = fusedFrame("000003", 4, 2, 7.f, 50.f);
+  const msf::DepthFusionConfig fusion;
+  const double fb = 386.0;
+  // Without a canvas: the fused frame as it is.
+  EXPECT_EQ(msf::fusedDepthFrame(r, fusion, fb).depth.data, r.fused.depth.data);
+
+  r.lidar_canvas_depth = cv::Mat(4, 6, CV_32FC1, cv::Scalar(9.f));
+  r.lidar_canvas_distance = cv::Mat(4, 6, CV_32FC1, cv::Scalar(0.f));
+  r.lidar_canvas_camera = r.fused.camera;
+  r.lidar_canvas_camera.cx += 1.f, r.lidar_canvas_camera.cy += 1.f;
+  r.lidar_canvas_camera.width = 6, r.lidar_canvas_camera.height = 4;
+  const msf::DepthFrame f = msf::fusedDepthFrame(r, fusion, fb);
+  ASSERT_EQ(f.depth.size(), cv::Size(6, 4));
+  EXPECT_EQ(f.camera.cx, 2.5f);
+  EXPECT_EQ(f.depth.at<float>(0, 0), 9.f);  // margin: the LiDAR
+  EXPECT_EQ(f.depth.at<float>(1, 1), 7.f);  // image: the fused depth
+  EXPECT_EQ(f.weight.at<float>(1, 1), 50.f);
+  // A real return in the margin weighs the LiDAR's range noise.
+  EXPECT_NEAR(f.weight.at<float>(3, 5), 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m), 1e-2f);
+  EXPECT_EQ(f.color.at<cv::Vec3b>(0, 0), cv::Vec3b(10, 20, 30));
+  f.validate();
+  // The LiDAR alone lives on the canvas too.
+  r.lidar_depth = cv::Mat(2, 4, CV_32FC1, cv::Scalar(9.f));
+  r.lidar_distance = cv::Mat(2, 4, CV_32FC1, cv::Scalar(0.f));
+  EXPECT_EQ(msf::sourceDepthFrame(r, msf::DepthSource::Lidar, fusion, fb).depth.size(), cv::Size(6, 4));
+  // A canvas that cannot hold the image is an error naming the frame.
+  r.lidar_canvas_distance = cv::Mat(3, 6, CV_32FC1, cv::Scalar(0.f));
+  try {
+    msf::fusedDepthFrame(r, fusion, fb);
+    ADD_FAILURE() << "a bad canvas was accepted";
+  } catch (const msf::InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 000003's LiDAR canvas"), std::string::npos) << e.what();
+  }
 }
 
 } // namespace

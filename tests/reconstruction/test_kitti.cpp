@@ -107,7 +107,7 @@ TEST(KittiReconstruction, StereoDepthWithRegularizationAgreesWithLidar) {
   const double median = medianDistanceToMesh(sequence, 2, mesh, 20.0, within);
   std::printf("  SGBM frames 0-4, lambda 5 -> %zu triangles; LiDAR scan 2: median distance %.3f m, %.1f %% within 0.3 m\n",
               mesh.triangles.size(), median, 100 * within);
-  // SGBM's own depth error on KITTI is about a metre at range (DESIGN.md); fused over 5 frames
+  // SGBM's own depth error on KITTI is about a metre at range (docs/results.md); fused over 5 frames
   // the surface is a few decimetres from the LiDAR points.
   EXPECT_LT(median, 0.35);
   EXPECT_GT(within, 0.45);

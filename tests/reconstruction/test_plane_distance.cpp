@@ -4,6 +4,7 @@
 #include <msf/reconstruction/plane_distance.h>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include <cmath>
 
@@ -96,4 +97,39 @@ TEST(PlaneDistance, RejectsBadInput) {
   PlaneDistanceConfig bad;
   bad.min_scale = 0.f;
   EXPECT_THROW(planeDistanceScale(cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.f)), camera, bad, scale), InvalidInputError);
+}
+
+TEST(SmoothSurfaceExtent, HowFarTheSurfaceGoesOnAlongItsRowAndColumn) {
+  // The road (y down, 1.65 m below the camera) and, on the columns 100..199 from row 150 down,
+  // a box's face 8 m away standing on it: its pixels' surface goes on only to its own edge,
+  // the road's to the farthest road pixel of its column or row.
+  const PinholeCamera camera = test::smallCamera();
+  cv::Mat depth = planeDepth(camera, Eigen::Vector3f(0.f, 1.f, 0.f), 1.65f);
+  for (int v = 150; v < camera.height; ++v)
+    for (int u = 100; u < 200; ++u)
+      depth.at<float>(v, u) = 8.f;
+  cv::Mat extent;
+  smoothSurfaceExtent(depth, PlaneDistanceConfig().max_curvature, extent);
+  // On the face, the surface goes no deeper than itself.
+  EXPECT_NEAR(extent.at<float>(200, 150), 0.f, 1e-5f);
+  // The road right of the box: its row is one depth, its column reaches the horizon's rows.
+  const float road = depth.at<float>(200, 250);
+  EXPECT_GT(extent.at<float>(200, 250), depth.at<float>(static_cast<int>(camera.cy) + 3, 250) - road - 1e-3f);
+  // The road just above the face's top edge: its column's run stops at the edge below it, not
+  // above, so it still reaches far.
+  EXPECT_GT(extent.at<float>(148, 150), 10.f);
+  // Stereo-like noise (half a pixel of KITTI disparity at 20 m: 3 % of the depth) breaks the
+  // road into short runs: a noisy surface is not seen to go on, and its plane's band stays short.
+  cv::Mat noisy = depth.clone();
+  cv::Mat noise(depth.size(), CV_32FC1);
+  cv::randn(noise, 0.0, 0.03);
+  noisy = noisy.mul(1.f + noise);
+  cv::Mat noisy_extent;
+  smoothSurfaceExtent(noisy, PlaneDistanceConfig().max_curvature, noisy_extent);
+  EXPECT_LT(noisy_extent.at<float>(200, 250), 0.25f * extent.at<float>(200, 250));
+  // No depth, no extent; a bad type is an error.
+  depth.at<float>(230, 300) = 0.f;
+  smoothSurfaceExtent(depth, 0.05f, extent);
+  EXPECT_EQ(extent.at<float>(230, 300), 0.f);
+  EXPECT_THROW(smoothSurfaceExtent(cv::Mat(4, 4, CV_16UC1), 0.05f, extent), InvalidInputError);
 }

@@ -146,7 +146,15 @@ TEST(Tools, IntegrateRejectsBadInputAndLeavesNoFile) {
   expectToolError(test::runTool("msf_integrate", f.cloudArgs() + "-poses " + f.dir.file("poses.txt") + " -o " + out +
                                                      " -weighting cubic"),
                   "msf_integrate", "cubic");
+  expectToolError(test::runTool("msf_integrate", f.cloudArgs() + "-poses " + f.dir.file("poses.txt") + " -o " + out +
+                                                     " -carving -no_carving"),
+                  "msf_integrate", "choose one");
   EXPECT_EQ(test::countEntries(f.dir.file("out")), 0u);
+  // -no_carving turns off what is on by default: the printed configuration says so.
+  const auto r = test::runTool("msf_integrate", f.cloudArgs() + "-poses " + f.dir.file("poses.txt") + " -o " + out +
+                                                    " -no_carving -print_config");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("space_carving: false"), std::string::npos) << r.out;
 }
 
 TEST(Tools, MeshRejectsBadInput) {

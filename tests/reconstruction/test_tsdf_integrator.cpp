@@ -498,3 +498,67 @@ TEST(TsdfIntegrator, CarvingRemovesTheGhostOfACarAheadAndKeepsTheStreet) {
   EXPECT_GT(ghosts[0], 1000u);
   EXPECT_LT(ghosts[1], ghosts[0] / 20);
 }
+
+TEST(TsdfIntegrator, ARoofSeenAtAGrazingAngleIsMeshedWithoutASkirt) {
+  // A box 1.2 m tall 8-12 m ahead, its roof 0.45 m below the camera: seen at 2-3 degrees, the
+  // roof's plane runs metres along the rays, but behind its far edge is free space (then the
+  // road 1.2 m lower): the band below the plane stops where the roof is seen to stop.
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.65);
+  scene.addBox(Eigen::Vector3d(0, 1.65 - 0.6, 10), Eigen::Vector3d(0.9, 0.6, 2));
+  const PinholeCamera camera = streetCamera();
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(0.3 * i, 0, 0); // a little sideways: the box stays ahead
+    DepthFrame frame;
+    frame.camera = camera;
+    frame.depth = scene.renderDepth(camera, pose, 60.0); // the road past the box too: free space over it
+    integrator.integrate(frame, pose);
+  }
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  std::size_t roof = 0, skirt = 0;
+  for (const auto& v : mesh.vertices) {
+    const bool over_box = std::abs(v.x()) < 0.8f;
+    roof += over_box && std::abs(v.y() - 0.45f) < 0.05f && v.z() > 8.2f && v.z() < 11.8f;
+    skirt += over_box && v.y() < 1.5f && v.z() > 12.3f && v.z() < 19.f; // above the road behind the box
+  }
+  std::printf("  roof vertices %zu, skirt vertices %zu\n", roof, skirt);
+  EXPECT_GT(roof, 100u);
+  EXPECT_EQ(skirt, 0u);
+}
+
+TEST(TsdfIntegrator, FarStereoNeitherOverwritesNearLidarGeometryNorLeavesSpecks) {
+  // Weights are inverse variances: a LiDAR-backed wall at 5 m (sigma 3 cm: 1111 m^-2), then
+  // frames of far stereo through it (20 m, sigma 1 m: 1 m^-2, say a mismatch in the sky). The
+  // free space those rays claim weighs a thousandth of the wall: the wall stays. Nor is the far
+  // match a surface of its own: five frames of it weigh 5 m^-2, under marching cubes' 10.
+  const PinholeCamera camera = test::smallCamera();
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  DepthFrame frame;
+  frame.camera = camera;
+  frame.depth = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(5.f));
+  frame.weight = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(1111.f));
+  integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  frame.depth.setTo(20.f);
+  frame.weight.setTo(1.f);
+  for (int i = 0; i < 5; ++i)
+    integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  std::size_t wall = 0, far = 0;
+  for (const auto& v : mesh.vertices)
+    (std::abs(v.z() - 5.f) < 0.05f ? wall : far) += 1;
+  EXPECT_GT(wall, 1500u); // 5.3 m x 4 m at 0.1 m
+  EXPECT_EQ(far, 0u);
+  // Seen 11 times (11 m^-2), the same far surface is meshed: the minimum is a precision.
+  TsdfVolume far_only(0.1, 0.3);
+  TsdfIntegrator far_integrator(far_only);
+  for (int i = 0; i < 11; ++i)
+    far_integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  MarchingCubes().extract(far_only, mesh);
+  EXPECT_GT(mesh.vertices.size(), 1000u);
+}

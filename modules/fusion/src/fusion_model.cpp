@@ -65,6 +65,9 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
   const float* __restrict__ z_lidar = lidar_depth.ptr<float>(v);
   const DepthFusionConfig config = c; // a local copy: the compiler may keep it in registers
   if (config.method == FusionMethod::Paper) {
+    // Eq. 6's weight is a trust in [0, 1]; the integrator averages with inverse variances
+    // (m^-2): 1 is the best stereo match's at that depth.
+    const float best_stereo = 1.f / (config.stereo_sigma_min_px * config.stereo_sigma_min_px);
     for (int u = 0; u < width; ++u) {
       FusionInputs in;
       in.z_lidar = z_lidar[u];
@@ -73,7 +76,7 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
       in.stereo_confidence = stereo_confidence[u];
       const FusionResult r = fusePaper(in, config);
       fused_z[u] = r.z;
-      fused_weight[u] = r.weight;
+      fused_weight[u] = r.weight * depthWeight(r.z, best_stereo, focal_baseline);
     }
     return;
   }

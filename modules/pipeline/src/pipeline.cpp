@@ -3,6 +3,7 @@
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
 #include <msf/stereo/color_sampler.h>
@@ -64,6 +65,9 @@ FrameResult Pipeline::startFrame(const Frame& frame) const {
 void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   stages_->lidar.computeDepth(*frame.scan, result.lidar_depth, &result.lidar_distance);
+  stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
+  stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
+  result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
   result.times.lidar_ms = msSince(start);
   if (keep_sparse_)
     stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);
@@ -128,7 +132,7 @@ void Pipeline::integrate(FrameResult& result) {
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
                             " has no pose: integration needs the sequence's poses");
   const auto start = Clock::now();
-  integrator_->integrate(result.fused, result.T_world_cam0);
+  integrator_->integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), result.T_world_cam0);
   result.times.integrate_ms = msSince(start);
 }
 

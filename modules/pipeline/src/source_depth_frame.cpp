@@ -8,6 +8,79 @@
 
 namespace msf {
 
+namespace {
+
+std::string frameName(const FrameResult& result) {
+  return result.name.empty() ? std::to_string(result.index) : result.name;
+}
+
+/// Where the image lies in the LiDAR's canvas of `result`, or an empty rectangle when the
+/// frame has no canvas around its image.
+cv::Rect imageInCanvas(const FrameResult& result, const cv::Size& image) {
+  const cv::Mat& canvas = result.lidar_canvas_depth;
+  if (canvas.empty() || canvas.size() == image)
+    return {};
+  const int margin_x = (canvas.cols - image.width) / 2, margin_y = (canvas.rows - image.height) / 2;
+  if (canvas.type() != CV_32FC1 || result.lidar_canvas_distance.size() != canvas.size() || margin_x <= 0 ||
+      margin_y <= 0 || result.lidar_canvas_camera.width != canvas.cols ||
+      result.lidar_canvas_camera.height != canvas.rows)
+    throw InvalidInputError("frame " + frameName(result) + "'s LiDAR canvas (" + std::to_string(canvas.cols) + "x" +
+                            std::to_string(canvas.rows) + ") does not hold its " + std::to_string(image.width) +
+                            "x" + std::to_string(image.height) + " image with its distance image and camera");
+  return {margin_x, margin_y, image.width, image.height};
+}
+
+/// The LiDAR's inverse variances of `depth` (lidarDepthWeight): its interpolation error from the
+/// distance to the nearest real return and, when `range` is given, the local disparity range.
+cv::Mat lidarWeights(const cv::Mat& depth, const cv::Mat& distance, const cv::Mat& range,
+                     const DepthFusionConfig& fusion, float focal_baseline) {
+  cv::Mat weight(depth.size(), CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* z = depth.ptr<float>(v);
+    const float* d = distance.empty() ? nullptr : distance.ptr<float>(v);
+    const float* r = range.empty() ? nullptr : range.ptr<float>(v);
+    float* w = weight.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      const float error_px =
+          fusion.lidar_sigma_per_distance * (d ? d[u] : 0.f) + fusion.lidar_sigma_per_range * (r ? r[u] : 0.f);
+      w[u] = std::isfinite(z[u]) && z[u] > 0.f ? lidarDepthWeight(z[u], error_px, focal_baseline, fusion) : 0.f;
+    }
+  }
+  return weight;
+}
+
+/// The image's colours in the canvas, the border pixels repeated over the margin.
+cv::Mat canvasColour(const cv::Mat& colour, const cv::Rect& image, const cv::Size& canvas) {
+  cv::Mat out;
+  cv::copyMakeBorder(colour, out, image.y, canvas.height - image.br().y, image.x, canvas.width - image.br().x,
+                     cv::BORDER_REPLICATE);
+  return out;
+}
+
+void requireBaseline(double focal_baseline) {
+  if (!(focal_baseline > 0.0))
+    throw InvalidInputError("the frames for integration need f B > 0, got " + std::to_string(focal_baseline));
+}
+
+} // namespace
+
+DepthFrame fusedDepthFrame(const FrameResult& result, const DepthFusionConfig& fusion, double focal_baseline) {
+  requireBaseline(focal_baseline);
+  const cv::Rect image = imageInCanvas(result, result.fused.depth.size());
+  if (image.empty())
+    return result.fused;
+  DepthFrame frame;
+  frame.camera = result.lidar_canvas_camera;
+  result.lidar_canvas_depth.copyTo(frame.depth);
+  frame.weight = lidarWeights(frame.depth, result.lidar_canvas_distance, cv::Mat(), fusion,
+                              static_cast<float>(focal_baseline));
+  result.fused.depth.copyTo(frame.depth(image));
+  result.fused.weight.copyTo(frame.weight(image));
+  if (!result.fused.color.empty())
+    frame.color = canvasColour(result.fused.color, image, frame.depth.size());
+  return frame;
+}
+
 const char* toString(DepthSource source) { return source == DepthSource::Lidar ? "lidar" : "stereo"; }
 
 DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const DepthFusionConfig& fusion,
@@ -15,39 +88,43 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
   const bool lidar = source == DepthSource::Lidar;
   const cv::Mat& depth = lidar ? result.lidar_depth : result.stereo_depth;
   const cv::Mat& cue = lidar ? result.lidar_distance : result.stereo_confidence;
-  const std::string frame = result.name.empty() ? std::to_string(result.index) : result.name;
   if (depth.empty() || depth.type() != CV_32FC1)
-    throw InvalidInputError(std::string("frame ") + frame + " has no " + toString(source) + " depth image");
+    throw InvalidInputError("frame " + frameName(result) + " has no " + toString(source) + " depth image");
   if (!cue.empty() && (cue.type() != CV_32FC1 || cue.size() != depth.size()))
-    throw InvalidInputError(std::string("frame ") + frame + "'s " + (lidar ? "LiDAR distance" : "stereo confidence") +
+    throw InvalidInputError("frame " + frameName(result) + "'s " + (lidar ? "LiDAR distance" : "stereo confidence") +
                             " image is not CV_32FC1 of the depth's size");
   if (result.fused.color.empty())
-    throw InvalidInputError("frame " + frame + " has no fused colour to integrate its " + toString(source) + " depth with");
-  if (!(focal_baseline > 0.0))
-    throw InvalidInputError("sourceDepthFrame needs f B > 0, got " + std::to_string(focal_baseline));
-  DepthFrame out;
-  out.depth = depth;
-  out.color = result.fused.color;
-  out.camera = result.fused.camera;
-  // The LiDAR alone has no stereo to settle its edges (returns seen past a foreground edge,
-  // interpolation across one): its weight counts the local disparity range too, as the
-  // fusion's sigma does.
-  cv::Mat range;
-  if (lidar)
-    localDisparityRange(depth, focal_baseline, fusion.lidar_range_window_px, range);
+    throw InvalidInputError("frame " + frameName(result) + " has no fused colour to integrate its " +
+                            toString(source) + " depth with");
+  requireBaseline(focal_baseline);
   const float fb = static_cast<float>(focal_baseline);
-  out.weight.create(depth.size(), CV_32FC1);
-  for (int v = 0; v < depth.rows; ++v) {
-    const float* z = depth.ptr<float>(v);
-    const float* c = cue.empty() ? nullptr : cue.ptr<float>(v);
-    float* w = out.weight.ptr<float>(v);
-    for (int u = 0; u < depth.cols; ++u) {
-      const bool valid = std::isfinite(z[u]) && z[u] > 0.f;
-      const float sigma = stereoSigmaPx(c ? c[u] : 1.f, fusion);
-      w[u] = !valid ? 0.f
-             : lidar ? lidarDepthWeight(z[u], lidarSigmaPx(c ? c[u] : 0.f, range.ptr<float>(v)[u], fusion) -
-                                                  fusion.lidar_sigma_px, fb, fusion)
-                     : depthWeight(z[u], 1.f / (sigma * sigma), fb);
+  DepthFrame out;
+  if (lidar) {
+    // The LiDAR alone has no stereo to settle its edges (returns seen past a foreground edge,
+    // interpolation across one): its weight counts the local disparity range too, as the
+    // fusion's sigma does. On its canvas, as the fused frame.
+    const cv::Rect image = imageInCanvas(result, depth.size());
+    const cv::Mat& canvas = image.empty() ? depth : result.lidar_canvas_depth;
+    const cv::Mat& distance = image.empty() ? cue : result.lidar_canvas_distance;
+    cv::Mat range;
+    localDisparityRange(canvas, focal_baseline, fusion.lidar_range_window_px, range);
+    out.depth = canvas;
+    out.weight = lidarWeights(canvas, distance, range, fusion, fb);
+    out.camera = image.empty() ? result.fused.camera : result.lidar_canvas_camera;
+    out.color = image.empty() ? result.fused.color : canvasColour(result.fused.color, image, canvas.size());
+  } else {
+    out.depth = depth;
+    out.color = result.fused.color;
+    out.camera = result.fused.camera;
+    out.weight.create(depth.size(), CV_32FC1);
+    for (int v = 0; v < depth.rows; ++v) {
+      const float* z = depth.ptr<float>(v);
+      const float* c = cue.empty() ? nullptr : cue.ptr<float>(v);
+      float* w = out.weight.ptr<float>(v);
+      for (int u = 0; u < depth.cols; ++u) {
+        const float sigma = stereoSigmaPx(c ? c[u] : 1.f, fusion);
+        w[u] = std::isfinite(z[u]) && z[u] > 0.f ? depthWeight(z[u], 1.f / (sigma * sigma), fb) : 0.f;
+      }
     }
   }
   out.validate();

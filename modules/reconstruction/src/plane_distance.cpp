@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace msf {
 
@@ -70,6 +71,69 @@ void planeDistanceScale(const cv::Mat& depth, const PinholeCamera& camera, const
       }
     }
   });
+}
+
+namespace {
+
+/// The runs of one line of n samples of 1/z (stride apart; 0 = none): `largest[i]` becomes
+/// the largest depth of sample i's run. A sample whose 1/z bends by more than `curvature` of
+/// itself against its two neighbours ends the runs on either side (it is alone).
+void lineRuns(const float* depth, std::ptrdiff_t stride, int n, float curvature, float* largest,
+              std::ptrdiff_t out_stride, std::vector<char>& kink) {
+  kink.assign(static_cast<std::size_t>(n), 0);
+  auto inverse = [&](int i) { const float z = depth[i * stride]; return z > 0.f ? 1.f / z : 0.f; };
+  for (int i = 1; i + 1 < n; ++i) {
+    const float a = inverse(i - 1), b = inverse(i), c = inverse(i + 1);
+    kink[static_cast<std::size_t>(i)] = a > 0.f && b > 0.f && c > 0.f && std::abs(a + c - 2.f * b) > curvature * b;
+  }
+  int begin = 0;
+  while (begin < n) {
+    if (!(depth[begin * stride] > 0.f)) {
+      largest[begin * out_stride] = 0.f;
+      ++begin;
+      continue;
+    }
+    int end = begin + 1; // [begin, end): valid samples, no kink inside
+    while (end < n && depth[end * stride] > 0.f && !kink[static_cast<std::size_t>(end)] &&
+           !kink[static_cast<std::size_t>(end - 1)])
+      ++end;
+    float run_max = 0.f;
+    for (int i = begin; i < end; ++i)
+      run_max = std::max(run_max, depth[i * stride]);
+    for (int i = begin; i < end; ++i)
+      largest[i * out_stride] = run_max;
+    begin = end;
+  }
+}
+
+} // namespace
+
+void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& extent) {
+  if (depth.type() != CV_32FC1)
+    throw InvalidInputError("smoothSurfaceExtent: the depth image must be CV_32FC1");
+  const int width = depth.cols, height = depth.rows;
+  extent.create(depth.size(), CV_32FC1);
+  cv::Mat along_columns(depth.size(), CV_32FC1);
+  const std::ptrdiff_t depth_step = static_cast<std::ptrdiff_t>(depth.step1());
+  const std::ptrdiff_t out_step = static_cast<std::ptrdiff_t>(extent.step1());
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    std::vector<char> kink;
+    for (int v = rows.start; v < rows.end; ++v)
+      lineRuns(depth.ptr<float>(v), 1, width, max_curvature, extent.ptr<float>(v), 1, kink);
+  });
+  cv::parallel_for_(cv::Range(0, width), [&](const cv::Range& columns) {
+    std::vector<char> kink;
+    for (int u = columns.start; u < columns.end; ++u)
+      lineRuns(depth.ptr<float>(0) + u, depth_step, height, max_curvature, along_columns.ptr<float>(0) + u, out_step,
+               kink);
+  });
+  for (int v = 0; v < height; ++v) {
+    const float* d = depth.ptr<float>(v);
+    const float* c = along_columns.ptr<float>(v);
+    float* e = extent.ptr<float>(v);
+    for (int u = 0; u < width; ++u)
+      e[u] = d[u] > 0.f ? std::max(e[u], c[u]) - d[u] : 0.f;
+  }
 }
 
 } // namespace msf

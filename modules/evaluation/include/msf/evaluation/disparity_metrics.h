@@ -5,7 +5,7 @@
 
 namespace msf {
 
-/// The KITTI 2015 devkit's disparity evaluation (DESIGN.md protocol 1), and the paper's
+/// The KITTI 2015 devkit's disparity evaluation (protocol 1, docs/design.md), and the paper's
 /// eq. 8 mean absolute disparity error.
 struct DisparityEvalOptions {
   float abs_threshold_px = 3.f;   ///< a pixel is bad if its error is above both thresholds

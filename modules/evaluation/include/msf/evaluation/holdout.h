@@ -18,7 +18,7 @@
 
 namespace msf {
 
-/// Evaluation protocol 2 (DESIGN.md), ring hold-out on real scans: the rings with
+/// Evaluation protocol 2 (docs/design.md), ring hold-out on real scans: the rings with
 /// id % modulo == heldout_remainder are projected into camera 0 as ground-truth depth; the
 /// other rings are the only LiDAR input a method sees. Keys: sections `rings` and
 /// `projection` (whose camera must be 0: disparities are those of the grey pair).

@@ -45,7 +45,7 @@ private:
   std::unordered_map<Cell, std::vector<std::uint32_t>, CellHash, CellEqual> grid_;
 };
 
-/// Mesh quality against the true surface (DESIGN.md protocol 3).
+/// Mesh quality against the true surface (protocol 3, docs/design.md).
 struct MeshAccuracy {
   std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated (sampled)
   double accuracy_mean_m = 0;          ///< mean distance of mesh vertices to the truth (capped)

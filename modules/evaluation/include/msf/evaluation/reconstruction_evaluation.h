@@ -27,7 +27,7 @@ struct ReconstructionScore {
   DepthMetrics moving_within_range;
 };
 
-/// Evaluation protocol 4 (DESIGN.md): the reconstruction against ground truth it never saw.
+/// Evaluation protocol 4 (docs/design.md): the reconstruction against ground truth it never saw.
 /// The ground truth of each frame (protocol 2's held-out rings projected into camera 0, or a
 /// synthetic sequence's exact depth) is kept as the list of its pixels, not as images, so a
 /// long sequence stays small; per-frame depth images (the fused depth) are scored at those

@@ -17,8 +17,8 @@ FusionMethod parseFusionMethod(const std::string& name);
 const char* toString(FusionMethod method);
 
 /// Every parameter of DepthFusion, read from the `fusion` section of a config file.
-/// The defaults were measured on KITTI odometry 04 frames 0-9 under DESIGN.md protocol 2
-/// (msf_holdout; the README has the table).
+/// The defaults were measured on KITTI odometry 04 frames 0-9 under protocol 2
+/// (msf_holdout; docs/results.md has the table).
 struct DepthFusionConfig {
   FusionMethod method = FusionMethod::Uncertainty;
 

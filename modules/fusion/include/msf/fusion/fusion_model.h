@@ -19,8 +19,9 @@ struct FusionInputs {
   float stereo_confidence = 1.f; ///< in [0, 1], stereo_confidence.h
 };
 
-/// Fused depth (0 = none) and its weight (0 = none): the paper method's in [0, 1], the uncertainty
-/// method's the inverse variance of the depth in m^-2 (depthWeight).
+/// Fused depth (0 = none) and its weight (0 = none): fusePaper's in [0, 1], fuseUncertainty's
+/// the inverse variance of the depth in m^-2 (depthWeight). fuseRow gives both methods' in
+/// m^-2, what the integrator averages with.
 struct FusionResult {
   float z = 0.f;
   float weight = 0.f;
@@ -33,7 +34,7 @@ inline bool validDepth(float z) { return z > 0.f && std::isfinite(z); }
 // The per-pixel functions below are written with selects rather than branches, so that the
 // row loops (fuseRow) vectorise. A depth that is not > 0 (0, negative, NaN) is none.
 
-/// The paper's eq. 6 (DESIGN.md step 4), y = (y1 w1 + y2 w2 w1) / (w1 + w2 w1), with
+/// The paper's eq. 6 (docs/design.md, step 4), y = (y1 w1 + y2 w2 w1) / (w1 + w2 w1), with
 /// y1 the stereo depth, y2 the LiDAR depth and the dynamic weights
 ///   w_L = paper_lidar_gain / (1 + distance / paper_lidar_distance_px)   (0 without LiDAR)
 ///          trust in the LiDAR, halved paper_lidar_distance_px pixels from a real return;

@@ -32,6 +32,10 @@ struct FrameResult {
   cv::Mat lidar_sparse;       ///< projected scan (step 1), if kept (setKeepSparse)
   cv::Mat lidar_depth;        ///< interpolated LiDAR (step 2)
   cv::Mat lidar_distance;     ///< pixels from each pixel to the nearest real return (step 2)
+  /// The same on the LiDAR's canvas, the image grown by projection.margin_px, and its camera:
+  /// what the map takes beyond the image's border (fusedDepthFrame).
+  cv::Mat lidar_canvas_depth, lidar_canvas_distance;
+  PinholeCamera lidar_canvas_camera;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
@@ -40,7 +44,7 @@ struct FrameResult {
   StageTimes times;
 };
 
-/// The whole method (DESIGN.md data flow) for a sequence: per frame, LiDAR projection and
+/// The whole method (the README's data flow) for a sequence: per frame, LiDAR projection and
 /// compound interpolation (LidarCompletion: the scan is projected onto the image grown by
 /// a margin, so gaps across the image's border are bridged) run at the same time as SGBM, then the two depth images are
 /// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
@@ -70,8 +74,9 @@ public:
   /// scan that do not fit the calibration.
   FrameResult computeDepth(const Frame& frame);
 
-  /// Integrates the fused depth of `result` at its pose (step 5). Throws InvalidInputError
-  /// when the frame has no pose.
+  /// Integrates the fused depth of `result` at its pose (step 5), grown by the interpolated
+  /// LiDAR of the canvas's margin (fusedDepthFrame). Throws InvalidInputError when the frame
+  /// has no pose.
   void integrate(FrameResult& result);
 
   struct RunStats {

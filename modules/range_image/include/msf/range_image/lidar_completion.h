@@ -48,6 +48,12 @@ public:
   /// the scan has none in the canvas).
   void computeDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth, cv::Mat* distance = nullptr);
 
+  /// The whole canvas of the last computeDepth (the image and its margin): depth, and the
+  /// distance to the nearest real return when computeDepth was asked for it. Views of work
+  /// buffers, valid until the next call.
+  const cv::Mat& canvasDepth() const { return dense_; }
+  const cv::Mat& canvasDistance() const { return distance_; }
+
   /// The organized cloud of the image: real returns keep their exact points, the others
   /// lie on their pixels' rays with the reflectance of the nearest return; `distance` as
   /// above (0 on real returns).

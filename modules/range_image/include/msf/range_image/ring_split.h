@@ -9,7 +9,7 @@
 namespace msf {
 
 /// Section `rings` of the YAML config: which rings of a scan are held out as ground truth
-/// (evaluation protocol 2, DESIGN.md).
+/// (evaluation protocol 2, docs/design.md).
 struct RingSplitConfig {
   int modulo = 4;            ///< rings with id % modulo == heldout_remainder are held out
   int heldout_remainder = 2;

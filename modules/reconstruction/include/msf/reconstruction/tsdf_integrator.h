@@ -164,7 +164,7 @@ private:
   std::vector<float> data_term_;  // y of eq. 7 for the changed voxels, reused across frames
   std::vector<std::uint16_t> changed_index_; // local indices of the changed voxels, per block
   std::vector<float> tile_min_, tile_max_, tile_band_; // depth range and widest band of 8x8-pixel tiles, reused
-  cv::Mat scale_; // planeDistanceScale of the frame, reused
+  cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
   cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_

@@ -10,7 +10,7 @@ namespace msf {
 
 /// Every parameter of SgbmStereo, read from the `stereo` section of a config file.
 /// Defaults: OpenCV's 3-way SGBM on 128 disparities with 5x5 blocks (the setting of the
-/// DESIGN's measured baseline), narrowed by a LiDAR depth prior when one is given.
+/// baseline docs/results.md quotes), narrowed by a LiDAR depth prior when one is given.
 struct SgbmConfig {
   /// native: our AVX2 / AVX-512 matcher (SemiGlobalMatcher), the same algorithm and
   /// parameters as OpenCV's 3-way SGBM, 2-3x faster per core; on a CPU without AVX2, or for

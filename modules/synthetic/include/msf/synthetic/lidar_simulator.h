@@ -18,7 +18,7 @@ namespace msf::synthetic {
 /// motion of the sensor or of moving objects during the sweep), so it agrees exactly with
 /// the camera's ground truth.
 /// Points are written ring after ring, top laser first, each ring one sweep of rising
-/// atan2(y, x): the ring split of DESIGN.md protocol 2 finds exactly 64 rings.
+/// atan2(y, x): the ring split of protocol 2 (docs/design.md) finds exactly 64 rings.
 /// Each return: range + Gaussian noise, lost with probability lidar_dropout (and half the
 /// time on glass), none from the sky or beyond lidar_max_range_m; intensity from the
 /// surface's infrared reflectivity and incidence angle, in KITTI's 0..1 with 0.01 steps
