@@ -20,16 +20,9 @@
 
 namespace {
 
-/// Scans of frames 0-9, loaded once, as the odometry's points.
+/// Scans of frames 0-9, loaded once.
 struct Data {
-  std::vector<pcl::PointCloud<pcl::PointXYZI>> scans;
-  Data() {
-    const msf::Sequence sequence = msf::bench::kittiSequence();
-    for (std::size_t i = 0; i < msf::bench::kFrames && i < sequence.size(); ++i) {
-      scans.emplace_back();
-      msf::loadVelodyneBin(sequence.scanPath(i), scans.back());
-    }
-  }
+  std::vector<pcl::PointCloud<pcl::PointXYZI>> scans = msf::bench::kittiScans(msf::bench::kittiSequence());
 };
 
 const Data& data() {

@@ -2,9 +2,9 @@
 // with a picture of both from above.
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
-#include <msf/common/line_plot.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/odometry_metrics.h>
+#include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
@@ -60,25 +60,6 @@ msf::PoseList loadReference(const std::string& path, const std::string& frames_t
   return msf::PoseList(all.begin() + range.first, all.begin() + last + 1);
 }
 
-/// Both trajectories from above: forward (z) to the right, left (-x) up, in the reference's
-/// first camera frame; each axis fitted to the drive, so a lateral drift shows.
-cv::Mat plotFromAbove(const msf::PoseList& estimate, const msf::PoseList& reference) {
-  const Eigen::Isometry3d to_first = reference.front().inverse();
-  msf::LinePlot plot("Trajectories from above (first camera frame; axes scaled apart)", "forward z (m)",
-                     "left -x (m)");
-  for (const auto& [name, poses] : {std::pair<const char*, const msf::PoseList*>{"reference", &reference},
-                                    {"estimate (first pose aligned)", &estimate}}) {
-    std::vector<double> forward, left;
-    for (const auto& T : *poses) {
-      const Eigen::Vector3d p = to_first * T.translation();
-      forward.push_back(p.z());
-      left.push_back(-p.x());
-    }
-    plot.addSeries(name, forward, left);
-  }
-  return plot.render();
-}
-
 } // namespace
 
 int main(int argc, char** argv) {
@@ -123,7 +104,8 @@ int main(int argc, char** argv) {
     print_value("%.4f m = %.3f %%", m.end_drift_m, m.end_drift_pct);
     print_info(" of the path, rotation %.4f deg\n", m.end_rotation_error_deg);
 
-    msf::writeImage(plot_path, plotFromAbove(msf::alignFirstPose(estimate, reference), reference));
+    msf::writeImage(plot_path, msf::plotTrajectoriesFromAbove(
+        {{"reference", reference}, {"estimate", msf::alignFirstPose(estimate, reference)}}));
     print_info("Plot: ");
     print_value("%s\n", plot_path.c_str());
     return 0;

@@ -42,13 +42,6 @@ void printHelp(const char* name) {
   print_info("    -print_config  print the configuration in effect\n");
 }
 
-/// The dataset's reference trajectory in words.
-std::string referenceName(const msf::Sequence& sequence) {
-  if (!sequence.groundTruthDir().empty())
-    return "the synthetic ground truth";
-  return sequence.layout() == msf::Sequence::Layout::Raw ? "OXTS (GPS/IMU)" : "the odometry ground truth";
-}
-
 void printMetrics(const msf::OdometryMetrics& m) {
   print_info("  ATE (first poses aligned) ");
   print_value("%.3f m", m.ate_rmse_m);
@@ -137,7 +130,7 @@ int main(int argc, char** argv) {
       msf::PoseList reference;
       for (std::size_t i : frames)
         reference.push_back(sequence.poses()[i]);
-      print_info("Against %s:\n", referenceName(sequence).c_str());
+      print_info("Against %s:\n", sequence.posesName().c_str());
       printMetrics(msf::evaluateOdometry(T_world_cam0, reference));
     }
     return 0;

@@ -8,6 +8,7 @@
 #include <msf/evaluation/holdout.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
+#include <msf/evaluation/trajectory_plot.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
@@ -398,8 +399,10 @@ int main(int argc, char** argv) {
     pipeline.setFrameFilter([&](msf::Frame& frame) {
       if (holdout)
         heldout_truth.put(frame.index, holdOutRings(frame, sequence, holdout_config));
-      poses.apply(frame); // after the hold-out: the odometry sees the scan the pipeline sees
+      poses.apply(frame);
     });
+    if (poses.kind() == msf::PoseSource::Kind::Estimated) // after the hold-out: the scan the pipeline sees
+      pipeline.setPoseEstimator([&](const msf::Frame& frame) { return poses.estimate(frame); });
     msf::PoseList used_poses;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
@@ -599,8 +602,24 @@ int main(int argc, char** argv) {
     }
 
     report.pose_ms = poses.estimateMs();
-    if (!used_poses.empty())
+    if (!used_poses.empty()) {
       msf::saveOdometryPoses((fs::path(out) / report.poses_file).string(), used_poses);
+      std::vector<std::pair<std::string, msf::PoseList>> trajectories{{"used (" + poses.description() + ")", used_poses}};
+      if (sequence.hasPoses() && poses.kind() != msf::PoseSource::Kind::Dataset) {
+        msf::PoseList reference;
+        for (const auto& f : report.frames)
+          reference.push_back(sequence.poses()[f.index]);
+        trajectories.emplace_back(sequence.posesName(), reference);
+        if (used_poses.size() > 1) {
+          report.trajectory_metrics = msf::evaluateOdometry(used_poses, reference);
+          report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
+          report.trajectory_reference = sequence.posesName();
+        }
+      }
+      report.trajectory_plot_file = "trajectory.png";
+      msf::writeImage((fs::path(out) / report.trajectory_plot_file).string(),
+                      msf::plotTrajectoriesFromAbove(trajectories));
+    }
     report.peak_memory_mb = msf::peakMemoryMb();
     report.writeFramesCsv((fs::path(out) / "frames.csv").string());
     if (!report.frames.empty())

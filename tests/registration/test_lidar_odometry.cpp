@@ -1,4 +1,5 @@
 #include "box_scene.h"
+#include "test_support.h"
 
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
@@ -30,14 +31,7 @@ msf::LidarOdometry::Config snapshots() {
   return config;
 }
 
-std::string messageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const msf::InvalidInputError& e) {
-    return e.what();
-  }
-  return "(no InvalidInputError)";
-}
+using msf::test::errorOf;
 
 /// Scans of the synthetic street by its own LiDAR (msf_synth's scene and sensor; scans only,
 /// no images): the geometry the odometry is measured on, built once for the suite.
@@ -173,20 +167,20 @@ TEST(StreetOdometry, DrivesTheStreetWithItsMovingCars) {
 TEST(LidarOdometry, DegenerateScansAreErrorsThatNameTheScanNotAPose) {
   msf::LidarOdometry odometry(snapshots());
   // Empty, and all NaN.
-  EXPECT_NE(messageOf([&] { odometry.registerPoints({}, "scan 'empty.bin'"); }).find("scan 'empty.bin': none of its 0 points"),
+  EXPECT_NE(errorOf([&] { odometry.registerPoints({}, "scan 'empty.bin'"); }).find("scan 'empty.bin': no points"),
             std::string::npos);
   pcl::PointCloud<pcl::PointXYZI> nans;
   nans.resize(50);
   for (auto& p : nans)
     p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
-  const std::string nan_message = messageOf([&] { odometry.registerScan(nans, "scan 'nan.bin'"); });
+  const std::string nan_message = errorOf([&] { odometry.registerScan(nans, "scan 'nan.bin'"); });
   EXPECT_NE(nan_message.find("scan 'nan.bin': none of its 50 points is a finite return"), std::string::npos)
       << nan_message;
   // A single plane: the road alone constrains height, roll and pitch only.
   const std::vector<msf::test::Box> road{{{-100, -100, -1}, {100, 100, 0}}};
   const msf::PointList plane = scanBoxes(road, sensorPose(0.0), 5);
   ASSERT_GT(plane.size(), 5000u);
-  const std::string plane_message = messageOf([&] { odometry.registerPoints(plane, "scan 'road.bin'"); });
+  const std::string plane_message = errorOf([&] { odometry.registerPoints(plane, "scan 'road.bin'"); });
   EXPECT_NE(plane_message.find("scan 'road.bin': its planes leave 3 of 6 degrees of freedom unconstrained"),
             std::string::npos)
       << plane_message;
@@ -204,7 +198,7 @@ TEST(LidarOdometry, DegenerateScansAreErrorsThatNameTheScanNotAPose) {
   msf::PointList lifted = scanBoxes(boxes, sensorPose(0.0), 8);
   for (auto& p : lifted)
     p.z() += 30.0;
-  const std::string far = messageOf([&] { odometry.registerPoints(lifted, "scan 'far'"); });
+  const std::string far = errorOf([&] { odometry.registerPoints(lifted, "scan 'far'"); });
   EXPECT_NE(far.find("scan 'far': scan-to-map ICP"), std::string::npos) << far;
 }
 

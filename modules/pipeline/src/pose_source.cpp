@@ -15,9 +15,7 @@ PoseSource::PoseSource(const std::string& option, const Sequence& sequence, cons
                               "' has no poses (odometry poses/XX.txt or raw oxts/); -poses estimate tracks them "
                               "from the scans");
     kind_ = Kind::Dataset;
-    description_ = !sequence.groundTruthDir().empty()            ? "dataset (synthetic ground truth)"
-                   : sequence.layout() == Sequence::Layout::Raw ? "dataset (OXTS)"
-                                                                 : "dataset (odometry poses file)";
+    description_ = "the dataset's: " + sequence.posesName();
   } else if (choice == "estimate") {
     kind_ = Kind::Estimated;
     description_ = "estimated (LiDAR odometry)";
@@ -37,19 +35,21 @@ PoseSource::PoseSource(const std::string& option, const Sequence& sequence, cons
 
 PoseSource::~PoseSource() = default;
 
-void PoseSource::apply(Frame& frame) {
-  if (kind_ == Kind::Dataset)
-    return; // Sequence::load set it
-  if (kind_ == Kind::File) {
-    frame.T_world_cam0 = file_poses_.at(frame.index);
-  } else {
-    const auto start = std::chrono::steady_clock::now();
-    const Eigen::Isometry3d T_velo0_velo =
-        odometry_->registerScan(*frame.scan, "scan '" + sequence_.scanPath(frame.index) + "'");
-    frame.T_world_cam0 = cameraPose(T_velo0_velo, sequence_.calibration().T_cam0_velo, T_world_cam0_first_);
-    estimate_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
+void PoseSource::apply(Frame& frame) const {
+  if (kind_ != Kind::File)
+    return;
+  frame.T_world_cam0 = file_poses_.at(frame.index);
   frame.has_pose = true;
+}
+
+Eigen::Isometry3d PoseSource::estimate(const Frame& frame) {
+  if (!odometry_)
+    throw InvalidInputError("PoseSource::estimate: the poses are " + description_ + ", not estimated");
+  const auto start = std::chrono::steady_clock::now();
+  const Eigen::Isometry3d T_velo0_velo =
+      odometry_->registerScan(*frame.scan, "scan '" + sequence_.scanPath(frame.index) + "'");
+  estimate_ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  return cameraPose(T_velo0_velo, sequence_.calibration().T_cam0_velo, T_world_cam0_first_);
 }
 
 } // namespace msf

@@ -81,6 +81,9 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
       in_range.push_back(p);
   }
   stats.input_points = in_range.size();
+  if (points_sensor.empty())
+    throw InvalidInputError(name + ": no points (an empty scan, or one whose every return was NaN or infinite: "
+                                   "the scan reader drops those)");
   if (in_range.empty())
     throw InvalidInputError(name + ": none of its " + std::to_string(points_sensor.size()) +
                             " points is a finite return between odometry.min_range_m " +

@@ -9,11 +9,11 @@
 namespace msf {
 
 /// Where a reconstruction's poses come from (msf_reconstruct -poses): the dataset's own, a
-/// KITTI poses file, or LiDAR odometry estimated as each frame is loaded. apply() goes in
-/// Pipeline::setFrameFilter, on the loading thread, after the frame's other changes (the
-/// ring hold-out: the odometry sees only the scan the pipeline sees) and before any stage
-/// sees the frame: a frame leaves the loader with its pose, and the rest of the pipeline
-/// does not know where it came from.
+/// KITTI poses file, or LiDAR odometry estimated as the frames are loaded. A file's poses are
+/// set by apply() in Pipeline::setFrameFilter, after the frame's other changes; the odometry
+/// runs in Pipeline::setPoseEstimator, on a thread of its own beside the depth stages, and sees
+/// the scan after the filter (the ring hold-out: the odometry sees only the scan the pipeline
+/// sees). Either way the rest of the pipeline does not know where a pose came from.
 class PoseSource {
 public:
   enum class Kind { Dataset, File, Estimated };
@@ -28,12 +28,15 @@ public:
              const LidarOdometry::Config& odometry);
   ~PoseSource();
 
-  /// Sets the frame's pose. Frames in order: the odometry tracks from one to the next.
-  /// Throws what LidarOdometry throws, naming the frame's scan.
-  void apply(Frame& frame);
+  /// Sets the frame's pose from a file (nothing for the dataset's, which Sequence::load set, or
+  /// for an estimate, which estimate() gives).
+  void apply(Frame& frame) const;
+  /// The odometry's pose of the frame's scan. Frames in order: it tracks from one to the next.
+  /// Throws what LidarOdometry throws, naming the frame's scan; InvalidInputError unless Estimated.
+  Eigen::Isometry3d estimate(const Frame& frame);
 
   Kind kind() const { return kind_; }
-  /// In words, for the report: "dataset (...)", "file '...'" or "estimated (LiDAR odometry)".
+  /// In words, for the report: "the dataset's: ...", "file '...'" or "estimated (LiDAR odometry)".
   const std::string& description() const { return description_; }
   /// Milliseconds the odometry took for each frame applied (empty unless estimated).
   const std::vector<double>& estimateMs() const { return estimate_ms_; }

@@ -11,6 +11,7 @@
 #include <pcl/point_cloud.h>
 
 #include <iosfwd>
+#include <memory>
 #include <string>
 
 namespace msf {
@@ -27,6 +28,9 @@ namespace msf {
 /// an empty road) is an error, not a pose that merely repeats the prediction.
 class LidarOdometry {
 public:
+  using Ptr = std::shared_ptr<LidarOdometry>;
+  using ConstPtr = std::shared_ptr<const LidarOdometry>;
+
   /// Section `odometry`.
   struct Config {
     /// Voxel of the local map; scans are kept at half of it for the map and registered at

@@ -4,6 +4,7 @@
 #include <msf/registration/voxel_table.h>
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace msf {
@@ -16,6 +17,9 @@ namespace msf {
 /// the sensor are dropped, so the map follows the drive and its size is bounded.
 class LocalMap {
 public:
+  using Ptr = std::shared_ptr<LocalMap>;
+  using ConstPtr = std::shared_ptr<const LocalMap>;
+
   /// A map point near a query, with the plane of its voxel when the voxel's returns lie on
   /// one: at least 5, spread over a tenth of a voxel in two directions and 7 times less in
   /// the third.
