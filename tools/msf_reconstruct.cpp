@@ -604,12 +604,16 @@ int main(int argc, char** argv) {
     report.pose_ms = poses.estimateMs();
     if (!used_poses.empty()) {
       msf::saveOdometryPoses((fs::path(out) / report.poses_file).string(), used_poses);
-      std::vector<std::pair<std::string, msf::PoseList>> trajectories{{"used (" + poses.description() + ")", used_poses}};
+      // Short names: the legend beside the plot is narrow.
+      const char* used_name = poses.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
+                              : poses.kind() == msf::PoseSource::Kind::File    ? "poses file"
+                                                                                : "dataset";
+      std::vector<std::pair<std::string, msf::PoseList>> trajectories{{used_name, used_poses}};
       if (sequence.hasPoses() && poses.kind() != msf::PoseSource::Kind::Dataset) {
         msf::PoseList reference;
         for (const auto& f : report.frames)
           reference.push_back(sequence.poses()[f.index]);
-        trajectories.emplace_back(sequence.posesName(), reference);
+        trajectories.emplace_back("dataset", reference);
         if (used_poses.size() > 1) {
           report.trajectory_metrics = msf::evaluateOdometry(used_poses, reference);
           report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
