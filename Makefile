@@ -6,9 +6,9 @@ PREFIX ?= /usr/local
 KITTI_DIR ?= $(abspath ../shared/data/kitti)
 DEMO_OUT ?= out/demo
 
-# Every Debian package the project needs to build and test.
+# Every Debian package the project needs to build, test and view its results (pcl_viewer).
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
-                libflann-dev libboost-dev libgtest-dev libbenchmark-dev
+                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools
 # Only the Open3D baseline of `make bench` needs these.
 BENCH_PACKAGES := python3-open3d python3-numpy
 

@@ -12,6 +12,7 @@
 #include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
+#include <cmath>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -20,7 +21,7 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config"};
+const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-voxel", "-trunc"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <volume.pcd> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
@@ -32,6 +33,9 @@ void printHelp(const char* name) {
              "                    remove connected pieces of fewer than N triangles (default ");
   print_value("%s", msf::configValue(defaults.min_component_triangles).c_str()); print_info("; 0 keeps all)\n");
   print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
+  print_info("    -voxel V -trunc T\n"
+             "                    voxel size and truncation (m) of a volume whose header comment a PCL\n"
+             "                    rewrite dropped (otherwise read from the file, and checked if given)\n");
 }
 
 int run(int argc, char** argv) {
@@ -57,7 +61,12 @@ int run(int argc, char** argv) {
   print_highlight("Loading ");
   print_value("%s ", files[0].c_str());
   tt.tic();
-  const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0]);
+  double voxel = 0, trunc = 0;
+  msf::tool::parseArgument(argc, argv, "-voxel", voxel);
+  msf::tool::parseArgument(argc, argv, "-trunc", trunc);
+  if (voxel < 0 || trunc < 0 || !std::isfinite(voxel) || !std::isfinite(trunc))
+    throw msf::InvalidInputError("-voxel and -trunc must be > 0 m");
+  const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0], voxel, trunc);
   msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
 
   print_highlight("Meshing ");

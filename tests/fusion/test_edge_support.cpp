@@ -57,6 +57,13 @@ TEST(EdgeSupport, ValuesOnASurfaceOrWithoutReturnsAreKept) {
   EXPECT_FLOAT_EQ(fused.at<float>(7, 5), 10.f);
 }
 
+TEST(EdgeSupport, ValuesNearerOrFartherThanBothSurfacesAreKept) {
+  // A pole the LiDAR missed (5 m: 76 px, nearer than every return in the window) is not
+  // between the two surfaces: it keeps its depth, as does a value beyond the background.
+  EXPECT_FLOAT_EQ(Scene(5.f).run().at<float>(7, 5), 5.f);
+  EXPECT_FLOAT_EQ(Scene(80.f).run().at<float>(7, 5), 80.f); // 4.75 px, beyond 40 m's 9.5
+}
+
 TEST(EdgeSupport, TheJumpAndTheWindowBoundWhatIsAnEdge) {
   msf::DepthFusionConfig config;
   config.edge_jump_px = 30.f; // 38 - 9.5 = 28.5 px is no edge now

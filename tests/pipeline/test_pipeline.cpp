@@ -195,6 +195,10 @@ TEST(Reconstruct, BadInputIsAClearError) {
   r = msf::test::runTool("msf_reconstruct", dir.path() + " -config " + dir.file("bad.yaml"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("tsdf_volume.voxel_size_m"), std::string::npos) << r.err;
+  std::ofstream(dir.file("camera2.yaml")) << "%YAML:1.0\nprojection:\n  camera: 2\n";
+  r = msf::test::runTool("msf_reconstruct", dir.path() + " -config " + dir.file("camera2.yaml"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("projection.camera is 2"), std::string::npos) << r.err;
   r = msf::test::runTool("msf_reconstruct", "-frames 3:1");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_FALSE(msf::test::fileExists("msf_out/summary.json"));

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 using msf::RunReport;
 
 namespace {
@@ -25,4 +28,19 @@ TEST(RunReport, RateAfterTheFirstFrameNeedsTwoFrames) {
   EXPECT_EQ(reportOf(1, 0.5, 0.5).framesPerSecondAfterFirst(), 0.0);
   EXPECT_EQ(reportOf(0, 0.0, 0.0).framesPerSecondAfterFirst(), 0.0);
   EXPECT_EQ(reportOf(3, 0.5, 0.5).framesPerSecondAfterFirst(), 0.0); // no time after the first: no rate
+}
+
+TEST(RunReport, IntegersEndingInZeroKeepTheirDigits) {
+  // num() stripped the trailing zeros of every number, those of an integer too: 720 MiB -> "72".
+  RunReport report = reportOf(2, 1.0, 0.5);
+  report.peak_memory_mb = 7200;  // above this test process's own peak, which the report takes if larger
+  report.observed_voxels = 100;
+  report.mesh_ms = 10;
+  const std::string path = ::testing::TempDir() + "run_report_integers.md";
+  report.writeMarkdown(path);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("peak memory 7200 MiB"), std::string::npos) << text;
+  EXPECT_NE(text.find("mesh extraction 10 ms"), std::string::npos) << text;
+  EXPECT_NE(text.find("2 frames per second"), std::string::npos) << text;
 }

@@ -8,6 +8,7 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
 #include <cstdio>
@@ -100,6 +101,23 @@ TEST(Tools, IntegrateThenMeshTheSphere) {
     for (const auto& p : vertices)
       sum += std::abs(f.scene.signedDistance(Eigen::Vector3d(p.x, p.y, p.z)));
     EXPECT_LE(sum / static_cast<double>(vertices.size()), 0.1 * 0.04) << name;
+  }
+  // A volume rewritten by PCL loses its header comment: msf_mesh names the way out, and
+  // meshes it given -voxel and -trunc.
+  {
+    pcl::PCLPointCloud2 blob;
+    loadCloudBlob(volume, blob);
+    pcl::io::savePCDFile(f.dir.file("out/rewritten.pcd"), blob, Eigen::Vector4f::Zero(),
+                         Eigen::Quaternionf::Identity(), true);
+    r = test::runTool("msf_mesh", f.dir.file("out/rewritten.pcd") + " " + f.dir.file("out/r.ply"));
+    expectToolError(r, "msf_mesh", "-voxel V -trunc T");
+    r = test::runTool("msf_mesh", f.dir.file("out/rewritten.pcd") + " " + f.dir.file("out/r.ply") +
+                                      " -voxel 0.04 -trunc 0.12");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    pcl::PolygonMesh rewritten, original;
+    loadMesh(f.dir.file("out/r.ply"), rewritten);
+    loadMesh(f.dir.file("out/mesh.ply"), original);
+    EXPECT_EQ(rewritten.polygons.size(), original.polygons.size());
   }
   // A minimum weight above every voxel's leaves no surface: an error, and no file.
   r = test::runTool("msf_mesh", volume + " " + f.dir.file("out/empty.ply") + " -min_weight 1e6");

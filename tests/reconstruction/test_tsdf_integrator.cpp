@@ -3,6 +3,7 @@
 
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
+#include <msf/io/point_types.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
@@ -12,19 +13,6 @@
 
 #include <cmath>
 #include <cstdio>
-
-namespace msf::test {
-/// A point type like the fusion stage's: x y z rgb and a per-pixel weight.
-struct EIGEN_ALIGN16 PointFused {
-  PCL_ADD_POINT4D;
-  PCL_ADD_RGB;
-  float weight;
-  PCL_MAKE_ALIGNED_OPERATOR_NEW
-};
-} // namespace msf::test
-POINT_CLOUD_REGISTER_POINT_STRUCT(msf::test::PointFused,
-                                  (float, x, x)(float, y, y)(float, z, z)(float, rgb, rgb)(float, weight, weight))
-#include <msf/reconstruction/impl/depth_frame.hpp>
 
 using namespace msf;
 using test::SceneKind;
@@ -244,8 +232,9 @@ TEST(TsdfIntegrator, OrganizedCloudsOfAnyPointTypeWithRecoveredIntrinsics) {
     ASSERT_LT((a.vertices[i] - b.vertices[i]).norm(), 1e-4f);
   EXPECT_EQ(a.colors.front(), (std::array<std::uint8_t, 3>{200, 100, 50}));
 
-  // A fusion-like type: its weight field becomes the per-pixel weight.
-  pcl::PointCloud<test::PointFused> fused;
+  // The fusion stage's type, through the library's own instantiation: its weight field
+  // becomes the per-pixel weight.
+  pcl::PointCloud<PointXYZRGBWeight> fused;
   depthImageToCloud(depth, calibration, 0, rgb);
   fused.resize(rgb.size());
   fused.width = rgb.width;

@@ -184,10 +184,24 @@ TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
   } catch (const IOError& e) {
     EXPECT_NE(std::string(e.what()).find("plain.pcd"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("voxel_size_m"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("-voxel V -trunc T"), std::string::npos) << e.what();
   }
+  // Given the voxel size and truncation the PCL rewrite dropped, it loads.
+  const TsdfVolume given = TsdfVolume::load(dir.file("plain.pcd"), 0.1, 0.3);
+  EXPECT_DOUBLE_EQ(given.voxelSize(), 0.1);
+  EXPECT_DOUBLE_EQ(given.truncation(), 0.3);
+  EXPECT_EQ(given.numObservedVoxels(), 1u);
+  EXPECT_THROW(TsdfVolume::load(dir.file("plain.pcd"), 0.1, 0), IOError); // half of it is not enough
   // A cloud without the sdf field.
   empty.save(dir.file("one.pcd"));
   EXPECT_EQ(TsdfVolume::load(dir.file("one.pcd")).numObservedVoxels(), 1u);
+  EXPECT_EQ(TsdfVolume::load(dir.file("one.pcd"), empty.voxelSize(), empty.truncation()).numObservedVoxels(), 1u);
+  try { // values that contradict the file's own are an error, not a silent choice
+    TsdfVolume::load(dir.file("one.pcd"), 2 * empty.voxelSize());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("was written with voxel_size_m"), std::string::npos) << e.what();
+  }
   pcl::PointCloud<pcl::PointXYZ> xyz;
   xyz.push_back(pcl::PointXYZ(0, 0, 0));
   pcl::io::savePCDFileASCII(dir.file("xyz.pcd"), xyz);

@@ -39,7 +39,8 @@ MSF_VECTOR_CLONES void returnSteps(const float* __restrict__ z, const float* __r
 }
 
 /// 1 where the fused disparity lies at an edge of the returns (the window's extremes more
-/// than `jump` apart) and farther than `tolerance` from both extremes; 0 elsewhere. All in
+/// than `jump` apart), between the extremes and farther than `tolerance` from both; 0
+/// elsewhere. All in
 /// steps. Returns how many there are.
 MSF_VECTOR_CLONES int edgeCandidates(const float* __restrict__ z, const std::uint16_t* __restrict__ high,
                                       const std::uint16_t* __restrict__ low, int cols, float fB, float jump,
@@ -48,11 +49,11 @@ MSF_VECTOR_CLONES int edgeCandidates(const float* __restrict__ z, const std::uin
   for (int u = 0; u < cols; ++u) {
     const float d = fB * kSteps / (z[u] > 0.f ? z[u] : 1.f);
     const float h = high[u], l = low[u];
-    const float to_high = std::abs(d - h), to_low = std::abs(d - l);
-    const float to_nearer = to_high < to_low ? to_high : to_low;
     // No fused depth, or no return in the window (0 - kNone): never > jump.
     const float span = z[u] > 0.f ? h - l : 0.f;
-    candidate[u] = (span > jump) & (to_nearer > tolerance);
+    // Strictly between the extremes: a value nearer than every return (a pole the LiDAR
+    // missed) or beyond all of them is no blend of the two surfaces.
+    candidate[u] = (span > jump) & (d - l > tolerance) & (h - d > tolerance);
     count += candidate[u];
   }
   return count;

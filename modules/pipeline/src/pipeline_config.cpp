@@ -73,6 +73,12 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
 
 void PipelineConfig::validate() const {
   projection.validate();
+  // Stereo matches cameras 0 and 1 and the map integrates in camera 0 at its pose: LiDAR in
+  // another camera would be fused with pixels it does not cover.
+  if (projection.camera != 0)
+    throw ConfigError("projection.camera is " + std::to_string(projection.camera) +
+                      ": the pipeline fuses the LiDAR with the stereo pair of cameras 0 and 1 in camera 0 "
+                      "(msf_project -camera projects into another camera on its own)");
   interpolation.validate();
   rings.validate();
   stereo.validate();

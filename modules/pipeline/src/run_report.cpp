@@ -66,6 +66,8 @@ std::string num(double v, int precision = 4) {
   std::ostringstream s;
   s << std::setprecision(precision) << std::fixed << v;
   std::string text = s.str();
+  if (text.find('.') == std::string::npos)
+    return text;  // an integer's zeros are digits, not padding
   text.erase(text.find_last_not_of('0') + 1);
   if (text.back() == '.')
     text.pop_back();

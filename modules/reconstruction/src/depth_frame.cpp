@@ -1,4 +1,5 @@
 #include <msf/reconstruction/impl/depth_frame.hpp>
+#include <msf/io/point_types.h>
 
 #include <msf/common/exceptions.h>
 
@@ -109,5 +110,8 @@ MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZ)
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZI)
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZRGB)
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZRGBA)
+MSF_INSTANTIATE_DEPTH_FRAME(msf::PointXYZID)            // msf_interpolate's
+MSF_INSTANTIATE_DEPTH_FRAME(msf::PointXYZRGBConfidence) // msf_stereo's
+MSF_INSTANTIATE_DEPTH_FRAME(msf::PointXYZRGBWeight)     // msf_fuse's, its weight per pixel
 
 } // namespace msf

@@ -300,7 +300,7 @@ void TsdfVolume::save(const std::string& path) const {
   });
 }
 
-TsdfVolume TsdfVolume::load(const std::string& path) {
+TsdfVolume TsdfVolume::load(const std::string& path, double voxel_size_m, double truncation_m) {
   requireFile(path, "volume");
   double voxel_size = 0.0, truncation = 0.0;
   {
@@ -318,9 +318,20 @@ TsdfVolume TsdfVolume::load(const std::string& path) {
         break;
       }
     }
-    if (!found)
+    auto given = [&](double value, double& from_file, const char* name) {
+      if (value <= 0.0)
+        return;
+      if (found && std::abs(value - from_file) > 1e-9 * std::max(1.0, from_file))
+        throw ConfigError("volume '" + path + "' was written with " + name + " " + number(from_file) + ", not " +
+                          number(value));
+      from_file = value;
+    };
+    given(voxel_size_m, voxel_size, "voxel_size_m");
+    given(truncation_m, truncation, "truncation_m");
+    if (!found && !(voxel_size > 0.0 && truncation > 0.0))
       throw IOError("volume '" + path + "' has no header comment '" + kHeaderTag +
-                    " voxel_size_m V truncation_m T' (not written by msf_integrate?)");
+                    " voxel_size_m V truncation_m T' (a PCL rewrite drops it): give the voxel size and "
+                    "truncation it was made with (msf_mesh -voxel V -trunc T)");
   }
   TsdfVolume volume(voxel_size, truncation);
   pcl::PointCloud<PointTsdf> cloud;

@@ -9,6 +9,8 @@
 #include <opencv2/core/mat.hpp>
 #include <pcl/point_cloud.h>
 
+#include <memory>
+
 namespace msf {
 
 /// Paper step 4: per-pixel fusion of two organized depth clouds of one camera, the
@@ -34,6 +36,9 @@ template <typename PointLidarT = PointXYZID, typename PointStereoT = PointXYZRGB
           typename PointOutT = PointXYZRGBWeight>
 class DepthFusion {
 public:
+  using Ptr = std::shared_ptr<DepthFusion<PointLidarT, PointStereoT, PointOutT>>;
+  using ConstPtr = std::shared_ptr<const DepthFusion<PointLidarT, PointStereoT, PointOutT>>;
+
   using PointCloudLidar = pcl::PointCloud<PointLidarT>;
   using PointCloudLidarConstPtr = typename PointCloudLidar::ConstPtr;
   using PointCloudStereo = pcl::PointCloud<PointStereoT>;

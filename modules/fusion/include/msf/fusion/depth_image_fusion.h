@@ -6,6 +6,8 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <memory>
+
 namespace msf {
 
 /// DepthFusion on images, for pipelines that keep depth images between stages (the
@@ -18,6 +20,9 @@ namespace msf {
 ///   fusion.fuse(lidar_depth, lidar_distance, stereo_depth, stereo_confidence, fused_depth);
 class DepthImageFusion {
 public:
+  using Ptr = std::shared_ptr<DepthImageFusion>;
+  using ConstPtr = std::shared_ptr<const DepthImageFusion>;
+
   /// Throws ConfigError for an invalid config.
   explicit DepthImageFusion(const DepthFusionConfig& config = {}) { setConfig(config); }
   /// Throws ConfigError for an invalid config.

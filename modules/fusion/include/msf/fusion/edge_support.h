@@ -14,8 +14,8 @@ struct EdgeSupportBuffers {
 
 /// The last step of both fusion methods (fusion.edge_support): where the real LiDAR returns
 /// in the window around a pixel span a depth edge (their disparities differ by more than
-/// edge_jump_px), a fused disparity farther than edge_tolerance_px from every one of them
-/// lies between the two surfaces (the interpolation's hole filling blends them, stereo
+/// edge_jump_px), a fused disparity between the window's nearest and farthest returns and
+/// farther than edge_tolerance_px from both lies between the two surfaces (the interpolation's hole filling blends them, stereo
 /// fattens the nearer one) and takes the depth of the return nearest it in disparity.
 ///
 /// lidar_depth: CV_32FC1 metres (not > 0 = none); lidar_distance: CV_32FC1 pixels to the

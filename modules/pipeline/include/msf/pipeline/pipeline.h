@@ -63,6 +63,9 @@ struct FrameResult {
 /// bounded by the map, not by the number of frames.
 class Pipeline {
 public:
+  using Ptr = std::shared_ptr<Pipeline>;
+  using ConstPtr = std::shared_ptr<const Pipeline>;
+
   /// Throws ConfigError for an invalid config, CalibrationError when the calibration has no
   /// image size.
   Pipeline(const Calibration& calibration, const PipelineConfig& config);

@@ -21,6 +21,9 @@ namespace msf {
 template <typename PointT>
 class CompoundInterpolation : public DepthCompletionFilter<PointT> {
 public:
+  using Ptr = pcl::shared_ptr<CompoundInterpolation<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const CompoundInterpolation<PointT>>;
+
   CompoundInterpolation() { this->filter_name_ = "CompoundInterpolation"; }
 
   /// Throws ConfigError for an invalid config.

@@ -16,6 +16,9 @@ namespace msf {
 template <typename PointT>
 class DepthCompletionFilter : public pcl::Filter<PointT> {
 public:
+  using Ptr = pcl::shared_ptr<DepthCompletionFilter<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const DepthCompletionFilter<PointT>>;
+
   using PointCloud = typename pcl::Filter<PointT>::PointCloud;
 
   /// Intrinsics of the camera the cloud is organized by. When unset (the default), they

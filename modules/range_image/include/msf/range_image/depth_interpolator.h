@@ -5,6 +5,7 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/persistence.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,9 @@ struct InterpolationConfig {
 /// for any number of threads.
 class DepthInterpolator {
 public:
+  using Ptr = std::shared_ptr<DepthInterpolator>;
+  using ConstPtr = std::shared_ptr<const DepthInterpolator>;
+
   explicit DepthInterpolator(const InterpolationConfig& config = {});
   /// Throws ConfigError for an invalid config.
   void setConfig(const InterpolationConfig& config);

@@ -9,6 +9,9 @@ namespace msf {
 template <typename PointT>
 class IpBasicCompletion : public DepthCompletionFilter<PointT> {
 public:
+  using Ptr = pcl::shared_ptr<IpBasicCompletion<PointT>>;
+  using ConstPtr = pcl::shared_ptr<const IpBasicCompletion<PointT>>;
+
   IpBasicCompletion() { this->filter_name_ = "IpBasicCompletion"; }
 
   void setConfig(const IpBasicConfig& config) {

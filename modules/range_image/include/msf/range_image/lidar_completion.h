@@ -11,6 +11,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <memory>
 #include <string>
 
 namespace msf {
@@ -38,6 +39,9 @@ const char* toString(CompletionMethod method);
 ///   lidar.compute(*scan, cloud);                         // organized msf::PointXYZID
 class LidarCompletion {
 public:
+  using Ptr = std::shared_ptr<LidarCompletion>;
+  using ConstPtr = std::shared_ptr<const LidarCompletion>;
+
   /// Throws CalibrationError or ConfigError naming what is wrong.
   explicit LidarCompletion(const Calibration& calibration, CompletionMethod method = CompletionMethod::Compound,
                            const ProjectionConfig& projection = {}, const InterpolationConfig& interpolation = {},

@@ -9,13 +9,14 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <memory>
 #include <vector>
 
 namespace msf {
 
 /// Section `projection` of the YAML config.
 struct ProjectionConfig {
-  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills
+  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills; the pipeline needs 0
   float min_range_m = 0.f;    ///< returns closer to the LiDAR than this are dropped
   float max_range_m = 120.f;  ///< returns farther than this are dropped (HDL-64E: 120 m)
   /// Border of the canvas (projectToCanvas): returns up to this many pixels outside the
@@ -40,6 +41,9 @@ struct ProjectionConfig {
 /// Not thread-safe: an object keeps per-point work buffers between scans.
 class LidarProjector {
 public:
+  using Ptr = std::shared_ptr<LidarProjector>;
+  using ConstPtr = std::shared_ptr<const LidarProjector>;
+
   LidarProjector() = default;
   /// Throws CalibrationError when the calibration has no image size, ConfigError for a
   /// bad config.

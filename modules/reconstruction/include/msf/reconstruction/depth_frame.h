@@ -27,7 +27,9 @@ struct DepthFrame {
 /// Organized cloud (NaN where there is no depth) to a DepthFrame: depth = z; colour from the
 /// rgb field when PointT has one; weight from a float field named `weight` when PointT has
 /// one (pcl::traits::has_field), as the fusion stage's point type does. `camera` = nullptr
-/// recovers the intrinsics from the cloud (estimatePinholeCamera).
+/// recovers the intrinsics from the cloud (estimatePinholeCamera). Instantiated for PCL's
+/// PointXYZ, PointXYZI, PointXYZRGB, PointXYZRGBA and the stages' PointXYZID,
+/// PointXYZRGBConfidence and PointXYZRGBWeight (MSF_NO_PRECOMPILE for other types).
 /// Throws InvalidInputError when the cloud is not organized.
 template <typename PointT>
 DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamera* camera = nullptr);

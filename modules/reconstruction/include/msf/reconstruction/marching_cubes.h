@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct TriangleMesh {
 /// A cube is meshed only when all 8 of its voxels have weight > min_weight.
 class MarchingCubes {
 public:
+  using Ptr = std::shared_ptr<MarchingCubes>;
+  using ConstPtr = std::shared_ptr<const MarchingCubes>;
+
   struct Config {
     /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
     /// TsdfIntegrator::Weighting): 10 meshes what is known to sigma 0.32 m, which a LiDAR-backed

@@ -6,6 +6,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace msf {
@@ -30,6 +31,9 @@ namespace msf {
 /// at many poses allocates nothing per frame or per triangle.
 class MeshRasterizer {
 public:
+  using Ptr = std::shared_ptr<MeshRasterizer>;
+  using ConstPtr = std::shared_ptr<const MeshRasterizer>;
+
   /// Surfaces nearer the camera than `near_m` (metres, > 0) are cut away. Throws
   /// InvalidInputError for a value that is not > 0 and finite.
   void setNearPlane(float near_m);

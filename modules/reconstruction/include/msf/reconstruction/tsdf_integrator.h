@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct PixelBand {
 /// Not thread-safe: one integrator per volume at a time.
 class TsdfIntegrator {
 public:
+  using Ptr = std::shared_ptr<TsdfIntegrator>;
+  using ConstPtr = std::shared_ptr<const TsdfIntegrator>;
+
   /// A voxel's weight is the inverse variance of its signed distance, in m^-2: observations
   /// add 1 / sigma^2, so that a voxel seen often or closely is both more precise and harder to
   /// overwrite, and a threshold on it (MarchingCubes min_weight) is a precision.

@@ -88,9 +88,12 @@ public:
   /// ("# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3"). Atomic. Throws IOError naming
   /// the file, InvalidInputError when the volume has no observed voxel.
   void save(const std::string& path) const;
-  /// Loads a volume written by save(). Throws IOError naming the file when it is missing,
-  /// lacks a field or the msfusion header comment.
-  static TsdfVolume load(const std::string& path);
+  /// Loads a volume written by save(). A PCL rewrite of the file (pcl_convert_pcd_ascii_binary,
+  /// pcl::io::savePCDFile) drops the header comment: then `voxel_size_m` and `truncation_m`
+  /// (> 0) say what it held; 0 = from the comment. Throws IOError naming the file when it is
+  /// missing, lacks a field, or has neither the comment nor the two values, ConfigError when
+  /// a given value contradicts the comment.
+  static TsdfVolume load(const std::string& path, double voxel_size_m = 0, double truncation_m = 0);
 
 private:
   double voxel_size_;

@@ -2,6 +2,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace msf {
@@ -27,6 +28,9 @@ namespace msf {
 /// a size nothing is allocated.
 class SemiGlobalMatcher {
 public:
+  using Ptr = std::shared_ptr<SemiGlobalMatcher>;
+  using ConstPtr = std::shared_ptr<const SemiGlobalMatcher>;
+
   /// OpenCV's StereoSGBM parameters, with its meaning for each.
   struct Params {
     int min_disparity = 0;

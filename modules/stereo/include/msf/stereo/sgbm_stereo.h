@@ -6,6 +6,8 @@
 #include <opencv2/core/mat.hpp>
 #include <pcl/point_cloud.h>
 
+#include <memory>
+
 namespace cv {
 class StereoSGBM;
 }
@@ -29,6 +31,9 @@ namespace msf {
 /// matcher is kept between frames, so its buffers are reused.
 class SgbmStereo {
 public:
+  using Ptr = std::shared_ptr<SgbmStereo>;
+  using ConstPtr = std::shared_ptr<const SgbmStereo>;
+
   using Config = SgbmConfig;
 
   SgbmStereo() = default;
