@@ -146,6 +146,12 @@ Sequence::Sequence(const std::string& dir) {
     calibration_.image_size = readImage(imagePath(0, 0), cv::IMREAD_GRAYSCALE).size();
 }
 
+std::string Sequence::posesName() const {
+  if (!gt_dir_.empty())
+    return "the synthetic ground truth";
+  return layout_ == Layout::Raw ? "OXTS (GPS/IMU)" : "the odometry ground truth";
+}
+
 std::string Sequence::scanPath(std::size_t i) const {
   const fs::path p(dir_);
   if (layout_ == Layout::Odometry)

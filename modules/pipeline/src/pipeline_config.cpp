@@ -65,6 +65,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.integrator.read(file.section("tsdf_integrator"));
   config.mesher.read(file.section("marching_cubes"));
   config.scheduling.read(file.section("pipeline"));
+  config.odometry.read(file.section("odometry"));
   file.rejectUnknownKeys();
   config.validate();
   return config;
@@ -86,6 +87,7 @@ void PipelineConfig::validate() const {
   integrator.validate();
   mesher.validate();
   scheduling.validate();
+  odometry.validate();
 }
 
 void PipelineConfig::print(std::ostream& out) const {
@@ -99,6 +101,7 @@ void PipelineConfig::print(std::ostream& out) const {
   integrator.print(out);
   mesher.print(out);
   scheduling.print(out);
+  odometry.print(out);
 }
 
 } // namespace msf

@@ -3,6 +3,7 @@
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/ring_split.h>
+#include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/stereo/sgbm_config.h>
@@ -50,6 +51,8 @@ struct PipelineConfig {
   TsdfIntegrator::Config integrator;        ///< `tsdf_integrator`
   MarchingCubes::Config mesher;             ///< `marching_cubes`
   SchedulingConfig scheduling;              ///< `pipeline`
+  /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
+  LidarOdometry::Config odometry;
 
   /// Defaults overridden by the sections present in `path` ("" = all defaults).
   /// Throws IOError for a missing file, ConfigError naming a bad key.
