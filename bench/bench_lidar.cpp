@@ -33,10 +33,7 @@ struct Data {
   Data() {
     const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
-    for (std::size_t i = 0; i < msf::bench::kFrames && i < sequence.size(); ++i) {
-      scans.emplace_back();
-      msf::loadVelodyneBin(sequence.scanPath(i), scans.back());
-    }
+    scans = msf::bench::kittiScans(sequence);
   }
 };
 

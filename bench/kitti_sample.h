@@ -2,6 +2,7 @@
 // The KITTI sample the benchmarks time: odometry sequence 04, frames 0-9 (../shared/data/kitti;
 // KITTI data is never copied into the repository).
 #include <msf/io/sequence.h>
+#include <msf/io/velodyne_io.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -10,6 +11,7 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <vector>
 
 namespace msf::bench {
 
@@ -31,6 +33,16 @@ inline Sequence kittiSequence() {
 
 /// Frames of it that the benchmarks time.
 constexpr std::size_t kFrames = 10;
+
+/// The scans of those frames, as the reader gives them.
+inline std::vector<pcl::PointCloud<pcl::PointXYZI>> kittiScans(const Sequence& sequence) {
+  std::vector<pcl::PointCloud<pcl::PointXYZI>> scans;
+  for (std::size_t i = 0; i < kFrames && i < sequence.size(); ++i) {
+    scans.emplace_back();
+    loadVelodyneBin(sequence.scanPath(i), scans.back());
+  }
+  return scans;
+}
 
 /// OpenCV's parallel loops on the calling thread while it lives: per-core costs, steadier
 /// than wall time on a machine shared with other work.

@@ -33,6 +33,7 @@ void printHelp(const char* name) {
              "  ideally with 'confidence' (without it every match counts as confident) and 'rgb'.\n");
   print_info("  where options are:\n");
   print_info("    -calib PATH        KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)\n");
+  print_info("    -image_size WxH    image size where no image lies beside the calibration\n");
   print_info("    -method NAME       paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)\n");
   print_info("    -config FILE       YAML config, section fusion\n");
   print_info("    -color PATH        colour camera image (image_2) to colour every fused point by projection\n");
@@ -83,7 +84,7 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_fuse", 4, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-method", "-config", "-color"};
+    const std::vector<std::string> value_options{"-calib", "-image_size", "-method", "-config", "-color"};
     msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);
     if (files.size() != 3)
@@ -93,6 +94,9 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
     std::string calib_path, method, config_path, color_path;
     msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    std::string image_size_text;
+    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
+    const cv::Size image_size = msf::parseImageSize(image_size_text);
     msf::tool::parseArgument(argc, argv, "-method", method);
     msf::tool::parseArgument(argc, argv, "-config", config_path);
     msf::tool::parseArgument(argc, argv, "-color", color_path);
@@ -106,7 +110,7 @@ int main(int argc, char** argv) {
       config.method = msf::parseFusionMethod(method);
     if (find_switch(argc, argv, "-print_config"))
       config.print(std::cout);
-    const msf::Calibration calibration = msf::loadCalibration(calib_path);
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
 
     TicToc tt;
     tt.tic();

@@ -36,6 +36,7 @@ void printHelp(const char* name) {
   print_info("    -method NAME     compound (default, paper step 2) | linear | cubic | ipbasic | ipbasic_multiscale\n");
   print_info("    -config FILE     YAML config, sections interpolation, projection, ip_basic\n");
   print_info("    -calib PATH      calibration: camera of the cloud (else recovered from its points); needed for a scan\n");
+  print_info("    -image_size WxH  image size where no image lies beside the calibration\n");
   print_info("    -camera N        rectified camera 0..3 of -calib (default 0)\n");
   print_info("    -short_gap N     gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)\n");
   print_info("    -max_gap N       longer gaps stay empty (interpolation.max_gap_px)\n");
@@ -54,7 +55,7 @@ std::size_t countValid(const pcl::PointCloud<msf::PointXYZID>& cloud) {
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_interpolate", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-method", "-config", "-calib", "-camera",
+    const std::vector<std::string> value_options{"-method", "-config", "-calib", "-image_size", "-camera",
                                                  "-short_gap", "-max_gap", "-threads"};
     msf::tool::checkOptions(argc, argv, value_options, {"-no_gaussian"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);
@@ -72,6 +73,9 @@ int main(int argc, char** argv) {
     const msf::CompletionMethod method = msf::parseCompletionMethod(method_name);
     msf::tool::parseArgument(argc, argv, "-config", config_path);
     msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    std::string image_size_text;
+    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
+    const cv::Size image_size = msf::parseImageSize(image_size_text);
     const msf::ConfigFile file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
     msf::ProjectionConfig projection;
     projection.read(file.section("projection"));
@@ -116,7 +120,7 @@ int main(int argc, char** argv) {
       if (calib_path.empty())
         throw msf::InvalidInputError("'" + in + "' is a scan (not an organized cloud): give -calib to project it, "
                                      "or project it first with msf_project");
-      msf::LidarCompletion completion(msf::loadCalibration(calib_path), method, projection, interpolation, ip_basic);
+      msf::LidarCompletion completion(msf::loadCalibration(calib_path, image_size), method, projection, interpolation, ip_basic);
       completion.compute(*input, dense);
     } else {
       pcl::PointCloud<msf::PointXYZID>::Ptr sparse(new pcl::PointCloud<msf::PointXYZID>);
@@ -125,7 +129,7 @@ int main(int argc, char** argv) {
         p.distance = std::isfinite(p.z) ? 0.f : std::numeric_limits<float>::infinity();
       msf::PinholeCamera camera;
       if (!calib_path.empty())
-        camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib_path), projection.camera);
+        camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib_path, image_size), projection.camera);
       if (ip) {
         msf::IpBasicCompletion<msf::PointXYZID> filter;
         filter.setConfig(ip_basic);

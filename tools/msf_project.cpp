@@ -26,6 +26,7 @@ void printHelp(const char* name) {
              "  reflectance kept, NaN where no return lands.\n");
   print_info("  where options are:\n");
   print_info("    -calib PATH      KITTI odometry calib.txt, raw date folder, object calib or YAML camera file\n");
+  print_info("    -image_size WxH  image size where no image lies beside the calibration\n");
   print_info("    -camera N        rectified camera 0..3 (default: 0, or projection.camera of -config)\n");
   print_info("    -config FILE     YAML config, section projection\n");
   print_info("    -min_range M     drop returns closer than M metres to the LiDAR (default 0)\n");
@@ -36,7 +37,7 @@ void printHelp(const char* name) {
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_project", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-camera", "-config", "-min_range", "-max_range"};
+    const std::vector<std::string> value_options{"-calib", "-image_size", "-camera", "-config", "-min_range", "-max_range"};
     msf::tool::checkOptions(argc, argv, value_options, {});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);
     if (files.size() != 2)
@@ -49,6 +50,9 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
     std::string calib_path, config_path;
     msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    std::string image_size_text;
+    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
+    const cv::Size image_size = msf::parseImageSize(image_size_text);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required: the projection needs the camera and T_cam0_velo");
     msf::tool::parseArgument(argc, argv, "-config", config_path);
@@ -60,7 +64,7 @@ int main(int argc, char** argv) {
     msf::tool::parseArgument(argc, argv, "-min_range", config.min_range_m);
     msf::tool::parseArgument(argc, argv, "-max_range", config.max_range_m);
     config.validate();
-    const msf::Calibration calibration = msf::loadCalibration(calib_path);
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     const msf::LidarProjector projector(calibration, config);
 
     pcl::PointCloud<pcl::PointXYZI> scan;

@@ -8,6 +8,7 @@
 #include <msf/evaluation/holdout.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
+#include <msf/evaluation/trajectory_plot.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
@@ -16,6 +17,7 @@
 #include <msf/pipeline/depth_panel.h>
 #include <msf/pipeline/mesh_renderer.h>
 #include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/pose_source.h>
 #include <msf/pipeline/run_report.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/synthetic/ground_truth.h>
@@ -64,9 +66,12 @@ void printHelp(const char* name) {
   print_info("  where options are:\n");
   print_info("    -o DIR         output folder (default msf_out): mesh.ply, volume.pcd, summary.json,\n"
              "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md,\n"
-             "                   config.yaml\n");
+             "                   config.yaml, poses.txt\n");
   print_info("    -config FILE   YAML configuration (config/kitti.yaml); flags below override it\n");
   print_info("    -frames a:b    frame range, inclusive (default: all)\n");
+  print_info("    -poses P       dataset: the dataset's poses (the default when it has them) | estimate: LiDAR\n"
+             "                   odometry as each frame is loaded (the default without them; section odometry)\n"
+             "                   | a KITTI poses file, line i for frame i. OUT/poses.txt holds the poses used\n");
   print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
   print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
   print_info("    -panels N      depth panels to draw, spread over the frames (default 3)\n");
@@ -297,7 +302,8 @@ constexpr double kGhostDistanceM = 0.2; // farther than this from the static sur
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
-    const std::vector<std::string> value_options{"-o", "-config", "-frames", "-voxel", "-lambda", "-panels", "-stream"};
+    const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",
+                                                 "-lambda", "-panels", "-poses",  "-stream"};
     msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() > 1) {
@@ -308,12 +314,13 @@ int main(int argc, char** argv) {
                                    "' too (-save_depth, -holdout and -compare_sources take no value; see -h)");
     }
 
-    std::string out = "msf_out", config_path, frames_text = "0:";
+    std::string out = "msf_out", config_path, frames_text = "0:", poses_option;
     int panels = 3;
     msf::tool::parseArgument(argc, argv, "-o", out);
     msf::tool::parseArgument(argc, argv, "-config", config_path);
     msf::tool::parseArgument(argc, argv, "-frames", frames_text);
     msf::tool::parseArgument(argc, argv, "-panels", panels);
+    msf::tool::parseArgument(argc, argv, "-poses", poses_option);
     const bool save_depth = find_switch(argc, argv, "-save_depth");
     const bool holdout = find_switch(argc, argv, "-holdout");
     const bool compare_sources = find_switch(argc, argv, "-compare_sources");
@@ -352,10 +359,8 @@ int main(int argc, char** argv) {
     }
 
     const msf::Sequence sequence(dataset);
-    if (!sequence.hasPoses())
-      throw msf::InvalidInputError("sequence '" + sequence.directory() + "' has no poses (odometry poses/XX.txt or raw " +
-                                   "oxts/): the map needs them" + (holdout ? ", and -holdout renders it at them" : ""));
     const std::vector<std::size_t> frames = sequence.indices(range);
+    msf::PoseSource poses(poses_option, sequence, frames, config.odometry);
     const msf::Calibration& calibration = sequence.calibration();
     const msf::HoldoutConfig holdout_config{config.rings, config.projection, {}};
     if (holdout) {
@@ -378,6 +383,7 @@ int main(int argc, char** argv) {
     config.print(config_yaml);
     report.config_yaml = config_yaml.str();
     report.config_file = "config.yaml";
+    report.trajectory = poses.description();
 
     GroundTruthScores scores;
     if (!sequence.groundTruthDir().empty())
@@ -404,8 +410,8 @@ int main(int argc, char** argv) {
     print_value("%s", sequence.directory().c_str());
     print_info(" into ");
     print_value("%s", out.c_str());
-    print_info("%s%s\n", holdout ? ", held-out rings removed from every scan" : "",
-               compare_sources ? ", with a map of each source alone" : "");
+    print_info("%s%s; poses: %s\n", holdout ? ", held-out rings removed from every scan" : "",
+               compare_sources ? ", with a map of each source alone" : "", poses.description().c_str());
 
     msf::Pipeline pipeline(calibration, config);
     if (streaming)
@@ -413,9 +419,14 @@ int main(int argc, char** argv) {
     const std::set<std::size_t> panel_frames = spread(frames, panels);
     pipeline.setKeepSparse(!panel_frames.empty()); // the panels show the projected scan
     PendingTruth heldout_truth;
-    if (holdout)
-      pipeline.setFrameFilter(
-          [&](msf::Frame& frame) { heldout_truth.put(frame.index, holdOutRings(frame, sequence, holdout_config)); });
+    pipeline.setFrameFilter([&](msf::Frame& frame) {
+      if (holdout)
+        heldout_truth.put(frame.index, holdOutRings(frame, sequence, holdout_config));
+      poses.apply(frame);
+    });
+    if (poses.kind() == msf::PoseSource::Kind::Estimated) // after the hold-out: the scan the pipeline sees
+      pipeline.setPoseEstimator([&](const msf::Frame& frame) { return poses.estimate(frame); });
+    msf::PoseList used_poses;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     Progress progress(frames.size());
@@ -426,6 +437,7 @@ int main(int argc, char** argv) {
           report.frames.push_back({r.index, r.name, r.times,
                                    r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms,
                                    msf::residentMemoryMb()});
+          used_poses.push_back(r.T_world_cam0);
           cv::Mat synthetic_depth;
           if (scores.truth) {
             synthetic_depth = scores.truth->depth(scores.truth->indexOf(r.name));
@@ -531,7 +543,7 @@ int main(int argc, char** argv) {
     if (!mesh.triangles.empty()) {
       // Preview: from above, and from the first frame's camera.
       const cv::Size size = calibration.requireImageSize();
-      const Eigen::Isometry3d first_pose = sequence.poses()[frames.front()];
+      const Eigen::Isometry3d first_pose = used_poses.front();
       cv::Mat above = msf::MeshRenderer::renderFromAbove(mesh, -(first_pose.linear().col(1)),
                                                          cv::Size(size.width, size.width / 2));
       cv::Mat camera = msf::MeshRenderer::render(mesh, first_pose, calibration.fx(), calibration.fy(),
@@ -627,6 +639,29 @@ int main(int argc, char** argv) {
           }
     }
 
+    report.pose_ms = poses.estimateMs();
+    if (!used_poses.empty()) {
+      msf::saveOdometryPoses((fs::path(out) / report.poses_file).string(), used_poses);
+      // Short names: the legend beside the plot is narrow.
+      const char* used_name = poses.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
+                              : poses.kind() == msf::PoseSource::Kind::File    ? "poses file"
+                                                                                : "dataset";
+      std::vector<std::pair<std::string, msf::PoseList>> trajectories{{used_name, used_poses}};
+      if (sequence.hasPoses() && poses.kind() != msf::PoseSource::Kind::Dataset) {
+        msf::PoseList reference;
+        for (const auto& f : report.frames)
+          reference.push_back(sequence.poses()[f.index]);
+        trajectories.emplace_back("dataset", reference);
+        if (used_poses.size() > 1) {
+          report.trajectory_metrics = msf::evaluateOdometry(used_poses, reference);
+          report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
+          report.trajectory_reference = sequence.posesName();
+        }
+      }
+      report.trajectory_plot_file = "trajectory.png";
+      msf::writeImage((fs::path(out) / report.trajectory_plot_file).string(),
+                      msf::plotTrajectoriesFromAbove(trajectories));
+    }
     report.peak_memory_mb = msf::peakMemoryMb();
     report.writeFramesCsv((fs::path(out) / "frames.csv").string());
     if (!report.frames.empty())

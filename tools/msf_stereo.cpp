@@ -36,6 +36,7 @@ void printHelp(const char* name) {
              "  (fields x y z rgb confidence; NaN where there is no match).\n");
   print_info("  where options are:\n");
   print_info("    -calib PATH            KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
+  print_info("    -image_size WxH        image size where no image lies beside the calibration\n");
   print_info("    -color PATH            colour camera image (image_2), projected for each point's colour;\n");
   print_info("                           without it the colour is the left image's grey\n");
   print_info("    -disparity_png PATH    also write the disparity as a KITTI 16-bit PNG (pixels x 256)\n");
@@ -76,7 +77,7 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_stereo", 4, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-color", "-disparity_png", "-prior", "-config",
+    const std::vector<std::string> value_options{"-calib", "-image_size", "-color", "-disparity_png", "-prior", "-config",
                                                  "-num_disparities", "-block_size", "-mode"};
     msf::tool::checkOptions(argc, argv, value_options, {"-lr_check", "-print_config"});
     const auto files = msf::tool::positionalArguments(argc, argv, value_options);
@@ -87,6 +88,9 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
     std::string calib_path, color_path, disparity_path, prior_path, config_path, mode;
     msf::tool::parseArgument(argc, argv, "-calib", calib_path);
+    std::string image_size_text;
+    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
+    const cv::Size image_size = msf::parseImageSize(image_size_text);
     msf::tool::parseArgument(argc, argv, "-color", color_path);
     msf::tool::parseArgument(argc, argv, "-disparity_png", disparity_path);
     msf::tool::parseArgument(argc, argv, "-prior", prior_path);
@@ -114,7 +118,7 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Loading ");
     print_value("%s %s ", files[0].c_str(), files[1].c_str());
-    const msf::Calibration calibration = msf::loadCalibration(calib_path);
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     const cv::Mat left = msf::readImage(files[0], cv::IMREAD_GRAYSCALE);
     const cv::Mat right = msf::readImage(files[1], cv::IMREAD_GRAYSCALE);
     cv::Mat color;

@@ -410,14 +410,7 @@ TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {
 
 // ---- bad input -----------------------------------------------------------------------------
 
-std::string errorOf(const std::function<void()>& call) {
-  try {
-    call();
-  } catch (const msf::Error& e) {
-    return e.what();
-  }
-  return "no exception";
-}
+using msf::test::errorOf;
 
 TEST(DepthFusion, BadInputNamesWhatIsWrong) {
   Inputs a(6, 4), b(5, 4);

@@ -94,6 +94,16 @@ TEST(FusionKitti, CloudClassMatchesImageFunction) {
   fusion.fuse(fused);
   ASSERT_EQ(fused.width, 1226u);
   ASSERT_EQ(fused.height, 370u);
+  // Headers: the scan's stamp (microseconds from the first frame, times.txt) and frame id,
+  // carried through every stage into camera 0's frame.
+  EXPECT_EQ(frame.scan->header.frame_id, "velodyne");
+  EXPECT_NEAR(static_cast<double>(frame.scan->header.stamp), frame.timestamp * 1e6, 1.0);
+  EXPECT_GT(frame.scan->header.stamp, 0u);
+  for (const auto* header : {&lidar_cloud->header, &fused.header}) {
+    EXPECT_EQ(header->frame_id, "camera_0");
+    EXPECT_EQ(header->stamp, frame.scan->header.stamp);
+  }
+  EXPECT_EQ(stereo_cloud->header.frame_id, "camera_0");
 
   cv::Mat distance(lidar_depth.size(), CV_32FC1);
   for (int v = 0; v < distance.rows; ++v)

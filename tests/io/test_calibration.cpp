@@ -135,8 +135,49 @@ protected:
 };
 
 TEST_F(CalibrationErrors, MissingKeyNamesKeyAndFile) {
+  const auto path = write("calib.txt", row("P0", 12) + row("P1", 12) + row("P3", 12) + row("Tr", 12));
+  expectError(path, {"'P2'", path});
+}
+
+TEST_F(CalibrationErrors, CamerasOnlyLoadsAndTheLidarStagesSayWhatIsMissing) {
+  // The KITTI stereo benchmarks' calib files: P0..P3, no Tr, no image beside them.
   const auto path = write("calib.txt", row("P0", 12) + row("P1", 12) + row("P2", 12) + row("P3", 12));
-  expectError(path, {"'Tr'", path});
+  const msf::Calibration c = msf::loadCalibration(path);
+  EXPECT_FALSE(c.has_velodyne);
+  EXPECT_EQ(c.image_size, cv::Size(0, 0));
+  try {
+    c.requireVelodyne();
+    FAIL();
+  } catch (const msf::CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("cameras only"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(msf::loadCalibration(write("full.txt", row("P0", 12) + row("P1", 12) + row("P2", 12) + row("P3", 12) +
+                                                         row("Tr", 12)))
+                  .has_velodyne);
+  // Written back without a Tr it does not have, in both formats.
+  msf::Calibration sized = msf::loadCalibration(path, {1242, 375});
+  EXPECT_EQ(sized.image_size, cv::Size(1242, 375));
+  msf::saveCalibrationYaml(sized, dir.file("camera.yaml"));
+  msf::saveOdometryCalibration(sized, dir.file("again.txt"));
+  EXPECT_FALSE(msf::loadCalibration(dir.file("camera.yaml")).has_velodyne);
+  EXPECT_EQ(msf::loadCalibration(dir.file("camera.yaml")).image_size, cv::Size(1242, 375));
+  EXPECT_FALSE(msf::loadCalibration(dir.file("again.txt")).has_velodyne);
+  // A given size that contradicts the calibration's own is an error naming both.
+  try {
+    msf::loadCalibration(dir.file("camera.yaml"), {1000, 375});
+    FAIL();
+  } catch (const msf::CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("1000x375 given"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1242x375"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Calibration, ImageSizeText) {
+  EXPECT_EQ(msf::parseImageSize("1242x375"), cv::Size(1242, 375));
+  EXPECT_EQ(msf::parseImageSize(""), cv::Size(0, 0));
+  for (const char* bad : {"1242", "1242x", "x375", "0x375", "-5x3", "12x3x4", "1242*375", "12.5x3"})
+    EXPECT_THROW(msf::parseImageSize(bad), msf::InvalidInputError) << bad;
 }
 
 TEST_F(CalibrationErrors, WrongMatrixSizeNamesKeyAndCount) {

@@ -42,6 +42,16 @@ TEST(Poses, RoundTripAndMalformedLine) {
   } catch (const msf::IOError& e) {
     EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
   }
+  // Twelve numbers that are no rigid motion (a scale, a mirror) are errors, not a trajectory.
+  for (const char* matrix : {"2 0 0 0 0 2 0 0 0 0 2 0", "-1 0 0 0 0 1 0 0 0 0 1 0"}) {
+    std::ofstream(dir.file("scaled.txt")) << "1 0 0 0 0 1 0 0 0 0 1 0\n" << matrix << "\n";
+    try {
+      msf::loadOdometryPoses(dir.file("scaled.txt"));
+      FAIL() << "expected IOError for " << matrix;
+    } catch (const msf::IOError& e) {
+      EXPECT_NE(std::string(e.what()).find("line 2: not a rigid motion"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Poses, RawOxtsGiveCameraPosesFromTheFirstFrame) {

@@ -262,6 +262,8 @@ TEST(PipelineConfig, ThePrintedConfigurationIsCompleteAndReadsBackToTheSame) {
   edited.rings.heldout_remainder = 1;
   edited.mesher.min_weight = 0.25f;
   edited.scheduling.queue_capacity = 3;
+  edited.odometry.deskew = "none";
+  edited.odometry.min_constraint = 0.0025;
   std::vector<std::pair<std::string, msf::PipelineConfig>> configs = {{"defaults", msf::PipelineConfig{}},
                                                                       {"edited", edited}};
   for (const char* name : {"kitti.yaml", "synthetic.yaml"})
@@ -273,7 +275,7 @@ TEST(PipelineConfig, ThePrintedConfigurationIsCompleteAndReadsBackToTheSame) {
     // Every key a stage reads is in the file: the dump is the whole configuration.
     const msf::ConfigFile file(dir.file("config.yaml"));
     for (const char* section : {"projection", "interpolation", "rings", "stereo", "fusion", "tsdf_volume",
-                                "tsdf_integrator", "marching_cubes", "pipeline"}) {
+                                "tsdf_integrator", "marching_cubes", "pipeline", "odometry"}) {
       const std::vector<std::string> keys = msf::knownConfigKeys(section);
       EXPECT_FALSE(keys.empty()) << section;
       for (const std::string& key : keys)
@@ -295,6 +297,8 @@ TEST(PipelineConfig, ThePrintedConfigurationIsCompleteAndReadsBackToTheSame) {
   EXPECT_EQ(again.mesher.min_weight, 0.25f);
   EXPECT_EQ(again.scheduling.queue_capacity, 3);
   EXPECT_EQ(again.integrator.lambda, 5.0);
+  EXPECT_EQ(again.odometry.deskew, "none");
+  EXPECT_EQ(again.odometry.min_constraint, 0.0025);
 }
 
 TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <string>
 
 namespace {
 
@@ -74,6 +76,9 @@ TEST(RangeImageTools, ErrorsNameTheProblemAndLeaveNoFile) {
       {"msf_interpolate", scan + " " + out + " -calib " + q(odometry() + "/calib.txt") + " -short_gap 9 -max_gap 4",
        "short_gap_px"},
       {"msf_interpolate", scan + " " + q(tmp.file("out.ply")), "out.ply"},
+      {"msf_project", scan + " " + out + " -calib " + q(odometry() + "/calib.txt") + " -image_size 1000x370",
+       "1000x370 given"},
+      {"msf_project", scan + " " + out + " -calib " + q(odometry() + "/calib.txt") + " -image_size 12x", "'12x'"},
   };
   for (const auto& c : cases) {
     const auto r = msf::test::runTool(c.tool, c.args);
@@ -82,6 +87,40 @@ TEST(RangeImageTools, ErrorsNameTheProblemAndLeaveNoFile) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.tool << " " << c.args << ": " << r.err;
     EXPECT_EQ(msf::test::countEntries(tmp.path()), 0u) << c.tool << " " << c.args;
   }
+}
+
+TEST(RangeImageTools, CalibrationsWithoutAnImageOrATr) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir tmp;
+  std::ifstream in(odometry() + "/calib.txt");
+  std::string line, cameras, all;
+  for (int n = 0; std::getline(in, line); ++n) {
+    all += line + "\n";
+    if (n < 4)
+      cameras += line + "\n"; // P0..P3: a KITTI stereo benchmark's file
+  }
+  std::ofstream(tmp.file("cameras.txt")) << cameras;
+  std::ofstream(tmp.file("calib.txt")) << all; // no image_0 beside it
+  const std::string scan = q(odometry() + "/velodyne/000000.bin");
+  auto r = msf::test::runTool("msf_project", scan + " " + q(tmp.file("a.pcd")) + " -calib " + q(tmp.file("cameras.txt")));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("cameras only"), std::string::npos) << r.err;
+  r = msf::test::runTool("msf_project", scan + " " + q(tmp.file("a.pcd")) + " -calib " + q(tmp.file("calib.txt")));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("-image_size WxH"), std::string::npos) << r.err;
+  // Given the size, the same projection as with the images beside the calibration.
+  r = msf::test::runTool("msf_project", scan + " " + q(tmp.file("b.pcd")) + " -calib " + q(tmp.file("calib.txt")) +
+                                            " -image_size 1226x370");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = msf::test::runTool("msf_project", scan + " " + q(tmp.file("c.pcd")) + " -calib " + q(odometry() + "/calib.txt"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  pcl::PointCloud<pcl::PointXYZ> b, c;
+  msf::loadCloud(tmp.file("b.pcd"), b);
+  msf::loadCloud(tmp.file("c.pcd"), c);
+  ASSERT_EQ(b.size(), c.size());
+  EXPECT_EQ(b.width, 1226u);
+  for (std::size_t i = 0; i < b.size(); ++i)
+    ASSERT_TRUE(std::isnan(b[i].z) ? std::isnan(c[i].z) : b[i].z == c[i].z) << i;
 }
 
 TEST(RangeImageTools, HelpExitsZero) {

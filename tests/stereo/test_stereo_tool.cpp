@@ -144,6 +144,21 @@ TEST(StereoToolKitti, OdometryFrameWithColour) {
   }
   EXPECT_GT(valid, 0.8 * cloud.size()); // 128 disparities: the first 128 columns have no match
   EXPECT_GT(coloured, valid / 2);
+
+  // A KITTI stereo benchmark's calibration (P0..P3, no Tr) is all the matching needs.
+  std::ifstream in(seq + "calib.txt");
+  std::string line, cameras;
+  for (int n = 0; n < 4 && std::getline(in, line); ++n)
+    cameras += line + "\n";
+  std::ofstream(dir.file("cameras.txt")) << cameras;
+  const auto p = msf::test::runTool("msf_stereo", seq + "image_0/000000.png " + seq + "image_1/000000.png " +
+                                                      dir.file("p.pcd") + " -calib " + dir.file("cameras.txt"));
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  pcl::PointCloud<msf::PointXYZRGBConfidence> same;
+  msf::loadCloud(dir.file("p.pcd"), same);
+  ASSERT_EQ(same.size(), cloud.size());
+  for (std::size_t i = 0; i < same.size(); i += 97)
+    ASSERT_TRUE(std::isnan(same[i].z) ? std::isnan(cloud[i].z) : same[i].z == cloud[i].z) << i;
 }
 
 } // namespace

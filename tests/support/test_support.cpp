@@ -1,5 +1,7 @@
 #include "test_support.h"
 
+#include <msf/common/exceptions.h>
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -86,6 +88,15 @@ std::size_t countEntries(const std::string& folder) {
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(folder))
     ++n;
   return n;
+}
+
+std::string errorOf(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const msf::Error& e) {
+    return e.what();
+  }
+  return "no exception";
 }
 
 } // namespace msf::test

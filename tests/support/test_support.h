@@ -1,6 +1,7 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 namespace msf::test {
@@ -44,6 +45,9 @@ CommandResult runCommand(const std::string& command_line);
 CommandResult runTool(const std::string& tool, const std::string& arguments);
 
 bool fileExists(const std::string& path);
+
+/// The message of the msf::Error that `call` throws, or "no exception".
+std::string errorOf(const std::function<void()>& call);
 
 /// Number of entries in a folder (to check that a failed tool left no file behind).
 std::size_t countEntries(const std::string& folder);

@@ -6,6 +6,7 @@
 
 #include <opencv2/core/persistence.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -29,8 +30,15 @@ double Calibration::baseline(int camera_a, int camera_b) const {
 cv::Size Calibration::requireImageSize() const {
   if (image_size.width <= 0 || image_size.height <= 0)
     throw CalibrationError("calibration '" + source +
-                           "' has no image size (no S_rect_00 key and no image beside it)");
+                           "' has no image size (no S_rect_00 key and no image beside it; the tools take -image_size WxH)");
   return image_size;
+}
+
+void Calibration::requireVelodyne() const {
+  if (!has_velodyne)
+    throw CalibrationError("calibration '" + source +
+                           "' holds the cameras only (no 'Tr', 'Tr_velo_to_cam' or 'T_cam0_velo'): projecting a "
+                           "scan needs the LiDAR's extrinsics");
 }
 
 namespace {
@@ -148,7 +156,9 @@ Calibration fromOdometry(const KeyValueFile& f) {
   c.source = f.path();
   for (int i = 0; i < 4; ++i)
     c.P[i] = f.projection("P" + std::to_string(i));
-  c.T_cam0_velo = f.transform3x4("Tr");
+  c.has_velodyne = f.has("Tr");
+  if (c.has_velodyne)
+    c.T_cam0_velo = f.transform3x4("Tr");
   c.image_size = imageSizeOf(firstFile(fs::path(f.path()).parent_path() / "image_0"));
   return c;
 }
@@ -223,8 +233,9 @@ Calibration fromYaml(const std::string& path) {
   c.image_size = cv::Size(static_cast<int>(in["image_width"]), static_cast<int>(in["image_height"]));
   cv::Mat T;
   in["T_cam0_velo"] >> T;
-  if (T.empty())
-    throw CalibrationError("calibration '" + path + "' has no key 'T_cam0_velo'");
+  c.has_velodyne = !T.empty();
+  if (!c.has_velodyne)
+    return c;
   if (T.rows != 4 || T.cols != 4)
     throw CalibrationError("calibration '" + path + "': key 'T_cam0_velo' is " + std::to_string(T.rows) +
                            "x" + std::to_string(T.cols) + ", expected 4x4");
@@ -268,6 +279,31 @@ Calibration loadCalibration(const std::string& path) {
                          "' is not a KITTI odometry, raw or object calibration (no key P0, P_rect_00 or R0_rect)");
 }
 
+Calibration loadCalibration(const std::string& path, cv::Size image_size) {
+  Calibration c = loadCalibration(path);
+  if (image_size.width <= 0 || image_size.height <= 0)
+    return c;
+  if (c.image_size.width > 0 && c.image_size != image_size)
+    throw CalibrationError("image size " + std::to_string(image_size.width) + "x" + std::to_string(image_size.height) +
+                           " given, but calibration '" + path + "' has " + std::to_string(c.image_size.width) + "x" +
+                           std::to_string(c.image_size.height));
+  c.image_size = image_size;
+  return c;
+}
+
+std::string cameraFrameId(int camera) { return "camera_" + std::to_string(camera); }
+
+cv::Size parseImageSize(const std::string& text) {
+  if (text.empty())
+    return {0, 0};
+  int width = 0, height = 0;
+  char x = 0, rest = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &rest) != 3 || x != 'x' || width <= 0 ||
+      height <= 0)
+    throw InvalidInputError("image size '" + text + "' is not WIDTHxHEIGHT with both > 0 (e.g. 1242x375)");
+  return {width, height};
+}
+
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path) {
   writeAtomically(path, [&](const std::string& tmp) {
     cv::FileStorage out(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
@@ -282,11 +318,13 @@ void saveCalibrationYaml(const Calibration& calibration, const std::string& path
     }
     out << "image_width" << calibration.image_size.width;
     out << "image_height" << calibration.image_size.height;
-    cv::Mat T(4, 4, CV_64F);
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c)
-        T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
-    out << "T_cam0_velo" << T;
+    if (calibration.has_velodyne) {
+      cv::Mat T(4, 4, CV_64F);
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+          T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
+      out << "T_cam0_velo" << T;
+    }
     out.release();
   });
 }
@@ -304,7 +342,8 @@ void saveOdometryCalibration(const Calibration& calibration, const std::string& 
     };
     for (int i = 0; i < 4; ++i)
       row("P" + std::to_string(i), calibration.P[i]);
-    row("Tr", calibration.T_cam0_velo.matrix().topRows<3>());
+    if (calibration.has_velodyne)
+      row("Tr", calibration.T_cam0_velo.matrix().topRows<3>());
     if (!out)
       throw IOError("cannot write calibration '" + path + "'");
   });

@@ -35,6 +35,14 @@ PoseList loadOdometryPoses(const std::string& path) {
     if (n != 12 || !ss.eof())
       throw IOError("poses '" + path + "' line " + std::to_string(line_no) +
                     ": expected 12 numbers (a 3x4 row-major matrix), got " + std::to_string(n));
+    // A scaled, sheared or mirrored matrix would pass on as a wrong trajectory: KITTI's
+    // files hold rotations to 1e-6; 1e-3 leaves room for files written with fewer digits.
+    const Eigen::Matrix3d R = T.linear();
+    const double off = (R * R.transpose() - Eigen::Matrix3d::Identity()).norm();
+    if (!T.matrix().allFinite() || !(off <= 1e-3) || R.determinant() < 0.0)
+      throw IOError("poses '" + path + "' line " + std::to_string(line_no) +
+                    ": not a rigid motion (|R R^T - I| = " + std::to_string(off) + ", det R = " +
+                    std::to_string(R.determinant()) + "); expected a rotation and a translation");
     poses.push_back(T);
   }
   return poses;

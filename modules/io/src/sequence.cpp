@@ -7,6 +7,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -144,6 +146,12 @@ Sequence::Sequence(const std::string& dir) {
     calibration_.image_size = readImage(imagePath(0, 0), cv::IMREAD_GRAYSCALE).size();
 }
 
+std::string Sequence::posesName() const {
+  if (!gt_dir_.empty())
+    return "the synthetic ground truth";
+  return layout_ == Layout::Raw ? "OXTS (GPS/IMU)" : "the odometry ground truth";
+}
+
 std::string Sequence::scanPath(std::size_t i) const {
   const fs::path p(dir_);
   if (layout_ == Layout::Odometry)
@@ -180,6 +188,9 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
     color = read(imagePath(2, i), cv::IMREAD_COLOR);
   f.scan.reset(new pcl::PointCloud<pcl::PointXYZI>);
   loadVelodyneBin(scanPath(i), *f.scan);
+  f.scan->header.frame_id = kVelodyneFrameId; // the stages carry its stamp into camera 0
+  f.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, f.timestamp) * 1e6));
+  f.scan->header.seq = static_cast<std::uint32_t>(i);
   f.left = left.get();
   f.right = right.get();
   if (color.valid())

@@ -170,6 +170,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
   BoundedQueue<Loaded> loaded(capacity);
   BoundedQueue<FrameResult> depths(capacity);
+  BoundedQueue<Frame> to_track(capacity);            // scans for the pose estimator
+  BoundedQueue<Eigen::Isometry3d> tracked(capacity);  // its poses, in frame order
   std::exception_ptr failure;
   std::mutex failure_mutex;
   auto fail = [&](std::exception_ptr e) {
@@ -180,6 +182,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
     }
     loaded.close();
     depths.close();
+    to_track.close();
+    tracked.close();
   };
   std::atomic<bool> interrupted{false};
 
@@ -199,6 +203,14 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
         if (frame_filter_)
           frame_filter_(item.frame);
         item.load_ms = msSince(start);
+        if (pose_estimator_) {
+          Frame scan_only;
+          scan_only.index = item.frame.index;
+          scan_only.timestamp = item.frame.timestamp;
+          scan_only.scan = item.frame.scan; // shared, read only: no stage changes a scan after the filter
+          if (!to_track.push(std::move(scan_only)))
+            break;
+        }
         item.result = startFrame(item.frame);
         // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior or guidance.
         if (lidarBeforeStereo())
@@ -210,7 +222,20 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
       fail(std::current_exception());
     }
     loaded.close();
+    to_track.close();
   });
+  std::thread tracker;
+  if (pose_estimator_)
+    tracker = std::thread([&] {
+      try {
+        while (auto frame = to_track.pop())
+          if (!tracked.push(pose_estimator_(*frame)))
+            break;
+      } catch (...) {
+        fail(std::current_exception());
+      }
+      tracked.close();
+    });
   std::thread depth([&] {
     try {
       while (auto item = loaded.pop()) {
@@ -242,6 +267,13 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   RunStats stats;
   try {
     while (auto result = depths.pop()) {
+      if (pose_estimator_) {
+        auto pose = tracked.pop();
+        if (!pose)
+          break; // the estimator failed (its error is rethrown below) or the run stopped
+        result->T_world_cam0 = *pose;
+        result->has_pose = true;
+      }
       integrate(*result);
       if (config_.scheduling.mesh_every_n_frames > 0 &&
           (stats.frames_done + 1) % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
@@ -261,8 +293,12 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   }
   loaded.close(); // wakes the other stages when the loop ended early
   depths.close();
+  to_track.close();
+  tracked.close();
   loader.join();
   depth.join();
+  if (tracker.joinable())
+    tracker.join();
   if (failure)
     std::rethrow_exception(failure);
   stats.wall_s = msSince(run_start) / 1000.0;

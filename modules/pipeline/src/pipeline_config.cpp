@@ -66,6 +66,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.mesher.read(file.section("marching_cubes"));
   config.scheduling.read(file.section("pipeline"));
   config.streaming.read(file.section("streaming"));
+  config.odometry.read(file.section("odometry"));
   file.rejectUnknownKeys();
   config.validate();
   return config;
@@ -88,6 +89,7 @@ void PipelineConfig::validate() const {
   mesher.validate();
   scheduling.validate();
   streaming.validate();
+  odometry.validate();
 }
 
 void PipelineConfig::print(std::ostream& out) const {
@@ -102,6 +104,7 @@ void PipelineConfig::print(std::ostream& out) const {
   mesher.print(out);
   scheduling.print(out);
   streaming.print(out);
+  odometry.print(out);
 }
 
 } // namespace msf

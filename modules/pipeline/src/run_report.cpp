@@ -189,6 +189,18 @@ void RunReport::writeSummaryJson(const std::string& path) const {
   s << "{\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
     << "  \"layout\": " << jsonString(layout) << ",\n"
+    << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);
+  if (!pose_ms.empty())
+    s << ", \"estimate_ms\": {\"median\": " << num(median(pose_ms), 3) << ", \"p95\": " << num(percentile(pose_ms, 95), 3)
+      << "}";
+  if (has_trajectory_metrics) {
+    const OdometryMetrics& m = trajectory_metrics;
+    s << ", \"reference\": " << jsonString(trajectory_reference) << ", \"ate_rmse_m\": " << num(m.ate_rmse_m, 4)
+      << ", \"end_drift_m\": " << num(m.end_drift_m, 4) << ", \"end_drift_pct\": " << num(m.end_drift_pct, 3)
+      << ", \"translation_error_pct\": " << num(m.translation_error_pct, 3)
+      << ", \"rotation_error_deg_per_m\": " << num(m.rotation_error_deg_per_m, 5);
+  }
+  s << "},\n"
     << "  \"frames\": " << frames.size() << ",\n"
     << "  \"frames_requested\": " << frames_requested << ",\n"
     << "  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n"
@@ -274,6 +286,22 @@ void RunReport::writeMarkdown(const std::string& path) const {
     << "Dataset `" << dataset << "` (" << layout << "), " << frames.size() << " of " << frames_requested
     << " frames" << (interrupted ? " (interrupted: the map holds the frames integrated before the stop)" : "")
     << ". Voxel " << num(voxel_size_m) << " m, lambda " << num(lambda) << ".\n\n"
+    << "Trajectory: " << trajectory << ", [`" << poses_file << "`](" << poses_file << ")";
+  if (!pose_ms.empty())
+    s << "; the odometry took " << num(median(pose_ms), 1) << " ms per frame (median, p95 "
+      << num(percentile(pose_ms, 95), 1) << ") on its own thread";
+  s << ".";
+  if (has_trajectory_metrics) {
+    const OdometryMetrics& m = trajectory_metrics;
+    s << " Against " << trajectory_reference << " (protocol 5, first poses aligned): ATE " << num(m.ate_rmse_m, 3)
+      << " m RMSE, end-point drift " << num(m.end_drift_m, 3) << " m = " << num(m.end_drift_pct, 2) << " % of "
+      << num(m.path_length_m, 1) << " m, devkit translation error " << num(m.translation_error_pct, 2)
+      << " %, rotation " << num(m.rotation_error_deg_per_m, 4) << " deg/m.";
+  }
+  s << "\n\n";
+  if (!trajectory_plot_file.empty())
+    s << "![the trajectory from above](" << trajectory_plot_file << ")\n\n";
+  s
     << "## Speed\n\n"
     << num(framesPerSecond(), 2) << " frames per second end to end (" << num(wall_s, 2) << " s; "
     << num(framesPerSecondAfterFirst(), 2) << " after the first frame, done at " << num(first_frame_s, 2)

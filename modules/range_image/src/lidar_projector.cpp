@@ -46,6 +46,7 @@ LidarProjector::LidarProjector(const Calibration& calibration, const ProjectionC
 }
 
 void LidarProjector::setCalibration(const Calibration& calibration) {
+  calibration.requireVelodyne();
   camera_ = PinholeCamera::fromCalibration(calibration, config_.camera);
   // P_i = K_i [I | t_i] on the rectified frame of camera 0, so the point in camera i's
   // frame is X_0 + K_i^-1 P_i.col(3) (a translation only: the cameras share one plane).
@@ -187,6 +188,8 @@ void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   cloud.resize(static_cast<std::size_t>(W) * H);
   cloud.width = static_cast<std::uint32_t>(W);
   cloud.height = static_cast<std::uint32_t>(H);
+  cloud.header = scan.header; // the scan's stamp, in the camera's frame
+  cloud.header.frame_id = cameraFrameId(config_.camera);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
   const int* w = winner_.ptr<int>();

@@ -19,6 +19,9 @@ struct Calibration {
   Eigen::Isometry3d T_cam0_velo = Eigen::Isometry3d::Identity(); ///< velodyne -> rectified cam 0
   Eigen::Isometry3d T_velo_imu = Eigen::Isometry3d::Identity();  ///< IMU -> velodyne (raw only)
   bool has_imu = false;                     ///< true when T_velo_imu was read
+  /// false for a camera-only file (the KITTI stereo benchmarks' P0..P3, no Tr): T_cam0_velo
+  /// is then the identity and means nothing
+  bool has_velodyne = true;
   std::string source;                       ///< where it was read from, for messages
 
   double fx(int camera = 0) const { return P[camera](0, 0); }
@@ -37,10 +40,14 @@ struct Calibration {
   double focalBaseline() const { return fx(0) * baselineGrey(); }
   /// Throws CalibrationError naming `source` when the image size is unknown.
   cv::Size requireImageSize() const;
+  /// Throws CalibrationError naming `source` when it holds the cameras only (no LiDAR
+  /// extrinsics), for the stages that project a scan.
+  void requireVelodyne() const;
 };
 
 /// Reads a calibration, the format detected from `path`:
-///  - a KITTI odometry `calib.txt` (P0..P3, Tr), or a sequence folder holding one;
+///  - a KITTI odometry `calib.txt` (P0..P3, Tr), or a sequence folder holding one; a file of
+///    P0..P3 only (the KITTI stereo benchmarks) is a camera-only calibration (has_velodyne);
 ///  - a KITTI raw date folder (calib_cam_to_cam.txt with P_rect_0X, R_rect_00, S_rect_0X,
 ///    plus calib_velo_to_cam.txt and, when present, calib_imu_to_velo.txt), a drive folder
 ///    inside it, or calib_cam_to_cam.txt itself;
@@ -50,12 +57,25 @@ struct Calibration {
 /// calibration when there is one. A missing key or a matrix with the wrong number of values
 /// throws CalibrationError naming key and file; a missing path throws IOError.
 Calibration loadCalibration(const std::string& path);
+/// The same, with the image size a user gives (a tool's -image_size WxH) where no image lies
+/// beside the calibration; {0, 0} = none given. A size that contradicts the calibration's own
+/// throws CalibrationError naming both.
+Calibration loadCalibration(const std::string& path, cv::Size image_size);
+
+/// The frame id of clouds in a rectified camera's frame ("camera_0" .. "camera_3"); scans of
+/// a Sequence are in "velodyne". Stamps are microseconds from the sequence's first frame.
+std::string cameraFrameId(int camera);
+inline constexpr const char* kVelodyneFrameId = "velodyne";
+
+/// "WxH" (e.g. 1242x375) to a size, "" to {0, 0} (none given); throws InvalidInputError
+/// naming the text otherwise.
+cv::Size parseImageSize(const std::string& text);
 
 /// Writes the project's YAML camera file (keys P0..P3 as 3x4, image_width, image_height,
-/// T_cam0_velo as 4x4). Atomic: nothing is left behind on failure.
+/// T_cam0_velo as 4x4 unless the calibration is camera-only). Atomic: nothing is left behind on failure.
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path);
 
-/// Writes a KITTI odometry calib.txt (P0..P3, Tr). Atomic.
+/// Writes a KITTI odometry calib.txt (P0..P3, and Tr unless camera-only). Atomic.
 void saveOdometryCalibration(const Calibration& calibration, const std::string& path);
 
 } // namespace msf

@@ -51,6 +51,9 @@ public:
   std::size_t size() const { return frame_names_.size(); }
   bool hasPoses() const { return !poses_.empty(); }
   const PoseList& poses() const { return poses_; }
+  /// Where poses() come from, in words: "the synthetic ground truth", "OXTS (GPS/IMU)" or
+  /// "the odometry ground truth" (whether or not there are any).
+  std::string posesName() const;
   /// Folder of synthetic ground truth (`<root>/gt`), "" when there is none.
   const std::string& groundTruthDir() const { return gt_dir_; }
   /// File stem of a frame ("000042" or "0000000042").

@@ -113,6 +113,14 @@ public:
   using FrameFilter = std::function<void(Frame&)>;
   void setFrameFilter(FrameFilter filter) { frame_filter_ = std::move(filter); }
 
+  /// Gives each frame its pose T_world_cam0 on a thread of its own (LiDAR odometry: the
+  /// tracking module), beside steps 1-4, which do not need it; integration waits for it.
+  /// run() calls it once per frame in frame order, after the frame filter, with the frame's
+  /// index, timestamp and scan (no images). It runs beside the filter and the callback: what
+  /// they share needs a lock. An exception stops the run like a failing stage. Set it before run().
+  using PoseEstimator = std::function<Eigen::Isometry3d(const Frame&)>;
+  void setPoseEstimator(PoseEstimator estimator) { pose_estimator_ = std::move(estimator); }
+
   /// The mesh of the volume, re-meshing only the blocks changed since the last call.
   const TriangleMesh& updateMesh();
   /// What the last updateMesh did (blocks meshed, small pieces removed).
@@ -157,6 +165,7 @@ private:
   std::unique_ptr<StreamingMap> streaming_;
   bool keep_sparse_ = false;
   FrameFilter frame_filter_;
+  PoseEstimator pose_estimator_;
 };
 
 } // namespace msf

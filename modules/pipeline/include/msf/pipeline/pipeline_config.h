@@ -3,6 +3,7 @@
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/ring_split.h>
+#include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -52,6 +53,8 @@ struct PipelineConfig {
   MarchingCubes::Config mesher;             ///< `marching_cubes`
   SchedulingConfig scheduling;              ///< `pipeline`
   StreamingMap::Config streaming;           ///< `streaming`: the map in bounded memory (off by default)
+  /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
+  LidarOdometry::Config odometry;
 
   /// Defaults overridden by the sections present in `path` ("" = all defaults).
   /// Throws IOError for a missing file, ConfigError naming a bad key.

@@ -2,6 +2,7 @@
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
+#include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/pipeline/pipeline.h>
 
@@ -53,6 +54,12 @@ public:
 
   std::string dataset;            ///< folder reconstructed
   std::string layout;             ///< odometry, raw or synthetic
+  std::string trajectory;         ///< where the poses came from, in words (PoseSource::description)
+  std::vector<double> pose_ms;    ///< per frame, when the poses were estimated (the odometry's thread)
+  /// The poses used against the dataset's own (protocol 5), when they came from elsewhere.
+  bool has_trajectory_metrics = false;
+  OdometryMetrics trajectory_metrics;
+  std::string trajectory_reference;  ///< what they were compared with, in words
   std::size_t frames_requested = 0;
   bool interrupted = false;
   double wall_s = 0;
@@ -75,6 +82,8 @@ public:
   std::string config_file;                    ///< its copy beside the report, e.g. config.yaml
   std::vector<std::string> depth_panels;      ///< file names of the depth panels written
   std::string mesh_file = "mesh.ply", volume_file = "volume.pcd", preview_file;
+  std::string poses_file = "poses.txt";        ///< the poses used, T_world_cam0 in KITTI's format
+  std::string trajectory_plot_file;            ///< them from above (with the reference), if drawn
 
   /// Frames over the whole run, wall_s: with the first frame's way through the empty pipeline.
   double framesPerSecond() const;

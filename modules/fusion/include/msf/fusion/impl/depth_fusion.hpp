@@ -74,7 +74,13 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   output.resize(static_cast<std::size_t>(rows) * cols);
   output.width = static_cast<std::uint32_t>(cols);
   output.height = static_cast<std::uint32_t>(rows);
+  // The stereo cloud's header (camera 0); SGBM works on images that carry no stamp, so the
+  // LiDAR's, the scan's carried through projection, fills one the stereo cloud lacks.
   output.header = stereo_->header;
+  if (output.header.stamp == 0)
+    output.header.stamp = lidar_->header.stamp;
+  if (output.header.frame_id.empty())
+    output.header.frame_id = lidar_->header.frame_id;
   output.sensor_origin_ = stereo_->sensor_origin_;
   output.sensor_orientation_ = stereo_->sensor_orientation_;
   // 1. The fused depth and weight images, a row at a time in contiguous arrays for fuseRow.

@@ -24,6 +24,7 @@ void depthImageToCloud(const cv::Mat& depth, const Calibration& calibration, int
   cloud.resize(static_cast<std::size_t>(depth.cols) * depth.rows);
   cloud.width = static_cast<std::uint32_t>(depth.cols);
   cloud.height = static_cast<std::uint32_t>(depth.rows);
+  cloud.header.frame_id = cameraFrameId(camera);
   bool dense = true;
 #pragma omp parallel for reduction(&& : dense)
   for (int v = 0; v < depth.rows; ++v) {

@@ -27,6 +27,7 @@ void SgbmStereo::compute(pcl::PointCloud<PointT>& output) {
   const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, config_.color_camera);
   output.resize(static_cast<std::size_t>(rows) * cols);
   output.width = static_cast<std::uint32_t>(cols);
+  output.header.frame_id = cameraFrameId(0); // the disparity of the left grey camera
   output.height = static_cast<std::uint32_t>(rows);
   // cv::parallel_for_ (work stealing) keeps both cores busy on a shared machine.
   std::atomic<bool> dense{true};

@@ -1,0 +1,128 @@
+#pragma once
+#include <msf/io/poses.h>
+#include <msf/io/sequence.h>
+#include <msf/registration/adaptive_threshold.h>
+#include <msf/registration/local_map.h>
+#include <msf/registration/point_list.h>
+#include <msf/registration/scan_constraints.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core/persistence.hpp>
+#include <pcl/point_cloud.h>
+
+#include <iosfwd>
+#include <memory>
+#include <string>
+
+namespace msf {
+
+/// LiDAR odometry (the tracking module): each scan is registered to a local map of the scans
+/// before it (scan to map, not scan to scan: errors do not add up frame by frame), from a
+/// constant-velocity prediction, after the KISS-ICP recipe (Vizzo et al. 2023): voxel
+/// downsampling, ICP with a robust kernel, and a correspondence threshold that adapts to how
+/// wrong the prediction has been. Beyond it: the map keeps the plane of every voxel's returns
+/// and the ICP measures distances to those planes where there are some (points slide along
+/// the road instead of snapping to the rings of earlier scans); and a spinning LiDAR's sweep
+/// is deskewed with the same constant velocity (deskew: sweep; msf_synth's scans are
+/// snapshots). A scan whose planes leave a degree of freedom unconstrained (a single plane,
+/// an empty road) is an error, not a pose that merely repeats the prediction.
+class LidarOdometry {
+public:
+  using Ptr = std::shared_ptr<LidarOdometry>;
+  using ConstPtr = std::shared_ptr<const LidarOdometry>;
+
+  /// Section `odometry`.
+  struct Config {
+    /// Voxel of the local map; scans are kept at half of it for the map and registered at
+    /// 1.5 times it (a few thousand points: the ICP's cost).
+    double voxel_size_m = 1.0;
+    /// Returns nearer than this (the car itself) or farther are dropped; the map keeps the
+    /// voxels within max_range_m of the sensor.
+    double min_range_m = 3.0;
+    double max_range_m = 100.0;
+    /// 10: the planes come from every return (PointMoments), so the points only need to be a
+    /// nearest neighbour; fewer make the search faster (KISS-ICP keeps 20).
+    int max_points_per_voxel = 10;
+    /// Distances to the map's planes where its voxels are planar (ScanToMap ICP), else to points.
+    bool point_to_plane = true;
+    /// How scans are motion-compensated: sweep (deskewSweep with the constant-velocity motion:
+    /// a spinning LiDAR, KITTI's HDL-64E), none (snapshots: msf_synth's LiDAR), or auto,
+    /// which resolveDeskew makes none for a synthetic sequence and sweep otherwise (and
+    /// LidarOdometry takes as sweep).
+    std::string deskew = "auto";
+    /// Correspondence distance until a frame has moved (AdaptiveThreshold).
+    double initial_threshold_m = 2.0;
+    /// Corrections of the prediction that move points less than this are no samples of its
+    /// error (AdaptiveThreshold): the threshold stays above 3 times this.
+    double min_correction_m = 0.1;
+    int max_iterations = 100;
+    double convergence = 1e-4;
+    /// Smallest eigenvalue of a scan's normalised plane information (ScanConstraints) that
+    /// counts as constrained: KITTI 04 and raw 0009 have 0.016 or more, the synthetic street
+    /// 0.003 or more, a single plane 0.
+    double min_constraint = 1e-3;
+
+    /// Overrides the keys present in a YAML section; throws ConfigError naming a bad key.
+    void read(const cv::FileNode& node);
+    void validate() const;
+    void print(std::ostream& out) const;
+  };
+
+  /// What the last registerScan did.
+  struct Stats {
+    std::size_t input_points = 0;   ///< finite returns within range
+    std::size_t map_points_added = 0; ///< the scan at half a voxel
+    std::size_t source_points = 0;  ///< the scan registered, at 1.5 voxels
+    std::size_t map_points = 0;     ///< the local map after the scan
+    int iterations = 0;
+    std::size_t correspondences = 0;
+    double threshold_m = 0;         ///< correspondence distance used
+    double constraint = 0;          ///< ScanConstraints::weakest of the scan
+  };
+
+  LidarOdometry();
+  /// Throws ConfigError naming a bad key.
+  explicit LidarOdometry(const Config& config);
+
+  /// Registers the next scan (time order), given in its sensor's frame, and returns its pose
+  /// T_world_sensor, the world being the first scan's sensor frame. Non-finite points are
+  /// skipped. Throws InvalidInputError starting with `name` for a scan without a finite point
+  /// in range, one whose planes leave a degree of freedom unconstrained, or one that does not
+  /// overlap the map; the odometry is then unchanged.
+  template <typename PointT>
+  Eigen::Isometry3d registerScan(const pcl::PointCloud<PointT>& scan, const std::string& name = "scan") {
+    PointList points; // non-finite ones too: registerPoints counts them in its message
+    points.reserve(scan.size());
+    for (const PointT& p : scan)
+      points.emplace_back(p.x, p.y, p.z);
+    return registerPoints(points, name);
+  }
+  Eigen::Isometry3d registerPoints(const PointList& points_sensor, const std::string& name = "scan");
+
+  /// T_world_sensor of every scan registered.
+  const PoseList& poses() const { return poses_; }
+  const LocalMap& map() const { return map_; }
+  const Stats& lastStats() const { return stats_; }
+  const Config& config() const { return config_; }
+
+private:
+  Config config_;
+  LocalMap map_;
+  AdaptiveThreshold threshold_;
+  PoseList poses_;
+  bool sweeps_;               // deskew != none
+  PointList first_returns_;  // the first scan, until the second tells the motion to deskew it
+  Stats stats_;
+};
+
+/// `config` with deskew auto resolved for `sequence`: none for a synthetic sequence (msf_synth's
+/// LiDAR takes a snapshot at the frame's pose), sweep for KITTI's.
+LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const Sequence& sequence);
+
+/// Camera 0's pose from the odometry's T_velo0_velo (its world is the first scan's sensor
+/// frame), with the first frame's camera 0 at T_world_cam0_first (the identity in KITTI's
+/// poses files).
+Eigen::Isometry3d cameraPose(const Eigen::Isometry3d& T_velo0_velo, const Eigen::Isometry3d& T_cam0_velo,
+                             const Eigen::Isometry3d& T_world_cam0_first = Eigen::Isometry3d::Identity());
+
+} // namespace msf

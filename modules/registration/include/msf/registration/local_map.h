@@ -1,0 +1,88 @@
+#pragma once
+#include <msf/registration/point_list.h>
+#include <msf/registration/voxel_downsample.h>
+#include <msf/registration/voxel_table.h>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace msf {
+
+/// The local map scans are registered to: world points in a hashed grid of voxels, each
+/// holding a few points (not one: the nearest neighbour of a point must be a measured point
+/// near it, not a voxel's representative up to half a voxel away), and the plane of every
+/// return that fell in the voxel, from all scans (a single scan's rings are lines, not
+/// planes, beyond a few metres; successive scans' rings fill the voxel in). Voxels far from
+/// the sensor are dropped, so the map follows the drive and its size is bounded.
+class LocalMap {
+public:
+  using Ptr = std::shared_ptr<LocalMap>;
+  using ConstPtr = std::shared_ptr<const LocalMap>;
+
+  /// A map point near a query, with the plane of its voxel when the voxel's returns lie on
+  /// one: at least 5, spread over a tenth of a voxel in two directions and 7 times less in
+  /// the third.
+  struct Neighbor {
+    Eigen::Vector3d point;
+    double distance2 = 0;  ///< squared distance from the query
+    bool planar = false;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    Eigen::Vector3d plane_point = Eigen::Vector3d::Zero();  ///< the mean of the voxel's returns
+  };
+
+  /// Throws InvalidInputError for a voxel size that is not > 0 or fewer than 1 point a voxel.
+  LocalMap(double voxel_size, int max_points_per_voxel);
+
+  /// Adds a scan in world coordinates: `points_world` (downsampled) each where its voxel has
+  /// room and no point already lies within voxel_size / sqrt(max_points_per_voxel), so a
+  /// voxel fills with points spread over it, not with the same spot seen from successive
+  /// frames; and the returns each point stands for (`moments`, in world axes, one per point,
+  /// or none), to the planes of the points' voxels only.
+  void addScan(const PointList& points_world, const std::vector<PointMoments>& moments);
+  /// Points only, each its own return.
+  void addPoints(const PointList& points_world);
+  /// Drops the voxels whose centre is farther than `max_distance` from `origin`.
+  void removeFarFrom(const Eigen::Vector3d& origin, double max_distance);
+  void clear();
+
+  /// The map point nearest to `p` among the voxels within one voxel of p's and closer than
+  /// `max_distance`; false when there is none.
+  bool nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor) const;
+
+  std::size_t size() const { return points_; }
+  std::size_t voxelCount() const { return voxels_.size(); }
+  bool empty() const { return points_ == 0; }
+  double voxelSize() const { return voxel_size_; }
+  /// Every point of the map (for pictures and tests).
+  PointList points() const;
+
+private:
+  // What a search reads, apart from what only adding a scan reads, so that a search touches
+  // one cache line per voxel.
+  struct Voxel {
+    Eigen::Vector3i index = Eigen::Vector3i::Zero();
+    int count = 0;  // points
+    bool planar = false;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
+  };
+  // A voxel's returns, about its low corner (small numbers far from the origin).
+  struct Moments {
+    PointMoments returns;
+    bool changed = false;  // returns added since the plane was fitted
+  };
+  const Eigen::Vector3d* voxelPoints(int v) const { return &pool_[static_cast<std::size_t>(v) * max_points_]; }
+  int voxelFor(const Eigen::Vector3d& p);  // its index, created when absent
+  void rebuildTable();
+  void fitPlane(Voxel& voxel, const Moments& moments) const;
+
+  double voxel_size_, inv_voxel_size_, min_spacing2_;
+  int max_points_;
+  std::vector<Voxel> voxels_;
+  std::vector<Moments> moments_;  // in voxels_' order
+  PointList pool_;  // max_points_ slots per voxel, in voxels_' order
+  VoxelTable table_;
+  std::size_t points_ = 0;
+};
+
+} // namespace msf

@@ -1,0 +1,42 @@
+#pragma once
+#include <msf/registration/local_map.h>
+#include <msf/registration/point_list.h>
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+
+namespace msf {
+
+/// One registration of a scan to the local map: Gauss-Newton on the distance of each point
+/// to its nearest map point, or to that point's plane where its voxel is planar
+/// (point_to_plane), pairs farther than max_correspondence_m dropped and the rest weighed by
+/// a Geman-McClure kernel of scale kernel_scale_m, so that what moved (a car) or was not seen
+/// before pulls little. A plane lets a point slide along the surface it lies on: on a road
+/// seen ring by ring, the nearest map point is on the ring of an earlier scan, and
+/// point-to-point distances pull the scan back towards where that scan was taken.
+struct IcpSettings {
+  double max_correspondence_m = 2.0;
+  double kernel_scale_m = 0.66;
+  bool point_to_plane = true;
+  /// Planes only, no point-to-point pair (point_to_plane on).
+  bool planes_only = false;
+  int max_iterations = 100;
+  /// Stops when an update moves the pose by less than this (metres plus radians).
+  double convergence = 1e-4;
+};
+
+struct IcpResult {
+  Eigen::Isometry3d T_world_sensor = Eigen::Isometry3d::Identity();
+  int iterations = 0;
+  std::size_t correspondences = 0;  ///< pairs of the last iteration
+  std::size_t planes = 0;           ///< of which point-to-plane
+  bool converged = false;           ///< the last update was below `convergence`
+};
+
+/// Aligns `points_sensor` (a scan in its sensor's frame) to `map`, from `initial_guess`.
+/// Throws InvalidInputError when fewer than 6 points find a map point within reach.
+IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
+                         const IcpSettings& settings);
+
+} // namespace msf

@@ -1,0 +1,29 @@
+#pragma once
+#include <msf/registration/point_list.h>
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace msf {
+
+/// The spread of the points a downsampled point stands for: their count, and the sums of
+/// their offsets from it and of the offsets' outer products (upper triangle), in the
+/// points' axes. Moments add up, so a map can fit planes to every return it was given
+/// from the few points it keeps.
+struct PointMoments {
+  int count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  /// The same points seen in axes turned by R (the offsets turn, the count stays).
+  PointMoments rotated(const Eigen::Matrix3d& R) const;
+};
+
+/// One point per voxel of edge `voxel_size`: the first one in `points`' order, a measured
+/// point rather than a centroid that lies on no surface at an edge. The order of the kept
+/// points is their input order. With `moments`, also the moments of each kept point's voxel
+/// about it, in the same order. Throws InvalidInputError for a voxel size that is not > 0.
+PointList voxelDownsample(const PointList& points, double voxel_size, std::vector<PointMoments>* moments = nullptr);
+
+} // namespace msf

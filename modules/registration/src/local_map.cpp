@@ -1,0 +1,197 @@
+#include <msf/common/exceptions.h>
+#include <msf/registration/local_map.h>
+#include <msf/registration/plane_fit.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace msf {
+
+LocalMap::LocalMap(double voxel_size, int max_points_per_voxel)
+    : voxel_size_(voxel_size), inv_voxel_size_(1.0 / voxel_size), max_points_(max_points_per_voxel) {
+  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size))
+    throw InvalidInputError("local map: voxel size must be > 0, got " + std::to_string(voxel_size));
+  if (max_points_per_voxel < 1)
+    throw InvalidInputError("local map: max points per voxel must be >= 1, got " + std::to_string(max_points_per_voxel));
+  const double spacing = voxel_size / std::sqrt(static_cast<double>(max_points_per_voxel));
+  min_spacing2_ = spacing * spacing;
+}
+
+int LocalMap::voxelFor(const Eigen::Vector3d& p) {
+  const Eigen::Vector3i index = voxelOf(p, inv_voxel_size_);
+  const auto [v, inserted] = table_.insert(voxelKey(index), static_cast<int>(voxels_.size()));
+  if (inserted) {
+    Voxel voxel;
+    voxel.index = index;
+    voxels_.push_back(voxel);
+    moments_.emplace_back();
+    pool_.resize(voxels_.size() * static_cast<std::size_t>(max_points_));
+  }
+  return v;
+}
+
+void LocalMap::addPoints(const PointList& points_world) {
+  std::vector<PointMoments> moments(points_world.size());
+  for (auto& m : moments)
+    m.count = 1;
+  addScan(points_world, moments);
+}
+
+void LocalMap::addScan(const PointList& points_world, const std::vector<PointMoments>& moments) {
+  if (!moments.empty() && moments.size() != points_world.size())
+    throw InvalidInputError("local map: " + std::to_string(moments.size()) + " moments for " +
+                            std::to_string(points_world.size()) + " points");
+  std::vector<int> changed;
+  for (std::size_t i = 0; i < points_world.size(); ++i) {
+    const Eigen::Vector3d& p = points_world[i];
+    const int v = voxelFor(p);
+    Voxel& voxel = voxels_[static_cast<std::size_t>(v)];
+    if (!moments.empty()) {
+      // The point's returns, moved from offsets about the point to offsets about the corner.
+      const PointMoments& in = moments[i];
+      Moments& m = moments_[static_cast<std::size_t>(v)];
+      const Eigen::Vector3d d = p - voxel.index.cast<double>() * voxel_size_;
+      const Eigen::Matrix3d cross = d * in.sum.transpose();
+      m.returns.count += in.count;
+      m.returns.sum += in.count * d + in.sum;
+      m.returns.outer += in.count * d * d.transpose() + cross + cross.transpose() +
+                         Eigen::Matrix3d(in.outer.selfadjointView<Eigen::Upper>());
+      if (!m.changed) {
+        m.changed = true;
+        changed.push_back(v);
+      }
+    }
+    if (voxel.count >= max_points_)
+      continue;
+    Eigen::Vector3d* slots = &pool_[static_cast<std::size_t>(v) * max_points_];
+    bool crowded = false;
+    for (int k = 0; k < voxel.count && !crowded; ++k)
+      crowded = (slots[k] - p).squaredNorm() < min_spacing2_;
+    if (crowded)
+      continue;
+    slots[voxel.count++] = p;
+    ++points_;
+  }
+  for (int v : changed) {
+    const auto k = static_cast<std::size_t>(v);
+    fitPlane(voxels_[k], moments_[k]);
+    moments_[k].changed = false;
+  }
+}
+
+void LocalMap::fitPlane(Voxel& voxel, const Moments& moments) const {
+  PlaneFit plane;
+  voxel.planar = msf::fitPlane(moments.returns, 0.1 * voxel_size_, plane);
+  if (!voxel.planar)
+    return;
+  voxel.normal = plane.normal;
+  voxel.mean = plane.mean + voxel.index.cast<double>() * voxel_size_;
+}
+
+void LocalMap::removeFarFrom(const Eigen::Vector3d& origin, double max_distance) {
+  const double max2 = max_distance * max_distance;
+  std::size_t kept = 0;
+  points_ = 0;
+  const auto per_voxel = static_cast<std::size_t>(max_points_);
+  for (std::size_t v = 0; v < voxels_.size(); ++v) {
+    const Eigen::Vector3d centre = (voxels_[v].index.cast<double>() + Eigen::Vector3d::Constant(0.5)) * voxel_size_;
+    if ((centre - origin).squaredNorm() > max2)
+      continue;
+    if (kept != v) {
+      voxels_[kept] = voxels_[v];
+      moments_[kept] = moments_[v];
+      std::copy_n(pool_.begin() + static_cast<std::ptrdiff_t>(v * per_voxel), voxels_[v].count,
+                  pool_.begin() + static_cast<std::ptrdiff_t>(kept * per_voxel));
+    }
+    points_ += static_cast<std::size_t>(voxels_[kept].count);
+    ++kept;
+  }
+  if (kept == voxels_.size())
+    return;
+  voxels_.resize(kept);
+  moments_.resize(kept);
+  pool_.resize(kept * per_voxel);
+  rebuildTable();
+}
+
+void LocalMap::clear() {
+  voxels_.clear();
+  moments_.clear();
+  pool_.clear();
+  table_.clear();
+  points_ = 0;
+}
+
+void LocalMap::rebuildTable() {
+  table_.clear();
+  table_.reserve(voxels_.size());
+  for (std::size_t v = 0; v < voxels_.size(); ++v)
+    table_.insert(voxelKey(voxels_[v].index), static_cast<int>(v));
+}
+
+bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor) const {
+  const Eigen::Vector3i centre = voxelOf(p, inv_voxel_size_);
+  // Where p lies in its voxel, to skip neighbours whose nearest face is already farther than
+  // the best point found: p's own voxel first, then its 26 neighbours.
+  const Eigen::Vector3d low = centre.cast<double>() * voxel_size_;
+  const Eigen::Vector3d to_low = p - low, to_high = low + Eigen::Vector3d::Constant(voxel_size_) - p;
+  double best = max_distance * max_distance;
+  const Eigen::Vector3d* best_point = nullptr;
+  int best_voxel = VoxelTable::kAbsent;
+  auto search = [&](const Eigen::Vector3i& offset) {
+    double gap2 = 0.0; // squared distance from p to the neighbour's box
+    for (int a = 0; a < 3; ++a) {
+      const double gap = offset[a] < 0 ? to_low[a] : offset[a] > 0 ? to_high[a] : 0.0;
+      gap2 += gap * gap;
+    }
+    if (gap2 >= best)
+      return;
+    const int v = table_.find(voxelKey(centre + offset));
+    if (v == VoxelTable::kAbsent)
+      return;
+    const Eigen::Vector3d* pts = voxelPoints(v);
+    for (int k = 0; k < voxels_[static_cast<std::size_t>(v)].count; ++k) {
+      const double d2 = (pts[k] - p).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        best_point = &pts[k];
+        best_voxel = v;
+      }
+    }
+  };
+  // Own voxel, then the 6 sharing a face, the 12 sharing an edge, the 8 sharing a corner:
+  // nearest boxes first, so the best distance shrinks early and prunes the rest.
+  static const std::array<Eigen::Vector3i, 27> kOrder = [] {
+    std::array<Eigen::Vector3i, 27> order;
+    int k = 0;
+    for (int axes = 0; axes <= 3; ++axes)
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz)
+            if ((dx != 0) + (dy != 0) + (dz != 0) == axes)
+              order[static_cast<std::size_t>(k++)] = Eigen::Vector3i(dx, dy, dz);
+    return order;
+  }();
+  for (const Eigen::Vector3i& offset : kOrder)
+    search(offset);
+  if (!best_point)
+    return false;
+  const Voxel& voxel = voxels_[static_cast<std::size_t>(best_voxel)];
+  neighbor.point = *best_point;
+  neighbor.distance2 = best;
+  neighbor.planar = voxel.planar;
+  neighbor.normal = voxel.normal;
+  neighbor.plane_point = voxel.mean;
+  return true;
+}
+
+PointList LocalMap::points() const {
+  PointList all;
+  all.reserve(points_);
+  for (std::size_t v = 0; v < voxels_.size(); ++v)
+    all.insert(all.end(), voxelPoints(static_cast<int>(v)), voxelPoints(static_cast<int>(v)) + voxels_[v].count);
+  return all;
+}
+
+} // namespace msf

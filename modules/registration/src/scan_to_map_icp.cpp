@@ -1,0 +1,101 @@
+#include <msf/common/exceptions.h>
+#include <msf/registration/scan_to_map_icp.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <string>
+
+namespace msf {
+
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// exp of a twist [translation; rotation vector] as an isometry (rotation by Rodrigues).
+Eigen::Isometry3d exponential(const Vector6d& delta) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d omega = delta.tail<3>();
+  const double angle = omega.norm();
+  if (angle > 0.0)
+    T.linear() = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  T.translation() = delta.head<3>();
+  return T;
+}
+
+} // namespace
+
+IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
+                         const IcpSettings& settings) {
+  IcpResult result;
+  result.T_world_sensor = initial_guess;
+  const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
+  LocalMap::Neighbor neighbor;
+  for (result.iterations = 1; result.iterations <= settings.max_iterations; ++result.iterations) {
+    // Normal equations for a left update T <- exp(delta) T. A point w = T p moves by
+    // delta_t + delta_r x w: the point residual's Jacobian is [I, -[w]x], the plane
+    // residual's n^T [I, -[w]x] = [n^T, (w x n)^T]. The point terms are summed in 3x3
+    // blocks, not as 6x6 products per point.
+    Eigen::Matrix3d H_tt = Eigen::Matrix3d::Zero(), H_tr = Eigen::Matrix3d::Zero(), H_rr = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g_t = Eigen::Vector3d::Zero(), g_r = Eigen::Vector3d::Zero();
+    Matrix6d H_plane = Matrix6d::Zero();
+    Vector6d g_plane = Vector6d::Zero();
+    std::size_t pairs = 0, planes = 0;
+    for (const Eigen::Vector3d& p : points_sensor) {
+      const Eigen::Vector3d w = result.T_world_sensor * p;
+      if (!map.nearest(w, settings.max_correspondence_m, neighbor))
+        continue;
+      ++pairs;
+      if (settings.point_to_plane && neighbor.planar) {
+        const double e = neighbor.normal.dot(w - neighbor.plane_point);
+        const double weight = 1.0 / ((1.0 + e * e / scale2) * (1.0 + e * e / scale2));
+        Vector6d J;
+        J << neighbor.normal, w.cross(neighbor.normal);
+        H_plane.selfadjointView<Eigen::Upper>().rankUpdate(J, weight);
+        g_plane += weight * e * J;
+        ++planes;
+        continue;
+      }
+      if (settings.planes_only) {
+        --pairs;
+        continue;
+      }
+      const double d2 = neighbor.distance2;
+      const double weight = 1.0 / ((1.0 + d2 / scale2) * (1.0 + d2 / scale2));
+      const Eigen::Vector3d r = w - neighbor.point;
+      Eigen::Matrix3d W; // [w]x
+      W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      H_tt.diagonal().array() += weight;
+      H_tr -= weight * W;
+      H_rr -= weight * W * W;
+      g_t += weight * r;
+      g_r += weight * w.cross(r); // (-[w]x)^T r = [w]x r
+    }
+    result.correspondences = pairs;
+    result.planes = planes;
+    if (pairs < 6)
+      throw InvalidInputError("scan-to-map ICP: " + std::to_string(pairs) + " of " +
+                              std::to_string(points_sensor.size()) + " points have a map point within " +
+                              std::to_string(settings.max_correspondence_m) + " m; at least 6 are needed");
+    Matrix6d H;
+    H << H_tt, H_tr, H_tr.transpose(), H_rr;
+    H += H_plane.selfadjointView<Eigen::Upper>();
+    Vector6d g;
+    g << g_t, g_r;
+    g += g_plane;
+    const Vector6d delta = H.ldlt().solve(-g);
+    result.T_world_sensor = exponential(delta) * result.T_world_sensor;
+    // Back onto the rotations: rounding leaves R slightly off, and the constant-velocity
+    // prediction (which inverts by transposing) would double that every frame.
+    result.T_world_sensor.linear() = Eigen::Quaterniond(result.T_world_sensor.linear()).normalized().toRotationMatrix();
+    if (delta.norm() < settings.convergence) {
+      result.converged = true;
+      break;
+    }
+  }
+  result.iterations = std::min(result.iterations, settings.max_iterations);
+  return result;
+}
+
+} // namespace msf

@@ -1,0 +1,138 @@
+// msf_odometry: camera 0's trajectory of a sequence from its LiDAR scans (the tracking module),
+// in KITTI's poses format.
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/common/statistics.h>
+#include <msf/common/tool.h>
+#include <msf/evaluation/odometry_metrics.h>
+#include <msf/io/poses.h>
+#include <msf/io/sequence.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/registration/lidar_odometry.h>
+
+#include <pcl/console/parse.h>
+#include <pcl/console/print.h>
+#include <pcl/console/time.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+using namespace pcl::console;
+
+namespace {
+
+const std::vector<std::string> kValueOptions{"-o", "-frames", "-config"};
+
+void printHelp(const char* name) {
+  print_error("Syntax is: %s DATASET_DIR -o poses.txt [options]\n", name);
+  print_info("  Estimates camera 0's pose of every frame from the LiDAR scans alone (LidarOdometry: each scan\n"
+             "  registered to a local map of the scans before it) and writes T_world_cam0 in KITTI's poses\n"
+             "  format, a 3x4 row-major matrix a line, one line per frame run. DATASET_DIR: a KITTI odometry\n"
+             "  sequence, a KITTI raw drive or a synthetic sequence (msf_synth). The first frame is at the\n"
+             "  dataset's pose when it has poses (the identity on KITTI), else at the identity; with\n"
+             "  poses, the estimate is also scored against them (evaluation protocol 5, msf_eval_odometry).\n");
+  print_info("  where options are:\n");
+  print_info("    -o FILE        output poses file (written whole or not at all)\n");
+  print_info("    -frames a:b    frame range, inclusive (default: all)\n");
+  print_info("    -config FILE   YAML configuration; its `odometry` section (config/kitti.yaml)\n");
+  print_info("    -print_config  print the configuration in effect\n");
+}
+
+void printMetrics(const msf::OdometryMetrics& m) {
+  print_info("  ATE (first poses aligned) ");
+  print_value("%.3f m", m.ate_rmse_m);
+  print_info(" RMSE, %.3f m max; end-point drift ", m.ate_max_m);
+  print_value("%.3f m = %.2f %%", m.end_drift_m, m.end_drift_pct);
+  print_info(" of %.1f m, %.3f deg\n", m.path_length_m, m.end_rotation_error_deg);
+  print_info("  KITTI devkit over %zu segments of %s: translation ", m.segments,
+             m.devkit_lengths ? "100-800 m" : "k/8 of the path (k = 1..7; the devkit's 100 m is longer than the path)");
+  print_value("%.2f %%", m.translation_error_pct);
+  print_info(", rotation ");
+  print_value("%.4f deg/m\n", m.rotation_error_deg_per_m);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return msf::tool::runWithHelp(argc, argv, "msf_odometry", 2, printHelp, [&] {
+    msf::tool::checkOptions(argc, argv, kValueOptions, {"-print_config"});
+    const auto positional = msf::tool::positionalArguments(argc, argv, kValueOptions);
+    if (positional.size() != 1)
+      throw msf::InvalidInputError("expected one DATASET_DIR, got " + std::to_string(positional.size()) +
+                                   " positional arguments (see -h)");
+    std::string output, config_path, frames_text = "0:";
+    msf::tool::parseArgument(argc, argv, "-o", output);
+    msf::tool::parseArgument(argc, argv, "-config", config_path);
+    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
+    if (output.empty())
+      throw msf::InvalidInputError("no output file: give -o poses.txt");
+    msf::LidarOdometry::Config config;
+    if (!config_path.empty())
+      msf::readConfigSection(config_path, "odometry", config);
+    if (find_switch(argc, argv, "-print_config"))
+      config.print(std::cout);
+
+    const msf::Sequence sequence(positional.front());
+    const std::vector<std::size_t> frames = sequence.indices(msf::FrameRange::parse(frames_text));
+    const msf::Calibration& calibration = sequence.calibration();
+    const Eigen::Isometry3d T_world_cam0_first =
+        sequence.hasPoses() ? sequence.poses()[frames.front()] : Eigen::Isometry3d::Identity();
+
+    print_highlight("Tracking ");
+    print_value("%zu", frames.size());
+    print_info(" frames of ");
+    print_value("%s\n", sequence.directory().c_str());
+    msf::LidarOdometry odometry(msf::resolveDeskew(config, sequence));
+    msf::PoseList T_world_cam0;
+    std::vector<double> register_ms;
+    const bool tty = ::isatty(STDOUT_FILENO);
+    const auto start = std::chrono::steady_clock::now();
+    pcl::PointCloud<pcl::PointXYZI> scan;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      const std::string path = sequence.scanPath(frames[k]);
+      msf::loadVelodyneBin(path, scan);
+      TicToc tt;
+      tt.tic();
+      const Eigen::Isometry3d T_velo0_velo = odometry.registerScan(scan, "scan '" + path + "'");
+      register_ms.push_back(tt.toc());
+      T_world_cam0.push_back(msf::cameraPose(T_velo0_velo, calibration.T_cam0_velo, T_world_cam0_first));
+      const auto& s = odometry.lastStats();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double fps = static_cast<double>(k + 1) / elapsed;
+      if (tty)
+        std::printf("\r  frame %zu/%zu  %.1f fps  %.0f s left   ", k + 1, frames.size(), fps,
+                    static_cast<double>(frames.size() - k - 1) / fps);
+      else
+        std::printf("  frame %s (%zu/%zu): %.1f ms, %zu points, %d iterations, threshold %.2f m, constraint %.3f, "
+                    "map %zu points\n",
+                    sequence.frameName(frames[k]).c_str(), k + 1, frames.size(), register_ms.back(), s.source_points,
+                    s.iterations, s.threshold_m, s.constraint, s.map_points);
+      std::fflush(stdout);
+    }
+    if (tty)
+      std::printf("\n");
+    print_info("Registration: median ");
+    print_value("%.1f ms", msf::median(register_ms));
+    print_info(", p95 %.1f ms per frame (loading apart)\n", msf::percentile(register_ms, 95));
+
+    TicToc tt;
+    tt.tic();
+    print_highlight("Saving ");
+    print_value("%s ", output.c_str());
+    msf::saveOdometryPoses(output, T_world_cam0);
+    msf::tool::printDone(tt.toc(), T_world_cam0.size());
+
+    if (sequence.hasPoses()) {
+      msf::PoseList reference;
+      for (std::size_t i : frames)
+        reference.push_back(sequence.poses()[i]);
+      print_info("Against %s:\n", sequence.posesName().c_str());
+      printMetrics(msf::evaluateOdometry(T_world_cam0, reference));
+    }
+    return 0;
+  });
+}
