@@ -6,6 +6,7 @@
 #include <msf/common/tool.h>
 #include <msf/io/cloud_io.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <pcl/console/time.h>
@@ -13,7 +14,10 @@
 #include <pcl/console/print.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,11 +25,14 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-voxel", "-trunc"};
+const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-voxel", "-trunc",
+                                                 "-region"};
 
 void printHelp(const char* name) {
-  print_error("Syntax is: %s <volume.pcd> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
-  print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. Options:\n");
+  print_error("Syntax is: %s <volume.pcd | STORE_DIR> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
+  print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. STORE_DIR is the\n"
+             "  output folder of msf_reconstruct -stream (its tsdf/index.txt and block files): meshed tile by tile\n"
+             "  in bounded memory into mesh.ply (a PLY only) and its tiles into mesh.ply.tiles/. Options:\n");
   const msf::MarchingCubes::Config defaults; // the help says what the code does
   print_info("    -min_weight W   voxels with weight <= W (m^-2, an inverse variance) make no triangles (default ");
   print_value("%s", msf::configValue(defaults.min_weight).c_str()); print_info(")\n");
@@ -36,6 +43,50 @@ void printHelp(const char* name) {
   print_info("    -voxel V -trunc T\n"
              "                    voxel size and truncation (m) of a volume whose header comment a PCL\n"
              "                    rewrite dropped (otherwise read from the file, and checked if given)\n");
+  print_info("    -region x0,y0,z0,x1,y1,z1  a store's tiles within this box only (metres, world frame)\n");
+}
+
+/// A streamed store: tile by tile (the small-piece filter is not applied across tiles).
+int remeshStore(const std::string& store, const std::string& output, const msf::MarchingCubes::Config& config,
+                int argc, char** argv) {
+  if (msf::fileExtension(output) != ".ply")
+    throw msf::InvalidInputError("output mesh '" + output + "': a store is meshed into a .ply");
+  if (config.min_component_triangles > 0)
+    throw msf::InvalidInputError("-min_component_triangles: a store is meshed tile by tile, pieces cross tiles");
+  if (find_argument(argc, argv, "-voxel") >= 0 || find_argument(argc, argv, "-trunc") >= 0)
+    throw msf::InvalidInputError("-voxel and -trunc are for a volume .pcd: a store's index gives them");
+  Eigen::Vector3d lo = Eigen::Vector3d::Ones(), hi = Eigen::Vector3d::Zero();
+  std::string region;
+  if (msf::tool::parseArgument(argc, argv, "-region", region) >= 0) {
+    std::vector<double> v;
+    std::stringstream ss(region);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      char* end = nullptr;
+      const double x = std::strtod(item.c_str(), &end);
+      if (item.empty() || *end != '\0' || !std::isfinite(x))
+        throw msf::InvalidInputError("-region: '" + item + "' is not a number");
+      v.push_back(x);
+    }
+    if (v.size() != 6 || v[0] > v[3] || v[1] > v[4] || v[2] > v[5])
+      throw msf::InvalidInputError("-region: need x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1, z0 <= z1, got '" + region +
+                                   "'");
+    lo = Eigen::Vector3d(v[0], v[1], v[2]);
+    hi = Eigen::Vector3d(v[3], v[4], v[5]);
+  }
+  pcl::console::TicToc tt;
+  print_highlight("Meshing the store ");
+  print_value("%s ", store.c_str());
+  print_info("tile by tile into ");
+  print_value("%s ", output.c_str());
+  tt.tic();
+  const std::size_t triangles = msf::StreamingMap::remesh(store, config, output, lo, hi);
+  msf::tool::printDone(tt.toc(), triangles);
+  if (triangles == 0)
+    throw msf::InvalidInputError("store '" + store + "' has no surface above weight " +
+                                 std::to_string(config.min_weight) + (region.empty() ? "" : " in the region") +
+                                 ": no mesh written");
+  return 0;
 }
 
 int run(int argc, char** argv) {
@@ -56,6 +107,10 @@ int run(int argc, char** argv) {
   msf::tool::parseArgument(argc, argv, "-min_weight", config.min_weight);
   msf::tool::parseArgument(argc, argv, "-min_component_triangles", config.min_component_triangles);
   msf::MarchingCubes mesher(config);
+  if (std::filesystem::is_directory(files[0]))
+    return remeshStore(files[0], files[1], config, argc, argv);
+  if (find_argument(argc, argv, "-region") >= 0)
+    throw msf::InvalidInputError("-region applies to a store folder (msf_reconstruct -stream), not to a volume .pcd");
 
   pcl::console::TicToc tt;
   print_highlight("Loading ");

@@ -75,6 +75,11 @@ void printHelp(const char* name) {
   print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
   print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
   print_info("    -panels N      depth panels to draw, spread over the frames (default 3)\n");
+  print_info("    -stream R      keep only R metres around the camera in memory (streaming.active_radius_m;\n"
+             "                   at least the integrator's max_depth_m + truncation + 2 m + a tile): the rest\n"
+             "                   is meshed into OUT/tiles/X_Y_Z.ply and its TSDF written to OUT/tsdf/ as it\n"
+             "                   leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview;\n"
+             "                   msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md\n");
   print_info("    -save_depth    also write each frame's fused depth as OUT/depth/NNNNNN.pcd\n");
   print_info("    -holdout       evaluation protocol 4: the held-out rings (config section rings) are removed\n"
              "                   from every scan before the pipeline sees it and become the ground truth; the\n"
@@ -92,6 +97,9 @@ struct GroundTruthScores {
   std::unique_ptr<msf::synthetic::GroundTruth> truth;
   std::map<std::string, msf::DepthErrorAccumulator> all, background, foreground;
   std::vector<Eigen::Vector3f> seen_surface;  // ground-truth depth back-projected to the world
+  /// For the mesh's completeness; not for a streamed map (no mesh scores): it grows by ~0.3 MB
+  /// a frame, what a drive in bounded memory cannot keep.
+  bool keep_surface = true;
 
   void add(const msf::FrameResult& r, const cv::Mat& gt, const msf::Calibration& calibration, double max_depth_m) {
     const std::size_t gt_index = truth->indexOf(r.name);
@@ -106,6 +114,8 @@ struct GroundTruthScores {
     }
     // Every 4th pixel of the true static surface in range, for the mesh's completeness against
     // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
+    if (!keep_surface)
+      return;
     const cv::Mat moving = truth->movingMask(gt_index);
     const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
     const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
@@ -292,7 +302,8 @@ constexpr double kGhostDistanceM = 0.2; // farther than this from the static sur
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
-    const std::vector<std::string> value_options{"-o", "-config", "-frames", "-voxel", "-lambda", "-panels", "-poses"};
+    const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",
+                                                 "-lambda", "-panels", "-poses",  "-stream"};
     msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() > 1) {
@@ -318,7 +329,14 @@ int main(int argc, char** argv) {
       msf::tool::parseArgument(argc, argv, "-voxel", config.volume.voxel_size_m);
     if (find_argument(argc, argv, "-lambda") >= 0)
       msf::tool::parseArgument(argc, argv, "-lambda", config.integrator.lambda);
+    if (find_argument(argc, argv, "-stream") >= 0)
+      msf::tool::parseArgument(argc, argv, "-stream", config.streaming.active_radius_m);
     config.validate();
+    const bool streaming = config.streaming.enabled();
+    if (streaming && (holdout || compare_sources))
+      throw msf::InvalidInputError(std::string(holdout ? "-holdout" : "-compare_sources") +
+                                   " needs the whole map in memory: not with a streamed map (-stream, " +
+                                   "streaming.active_radius_m)");
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 
     OutputFolder output(out);
@@ -370,10 +388,13 @@ int main(int argc, char** argv) {
     GroundTruthScores scores;
     if (!sequence.groundTruthDir().empty())
       scores.truth = std::make_unique<msf::synthetic::GroundTruth>(sequence.groundTruthDir());
+    scores.keep_surface = !streaming;
 
     // Protocol 4: the held-out rings with -holdout, else a synthetic sequence's exact depth.
     std::unique_ptr<msf::ReconstructionEvaluation> evaluation;
-    if (holdout || scores.truth)
+    // Protocol 4 renders the whole mesh at every frame's pose: not for a streamed map, whose
+    // mesh is on disk (its depth scores are bounded and kept).
+    if (!streaming && (holdout || scores.truth))
       evaluation = std::make_unique<msf::ReconstructionEvaluation>(msf::PinholeCamera::fromCalibration(calibration, 0),
                                                                    calibration.focalBaseline(),
                                                                    config.integrator.max_depth_m, holdout_config.d1);
@@ -393,6 +414,8 @@ int main(int argc, char** argv) {
                compare_sources ? ", with a map of each source alone" : "", poses.description().c_str());
 
     msf::Pipeline pipeline(calibration, config);
+    if (streaming)
+      pipeline.setStreamingDirectory(out);
     const std::set<std::size_t> panel_frames = spread(frames, panels);
     pipeline.setKeepSparse(!panel_frames.empty()); // the panels show the projected scan
     PendingTruth heldout_truth;
@@ -412,7 +435,8 @@ int main(int argc, char** argv) {
         sequence, frames,
         [&](msf::FrameResult& r) {
           report.frames.push_back({r.index, r.name, r.times,
-                                   r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms});
+                                   r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms,
+                                   msf::residentMemoryMb()});
           used_poses.push_back(r.T_world_cam0);
           cv::Mat synthetic_depth;
           if (scores.truth) {
@@ -460,17 +484,26 @@ int main(int argc, char** argv) {
 
     TicToc tt;
     tt.tic();
-    print_highlight("Meshing ");
-    const msf::TriangleMesh& mesh = pipeline.updateMesh();
-    report.mesh_ms = tt.toc();
-    msf::tool::printDone(report.mesh_ms, mesh.triangles.size());
-    report.vertices = mesh.vertices.size();
-    report.triangles = mesh.triangles.size();
-    report.pieces_removed = pipeline.meshStats().components_removed;
-    report.triangles_removed = pipeline.meshStats().triangles_removed;
+    print_highlight(streaming ? "Meshing the tiles in memory, writing the union " : "Meshing ");
+    // A streamed map's mesh is on disk (the union of OUT/tiles in OUT/mesh.ply), not in memory.
     report.observed_voxels = pipeline.volume().numObservedVoxels();
     report.blocks = pipeline.volume().numBlocks();
     report.volume_memory_mb = static_cast<double>(pipeline.volume().memoryBytes()) / (1024.0 * 1024.0);
+    msf::TriangleMesh streamed;
+    const std::size_t streamed_triangles =
+        streaming ? pipeline.finishStreaming((fs::path(out) / report.mesh_file).string()) : 0;
+    const msf::TriangleMesh& mesh = streaming ? streamed : pipeline.updateMesh();
+    report.mesh_ms = tt.toc();
+    msf::tool::printDone(report.mesh_ms, streaming ? streamed_triangles : mesh.triangles.size());
+    report.vertices = mesh.vertices.size();
+    report.triangles = streaming ? streamed_triangles : mesh.triangles.size();
+    report.pieces_removed = pipeline.meshStats().components_removed;
+    report.triangles_removed = pipeline.meshStats().triangles_removed;
+    if (streaming) {
+      const msf::StreamingMap::Stats& st = pipeline.streaming()->stats();
+      print_info("Streamed: %zu tiles written, %zu read back, %zu meshed again; %zu blocks freed; %.0f ms in all\n",
+                 st.tiles_written, st.tiles_reloaded, st.tiles_remeshed, st.blocks_freed, st.stream_ms);
+    }
     for (auto& map : source_maps) {
       tt.tic();
       print_highlight("Meshing the %s map ", msf::toString(map->source));
@@ -480,10 +513,14 @@ int main(int argc, char** argv) {
 
     tt.tic();
     print_highlight("Saving ");
-    print_value("%s/{mesh.ply, volume.pcd%s} ", out.c_str(), compare_sources ? ", mesh_lidar.ply, mesh_stereo.ply" : "");
+    print_value("%s/{%s%s} ", out.c_str(), streaming ? "config.yaml (mesh.ply, tiles/, tsdf/ are written)" : "mesh.ply, volume.pcd",
+                compare_sources ? ", mesh_lidar.ply, mesh_stereo.ply" : "");
     pcl::PolygonMesh polygon_mesh;
     mesh.toPolygonMesh(polygon_mesh);
-    if (!mesh.triangles.empty()) {
+    if (streaming) {
+      if (streamed_triangles == 0)
+        print_warn("\nno surface was reconstructed: mesh.ply is not written\n");
+    } else if (!mesh.triangles.empty()) {
       msf::saveMesh((fs::path(out) / report.mesh_file).string(), polygon_mesh);
       pipeline.volume().save((fs::path(out) / report.volume_file).string());
     } else {
@@ -518,8 +555,9 @@ int main(int argc, char** argv) {
     }
 
     // The meshes against the true surface (synthetic), each as the fused one.
-    std::map<std::string, std::pair<const msf::TriangleMesh*, const pcl::PolygonMesh*>> meshes{
-        {"mesh", {&mesh, &polygon_mesh}}};
+    std::map<std::string, std::pair<const msf::TriangleMesh*, const pcl::PolygonMesh*>> meshes;
+    if (!streaming)
+      meshes["mesh"] = {&mesh, &polygon_mesh};
     for (const auto& map : source_maps)
       meshes[map->name()] = {&map->mesh, source_polygons.count(map->name()) ? &source_polygons[map->name()] : nullptr};
     std::map<std::string, msf::MeshAccuracy> accuracy;

@@ -32,6 +32,8 @@ void printHelp(const char* name) {
   print_info("    -frames N      number of frames (default 10)\n");
   print_info("    -seed S        random seed, a whole number >= 0 (default 1)\n");
   print_info("    -scene NAME    scene to render: street (default)\n");
+  print_info("    -loop          drive out, turn round across the road and drive back in the other lane to\n"
+             "                   the start (synthetic.loop): the way back revisits the street\n");
   print_info("    -config FILE   YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)\n");
   print_info("    -print_config  print the configuration in effect\n");
 }
@@ -50,7 +52,7 @@ int intOption(int argc, char** argv, const char* option, int fallback, int lo, i
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_synth", 2, printHelp, [&] {
     const std::vector<std::string> value_options{"-o", "-frames", "-seed", "-scene", "-config"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
+    msf::tool::checkOptions(argc, argv, value_options, {"-print_config", "-loop"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (!positional.empty())
       throw msf::InvalidInputError("unexpected argument '" + positional.front() + "' (the output folder goes after -o)");
@@ -64,6 +66,8 @@ int main(int argc, char** argv) {
     config.frames = intOption(argc, argv, "-frames", config.frames, 1, 999999);
     config.seed = intOption(argc, argv, "-seed", config.seed, 0, 2147483647);
     msf::tool::parseArgument(argc, argv, "-scene", config.scene);
+    if (find_switch(argc, argv, "-loop"))
+      config.loop = true;
     if (config.scene != "street")
       throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
     config.validate();

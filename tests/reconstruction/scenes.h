@@ -12,15 +12,18 @@
 
 namespace msf::test {
 
-inline PinholeCamera smallCamera() {
+/// A pinhole camera of `width` x `height` pixels, focal length `f` pixels, centred.
+inline PinholeCamera centredCamera(int width, int height, double f) {
   PinholeCamera c;
-  c.width = 320;
-  c.height = 240;
-  c.fx = c.fy = 300.0;
-  c.cx = 159.5;
-  c.cy = 119.5;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = f;
+  c.cx = 0.5 * (width - 1);
+  c.cy = 0.5 * (height - 1);
   return c;
 }
+
+inline PinholeCamera smallCamera() { return centredCamera(320, 240, 300.0); }
 
 /// Camera at `eye` looking at `target` (camera x right, y down, z forward; world y down too).
 inline Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {

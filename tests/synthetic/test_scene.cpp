@@ -182,6 +182,36 @@ TEST(SyntheticTrajectory, DrivesTenMetresASecondFromTheWorldOrigin) {
   EXPECT_DOUBLE_EQ(times[10], 1.0);
 }
 
+TEST(SyntheticTrajectory, ALoopTurnsRoundAndDrivesBackInTheOtherLaneClearOfTheCars) {
+  SyntheticConfig config;
+  config.frames = 200;
+  config.loop = true;
+  const msf::PoseList poses = streetTrajectory(config);
+  ASSERT_EQ(poses.size(), 200u);
+  const int out = loopOutFrames(config);
+  EXPECT_EQ(out, 95);
+  EXPECT_NEAR(poses[out - 1].translation().z(), 94.0, 0.01);
+  // Back where it began, a lane to the left, facing the other way.
+  const Eigen::Vector3d end = poses.back().translation();
+  EXPECT_NEAR(end.z(), poses[out - 1].translation().z() - 94.0, 0.01);
+  EXPECT_NEAR(end.x() - poses[out - 1].translation().x(), -StreetLayout().lane_width_m, 1e-6);
+  EXPECT_NEAR((poses.back().linear() * Eigen::Vector3d::UnitZ()).z(), -1.0, 1e-9);
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Eigen::Vector3d step = poses[i].translation() - poses[i - 1].translation();
+    EXPECT_LT(step.norm(), 1.01) << i;
+    // Forward is along the step (the turn's steps are chords of its arc).
+    const Eigen::Vector3d forward = poses[i].linear() * Eigen::Vector3d::UnitZ();
+    EXPECT_GT(forward.dot(step.normalized()), 0.95) << i;
+  }
+  // No moving car ever covers the cameras, on the way out, in the turn or back.
+  const Scene scene = buildStreetScene(config, 100.0);
+  ASSERT_FALSE(scene.movers.empty());
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (const auto& mover : scene.movers)
+      EXPECT_FALSE(mover.boxAt(static_cast<double>(i) / config.frame_rate_hz).contains(poses[i].translation(), 1.0))
+          << "frame " << i;
+}
+
 TEST(SyntheticTextures, PulseCoverageIsTheExactBoxFilter) {
   // Pulses [0, 0.25) of period 1: a box of width 0.5 centred at 0 covers [-0.25, 0.25).
   EXPECT_NEAR(pulseCoverage(0.0, 1.0, 0.25, 0.5), 0.5, 1e-9);

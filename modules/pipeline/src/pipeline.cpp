@@ -132,8 +132,32 @@ void Pipeline::integrate(FrameResult& result) {
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
                             " has no pose: integration needs the sequence's poses");
   const auto start = Clock::now();
+  if (streaming_)
+    streaming_->beforeIntegration(result.T_world_cam0.translation());
   integrator_->integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), result.T_world_cam0);
+  if (streaming_) {
+    const std::size_t freed = streaming_->stats().blocks_freed;
+    streaming_->afterIntegration(result.T_world_cam0.translation());
+    if (streaming_->stats().blocks_freed != freed)
+      mesher_.reset(); // its cache holds the freed blocks' meshes
+  }
   result.times.integrate_ms = msSince(start);
+}
+
+void Pipeline::setStreamingDirectory(const std::string& directory) {
+  if (!config_.streaming.enabled())
+    throw ConfigError("streaming.active_radius_m is 0: the map is not streamed, no folder is needed");
+  // All the integrator can touch around the camera: its depth range, the band behind a
+  // surface, and a margin for the canvas's and the LiDAR's rays.
+  const double reach = config_.integrator.max_depth_m + config_.volume.truncation_m + 2.0;
+  streaming_ = std::make_unique<StreamingMap>(*volume_, config_.streaming, config_.mesher, reach, directory);
+}
+
+std::size_t Pipeline::finishStreaming(const std::string& mesh_path) {
+  if (!streaming_)
+    throw ConfigError("finishStreaming: the map is not streamed (setStreamingDirectory)");
+  mesher_.reset();
+  return streaming_->finish(mesh_path);
 }
 
 Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std::size_t>& frames,
@@ -238,6 +262,8 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
     depths.close();
   });
 
+  if (config_.streaming.enabled() && !streaming_)
+    throw ConfigError("streaming.active_radius_m > 0 needs a folder for the tiles: Pipeline::setStreamingDirectory");
   RunStats stats;
   try {
     while (auto result = depths.pop()) {

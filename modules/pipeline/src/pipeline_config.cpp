@@ -65,6 +65,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.integrator.read(file.section("tsdf_integrator"));
   config.mesher.read(file.section("marching_cubes"));
   config.scheduling.read(file.section("pipeline"));
+  config.streaming.read(file.section("streaming"));
   config.odometry.read(file.section("odometry"));
   file.rejectUnknownKeys();
   config.validate();
@@ -87,6 +88,7 @@ void PipelineConfig::validate() const {
   integrator.validate();
   mesher.validate();
   scheduling.validate();
+  streaming.validate();
   odometry.validate();
 }
 
@@ -101,6 +103,7 @@ void PipelineConfig::print(std::ostream& out) const {
   integrator.print(out);
   mesher.print(out);
   scheduling.print(out);
+  streaming.print(out);
   odometry.print(out);
 }
 

@@ -8,6 +8,7 @@
 
 #include <opencv2/core/persistence.hpp>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -151,6 +152,14 @@ double peakMemoryMb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB on Linux
 }
 
+double residentMemoryMb() {
+  std::ifstream statm("/proc/self/statm");
+  double pages_total = 0, pages_resident = 0;
+  if (!(statm >> pages_total >> pages_resident))
+    return 0.0;
+  return pages_resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
 double RunReport::framesPerSecond() const {
   return wall_s > 0 ? static_cast<double>(frames.size()) / wall_s : 0.0;
 }
@@ -165,12 +174,12 @@ void RunReport::writeFramesCsv(const std::string& path) const {
   s << "frame,name";
   for (const auto& c : stageColumns())
     s << "," << c.name << "_ms";
-  s << "\n";
+  s << ",rss_mb\n";
   for (const auto& r : frames) {
     s << r.index << "," << r.name;
     for (const auto& c : stageColumns())
       s << "," << num(c.get(r), 3);
-    s << "\n";
+    s << "," << num(r.rss_mb, 1) << "\n";
   }
   writeText(path, s.str());
 }

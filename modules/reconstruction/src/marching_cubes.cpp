@@ -246,6 +246,78 @@ private:
   std::size_t mask_;
 };
 
+/// The mesh of block meshes, welded through their shared vertices' keys, in block order
+/// (sorted here), whatever the order of `order`.
+void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMesh*>>& order, TriangleMesh& mesh) {
+  order.erase(std::remove_if(order.begin(), order.end(), [](const auto& p) { return p.second->triangles.empty(); }),
+              order.end());
+  std::size_t total_shared = 0;
+  for (const auto& entry : order)
+    for (const std::uint64_t k : entry.second->keys)
+      total_shared += k != MarchingCubes::kInterior;
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return lessIndex(a.first, b.first); });
+  // Vertices that several blocks may make are numbered first, serially through a hash of
+  // their grid keys; each block's interior vertices follow in block order, copied in parallel.
+  const std::size_t parts = order.size();
+  std::vector<std::size_t> remap_offset(parts + 1, 0), triangle_offset(parts + 1, 0), interior_offset(parts + 1, 0);
+  for (std::size_t i = 0; i < parts; ++i) {
+    remap_offset[i + 1] = remap_offset[i] + order[i].second->vertices.size();
+    triangle_offset[i + 1] = triangle_offset[i] + order[i].second->triangles.size();
+  }
+  std::vector<std::uint32_t> remap(remap_offset[parts]);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_source; // (part, vertex) of each shared vertex
+  shared_source.reserve(total_shared);
+  VertexIndexMap shared(total_shared);
+  for (std::size_t i = 0; i < parts; ++i) {
+    const MarchingCubes::BlockMesh& part = *order[i].second;
+    std::size_t interior = 0;
+    for (std::size_t v = 0; v < part.keys.size(); ++v) {
+      constexpr std::size_t kAhead = 8;
+      if (v + kAhead < part.keys.size() && part.keys[v + kAhead] != MarchingCubes::kInterior)
+        shared.prefetch(part.keys[v + kAhead]);
+      if (part.keys[v] == MarchingCubes::kInterior) {
+        ++interior;
+        continue;
+      }
+      bool inserted = false;
+      const auto next = static_cast<std::uint32_t>(shared_source.size());
+      remap[remap_offset[i] + v] = shared.findOrInsert(part.keys[v], next, inserted);
+      if (inserted)
+        shared_source.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(v));
+    }
+    interior_offset[i + 1] = interior_offset[i] + interior;
+  }
+  const std::size_t n_shared = shared_source.size();
+  const std::size_t n_vertices = n_shared + interior_offset[parts];
+  mesh.vertices.resize(n_vertices);
+  mesh.colors.resize(n_vertices);
+  mesh.triangles.resize(triangle_offset[parts]);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
+  for (int i = range.start; i < range.end; ++i) {
+    const MarchingCubes::BlockMesh& part = *order[i].second;
+    std::uint32_t* map = &remap[remap_offset[i]];
+    auto next = static_cast<std::uint32_t>(n_shared + interior_offset[i]);
+    for (std::size_t v = 0; v < part.keys.size(); ++v)
+      if (part.keys[v] == MarchingCubes::kInterior) {
+        map[v] = next;
+        mesh.vertices[next] = part.vertices[v];
+        mesh.colors[next] = part.colors[v];
+        ++next;
+      }
+    std::array<std::uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
+    for (std::size_t t = 0; t < part.triangles.size(); ++t)
+      out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
+  }
+  }, std::max(1.0, static_cast<double>(parts) / 16));
+  cv::parallel_for_(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      const MarchingCubes::BlockMesh& part = *order[shared_source[k].first].second;
+      mesh.vertices[k] = part.vertices[shared_source[k].second];
+      mesh.colors[k] = part.colors[shared_source[k].second];
+    }
+  }, 8);
+}
+
 } // namespace
 
 void MarchingCubes::Config::read(const cv::FileNode& node) {
@@ -337,75 +409,9 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
   const auto t1 = Clock::now();
   std::vector<std::pair<GridIndex, const BlockMesh*>> order;
   order.reserve(cache_.size());
-  std::size_t total_shared = 0;
-  for (const auto& [index, part] : cache_) {
-    if (part.triangles.empty())
-      continue;
+  for (const auto& [index, part] : cache_)
     order.emplace_back(index, &part);
-    for (const std::uint64_t k : part.keys)
-      total_shared += k != kInterior;
-  }
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return lessIndex(a.first, b.first); });
-  // Vertices that several blocks may make are numbered first, serially through a hash of
-  // their grid keys; each block's interior vertices follow in block order, copied in parallel.
-  const std::size_t parts = order.size();
-  std::vector<std::size_t> remap_offset(parts + 1, 0), triangle_offset(parts + 1, 0), interior_offset(parts + 1, 0);
-  for (std::size_t i = 0; i < parts; ++i) {
-    remap_offset[i + 1] = remap_offset[i] + order[i].second->vertices.size();
-    triangle_offset[i + 1] = triangle_offset[i] + order[i].second->triangles.size();
-  }
-  std::vector<std::uint32_t> remap(remap_offset[parts]);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_source; // (part, vertex) of each shared vertex
-  shared_source.reserve(total_shared);
-  VertexIndexMap shared(total_shared);
-  for (std::size_t i = 0; i < parts; ++i) {
-    const BlockMesh& part = *order[i].second;
-    std::size_t interior = 0;
-    for (std::size_t v = 0; v < part.keys.size(); ++v) {
-      constexpr std::size_t kAhead = 8;
-      if (v + kAhead < part.keys.size() && part.keys[v + kAhead] != kInterior)
-        shared.prefetch(part.keys[v + kAhead]);
-      if (part.keys[v] == kInterior) {
-        ++interior;
-        continue;
-      }
-      bool inserted = false;
-      const auto next = static_cast<std::uint32_t>(shared_source.size());
-      remap[remap_offset[i] + v] = shared.findOrInsert(part.keys[v], next, inserted);
-      if (inserted)
-        shared_source.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(v));
-    }
-    interior_offset[i + 1] = interior_offset[i] + interior;
-  }
-  const std::size_t n_shared = shared_source.size();
-  const std::size_t n_vertices = n_shared + interior_offset[parts];
-  mesh.vertices.resize(n_vertices);
-  mesh.colors.resize(n_vertices);
-  mesh.triangles.resize(triangle_offset[parts]);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
-  for (int i = range.start; i < range.end; ++i) {
-    const BlockMesh& part = *order[i].second;
-    std::uint32_t* map = &remap[remap_offset[i]];
-    auto next = static_cast<std::uint32_t>(n_shared + interior_offset[i]);
-    for (std::size_t v = 0; v < part.keys.size(); ++v)
-      if (part.keys[v] == kInterior) {
-        map[v] = next;
-        mesh.vertices[next] = part.vertices[v];
-        mesh.colors[next] = part.colors[v];
-        ++next;
-      }
-    std::array<std::uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
-    for (std::size_t t = 0; t < part.triangles.size(); ++t)
-      out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
-  }
-  }, std::max(1.0, static_cast<double>(parts) / 16));
-  cv::parallel_for_(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k) {
-      const BlockMesh& part = *order[shared_source[k].first].second;
-      mesh.vertices[k] = part.vertices[shared_source[k].second];
-      mesh.colors[k] = part.colors[shared_source[k].second];
-    }
-  }, 8);
+  assembleParts(order, mesh);
   stats_.assemble_ms = msSince(t1);
   if (config_.min_component_triangles > 0) {
     // On the assembled mesh only: a piece may span many blocks, and the cache stays whole.
@@ -416,6 +422,26 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     stats_.triangles_removed = removed.triangles_removed;
     stats_.filter_ms = msSince(t2);
   }
+}
+
+void MarchingCubes::extractBlocks(const TsdfVolume& volume, const std::vector<GridIndex>& blocks,
+                                  TriangleMesh& mesh) const {
+  std::vector<const TsdfBlock*> present;
+  for (const GridIndex& index : blocks)
+    if (const TsdfBlock* block = volume.findBlock(index))
+      present.push_back(block);
+  std::vector<BlockMesh> parts(present.size());
+  const float min_weight = config_.min_weight;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(present.size())), [&](const cv::Range& range) {
+    Scratch scratch;
+    for (int i = range.start; i < range.end; ++i)
+      meshBlock(volume, *present[i], min_weight, parts[i], scratch);
+  }, std::max(1.0, static_cast<double>(present.size()) / 16));
+  std::vector<std::pair<GridIndex, const BlockMesh*>> order;
+  order.reserve(present.size());
+  for (std::size_t i = 0; i < present.size(); ++i)
+    order.emplace_back(present[i]->index, &parts[i]);
+  assembleParts(order, mesh);
 }
 
 void MarchingCubes::extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh) {

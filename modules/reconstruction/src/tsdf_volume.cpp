@@ -179,6 +179,43 @@ void TsdfVolume::allocateBlocks(const std::vector<GridIndex>& indices, std::vect
     blocks[i] = blocks_[static_cast<std::size_t>(position[i])];
 }
 
+void TsdfVolume::removeBlocks(const std::vector<GridIndex>& indices) {
+  if (indices.empty() || blocks_.empty())
+    return;
+  std::vector<char> gone(blocks_.size(), 0);
+  std::size_t removed = 0;
+  for (const GridIndex& index : indices) {
+    const Slot& slot = table_[slotOf(index)];
+    if (slot.block >= 0 && !gone[static_cast<std::size_t>(slot.block)]) {
+      gone[static_cast<std::size_t>(slot.block)] = 1;
+      ++removed;
+    }
+  }
+  // Each hole below the new count takes a surviving block from the end.
+  const std::size_t keep = blocks_.size() - removed;
+  std::size_t from = blocks_.size();
+  for (std::size_t hole = 0; hole < keep; ++hole) {
+    if (!gone[hole])
+      continue;
+    do
+      --from;
+    while (gone[from]);
+    blocks_[hole] = new (storage(hole)) TsdfBlock(*blocks_[from]);
+  }
+  blocks_.resize(keep);
+  chunks_.resize((keep + kBlocksPerChunk - 1) / kBlocksPerChunk);
+  std::size_t capacity = 1024;
+  while (capacity < 2 * keep)
+    capacity <<= 1;
+  std::vector<Slot>(capacity).swap(table_);
+  mask_ = capacity - 1;
+  for (std::size_t b = 0; b < keep; ++b) {
+    Slot& slot = table_[slotOf(blocks_[b]->index)];
+    slot.key = blocks_[b]->index;
+    slot.block = static_cast<std::int32_t>(b);
+  }
+}
+
 void TsdfVolume::ChunkFree::operator()(void* chunk) const noexcept { std::free(chunk); }
 
 const TsdfVoxel* TsdfVolume::findVoxel(const GridIndex& v) const {

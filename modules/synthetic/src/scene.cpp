@@ -152,19 +152,23 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
     return found;
   const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
   // Nodes whose box the ray enters, with the entry distance: a node is skipped when a hit
-  // found meanwhile lies before it; of two children the nearer is visited first.
-  struct Entry {
-    std::int32_t node;
-    float t;
-  };
-  Entry stack[64];
+  // found meanwhile lies before it; of two children the nearer is visited first. Node and
+  // distance in two arrays: an {int, float} pair written as two 4-byte stores and read back as
+  // one 8-byte load missed the store forwarding, a quarter of the renderer's time.
+  std::int32_t stack_node[64];
+  float stack_t[64];
   int top = 0;
-  stack[top++] = {0, entry};
+  auto push = [&](std::int32_t node, float t) {
+    stack_node[top] = node;
+    stack_t[top++] = t;
+  };
+  push(0, entry);
   while (top > 0) {
-    const Entry e = stack[--top];
-    if (e.t > hit.t)
+    --top;
+    const std::int32_t current = stack_node[top];
+    if (stack_t[top] > hit.t)
       continue;
-    const Node& node = nodes_[static_cast<std::size_t>(e.node)];
+    const Node& node = nodes_[static_cast<std::size_t>(current)];
     if (node.count > 0) {
       for (std::int32_t i = node.index; i < node.index + node.count; ++i) {
         const std::int32_t p = order_[static_cast<std::size_t>(i)];
@@ -175,7 +179,7 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
       }
       continue;
     }
-    const std::int32_t left = e.node + 1, right = node.index;
+    const std::int32_t left = current + 1, right = node.index;
     float t_left = 0.f, t_right = 0.f;
     const bool hit_left = rayEntersBox(nodes_[static_cast<std::size_t>(left)].lo,
                                        nodes_[static_cast<std::size_t>(left)].hi, ray.origin, inv, tmin, hit.t, t_left);
@@ -184,16 +188,16 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
                      inv, tmin, hit.t, t_right);
     if (hit_left && hit_right) {
       if (t_left <= t_right) {
-        stack[top++] = {right, t_right};
-        stack[top++] = {left, t_left};
+        push(right, t_right);
+        push(left, t_left);
       } else {
-        stack[top++] = {left, t_left};
-        stack[top++] = {right, t_right};
+        push(left, t_left);
+        push(right, t_right);
       }
     } else if (hit_left) {
-      stack[top++] = {left, t_left};
+      push(left, t_left);
     } else if (hit_right) {
-      stack[top++] = {right, t_right};
+      push(right, t_right);
     }
   }
   return found;

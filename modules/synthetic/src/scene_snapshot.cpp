@@ -1,5 +1,7 @@
 #include <msf/synthetic/scene_snapshot.h>
 
+#include <algorithm>
+
 namespace msf::synthetic {
 
 SceneSnapshot::SceneSnapshot(const Scene& scene, double time_s)
@@ -20,6 +22,28 @@ SceneSnapshot::SceneSnapshot(const Scene& scene, double time_s)
     placed_movers_.push_back(m);
     present_.push_back(&mover);
   }
+  // Groups of movers neighbouring along the longest axis of their bounds (the street's):
+  // a ray meets the movers of a few groups at most.
+  constexpr std::size_t kGroup = 4;
+  if (placed_movers_.size() > kGroup) {
+    const V3 extent = movers_hi_ - movers_lo_;
+    const int axis = extent.x > extent.z ? (extent.x > extent.y ? 0 : 1) : (extent.z > extent.y ? 2 : 1);
+    std::stable_sort(placed_movers_.begin(), placed_movers_.end(), [axis](const PlacedMover& a, const PlacedMover& b) {
+      return a.lo[axis] + a.hi[axis] < b.lo[axis] + b.hi[axis];
+    });
+  }
+  for (std::size_t i = 0; i < placed_movers_.size(); i += kGroup) {
+    MoverGroup g;
+    g.begin = static_cast<std::int32_t>(i);
+    g.end = static_cast<std::int32_t>(std::min(placed_movers_.size(), i + kGroup));
+    g.lo = placed_movers_[i].lo;
+    g.hi = placed_movers_[i].hi;
+    for (std::int32_t k = g.begin; k < g.end; ++k) {
+      g.lo = minV(g.lo, placed_movers_[static_cast<std::size_t>(k)].lo);
+      g.hi = maxV(g.hi, placed_movers_[static_cast<std::size_t>(k)].hi);
+    }
+    groups_.push_back(g);
+  }
 }
 
 bool SceneSnapshot::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
@@ -31,14 +55,19 @@ bool SceneSnapshot::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) 
   // The movers are cars on the road, below the sensors: most rays pass over all of them.
   if (!rayEntersBox(movers_lo_, movers_hi_, ray.origin, inv, tmin, hit.t, entry))
     return found;
-  for (const PlacedMover& m : placed_movers_) {
-    if (!rayEntersBox(m.lo, m.hi, ray.origin, inv, tmin, hit.t, entry))
+  for (const MoverGroup& g : groups_) {
+    if (groups_.size() > 1 && !rayEntersBox(g.lo, g.hi, ray.origin, inv, tmin, hit.t, entry))
       continue;
-    for (std::int32_t i = m.begin; i < m.end; ++i)
-      if (placed_[static_cast<std::size_t>(i)].intersect(ray, tmin, hit)) {
-        hit.primitive = static_cast<int>(static_count_) + i;
-        found = true;
-      }
+    for (std::int32_t k = g.begin; k < g.end; ++k) {
+      const PlacedMover& m = placed_movers_[static_cast<std::size_t>(k)];
+      if (!rayEntersBox(m.lo, m.hi, ray.origin, inv, tmin, hit.t, entry))
+        continue;
+      for (std::int32_t i = m.begin; i < m.end; ++i)
+        if (placed_[static_cast<std::size_t>(i)].intersect(ray, tmin, hit)) {
+          hit.primitive = static_cast<int>(static_count_) + i;
+          found = true;
+        }
+    }
   }
   return found;
 }

@@ -30,6 +30,7 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "moving_cars_oncoming", moving_cars_oncoming);
   readKey(node, "oncoming_car_speed_mps", oncoming_car_speed_mps);
   readKey(node, "oncoming_group_period_s", oncoming_group_period_s);
+  readKey(node, "loop", loop);
   validate();
 }
 
@@ -80,6 +81,8 @@ void SyntheticConfig::validate() const {
           oncoming_car_speed_mps, "must be in (0, 40]");
   require(oncoming_group_period_s >= 1.0 && oncoming_group_period_s <= 3600.0, "oncoming_group_period_s",
           oncoming_group_period_s, "must be in 1..3600");
+  require(!loop || frames >= kLoopTurnFrames + 2, "frames", frames,
+          "must be >= 12 for a loop (out, the turn of 10 frames, back)");
 }
 
 namespace {
@@ -116,7 +119,8 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  moving_cars_ahead: " << moving_cars_ahead << "\n"
       << "  moving_cars_oncoming: " << moving_cars_oncoming << "\n"
       << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
-      << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n";
+      << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n"
+      << "  loop: " << (loop ? "true" : "false") << "\n";
 }
 
 } // namespace msf::synthetic

@@ -41,6 +41,14 @@ std::string frameName(std::size_t i) {
   return name;
 }
 
+/// How far along the street the drive goes (a loop comes back).
+double farthestZ(const PoseList& poses) {
+  double z = 0.0;
+  for (const auto& T : poses)
+    z = std::max(z, T.translation().z());
+  return z;
+}
+
 void writeText(const fs::path& path, const std::string& text) {
   writeAtomically(path.string(), [&](const std::string& tmp) {
     std::ofstream out(tmp);
@@ -115,7 +123,7 @@ SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
     : config_(validated(config)),
       calibration_(kittiRig()),
       poses_(streetTrajectory(config_)),
-      scene_(buildStreetScene(config_, poses_.back().translation().z())),
+      scene_(buildStreetScene(config_, farthestZ(poses_))),
       renderer_(calibration_, config_),
       lidar_(config_) {}
 

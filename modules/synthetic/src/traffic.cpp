@@ -1,6 +1,7 @@
 #include <msf/synthetic/car.h>
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/traffic.h>
+#include <msf/synthetic/trajectory.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,7 +33,11 @@ void addCar(SequentialRng& rng, Scene& scene, std::uint32_t id, float lane_x, do
 void addTraffic(const SyntheticConfig& config, Scene& scene) {
   const auto seed = static_cast<std::uint64_t>(config.seed);
   const double v = config.speed_mps;
-  const double duration = (config.frames - 1) / config.frame_rate_hz;
+  // The cameras drive along the street (z = v t) for the drive, or a loop's first leg: the
+  // cars are met there. A loop's turn meets none (no group within 3 s before it); on the way
+  // back the cameras follow the oncoming cars met before, at their speed.
+  const double duration = (loopOutFrames(config) - 1) / config.frame_rate_hz;
+  const double last_meeting_s = config.loop ? duration - 3.0 : 1e300;
   std::uint32_t id = scene.objectCount();
 
   if (config.moving_cars_ahead > 0) {
@@ -65,6 +70,8 @@ void addTraffic(const SyntheticConfig& config, Scene& scene) {
         // A long group runs into the next one's time: keep the spacing.
         meeting = std::max(meeting, last_meeting + kMinSpacingOncomingM / closing);
         last_meeting = meeting;
+        if (meeting > last_meeting_s)
+          break;
         // Its centre passes the cameras (at z = v t) at `meeting`, driving -z at u.
         addCar(rng, scene, ++id, scene.layout.leftLaneX(), (v + u) * meeting, kPiF, u);
       }

@@ -3,6 +3,7 @@
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
@@ -125,6 +126,17 @@ public:
   /// What the last updateMesh did (blocks meshed, small pieces removed).
   const MarchingCubes::Stats& meshStats() const { return mesher_.lastStats(); }
 
+  /// With `streaming.active_radius_m` > 0 (docs/streaming.md): the map keeps in memory only
+  /// the tiles around the camera and streams the others into `directory` (tiles/*.ply,
+  /// tsdf/*.blk); required before run() then. Its time counts as integration. Throws
+  /// ConfigError when streaming is off or the radius is below the integrator's reach.
+  void setStreamingDirectory(const std::string& directory);
+  /// Writes the tiles still in memory and the union of all as `mesh_path`; the volume is
+  /// empty afterwards. Returns the triangles written.
+  std::size_t finishStreaming(const std::string& mesh_path);
+  /// The streaming map, or nullptr when the map stays in memory.
+  const StreamingMap* streaming() const { return streaming_.get(); }
+
   const PipelineConfig& config() const { return config_; }
   const Calibration& calibration() const { return calibration_; }
   TsdfVolume& volume() { return *volume_; }
@@ -150,6 +162,7 @@ private:
   std::unique_ptr<Stages> stages_;
   MarchingCubes mesher_;
   TriangleMesh mesh_;
+  std::unique_ptr<StreamingMap> streaming_;
   bool keep_sparse_ = false;
   FrameFilter frame_filter_;
   PoseEstimator pose_estimator_;

@@ -5,6 +5,7 @@
 #include <msf/range_image/ring_split.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/stereo/sgbm_config.h>
 
@@ -51,6 +52,7 @@ struct PipelineConfig {
   TsdfIntegrator::Config integrator;        ///< `tsdf_integrator`
   MarchingCubes::Config mesher;             ///< `marching_cubes`
   SchedulingConfig scheduling;              ///< `pipeline`
+  StreamingMap::Config streaming;           ///< `streaming`: the map in bounded memory (off by default)
   /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
   LidarOdometry::Config odometry;
 

@@ -24,6 +24,7 @@ public:
     std::string name;
     StageTimes times;
     double latency_ms = 0;  ///< from the start of its loading to the end of its integration
+    double rss_mb = 0;      ///< resident memory of the process after it (0: not measured)
   };
 
   /// Depth errors of one method over all frames: every pixel with ground truth, and the
@@ -101,5 +102,7 @@ private:
 
 /// Peak resident memory of this process so far, in MiB (getrusage).
 double peakMemoryMb();
+/// Resident memory of this process now, in MiB (/proc/self/statm; 0 where there is none).
+double residentMemoryMb();
 
 } // namespace msf

@@ -72,6 +72,11 @@ public:
   void extract(const TsdfVolume& volume, TriangleMesh& mesh);
   /// The same as a pcl::PolygonMesh (fields x y z rgb; triangles as pcl::Vertices).
   void extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh);
+  /// Meshes only the blocks at `blocks` (absent ones are skipped), not incrementally and
+  /// without the small-piece filter: the cubes of a block read its +x, +y, +z neighbours,
+  /// which `volume` must hold for the block's mesh to be the one extract() gives. StreamingMap
+  /// meshes a tile this way.
+  void extractBlocks(const TsdfVolume& volume, const std::vector<GridIndex>& blocks, TriangleMesh& mesh) const;
   /// Forgets the cached block meshes: the next call meshes everything.
   void reset();
 

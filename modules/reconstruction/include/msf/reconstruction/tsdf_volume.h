@@ -56,8 +56,13 @@ public:
   /// allocateBlock for each index, the new blocks constructed in parallel: `blocks[i]` is
   /// the block at `indices[i]`. Not thread-safe (it runs its own threads).
   void allocateBlocks(const std::vector<GridIndex>& indices, std::vector<TsdfBlock*>& blocks);
-  /// Every allocated block, in allocation order (stable addresses).
+  /// Every allocated block (stable addresses until removeBlocks).
   const std::vector<TsdfBlock*>& blocks() const { return blocks_; }
+  /// Frees the blocks at `indices` (absent ones are ignored) and the memory they held: the
+  /// last blocks move into the holes, so pointers to blocks are invalid afterwards and the
+  /// order of blocks() changes. The cost is that of the removed blocks plus a rehash of the
+  /// map, not a pass over the volume's voxels (StreamingMap calls it as the sensor moves on).
+  void removeBlocks(const std::vector<GridIndex>& indices);
 
   /// The voxel with global index v, or nullptr when its block is not allocated.
   const TsdfVoxel* findVoxel(const GridIndex& v) const;

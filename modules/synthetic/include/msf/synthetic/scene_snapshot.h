@@ -12,9 +12,10 @@ namespace msf::synthetic {
 /// The street at one instant: the scene's static solids with their hierarchy, and its
 /// movers placed where they are at that time. A mover is present while its bounds lie in
 /// the street's open stretch (it appears and vanishes inside the buildings across the
-/// street's ends). A ray tests the hierarchy, then the bounds of all present movers, each
-/// one's bounds, and only then its few solids: movers are a handful, so a flat list beats a
-/// hierarchy rebuilt every frame. Holds a reference to the scene, which must outlive it.
+/// street's ends). A ray tests the hierarchy, then the bounds of all present movers, of
+/// groups of a few movers neighbouring along the street, of each mover of a group it enters,
+/// and only then their few solids: a long street has dozens of movers, a hierarchy of two
+/// levels is built in no time every frame. Holds a reference to the scene, which must outlive it.
 class SceneSnapshot {
 public:
   SceneSnapshot(const Scene& scene, double time_s);
@@ -55,6 +56,11 @@ private:
   std::size_t static_count_;
   std::vector<Primitive> placed_;
   std::vector<PlacedMover> placed_movers_;
+  struct MoverGroup {
+    V3 lo, hi;                       ///< bounds of its movers
+    std::int32_t begin = 0, end = 0; ///< its movers in placed_movers_
+  };
+  std::vector<MoverGroup> groups_;
   V3 movers_lo_, movers_hi_; ///< bounds of all present movers
   std::vector<const MovingObject*> present_;
 };

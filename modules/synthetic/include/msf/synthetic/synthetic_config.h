@@ -31,6 +31,10 @@ struct SyntheticConfig {
   int moving_cars_oncoming = 2;         ///< oncoming cars met in each group (0..20)
   double oncoming_car_speed_mps = 10.0; ///< their speed along the street, (0, 40]
   double oncoming_group_period_s = 4.0; ///< a group is met every this many seconds [1, 3600]
+  /// Drive out, turn round across the road (kLoopTurnFrames frames) and drive back in the
+  /// other lane to where the drive began: the second half revisits the first's street.
+  bool loop = false;
+  static constexpr int kLoopTurnFrames = 10;
 
   /// Overrides the keys present in `node` (a `synthetic` section), then validates.
   /// Throws ConfigError naming a key with a wrong type or value.

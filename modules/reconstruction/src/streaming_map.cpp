@@ -1,0 +1,681 @@
+#include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/streaming_map.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <tuple>
+
+namespace msf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr int kSide = TsdfBlock::kSide;
+constexpr char kBlockMagic[8] = {'M', 'S', 'F', 'B', 'L', 'K', '0', '1'};
+constexpr const char* kIndexTag = "msfusion-tsdf-store 1";
+constexpr std::int64_t kTileBias = 1 << 20;
+
+std::string number(double v) {
+  std::ostringstream ss;
+  ss.precision(9);
+  ss << v;
+  return ss.str();
+}
+
+std::string tileName(const GridIndex& t) {
+  return std::to_string(t.x()) + "_" + std::to_string(t.y()) + "_" + std::to_string(t.z());
+}
+
+/// The store's parameters, from DIR/tsdf/index.txt.
+struct StoreIndex {
+  double voxel_size = 0, truncation = 0;
+  int tile_blocks = 0;
+  std::vector<GridIndex> tiles;
+};
+
+StoreIndex readIndex(const std::string& directory) {
+  const std::string path = (fs::path(directory) / "tsdf" / "index.txt").string();
+  requireFile(path, "TSDF store index");
+  std::ifstream in(path);
+  std::string line;
+  StoreIndex index;
+  int side = 0;
+  std::size_t count = 0;
+  std::string k1, k2, k3, k4, k5;
+  if (!std::getline(in, line) || line != kIndexTag ||
+      !(in >> k1 >> index.voxel_size >> k2 >> index.truncation >> k3 >> side >> k4 >> index.tile_blocks >> k5 >>
+        count) ||
+      k1 != "voxel_size_m" || k2 != "truncation_m" || k3 != "block_side" || k4 != "tile_blocks" || k5 != "tiles" ||
+      side != kSide || !(index.voxel_size > 0) || !(index.truncation > 0) || index.tile_blocks < 1)
+    throw IOError("TSDF store index '" + path + "' is not one a StreamingMap wrote (first line '" + kIndexTag + "')");
+  for (std::size_t i = 0; i < count; ++i) {
+    GridIndex t;
+    if (!(in >> t.x() >> t.y() >> t.z()))
+      throw IOError("TSDF store index '" + path + "' lists " + std::to_string(count) + " tiles but ends after " +
+                    std::to_string(i));
+    index.tiles.push_back(t);
+  }
+  return index;
+}
+
+std::string blockPath(const std::string& directory, const GridIndex& tile) {
+  return (fs::path(directory) / "tsdf" / (tileName(tile) + ".blk")).string();
+}
+std::string meshPath(const std::string& tiles, const GridIndex& tile) {
+  return (fs::path(tiles) / (tileName(tile) + ".ply")).string();
+}
+
+/// Block file: magic, voxel size and truncation (float64), block side and block count
+/// (int32), then per block its index (3 x int32), its sign bits (2 bytes and 2 of padding)
+/// and its 512 voxels as in memory (12 bytes each, the integrator's flags zeroed; they are
+/// zero between frames anyway), little-endian as the host.
+void writeBlocks(const std::string& path, double voxel_size, double truncation, const std::vector<const TsdfBlock*>& blocks) {
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(kBlockMagic, sizeof(kBlockMagic));
+    const std::int32_t header[2] = {kSide, static_cast<std::int32_t>(blocks.size())};
+    out.write(reinterpret_cast<const char*>(&voxel_size), sizeof(double));
+    out.write(reinterpret_cast<const char*>(&truncation), sizeof(double));
+    out.write(reinterpret_cast<const char*>(header), sizeof(header));
+    std::array<TsdfVoxel, TsdfBlock::kVoxels> voxels;
+    for (const TsdfBlock* block : blocks) {
+      const std::int32_t index[3] = {block->index.x(), block->index.y(), block->index.z()};
+      out.write(reinterpret_cast<const char*>(index), sizeof(index));
+      // The sign bits as the integrator left them (they may be set for voxels that changed
+      // sign since: recomputing them would carve less than the map in memory does).
+      const std::uint8_t bits[4] = {block->signs, block->negative_subblocks, 0, 0};
+      out.write(reinterpret_cast<const char*>(bits), sizeof(bits));
+      voxels = block->voxels;
+      for (TsdfVoxel& v : voxels)
+        v.flags = 0;
+      out.write(reinterpret_cast<const char*>(voxels.data()), sizeof(voxels));
+    }
+    if (!out.flush())
+      throw IOError("cannot write TSDF blocks '" + path + "': disk full?");
+  });
+}
+
+/// Calls `add(index, voxels)` for each block of a block file.
+template <typename Add>
+void readBlocks(const std::string& path, double voxel_size, double truncation, Add&& add) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw IOError("cannot read TSDF blocks '" + path + "'");
+  char magic[8];
+  double vs = 0, trunc = 0;
+  std::int32_t header[2] = {0, 0};
+  in.read(magic, sizeof(magic));
+  in.read(reinterpret_cast<char*>(&vs), sizeof(double));
+  in.read(reinterpret_cast<char*>(&trunc), sizeof(double));
+  in.read(reinterpret_cast<char*>(header), sizeof(header));
+  if (!in || std::memcmp(magic, kBlockMagic, sizeof(magic)) != 0 || header[0] != kSide || header[1] < 0)
+    throw IOError("TSDF blocks '" + path + "' are not a block file of msfusion");
+  if (std::abs(vs - voxel_size) > 1e-9 * voxel_size || std::abs(trunc - truncation) > 1e-9 * truncation)
+    throw IOError("TSDF blocks '" + path + "' have voxel size " + number(vs) + " m and truncation " + number(trunc) +
+                  " m, the store " + number(voxel_size) + " and " + number(truncation));
+  TsdfBlock block;
+  for (std::int32_t b = 0; b < header[1]; ++b) {
+    std::int32_t index[3];
+    std::uint8_t bits[4];
+    in.read(reinterpret_cast<char*>(index), sizeof(index));
+    in.read(reinterpret_cast<char*>(bits), sizeof(bits));
+    in.read(reinterpret_cast<char*>(block.voxels.data()), sizeof(block.voxels));
+    if (!in)
+      throw IOError("TSDF blocks '" + path + "' end after " + std::to_string(b) + " of " + std::to_string(header[1]) +
+                    " blocks");
+    block.index = GridIndex(index[0], index[1], index[2]);
+    block.signs = bits[0];
+    block.negative_subblocks = bits[1];
+    add(block.index, block);
+  }
+}
+
+/// Puts a block read from disk (or copied) into `volume`.
+void putBlock(TsdfVolume& volume, const GridIndex& index, const TsdfBlock& source, std::uint64_t stamp) {
+  TsdfBlock& block = volume.allocateBlock(index);
+  block = source;
+  block.index = index;
+  block.stamp = stamp;
+}
+
+constexpr int kVertexBytes = 15, kFaceBytes = 13;
+
+struct PlyCounts {
+  std::size_t vertices = 0, faces = 0;
+  std::streamoff data = 0; // where the binary data starts
+};
+
+PlyCounts readPlyHeader(std::ifstream& in, const std::string& path) {
+  const char* expected[] = {"ply", "format binary_little_endian 1.0", nullptr, "property float x", "property float y",
+                            "property float z", "property uchar red", "property uchar green", "property uchar blue",
+                            nullptr, "property list uchar uint vertex_indices", "end_header"};
+  PlyCounts counts;
+  std::string line;
+  int k = 0;
+  while (k < 12 && std::getline(in, line)) {
+    if (line.rfind("comment", 0) == 0)
+      continue;
+    bool ok = false;
+    if (k == 2)
+      ok = std::sscanf(line.c_str(), "element vertex %zu", &counts.vertices) == 1;
+    else if (k == 9)
+      ok = std::sscanf(line.c_str(), "element face %zu", &counts.faces) == 1;
+    else
+      ok = line == expected[k];
+    if (!ok)
+      throw IOError("mesh '" + path + "' is not a PLY that msfusion streams (line '" + line + "')");
+    ++k;
+  }
+  if (k < 12)
+    throw IOError("mesh '" + path + "' ends inside its PLY header");
+  counts.data = in.tellg();
+  return counts;
+}
+
+std::string plyHeader(std::size_t vertices, std::size_t faces) {
+  return "ply\nformat binary_little_endian 1.0\ncomment msfusion streamed mesh\nelement vertex " +
+         std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+         "property uchar blue\nelement face " +
+         std::to_string(faces) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+}
+
+/// The union of the tile meshes `tiles` (existing files only) as one PLY at `path`, read one
+/// tile at a time: vertices in a first pass, triangles (renumbered) in a second. Returns the
+/// triangles; writes nothing when there are none.
+std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string& path) {
+  std::vector<std::string> present;
+  std::vector<PlyCounts> counts;
+  std::size_t vertices = 0, faces = 0;
+  for (const std::string& tile : tiles) {
+    std::ifstream in(tile, std::ios::binary);
+    if (!in)
+      continue;
+    counts.push_back(readPlyHeader(in, tile));
+    present.push_back(tile);
+    vertices += counts.back().vertices;
+    faces += counts.back().faces;
+  }
+  if (faces == 0)
+    return 0;
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    const std::string header = plyHeader(vertices, faces);
+    out.write(header.data(), static_cast<std::streamsize>(header.size()));
+    std::vector<char> buffer;
+    for (std::size_t i = 0; i < present.size(); ++i) {
+      std::ifstream in(present[i], std::ios::binary);
+      in.seekg(counts[i].data);
+      buffer.resize(counts[i].vertices * kVertexBytes);
+      in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      if (!in)
+        throw IOError("mesh '" + present[i] + "' ends inside its vertices");
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    }
+    std::uint32_t offset = 0;
+    for (std::size_t i = 0; i < present.size(); ++i) {
+      std::ifstream in(present[i], std::ios::binary);
+      in.seekg(counts[i].data + static_cast<std::streamoff>(counts[i].vertices * kVertexBytes));
+      buffer.resize(counts[i].faces * kFaceBytes);
+      in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      if (!in)
+        throw IOError("mesh '" + present[i] + "' ends inside its triangles");
+      for (std::size_t f = 0; f < counts[i].faces; ++f) {
+        char* p = buffer.data() + f * kFaceBytes + 1;
+        for (int k = 0; k < 3; ++k) {
+          std::uint32_t v;
+          std::memcpy(&v, p + 4 * k, 4);
+          v += offset;
+          std::memcpy(p + 4 * k, &v, 4);
+        }
+      }
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      offset += static_cast<std::uint32_t>(counts[i].vertices);
+    }
+    if (!out.flush())
+      throw IOError("cannot write mesh '" + path + "': disk full?");
+  });
+  return faces;
+}
+
+const GridIndex kUpper[7] = {{1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
+/// Blocks of tiles on disk, read on demand for the +x/+y/+z layer of the tiles being meshed.
+class TileCache {
+public:
+  TileCache(std::string directory, double voxel_size, double truncation)
+      : directory_(std::move(directory)), voxel_size_(voxel_size), truncation_(truncation) {}
+  /// The voxels of block `index` of stored tile `tile`, or nullptr when the tile lacks it.
+  const TsdfBlock* find(const GridIndex& tile, const GridIndex& index) {
+    const std::string name = tileName(tile);
+    auto it = tiles_.find(name);
+    if (it == tiles_.end()) {
+      if (tiles_.size() >= 32)
+        tiles_.clear(); // a tile's neighbours come in runs: a small cache holds them
+      auto& blocks = tiles_[name];
+      readBlocks(blockPath(directory_, tile), voxel_size_, truncation_,
+                 [&](const GridIndex& b, const TsdfBlock& v) {
+                   blocks.emplace(key(b), std::make_unique<TsdfBlock>(v));
+                 });
+      it = tiles_.find(name);
+    }
+    auto b = it->second.find(key(index));
+    return b == it->second.end() ? nullptr : b->second.get();
+  }
+
+private:
+  static std::uint64_t key(const GridIndex& b) {
+    return (static_cast<std::uint64_t>(b.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(b.y() + kTileBias) << 21) |
+           static_cast<std::uint64_t>(b.z() + kTileBias);
+  }
+  std::string directory_;
+  double voxel_size_, truncation_;
+  std::unordered_map<std::string,
+                     std::unordered_map<std::uint64_t, std::unique_ptr<TsdfBlock>>>
+      tiles_;
+};
+
+GridIndex tileOfBlock(const GridIndex& b, int tile_blocks) {
+  return {floorDiv(b.x(), tile_blocks), floorDiv(b.y(), tile_blocks), floorDiv(b.z(), tile_blocks)};
+}
+
+/// Meshes tile `tile` whose blocks are `blocks` (indices) with the +x/+y/+z layer around it,
+/// each block taken from `memory` when there, else from the store through `cache` when its
+/// tile `on_disk` says so. Writes TILES/X_Y_Z.ply (removes it when the tile has no
+/// triangle). Returns the triangles.
+template <typename OnDisk>
+std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks, const TsdfVolume* memory,
+                     OnDisk&& on_disk, TileCache& cache, const MarchingCubes& mesher, int tile_blocks,
+                     double voxel_size, double truncation, const std::string& tiles) {
+  TsdfVolume part(voxel_size, truncation);
+  const std::uint64_t stamp = part.beginGeneration();
+  auto copy = [&](const GridIndex& b) {
+    if (part.findBlock(b))
+      return;
+    if (memory)
+      if (const TsdfBlock* block = memory->findBlock(b)) {
+        putBlock(part, b, *block, stamp);
+        return;
+      }
+    const GridIndex t = tileOfBlock(b, tile_blocks);
+    if (on_disk(t))
+      if (const auto* voxels = cache.find(t, b))
+        putBlock(part, b, *voxels, stamp);
+  };
+  for (const GridIndex& b : blocks)
+    copy(b);
+  for (const GridIndex& b : blocks)
+    for (const GridIndex& d : kUpper)
+      if (tileOfBlock(b + d, tile_blocks) != tile)
+        copy(b + d);
+  TriangleMesh mesh;
+  mesher.extractBlocks(part, blocks, mesh);
+  const std::string path = meshPath(tiles, tile);
+  if (mesh.triangles.empty()) {
+    std::error_code e;
+    fs::remove(path, e);
+  } else {
+    StreamingMap::writeMesh(path, mesh);
+  }
+  return mesh.triangles.size();
+}
+
+} // namespace
+
+void StreamingMap::Config::read(const cv::FileNode& node) {
+  readKey(node, "active_radius_m", active_radius_m);
+  readKey(node, "tile_blocks", tile_blocks);
+  validate();
+}
+
+void StreamingMap::Config::validate() const {
+  if (!(active_radius_m >= 0.0) || !std::isfinite(active_radius_m))
+    throw ConfigError("streaming.active_radius_m must be >= 0 (0: the whole map in memory), got " +
+                      number(active_radius_m));
+  if (tile_blocks < 1 || tile_blocks > 64)
+    throw ConfigError("streaming.tile_blocks must be in 1..64, got " + std::to_string(tile_blocks));
+}
+
+void StreamingMap::Config::print(std::ostream& out) const {
+  out << "streaming:\n  active_radius_m: " << configValue(active_radius_m)
+      << "\n  tile_blocks: " << configValue(tile_blocks) << "\n";
+}
+
+StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const MarchingCubes::Config& mesher,
+                           double reach_m, const std::string& directory)
+    : volume_(volume), config_(config), mesher_(mesher), reach_m_(reach_m), directory_(directory) {
+  config_.validate();
+  if (!config_.enabled())
+    throw ConfigError("StreamingMap: streaming.active_radius_m is 0 (off)");
+  if (config_.active_radius_m < minimumRadius())
+    throw ConfigError("streaming.active_radius_m " + number(config_.active_radius_m) + " is below " +
+                      number(minimumRadius()) + " m, the integrator's reach (" + number(reach_m_) +
+                      " m: maximum depth, truncation and a margin) plus a tile (" +
+                      number(config_.tile_blocks * kSide * volume_.voxelSize()) + " m)");
+  ensureOutputDirectory(directory_);
+  for (const char* sub : {"tsdf", "tiles"}) {
+    const fs::path p = fs::path(directory_) / sub;
+    std::error_code e;
+    fs::remove_all(p, e); // an earlier run's tiles would join this one's union
+    fs::create_directories(p, e);
+    if (e)
+      throw IOError("cannot create folder '" + p.string() + "': " + e.message());
+  }
+  writeIndex();
+}
+
+std::string StreamingMap::tilesDirectory() const { return (fs::path(directory_) / "tiles").string(); }
+
+double StreamingMap::minimumRadius() const { return reach_m_ + config_.tile_blocks * kSide * volume_.voxelSize(); }
+
+StreamingMap::TileKey StreamingMap::tileOf(const GridIndex& block) const {
+  const GridIndex t = tileOfBlock(block, config_.tile_blocks);
+  return (static_cast<std::uint64_t>(t.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(t.y() + kTileBias) << 21) |
+         static_cast<std::uint64_t>(t.z() + kTileBias);
+}
+
+GridIndex StreamingMap::tileIndex(TileKey key) const {
+  const auto part = [&](int shift) { return static_cast<int>(static_cast<std::int64_t>((key >> shift) & 0x1fffff) - kTileBias); };
+  return {part(42), part(21), part(0)};
+}
+
+double StreamingMap::distanceToTile(TileKey key, const Eigen::Vector3d& p, int grow_blocks) const {
+  const int voxels = config_.tile_blocks * kSide;
+  const Eigen::Vector3d lo = ((tileIndex(key) * voxels).array() - grow_blocks * kSide).cast<double>() * volume_.voxelSize();
+  const Eigen::Vector3d hi = lo + Eigen::Vector3d::Constant((voxels - 1 + 2 * grow_blocks * kSide) * volume_.voxelSize());
+  return (p.cwiseMax(lo).cwiseMin(hi) - p).norm();
+}
+
+void StreamingMap::beforeIntegration(const Eigen::Vector3d& sensor) {
+  std::vector<TileKey> back;
+  for (const TileKey t : evicted_)
+    if (distanceToTile(t, sensor, 1) <= reach_m_)
+      back.push_back(t);
+  if (back.empty())
+    return;
+  const auto t0 = Clock::now();
+  std::sort(back.begin(), back.end());
+  const std::uint64_t stamp = volume_.beginGeneration();
+  for (const TileKey t : back) {
+    readBlocks(blockPath(directory_, tileIndex(t)), volume_.voxelSize(), volume_.truncation(),
+               [&](const GridIndex& b, const TsdfBlock& voxels) {
+                 if (!volume_.findBlock(b)) {
+                   putBlock(volume_, b, voxels, stamp);
+                   ++stats_.blocks_reloaded;
+                 }
+               });
+    evicted_.erase(t);
+    ++stats_.tiles_reloaded;
+    // The tiles whose cubes read this tile's blocks (their +x/+y/+z layer) may change their mesh.
+    const GridIndex ti = tileIndex(t);
+    for (const GridIndex& d : kUpper) {
+      const GridIndex n = ti - d;
+      const TileKey nk = tileOf(n * config_.tile_blocks);
+      if (evicted_.count(nk))
+        stale_.insert(nk);
+    }
+  }
+  stats_.stream_ms += msSince(t0);
+}
+
+void StreamingMap::afterIntegration(const Eigen::Vector3d& sensor) {
+  // A pass over the blocks' tiles is cheap but not free: once per quarter tile travelled.
+  const double step = 0.25 * config_.tile_blocks * kSide * volume_.voxelSize();
+  if ((sensor - last_check_).norm() < step)
+    return;
+  last_check_ = sensor;
+  const auto t0 = Clock::now();
+  std::unordered_set<TileKey> tiles;
+  TileKey last = ~TileKey(0);
+  for (const TsdfBlock* block : volume_.blocks()) {
+    const TileKey t = tileOf(block->index);
+    if (t != last)
+      tiles.insert(t);
+    last = t;
+  }
+  std::vector<TileKey> out;
+  for (const TileKey t : tiles)
+    if (distanceToTile(t, sensor, 1) > config_.active_radius_m)
+      out.push_back(t);
+  if (!out.empty())
+    evict(out);
+  stats_.stream_ms += msSince(t0);
+}
+
+void StreamingMap::evict(const std::vector<TileKey>& tiles_in) {
+  std::vector<TileKey> tiles = tiles_in;
+  std::sort(tiles.begin(), tiles.end());
+  std::unordered_map<TileKey, std::vector<GridIndex>> blocks;
+  for (const TileKey t : tiles)
+    blocks[t];
+  for (const TsdfBlock* block : volume_.blocks()) {
+    auto it = blocks.find(tileOf(block->index));
+    if (it != blocks.end())
+      it->second.push_back(block->index);
+  }
+  const double vs = volume_.voxelSize(), trunc = volume_.truncation();
+  TileCache cache(directory_, vs, trunc);
+  const auto on_disk = [&](const GridIndex& t) { return evicted_.count(tileOf(t * config_.tile_blocks)) > 0; };
+  std::vector<GridIndex> freed;
+  for (const TileKey t : tiles) {
+    std::vector<GridIndex>& mine = blocks[t];
+    const GridIndex ti = tileIndex(t);
+    if (evicted_.count(t)) {
+      // Blocks made in a tile on disk (a radius below what the integrator reaches): the
+      // stored ones join them, so that the file keeps both.
+      const std::uint64_t stamp = volume_.beginGeneration();
+      readBlocks(blockPath(directory_, ti), vs, trunc,
+                 [&](const GridIndex& b, const TsdfBlock& voxels) {
+                   if (!volume_.findBlock(b)) {
+                     putBlock(volume_, b, voxels, stamp);
+                     mine.push_back(b);
+                   }
+                 });
+    }
+    std::sort(mine.begin(), mine.end(), [](const GridIndex& a, const GridIndex& b) {
+      return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
+    });
+    meshTile(ti, mine, &volume_, on_disk, cache, mesher_, config_.tile_blocks, vs, trunc, tilesDirectory());
+    std::vector<const TsdfBlock*> pointers;
+    for (const GridIndex& b : mine)
+      pointers.push_back(volume_.findBlock(b));
+    writeBlocks(blockPath(directory_, ti), vs, trunc, pointers);
+    stored_.insert(t);
+    evicted_.insert(t);
+    stale_.erase(t);
+    ++stats_.tiles_written;
+    freed.insert(freed.end(), mine.begin(), mine.end());
+  }
+  volume_.removeBlocks(freed);
+  stats_.blocks_freed += freed.size();
+  writeIndex();
+}
+
+void StreamingMap::writeIndex() const {
+  std::vector<TileKey> keys(stored_.begin(), stored_.end());
+  std::sort(keys.begin(), keys.end());
+  std::ostringstream ss;
+  ss.precision(17);
+  ss << kIndexTag << "\nvoxel_size_m " << volume_.voxelSize() << "\ntruncation_m " << volume_.truncation()
+     << "\nblock_side " << kSide << "\ntile_blocks " << config_.tile_blocks << "\ntiles " << keys.size() << "\n";
+  for (const TileKey k : keys) {
+    const GridIndex t = tileIndex(k);
+    ss << t.x() << " " << t.y() << " " << t.z() << "\n";
+  }
+  const std::string text = ss.str();
+  writeAtomically((fs::path(directory_) / "tsdf" / "index.txt").string(), [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out.flush())
+      throw IOError("cannot write the TSDF store index in '" + directory_ + "': disk full?");
+  });
+}
+
+std::size_t StreamingMap::finish(const std::string& mesh_path) {
+  const auto t0 = Clock::now();
+  std::unordered_set<TileKey> tiles;
+  for (const TsdfBlock* block : volume_.blocks())
+    tiles.insert(tileOf(block->index));
+  if (!tiles.empty())
+    evict(std::vector<TileKey>(tiles.begin(), tiles.end()));
+  std::vector<TileKey> stale(stale_.begin(), stale_.end());
+  std::sort(stale.begin(), stale.end());
+  TileCache cache(directory_, volume_.voxelSize(), volume_.truncation());
+  const auto on_disk = [&](const GridIndex& t) { return evicted_.count(tileOf(t * config_.tile_blocks)) > 0; };
+  for (const TileKey t : stale) {
+    std::vector<GridIndex> mine;
+    readBlocks(blockPath(directory_, tileIndex(t)), volume_.voxelSize(), volume_.truncation(),
+               [&](const GridIndex& b, const TsdfBlock&) { mine.push_back(b); });
+    meshTile(tileIndex(t), mine, nullptr, on_disk, cache, mesher_, config_.tile_blocks, volume_.voxelSize(),
+             volume_.truncation(), tilesDirectory());
+    ++stats_.tiles_remeshed;
+  }
+  stale_.clear();
+  std::vector<TileKey> keys(stored_.begin(), stored_.end());
+  std::sort(keys.begin(), keys.end());
+  std::vector<std::string> meshes;
+  for (const TileKey k : keys)
+    meshes.push_back(meshPath(tilesDirectory(), tileIndex(k)));
+  const std::size_t triangles = writeUnion(meshes, mesh_path);
+  stats_.stream_ms += msSince(t0);
+  return triangles;
+}
+
+TsdfVolume StreamingMap::loadStore(const std::string& directory) {
+  const StoreIndex index = readIndex(directory);
+  TsdfVolume volume(index.voxel_size, index.truncation);
+  const std::uint64_t stamp = volume.beginGeneration();
+  for (const GridIndex& t : index.tiles)
+    readBlocks(blockPath(directory, t), index.voxel_size, index.truncation,
+               [&](const GridIndex& b, const TsdfBlock& voxels) {
+                 putBlock(volume, b, voxels, stamp);
+               });
+  return volume;
+}
+
+std::size_t StreamingMap::remesh(const std::string& directory, const MarchingCubes::Config& mesher_config,
+                                 const std::string& mesh_path, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const StoreIndex index = readIndex(directory);
+  const MarchingCubes mesher(mesher_config);
+  const std::string tiles = mesh_path + ".tiles";
+  std::error_code e;
+  fs::remove_all(tiles, e);
+  fs::create_directories(tiles, e);
+  if (e)
+    throw IOError("cannot create folder '" + tiles + "': " + e.message());
+  TileCache cache(directory, index.voxel_size, index.truncation);
+  std::map<std::tuple<int, int, int>, bool> stored;
+  for (const GridIndex& t : index.tiles)
+    stored[{t.x(), t.y(), t.z()}] = true;
+  const auto on_disk = [&](const GridIndex& t) { return stored.count({t.x(), t.y(), t.z()}) > 0; };
+  const bool region = (lo.array() <= hi.array()).all();
+  const double tile_m = index.tile_blocks * kSide * index.voxel_size;
+  std::vector<std::string> meshes;
+  for (const GridIndex& t : index.tiles) {
+    const Eigen::Vector3d tlo = t.cast<double>() * tile_m, thi = tlo + Eigen::Vector3d::Constant(tile_m);
+    if (region && ((thi.array() < lo.array()).any() || (tlo.array() > hi.array()).any()))
+      continue;
+    std::vector<GridIndex> mine;
+    readBlocks(blockPath(directory, t), index.voxel_size, index.truncation,
+               [&](const GridIndex& b, const TsdfBlock&) { mine.push_back(b); });
+    meshTile(t, mine, nullptr, on_disk, cache, mesher, index.tile_blocks, index.voxel_size, index.truncation, tiles);
+    meshes.push_back(meshPath(tiles, t));
+  }
+  return writeUnion(meshes, mesh_path);
+}
+
+void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) {
+  std::string data = plyHeader(mesh.vertices.size(), mesh.triangles.size());
+  const std::size_t start = data.size();
+  data.resize(start + mesh.vertices.size() * kVertexBytes + mesh.triangles.size() * kFaceBytes);
+  char* p = data.data() + start;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i, p += kVertexBytes) {
+    std::memcpy(p, mesh.vertices[i].data(), 12);
+    std::memcpy(p + 12, mesh.colors[i].data(), 3);
+  }
+  for (const auto& t : mesh.triangles) {
+    *p = 3;
+    std::memcpy(p + 1, t.data(), 12);
+    p += kFaceBytes;
+  }
+  writeAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+    if (!out.flush())
+      throw IOError("cannot write mesh '" + path + "': disk full?");
+  });
+}
+
+void StreamingMap::readMesh(const std::string& path, TriangleMesh& mesh) {
+  requireFile(path, "mesh");
+  std::ifstream in(path, std::ios::binary);
+  const PlyCounts counts = readPlyHeader(in, path);
+  std::vector<char> buffer(counts.vertices * kVertexBytes + counts.faces * kFaceBytes);
+  in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  if (!in)
+    throw IOError("mesh '" + path + "' ends before its " + std::to_string(counts.faces) + " triangles");
+  mesh.vertices.resize(counts.vertices);
+  mesh.colors.resize(counts.vertices);
+  mesh.triangles.resize(counts.faces);
+  const char* p = buffer.data();
+  for (std::size_t i = 0; i < counts.vertices; ++i, p += kVertexBytes) {
+    std::memcpy(mesh.vertices[i].data(), p, 12);
+    std::memcpy(mesh.colors[i].data(), p + 12, 3);
+  }
+  for (std::size_t f = 0; f < counts.faces; ++f, p += kFaceBytes) {
+    std::memcpy(mesh.triangles[f].data(), p + 1, 12);
+    if (*p != 3 || mesh.triangles[f][0] >= counts.vertices || mesh.triangles[f][1] >= counts.vertices ||
+        mesh.triangles[f][2] >= counts.vertices)
+      throw IOError("mesh '" + path + "': triangle " + std::to_string(f) + " is not 3 vertices of the mesh");
+  }
+}
+
+void StreamingMap::weldByPosition(TriangleMesh& mesh) {
+  struct Key {
+    std::uint32_t x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return (static_cast<std::size_t>(k.x) * 73856093u) ^ (static_cast<std::size_t>(k.y) * 19349663u) ^
+             (static_cast<std::size_t>(k.z) * 83492791u);
+    }
+  };
+  std::unordered_map<Key, std::uint32_t, Hash> seen;
+  seen.reserve(mesh.vertices.size());
+  std::vector<std::uint32_t> remap(mesh.vertices.size());
+  TriangleMesh out;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    Key k;
+    std::memcpy(&k.x, &mesh.vertices[i].x(), 4);
+    std::memcpy(&k.y, &mesh.vertices[i].y(), 4);
+    std::memcpy(&k.z, &mesh.vertices[i].z(), 4);
+    const auto [it, inserted] = seen.emplace(k, static_cast<std::uint32_t>(out.vertices.size()));
+    if (inserted) {
+      out.vertices.push_back(mesh.vertices[i]);
+      out.colors.push_back(mesh.colors[i]);
+    }
+    remap[i] = it->second;
+  }
+  out.triangles = mesh.triangles;
+  for (auto& t : out.triangles)
+    for (auto& v : t)
+      v = remap[v];
+  mesh = std::move(out);
+}
+
+} // namespace msf

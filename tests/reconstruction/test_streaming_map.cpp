@@ -1,0 +1,278 @@
+#include "scenes.h"
+#include "test_support.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/streaming_map.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <tuple>
+
+using namespace msf;
+
+namespace {
+
+// A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
+// either side every few metres, each a little different, so that no two tiles look alike.
+AnalyticScene corridor(double length) {
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5); // floor: y >= 1.5
+  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -4.0); // x >= 4
+  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -4.0);  // x <= -4
+  for (int i = 0; i * 3.0 < length; ++i) {
+    const double side = i % 2 ? 1.0 : -1.0;
+    scene.addBox(Eigen::Vector3d(side * (2.8 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
+                 Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
+                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
+  }
+  return scene;
+}
+
+constexpr double kVoxel = 0.2, kTruncation = 0.5, kMaxDepth = 8.0;
+// Reach as the pipeline sets it: maximum depth, truncation and a margin.
+constexpr double kReach = kMaxDepth + kTruncation + 2.0;
+
+/// Poses along the corridor at `step` metres: forward from z = 0 to `length`, then (when
+/// `back_to` >= 0) turned around and driven back to z = back_to.
+std::vector<Eigen::Isometry3d> drive(double length, double step, double back_to = -1.0) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (double z = 0; z <= length; z += step)
+    poses.push_back(test::lookAt(Eigen::Vector3d(0.3 * std::sin(z), 0.0, z), Eigen::Vector3d(0, 0.3, z + 10)));
+  if (back_to >= 0)
+    for (double z = length; z >= back_to; z -= step)
+      poses.push_back(test::lookAt(Eigen::Vector3d(-0.3, 0.0, z), Eigen::Vector3d(0, 0.3, z - 10)));
+  return poses;
+}
+
+struct DriveResult {
+  TriangleMesh mesh;
+  std::size_t peak_blocks = 0;
+  std::vector<std::size_t> blocks; ///< after each frame
+  StreamingMap::Stats stats;
+};
+
+/// Integrates the drive; with `directory`, streamed with radius `radius` and the mesh read
+/// back from the union the map writes (welded by position), else meshed in memory.
+DriveResult integrateDrive(const std::vector<Eigen::Isometry3d>& poses, double length, const std::string& directory = "",
+                   double radius = 0.0) {
+  const AnalyticScene scene = corridor(length + 10);
+  TsdfVolume volume(kVoxel, kTruncation);
+  TsdfIntegrator::Config config;
+  config.max_depth_m = kMaxDepth;
+  TsdfIntegrator integrator(volume, config);
+  MarchingCubes::Config mesher;
+  mesher.min_weight = 0.f;
+  std::unique_ptr<StreamingMap> map;
+  if (!directory.empty()) {
+    StreamingMap::Config streaming;
+    streaming.active_radius_m = radius;
+    streaming.tile_blocks = 2;
+    map = std::make_unique<StreamingMap>(volume, streaming, mesher, kReach, directory);
+  }
+  DriveResult run;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    DepthFrame frame = test::renderFrame(scene, test::centredCamera(64, 48, 40.0), poses[i]);
+    frame.depth.setTo(0.f, frame.depth > kMaxDepth - 0.5); // the far end of the corridor is not a surface
+    frame.color = cv::Mat(frame.depth.size(), CV_8UC3, cv::Scalar(static_cast<double>(i % 200), 90, 200));
+    if (map)
+      map->beforeIntegration(poses[i].translation());
+    integrator.integrate(frame, poses[i]);
+    if (map)
+      map->afterIntegration(poses[i].translation());
+    run.blocks.push_back(volume.numBlocks());
+    run.peak_blocks = std::max(run.peak_blocks, volume.numBlocks());
+  }
+  if (map) {
+    const std::string path = directory + "/mesh.ply";
+    EXPECT_GT(map->finish(path), 0u);
+    EXPECT_EQ(volume.numBlocks(), 0u);
+    StreamingMap::readMesh(path, run.mesh);
+    StreamingMap::weldByPosition(run.mesh);
+    run.stats = map->stats();
+  } else {
+    MarchingCubes(mesher).extract(volume, run.mesh);
+  }
+  return run;
+}
+
+using Point = std::array<float, 3>;
+using Triangle = std::array<Point, 3>;
+
+Point pointOf(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+
+/// Triangles by their vertices' positions, each rotated to start at its least vertex (the
+/// orientation kept), sorted: equal for the same triangles in any order and welding.
+std::vector<Triangle> triangleSet(const TriangleMesh& mesh) {
+  std::vector<Triangle> out;
+  for (const auto& t : mesh.triangles) {
+    Triangle tri = {pointOf(mesh.vertices[t[0]]), pointOf(mesh.vertices[t[1]]), pointOf(mesh.vertices[t[2]])};
+    const int first = static_cast<int>(std::min_element(tri.begin(), tri.end()) - tri.begin());
+    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// Edges used by one triangle only, by their end positions.
+std::set<std::pair<Point, Point>> boundaryEdges(const TriangleMesh& mesh) {
+  std::map<std::pair<Point, Point>, int> uses;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      Point a = pointOf(mesh.vertices[t[k]]), b = pointOf(mesh.vertices[t[(k + 1) % 3]]);
+      if (b < a)
+        std::swap(a, b);
+      ++uses[{a, b}];
+    }
+  std::set<std::pair<Point, Point>> out;
+  for (const auto& [edge, n] : uses)
+    if (n == 1)
+      out.insert(edge);
+  return out;
+}
+
+} // namespace
+
+TEST(TsdfVolumeRemove, RemovedBlocksAreGoneAndTheOthersKeepTheirVoxels) {
+  TsdfVolume volume(0.1, 0.3);
+  for (int i = 0; i < 1000; ++i) {
+    TsdfBlock& block = volume.allocateBlock(GridIndex(i, -i, i % 7));
+    block.voxels[i % TsdfBlock::kVoxels].weight = static_cast<float>(i + 1);
+  }
+  const std::size_t before = volume.memoryBytes();
+  std::vector<GridIndex> gone;
+  for (int i = 0; i < 1000; i += 3)
+    gone.push_back(GridIndex(i, -i, i % 7));
+  gone.push_back(GridIndex(5000, 0, 0)); // absent: ignored
+  volume.removeBlocks(gone);
+  EXPECT_EQ(volume.numBlocks(), 666u);
+  EXPECT_LT(volume.memoryBytes(), before);
+  for (int i = 0; i < 1000; ++i) {
+    const TsdfBlock* block = volume.findBlock(GridIndex(i, -i, i % 7));
+    if (i % 3 == 0) {
+      EXPECT_EQ(block, nullptr) << i;
+    } else {
+      ASSERT_NE(block, nullptr) << i;
+      EXPECT_EQ(block->index, GridIndex(i, -i, i % 7));
+      EXPECT_EQ(block->voxels[i % TsdfBlock::kVoxels].weight, static_cast<float>(i + 1));
+    }
+  }
+  std::vector<GridIndex> rest;
+  for (const TsdfBlock* b : volume.blocks())
+    rest.push_back(b->index);
+  volume.removeBlocks(rest);
+  EXPECT_EQ(volume.numBlocks(), 0u);
+  volume.allocateBlock(GridIndex(1, 2, 3)); // still usable
+  EXPECT_EQ(volume.numBlocks(), 1u);
+}
+
+TEST(StreamingMap, StreamedMeshIsTheInMemoryMeshWithNoSeams) {
+  const double length = 60.0;
+  const auto poses = drive(length, 0.5);
+  const DriveResult memory = integrateDrive(poses, length);
+  test::TempDir dir;
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  EXPECT_GT(streamed.stats.blocks_freed, 0u);
+  EXPECT_GT(streamed.stats.tiles_written, 10u);
+  EXPECT_EQ(streamed.stats.tiles_reloaded, 0u);
+  EXPECT_LT(streamed.peak_blocks * 2, memory.peak_blocks) << streamed.peak_blocks << " of " << memory.peak_blocks;
+  ASSERT_GT(memory.mesh.triangles.size(), 1000u);
+  EXPECT_EQ(streamed.mesh.triangles.size(), memory.mesh.triangles.size());
+  EXPECT_TRUE(triangleSet(streamed.mesh) == triangleSet(memory.mesh));
+  // Welded, the tiles are one surface: the only open edges are the in-memory mesh's.
+  EXPECT_EQ(streamed.mesh.vertices.size(), memory.mesh.vertices.size());
+  EXPECT_TRUE(boundaryEdges(streamed.mesh) == boundaryEdges(memory.mesh));
+  // Tiles were written while the drive went on, each a readable PLY.
+  std::size_t tiles = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path() + "/tiles")) {
+    TriangleMesh tile;
+    StreamingMap::readMesh(entry.path().string(), tile);
+    EXPECT_GT(tile.triangles.size(), 0u);
+    ++tiles;
+  }
+  EXPECT_GT(tiles, 10u);
+}
+
+TEST(StreamingMap, StoreReloadsAndMeshesAgainToTheSameMesh) {
+  const double length = 20.0;
+  const auto poses = drive(length, 0.5);
+  const DriveResult memory = integrateDrive(poses, length);
+  test::TempDir dir;
+  integrateDrive(poses, length, dir.path(), 14.0);
+  MarchingCubes::Config mesher;
+  mesher.min_weight = 0.f;
+  // Tile by tile from the block files.
+  EXPECT_EQ(StreamingMap::remesh(dir.path(), mesher, dir.file("remesh.ply")), memory.mesh.triangles.size());
+  TriangleMesh remeshed;
+  StreamingMap::readMesh(dir.file("remesh.ply"), remeshed);
+  EXPECT_TRUE(triangleSet(remeshed) == triangleSet(memory.mesh));
+  // The whole store as one volume.
+  const TsdfVolume volume = StreamingMap::loadStore(dir.path());
+  TriangleMesh whole;
+  MarchingCubes(mesher).extract(volume, whole);
+  EXPECT_TRUE(triangleSet(whole) == triangleSet(memory.mesh));
+  // A region: fewer triangles, all of them the whole mesh's.
+  const std::size_t part = StreamingMap::remesh(dir.path(), mesher, dir.file("part.ply"), Eigen::Vector3d(-10, -10, 0),
+                                                Eigen::Vector3d(10, 10, 6));
+  EXPECT_GT(part, 0u);
+  EXPECT_LT(part, memory.mesh.triangles.size());
+}
+
+TEST(StreamingMap, ALoopBackIntoStreamedSpaceReadsItBackAndDoublesNoSurface) {
+  // Back to 25 m: the tiles near the turn are read back and written again, and the tiles
+  // before them, on disk, are meshed again at the end (their cubes read the blocks read back).
+  const double length = 40.0;
+  const auto poses = drive(length, 0.5, 25.0);
+  const DriveResult memory = integrateDrive(poses, length);
+  test::TempDir dir;
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  EXPECT_GT(streamed.stats.tiles_reloaded, 0u);
+  EXPECT_GT(streamed.stats.blocks_reloaded, 0u);
+  EXPECT_GT(streamed.stats.tiles_remeshed, 0u);
+  EXPECT_EQ(streamed.mesh.triangles.size(), memory.mesh.triangles.size());
+  EXPECT_TRUE(triangleSet(streamed.mesh) == triangleSet(memory.mesh));
+  EXPECT_TRUE(boundaryEdges(streamed.mesh) == boundaryEdges(memory.mesh));
+}
+
+TEST(StreamingMap, MemoryStaysBoundedOnALongDrive) {
+  const double length = 240.0;
+  const auto poses = drive(length, 0.6);
+  test::TempDir dir;
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  const std::size_t n = streamed.blocks.size();
+  const auto peak = [&](std::size_t a, std::size_t b) {
+    return *std::max_element(streamed.blocks.begin() + static_cast<long>(a), streamed.blocks.begin() + static_cast<long>(b));
+  };
+  const std::size_t early = peak(n / 10, n / 5), late = peak(9 * n / 10, n);
+  EXPECT_LE(late, early + early / 10) << "early " << early << " late " << late;
+  EXPECT_GT(streamed.stats.blocks_freed, 5 * early);
+}
+
+TEST(StreamingMap, BadRadiusAndBadStoreAreClearErrors) {
+  TsdfVolume volume(kVoxel, kTruncation);
+  StreamingMap::Config config;
+  config.active_radius_m = 5.0;
+  test::TempDir dir;
+  try {
+    StreamingMap map(volume, config, MarchingCubes::Config(), kReach, dir.path());
+    FAIL() << "a radius below the reach was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("active_radius_m"), std::string::npos) << e.what();
+  }
+  config.active_radius_m = -1;
+  EXPECT_THROW(config.validate(), ConfigError);
+  EXPECT_THROW(StreamingMap::remesh(dir.path(), MarchingCubes::Config(), dir.file("m.ply")), IOError);
+  std::filesystem::create_directories(dir.path() + "/tsdf");
+  std::ofstream(dir.path() + "/tsdf/index.txt") << "something else\n";
+  EXPECT_THROW(StreamingMap::loadStore(dir.path()), IOError);
+  std::ofstream(dir.file("bad.ply")) << "ply\nformat ascii 1.0\n";
+  TriangleMesh mesh;
+  EXPECT_THROW(StreamingMap::readMesh(dir.file("bad.ply"), mesh), IOError);
+}
