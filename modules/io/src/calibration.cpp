@@ -1,11 +1,13 @@
 #include <msf/common/atomic_file.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/calibration.h>
 #include <msf/io/image_io.h>
 
 #include <opencv2/core/persistence.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -53,28 +55,38 @@ public:
       key.erase(key.find_last_not_of(" \t\r") + 1);
       std::istringstream values(line.substr(colon + 1));
       std::vector<double> numbers;
-      std::string token;
-      bool numeric = true;
+      std::string token, bad;
       while (values >> token) {
         try {
           std::size_t used = 0;
           numbers.push_back(std::stod(token, &used));
-          numeric = numeric && used == token.size();
+          if (used != token.size() && bad.empty())
+            bad = token;
         } catch (const std::exception&) {
-          numeric = false;
+          if (bad.empty())
+            bad = token;
         }
       }
-      if (numeric)
+      // A line that is not numbers (a date, a comment) is kept as such: asking for its key
+      // names the value at fault, not a missing key.
+      if (bad.empty())
         entries_[key] = numbers;
+      else
+        not_numeric_[key] = bad;
     }
   }
 
-  bool has(const std::string& key) const { return entries_.count(key) > 0; }
+  bool has(const std::string& key) const { return entries_.count(key) > 0 || not_numeric_.count(key) > 0; }
 
   std::vector<double> get(const std::string& key, std::size_t count) const {
     const auto it = entries_.find(key);
-    if (it == entries_.end())
+    if (it == entries_.end()) {
+      const auto bad = not_numeric_.find(key);
+      if (bad != not_numeric_.end())
+        throw CalibrationError("calibration '" + path_ + "': key '" + key + "' has a value that is not a number: '" +
+                               bad->second + "'");
       throw CalibrationError("calibration '" + path_ + "' has no key '" + key + "'");
+    }
     if (it->second.size() != count)
       throw CalibrationError("calibration '" + path_ + "': key '" + key + "' has " +
                              std::to_string(it->second.size()) + " values, expected " +
@@ -123,6 +135,7 @@ public:
 private:
   std::string path_;
   std::map<std::string, std::vector<double>> entries_;
+  std::map<std::string, std::string> not_numeric_; ///< key -> its first value that is not a number
 };
 
 cv::Size imageSizeOf(const fs::path& image) {
@@ -175,6 +188,8 @@ Calibration fromRawDateFolder(const fs::path& date_dir) {
   for (int i = 0; i < 4; ++i)
     c.P[i] = cam.projection("P_rect_0" + std::to_string(i));
   const auto size = cam.get("S_rect_00", 2);
+  if (!(size[0] >= 1 && size[0] <= limits::kMaxImageSide && size[1] >= 1 && size[1] <= limits::kMaxImageSide))
+    limits::checkImageSize(-1, -1, "calibration '" + cam.path() + "': key 'S_rect_00'");
   c.image_size = cv::Size(static_cast<int>(size[0]), static_cast<int>(size[1]));
   Eigen::Isometry3d R_rect = Eigen::Isometry3d::Identity();
   R_rect.linear() = cam.rotation("R_rect_00");
@@ -221,6 +236,8 @@ Calibration fromYaml(const std::string& path) {
     if (in[key].empty() || !in[key].isInt())
       throw CalibrationError("calibration '" + path + "' has no integer key '" + key + "'");
   c.image_size = cv::Size(static_cast<int>(in["image_width"]), static_cast<int>(in["image_height"]));
+  limits::checkImageSize(c.image_size.width, c.image_size.height,
+                         "calibration '" + path + "': keys 'image_width' and 'image_height'");
   cv::Mat T;
   in["T_cam0_velo"] >> T;
   if (T.empty())
@@ -237,7 +254,8 @@ Calibration fromYaml(const std::string& path) {
 
 } // namespace
 
-Calibration loadCalibration(const std::string& path) {
+namespace {
+Calibration readCalibration(const std::string& path) {
   std::error_code ec;
   const fs::path p(path);
   if (!fs::exists(p, ec))
@@ -266,6 +284,49 @@ Calibration loadCalibration(const std::string& path) {
     return fromOdometry(f);
   throw CalibrationError("calibration '" + path +
                          "' is not a KITTI odometry, raw or object calibration (no key P0, P_rect_00 or R0_rect)");
+}
+} // namespace
+
+void Calibration::validate() const {
+  const std::string where = "calibration '" + source + "'";
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = "P" + std::to_string(i);
+    if (!P[i].allFinite())
+      throw CalibrationError(where + ": " + key + " has a value that is not finite (NaN or inf)");
+    if (!(fx(i) > 0.0 && fy(i) > 0.0))
+      throw CalibrationError(where + ": " + key + " has fx " + std::to_string(fx(i)) + " and fy " +
+                             std::to_string(fy(i)) + ": focal lengths must be > 0");
+    if (P[i].block<1, 3>(2, 0) != Eigen::RowVector3d(0, 0, 1))
+      throw CalibrationError(where + ": " + key + "'s third row must start 0 0 1 (a rectified camera)");
+    if (std::abs(P[i](0, 1)) > 1e-6 * fx(i) || std::abs(P[i](1, 0)) > 1e-6 * fx(i))
+      throw CalibrationError(where + ": " + key + " has a skew or rotation term (P(0,1), P(1,0) must be 0)");
+    if (!(cameraCenter(i).cwiseAbs().maxCoeff() <= limits::kMaxTranslationM))
+      throw CalibrationError(where + ": " + key + "'s camera centre is beyond " +
+                             std::to_string(limits::kMaxTranslationM) + " m");
+  }
+  if (image_size.width != 0 || image_size.height != 0)
+    limits::checkImageSize(image_size.width, image_size.height, where);
+  try {
+    limits::checkRigid(T_cam0_velo, where + ": the LiDAR-to-camera transform");
+    if (has_imu)
+      limits::checkRigid(T_velo_imu, where + ": the IMU-to-LiDAR transform");
+  } catch (const InvalidInputError& e) {
+    throw CalibrationError(e.what());
+  }
+}
+
+double Calibration::focalBaseline() const {
+  const double fb = fx(0) * baselineGrey();
+  if (!(fb > 0.0) || !std::isfinite(fb))
+    throw CalibrationError("calibration '" + source + "': the grey pair's focal length x baseline is " +
+                           std::to_string(fb) + " (P0 and P1 must have fx > 0 and different centres) ");
+  return fb;
+}
+
+Calibration loadCalibration(const std::string& path) {
+  Calibration c = readCalibration(path);
+  c.validate();
+  return c;
 }
 
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path) {
