@@ -15,6 +15,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 
 namespace fs = std::filesystem;
@@ -214,6 +215,58 @@ TEST(HostileSequence, WrongSizeRightImageIsNamedWithItsOwnSize) {
   const msf::Sequence s(d);
   const std::string e = errorOf([&] { s.load(0, false); });
   EXPECT_NE(e.find("image_1/000000.png' is 8x6, not the calibration's 1226x370"), std::string::npos) << e;
+}
+
+/// The inputs fuzz/ found crashes with (tests/io/fuzz_regressions/<target>/), read as the
+/// fuzz target reads them: the first byte picks the format. Each must load or end in an
+/// msf::Error; any other exception (PCL's std::out_of_range, OpenCV's cv::Exception) fails.
+std::vector<fs::path> regressions(const std::string& target) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(fs::path(msf::test::sourceDir()) / "tests/io/fuzz_regressions" / target))
+    files.push_back(e.path());
+  return files;
+}
+
+std::string bodyOf(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return bytes;
+}
+
+TEST(FuzzRegressions, CloudReaders) {
+  msf::test::TempDir dir;
+  const auto files = regressions("cloud");
+  ASSERT_FALSE(files.empty());
+  for (const auto& f : files) {
+    const std::string bytes = bodyOf(f);
+    const std::string path = dir.file(bytes.at(0) & 1 ? "c.ply" : "c.pcd");
+    write(path, bytes.substr(1));
+    pcl::PointCloud<pcl::PointXYZI> cloud;
+    try {
+      msf::loadCloud(path, cloud);
+    } catch (const msf::Error&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << f << ": " << e.what();
+    }
+  }
+}
+
+TEST(FuzzRegressions, CalibrationParsers) {
+  msf::test::TempDir dir;
+  const auto files = regressions("calibration");
+  ASSERT_FALSE(files.empty());
+  for (const auto& f : files) {
+    const std::string bytes = bodyOf(f);
+    const char* names[] = {"calib.txt", "000000.txt", "calib_cam_to_cam.txt", "camera.yaml"};
+    const std::string path = dir.file(names[static_cast<unsigned char>(bytes.at(0)) % 4]);
+    write(path, bytes.substr(1));
+    try {
+      msf::loadCalibration(path);
+    } catch (const msf::Error&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << f << ": " << e.what();
+    }
+  }
 }
 
 } // namespace

@@ -202,22 +202,31 @@ Calibration fromRawDateFolder(const fs::path& date_dir) {
   return c;
 }
 
-Calibration::Projection readProjectionYaml(const cv::FileStorage& fs_in, const std::string& key,
-                                           const std::string& path) {
-  cv::Mat m;
-  fs_in[key] >> m;
-  if (m.empty())
+/// An opencv-matrix of `rows` x `cols`, as doubles. Its rows, cols and number of values are
+/// checked before OpenCV reads it: OpenCV allocates rows x cols first ("cols: ....4" asked
+/// for 48 GB, found by fuzz/fuzz_calibration).
+cv::Mat readMatrixYaml(const cv::FileStorage& in, const std::string& key, int rows, int cols, const std::string& path) {
+  const cv::FileNode node = in[key];
+  if (node.empty())
     throw CalibrationError("calibration '" + path + "' has no key '" + key + "'");
-  if (m.rows != 3 || m.cols != 4)
-    throw CalibrationError("calibration '" + path + "': key '" + key + "' is " + std::to_string(m.rows) +
-                           "x" + std::to_string(m.cols) + ", expected 3x4");
+  const auto count = [](const cv::FileNode& n) { return n.isInt() ? static_cast<int>(n) : -1; };
+  const int r = node.isMap() ? count(node["rows"]) : -1, c = node.isMap() ? count(node["cols"]) : -1;
+  if (r != rows || c != cols)
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' is " +
+                           (r < 0 || c < 0 ? std::string("not a matrix with integer rows and cols")
+                                           : std::to_string(r) + "x" + std::to_string(c)) +
+                           ", expected " + std::to_string(rows) + "x" + std::to_string(cols));
+  const cv::FileNode data = node["data"];
+  if (!data.isSeq() || data.size() != static_cast<std::size_t>(rows) * cols)
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' needs " + std::to_string(rows * cols) +
+                           " values in 'data'");
+  cv::Mat m;
+  node >> m;
   m.convertTo(m, CV_64F);
-  Calibration::Projection P;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c)
-      P(r, c) = m.at<double>(r, c);
-  return P;
+  return m;
 }
+
+Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path);
 
 Calibration fromYaml(const std::string& path) {
   cv::FileStorage in;
@@ -225,27 +234,40 @@ Calibration fromYaml(const std::string& path) {
     in.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
     throw IOError("calibration '" + path + "' is not valid YAML: " + e.err);
+  } catch (const std::exception& e) {
+    // OpenCV's parser also throws std::length_error on some malformed files (fuzz/fuzz_calibration).
+    throw IOError("calibration '" + path + "' is not valid YAML: " + e.what());
   }
   if (!in.isOpened())
     throw IOError("calibration '" + path + "' cannot be opened");
+  try {
+    return fromYamlNodes(in, path);
+  } catch (const Error&) {
+    throw;
+  } catch (const cv::Exception& e) {
+    // OpenCV asserts on a matrix whose data does not match rows x cols (fuzz/fuzz_calibration).
+    throw CalibrationError("calibration '" + path + "' is not a valid camera file: " + e.err);
+  } catch (const std::exception& e) {
+    throw CalibrationError("calibration '" + path + "' is not a valid camera file: " + e.what());
+  }
+}
+
+Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path) {
   Calibration c;
   c.source = path;
-  for (int i = 0; i < 4; ++i)
-    c.P[i] = readProjectionYaml(in, "P" + std::to_string(i), path);
+  for (int i = 0; i < 4; ++i) {
+    const cv::Mat P = readMatrixYaml(in, "P" + std::to_string(i), 3, 4, path);
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 4; ++col)
+        c.P[i](r, col) = P.at<double>(r, col);
+  }
   for (const char* key : {"image_width", "image_height"})
     if (in[key].empty() || !in[key].isInt())
       throw CalibrationError("calibration '" + path + "' has no integer key '" + key + "'");
   c.image_size = cv::Size(static_cast<int>(in["image_width"]), static_cast<int>(in["image_height"]));
   limits::checkImageSize(c.image_size.width, c.image_size.height,
                          "calibration '" + path + "': keys 'image_width' and 'image_height'");
-  cv::Mat T;
-  in["T_cam0_velo"] >> T;
-  if (T.empty())
-    throw CalibrationError("calibration '" + path + "' has no key 'T_cam0_velo'");
-  if (T.rows != 4 || T.cols != 4)
-    throw CalibrationError("calibration '" + path + "': key 'T_cam0_velo' is " + std::to_string(T.rows) +
-                           "x" + std::to_string(T.cols) + ", expected 4x4");
-  T.convertTo(T, CV_64F);
+  const cv::Mat T = readMatrixYaml(in, "T_cam0_velo", 4, 4, path);
   for (int r = 0; r < 4; ++r)
     for (int col = 0; col < 4; ++col)
       c.T_cam0_velo.matrix()(r, col) = T.at<double>(r, col);

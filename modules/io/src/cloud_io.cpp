@@ -217,28 +217,35 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
   requireFile(path, "cloud");
   const std::string ext = fileExtension(path);
   int result = -1;
-  if (ext == ".pcd") {
-    // PCL 1.13's PCDReader::read crashes on a file without a valid header: check it first.
-    checkPcdHeader(path);
-    pcl::PCDReader reader;
-    Eigen::Vector4f origin;
-    Eigen::Quaternionf orientation;
-    int version = 0, data_type = 0;
-    unsigned int data_index = 0;
-    if (reader.readHeader(path, blob, origin, orientation, version, data_type, data_index) < 0 ||
-        blob.fields.empty())
-      throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header)");
-    if (static_cast<std::size_t>(blob.width) * blob.height == 0)
-      throw IOError("cloud '" + path + "' has no points");
-    checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
-    result = reader.read(path, blob);
+  // PCL's readers throw std::out_of_range and friends on some malformed headers (found by
+  // fuzz/fuzz_cloud): those become an IOError naming the file, as the library promises.
+  try {
+    if (ext == ".pcd") {
+      // PCL 1.13's PCDReader::read crashes on a file without a valid header: check it first.
+      checkPcdHeader(path);
+      pcl::PCDReader reader;
+      Eigen::Vector4f origin;
+      Eigen::Quaternionf orientation;
+      int version = 0, data_type = 0;
+      unsigned int data_index = 0;
+      if (reader.readHeader(path, blob, origin, orientation, version, data_type, data_index) < 0 ||
+          blob.fields.empty())
+        throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header)");
+      if (static_cast<std::size_t>(blob.width) * blob.height == 0)
+        throw IOError("cloud '" + path + "' has no points");
+      checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
+      result = reader.read(path, blob);
+    } else if (ext == ".ply") {
+      checkPlyBody(path);
+      result = pcl::PLYReader().read(path, blob);
+    } else {
+      throw IOError("cloud '" + path + "' is neither .pcd nor .ply");
+    }
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw IOError("cloud '" + path + "' cannot be parsed as " + ext.substr(1) + ": " + e.what());
   }
-  else if (ext == ".ply") {
-    checkPlyBody(path);
-    result = pcl::PLYReader().read(path, blob);
-  }
-  else
-    throw IOError("cloud '" + path + "' is neither .pcd nor .ply");
   if (result < 0)
     throw IOError("cloud '" + path + "' cannot be parsed as " + ext.substr(1));
 }
