@@ -17,7 +17,7 @@ BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench deps-fuzz build test test-sanitize fuzz demo bench install clean
+.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -61,16 +61,25 @@ test: deps
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
 
 # Third-party reports are suppressed by name in tests/sanitize/*.supp (each with its reason).
+SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
+  -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
+  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
+SANITIZE_CTEST = cd $(SANITIZE_BUILD_DIR) && \
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
+  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp \
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
+  ctest --output-on-failure -j$(JOBS) --timeout 1500
+
 test-sanitize: deps
-	cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
-	  -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
-	  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
+	$(SANITIZE_CONFIGURE)
 	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS)
-	cd $(SANITIZE_BUILD_DIR) && \
-	  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
-	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp \
-	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
-	  ctest --output-on-failure -j$(JOBS) --timeout 1500 $(CTEST_ARGS)
+	$(SANITIZE_CTEST) $(CTEST_ARGS)
+
+# The fast subset .ci/run runs: the file readers and their tools (tests labelled common, io).
+test-sanitize-fast: deps
+	$(SANITIZE_CONFIGURE)
+	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS) --target test_common test_io msf_info msf_kitti2pcd msf_pcd2png
+	$(SANITIZE_CTEST) -L '^(common|io)$$'
 
 fuzz: deps-fuzz
 	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang \
