@@ -1,4 +1,5 @@
-# Thin wrapper over CMake: make deps | build | test | demo | bench | install | clean
+# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
+SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
@@ -9,12 +10,25 @@ DEMO_OUT ?= out/demo
 # Every Debian package the project needs to build, test and view its results (pcl_viewer).
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools
+# Only `make fuzz` needs these: clang's libFuzzer and its OpenMP runtime.
+FUZZ_PACKAGES := clang libomp-dev
 # Only the Open3D baseline of `make bench` needs these.
 BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench build test demo bench install clean
+.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+
+# `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
+# Sanitizer (float-cast-overflow included), the first report fatal.
+SANITIZE_BUILD_DIR ?= build-sanitize
+SANITIZE_FLAGS := -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
+                  -fno-omit-frame-pointer
+# `make fuzz`: each libFuzzer target of fuzz/ runs FUZZ_SECONDS from a seed corpus made of
+# the KITTI sample; crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/.
+FUZZ_BUILD_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := cloud calibration poses velodyne
 
 all: build
 
@@ -33,6 +47,9 @@ deps:
 deps-bench: deps
 	$(call apt_install,$(BENCH_PACKAGES))
 
+deps-fuzz: deps
+	$(call apt_install,$(FUZZ_PACKAGES))
+
 $(BUILD_DIR)/CMakeCache.txt:
 	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DMSF_KITTI_DIR=$(KITTI_DIR)
 
@@ -42,6 +59,47 @@ build: $(BUILD_DIR)/CMakeCache.txt
 test: deps
 	$(MAKE) build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
+
+# Third-party reports are suppressed by name in tests/sanitize/*.supp (each with its reason).
+# -Wno-maybe-uninitialized: GCC 12 warns inside libstdc++'s std::regex under -fsanitize (a
+# false positive that -Werror would make fatal).
+SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
+  -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
+  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
+SANITIZE_CTEST = cd $(SANITIZE_BUILD_DIR) && \
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:alloc_dealloc_mismatch=0:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
+  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp \
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
+  ctest --output-on-failure -j$(JOBS) --timeout 1500
+
+test-sanitize: deps
+	$(SANITIZE_CONFIGURE)
+	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS)
+	$(SANITIZE_CTEST) $(CTEST_ARGS)
+
+# The fast subset .ci/run runs: the file readers and their tools (tests labelled common, io).
+test-sanitize-fast: deps
+	$(SANITIZE_CONFIGURE)
+	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS) --target test_common test_io msf_info msf_kitti2pcd msf_pcd2png
+	$(SANITIZE_CTEST) -L '^(common|io)$$'
+
+fuzz: deps-fuzz
+	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_CXX_COMPILER=clang++ -DMSF_BUILD_TESTS=OFF -DMSF_BUILD_TOOLS=OFF -DMSF_BUILD_BENCH=OFF \
+	  -DMSF_BUILD_FUZZ=ON -DMSF_WARNINGS_AS_ERRORS=OFF \
+	  -DCMAKE_CXX_FLAGS="-g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
+	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_all
+	python3 fuzz/make_corpus.py $(KITTI_DIR) $(FUZZ_BUILD_DIR)/seeds
+	@for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/findings/$$t; \
+	  echo "== fuzz_$$t: $(FUZZ_SECONDS) s"; \
+	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=65536 \
+	    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+	    -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$$t/ \
+	    $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/seeds/$$t 2>&1 | \
+	    tee $(FUZZ_BUILD_DIR)/fuzz_$$t.log | grep -E "^(#[0-9]+ *DONE|stat::number_of_executed_units|stat::average_exec_per_sec|==[0-9]+==ERROR|SUMMARY)" ; \
+	  test $${PIPESTATUS[0]} -eq 0 || { echo "fuzz_$$t found a crash: $(FUZZ_BUILD_DIR)/findings/$$t/"; exit 1; }; \
+	done
 
 demo: deps
 	$(MAKE) build
@@ -55,4 +113,4 @@ install: build
 	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
 
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(SANITIZE_BUILD_DIR) $(FUZZ_BUILD_DIR)

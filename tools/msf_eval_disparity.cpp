@@ -62,7 +62,11 @@ msf::DisparityEvaluation evaluateFiles(const std::string& gt_path, const std::st
                                    std::to_string(obj_map.rows) + " but ground truth '" + gt_path + "' is " +
                                    std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
   }
-  return msf::evaluateDisparity(gt, est, obj_map, options);
+  const msf::DisparityEvaluation e = msf::evaluateDisparity(gt, est, obj_map, options);
+  // A ground truth without a valid pixel scores nothing: D1 0.00 % would read as perfect.
+  if (e.all.gt_pixels == 0)
+    throw msf::InvalidInputError("ground truth '" + gt_path + "' has no valid pixel (every disparity is 0)");
+  return e;
 }
 
 bool isDirectory(const std::string& path) {

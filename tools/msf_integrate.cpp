@@ -26,7 +26,7 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-poses", "-o", "-voxel", "-trunc", "-lambda", "-sweeps", "-weighting",
+const std::vector<std::string> kValueOptions = {"-poses", "-o", "-voxel", "-trunc", "-max_memory", "-lambda", "-sweeps", "-weighting",
                                                 "-max_weight", "-max_depth", "-calib", "-input_dir", "-frames", "-config"};
 const std::vector<std::string> kSwitches = {"-carving", "-no_carving", "-print_config"};
 
@@ -43,6 +43,7 @@ void printHelp(const char* name) {
   print_info("    -voxel M            voxel size in metres (default "); print_value("0.1"); print_info(")\n");
   print_info("    -trunc M            truncation distance in metres (default "); print_value("0.3"); print_info(")\n");
   print_info("    -lambda L           eq. 7 regularization (default "); print_value("0"); print_info(", the paper's KITTI value is 5)\n");
+  print_info("    -max_memory MB      memory budget of the volume (tsdf_volume.max_memory_mb; default 0: 3/4 of RAM)\n");
   print_info("    -sweeps N           Gauss-Seidel sweeps per frame (default "); print_value("1"); print_info(")\n");
   const msf::TsdfIntegrator::Config defaults; // the help says what the code does
   print_info("    -weighting W        constant | inverse_square | per_pixel (default ");
@@ -101,6 +102,7 @@ int run(int argc, char** argv) {
   }
   msf::tool::parseArgument(argc, argv, "-voxel", volume_config.voxel_size_m);
   msf::tool::parseArgument(argc, argv, "-trunc", volume_config.truncation_m);
+  msf::tool::parseArgument(argc, argv, "-max_memory", volume_config.max_memory_mb);
   msf::tool::parseArgument(argc, argv, "-lambda", config.lambda);
   msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
   msf::tool::parseArgument(argc, argv, "-max_weight", config.max_weight);

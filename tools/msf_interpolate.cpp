@@ -144,7 +144,15 @@ int main(int argc, char** argv) {
         filter.filter(dense);
       }
     }
-    msf::tool::printDone(watch.getTime(), countValid(dense));
+    const std::size_t valid = countValid(dense);
+    msf::tool::printDone(watch.getTime(), valid);
+    // As msf_project: an empty or all-NaN input (or a scan none of whose returns lands in
+    // the camera) is an error, not an empty cloud written with exit code 0.
+    if (valid == 0)
+      throw msf::InvalidInputError("no depth of '" + in + "' lands in the image" +
+                                   (is_scan ? " of camera " + std::to_string(projection.camera) +
+                                                  ": wrong calibration or scan?"
+                                            : ": the cloud has no finite point"));
 
     watch.reset();
     print_highlight("Saving ");

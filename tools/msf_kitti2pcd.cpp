@@ -82,8 +82,28 @@ int main(int argc, char** argv) {
       if (scans.empty())
         throw msf::IOError("input folder '" + input_dir + "' has no .bin scan");
       std::sort(scans.begin(), scans.end());
+      // The batch is a unit: a truncated scan is found before anything is written, and a
+      // failure later removes the clouds this run wrote.
       for (const auto& scan : scans)
-        convert(scan.string(), (fs::path(output_dir) / (scan.stem().string() + ".pcd")).string(), ascii);
+        if (fs::file_size(scan) % 16 != 0)
+          throw msf::IOError("scan '" + scan.string() + "' has " + std::to_string(fs::file_size(scan)) +
+                             " bytes, not a multiple of 16 (float32 x, y, z, reflectance): truncated or not a "
+                             "KITTI .bin; nothing was converted");
+      std::vector<fs::path> written;
+      try {
+        for (const auto& scan : scans) {
+          const fs::path out = fs::path(output_dir) / (scan.stem().string() + ".pcd");
+          const bool existed = fs::exists(out);
+          convert(scan.string(), out.string(), ascii);
+          if (!existed)
+            written.push_back(out);
+        }
+      } catch (...) {
+        std::error_code ec;
+        for (const auto& f : written)
+          fs::remove(f, ec);
+        throw;
+      }
       print_info("converted %zu scans\n", scans.size());
       return 0;
     }

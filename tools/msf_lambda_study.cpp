@@ -45,7 +45,6 @@ int run(int argc, char** argv) {
     printHelp(argv[0]);
     throw msf::InvalidInputError("need -o DIR");
   }
-  msf::ensureOutputDirectory(out_dir);
   msf::LambdaStudy::Config config;
   std::string config_path;
   if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0)
@@ -54,7 +53,8 @@ int run(int argc, char** argv) {
   msf::tool::parseArgument(argc, argv, "-voxel", config.voxel_size_m);
   msf::tool::parseArgument(argc, argv, "-trunc", config.truncation_m);
   msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
-  const msf::LambdaStudy study(config);
+  const msf::LambdaStudy study(config); // validates: a bad value leaves no output folder
+  msf::ensureOutputDirectory(out_dir);
   config.print(std::cout);
 
   std::vector<msf::LambdaStudy::Cell> cells;

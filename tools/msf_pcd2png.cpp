@@ -69,12 +69,22 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Saving ");
     print_value("%s ", files[1].c_str());
+    // The KITTI PNG holds value x 256 in 16 bits: larger values saturate at 255.996, said.
+    const auto warnSaturated = [&](const cv::Mat& values, const char* what) {
+      const int n = cv::countNonZero(values >= 65535.5f / 256.f);
+      if (n > 0)
+        print_warn("%d pixel%s of the %s beyond the format's largest value (255.996) saturate\n", n, n > 1 ? "s" : "",
+                   what);
+    };
     if (disparity) {
       const msf::Calibration calibration = msf::loadCalibration(calib_path);
-      msf::writeKittiDisparityPng(files[1], msf::depthToDisparity(depth, calibration));
+      const cv::Mat d = msf::depthToDisparity(depth, calibration);
+      warnSaturated(d, "disparity");
+      msf::writeKittiDisparityPng(files[1], d);
     } else if (colour) {
       msf::writeImage(files[1], msf::colorizeDepth(depth, static_cast<float>(range_min), static_cast<float>(range_max)));
     } else {
+      warnSaturated(depth, "depth");
       msf::writeKittiDepthPng(files[1], depth);
     }
     msf::tool::printDone(tt.toc(), static_cast<std::size_t>(cv::countNonZero(depth)));

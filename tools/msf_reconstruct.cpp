@@ -41,12 +41,20 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>     // AT_FDCWD
+#include <signal.h>    // kill
+#include <stdio.h>     // renameat2, RENAME_EXCHANGE
 #include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace pcl::console;
 
 namespace {
+
+constexpr int kMaxPanels = 100;
 
 std::atomic<bool> g_stop{false};
 
@@ -74,12 +82,13 @@ void printHelp(const char* name) {
              "                   | a KITTI poses file, line i for frame i. OUT/poses.txt holds the poses used\n");
   print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
   print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
-  print_info("    -panels N      depth panels to draw, spread over the frames (default 3)\n");
+  print_info("    -panels N      depth panels to draw, spread over the frames (default 3, at most 100)\n");
   print_info("    -stream R      keep only R metres around the camera in memory (streaming.active_radius_m;\n"
              "                   at least the integrator's max_depth_m + truncation + 2 m + a tile): the rest\n"
              "                   is meshed into OUT/tiles/X_Y_Z.ply and its TSDF written to OUT/tsdf/ as it\n"
              "                   leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview;\n"
              "                   msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md\n");
+  print_info("    -max_memory MB memory budget of the volume (tsdf_volume.max_memory_mb; 0: 3/4 of RAM)\n");
   print_info("    -save_depth    also write each frame's fused depth as OUT/depth/NNNNNN.pcd\n");
   print_info("    -holdout       evaluation protocol 4: the held-out rings (config section rings) are removed\n"
              "                   from every scan before the pipeline sees it and become the ground truth; the\n"
@@ -182,7 +191,9 @@ struct SourceMap {
   msf::TsdfIntegrator integrator;
   msf::TriangleMesh mesh;
   SourceMap(msf::DepthSource s, const msf::PipelineConfig& config)
-      : source(s), volume(config.volume.voxel_size_m, config.volume.truncation_m), integrator(volume, config.integrator) {}
+      : source(s), volume(config.volume.voxel_size_m, config.volume.truncation_m), integrator(volume, config.integrator) {
+    volume.setMaxMemoryMb(config.volume.max_memory_mb);
+  }
   std::string name() const { return std::string("mesh_") + msf::toString(source); }
 };
 
@@ -255,24 +266,96 @@ std::string generateDefaultStreet(const std::string& dir) {
   return dir;
 }
 
-/// Removes the output folder when this run created it and did not finish: a failed run
-/// leaves nothing behind.
-class OutputFolder {
+/// The run's outputs as a unit: everything is written into a hidden folder beside OUT
+/// (.NAME.partial.PID) that replaces OUT by one rename at the end (an atomic exchange when
+/// OUT exists), so a failed or killed run leaves OUT as it was, never a mix of two runs'
+/// files. A failed run removes its folder; a killed one's is removed by the next run.
+class StagedOutput {
 public:
-  explicit OutputFolder(const std::string& path) : path_(path), created_(!fs::exists(path)) {
-    msf::ensureOutputDirectory(path);
+  explicit StagedOutput(const std::string& path) : final_(fs::absolute(path).lexically_normal()) {
+    if (final_.filename().empty())
+      final_ = final_.parent_path();
+    const fs::path parent = final_.parent_path();
+    msf::requireDirectory(parent.string(), "parent folder of the output folder '" + path + "'");
+    std::error_code ec;
+    if (fs::exists(final_, ec)) {
+      if (!fs::is_directory(final_, ec))
+        throw msf::IOError("output '" + path + "' exists and is not a folder");
+      // The folder is replaced as a whole: only a previous run's files may be in it.
+      for (const auto& e : fs::directory_iterator(final_)) {
+        const std::string name = e.path().filename().string();
+        if (!isRunOutput(name, e.is_directory()))
+          throw msf::IOError("output folder '" + path + "' holds '" + name +
+                             "', which no msf_reconstruct run writes: the run replaces the folder as a whole; "
+                             "choose a new or empty folder");
+      }
+    }
+    removeStale(parent);
+    staging_ = parent / (prefix() + std::to_string(::getpid()));
+    fs::remove_all(staging_, ec);
+    if (!fs::create_directory(staging_, ec))
+      throw msf::IOError("cannot create '" + staging_.string() + "': " + ec.message());
   }
-  ~OutputFolder() {
-    if (created_ && !kept_) {
-      std::error_code e;
-      fs::remove_all(path_, e);
+  ~StagedOutput() {
+    std::error_code e;
+    fs::remove_all(staging_, e);
+  }
+  StagedOutput(const StagedOutput&) = delete;
+  StagedOutput& operator=(const StagedOutput&) = delete;
+
+  /// Where the run writes.
+  const fs::path& dir() const { return staging_; }
+
+  /// Puts the outputs in place: OUT becomes the staging folder in one rename.
+  void commit() {
+    std::error_code ec;
+    if (fs::exists(final_, ec)) {
+      if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, final_.c_str(), RENAME_EXCHANGE) != 0)
+        throw msf::IOError("cannot replace '" + final_.string() + "' by '" + staging_.string() +
+                           "': " + std::strerror(errno));
+      // staging_ now holds the previous run's files; the destructor removes them.
+    } else {
+      fs::rename(staging_, final_, ec);
+      if (ec)
+        throw msf::IOError("cannot rename '" + staging_.string() + "' to '" + final_.string() + "': " + ec.message());
     }
   }
-  void keep() { kept_ = true; }
 
 private:
-  std::string path_;
-  bool created_, kept_ = false;
+  std::string prefix() const { return "." + final_.filename().string() + ".partial."; }
+
+  /// Names a run writes (and the hidden temporaries of its atomic writes).
+  static bool isRunOutput(const std::string& name, bool directory) {
+    if (directory)
+      return name == "depth" || name == "tiles" || name == "tsdf"; // -save_depth, -stream
+    if (!name.empty() && name[0] == '.')
+      return name.find(".tmp") != std::string::npos;
+    const std::string ext = msf::fileExtension(name);
+    return ext == ".ply" || ext == ".pcd" || ext == ".json" || ext == ".md" || ext == ".csv" || ext == ".png" ||
+           ext == ".yaml" || ext == ".txt"; // poses.txt
+  }
+
+  /// Staging folders of this OUT left by killed runs (their process is gone).
+  void removeStale(const fs::path& parent) const {
+    std::error_code ec;
+    const std::string p = prefix();
+    for (const auto& e : fs::directory_iterator(parent, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(p, 0) != 0)
+        continue;
+      const std::string pid_text = name.substr(p.size());
+      char* end = nullptr;
+      const long pid = std::strtol(pid_text.c_str(), &end, 10);
+      if (end == pid_text.c_str() || *end != '\0' || pid <= 0)
+        continue;
+      if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+        std::error_code rm;
+        fs::remove_all(e.path(), rm);
+      }
+    }
+  }
+
+  fs::path final_, staging_;
 };
 
 /// The console's protocol 4 table: per source, coverage, D1 (missing = bad) and MAE within
@@ -302,8 +385,8 @@ constexpr double kGhostDistanceM = 0.2; // farther than this from the static sur
 
 int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
-    const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",
-                                                 "-lambda", "-panels", "-poses",  "-stream"};
+    const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",    "-lambda",
+                                                 "-panels", "-poses",  "-stream", "-max_memory"};
     msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() > 1) {
@@ -331,7 +414,10 @@ int main(int argc, char** argv) {
       msf::tool::parseArgument(argc, argv, "-lambda", config.integrator.lambda);
     if (find_argument(argc, argv, "-stream") >= 0)
       msf::tool::parseArgument(argc, argv, "-stream", config.streaming.active_radius_m);
+    msf::tool::parseArgument(argc, argv, "-max_memory", config.volume.max_memory_mb);
     config.validate();
+    if (panels < 0 || panels > kMaxPanels)
+      throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " + std::to_string(panels));
     const bool streaming = config.streaming.enabled();
     if (streaming && (holdout || compare_sources))
       throw msf::InvalidInputError(std::string(holdout ? "-holdout" : "-compare_sources") +
@@ -339,7 +425,8 @@ int main(int argc, char** argv) {
                                    "streaming.active_radius_m)");
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 
-    OutputFolder output(out);
+    StagedOutput output(out);
+    const std::string stage = output.dir().string(); // where this run writes; `out` at the end
 
     // The dataset, or the default synthetic street in a temporary folder removed at the end.
     std::string dataset;
@@ -362,6 +449,9 @@ int main(int argc, char** argv) {
     const std::vector<std::size_t> frames = sequence.indices(range);
     msf::PoseSource poses(poses_option, sequence, frames, config.odometry);
     const msf::Calibration& calibration = sequence.calibration();
+    if (!fs::is_directory(fs::path(sequence.imagePath(2, frames.front())).parent_path()))
+      print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
+                 sequence.directory().c_str());
     const msf::HoldoutConfig holdout_config{config.rings, config.projection, {}};
     if (holdout) {
       // The first frame's split, before any work: a scan without rings is a clear error at once.
@@ -369,7 +459,7 @@ int main(int argc, char** argv) {
       holdOutRings(first, sequence, holdout_config);
     }
     if (save_depth)
-      fs::create_directories(fs::path(out) / "depth");
+      fs::create_directories(fs::path(stage) / "depth");
 
     msf::RunReport report;
     report.dataset = sequence.directory();
@@ -415,7 +505,7 @@ int main(int argc, char** argv) {
 
     msf::Pipeline pipeline(calibration, config);
     if (streaming)
-      pipeline.setStreamingDirectory(out);
+      pipeline.setStreamingDirectory(stage);
     const std::set<std::size_t> panel_frames = spread(frames, panels);
     pipeline.setKeepSparse(!panel_frames.empty()); // the panels show the projected scan
     PendingTruth heldout_truth;
@@ -456,7 +546,7 @@ int main(int argc, char** argv) {
             map->integrator.integrate(
                 msf::sourceDepthFrame(r, map->source, config.fusion, calibration.focalBaseline()), r.T_world_cam0);
           if (save_depth)
-            msf::saveCloud((fs::path(out) / "depth" / (r.name + ".pcd")).string(), fusedCloud(r.fused, calibration));
+            msf::saveCloud((fs::path(stage) / "depth" / (r.name + ".pcd")).string(), fusedCloud(r.fused, calibration));
           if (panel_frames.count(r.index)) {
             const cv::Mat& fused = r.fused.depth;
             msf::DepthPanel panel;
@@ -469,7 +559,7 @@ int main(int argc, char** argv) {
             if (scores.truth)
               panel.addError("|fused - ground truth|", fused, synthetic_depth, 2.f);
             const std::string name = "depth_" + r.name + ".png";
-            msf::writeImage((fs::path(out) / name).string(), panel.render());
+            msf::writeImage((fs::path(stage) / name).string(), panel.render());
             report.depth_panels.push_back(name);
           }
           progress.frame(r, report.frames.size());
@@ -491,7 +581,7 @@ int main(int argc, char** argv) {
     report.volume_memory_mb = static_cast<double>(pipeline.volume().memoryBytes()) / (1024.0 * 1024.0);
     msf::TriangleMesh streamed;
     const std::size_t streamed_triangles =
-        streaming ? pipeline.finishStreaming((fs::path(out) / report.mesh_file).string()) : 0;
+        streaming ? pipeline.finishStreaming((fs::path(stage) / report.mesh_file).string()) : 0;
     const msf::TriangleMesh& mesh = streaming ? streamed : pipeline.updateMesh();
     report.mesh_ms = tt.toc();
     msf::tool::printDone(report.mesh_ms, streaming ? streamed_triangles : mesh.triangles.size());
@@ -521,8 +611,8 @@ int main(int argc, char** argv) {
       if (streamed_triangles == 0)
         print_warn("\nno surface was reconstructed: mesh.ply is not written\n");
     } else if (!mesh.triangles.empty()) {
-      msf::saveMesh((fs::path(out) / report.mesh_file).string(), polygon_mesh);
-      pipeline.volume().save((fs::path(out) / report.volume_file).string());
+      msf::saveMesh((fs::path(stage) / report.mesh_file).string(), polygon_mesh);
+      pipeline.volume().save((fs::path(stage) / report.volume_file).string());
     } else {
       print_warn("\nno surface was reconstructed: mesh.ply and volume.pcd are not written\n");
     }
@@ -530,9 +620,9 @@ int main(int argc, char** argv) {
     for (const auto& map : source_maps)
       if (!map->mesh.triangles.empty()) {
         map->mesh.toPolygonMesh(source_polygons[map->name()]);
-        msf::saveMesh((fs::path(out) / (map->name() + ".ply")).string(), source_polygons[map->name()]);
+        msf::saveMesh((fs::path(stage) / (map->name() + ".ply")).string(), source_polygons[map->name()]);
       }
-    msf::writeAtomically((fs::path(out) / report.config_file).string(), [&](const std::string& tmp) {
+    msf::writeAtomically((fs::path(stage) / report.config_file).string(), [&](const std::string& tmp) {
       std::ofstream file(tmp);
       file << report.config_yaml;
       if (!file)
@@ -551,7 +641,7 @@ int main(int argc, char** argv) {
       cv::Mat preview;
       cv::vconcat(above, camera, preview);
       report.preview_file = "mesh_preview.png";
-      msf::writeImage((fs::path(out) / report.preview_file).string(), preview);
+      msf::writeImage((fs::path(stage) / report.preview_file).string(), preview);
     }
 
     // The meshes against the true surface (synthetic), each as the fused one.
@@ -641,7 +731,7 @@ int main(int argc, char** argv) {
 
     report.pose_ms = poses.estimateMs();
     if (!used_poses.empty()) {
-      msf::saveOdometryPoses((fs::path(out) / report.poses_file).string(), used_poses);
+      msf::saveOdometryPoses((fs::path(stage) / report.poses_file).string(), used_poses);
       // Short names: the legend beside the plot is narrow.
       const char* used_name = poses.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
                               : poses.kind() == msf::PoseSource::Kind::File    ? "poses file"
@@ -659,16 +749,16 @@ int main(int argc, char** argv) {
         }
       }
       report.trajectory_plot_file = "trajectory.png";
-      msf::writeImage((fs::path(out) / report.trajectory_plot_file).string(),
+      msf::writeImage((fs::path(stage) / report.trajectory_plot_file).string(),
                       msf::plotTrajectoriesFromAbove(trajectories));
     }
     report.peak_memory_mb = msf::peakMemoryMb();
-    report.writeFramesCsv((fs::path(out) / "frames.csv").string());
+    report.writeFramesCsv((fs::path(stage) / "frames.csv").string());
     if (!report.frames.empty())
-      report.writeRuntimePlot((fs::path(out) / "runtime.png").string());
-    report.writeSummaryJson((fs::path(out) / "summary.json").string());
-    report.writeMarkdown((fs::path(out) / "report.md").string());
-    output.keep();
+      report.writeRuntimePlot((fs::path(stage) / "runtime.png").string());
+    report.writeSummaryJson((fs::path(stage) / "summary.json").string());
+    report.writeMarkdown((fs::path(stage) / "report.md").string());
+    output.commit();
 
     print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
     print_value("%.1f fps", report.framesPerSecond());
@@ -685,6 +775,9 @@ int main(int argc, char** argv) {
       printMapEvaluation(report.map_evaluation);
     print_info("Report: ");
     print_value("%s/report.md\n", out.c_str());
+    if (report.triangles == 0 && !stats.interrupted)
+      throw msf::InvalidInputError("no surface was reconstructed from " + std::to_string(report.frames.size()) +
+                                   " frames (no mesh.ply): see " + out + "/report.md");
     return stats.interrupted ? 130 : 0;
   });
 }

@@ -55,6 +55,14 @@ void printHelp(const char* name) {
 void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& guidance) {
   pcl::PCLPointCloud2 blob;
   msf::loadCloudBlob(path, blob);
+  // PCL fills a missing field with zeros and only warns: a prior without x y z is no prior.
+  for (const char* field : {"x", "y", "z"})
+    if (pcl::getFieldIndex(blob, field) < 0)
+      throw msf::InvalidInputError("-prior '" + path + "' has no field '" + field +
+                                   "' (an organized depth cloud, as msf_interpolate writes)");
+  if (blob.height <= 1)
+    throw msf::InvalidInputError("-prior '" + path + "' is not organized (" + std::to_string(blob.width) + "x" +
+                                 std::to_string(blob.height) + "): it must be the image's size");
   if (!guided || pcl::getFieldIndex(blob, "distance") < 0) {
     if (guided)
       print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
@@ -144,6 +152,8 @@ int main(int argc, char** argv) {
       valid += std::isfinite(p.z);
     print_value("(%d disparities) ", stereo.getSearchedDisparities());
     msf::tool::printDone(tt.toc(), valid);
+    if (valid == 0)
+      print_warn("no pixel was matched: check the images (a rectified left/right pair?) and the disparity range\n");
 
     tt.tic();
     print_highlight("Saving ");

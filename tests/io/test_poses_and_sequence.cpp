@@ -49,7 +49,7 @@ TEST(Poses, RoundTripAndMalformedLine) {
       msf::loadOdometryPoses(dir.file("scaled.txt"));
       FAIL() << "expected IOError for " << matrix;
     } catch (const msf::IOError& e) {
-      EXPECT_NE(std::string(e.what()).find("line 2: not a rigid motion"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("line 2 is not a rigid transform"), std::string::npos) << e.what();
     }
   }
 }

@@ -122,7 +122,7 @@ TEST_F(PipelineTest, BadPoseFilesAreClearErrors) {
   EXPECT_FALSE(fs::exists(dir.file("out")));
   r = msf::test::runTool("msf_reconstruct",
                          dataset() + " -poses " + dir.file("scaled.txt") + " -panels 0 -o " + dir.file("out"));
-  expectToolError(r, "msf_reconstruct", "not a rigid motion");
+  expectToolError(r, "msf_reconstruct", "is not a rigid transform");
   expectToolError(msf::test::runTool("msf_odometry", dataset()), "msf_odometry", "-o poses.txt");
 }
 

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <random>
 
 namespace msf::test {
@@ -47,6 +48,23 @@ inline SyntheticPair makeSyntheticPair(cv::Size size, float background_px, float
   // A second texture for the square, so its edges are real depth edges.
   cv::Mat texture2 = texture.clone();
   cv::randu(texture2, 0, 256);
+  // The right view reads up to column u + d + margin: the textures get d + 1 more columns.
+  // They hold the start of the next row, which is what the reads past a row's end used to
+  // see (so the images the tests were tuned on do not change); the last row's, which read
+  // past the buffer (ASan: heap-buffer-overflow), are new texture.
+  const int reach = static_cast<int>(std::max(background_px, square_px)) + 1;
+  auto widen = [&](const cv::Mat& narrow) {
+    cv::Mat wide(narrow.rows, narrow.cols + reach, CV_8UC1);
+    narrow.copyTo(wide.colRange(0, narrow.cols));
+    for (int v = 0; v < narrow.rows; ++v)
+      for (int k = 0; k < reach; ++k)
+        wide.at<std::uint8_t>(v, narrow.cols + k) =
+            v + 1 < narrow.rows && k < narrow.cols ? narrow.at<std::uint8_t>(v + 1, k)
+                                                   : static_cast<std::uint8_t>(grey(rng));
+    return wide;
+  };
+  texture = widen(texture);
+  texture2 = widen(texture2);
   SyntheticPair pair;
   pair.square = cv::Rect(size.width / 2, size.height / 4, size.width / 4, size.height / 2);
   pair.left.create(size, CV_8UC1);

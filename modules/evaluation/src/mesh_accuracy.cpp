@@ -44,7 +44,9 @@ Eigen::Vector3f closestOnTriangle(const Eigen::Vector3f& p, const Eigen::Vector3
 void meshArrays(const pcl::PolygonMesh& mesh, std::vector<Eigen::Vector3f>& vertices,
                 std::vector<std::array<std::uint32_t, 3>>& triangles) {
   pcl::PointCloud<pcl::PointXYZ> cloud;
-  pcl::fromPCLPointCloud2(mesh.cloud, cloud);
+  // PCL indexes data[0] of an empty cloud (UBSan: reference binding to null pointer).
+  if (!mesh.cloud.data.empty())
+    pcl::fromPCLPointCloud2(mesh.cloud, cloud);
   vertices.resize(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i)
     vertices[i] = cloud[i].getVector3fMap();

@@ -1,11 +1,13 @@
 #include <msf/common/atomic_file.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/calibration.h>
 #include <msf/io/image_io.h>
 
 #include <opencv2/core/persistence.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -61,28 +63,38 @@ public:
       key.erase(key.find_last_not_of(" \t\r") + 1);
       std::istringstream values(line.substr(colon + 1));
       std::vector<double> numbers;
-      std::string token;
-      bool numeric = true;
+      std::string token, bad;
       while (values >> token) {
         try {
           std::size_t used = 0;
           numbers.push_back(std::stod(token, &used));
-          numeric = numeric && used == token.size();
+          if (used != token.size() && bad.empty())
+            bad = token;
         } catch (const std::exception&) {
-          numeric = false;
+          if (bad.empty())
+            bad = token;
         }
       }
-      if (numeric)
+      // A line that is not numbers (a date, a comment) is kept as such: asking for its key
+      // names the value at fault, not a missing key.
+      if (bad.empty())
         entries_[key] = numbers;
+      else
+        not_numeric_[key] = bad;
     }
   }
 
-  bool has(const std::string& key) const { return entries_.count(key) > 0; }
+  bool has(const std::string& key) const { return entries_.count(key) > 0 || not_numeric_.count(key) > 0; }
 
   std::vector<double> get(const std::string& key, std::size_t count) const {
     const auto it = entries_.find(key);
-    if (it == entries_.end())
+    if (it == entries_.end()) {
+      const auto bad = not_numeric_.find(key);
+      if (bad != not_numeric_.end())
+        throw CalibrationError("calibration '" + path_ + "': key '" + key + "' has a value that is not a number: '" +
+                               bad->second + "'");
       throw CalibrationError("calibration '" + path_ + "' has no key '" + key + "'");
+    }
     if (it->second.size() != count)
       throw CalibrationError("calibration '" + path_ + "': key '" + key + "' has " +
                              std::to_string(it->second.size()) + " values, expected " +
@@ -131,6 +143,7 @@ public:
 private:
   std::string path_;
   std::map<std::string, std::vector<double>> entries_;
+  std::map<std::string, std::string> not_numeric_; ///< key -> its first value that is not a number
 };
 
 cv::Size imageSizeOf(const fs::path& image) {
@@ -185,6 +198,8 @@ Calibration fromRawDateFolder(const fs::path& date_dir) {
   for (int i = 0; i < 4; ++i)
     c.P[i] = cam.projection("P_rect_0" + std::to_string(i));
   const auto size = cam.get("S_rect_00", 2);
+  if (!(size[0] >= 1 && size[0] <= limits::kMaxImageSide && size[1] >= 1 && size[1] <= limits::kMaxImageSide))
+    limits::checkImageSize(-1, -1, "calibration '" + cam.path() + "': key 'S_rect_00'");
   c.image_size = cv::Size(static_cast<int>(size[0]), static_cast<int>(size[1]));
   Eigen::Isometry3d R_rect = Eigen::Isometry3d::Identity();
   R_rect.linear() = cam.rotation("R_rect_00");
@@ -197,22 +212,31 @@ Calibration fromRawDateFolder(const fs::path& date_dir) {
   return c;
 }
 
-Calibration::Projection readProjectionYaml(const cv::FileStorage& fs_in, const std::string& key,
-                                           const std::string& path) {
-  cv::Mat m;
-  fs_in[key] >> m;
-  if (m.empty())
+/// An opencv-matrix of `rows` x `cols`, as doubles. Its rows, cols and number of values are
+/// checked before OpenCV reads it: OpenCV allocates rows x cols first ("cols: ....4" asked
+/// for 48 GB, found by fuzz/fuzz_calibration).
+cv::Mat readMatrixYaml(const cv::FileStorage& in, const std::string& key, int rows, int cols, const std::string& path) {
+  const cv::FileNode node = in[key];
+  if (node.empty())
     throw CalibrationError("calibration '" + path + "' has no key '" + key + "'");
-  if (m.rows != 3 || m.cols != 4)
-    throw CalibrationError("calibration '" + path + "': key '" + key + "' is " + std::to_string(m.rows) +
-                           "x" + std::to_string(m.cols) + ", expected 3x4");
+  const auto count = [](const cv::FileNode& n) { return n.isInt() ? static_cast<int>(n) : -1; };
+  const int r = node.isMap() ? count(node["rows"]) : -1, c = node.isMap() ? count(node["cols"]) : -1;
+  if (r != rows || c != cols)
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' is " +
+                           (r < 0 || c < 0 ? std::string("not a matrix with integer rows and cols")
+                                           : std::to_string(r) + "x" + std::to_string(c)) +
+                           ", expected " + std::to_string(rows) + "x" + std::to_string(cols));
+  const cv::FileNode data = node["data"];
+  if (!data.isSeq() || data.size() != static_cast<std::size_t>(rows) * cols)
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' needs " + std::to_string(rows * cols) +
+                           " values in 'data'");
+  cv::Mat m;
+  node >> m;
   m.convertTo(m, CV_64F);
-  Calibration::Projection P;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c)
-      P(r, c) = m.at<double>(r, c);
-  return P;
+  return m;
 }
+
+Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path);
 
 Calibration fromYaml(const std::string& path) {
   cv::FileStorage in;
@@ -220,26 +244,43 @@ Calibration fromYaml(const std::string& path) {
     in.open(path, cv::FileStorage::READ);
   } catch (const cv::Exception& e) {
     throw IOError("calibration '" + path + "' is not valid YAML: " + e.err);
+  } catch (const std::exception& e) {
+    // OpenCV's parser also throws std::length_error on some malformed files (fuzz/fuzz_calibration).
+    throw IOError("calibration '" + path + "' is not valid YAML: " + e.what());
   }
   if (!in.isOpened())
     throw IOError("calibration '" + path + "' cannot be opened");
+  try {
+    return fromYamlNodes(in, path);
+  } catch (const Error&) {
+    throw;
+  } catch (const cv::Exception& e) {
+    // OpenCV asserts on a matrix whose data does not match rows x cols (fuzz/fuzz_calibration).
+    throw CalibrationError("calibration '" + path + "' is not a valid camera file: " + e.err);
+  } catch (const std::exception& e) {
+    throw CalibrationError("calibration '" + path + "' is not a valid camera file: " + e.what());
+  }
+}
+
+Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path) {
   Calibration c;
   c.source = path;
-  for (int i = 0; i < 4; ++i)
-    c.P[i] = readProjectionYaml(in, "P" + std::to_string(i), path);
+  for (int i = 0; i < 4; ++i) {
+    const cv::Mat P = readMatrixYaml(in, "P" + std::to_string(i), 3, 4, path);
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 4; ++col)
+        c.P[i](r, col) = P.at<double>(r, col);
+  }
   for (const char* key : {"image_width", "image_height"})
     if (in[key].empty() || !in[key].isInt())
       throw CalibrationError("calibration '" + path + "' has no integer key '" + key + "'");
   c.image_size = cv::Size(static_cast<int>(in["image_width"]), static_cast<int>(in["image_height"]));
-  cv::Mat T;
-  in["T_cam0_velo"] >> T;
-  c.has_velodyne = !T.empty();
+  limits::checkImageSize(c.image_size.width, c.image_size.height,
+                         "calibration '" + path + "': keys 'image_width' and 'image_height'");
+  c.has_velodyne = !in["T_cam0_velo"].empty(); // camera-only: no LiDAR extrinsics
   if (!c.has_velodyne)
     return c;
-  if (T.rows != 4 || T.cols != 4)
-    throw CalibrationError("calibration '" + path + "': key 'T_cam0_velo' is " + std::to_string(T.rows) +
-                           "x" + std::to_string(T.cols) + ", expected 4x4");
-  T.convertTo(T, CV_64F);
+  const cv::Mat T = readMatrixYaml(in, "T_cam0_velo", 4, 4, path);
   for (int r = 0; r < 4; ++r)
     for (int col = 0; col < 4; ++col)
       c.T_cam0_velo.matrix()(r, col) = T.at<double>(r, col);
@@ -248,7 +289,8 @@ Calibration fromYaml(const std::string& path) {
 
 } // namespace
 
-Calibration loadCalibration(const std::string& path) {
+namespace {
+Calibration readCalibration(const std::string& path) {
   std::error_code ec;
   const fs::path p(path);
   if (!fs::exists(p, ec))
@@ -278,6 +320,49 @@ Calibration loadCalibration(const std::string& path) {
   throw CalibrationError("calibration '" + path +
                          "' is not a KITTI odometry, raw or object calibration (no key P0, P_rect_00 or R0_rect)");
 }
+} // namespace
+
+void Calibration::validate() const {
+  const std::string where = "calibration '" + source + "'";
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = "P" + std::to_string(i);
+    if (!P[i].allFinite())
+      throw CalibrationError(where + ": " + key + " has a value that is not finite (NaN or inf)");
+    if (!(fx(i) > 0.0 && fy(i) > 0.0))
+      throw CalibrationError(where + ": " + key + " has fx " + std::to_string(fx(i)) + " and fy " +
+                             std::to_string(fy(i)) + ": focal lengths must be > 0");
+    if (P[i].block<1, 3>(2, 0) != Eigen::RowVector3d(0, 0, 1))
+      throw CalibrationError(where + ": " + key + "'s third row must start 0 0 1 (a rectified camera)");
+    if (std::abs(P[i](0, 1)) > 1e-6 * fx(i) || std::abs(P[i](1, 0)) > 1e-6 * fx(i))
+      throw CalibrationError(where + ": " + key + " has a skew or rotation term (P(0,1), P(1,0) must be 0)");
+    if (!(cameraCenter(i).cwiseAbs().maxCoeff() <= limits::kMaxTranslationM))
+      throw CalibrationError(where + ": " + key + "'s camera centre is beyond " +
+                             std::to_string(limits::kMaxTranslationM) + " m");
+  }
+  if (image_size.width != 0 || image_size.height != 0)
+    limits::checkImageSize(image_size.width, image_size.height, where);
+  try {
+    limits::checkRigid(T_cam0_velo, where + ": the LiDAR-to-camera transform");
+    if (has_imu)
+      limits::checkRigid(T_velo_imu, where + ": the IMU-to-LiDAR transform");
+  } catch (const InvalidInputError& e) {
+    throw CalibrationError(e.what());
+  }
+}
+
+double Calibration::focalBaseline() const {
+  const double fb = fx(0) * baselineGrey();
+  if (!(fb > 0.0) || !std::isfinite(fb))
+    throw CalibrationError("calibration '" + source + "': the grey pair's focal length x baseline is " +
+                           std::to_string(fb) + " (P0 and P1 must have fx > 0 and different centres) ");
+  return fb;
+}
+
+Calibration loadCalibration(const std::string& path) {
+  Calibration c = readCalibration(path);
+  c.validate();
+  return c;
+}
 
 Calibration loadCalibration(const std::string& path, cv::Size image_size) {
   Calibration c = loadCalibration(path);
@@ -287,6 +372,7 @@ Calibration loadCalibration(const std::string& path, cv::Size image_size) {
     throw CalibrationError("image size " + std::to_string(image_size.width) + "x" + std::to_string(image_size.height) +
                            " given, but calibration '" + path + "' has " + std::to_string(c.image_size.width) + "x" +
                            std::to_string(c.image_size.height));
+  limits::checkImageSize(image_size.width, image_size.height, "the image size given");
   c.image_size = image_size;
   return c;
 }

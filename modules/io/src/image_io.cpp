@@ -1,19 +1,54 @@
 #include <msf/common/atomic_file.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/image_io.h>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
 
 namespace msf {
 
+namespace {
+/// Width and height from a PNG's IHDR chunk, or {0, 0} when the file is not a PNG: the size
+/// is checked before the decoder allocates it (a 30000x20000 PNG took 1.8 GB, then the
+/// matcher crashed on it).
+cv::Size pngSize(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char h[24] = {};
+  if (!in.read(reinterpret_cast<char*>(h), sizeof h))
+    return {0, 0};
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (std::memcmp(h, kSignature, 8) != 0 || std::memcmp(h + 12, "IHDR", 4) != 0)
+    return {0, 0};
+  auto be32 = [&](int at) {
+    return (std::uint32_t(h[at]) << 24) | (std::uint32_t(h[at + 1]) << 16) | (std::uint32_t(h[at + 2]) << 8) | h[at + 3];
+  };
+  const std::uint32_t w = be32(16), ht = be32(20);
+  return {static_cast<int>(std::min<std::uint32_t>(w, INT_MAX)), static_cast<int>(std::min<std::uint32_t>(ht, INT_MAX))};
+}
+} // namespace
+
 cv::Mat readImage(const std::string& path, int flags) {
   requireFile(path, "image");
-  cv::Mat image = cv::imread(path, flags);
+  const cv::Size header = pngSize(path);
+  if (header.width > 0 || header.height > 0)
+    limits::checkImageSize(header.width, header.height, "image '" + path + "'");
+  cv::Mat image;
+  try {
+    image = cv::imread(path, flags);
+  } catch (const cv::Exception& e) {
+    throw IOError("image '" + path + "' cannot be decoded: " + e.err);
+  }
   if (image.empty())
     throw IOError("image '" + path + "' cannot be decoded");
+  limits::checkImageSize(image.cols, image.rows, "image '" + path + "'");
   return image;
 }
 
@@ -52,9 +87,11 @@ void writeScaled16(const std::string& path, const cv::Mat& values, const char* w
     auto* o = out.ptr<std::uint16_t>(v);
     for (int u = 0; u < values.cols; ++u) {
       const float x = in[u];
-      // KITTI: 0 means no value, so tiny positives round up to the smallest step.
+      // KITTI: 0 means no value, so tiny positives round up to the smallest step; values
+      // beyond the format's 65535 / 256 saturate (clamped before the cast: lround of 1e30 x
+      // 256 is undefined, and gave 0.004).
       o[u] = (std::isfinite(x) && x > 0.f)
-                 ? static_cast<std::uint16_t>(std::clamp(std::lround(x * 256.0f), 1L, 65535L))
+                 ? static_cast<std::uint16_t>(std::lround(std::clamp(x * 256.0f, 1.0f, 65535.0f)))
                  : 0;
     }
   }

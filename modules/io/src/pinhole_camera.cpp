@@ -1,8 +1,11 @@
 #include <msf/io/impl/pinhole_camera.hpp>
+#include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace msf {
 
@@ -10,6 +13,8 @@ PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int
   if (camera < 0 || camera > 3)
     throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
   const cv::Size size = calibration.requireImageSize();
+  // Pixel indices (v * width + u, with a margin) are ints: the size is bounded first.
+  limits::checkImageSize(size.width, size.height, "calibration '" + calibration.source + "'");
   PinholeCamera c;
   c.fx = static_cast<float>(calibration.fx(camera));
   c.fy = static_cast<float>(calibration.fy(camera));
@@ -17,9 +22,10 @@ PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int
   c.cy = static_cast<float>(calibration.cy(camera));
   c.width = size.width;
   c.height = size.height;
-  if (!(c.fx > 0.f && c.fy > 0.f))
+  if (!(c.fx > 0.f && c.fy > 0.f) || !std::isfinite(c.fx) || !std::isfinite(c.fy) || !std::isfinite(c.cx) ||
+      !std::isfinite(c.cy))
     throw CalibrationError("calibration '" + calibration.source + "': camera " + std::to_string(camera) +
-                           " has a non-positive focal length");
+                           " has a focal length that is not > 0 and finite, or a NaN centre");
   return c;
 }
 

@@ -1,5 +1,6 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/poses.h>
 
 #include <algorithm>
@@ -25,24 +26,33 @@ PoseList loadOdometryPoses(const std::string& path) {
       continue;
     std::istringstream ss(line);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    const std::string where = "poses '" + path + "' line " + std::to_string(line_no);
     int n = 0;
-    double v;
-    while (ss >> v) {
+    std::string token;
+    while (ss >> token) {
+      // Token by token: ">> double" stops at "nan" or "1.0x" and the count was then wrong.
+      double v = 0.0;
+      std::size_t used = 0;
+      try {
+        v = std::stod(token, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != token.size())
+        throw IOError(where + ": value " + std::to_string(n + 1) + " '" + token + "' is not a number");
+      if (!std::isfinite(v))
+        throw IOError(where + ": value " + std::to_string(n + 1) + " '" + token + "' is not finite");
       if (n < 12)
         T.matrix()(n / 4, n % 4) = v;
       ++n;
     }
-    if (n != 12 || !ss.eof())
-      throw IOError("poses '" + path + "' line " + std::to_string(line_no) +
-                    ": expected 12 numbers (a 3x4 row-major matrix), got " + std::to_string(n));
-    // A scaled, sheared or mirrored matrix would pass on as a wrong trajectory: KITTI's
-    // files hold rotations to 1e-6; 1e-3 leaves room for files written with fewer digits.
-    const Eigen::Matrix3d R = T.linear();
-    const double off = (R * R.transpose() - Eigen::Matrix3d::Identity()).norm();
-    if (!T.matrix().allFinite() || !(off <= 1e-3) || R.determinant() < 0.0)
-      throw IOError("poses '" + path + "' line " + std::to_string(line_no) +
-                    ": not a rigid motion (|R R^T - I| = " + std::to_string(off) + ", det R = " +
-                    std::to_string(R.determinant()) + "); expected a rotation and a translation");
+    if (n != 12)
+      throw IOError(where + ": expected 12 numbers (a 3x4 row-major matrix), got " + std::to_string(n));
+    try {
+      limits::checkRigid(T, where);
+    } catch (const InvalidInputError& e) {
+      throw IOError(e.what());
+    }
     poses.push_back(T);
   }
   return poses;

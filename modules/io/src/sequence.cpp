@@ -139,6 +139,15 @@ Sequence::Sequence(const std::string& dir) {
   }
   if (frame_names_.empty())
     throw IOError("sequence '" + dir_ + "' has no frames (no images in camera 0's folder)");
+  // More right images or scans than frames is a damaged or mixed copy whose extra frames
+  // would be dropped without a word (a frame whose file is missing is named when it loads).
+  for (const auto& [folder, ext] : {std::pair<fs::path, const char*>{fs::path(imagePath(1, 0)).parent_path(), ".png"},
+                                    {fs::path(scanPath(0)).parent_path(), ".bin"}}) {
+    const std::size_t n = fs::is_directory(folder, ec) ? stemsIn(folder, ext).size() : 0;
+    if (n > frame_names_.size())
+      throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " images in camera 0's " +
+                    "folder but " + std::to_string(n) + " " + ext + " files in '" + folder.string() + "'");
+  }
   if (!poses_.empty() && poses_.size() < frame_names_.size())
     throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " frames but only " +
                   std::to_string(poses_.size()) + " poses");
@@ -186,8 +195,13 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
   std::future<cv::Mat> color;
   if (with_color && fs::exists(imagePath(2, i)))
     color = read(imagePath(2, i), cv::IMREAD_COLOR);
+  else if (with_color && fs::is_directory(fs::path(imagePath(2, i)).parent_path()))
+    throw IOError("frame " + frameName(i) + ": colour image '" + imagePath(2, i) +
+                  "' is missing (camera 2's folder holds other frames)");
   f.scan.reset(new pcl::PointCloud<pcl::PointXYZI>);
   loadVelodyneBin(scanPath(i), *f.scan);
+  if (f.scan->empty())
+    throw IOError("frame " + frameName(i) + ": scan '" + scanPath(i) + "' has no finite point");
   f.scan->header.frame_id = kVelodyneFrameId; // the stages carry its stamp into camera 0
   f.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, f.timestamp) * 1e6));
   f.scan->header.seq = static_cast<std::uint32_t>(i);
@@ -196,10 +210,13 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
   if (color.valid())
     f.color = color.get();
   const cv::Size size = calibration_.image_size;
-  if (f.left.size() != size || f.right.size() != size)
-    throw InvalidInputError("frame " + frameName(i) + ": image size " + std::to_string(f.left.cols) + "x" +
-                            std::to_string(f.left.rows) + " does not match the calibration's " +
-                            std::to_string(size.width) + "x" + std::to_string(size.height));
+  const std::pair<const cv::Mat*, int> images[] = {{&f.left, 0}, {&f.right, 1}, {&f.color, 2}};
+  for (const auto& [image, camera] : images)
+    if (!image->empty() && image->size() != size)
+      throw InvalidInputError("frame " + frameName(i) + ": image '" + imagePath(camera, i) + "' is " +
+                              std::to_string(image->cols) + "x" + std::to_string(image->rows) +
+                              ", not the calibration's " + std::to_string(size.width) + "x" +
+                              std::to_string(size.height));
   if (hasPoses()) {
     f.has_pose = true;
     f.T_world_cam0 = poses_[i];
@@ -208,14 +225,20 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
 }
 
 std::vector<std::size_t> Sequence::indices(const FrameRange& range) const {
-  const int last = range.last < 0 ? static_cast<int>(size()) - 1 : std::min(range.last, static_cast<int>(size()) - 1);
-  std::vector<std::size_t> out;
-  for (int i = range.first; i <= last; ++i)
-    out.push_back(static_cast<std::size_t>(i));
-  if (out.empty())
+  // A last frame beyond the sequence is an error, as in msf_integrate: clamping it ran
+  // fewer frames than asked without a word.
+  if (range.first >= static_cast<int>(size()))
     throw InvalidInputError("frame range " + std::to_string(range.first) + ":" +
                             (range.last < 0 ? std::string() : std::to_string(range.last)) + " selects no frame of '" +
                             dir_ + "' (" + std::to_string(size()) + " frames)");
+  if (range.last >= static_cast<int>(size()))
+    throw InvalidInputError("frame range " + std::to_string(range.first) + ":" + std::to_string(range.last) +
+                            " goes beyond the last frame of '" + dir_ + "' (" + std::to_string(size()) +
+                            " frames, 0:" + std::to_string(size() - 1) + ")");
+  const int last = range.last < 0 ? static_cast<int>(size()) - 1 : range.last;
+  std::vector<std::size_t> out;
+  for (int i = range.first; i <= last; ++i)
+    out.push_back(static_cast<std::size_t>(i)); // not empty: FrameRange::parse orders first <= last
   return out;
 }
 

@@ -42,6 +42,7 @@ Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
   calibration_.requireImageSize();
   stages_ = std::make_unique<Stages>(calibration_, config_);
   volume_ = std::make_unique<TsdfVolume>(config_.volume.voxel_size_m, config_.volume.truncation_m);
+  volume_->setMaxMemoryMb(config_.volume.max_memory_mb);
   integrator_ = std::make_unique<TsdfIntegrator>(*volume_, config_.integrator);
 
   stages_->stereo.setConfig(config_.stereo);

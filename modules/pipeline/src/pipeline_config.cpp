@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/pipeline/pipeline_config.h>
 
 #include <cmath>
@@ -10,20 +11,17 @@ namespace msf {
 void VolumeConfig::read(const cv::FileNode& node) {
   readKey(node, "voxel_size_m", voxel_size_m);
   readKey(node, "truncation_m", truncation_m);
+  readKey(node, "max_memory_mb", max_memory_mb);
   validate();
 }
 
-void VolumeConfig::validate() const {
-  if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
-    throw ConfigError("tsdf_volume.voxel_size_m must be > 0, got " + std::to_string(voxel_size_m));
-  if (!(truncation_m > 0.0) || !std::isfinite(truncation_m))
-    throw ConfigError("tsdf_volume.truncation_m must be > 0, got " + std::to_string(truncation_m));
-}
+void VolumeConfig::validate() const { TsdfVolume::validate(voxel_size_m, truncation_m, max_memory_mb); }
 
 void VolumeConfig::print(std::ostream& out) const {
   out << "tsdf_volume:\n"
       << "  voxel_size_m: " << configValue(voxel_size_m) << "\n"
-      << "  truncation_m: " << configValue(truncation_m) << "\n";
+      << "  truncation_m: " << configValue(truncation_m) << "\n"
+      << "  max_memory_mb: " << configValue(max_memory_mb) << "\n";
 }
 
 void SchedulingConfig::read(const cv::FileNode& node) {
@@ -39,8 +37,7 @@ void SchedulingConfig::validate() const {
     throw ConfigError("pipeline.queue_capacity must be >= 1, got " + std::to_string(queue_capacity));
   if (mesh_every_n_frames < 0)
     throw ConfigError("pipeline.mesh_every_n_frames must be >= 0, got " + std::to_string(mesh_every_n_frames));
-  if (lidar_threads < 0)
-    throw ConfigError("pipeline.lidar_threads must be >= 0, got " + std::to_string(lidar_threads));
+  limits::checkThreads(lidar_threads, "pipeline.lidar_threads");
 }
 
 void SchedulingConfig::print(std::ostream& out) const {

@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/common/vector_clones.h>
 #include <msf/range_image/depth_interpolator.h>
 
@@ -108,8 +109,7 @@ void InterpolationConfig::validate() const {
     fail("gaussian_sigma_px", "must be > 0");
   if (!(gaussian_min_weight > 0.f && gaussian_min_weight <= 1.f))
     fail("gaussian_min_weight", "must be in (0, 1]");
-  if (threads < 0)
-    fail("threads", "must be >= 0");
+  limits::checkThreads(threads, "interpolation.threads (-threads)");
 }
 
 DepthInterpolator::DepthInterpolator(const InterpolationConfig& config) { setConfig(config); }

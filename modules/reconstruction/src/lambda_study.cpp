@@ -1,6 +1,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/common/line_plot.h>
 #include <msf/reconstruction/lambda_study.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -67,8 +68,15 @@ void LambdaStudy::Config::print(std::ostream& out) const {
 LambdaStudy::LambdaStudy(const Config& config) : config_(config), scene_(scene()) {
   if (config.frames < 1)
     throw ConfigError("lambda_study.frames must be >= 1, got " + std::to_string(config.frames));
-  if (config.width < 2 || config.height < 2 || !(config.focal_px > 0))
-    throw ConfigError("lambda_study: width, height and focal_px must be positive");
+  if (config.frames > 10000)
+    throw ConfigError("lambda_study.frames must be at most 10000, got " + std::to_string(config.frames));
+  if (config.width < 2 || config.height < 2 || !(config.focal_px > 0) || !std::isfinite(config.focal_px) ||
+      config.width > limits::kMaxImageSide || config.height > limits::kMaxImageSide)
+    throw ConfigError("lambda_study: width and height must be 2.." + std::to_string(limits::kMaxImageSide) +
+                      " and focal_px positive");
+  if (config.sweeps < 0 || config.sweeps > TsdfIntegrator::Config::kMaxSweeps)
+    throw ConfigError("lambda_study.sweeps (-sweeps) must be 0.." + std::to_string(TsdfIntegrator::Config::kMaxSweeps) +
+                      ", got " + std::to_string(config.sweeps));
   for (const double s : config.noise_mm)
     if (!(s >= 0))
       throw ConfigError("lambda_study.noise_mm must be >= 0, got " + std::to_string(s));

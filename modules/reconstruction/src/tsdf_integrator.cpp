@@ -1,5 +1,6 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
@@ -202,8 +203,12 @@ void TsdfIntegrator::Config::validate() const {
     throw ConfigError("tsdf_integrator.plane_max_curvature must be >= 0, got " + std::to_string(plane.max_curvature));
   if (!(plane.min_scale > 0.f && plane.min_scale <= 1.f))
     throw ConfigError("tsdf_integrator.plane_min_scale must be in (0, 1], got " + std::to_string(plane.min_scale));
-  if (sweeps < 0)
-    throw ConfigError("tsdf_integrator.sweeps must be >= 0, got " + std::to_string(sweeps));
+  if (sweeps < 0 || sweeps > kMaxSweeps)
+    throw ConfigError("tsdf_integrator.sweeps (-sweeps) must be 0.." + std::to_string(kMaxSweeps) + ", got " +
+                      std::to_string(sweeps));
+  if (!(max_depth_m <= kMaxDepthM))
+    throw ConfigError("tsdf_integrator.max_depth_m must be at most " + std::to_string(kMaxDepthM) + " m, got " +
+                      std::to_string(max_depth_m));
   if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
     throw ConfigError("tsdf_integrator: need 0 <= min_depth_m < max_depth_m, got " + std::to_string(min_depth_m) +
                       " and " + std::to_string(max_depth_m));
@@ -246,10 +251,22 @@ void TsdfIntegrator::setLambda(double lambda) {
   setConfig(c);
 }
 
+void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
+  // Block keys hold 20 bits an axis (packKey), and voxel coordinates are ints: a camera
+  // whose band reaches beyond that would alias blocks, or overflow a float -> int cast.
+  const double reach_m = 0.99 * double(1 << 19) * TsdfBlock::kSide * volume_.voxelSize();
+  const double far_m = T_world_cam.translation().cwiseAbs().maxCoeff() + config_.max_depth_m + volume_.truncation();
+  if (!(far_m < reach_m))
+    throw InvalidInputError("the frame's pose (translation " + std::to_string(T_world_cam.translation().norm()) +
+                            " m) with max_depth_m reaches " + std::to_string(far_m) +
+                            " m from the origin, beyond the volume's " + std::to_string(reach_m) + " m at " +
+                            std::to_string(volume_.voxelSize()) + " m voxels");
+}
+
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
-  if (!T_world_cam.matrix().allFinite())
-    throw InvalidInputError("T_world_cam has a value that is not finite");
+  limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
+  checkReach(T_world_cam);
   stats_ = Stats();
   const auto t_start = Clock::now();
 
@@ -684,6 +701,9 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
                             std::to_string(points_world.size()) + " points");
   if (!origin_world.allFinite())
     throw InvalidInputError("integrateRays: the sensor origin is not finite");
+  Eigen::Isometry3d T_world_origin = Eigen::Isometry3d::Identity();
+  T_world_origin.translation() = origin_world;
+  checkReach(T_world_origin);
   stats_ = Stats();
   const auto t_start = Clock::now();
   const std::uint64_t stamp = volume_.beginGeneration();

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -50,22 +51,41 @@ constexpr std::size_t kBlocksPerChunk = kChunkBytes / sizeof(TsdfBlock);
 void TsdfVolume::Config::read(const cv::FileNode& node) {
   readKey(node, "voxel_size_m", voxel_size_m);
   readKey(node, "truncation_m", truncation_m);
-  if (!(voxel_size_m > 0.0) || !std::isfinite(voxel_size_m))
-    throw ConfigError("tsdf_volume.voxel_size_m must be > 0, got " + number(voxel_size_m));
-  if (!(truncation_m > 0.0) || !std::isfinite(truncation_m))
-    throw ConfigError("tsdf_volume.truncation_m must be > 0, got " + number(truncation_m));
+  readKey(node, "max_memory_mb", max_memory_mb);
+  validate(voxel_size_m, truncation_m, max_memory_mb);
+}
+
+void TsdfVolume::validate(double voxel_size_m, double truncation_m, double max_memory_mb) {
+  if (!(voxel_size_m >= kMinVoxelSizeM && voxel_size_m <= kMaxVoxelSizeM))
+    throw ConfigError("tsdf_volume.voxel_size_m (-voxel, the voxel size) must be " + number(kMinVoxelSizeM) + " .. " +
+                      number(kMaxVoxelSizeM) + " m, got " + number(voxel_size_m));
+  if (!(truncation_m > 0.0 && truncation_m <= kMaxTruncationVoxels * voxel_size_m))
+    throw ConfigError("tsdf_volume.truncation_m (-trunc) must be > 0 and at most " + number(kMaxTruncationVoxels) +
+                      " voxels (" + number(kMaxTruncationVoxels * voxel_size_m) + " m), got " + number(truncation_m));
+  if (!(max_memory_mb >= 0.0) || !std::isfinite(max_memory_mb))
+    throw ConfigError("tsdf_volume.max_memory_mb (-max_memory) must be >= 0 (0: three quarters of RAM), got " +
+                      number(max_memory_mb));
+}
+
+void TsdfVolume::setMaxMemoryMb(double max_memory_mb) {
+  validate(voxel_size_, truncation_, max_memory_mb);
+  if (max_memory_mb > 0.0) {
+    max_memory_bytes_ = static_cast<std::size_t>(std::min(max_memory_mb, 1e12) * 1024.0 * 1024.0);
+  } else {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    max_memory_bytes_ = pages > 0 && page > 0 ? static_cast<std::size_t>(pages) / 4 * 3 * static_cast<std::size_t>(page)
+                                              : std::size_t(8) << 30;
+  }
 }
 
 void TsdfVolume::Config::print(std::ostream& out) const {
-  out << "tsdf_volume:\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m << "\n";
+  out << "tsdf_volume:\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m
+      << "\n  max_memory_mb: " << max_memory_mb << "\n";
 }
 
 TsdfVolume::TsdfVolume(double voxel_size_m, double truncation_m)
     : voxel_size_(voxel_size_m), truncation_(truncation_m), id_(newVolumeId()) {
-  if (!std::isfinite(voxel_size_m) || voxel_size_m <= 0.0)
-    throw ConfigError("TSDF voxel size must be > 0 m, got " + number(voxel_size_m));
-  if (!std::isfinite(truncation_m) || truncation_m <= 0.0)
-    throw ConfigError("TSDF truncation distance must be > 0 m, got " + number(truncation_m));
+  setMaxMemoryMb(0.0);
 }
 
 std::size_t TsdfVolume::numObservedVoxels() const {
@@ -104,6 +124,19 @@ void TsdfVolume::grow() {
 }
 
 void TsdfVolume::reserve(std::size_t blocks) {
+  // The budget is checked on what this call would hold, before any allocation.
+  std::size_t table = table_.size();
+  while (2 * blocks > table)
+    table = table ? 2 * table : 1024;
+  const std::size_t chunks = (blocks + kBlocksPerChunk - 1) / kBlocksPerChunk;
+  const std::size_t bytes = std::max(chunks, chunks_.size()) * kChunkBytes + table * sizeof(Slot) +
+                            std::max(blocks, blocks_.capacity()) * sizeof(void*);
+  if (bytes > max_memory_bytes_)
+    throw InvalidInputError("the TSDF volume needs " + std::to_string(bytes >> 20) + " MiB for " +
+                            std::to_string(blocks) + " blocks of " + number(voxel_size_) +
+                            " m voxels, over its memory budget of " + std::to_string(max_memory_bytes_ >> 20) +
+                            " MiB (tsdf_volume.max_memory_mb, -max_memory): use larger voxels, fewer frames or a "
+                            "larger budget");
   while (2 * blocks > table_.size())
     grow();
   while (chunks_.size() * kBlocksPerChunk < blocks) {

@@ -15,6 +15,13 @@ ColorSampler::ColorSampler(const cv::Mat& image, const Calibration& calibration,
     return;
   if (image.type() != CV_8UC3 && image.type() != CV_8UC1)
     throw InvalidInputError("colour image must be 8-bit BGR or grey");
+  // The cameras share one rectified image size: a colour image of another size is another
+  // camera's or a wrong file, and its colours would land on the wrong points.
+  const cv::Size expected = calibration.image_size;
+  if (expected.width > 0 && image.size() != expected)
+    throw InvalidInputError("colour image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                            " but calibration '" + calibration.source + "' is " + std::to_string(expected.width) +
+                            "x" + std::to_string(expected.height));
   image_ = image;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c)

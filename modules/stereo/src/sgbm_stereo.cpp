@@ -74,6 +74,13 @@ void SgbmStereo::checkInputs() const {
                             std::to_string(guidance_.type()));
   if (config_.lidarGuidance() && !guidance_.empty() && !has_calibration_)
     throw CalibrationError("SgbmStereo: guidance needs the calibration (f B turns its depth into disparity)");
+  // Without a prior the whole range is searched: a range as wide as the image leaves no
+  // column with a match (0 points, and no word of why).
+  if (prior_.empty() && config_.min_disparity_px + config_.num_disparities_px >= left_.cols)
+    throw InvalidInputError("SgbmStereo: the disparity range (stereo.num_disparities_px, -num_disparities " +
+                            std::to_string(config_.num_disparities_px) + ", from " +
+                            std::to_string(config_.min_disparity_px) + ") is as wide as the images " +
+                            sizeText(left_) + ": no column can be matched");
   if (config_.left_right_check && left_.cols <= config_.num_disparities_px)
     throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
 }

@@ -37,12 +37,20 @@ struct Calibration {
   double baselineGrey() const { return baseline(0, 1); }
   double baselineColor() const { return baseline(2, 3); }
   /// f * B of the grey pair, so that depth = focalBaseline() / disparity.
-  double focalBaseline() const { return fx(0) * baselineGrey(); }
+  /// Throws CalibrationError naming `source` when it is not > 0 and finite (fx 0, NaN, or
+  /// cameras 0 and 1 at one centre): a disparity made of it would be silently zero.
+  double focalBaseline() const;
   /// Throws CalibrationError naming `source` when the image size is unknown.
   cv::Size requireImageSize() const;
   /// Throws CalibrationError naming `source` when it holds the cameras only (no LiDAR
   /// extrinsics), for the stages that project a scan.
   void requireVelodyne() const;
+
+  /// Throws CalibrationError naming `source` and the key unless the calibration is
+  /// physical: P0..P3 finite, fx, fy > 0, third row 0 0 1 (rectified), no skew; an image
+  /// size of 0x0 (unknown) or 1..limits::kMaxImageSide a side; T_cam0_velo (and
+  /// T_velo_imu when read) rigid. loadCalibration calls it.
+  void validate() const;
 };
 
 /// Reads a calibration, the format detected from `path`:

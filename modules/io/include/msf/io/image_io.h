@@ -5,7 +5,9 @@
 
 namespace msf {
 
-/// cv::imread that throws IOError naming the file when it is missing or not an image.
+/// cv::imread that throws IOError naming the file when it is missing or not an image, and
+/// InvalidInputError when it is larger than limits::kMaxImageSide a side (a PNG is checked
+/// from its header, before it is decoded).
 /// flags: cv::ImreadModes (default: as stored).
 cv::Mat readImage(const std::string& path, int flags = -1);
 

@@ -18,6 +18,7 @@ namespace msf {
 struct VolumeConfig {
   double voxel_size_m = 0.1;
   double truncation_m = 0.3;
+  double max_memory_mb = 0.0; ///< the volume's memory budget, 0 = three quarters of RAM (TsdfVolume::Config)
 
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the key of a value out of range.

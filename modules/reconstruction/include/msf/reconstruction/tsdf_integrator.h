@@ -89,6 +89,8 @@ public:
     /// from the last frame, so it is refined over frames; solving each frame to convergence
     /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
     int sweeps = 1;
+    static constexpr int kMaxSweeps = 100;
+    static constexpr double kMaxDepthM = 1000.0; ///< max_depth_m's bound (the volume's reach)
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 40.0;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
@@ -155,6 +157,8 @@ public:
                      const Eigen::Vector3d& origin_world);
 
 private:
+  /// Throws InvalidInputError when the frame's band would reach beyond the volume's index range.
+  void checkReach(const Eigen::Isometry3d& T_world_cam) const;
   /// The weight of a depth without its own (Constant, InverseSquare), in m^-2.
   float depthWeight(float depth) const;
   /// Per pixel, the weight of the frame's depth (see Weighting); 0 where there is no depth.

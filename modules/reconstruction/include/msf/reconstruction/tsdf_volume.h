@@ -30,14 +30,33 @@ public:
   struct Config {
     double voxel_size_m = 0.1;  ///< edge of a voxel
     double truncation_m = 0.3;  ///< |sdf| is clamped here; observations update voxels within it
-    /// Overrides the keys present (voxel_size_m, truncation_m); throws ConfigError naming a bad one.
+    /// Memory the volume's blocks and map may take (MiB); 0 = three quarters of the
+    /// machine's RAM. A run that would exceed it stops with an error before allocating.
+    double max_memory_mb = 0.0;
+    /// Overrides the keys present (voxel_size_m, truncation_m, max_memory_mb); throws
+    /// ConfigError naming a bad one (see validate).
     void read(const cv::FileNode& node);
     void print(std::ostream& out) const;
   };
 
-  /// Throws ConfigError when voxel_size_m <= 0, truncation_m <= 0 (or either not finite).
+  /// Voxels from 1 mm to 10 m; a truncation of at most kMaxTruncationVoxels voxels (and > 0).
+  static constexpr double kMinVoxelSizeM = 1e-3;
+  static constexpr double kMaxVoxelSizeM = 10.0;
+  static constexpr double kMaxTruncationVoxels = 64.0;
+  /// Throws ConfigError naming the key when voxel_size_m or truncation_m is outside the
+  /// ranges above (or not finite), or max_memory_mb < 0.
+  static void validate(double voxel_size_m, double truncation_m, double max_memory_mb = 0.0);
+
+  /// Throws ConfigError as validate().
   TsdfVolume(double voxel_size_m, double truncation_m);
-  explicit TsdfVolume(const Config& config) : TsdfVolume(config.voxel_size_m, config.truncation_m) {}
+  explicit TsdfVolume(const Config& config) : TsdfVolume(config.voxel_size_m, config.truncation_m) {
+    setMaxMemoryMb(config.max_memory_mb);
+  }
+
+  /// The memory budget of blocks and map (MiB, 0 = three quarters of RAM): an allocation
+  /// that would exceed it throws InvalidInputError (naming the budget) before allocating.
+  void setMaxMemoryMb(double max_memory_mb);
+  std::size_t maxMemoryBytes() const { return max_memory_bytes_; }
 
   double voxelSize() const { return voxel_size_; }
   double truncation() const { return truncation_; }
@@ -103,6 +122,7 @@ public:
 private:
   double voxel_size_;
   double truncation_;
+  std::size_t max_memory_bytes_ = 0;
   std::uint64_t generation_ = 0;
   std::uint64_t id_;
   /// Open addressing (linear probing, load <= 1/2): lookups are in every inner loop that

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/fusion_model.h>
 #include <msf/stereo/color_sampler.h>
@@ -40,6 +41,18 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
                             size(*stereo_));
   if (!has_calibration_)
     throw CalibrationError("DepthFusion: no calibration set (setCalibration)");
+  // A finite depth beyond any sensor's range (1e30 m) is a broken input: it would pass
+  // through the fusion as a depth, so it is an error naming the cloud and the pixel.
+  const auto checkRange = [](const auto& cloud, const char* what) {
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      if (std::isfinite(cloud[i].z) && !(std::abs(cloud[i].z) <= limits::kMaxDepthM))
+        throw InvalidInputError(std::string("DepthFusion: the ") + what + " cloud has a depth of " +
+                                std::to_string(cloud[i].z) + " m at pixel (" + std::to_string(i % cloud.width) + ", " +
+                                std::to_string(i / cloud.width) + "), beyond " + std::to_string(limits::kMaxDepthM) +
+                                " m");
+  };
+  checkRange(*lidar_, "LiDAR");
+  checkRange(*stereo_, "stereo");
 
   const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
   const float fB = static_cast<float>(calibration_.focalBaseline());

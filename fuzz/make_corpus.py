@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""Seed corpora of the fuzz targets, from the KITTI sample (../shared/data/kitti).
+
+    make_corpus.py KITTI_DIR OUT_DIR
+
+Writes OUT_DIR/<target>/<seed> for the targets cloud, calibration, poses and velodyne; the
+first byte of a seed picks the format where a target reads several (see fuzz_*.cpp).
+"""
+import os
+import struct
+import sys
+
+kitti, out = sys.argv[1], sys.argv[2]
+seq = os.path.join(kitti, "odometry", "sequences", "04")
+raw = os.path.join(kitti, "raw", "2011_09_26")
+
+
+def put(target, name, data):
+    d = os.path.join(out, target)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+def read(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+# Velodyne: the first 100 and 1000 records of a scan, and a record cut short.
+scan = read(os.path.join(seq, "velodyne", "000000.bin"))
+put("velodyne", "scan100.bin", scan[:1600])
+put("velodyne", "scan1000.bin", scan[:16000])
+put("velodyne", "cut.bin", scan[:1602])
+
+# Clouds: 64 points of that scan as ASCII and binary .pcd (organized 8x8 and not) and .ply.
+pts = [struct.unpack_from("<4f", scan, 16 * i) for i in range(64)]
+def pcd(data, width, height):
+    head = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+            "WIDTH %d\nHEIGHT %d\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA %s\n" % (width, height, width * height, data))
+    if data == "ascii":
+        return head.encode() + "".join("%g %g %g %g\n" % p for p in pts).encode()
+    return head.encode() + b"".join(struct.pack("<4f", *p) for p in pts)
+put("cloud", "ascii.pcd", b"\0" + pcd("ascii", 64, 1))
+put("cloud", "binary.pcd", b"\0" + pcd("binary", 8, 8))
+def ply(fmt):
+    head = ("ply\nformat %s 1.0\nelement vertex 64\nproperty float x\nproperty float y\nproperty float z\n"
+            "property float intensity\nend_header\n" % fmt)
+    if fmt == "ascii":
+        return head.encode() + "".join("%g %g %g %g\n" % p for p in pts).encode()
+    return head.encode() + b"".join(struct.pack("<4f", *p) for p in pts)
+put("cloud", "ascii.ply", b"\1" + ply("ascii"))
+put("cloud", "binary.ply", b"\1" + ply("binary_little_endian"))
+
+# Calibrations: odometry, object (made of the odometry one), raw folder, YAML.
+odo = read(os.path.join(seq, "calib.txt"))
+put("calibration", "odometry.txt", b"\0" + odo)
+lines = dict(l.split(":", 1) for l in odo.decode().splitlines() if ":" in l)
+obj = "".join("P%d:%s\n" % (i, lines["P%d" % i]) for i in range(4))
+obj += "R0_rect: 1 0 0 0 1 0 0 0 1\nTr_velo_to_cam:%s\nTr_imu_to_velo:%s\n" % (lines["Tr"], lines["Tr"])
+put("calibration", "object.txt", b"\1" + obj.encode())
+parts = [read(os.path.join(raw, n)) for n in ("calib_cam_to_cam.txt", "calib_velo_to_cam.txt", "calib_imu_to_velo.txt")]
+put("calibration", "raw.txt", b"\2" + b"\n===\n".join(parts))
+put("calibration", "raw_no_imu.txt", b"\2" + b"\n===\n".join(parts[:2]))
+def mat(name, rows, cols, values):
+    return "%s: !!opencv-matrix\n   rows: %d\n   cols: %d\n   dt: d\n   data: [ %s ]\n" % (
+        name, rows, cols, ", ".join(values))
+yaml = "%YAML:1.0\n---\n" + "".join(mat("P%d" % i, 3, 4, lines["P%d" % i].split()) for i in range(4))
+yaml += "image_width: 1226\nimage_height: 370\n" + mat("T_cam0_velo", 4, 4, lines["Tr"].split() + ["0", "0", "0", "1"])
+put("calibration", "camera.yaml", b"\3" + yaml.encode())
+
+# Poses: 20 odometry poses; one OXTS record.
+poses = read(os.path.join(kitti, "odometry", "poses", "04.txt")).splitlines(True)
+put("poses", "poses.txt", b"\1" + b"".join(poses[:20]))
+oxts = os.path.join(raw, "2011_09_26_drive_0009_sync", "oxts", "data")
+put("poses", "oxts.txt", b"\0" + read(os.path.join(oxts, sorted(os.listdir(oxts))[0])))

@@ -1,0 +1,43 @@
+#pragma once
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <string>
+
+/// Limits a hostile or mistaken input is checked against before anything is allocated or
+/// converted: a run that cannot be done in reasonable memory or time, or whose numbers are
+/// not physical, stops with an error naming the option, key or file instead of crashing,
+/// running away or writing a silently wrong result (issue 19).
+namespace msf::limits {
+
+/// OpenMP threads a `threads` option may ask for (0 = all the cores).
+inline constexpr int kMaxThreads = 256;
+/// Side of an image, canvas or calibration in pixels: KITTI's is 1242, 8192 leaves room for
+/// any camera of the field and keeps every pixel index, area and offset within an int.
+inline constexpr int kMaxImageSide = 8192;
+/// Largest magnitude of a translation in metres (a pose, a calibration's extrinsics):
+/// 1000 km, beyond any drive; divided by the smallest voxel (1 mm) it still fits an int.
+inline constexpr double kMaxTranslationM = 1e6;
+/// Largest depth in metres an input depth image or cloud may hold: KITTI's LiDAR reaches
+/// 120 m; a depth of 1e30 m is a broken input, not a far surface.
+inline constexpr double kMaxDepthM = 1000.0;
+/// Tolerance of |R^T R - I| (largest element) and of |det R - 1| for a rotation that was
+/// written with 9 to 12 digits (KITTI's poses and calibrations).
+inline constexpr double kRotationTolerance = 1e-3;
+
+/// Throws ConfigError naming `name` unless 0 <= threads <= kMaxThreads.
+void checkThreads(int threads, const std::string& name);
+
+/// Throws InvalidInputError naming `what` unless 1 <= width, height <= kMaxImageSide.
+void checkImageSize(long long width, long long height, const std::string& what);
+
+/// Throws InvalidInputError naming `what` unless T's linear part is a rotation (orthonormal
+/// within kRotationTolerance, determinant +1), its translation finite and within
+/// kMaxTranslationM, and its last row 0 0 0 1.
+void checkRigid(const Eigen::Isometry3d& T, const std::string& what);
+
+/// `value` rounded to the nearest integer when it is finite and within [lo, hi]; throws
+/// InvalidInputError naming `what` otherwise (a double -> int cast of 1e30 is undefined).
+std::int64_t checkedRound(double value, std::int64_t lo, std::int64_t hi, const std::string& what);
+
+} // namespace msf::limits

@@ -1,0 +1,272 @@
+// Issue 19: files whose headers, values or shapes are hostile end in an error naming the
+// file and what is wrong, before anything large is allocated.
+#include <msf/common/exceptions.h>
+#include <msf/io/calibration.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/image_io.h>
+#include <msf/io/poses.h>
+#include <msf/io/sequence.h>
+
+#include "error_of.h"
+#include "test_support.h"
+
+#include <opencv2/core.hpp>
+#include <pcl/point_types.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using msf::test::errorOf;
+
+void write(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+
+std::string pcdHeader(const std::string& points, const std::string& data) {
+  return "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + points +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + points + "\nDATA " + data + "\n";
+}
+
+TEST(HostileClouds, PointCountBeyondTheFileSizeIsAnErrorNotAnAllocation) {
+  msf::test::TempDir dir;
+  for (const char* data : {"binary", "ascii", "binary_compressed"}) {
+    write(dir.file("bomb.pcd"), pcdHeader("1000000000", data) + std::string(1300, '\0'));
+    pcl::PCLPointCloud2 blob;
+    const std::string e = errorOf([&] { msf::loadCloudBlob(dir.file("bomb.pcd"), blob); });
+    EXPECT_NE(e.find("bomb.pcd' declares 1000000000 points"), std::string::npos) << data << ": " << e;
+  }
+  write(dir.file("bomb.ply"), "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
+                              "property float y\nproperty float z\nend_header\n" + std::string(1300, '\0'));
+  pcl::PCLPointCloud2 blob;
+  EXPECT_NE(errorOf([&] { msf::loadCloudBlob(dir.file("bomb.ply"), blob); }).find("declares 1000000000 vertex"),
+            std::string::npos);
+  pcl::PolygonMesh mesh;
+  EXPECT_NE(errorOf([&] { msf::loadMesh(dir.file("bomb.ply"), mesh); }).find("declares 1000000000 vertex"),
+            std::string::npos);
+}
+
+TEST(HostileClouds, ValidFilesStillLoad) {
+  msf::test::TempDir dir;
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (int i = 0; i < 50; ++i)
+    cloud.push_back(pcl::PointXYZ(float(i), 1.f, 2.f));
+  msf::saveCloud(dir.file("c.pcd"), cloud); // binary compressed
+  msf::saveCloud(dir.file("c.ply"), cloud);
+  write(dir.file("a.pcd"), pcdHeader("2", "ascii") + "1 2 3\nnan nan nan\n");
+  for (const char* name : {"c.pcd", "c.ply", "a.pcd"}) {
+    pcl::PointCloud<pcl::PointXYZ> back;
+    EXPECT_NO_THROW(msf::loadCloud(dir.file(name), back)) << name;
+  }
+}
+
+TEST(HostileClouds, AsciiValueThatIsNotANumberIsNamed) {
+  msf::test::TempDir dir;
+  write(dir.file("abc.pcd"), pcdHeader("2", "ascii") + "1 2 3\n1 2 abc\n");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  EXPECT_NE(errorOf([&] { msf::loadCloud(dir.file("abc.pcd"), cloud); }).find("value 'abc' on data line 2"),
+            std::string::npos);
+}
+
+TEST(HostileImages, HugePngHeaderIsRefusedBeforeDecoding) {
+  msf::test::TempDir dir;
+  // The signature and an IHDR of 30000 x 20000 (CRC not checked before the size).
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x75\x30\0\0\x4e\x20\x08\0\0\0\0\0\0\0\0", 33);
+  write(dir.file("huge.png"), png);
+  EXPECT_NE(errorOf([&] { msf::readImage(dir.file("huge.png")); }).find("image size 30000x20000 is outside"),
+            std::string::npos);
+}
+
+TEST(HostileImages, HugeDepthSaturatesInsteadOfWrapping) {
+  msf::test::TempDir dir;
+  cv::Mat d(1, 2, CV_32FC1);
+  d.at<float>(0, 0) = 1e30f; // lround(1e30 * 256) overflowed: written as 0.004 m
+  d.at<float>(0, 1) = std::numeric_limits<float>::max();
+  msf::writeKittiDepthPng(dir.file("d.png"), d);
+  const cv::Mat back = msf::readKittiDepthPng(dir.file("d.png"));
+  EXPECT_NEAR(back.at<float>(0, 0), 65535.0 / 256, 1e-4);
+  EXPECT_NEAR(back.at<float>(0, 1), 65535.0 / 256, 1e-4);
+}
+
+class HostileCalibration : public ::testing::Test {
+protected:
+  msf::test::TempDir dir;
+  msf::Calibration good;
+  void SetUp() override {
+    good.image_size = cv::Size(64, 48);
+    for (auto& P : good.P)
+      P << 60, 0, 32, 0, 0, 60, 24, 0, 0, 0, 1, 0;
+    good.P[1](0, 3) = -30;
+  }
+  std::string errorLoading(const msf::Calibration& c) {
+    msf::saveCalibrationYaml(c, dir.file("c.yaml"));
+    return errorOf([&] { msf::loadCalibration(dir.file("c.yaml")); });
+  }
+};
+
+TEST_F(HostileCalibration, PhysicalCalibrationLoads) { EXPECT_EQ(errorLoading(good), "(no error)"); }
+
+TEST_F(HostileCalibration, FocalLengthZeroOrNaN) {
+  msf::Calibration c = good;
+  c.P[0](0, 0) = 0;
+  EXPECT_NE(errorLoading(c).find("P0 has fx 0"), std::string::npos);
+  c = good;
+  c.P[2](1, 2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(errorLoading(c).find("P2 has a value that is not finite"), std::string::npos);
+}
+
+TEST_F(HostileCalibration, ImageSizeBeyondTheLimit) {
+  msf::Calibration c = good;
+  c.image_size = cv::Size(100000, 100000);
+  EXPECT_NE(errorLoading(c).find("image size 100000x100000 is outside"), std::string::npos);
+}
+
+TEST_F(HostileCalibration, ExtrinsicsThatAreNotRigid) {
+  msf::Calibration c = good;
+  c.T_cam0_velo.linear() *= 1000.0;
+  EXPECT_NE(errorLoading(c).find("LiDAR-to-camera transform is not a rigid transform"), std::string::npos);
+}
+
+TEST_F(HostileCalibration, ZeroBaselineIsAnErrorWhereItIsUsed) {
+  msf::Calibration c = good;
+  c.P[1](0, 3) = 0;
+  EXPECT_EQ(errorLoading(c), "(no error)"); // a mono calibration is fine...
+  c.source = "mono";
+  EXPECT_NE(errorOf([&] { c.focalBaseline(); }).find("'mono': the grey pair's focal length x baseline is 0"),
+            std::string::npos); // ...until a disparity needs it
+}
+
+TEST_F(HostileCalibration, ValueThatIsNotANumberIsNamed) {
+  write(dir.file("calib.txt"), "P0: 700 0 600 0 0 700 180 0 0 0 1 0\nP1: 700 0 1.0x -380 0 700 180 0 0 0 1 0\n"
+                               "P2: 700 0 600 0 0 700 180 0 0 0 1 0\nP3: 700 0 600 0 0 700 180 0 0 0 1 0\n"
+                               "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  EXPECT_NE(errorOf([&] { msf::loadCalibration(dir.file("calib.txt")); })
+                .find("key 'P1' has a value that is not a number: '1.0x'"),
+            std::string::npos);
+}
+
+TEST(HostilePoses, NanAndTextAreNamedNotMiscounted) {
+  msf::test::TempDir dir;
+  write(dir.file("nan.txt"), "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 nan 0 1 0 0 0 0 1 0\n");
+  EXPECT_NE(errorOf([&] { msf::loadOdometryPoses(dir.file("nan.txt")); }).find("line 2: value 4 'nan' is not finite"),
+            std::string::npos);
+  write(dir.file("x.txt"), "1 0 0 0 0 1 0 0 0 0 1 0x\n");
+  EXPECT_NE(errorOf([&] { msf::loadOdometryPoses(dir.file("x.txt")); }).find("value 12 '0x' is not a number"),
+            std::string::npos);
+}
+
+TEST(HostilePoses, RotationThatIsNotARotation) {
+  msf::test::TempDir dir;
+  write(dir.file("p.txt"), "1000 0 0 0 0 1000 0 0 0 0 1000 0\n");
+  EXPECT_NE(errorOf([&] { msf::loadOdometryPoses(dir.file("p.txt")); }).find("line 1 is not a rigid transform"),
+            std::string::npos);
+  write(dir.file("far.txt"), "1 0 0 1e30 0 1 0 0 0 0 1 0\n");
+  EXPECT_NE(errorOf([&] { msf::loadOdometryPoses(dir.file("far.txt")); }).find("translation of 1e+30 m"),
+            std::string::npos);
+}
+
+/// A copy of odometry 04 (links) with `frames` images a camera and `scans` scans.
+std::string smallDataset(const msf::test::TempDir& dir, int frames, int scans) {
+  const fs::path seq = fs::path(msf::test::kittiDir()) / "odometry/sequences/04";
+  const fs::path d = fs::path(dir.path()) / "sequences/04";
+  for (const char* sub : {"image_0", "image_1", "velodyne"})
+    fs::create_directories(d / sub);
+  fs::create_directories(fs::path(dir.path()) / "poses");
+  fs::create_symlink(seq / "calib.txt", d / "calib.txt");
+  char name[16];
+  for (int i = 0; i < frames; ++i) {
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    fs::create_symlink(seq / "image_0" / name, d / "image_0" / name);
+    fs::create_symlink(seq / "image_1" / name, d / "image_1" / name);
+  }
+  for (int i = 0; i < scans; ++i) {
+    std::snprintf(name, sizeof name, "%06d.bin", i);
+    fs::create_symlink(seq / "velodyne" / name, d / "velodyne" / name);
+  }
+  return d.string();
+}
+
+TEST(HostileSequence, MoreScansThanImagesIsAnError) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string d = smallDataset(dir, 3, 4);
+  EXPECT_NE(errorOf([&] { msf::Sequence s(d); }).find("has 3 images in camera 0's folder but 4 .bin files"),
+            std::string::npos);
+}
+
+TEST(HostileSequence, FrameRangeBeyondTheEndIsAnError) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const msf::Sequence s(smallDataset(dir, 3, 3));
+  EXPECT_EQ(s.indices(msf::FrameRange::parse("0:2")).size(), 3u);
+  EXPECT_NE(errorOf([&] { s.indices(msf::FrameRange::parse("0:100000")); }).find("goes beyond the last frame"),
+            std::string::npos);
+}
+
+TEST(HostileSequence, WrongSizeRightImageIsNamedWithItsOwnSize) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string d = smallDataset(dir, 2, 2);
+  fs::remove(fs::path(d) / "image_1/000000.png");
+  msf::writeImage((fs::path(d) / "image_1/000000.png").string(), cv::Mat(6, 8, CV_8UC1, cv::Scalar(9)));
+  const msf::Sequence s(d);
+  const std::string e = errorOf([&] { s.load(0, false); });
+  EXPECT_NE(e.find("image_1/000000.png' is 8x6, not the calibration's 1226x370"), std::string::npos) << e;
+}
+
+/// The inputs fuzz/ found crashes with (tests/io/fuzz_regressions/<target>/), read as the
+/// fuzz target reads them: the first byte picks the format. Each must load or end in an
+/// msf::Error; any other exception (PCL's std::out_of_range, OpenCV's cv::Exception) fails.
+std::vector<fs::path> regressions(const std::string& target) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(fs::path(msf::test::sourceDir()) / "tests/io/fuzz_regressions" / target))
+    files.push_back(e.path());
+  return files;
+}
+
+std::string bodyOf(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return bytes;
+}
+
+TEST(FuzzRegressions, CloudReaders) {
+  msf::test::TempDir dir;
+  const auto files = regressions("cloud");
+  ASSERT_FALSE(files.empty());
+  for (const auto& f : files) {
+    const std::string bytes = bodyOf(f);
+    const std::string path = dir.file(bytes.at(0) & 1 ? "c.ply" : "c.pcd");
+    write(path, bytes.substr(1));
+    pcl::PointCloud<pcl::PointXYZI> cloud;
+    try {
+      msf::loadCloud(path, cloud);
+    } catch (const msf::Error&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << f << ": " << e.what();
+    }
+  }
+}
+
+TEST(FuzzRegressions, CalibrationParsers) {
+  msf::test::TempDir dir;
+  const auto files = regressions("calibration");
+  ASSERT_FALSE(files.empty());
+  for (const auto& f : files) {
+    const std::string bytes = bodyOf(f);
+    const char* names[] = {"calib.txt", "000000.txt", "calib_cam_to_cam.txt", "camera.yaml"};
+    const std::string path = dir.file(names[static_cast<unsigned char>(bytes.at(0)) % 4]);
+    write(path, bytes.substr(1));
+    try {
+      msf::loadCalibration(path);
+    } catch (const msf::Error&) {
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << f << ": " << e.what();
+    }
+  }
+}
+
+} // namespace

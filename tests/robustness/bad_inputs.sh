@@ -1,0 +1,309 @@
+#!/usr/bin/env bash
+# The bad-input matrix of issue 19: hostile or mistaken inputs against the msf_* tools.
+# Every case must end in under 5 s and under 500 MB, with the exit code it expects (1: a
+# clear error; 0: a result, e.g. with a warning) and a message matching a pattern that names
+# the option, key or file at fault; a failed run must leave no output file behind.
+#
+#   tests/robustness/bad_inputs.sh BIN_DIR KITTI_DIR
+#
+# Prints one line a case and a summary; exits 1 when any case fails. KITTI_DIR is the
+# KITTI sample (../shared/data/kitti); the cases that need it are skipped without it unless
+# CI=true.
+set -uo pipefail
+BIN=$(cd "${1:?usage: bad_inputs.sh BIN_DIR KITTI_DIR}" && pwd)
+KITTI=${2:-}
+MAX_SECONDS=5
+MAX_KB=$((500 * 1024))
+T=$(mktemp -d /tmp/msf_bad_inputs_XXXXXX)
+trap 'rm -rf "$T"' EXIT
+
+SEQ=$KITTI/odometry/sequences/04
+have_kitti=0
+[ -f "$SEQ/calib.txt" ] && have_kitti=1
+if [ $have_kitti = 0 ] && [ "${CI:-}" = true ]; then
+  echo "KITTI sample not found at '$KITTI'; CI=true requires it" >&2
+  exit 1
+fi
+TIME=/usr/bin/time
+[ -x $TIME ] || TIME=
+
+failures=0 cases=0 skipped=0 slowest=0 largest=0
+
+# check NAME EXPECTED_EXIT PATTERN -- TOOL ARGS...
+# Runs the tool in $T/run (its outputs go there); the case passes when the exit code is
+# EXPECTED_EXIT, stderr (or stdout) matches PATTERN (grep -E), the run took < MAX_SECONDS
+# and < MAX_KB, and, for an error, the run folder holds no file.
+check() {
+  local name=$1 expected=$2 pattern=$3
+  shift 4
+  local tool=$1
+  shift
+  cases=$((cases + 1))
+  rm -rf "$T/run" && mkdir -p "$T/run"
+  local start end code kb=0 ms
+  start=$(date +%s%N)
+  if [ -n "$TIME" ]; then
+    (cd "$T/run" && timeout -s KILL $((MAX_SECONDS * 2)) $TIME -f '%M' -o "$T/mem" "$BIN/$tool" "$@" >"$T/out" 2>"$T/err")
+    code=$?
+    kb=$(tail -n 1 "$T/mem" 2>/dev/null | tr -dc 0-9)
+    kb=${kb:-0}
+  else
+    (cd "$T/run" && timeout -s KILL $((MAX_SECONDS * 2)) "$BIN/$tool" "$@" >"$T/out" 2>"$T/err")
+    code=$?
+  fi
+  end=$(date +%s%N)
+  ms=$(((end - start) / 1000000))
+  [ $ms -gt $slowest ] && slowest=$ms
+  [ "$kb" -gt $largest ] && largest=$kb
+  local why=""
+  [ "$code" = "$expected" ] || why="exit $code, expected $expected;"
+  grep -Eq -- "$pattern" "$T/err" "$T/out" || why="$why message does not match '$pattern';"
+  [ $ms -lt $((MAX_SECONDS * 1000)) ] || why="$why took $ms ms;"
+  [ "$kb" -lt $MAX_KB ] || why="$why used $((kb / 1024)) MB;"
+  if [ "$expected" != 0 ] && [ -n "$(ls -A "$T/run")" ]; then
+    why="$why left $(ls -A "$T/run" | tr '\n' ' ');"
+  fi
+  if [ -z "$why" ]; then
+    printf 'ok    %-44s %5d ms %5d MB\n' "$name" $ms $((kb / 1024))
+  else
+    failures=$((failures + 1))
+    printf 'FAIL  %-44s %s\n' "$name" "$why"
+    sed 's/^/      | /' "$T/err" | tail -n 5
+  fi
+}
+
+skip() {
+  skipped=$((skipped + 1))
+  printf 'skip  %-44s (no KITTI sample)\n' "$1"
+}
+
+# ---- fixtures --------------------------------------------------------------------------
+F=$T/f
+mkdir -p "$F"
+# A small organized depth cloud (8x6, camera 60 px focal), every third pixel with a depth.
+python3 - "$F" <<'EOF'
+import math, sys, struct
+f = sys.argv[1]
+W, H = 8, 6
+def pcd(path, rows, fields="x y z intensity", width=W, height=H):
+    n = len(fields.split())
+    with open(path, "w") as o:
+        o.write("# .PCD v0.7\nVERSION 0.7\nFIELDS %s\nSIZE %s\nTYPE %s\nCOUNT %s\n" % (
+            fields, " ".join(["4"] * n), " ".join(["F"] * n), " ".join(["1"] * n)))
+        o.write("WIDTH %d\nHEIGHT %d\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA ascii\n" % (width, height, width * height))
+        for r in rows:
+            o.write(" ".join(r) + "\n")
+def depth_rows(z_of):
+    rows = []
+    for v in range(H):
+        for u in range(W):
+            z = z_of(u, v)
+            if z is None:
+                rows.append(["nan", "nan", "nan", "0"])
+            else:
+                rows.append(["%g" % ((u - 3.5) * z / 60), "%g" % ((v - 2.5) * z / 60), "%g" % z, "0.5"])
+    return rows
+pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
+pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
+pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
+pcd(f + "/allnan.pcd", depth_rows(lambda u, v: None))
+pcd(f + "/wrong_fields.pcd", [["1", "2", "3"]] * (W * H), fields="a b c")
+rows = depth_rows(lambda u, v: 5.0)
+rows[3] = ["1", "2", "abc", "0"]
+pcd(f + "/abc.pcd", rows)
+# A 1.4 KB file whose header claims 1e9 points.
+with open(f + "/bomb.pcd", "w") as o:
+    o.write("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1000000000\nHEIGHT 1\n"
+            "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1000000000\nDATA binary\n")
+    o.write("\0" * 1300)
+with open(f + "/bomb.ply", "w") as o:
+    o.write("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n")
+    o.write("\0" * 1300)
+# A PNG whose header says 30000 x 20000 (the pixels are never read).
+import zlib
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+with open(f + "/huge.png", "wb") as o:
+    o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 30000, 20000, 8, 0, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b""))
+# Calibrations (the project's YAML): good, and each fault on its own.
+def yaml(path, fx=60.0, tx1=-30.0, w=8, h=6, nan=False):
+    P = lambda tx: "[ %s, 0., 3.5, %s, 0., %s, 2.5, 0., 0., 0., 1., 0. ]" % (fx, tx, fx)
+    with open(path, "w") as o:
+        o.write("%YAML:1.0\n---\n")
+        for i, tx in enumerate([0.0, tx1, 0.0, tx1]):
+            data = P(tx) if not (nan and i == 0) else P(0.0).replace("3.5", ".NaN")
+            o.write("P%d: !!opencv-matrix\n   rows: 3\n   cols: 4\n   dt: d\n   data: %s\n" % (i, data))
+        o.write("image_width: %d\nimage_height: %d\n" % (w, h))
+        o.write("T_cam0_velo: !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n"
+                "   data: [ 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1. ]\n")
+yaml(f + "/camera.yaml")
+yaml(f + "/fx0.yaml", fx=0.0)
+yaml(f + "/baseline0.yaml", tx1=0.0)
+yaml(f + "/nan.yaml", nan=True)
+yaml(f + "/huge.yaml", w=100000, h=100000)
+# Poses: one line each.
+I = "1 0 0 0 0 1 0 0 0 0 1 0"
+open(f + "/pose.txt", "w").write(I + "\n")
+open(f + "/pose_scaled.txt", "w").write("1000 0 0 0 0 1000 0 0 0 0 1000 0\n")
+open(f + "/pose_nan.txt", "w").write("1 0 0 nan 0 1 0 0 0 0 1 0\n")
+open(f + "/pose_far.txt", "w").write("1 0 0 1e30 0 1 0 0 0 0 1 0\n")
+open(f + "/pose_reach.txt", "w").write("1 0 0 900000 0 1 0 0 0 0 1 0\n")
+# Disparity ground truth with no valid pixel, an estimate, and a small grey image.
+def png(path, width, height, bits, value):
+    raw = b"".join(b"\0" + (value.to_bytes(2, "big") if bits == 16 else bytes([value])) * width for _ in range(height))
+    with open(path, "wb") as o:
+        o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, bits, 0, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+png(f + "/gt_empty.png", W, H, 16, 0)
+png(f + "/est.png", W, H, 16, 256 * 5)
+png(f + "/small.png", W, H, 8, 128)
+EOF
+
+if [ $have_kitti = 1 ]; then
+  K=$T/k
+  # Copies of odometry 04's calibration with one fault each.
+  mkdir -p "$K/scaled_tr" "$K/p1x"
+  sed -E 's/^Tr: ([^ ]+)/Tr: 1000/' "$SEQ/calib.txt" >"$K/scaled_tr/calib.txt"
+  sed -E 's/^(P1: [^ ]+ [^ ]+ )[^ ]+/\11.0x/' "$SEQ/calib.txt" >"$K/p1x/calib.txt"
+  # Small odometry datasets (links to the sample's files): 3 images and 4 scans; a right
+  # image of the wrong size; a pose with a NaN.
+  dataset() { # NAME FRAMES SCANS
+    local d=$K/$1/sequences/04
+    mkdir -p "$d/image_0" "$d/image_1" "$d/velodyne" "$K/$1/poses"
+    ln -s "$SEQ/calib.txt" "$d/calib.txt"
+    for i in $(seq 0 $(($2 - 1))); do
+      n=$(printf %06d "$i")
+      ln -s "$SEQ/image_0/$n.png" "$d/image_0/$n.png"
+      ln -s "$SEQ/image_1/$n.png" "$d/image_1/$n.png"
+    done
+    for i in $(seq 0 $(($3 - 1))); do
+      n=$(printf %06d "$i")
+      ln -s "$SEQ/velodyne/$n.bin" "$d/velodyne/$n.bin"
+    done
+    head -n "$2" "$KITTI/odometry/poses/04.txt" >"$K/$1/poses/04.txt"
+  }
+  dataset odo 3 4
+  dataset odo_small_right 2 2
+  rm "$K/odo_small_right/sequences/04/image_1/000000.png"
+  cp "$F/small.png" "$K/odo_small_right/sequences/04/image_1/000000.png"
+  dataset odo_nan 2 2
+  sed -i -E '2s/^([^ ]+ [^ ]+ [^ ]+ )[^ ]+/\1nan/' "$K/odo_nan/poses/04.txt"
+  cp "$F/small.png" "$K/small.png"
+  dataset odo_empty_scan 2 2
+  rm "$K/odo_empty_scan/sequences/04/velodyne/000000.bin"
+  : >"$K/odo_empty_scan/sequences/04/velodyne/000000.bin"
+  dataset odo_missing_color 2 2
+  mkdir -p "$K/odo_missing_color/sequences/04/image_2"
+  ln -s "$SEQ/image_2/000001.png" "$K/odo_missing_color/sequences/04/image_2/000001.png"
+fi
+
+# ---- limits checked before allocating ---------------------------------------------------
+check "interpolate -threads 100000" 1 "interpolation.threads \(-threads\) must be 0.*256, not 100000" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -threads 100000
+check "interpolate -threads -1" 1 "threads.*not -1" -- msf_interpolate "$F/sparse.pcd" o.pcd -threads -1
+check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_info "$F/bomb.pcd"
+check "interpolate: POINTS 1e9 in a 1.4 KB .pcd" 1 "bomb.pcd' declares 1000000000 points" -- \
+  msf_interpolate "$F/bomb.pcd" o.pcd
+check "info: element vertex 1e9 in a .ply" 1 "declares 1000000000 vertex" -- msf_info "$F/bomb.ply"
+check "integrate -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1e-06" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e-6
+check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 64 voxels" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -trunc 1e6
+check "integrate -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100, got 1000000" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps 1000000
+check "integrate: rotation scaled by 1000" 1 "pose_scaled.txt' line 1 is not a rigid transform" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose_scaled.txt" -o v.pcd
+check "integrate: translation 1e30" 1 "pose_far.txt' line 1 has a translation of 1e\+30 m" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose_far.txt" -o v.pcd
+check "integrate: pose beyond the volume's reach" 1 "beyond the volume's .* m at 0.001" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose_reach.txt" -o v.pcd -voxel 0.001 -trunc 0.003
+check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
+check "lambda_study -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_lambda_study -o out -voxel 1e-6
+check "lambda_study -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100" -- msf_lambda_study -o out -sweeps 1000000
+check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
+check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/nan.yaml"
+check "pcd2png -disparity, baseline 0" 1 "baseline0.yaml': the grey pair's focal length x baseline is 0" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/baseline0.yaml"
+check "pcd2png: a depth of 1e30 m saturates, said" 0 "1 pixel of the depth beyond the format.s largest value \(255.996\) saturate" -- \
+  msf_pcd2png "$F/far.pcd" d.png
+check "stereo: 30000x20000 PNG header" 1 "huge.png': image size 30000x20000 is outside 1x1 .. 8192x8192" -- \
+  msf_stereo "$F/huge.png" "$F/huge.png" o.pcd -calib "$F/camera.yaml"
+check "interpolate: empty (all-NaN) cloud" 1 "allnan.pcd' lands in the image: the cloud has no finite point" -- \
+  msf_interpolate "$F/allnan.pcd" o.pcd -calib "$F/camera.yaml"
+check "interpolate: empty cloud, no calibration" 1 "too few valid points \(0\)" -- msf_interpolate "$F/allnan.pcd" o.pcd
+check "info: '1 2 abc' in an ASCII .pcd" 1 "value 'abc' on data line 4 is not a number" -- msf_info "$F/abc.pcd"
+check "fuse: a LiDAR depth of 1e30 m" 1 "LiDAR cloud has a depth of 1000000015.*at pixel \(2, 2\)|LiDAR cloud has a depth of 1.*e\+30|LiDAR cloud has a depth of [0-9]{20,}" -- \
+  msf_fuse "$F/far.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera.yaml"
+check "eval_disparity: ground truth with no valid pixel" 1 "gt_empty.png' has no valid pixel" -- \
+  msf_eval_disparity "$F/gt_empty.png" "$F/est.png"
+
+if [ $have_kitti = 1 ]; then
+  SCAN=$SEQ/velodyne/000000.bin
+  L=$SEQ/image_0/000000.png R=$SEQ/image_1/000000.png
+  check "project: 100000x100000 calibration" 1 "huge.yaml': keys 'image_width' and 'image_height': image size 100000x100000" -- \
+    msf_project "$SCAN" o.pcd -calib "$F/huge.yaml"
+  check "interpolate: scan with a scaled rotation in Tr" 1 "LiDAR-to-camera transform is not a rigid transform" -- \
+    msf_interpolate "$SCAN" o.pcd -calib "$K/scaled_tr/calib.txt"
+  check "stereo -num_disparities 1232" 1 "-num_disparities 1232.*as wide as the images" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -num_disparities 1232
+  check "stereo -prior without x y z" 1 "-prior '.*wrong_fields.pcd' has no field 'x'" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
+  check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
+  check "P1 holds '1.0x'" 1 "key 'P1' has a value that is not a number: '1.0x'" -- \
+    msf_project "$SCAN" o.pcd -calib "$K/p1x/calib.txt"
+  check "reconstruct -frames 0:100000" 1 "frame range 0:100000 goes beyond the last frame" -- \
+    msf_reconstruct "$SEQ" -frames 0:100000 -panels 0 -o out
+  check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
+  check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
+    msf_reconstruct "$SEQ" -voxel 1e6 -o out
+  check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
+  check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \
+    msf_reconstruct "$K/odo/sequences/04" -o out
+  check "reconstruct: right image of the wrong size" 1 "image '.*image_1/000000.png' is 8x6, not the calibration's" -- \
+    msf_reconstruct "$K/odo_small_right/sequences/04" -frames 0:0 -panels 0 -o out
+  check "reconstruct: an empty scan" 1 "frame 000000: scan '.*velodyne/000000.bin' has no finite point" -- \
+    msf_reconstruct "$K/odo_empty_scan/sequences/04" -panels 0 -o out
+  check "reconstruct: a missing colour image" 1 "frame 000000: colour image '.*image_2/000000.png' is missing" -- \
+    msf_reconstruct "$K/odo_missing_color/sequences/04" -panels 0 -o out
+  check "reconstruct: NaN in a pose" 1 "poses '.*04.txt' line 2: value 4 'nan' is not finite" -- \
+    msf_reconstruct "$K/odo_nan/sequences/04" -o out
+  # kitti2pcd -input_dir: a truncated scan among good ones converts nothing.
+  mkdir -p "$K/scans" "$K/pcds"
+  ln -s "$SEQ/velodyne/000000.bin" "$K/scans/000000.bin"
+  head -c 1000 "$SEQ/velodyne/000001.bin" >"$K/scans/000001.bin"
+  check "kitti2pcd -input_dir with a truncated scan" 1 "000001.bin' has 1000 bytes.*nothing was converted" -- \
+    msf_kitti2pcd -input_dir "$K/scans" -output_dir "$K/pcds"
+  if [ -n "$(ls -A "$K/pcds")" ]; then
+    failures=$((failures + 1))
+    echo "FAIL  kitti2pcd -input_dir left $(ls "$K/pcds")"
+  fi
+  # reconstruct: a run killed in OUT leaves OUT as it was; the next run removes its staging.
+  mkdir -p "$T/killed/out"
+  echo '{"previous": true}' >"$T/killed/out/summary.json"
+  mkdir "$T/killed/.out.partial.999999999" && touch "$T/killed/.out.partial.999999999/.mesh.tmp1.ply"
+  mkdir -p "$T/foreign" && touch "$T/foreign/notes.txt"
+  check "reconstruct: existing OUT with a foreign file" 1 "holds 'notes.txt', which no msf_reconstruct run writes" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -o "$T/foreign"
+  check "reconstruct: failed run in an existing OUT" 1 "frame range 0:100000" -- \
+    msf_reconstruct "$SEQ" -frames 0:100000 -o "$T/killed/out"
+  if ! grep -q previous "$T/killed/out/summary.json" || [ -e "$T/killed/.out.partial.999999999" ]; then
+    failures=$((failures + 1))
+    echo "FAIL  reconstruct: the previous OUT changed or a killed run's staging folder remains"
+    ls -la "$T/killed" "$T/killed/out"
+  fi
+else
+  for c in project-huge-calib interpolate-scaled-tr stereo-num-disparities stereo-prior stereo-color p1x \
+           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-voxel-small reconstruct-scans \
+           reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out; do
+    skip "$c"
+  done
+fi
+
+echo "$cases cases, $failures failed, $skipped skipped; slowest $slowest ms, largest $((largest / 1024)) MB"
+[ $failures = 0 ]
