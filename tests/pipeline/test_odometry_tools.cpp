@@ -9,6 +9,7 @@
 #include "pipeline_fixture.h"
 #include "test_support.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -104,7 +105,7 @@ TEST_F(PipelineTest, BadPoseFilesAreClearErrors) {
   expectToolError(msf::test::runTool("msf_eval_odometry", dir.file("eleven.txt") + " " + good), "msf_eval_odometry",
                   "eleven.txt' line 2: expected 12 numbers");
   expectToolError(msf::test::runTool("msf_eval_odometry", dir.file("scaled.txt") + " " + good), "msf_eval_odometry",
-                  "scaled.txt' line 2: not a rigid motion");
+                  "scaled.txt' line 2 is not a rigid transform");
   expectToolError(msf::test::runTool("msf_eval_odometry", dir.file("short.txt") + " " + good), "msf_eval_odometry",
                   "has 2 poses");
   expectToolError(msf::test::runTool("msf_eval_odometry", dir.file("nope.txt") + " " + good), "msf_eval_odometry",
@@ -153,7 +154,10 @@ TEST_F(PipelineTest, DegenerateScansStopTheTrackingWithTheScansName) {
     expectToolError(r, "msf_odometry", "velodyne/000001.bin': " + message);
     EXPECT_FALSE(msf::test::fileExists(dir.file("est.txt")));
     r = msf::test::runTool("msf_reconstruct", sequence + " -panels 0 -o " + dir.file("out"));
-    expectToolError(r, "msf_reconstruct", "velodyne/000001.bin': " + message);
+    // The pipeline's loading refuses a scan without a finite point before the tracking sees it.
+    const bool no_point = points.empty() || std::isnan(points.front());
+    expectToolError(r, "msf_reconstruct",
+                    no_point ? "velodyne/000001.bin' has no finite point" : "velodyne/000001.bin': " + message);
     EXPECT_FALSE(fs::exists(dir.file("out")));
   }
 }

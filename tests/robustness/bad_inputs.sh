@@ -287,8 +287,8 @@ if [ $have_kitti = 1 ]; then
   mkdir -p "$T/killed/out"
   echo '{"previous": true}' >"$T/killed/out/summary.json"
   mkdir "$T/killed/.out.partial.999999999" && touch "$T/killed/.out.partial.999999999/.mesh.tmp1.ply"
-  mkdir -p "$T/foreign" && touch "$T/foreign/notes.txt"
-  check "reconstruct: existing OUT with a foreign file" 1 "holds 'notes.txt', which no msf_reconstruct run writes" -- \
+  mkdir -p "$T/foreign" && touch "$T/foreign/notes.odt"
+  check "reconstruct: existing OUT with a foreign file" 1 "holds 'notes.odt', which no msf_reconstruct run writes" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -o "$T/foreign"
   check "reconstruct: failed run in an existing OUT" 1 "frame range 0:100000" -- \
     msf_reconstruct "$SEQ" -frames 0:100000 -o "$T/killed/out"
