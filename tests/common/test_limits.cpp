@@ -2,7 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 
-#include "error_of.h"
+#include "test_support.h"
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -97,19 +97,11 @@ TEST(DisparityMetrics, AccumulatesFramesByPixels) {
 
 TEST(DisparityMetrics, BadInputNamesTheImage) {
   const cv::Mat gt = row({10, 10});
-  auto message = [](auto&& call) {
-    try {
-      call();
-    } catch (const msf::InvalidInputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
-  };
-  EXPECT_NE(message([&] { msf::evaluateDisparity(gt, row({1, 2, 3})); }).find("estimated disparity is 3x1 but the ground truth is 2x1"),
+  EXPECT_NE(msf::test::errorOf([&] { msf::evaluateDisparity(gt, row({1, 2, 3})); }).find("estimated disparity is 3x1 but the ground truth is 2x1"),
             std::string::npos);
-  EXPECT_NE(message([&] { msf::evaluateDisparity(gt, cv::Mat(1, 2, CV_16U)); }).find("estimated disparity"),
+  EXPECT_NE(msf::test::errorOf([&] { msf::evaluateDisparity(gt, cv::Mat(1, 2, CV_16U)); }).find("estimated disparity"),
             std::string::npos);
-  EXPECT_NE(message([&] { msf::evaluateDisparity(gt, gt, cv::Mat(1, 3, CV_8U)); }).find("object map is 3x1"),
+  EXPECT_NE(msf::test::errorOf([&] { msf::evaluateDisparity(gt, gt, cv::Mat(1, 3, CV_8U)); }).find("object map is 3x1"),
             std::string::npos);
   EXPECT_THROW(msf::interpolateBackground(cv::Mat(2, 2, CV_8U)), msf::InvalidInputError);
 }

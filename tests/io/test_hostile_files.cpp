@@ -7,7 +7,6 @@
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
 
-#include "error_of.h"
 #include "test_support.h"
 
 #include <opencv2/core.hpp>

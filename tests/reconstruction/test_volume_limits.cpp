@@ -1,6 +1,5 @@
 // Issue 19: volume sizes, sweeps, poses and memory that would run away end in an error
 // naming the key or option, before the volume allocates.
-#include "error_of.h"
 #include "test_support.h"
 
 #include <msf/common/exceptions.h>

@@ -238,27 +238,19 @@ TEST(StereoConfidence, HandMadeDisparity) {
 TEST(SgbmStereo, BadInputNamesWhatIsWrong) {
   const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
   msf::SgbmStereo stereo(smallConfig());
-  auto message = [&](auto&& call) {
-    try {
-      call();
-    } catch (const msf::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
-  };
   // A missing image.
   stereo.setInputImages(pair.left, cv::Mat());
-  EXPECT_NE(message([&] { stereo.computeDisparity(); }).find("right image is missing"), std::string::npos);
+  EXPECT_NE(msf::test::errorOf([&] { stereo.computeDisparity(); }).find("right image is missing"), std::string::npos);
   stereo.setInputImages(cv::Mat(), pair.right);
   EXPECT_THROW(stereo.computeDisparity(), msf::InvalidInputError);
   // Left and right of different sizes.
   stereo.setInputImages(pair.left, pair.right(cv::Rect(0, 0, 300, 160)));
-  EXPECT_NE(message([&] { stereo.computeDisparity(); }).find("320x160 but the right image is 300x160"),
+  EXPECT_NE(msf::test::errorOf([&] { stereo.computeDisparity(); }).find("320x160 but the right image is 300x160"),
             std::string::npos);
   // Images whose size does not match the calibration.
   stereo.setCalibration(msf::test::syntheticCalibration(cv::Size(1226, 370)));
   stereo.setInputImages(pair.left, pair.right);
-  EXPECT_NE(message([&] { stereo.computeDisparity(); }).find("320x160 but calibration 'synthetic' is 1226x370"),
+  EXPECT_NE(msf::test::errorOf([&] { stereo.computeDisparity(); }).find("320x160 but calibration 'synthetic' is 1226x370"),
             std::string::npos);
   // Not 8-bit.
   cv::Mat wide;

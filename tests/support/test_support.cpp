@@ -96,7 +96,7 @@ std::string errorOf(const std::function<void()>& call) {
   } catch (const msf::Error& e) {
     return e.what();
   }
-  return "no exception";
+  return "(no error)";
 }
 
 } // namespace msf::test

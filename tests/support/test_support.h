@@ -46,7 +46,8 @@ CommandResult runTool(const std::string& tool, const std::string& arguments);
 
 bool fileExists(const std::string& path);
 
-/// The message of the msf::Error that `call` throws, or "no exception".
+/// The message of the msf::Error that `call` throws, or "(no error)": tests of hostile inputs
+/// check that the message names the option, key or file at fault.
 std::string errorOf(const std::function<void()>& call);
 
 /// Number of entries in a folder (to check that a failed tool left no file behind).
