@@ -178,14 +178,18 @@ TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
   const float d = (20.f * vS + 21.f * vL) / (vL + vS); // 20.8
   const auto f = msf::fuseUncertainty(in, config, static_cast<float>(kFB));
   EXPECT_NEAR(f.z, kFB / d, 1e-4);
-  // The weight is the inverse variance of the fused depth, the sum of the two sources':
-  // the LiDAR's range noise and interpolation error (0.05 px a pixel of distance, in depth),
-  // the stereo's 0.3 px in depth.
+  // The weight is the inverse variance of the fused depth: the sum of the two sources' (the
+  // LiDAR's range noise and interpolation error, 0.05 px a pixel of distance, in depth; the
+  // stereo's 0.3 px in depth), and the two samples' spread about the mean, each weighted.
+  // The free space in front weighs the sum alone.
   const float fb = static_cast<float>(kFB), z_L = in.z_lidar, z_S = in.z_stereo;
   const float interpolation = z_L * z_L * 0.05f * 6.f / fb, range = config.lidar_range_sigma_m;
   const float sigma_S = z_S * z_S * 0.3f / fb;
-  EXPECT_NEAR(f.weight, 1.f / (range * range + interpolation * interpolation) + 1.f / (sigma_S * sigma_S),
-              1e-3f * f.weight);
+  const float w_L = 1.f / (range * range + interpolation * interpolation), w_S = 1.f / (sigma_S * sigma_S);
+  const float z = f.z, spread = (w_L * (z_L - z) * (z_L - z) + w_S * (z_S - z) * (z_S - z)) / (w_L + w_S);
+  EXPECT_NEAR(f.free_weight, w_L + w_S, 1e-3f * f.free_weight);
+  EXPECT_NEAR(f.weight, 1.f / (1.f / (w_L + w_S) + spread), 1e-3f * f.weight);
+  EXPECT_LT(f.weight, 0.5f * f.free_weight); // 0.6 m apart at 20 m: the mean is not a LiDAR return
   // Far apart (4 px > 3 * sqrt(0.45)): not averaged, the more certain (stereo) wins.
   in.z_stereo = static_cast<float>(kFB / 24.0);
   EXPECT_FLOAT_EQ(msf::fuseUncertainty(in, config, static_cast<float>(kFB)).z, in.z_stereo);
@@ -203,6 +207,65 @@ TEST(DepthFusionUncertainty, InverseVarianceMeanInDisparity) {
   EXPECT_FLOAT_EQ(msf::stereoSigmaPx(1.f, config), 0.3f);
   EXPECT_FLOAT_EQ(msf::stereoSigmaPx(0.f, config), 4.f);
   EXPECT_NEAR(msf::stereoSigmaPx(0.5f, config), 0.3f + 3.7f * 0.25f, 1e-6f);
+}
+
+TEST(DepthFusionUncertainty, AMeanBetweenTwoSurfacesDoesNotWeighAsAReturn) {
+  // The case seen on the synthetic street: a real LiDAR return on the background (38 m) past
+  // a pole that stereo sees at 27.8 m with a weak match, all within 3 sigma in disparity.
+  // Averaged, the depth lies between the two surfaces; its weight must say so, while the free
+  // space in front of both stays certain.
+  const msf::DepthFusionConfig config; // the defaults
+  const float fb = 389.f;              // KITTI's f B, px m
+  msf::FusionInputs in;
+  in.z_lidar = 38.f;
+  in.lidar_edge_px = 4.f; // the pole's edge in the LiDAR's disparity
+  in.z_stereo = 27.8f;
+  in.stereo_confidence = 0.f;
+  const auto f = msf::fuseUncertainty(in, config, fb);
+  ASSERT_GT(f.z, in.z_stereo + 1.f); // averaged, between the surfaces
+  ASSERT_LT(f.z, in.z_lidar - 1.f);
+  const float real_return = 1.f / (config.lidar_range_sigma_m * config.lidar_range_sigma_m);
+  EXPECT_GT(f.free_weight, real_return);  // the sum of the two
+  EXPECT_LT(f.weight, 0.25f); // sigma of metres: below the integrator's min_pixel_weight
+  // Where the two agree, the spread costs little: the road at 20 m, 2 cm apart.
+  in.z_lidar = 20.f;
+  in.z_stereo = 20.02f;
+  in.lidar_edge_px = 0.f;
+  in.stereo_confidence = 1.f;
+  const auto g = msf::fuseUncertainty(in, config, fb);
+  EXPECT_GT(g.weight, 0.5f * g.free_weight);
+}
+
+TEST(DepthFusionUncertainty, LidarEdgeCueBendIsZeroOnAPlaneAndTheStepAtAnEdge) {
+  // A steep plane (the road: disparity affine in v, 0.4 px a row) and a step of 6 px in
+  // disparity along the row. The bend is 0 on the plane however steep; the range is not.
+  const int rows = 40, cols = 40;
+  cv::Mat depth(rows, cols, CV_32FC1);
+  for (int v = 0; v < rows; ++v)
+    for (int u = 0; u < cols; ++u)
+      depth.at<float>(v, u) = static_cast<float>(kFB / (10.0 + 0.4 * v + (u >= 20 ? 6.0 : 0.0)));
+  cv::Mat bend, range;
+  msf::localDisparityBend(depth, kFB, 2, bend);
+  msf::localDisparityRange(depth, kFB, 5, range);
+  EXPECT_NEAR(bend.at<float>(10, 5), 0.f, 1e-3f);
+  EXPECT_NEAR(range.at<float>(10, 5), 1.6f, 1e-3f); // 4 rows of 0.4 px
+  EXPECT_NEAR(bend.at<float>(10, 19), 6.f, 1e-3f);  // within the step of the edge
+  EXPECT_NEAR(bend.at<float>(10, 20), 6.f, 1e-3f);
+  EXPECT_NEAR(bend.at<float>(10, 22), 0.f, 1e-3f); // past it
+  // A missing neighbour counts 0; a step < 1 is refused by name.
+  depth.at<float>(10, 17) = 0.f;
+  msf::localDisparityBend(depth, kFB, 2, bend);
+  EXPECT_NEAR(bend.at<float>(10, 19), 0.f, 1e-3f);
+  EXPECT_THROW(msf::localDisparityBend(depth, kFB, 0, bend), msf::InvalidInputError);
+  // The configuration chooses the cue.
+  msf::DepthFusionConfig config;
+  cv::Mat cue;
+  config.lidar_edge_cue = msf::LidarEdgeCue::Range;
+  msf::lidarEdgeCue(depth, kFB, config, cue);
+  EXPECT_NEAR(cue.at<float>(30, 5), 1.6f, 1e-3f);
+  config.lidar_edge_cue = msf::LidarEdgeCue::Bend;
+  msf::lidarEdgeCue(depth, kFB, config, cue);
+  EXPECT_NEAR(cue.at<float>(30, 5), 0.f, 1e-3f);
 }
 
 TEST(DepthFusionUncertainty, WeightsAreInverseDepthVariancesThatTrustTheLidar) {
@@ -469,6 +532,7 @@ TEST(DepthFusionConfig, ReadsTheFusionSectionAndRejectsBadValues) {
   EXPECT_TRUE(fails("stereo_sigma_min_px: 0", "fusion.stereo_sigma_min_px"));
   EXPECT_TRUE(fails("stereo_sigma_max_px: 0.1", "fusion.stereo_sigma_max_px"));
   EXPECT_TRUE(fails("lidar_range_window_px: 4", "fusion.lidar_range_window_px"));
+  EXPECT_TRUE(fails("lidar_edge_cue: slope", "fusion.lidar_edge_cue"));
   EXPECT_TRUE(fails("disagreement_k_sigma: many", "fusion.disagreement_k_sigma"));
 }
 

@@ -352,6 +352,41 @@ TEST(TsdfIntegrator, SpaceCarvingRemovesASurfaceSeenThrough) {
   }
 }
 
+TEST(TsdfIntegrator, FreeSpaceWeighsTheFramesFreeSpaceWeight) {
+  // The wall at 2 m, then a wall at 3 m whose depth is uncertain (weight 25, sigma 0.2 m: the
+  // fusion's average of two samples that disagree) but whose free space in front is not (the frame's
+  // free_space_weight): the free-space weight, not the depth's, clears the old wall. A frame
+  // whose free space weighs nothing keeps it.
+  for (const float free : {0.f, 400.f}) {
+    TsdfVolume volume(0.05, 0.15);
+    TsdfIntegrator integrator(volume, TsdfIntegrator::Config{});
+    DepthFrame frame;
+    frame.camera = test::smallCamera();
+    frame.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.0f));
+    frame.weight = cv::Mat(240, 320, CV_32FC1, cv::Scalar(400.f));
+    integrator.integrate(frame, Eigen::Isometry3d::Identity());
+    frame.depth.setTo(3.0f);
+    frame.weight.setTo(25.f);
+    frame.free_space_weight = cv::Mat(240, 320, CV_32FC1, cv::Scalar(free));
+    for (int i = 0; i < 4; ++i)
+      integrator.integrate(frame, Eigen::Isometry3d::Identity());
+    // A voxel just behind the old wall (carving clears the sub-blocks that hold a surface):
+    // -0.05 m, or towards +truncation when carved.
+    const TsdfVoxel* old_wall = volume.findVoxel(volume.voxelIndexOf(Eigen::Vector3d(0.0, 0.0, 2.05)));
+    ASSERT_NE(old_wall, nullptr);
+    if (free > 0.f)
+      EXPECT_GT(old_wall->sdf, 0.08f) << "carved: free space";
+    else
+      EXPECT_NEAR(old_wall->sdf, -0.05f, 0.01f) << "kept: the wall's surface";
+  }
+  DepthFrame bad;
+  bad.camera = test::smallCamera();
+  bad.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.0f));
+  bad.free_space_weight = cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.f));
+  EXPECT_EQ(test::errorOf([&] { bad.validate(); }),
+            "depth frame: the free-space weight image must be CV_32FC1 of the depth image's size");
+}
+
 namespace {
 
 /// A street for the tests of grazing angles and free space: the road 1.65 m below camera 0

@@ -36,7 +36,8 @@ void DepthImageFusion::setCalibration(const Calibration& calibration) {
 }
 
 void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
-                            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight) {
+                            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight,
+                            cv::Mat* free_space_weight) {
   if (lidar_depth.empty())
     throw InvalidInputError("depth fusion: the LiDAR depth image is empty");
   const cv::Size size = lidar_depth.size();
@@ -61,16 +62,22 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   const cv::Mat& lidar = lidar_depth;
   const cv::Mat& stereo = stereo_depth;
   if (uncertainty)
-    localDisparityExtremes(lidar, focal_baseline_, config_.lidar_range_window_px, largest_, smallest_);
+    lidarEdgeCue(lidar, focal_baseline_, config_, edge_);
+  else { // the paper's method reads no edge cue
+    edge_.create(size, CV_32FC1);
+    edge_.setTo(0);
+  }
   fused_depth.create(size, CV_32FC1);
   cv::Mat& weight = fused_weight ? *fused_weight : weight_;
   weight.create(size, CV_32FC1);
+  if (free_space_weight)
+    free_space_weight->create(size, CV_32FC1);
   const float fB = static_cast<float>(focal_baseline_);
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v)
-      fuseRow(config_, fB, parallax_, lidar, v, distance.ptr<float>(v),
-              uncertainty ? largest_.ptr<float>(v) : nullptr, uncertainty ? smallest_.ptr<float>(v) : nullptr,
-              stereo.ptr<float>(v), confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v));
+      fuseRow(config_, fB, parallax_, lidar, v, distance.ptr<float>(v), edge_.ptr<float>(v), stereo.ptr<float>(v),
+              confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v),
+              free_space_weight ? free_space_weight->ptr<float>(v) : nullptr);
   });
   if (config_.edge_support)
     supportAtDepthEdges(lidar, distance, fB, config_, fused_depth, edge_buffers_);

@@ -16,6 +16,8 @@ FusionMethod parseFusionMethod(const std::string& name) {
 
 const char* toString(FusionMethod method) { return method == FusionMethod::Paper ? "paper" : "uncertainty"; }
 
+const char* toString(LidarEdgeCue cue) { return cue == LidarEdgeCue::Bend ? "bend" : "range"; }
+
 namespace {
 void positive(float value, const char* key) {
   if (!(value > 0.f))
@@ -45,6 +47,11 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   readKey(node, "lidar_sigma_px", lidar_sigma_px);
   readKey(node, "lidar_sigma_per_distance", lidar_sigma_per_distance);
   readKey(node, "lidar_sigma_per_range", lidar_sigma_per_range);
+  std::string cue_name = toString(lidar_edge_cue);
+  readKey(node, "lidar_edge_cue", cue_name);
+  if (cue_name != "bend" && cue_name != "range")
+    throw ConfigError("config key 'fusion.lidar_edge_cue' must be bend or range, not '" + cue_name + "'");
+  lidar_edge_cue = cue_name == "bend" ? LidarEdgeCue::Bend : LidarEdgeCue::Range;
   readKey(node, "disagreement_k_sigma", disagreement_k_sigma);
   readKey(node, "lidar_range_window_px", lidar_range_window_px);
   readKey(node, "parallax_check", parallax_check);
@@ -95,6 +102,7 @@ void DepthFusionConfig::print(std::ostream& out) const {
       << "  lidar_sigma_px: " << configValue(lidar_sigma_px) << "\n"
       << "  lidar_sigma_per_distance: " << configValue(lidar_sigma_per_distance) << "\n"
       << "  lidar_sigma_per_range: " << configValue(lidar_sigma_per_range) << "\n"
+      << "  lidar_edge_cue: " << toString(lidar_edge_cue) << "\n"
       << "  lidar_range_sigma_m: " << configValue(lidar_range_sigma_m) << "\n"
       << "  disagreement_k_sigma: " << configValue(disagreement_k_sigma) << "\n"
       << "  lidar_range_window_px: " << configValue(lidar_range_window_px) << "\n"

@@ -5,7 +5,11 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace msf {
 
@@ -21,14 +25,9 @@ MSF_VECTOR_CLONES void disparityBounds(const float* __restrict__ z, int cols, fl
     smallest[u] = ok ? d : inf;
   }
 }
-} // namespace
 
 void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& largest,
                             cv::Mat& smallest) {
-  if (depth.type() != CV_32FC1)
-    throw InvalidInputError("LiDAR depth image must be CV_32FC1 (metres)");
-  if (window < 1 || window % 2 == 0)
-    throw InvalidInputError("local disparity range: window must be odd and >= 1");
   const int rows = depth.rows, cols = depth.cols;
   const float fB = static_cast<float>(focal_baseline);
   // Missing pixels are 0 for the maximum and +inf for the minimum, so both see only values.
@@ -43,24 +42,76 @@ void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int win
   cv::erode(smallest, smallest, kernel);
 }
 
+void requireDepth(const cv::Mat& depth) {
+  if (depth.type() != CV_32FC1)
+    throw InvalidInputError("LiDAR depth image must be CV_32FC1 (metres)");
+}
+
+/// |a + b - 2 c| where a, b and c are valid disparities (> 0), else 0.
+inline float bendOf(float a, float b, float c) {
+  return (a > 0.f) & (b > 0.f) & (c > 0.f) ? std::fabs(a + b - 2.f * c) : 0.f;
+}
+} // namespace
+
 void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& range) {
+  requireDepth(depth);
+  if (window < 1 || window % 2 == 0)
+    throw InvalidInputError("local disparity range: window must be odd and >= 1");
   cv::Mat largest, smallest;
   localDisparityExtremes(depth, focal_baseline, window, largest, smallest);
   range.create(depth.rows, depth.cols, CV_32FC1);
+  const float inf = std::numeric_limits<float>::infinity();
   for (int v = 0; v < depth.rows; ++v) {
     const float* __restrict__ h = largest.ptr<float>(v);
     const float* __restrict__ l = smallest.ptr<float>(v);
     float* __restrict__ out = range.ptr<float>(v);
     for (int u = 0; u < depth.cols; ++u)
-      out[u] = disparityRangeAt(h, l, u);
+      out[u] = l[u] < inf ? h[u] - l[u] : 0.f;
   }
+}
+
+void localDisparityBend(const cv::Mat& depth, double focal_baseline, int step, cv::Mat& bend) {
+  requireDepth(depth);
+  if (step < 1)
+    throw InvalidInputError("local disparity bend: step must be >= 1, not " + std::to_string(step));
+  const int rows = depth.rows, cols = depth.cols, s = step;
+  const float fB = static_cast<float>(focal_baseline);
+  // The disparities first (0 = none), then the second differences of whole rows.
+  cv::Mat d(rows, cols, CV_32FC1);
+  bend.create(rows, cols, CV_32FC1);
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
+    std::vector<float> unused(static_cast<std::size_t>(cols));
+    for (int v = r.start; v < r.end; ++v)
+      disparityBounds(depth.ptr<float>(v), cols, fB, d.ptr<float>(v), unused.data());
+  });
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
+    for (int v = r.start; v < r.end; ++v) {
+      const float* __restrict__ c = d.ptr<float>(v);
+      float* __restrict__ out = bend.ptr<float>(v);
+      const bool column = v - s >= 0 && v + s < rows;
+      const float* __restrict__ up = d.ptr<float>(column ? v - s : v);
+      const float* __restrict__ down = d.ptr<float>(column ? v + s : v);
+      for (int u = 0; u < cols; ++u)
+        out[u] = column ? bendOf(up[u], down[u], c[u]) : 0.f;
+      for (int u = s; u + s < cols; ++u)
+        out[u] = std::max(out[u], bendOf(c[u - s], c[u + s], c[u]));
+    }
+  });
+}
+
+void lidarEdgeCue(const cv::Mat& lidar_depth, double focal_baseline, const DepthFusionConfig& config,
+                  cv::Mat& cue) {
+  if (config.lidar_edge_cue == LidarEdgeCue::Bend)
+    localDisparityBend(lidar_depth, focal_baseline, std::max(1, config.lidar_range_window_px / 2), cue);
+  else
+    localDisparityRange(lidar_depth, focal_baseline, config.lidar_range_window_px, cue);
 }
 
 MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
                                const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
-                               const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
-                               const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
-                               float* __restrict__ fused_z, float* __restrict__ fused_weight) {
+                               const float* __restrict__ lidar_edge, const float* __restrict__ z_stereo,
+                               const float* __restrict__ stereo_confidence, float* __restrict__ fused_z,
+                               float* __restrict__ fused_weight, float* __restrict__ fused_free_weight) {
   const int width = lidar_depth.cols, rows = lidar_depth.rows;
   const float* __restrict__ z_lidar = lidar_depth.ptr<float>(v);
   const DepthFusionConfig config = c; // a local copy: the compiler may keep it in registers
@@ -78,21 +129,25 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
       fused_z[u] = r.z;
       fused_weight[u] = r.weight * depthWeight(r.z, best_stereo, focal_baseline);
     }
+    if (fused_free_weight)
+      std::copy_n(fused_weight, width, fused_free_weight);
     return;
   }
-  const float inf = std::numeric_limits<float>::infinity();
+  // A local array when the caller wants no free-space weights: the loop stays branch-free.
+  std::vector<float> free_buffer(fused_free_weight ? 0 : static_cast<std::size_t>(width));
+  float* __restrict__ free_weight = fused_free_weight ? fused_free_weight : free_buffer.data();
   int candidates = 0; // pixels for the parallax check below
   for (int u = 0; u < width; ++u) {
     FusionInputs in;
     in.z_lidar = z_lidar[u];
     in.lidar_distance = lidar_distance[u];
-    const float range = lidar_max[u] - lidar_min[u];
-    in.lidar_range_px = lidar_min[u] < inf ? range : 0.f;
+    in.lidar_edge_px = lidar_edge[u];
     in.z_stereo = z_stereo[u];
     in.stereo_confidence = stereo_confidence[u];
     const FusionResult r = fuseUncertainty(in, config, focal_baseline);
     fused_z[u] = r.z;
     fused_weight[u] = r.weight;
+    free_weight[u] = r.free_weight;
     candidates += (in.z_stereo > 0.f) & (r.z == in.z_lidar) & (in.z_stereo < in.z_lidar);
   }
   if (candidates == 0 || !(parallax.rows_per_px > 0.f))
@@ -109,6 +164,7 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
     if (past) {
       fused_z[u] = z_stereo[u];
       fused_weight[u] = depthWeight(z_stereo[u], 1.f / (s_S * s_S), focal_baseline);
+      free_weight[u] = fused_weight[u];
     }
   }
 }

@@ -92,7 +92,7 @@ void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   DepthFrame& fused = result.fused;
   stages_->fusion.fuse(result.lidar_depth, result.lidar_distance, result.stereo_depth, result.stereo_confidence,
-                       fused.depth, &fused.weight);
+                       fused.depth, &fused.weight, &fused.free_space_weight);
   // Colour from the colour camera at the fused point, also where only the LiDAR has depth.
   fused.camera = camera_;
   const ColorSampler sampler = frame.color.empty()

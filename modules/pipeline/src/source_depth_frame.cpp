@@ -76,6 +76,10 @@ DepthFrame fusedDepthFrame(const FrameResult& result, const DepthFusionConfig& f
                               static_cast<float>(focal_baseline));
   result.fused.depth.copyTo(frame.depth(image));
   result.fused.weight.copyTo(frame.weight(image));
+  if (!result.fused.free_space_weight.empty()) { // around the image, the LiDAR's own weight
+    frame.free_space_weight = frame.weight.clone();
+    result.fused.free_space_weight.copyTo(frame.free_space_weight(image));
+  }
   if (!result.fused.color.empty())
     frame.color = canvasColour(result.fused.color, image, frame.depth.size());
   return frame;
@@ -101,13 +105,13 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
   DepthFrame out;
   if (lidar) {
     // The LiDAR alone has no stereo to settle its edges (returns seen past a foreground edge,
-    // interpolation across one): its weight counts the local disparity range too, as the
+    // interpolation across one): its weight counts the edge cue too, as the
     // fusion's sigma does. On its canvas, as the fused frame.
     const cv::Rect image = imageInCanvas(result, depth.size());
     const cv::Mat& canvas = image.empty() ? depth : result.lidar_canvas_depth;
     const cv::Mat& distance = image.empty() ? cue : result.lidar_canvas_distance;
     cv::Mat range;
-    localDisparityRange(canvas, focal_baseline, fusion.lidar_range_window_px, range);
+    lidarEdgeCue(canvas, focal_baseline, fusion, range);
     out.depth = canvas;
     out.weight = lidarWeights(canvas, distance, range, fusion, fb);
     out.camera = image.empty() ? result.fused.camera : result.lidar_canvas_camera;

@@ -23,6 +23,8 @@ void DepthFrame::validate() const {
     throw InvalidInputError("depth frame: the colour image must be CV_8UC3 of the depth image's size");
   if (!weight.empty() && (weight.type() != CV_32FC1 || weight.size() != depth.size()))
     throw InvalidInputError("depth frame: the weight image must be CV_32FC1 of the depth image's size");
+  if (!free_space_weight.empty() && (free_space_weight.type() != CV_32FC1 || free_space_weight.size() != depth.size()))
+    throw InvalidInputError("depth frame: the free-space weight image must be CV_32FC1 of the depth image's size");
 }
 
 namespace detail {

@@ -311,17 +311,22 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // (beyond, free space holds it at +truncation: the full truncation cost 12 % more time for
   // the same maps), a voxel below it (enough for the sign change marching cubes needs).
   const float above_plane = std::min(trunc, 1.5f * vs), below_plane = std::min(trunc, vs);
+  // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
+  const bool own_free = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
+  const cv::Mat& free_weight = own_free ? frame.free_space_weight : cv::Mat();
+  const float carving_weight = static_cast<float>(config_.carving_weight);
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
       const float* e = extent_.ptr<float>(v);
+      const float* f = free_weight.empty() ? w : free_weight.ptr<float>(v);
       PixelBand* out = &pixels_[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
         const float noise = w[u] > 0.f ? sigmas / std::sqrt(w[u]) : 0.f;
         const float front = std::max({trunc, above_plane / s[u], noise});
         const float below = std::min(below_plane / s[u], e[u]); // not past where the surface is seen
-        out[u] = {s[u], front, std::min(front, std::max({trunc, below, noise})), w[u]};
+        out[u] = {s[u], front, std::min(front, std::max({trunc, below, noise})), w[u], carving_weight * f[u]};
       }
     }
   });
@@ -470,7 +475,6 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::vector<std::uint16_t> changed_count(blocks.size(), 0);
   const bool bilinear = config_.interpolate_depth;
   const bool carving = config_.space_carving;
-  const float carving_weight = static_cast<float>(config_.carving_weight);
   const bool dropoff = config_.weight_dropoff;
   const float colour_band = 1.5f * vs;
   const float max_weight = config_.max_weight;
@@ -614,12 +618,10 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       // 1 / scale^2 times larger, but weighting by it let grazing views of noisy far stereo
       // outweigh the rest: on the synthetic street, 0.145 m mesh accuracy against 0.043 m at
       // the same min_weight, and a worse accuracy at every completeness.)
-      float w = pixel.weight;
-      if (!(w > 0.f))
+      if (!(pixel.weight > 0.f))
         continue;
-      if (!in_band)
-        w *= carving_weight; // free space is weaker evidence than a surface
-      else if (dropoff && sdf < -vs && behind * scale > vs)
+      float w = in_band ? pixel.weight : pixel.free; // free space: carving_weight of the evidence
+      if (in_band && dropoff && sdf < -vs && behind * scale > vs)
         w *= (behind * scale + sdf) / (behind * scale - vs); // behind the surface the observation is a guess
       if (!(w > 0.f))
         continue; // at the band's far end the drop-off leaves nothing

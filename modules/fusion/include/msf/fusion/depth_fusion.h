@@ -85,7 +85,7 @@ private:
   PointCloudStereoConstPtr stereo_;
   cv::Mat color_;
   int color_camera_{2};
-  cv::Mat lidar_depth_, lidar_distance_, lidar_max_, lidar_min_; ///< work buffers, kept between frames
+  cv::Mat lidar_depth_, lidar_distance_, lidar_edge_; ///< work buffers, kept between frames
   cv::Mat fused_depth_, fused_weight_;
   EdgeSupportBuffers edge_buffers_;
 };

@@ -34,17 +34,19 @@ public:
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]
   /// (empty: all 1); all of one size. Writes fused_depth (CV_32FC1, 0 = none) and, when
-  /// given, fused_weight (CV_32FC1). Throws InvalidInputError naming the image whose type or
-  /// size is wrong, CalibrationError when no calibration was set.
+  /// given, fused_weight and free_space_weight (CV_32FC1, FusionResult). Throws
+  /// InvalidInputError naming the image whose type or size is wrong, CalibrationError when no
+  /// calibration was set.
   void fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
-            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr);
+            const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr,
+            cv::Mat* free_space_weight = nullptr);
 
 private:
   DepthFusionConfig config_;
   double focal_baseline_{0.0};
   Calibration calibration_;
   LidarParallax parallax_;
-  cv::Mat largest_, smallest_;          ///< local LiDAR disparity extremes, kept between frames
+  cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames
   cv::Mat weight_;                      ///< weights when the caller wants none
   cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none
   EdgeSupportBuffers edge_buffers_;

@@ -16,6 +16,13 @@ enum class FusionMethod {
 FusionMethod parseFusionMethod(const std::string& name);
 const char* toString(FusionMethod method);
 
+/// What marks an edge in the interpolated LiDAR, for its sigma (lidarEdgeCue).
+enum class LidarEdgeCue {
+  Bend, ///< the second difference of the disparity: 0 on any plane, the road at any slope
+  Range ///< max - min disparity in a window: a plane's slope counts as an edge
+};
+const char* toString(LidarEdgeCue cue);
+
 /// Every parameter of DepthFusion, read from the `fusion` section of a config file.
 /// The defaults were measured on KITTI odometry 04 frames 0-9 under protocol 2
 /// (msf_holdout; docs/results.md has the table).
@@ -33,12 +40,13 @@ struct DepthFusionConfig {
   float stereo_sigma_max_px = 2.5f;           ///< ... of confidence 0 (quadratic in 1 - confidence between)
   float lidar_sigma_px = 0.1f;                ///< sigma of the LiDAR on a smooth surface at a real return
   float lidar_sigma_per_distance = 0.02f;     ///< growth per pixel of distance to the nearest real return
-  float lidar_sigma_per_range = 0.3f;         ///< growth per pixel of local disparity range (an edge)
+  float lidar_sigma_per_range = 0.3f;         ///< growth per pixel of the edge cue (lidar_edge_cue)
+  LidarEdgeCue lidar_edge_cue = LidarEdgeCue::Bend; ///< bend (step lidar_range_window_px / 2) or range
   /// The range noise of a LiDAR return in metres, for the fused weight (lidarDepthWeight):
   /// the HDL-64E's is under 2 cm; 3 cm leaves room for calibration and timing.
   float lidar_range_sigma_m = 0.03f;
   float disagreement_k_sigma = 3.f;           ///< beyond k sigma the more certain sample wins alone
-  int lidar_range_window_px = 5;              ///< odd window of the LiDAR's local disparity range
+  int lidar_range_window_px = 5;              ///< odd window of the LiDAR's edge cue
   bool parallax_check = true;                 ///< stereo wins where the LiDAR saw past a foreground edge
   int parallax_max_rows = 16;                 ///< rows below a pixel searched for that foreground
 

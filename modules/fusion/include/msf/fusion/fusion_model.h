@@ -14,17 +14,20 @@ namespace msf {
 struct FusionInputs {
   float z_lidar = 0.f;           ///< interpolated LiDAR depth, metres
   float lidar_distance = 0.f;    ///< pixels from this pixel to the nearest real LiDAR return
-  float lidar_range_px = 0.f;    ///< max - min LiDAR disparity around the pixel (uncertainty only)
+  float lidar_edge_px = 0.f;     ///< the LiDAR's edge cue at the pixel, lidarEdgeCue (uncertainty only)
   float z_stereo = 0.f;          ///< stereo depth, metres
   float stereo_confidence = 1.f; ///< in [0, 1], stereo_confidence.h
 };
 
 /// Fused depth (0 = none) and its weight (0 = none): fusePaper's in [0, 1], fuseUncertainty's
 /// the inverse variance of the depth in m^-2 (depthWeight). fuseRow gives both methods' in
-/// m^-2, what the integrator averages with.
+/// m^-2, what the integrator averages with. free_weight: the weight of the evidence that the
+/// ray is free in front of the depth; the weight's, except for an average of two samples
+/// that disagree (fuseUncertainty): its depth is uncertain, the space in front of both is not.
 struct FusionResult {
   float z = 0.f;
   float weight = 0.f;
+  float free_weight = 0.f;
 };
 
 namespace detail {
@@ -59,6 +62,7 @@ inline FusionResult fusePaper(const FusionInputs& in, const DepthFusionConfig& c
   FusionResult r;
   r.z = stereo ? y : (lidar ? in.z_lidar : 0.f);
   r.weight = std::min(1.f, stereo ? w_L + w_S : w_L);
+  r.free_weight = r.weight;
   return r;
 }
 
@@ -71,11 +75,11 @@ inline float stereoSigmaPx(float confidence, const DepthFusionConfig& c) {
 
 /// Sigma of an interpolated LiDAR disparity (pixels): lidar_sigma_px on a real return on a
 /// smooth surface, growing linearly with the distance to the nearest real return and with
-/// the local disparity range (across an object edge interpolation mixes the two sides, and
+/// the edge cue (lidarEdgeCue: across an object edge interpolation mixes the two sides, and
 /// a return from behind a foreground edge, which the LiDAR mounted above the camera sees
 /// and the camera does not, sits next to the foreground's returns).
-inline float lidarSigmaPx(float distance, float range_px, const DepthFusionConfig& c) {
-  return c.lidar_sigma_px + c.lidar_sigma_per_distance * distance + c.lidar_sigma_per_range * range_px;
+inline float lidarSigmaPx(float distance, float edge_px, const DepthFusionConfig& c) {
+  return c.lidar_sigma_px + c.lidar_sigma_per_distance * distance + c.lidar_sigma_per_range * edge_px;
 }
 
 /// The inverse variance of a depth z, 1 / sigma_z^2 in m^-2, from the inverse variance of its
@@ -111,7 +115,7 @@ inline float lidarDepthWeight(float z, float interpolation_px, float focal_basel
 inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionConfig& c, float focal_baseline) {
   // Bitwise & and | on the flags, and every division done unconditionally: no branches.
   const bool lidar = in.z_lidar > 0.f, stereo = in.z_stereo > 0.f;
-  const float s_L = lidarSigmaPx(in.lidar_distance, in.lidar_range_px, c);
+  const float s_L = lidarSigmaPx(in.lidar_distance, in.lidar_edge_px, c);
   const float s_S = stereoSigmaPx(in.stereo_confidence, c);
   const float v_L = s_L * s_L, v_S = s_S * s_S, v_sum = v_L + v_S;
   const float d_L = focal_baseline / (lidar ? in.z_lidar : 1.f);
@@ -132,9 +136,17 @@ inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionCon
   // support).
   const float w_L = lidarDepthWeight(in.z_lidar, c.lidar_sigma_per_distance * in.lidar_distance, focal_baseline, c);
   const float w_S = depthWeight(in.z_stereo, 1.f / v_S, focal_baseline);
+  // An average's variance is its samples' spread about it as well as theirs: where the two
+  // disagree (a LiDAR return seen past a pole that stereo sees), the mean lies between two
+  // surfaces and must not weigh as a LiDAR return.
+  const float w_sum = both ? w_L + w_S : 1.f;
+  const float dz_L = in.z_lidar - z_mean, dz_S = in.z_stereo - z_mean;
+  const float spread = (w_L * dz_L * dz_L + w_S * dz_S * dz_S) / w_sum;
+  const float w_mean = 1.f / (1.f / w_sum + spread);
   FusionResult r;
   r.z = take_lidar ? in.z_lidar : (take_stereo ? in.z_stereo : (both ? z_mean : 0.f));
-  r.weight = take_lidar ? w_L : (take_stereo ? w_S : (both ? w_L + w_S : 0.f));
+  r.weight = take_lidar ? w_L : (take_stereo ? w_S : (both ? w_mean : 0.f));
+  r.free_weight = take_lidar ? w_L : (take_stereo ? w_S : (both ? w_L + w_S : 0.f));
   return r;
 }
 
@@ -172,31 +184,34 @@ LidarParallax lidarParallax(const Calibration& calibration, const DepthFusionCon
 
 /// One image row of the fusion, the loop both DepthFusion and DepthImageFusion run: `width`
 /// pixels of row `v` of `lidar_depth` (CV_32FC1, not > 0 = none), with the row's LiDAR
-/// distances and local disparity extremes (localDisparityExtremes; read by the uncertainty
-/// method only), stereo depths (not > 0 = none) and confidences; no pointer may be null. Writes
-/// fused depth (0 = none) and weight. The per-pixel pass vectorises; the rare parallax
-/// checks follow it.
+/// distances and edge cue (lidarEdgeCue; read by the uncertainty method only), stereo depths
+/// (not > 0 = none) and confidences; no input pointer may be null. Writes fused depth (0 =
+/// none), weight and, unless null, free-space weight (FusionResult). The per-pixel pass
+/// vectorises; the rare parallax checks follow it.
 void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
              const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,
-             const float* __restrict__ lidar_max, const float* __restrict__ lidar_min,
-             const float* __restrict__ z_stereo, const float* __restrict__ stereo_confidence,
-             float* __restrict__ fused_z, float* __restrict__ fused_weight);
+             const float* __restrict__ lidar_edge, const float* __restrict__ z_stereo,
+             const float* __restrict__ stereo_confidence, float* __restrict__ fused_z,
+             float* __restrict__ fused_weight, float* __restrict__ fused_free_weight);
 
 /// Local disparity range of a depth image (CV_32F metres, 0 = none): at each pixel, the
 /// largest minus the smallest disparity f B / z over the valid pixels of the odd `window`
 /// (0 where the window holds at most one value). Reuses `range` when it has the right size.
-/// Throws InvalidInputError for a wrong type.
+/// Throws InvalidInputError for a wrong type or an even window.
 void localDisparityRange(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& range);
 
-/// The two halves of localDisparityRange, for loops that take the difference themselves:
-/// the largest (0 where none) and the smallest (+inf where none) disparity in the window.
-/// Reuses the matrices when they have the right size.
-void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int window, cv::Mat& largest,
-                            cv::Mat& smallest);
+/// Local bend of a depth image's disparity d = f B / z (CV_32F metres, 0 = none): at each
+/// valid pixel, the larger of |d(u - s) + d(u + s) - 2 d(u)| along the row and along the
+/// column, s = step pixels (a side without both neighbours valid counts 0). On any plane d is
+/// affine in the pixel coordinates and the bend is 0, however steep (the road); at an object's
+/// edge it is the step's height. Reuses `bend` when it has the right size. Throws
+/// InvalidInputError for a wrong type or a step < 1.
+void localDisparityBend(const cv::Mat& depth, double focal_baseline, int step, cv::Mat& bend);
 
-/// localDisparityRange at one pixel from localDisparityExtremes' rows.
-inline float disparityRangeAt(const float* largest, const float* smallest, int u) {
-  return smallest[u] < std::numeric_limits<float>::infinity() ? largest[u] - smallest[u] : 0.f;
-}
+/// The LiDAR's edge cue for lidarSigmaPx, as config.lidar_edge_cue says: the local disparity
+/// bend with step lidar_range_window_px / 2 (bend), or the local disparity range over the
+/// window (range).
+void lidarEdgeCue(const cv::Mat& lidar_depth, double focal_baseline, const DepthFusionConfig& config,
+                  cv::Mat& cue);
 
 } // namespace msf

@@ -17,6 +17,10 @@ struct DepthFrame {
   cv::Mat depth;   ///< CV_32FC1, z in metres; 0 or NaN = no depth
   cv::Mat color;   ///< CV_8UC3 in OpenCV's BGR order, or empty
   cv::Mat weight;  ///< CV_32FC1 (>= 0), or empty
+  /// CV_32FC1 (>= 0): the weight of the free space in front of each pixel's depth, for space
+  /// carving; empty: the weight's. The fusion's differs where it averaged two samples that
+  /// disagree: where the surface is is uncertain, that the ray passed in front of both is not.
+  cv::Mat free_space_weight;
   PinholeCamera camera;
 
   /// Throws InvalidInputError naming the image that has a wrong type or size, or the camera

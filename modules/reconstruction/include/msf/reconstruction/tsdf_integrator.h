@@ -21,6 +21,7 @@ namespace detail {
 /// behind its depth voxels are updated (along the ray), and its weight.
 struct PixelBand {
   float scale, front, behind, weight;
+  float free; ///< the weight of a free-space update, carving_weight included
 };
 } // namespace detail
 

@@ -78,7 +78,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   });
   const bool uncertainty = config_.method == FusionMethod::Uncertainty;
   if (uncertainty)
-    localDisparityExtremes(lidar_depth_, fB, config_.lidar_range_window_px, lidar_max_, lidar_min_);
+    lidarEdgeCue(lidar_depth_, fB, config_, lidar_edge_);
 
   const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -112,8 +112,8 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
           confidence[u] = 1.f;
       }
       fuseRow(config, fB, parallax, lidar_depth_, v, lidar_distance_.empty() ? zeros.data() : lidar_distance_.ptr<float>(v),
-              uncertainty ? lidar_max_.ptr<float>(v) : nullptr, uncertainty ? lidar_min_.ptr<float>(v) : nullptr,
-              z_stereo.data(), confidence.data(), fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v));
+              uncertainty ? lidar_edge_.ptr<float>(v) : zeros.data(), z_stereo.data(), confidence.data(),
+              fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v), nullptr);
     }
   });
   if (config.edge_support)
