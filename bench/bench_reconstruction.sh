@@ -5,7 +5,8 @@
 # Prints one table per dataset: per depth source (the fused mesh, the per-frame fused depth,
 # the mesh of the interpolated LiDAR alone, of SGBM alone) coverage and D1 (missing = bad)
 # within the map's depth range and over all ground-truth pixels; on the street also the
-# meshes' accuracy, completeness and ghost share.
+# meshes' accuracy, completeness and ghost share, and completeness by the nearest distance
+# each piece of the surface was seen from.
 #
 # Usage: bench/bench_reconstruction.sh BIN_DIR KITTI_DIR [OUT [msf_reconstruct options...]]
 #   OUT keeps each run's folder (summary.json, report.md, meshes) and the generated street,
@@ -84,6 +85,12 @@ for name, title in titles.items():
         print(line)
     if e.get("moving_split"):
         print("  (static pixels; moving objects apart in summary.json)")
+    if synthetic:
+        for source, r in e["rows"].items():
+            bands = (r.get("accuracy") or {}).get("completeness_by_nearest_view", [])
+            if bands:
+                print(f"  {source} completeness by the nearest distance seen from: " + ", ".join(
+                    f"{b['lower_m']:g}-{b['upper_m']:g} m {100 * b['completeness']:.1f}% ({b['samples']})" for b in bands))
     if synthetic and e.get("no_ghosts"):
         print(f"  ghosts: {e['no_ghosts']}")
 print(f"\nRuns, logs and reports: {out}")

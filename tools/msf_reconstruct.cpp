@@ -106,7 +106,8 @@ struct GroundTruthScores {
   std::unique_ptr<msf::synthetic::GroundTruth> truth;
   std::map<std::string, msf::DepthErrorAccumulator> all, background, foreground;
   std::vector<Eigen::Vector3f> seen_surface;  // ground-truth depth back-projected to the world
-  /// For the mesh's completeness; not for a streamed map (no mesh scores): it grows by ~0.3 MB
+  std::vector<float> seen_depth;              // the depth each was seen at
+  /// For the mesh's completeness; not for a streamed map (no mesh scores): it grows by ~0.4 MB
   /// a frame, what a drive in bounded memory cannot keep.
   bool keep_surface = true;
 
@@ -132,8 +133,10 @@ struct GroundTruthScores {
     for (int v = 0; v < gt.rows; v += 4)
       for (int u = 0; u < gt.cols; u += 4) {
         const float z = gt.at<float>(v, u);
-        if (z > 0.f && z <= max_depth_m && moving.at<std::uint8_t>(v, u) == 0)
+        if (z > 0.f && z <= max_depth_m && moving.at<std::uint8_t>(v, u) == 0) {
           seen_surface.push_back(T * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
+          seen_depth.push_back(z);
+        }
       }
   }
 };
@@ -682,11 +685,16 @@ int main(int argc, char** argv) {
       std::unique_ptr<msf::SurfaceDistance> static_surface;
       if (was_moving)
         static_surface = std::make_unique<msf::SurfaceDistance>(truth); // gt/scene.ply: the static scene
+      // The nearest distance each piece of the seen surface was seen from (cells of a voxel):
+      // what a frame far away cannot place within the completeness threshold.
+      const std::vector<float> view_distance = msf::nearestViewDistance(
+          scores.seen_surface, scores.seen_depth, static_cast<float>(config.volume.voxel_size_m));
       for (const auto& [name, m] : meshes) {
         if (!m.second)
           continue;
         accuracy[name] =
-            msf::evaluateMesh(*m.second, truth, scores.seen_surface, 2.0 * config.volume.voxel_size_m, 1.0);
+            msf::evaluateMesh(*m.second, truth, scores.seen_surface, 2.0 * config.volume.voxel_size_m, 1.0, 200000,
+                              &view_distance);
         if (was_moving)
           ghosts[name] = msf::measureGhosts(m.first->vertices, *static_surface, was_moving, kGhostDistanceM);
       }

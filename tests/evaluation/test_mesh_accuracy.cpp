@@ -62,6 +62,43 @@ TEST(MeshAccuracy, OffsetPlaneGivesItsOffsetAndPartialCompleteness) {
   EXPECT_NEAR(a.completeness, 0.25, 1e-9);
 }
 
+TEST(MeshAccuracy, CompletenessByTheNearestDistanceASurfaceWasSeenFrom) {
+  // The same square; every sample seen from 25 m, and those with x, y < 2 also from 5 m (a
+  // second frame's samples at the same places). The mesh covers x, y < 2: what was seen near
+  // is complete, what was seen only from far is not.
+  const pcl::PolygonMesh truth = gridSquare(4.f, 8, 0.f);
+  const pcl::PolygonMesh mesh = gridSquare(2.f, 10, 0.02f);
+  std::vector<Eigen::Vector3f> seen;
+  std::vector<float> depth;
+  for (int j = 0; j < 40; ++j)
+    for (int i = 0; i < 40; ++i) {
+      const Eigen::Vector3f p(4.f * (i + 0.5f) / 40, 4.f * (j + 0.5f) / 40, 0.f);
+      seen.push_back(p);
+      depth.push_back(25.f);
+      if (p.x() < 2.f && p.y() < 2.f) {
+        seen.push_back(p);
+        depth.push_back(5.f);
+      }
+    }
+  const std::vector<float> nearest = msf::nearestViewDistance(seen, depth, 0.1f);
+  ASSERT_EQ(nearest.size(), seen.size());
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    EXPECT_EQ(nearest[i], seen[i].x() < 2.f && seen[i].y() < 2.f ? 5.f : 25.f);
+  const msf::MeshAccuracy a = msf::evaluateMesh(mesh, truth, seen, 0.05, 1.0, 200000, &nearest);
+  ASSERT_EQ(a.by_view_distance.size(), 3u); // 0-10, 10-20, 20-30 m
+  EXPECT_EQ(a.by_view_distance[0].samples, 800u);
+  EXPECT_DOUBLE_EQ(a.by_view_distance[0].completeness, 1.0);
+  EXPECT_EQ(a.by_view_distance[1].samples, 0u);
+  EXPECT_EQ(a.by_view_distance[2].samples, 1200u);
+  EXPECT_DOUBLE_EQ(a.by_view_distance[2].completeness, 0.0);
+  EXPECT_DOUBLE_EQ(a.by_view_distance[2].upper_m, 30.0);
+  // Sizes that differ are refused by name.
+  depth.pop_back();
+  EXPECT_EQ(msf::test::errorOf([&] { msf::nearestViewDistance(seen, depth, 0.1f); }),
+            "nearest view distance: 1999 depths for 2000 points");
+  EXPECT_THROW(msf::evaluateMesh(mesh, truth, seen, 0.05, 1.0, 200000, &depth), msf::InvalidInputError);
+}
+
 TEST(MeshAccuracy, EmptyMeshIsAnError) {
   EXPECT_THROW(msf::evaluateMesh(pcl::PolygonMesh(), gridSquare(1.f, 1, 0.f), {}, 0.1), msf::InvalidInputError);
   EXPECT_THROW(msf::SurfaceDistance(pcl::PolygonMesh()), msf::InvalidInputError);

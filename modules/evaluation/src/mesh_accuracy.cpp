@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <unordered_map>
 
 namespace msf {
 
@@ -138,7 +140,10 @@ float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) 
 
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m,
-                          std::size_t max_samples) {
+                          std::size_t max_samples, const std::vector<float>* view_distance_m) {
+  if (view_distance_m && view_distance_m->size() != seen_truth.size())
+    throw InvalidInputError("mesh evaluation: " + std::to_string(view_distance_m->size()) + " view distances for " +
+                            std::to_string(seen_truth.size()) + " samples of the seen surface");
   if (mesh.polygons.empty())
     throw InvalidInputError("the reconstructed mesh has no triangle");
   if (truth.polygons.empty())
@@ -172,13 +177,55 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   const SurfaceDistance to_mesh(std::move(vertices), std::move(triangles), std::max(threshold, 0.1f));
   const std::size_t truth_step = std::max<std::size_t>(1, (seen_truth.size() + max_samples - 1) / max_samples);
   const std::size_t samples = (seen_truth.size() + truth_step - 1) / truth_step;
-  std::size_t covered = 0;
-#pragma omp parallel for reduction(+ : covered) schedule(dynamic, 256)
+  std::vector<std::uint8_t> is_covered(samples);
+#pragma omp parallel for schedule(dynamic, 256)
   for (std::size_t i = 0; i < samples; ++i)
-    covered += to_mesh.distance(seen_truth[i * truth_step], threshold) < threshold;
+    is_covered[i] = to_mesh.distance(seen_truth[i * truth_step], threshold) < threshold;
+  const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
   result.truth_samples = samples;
   result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);
+  if (view_distance_m && samples > 0) {
+    constexpr double kBand = 10.0;
+    const float farthest = *std::max_element(view_distance_m->begin(), view_distance_m->end());
+    const int bands = std::max(1, static_cast<int>(std::ceil(farthest / kBand)));
+    std::vector<std::size_t> n(bands), hit(bands);
+    for (std::size_t i = 0; i < samples; ++i) {
+      const int b = std::clamp(static_cast<int>(std::ceil((*view_distance_m)[i * truth_step] / kBand)) - 1, 0, bands - 1);
+      ++n[b];
+      hit[b] += is_covered[i];
+    }
+    for (int b = 0; b < bands; ++b)
+      result.by_view_distance.push_back({kBand * b, kBand * (b + 1), n[b],
+                                         n[b] ? static_cast<double>(hit[b]) / static_cast<double>(n[b]) : 0.0});
+  }
   return result;
+}
+
+std::vector<float> nearestViewDistance(const std::vector<Eigen::Vector3f>& points, const std::vector<float>& depths,
+                                       float cell_m) {
+  if (points.size() != depths.size())
+    throw InvalidInputError("nearest view distance: " + std::to_string(depths.size()) + " depths for " +
+                            std::to_string(points.size()) + " points");
+  if (!(cell_m > 0.f))
+    throw InvalidInputError("nearest view distance: the cell must be > 0 m, not " + std::to_string(cell_m));
+  struct Hash {
+    std::size_t operator()(const Eigen::Vector3i& c) const {
+      return static_cast<std::size_t>(c.x()) * 73856093u ^ static_cast<std::size_t>(c.y()) * 19349663u ^
+             static_cast<std::size_t>(c.z()) * 83492791u;
+    }
+  };
+  std::unordered_map<Eigen::Vector3i, float, Hash> nearest;
+  nearest.reserve(points.size() / 4);
+  const auto cell = [cell_m](const Eigen::Vector3f& p) { return (p / cell_m).array().floor().cast<int>().matrix().eval(); };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    auto [it, fresh] = nearest.try_emplace(cell(points[i]), depths[i]);
+    if (!fresh)
+      it->second = std::min(it->second, depths[i]);
+  }
+  std::vector<float> out(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    out[i] = nearest.at(cell(points[i]));
+  return out;
 }
 
 } // namespace msf

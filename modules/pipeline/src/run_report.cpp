@@ -10,6 +10,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -99,11 +100,16 @@ std::string metricsJson(const DepthMetrics& m, const std::string& indent) {
 }
 
 std::string accuracyJson(const MeshAccuracy& m) {
+  std::string bands;
+  for (const auto& b : m.by_view_distance)
+    bands += std::string(bands.empty() ? "" : ", ") + "{\"lower_m\": " + num(b.lower_m) + ", \"upper_m\": " +
+             num(b.upper_m) + ", \"samples\": " + std::to_string(b.samples) + ", \"completeness\": " +
+             num(b.completeness) + "}";
   return "{\"accuracy_mean_m\": " + num(m.accuracy_mean_m) + ", \"accuracy_median_m\": " + num(m.accuracy_median_m) +
          ", \"precision\": " + num(m.precision) + ", \"completeness\": " + num(m.completeness) +
          ", \"threshold_m\": " + num(m.threshold_m) + ", \"cap_m\": " + num(m.cap_m) +
          ", \"mesh_vertices\": " + std::to_string(m.vertices) + ", \"truth_samples\": " +
-         std::to_string(m.truth_samples) + "}";
+         std::to_string(m.truth_samples) + ", \"completeness_by_nearest_view\": [" + bands + "]}";
 }
 
 /// A value of a configuration as JSON: numbers as numbers, true / false as booleans, words
@@ -350,7 +356,16 @@ void RunReport::writeMarkdown(const std::string& path) const {
       << num(m.cap_m) << " m): " << num(m.accuracy_mean_m, 3) << " m (median " << num(m.accuracy_median_m, 3)
       << " m); " << num(100 * m.precision, 1) << " % of vertices within " << num(m.threshold_m) << " m.\n"
       << "Completeness (share of " << m.truth_samples << " samples of the seen true surface within "
-      << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n\n";
+      << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n";
+    if (!m.by_view_distance.empty()) {
+      s << "By the nearest distance a frame saw the surface from:";
+      for (const auto& b : m.by_view_distance)
+        s << (&b == &m.by_view_distance.front() ? " " : ", ") << num(b.lower_m) << "–" << num(b.upper_m) << " m "
+          << num(100 * b.completeness, 1) << " % (" << num(100.0 * b.samples / std::max<std::size_t>(1, m.truth_samples), 1)
+          << " % of the samples)";
+      s << ".\n";
+    }
+    s << "\n";
   }
   if (!map_evaluation.rows.empty())
     writeMapEvaluation(s);

@@ -45,6 +45,13 @@ private:
   std::unordered_map<Cell, std::vector<std::uint32_t>, CellHash, CellEqual> grid_;
 };
 
+/// Completeness of the seen true surface whose nearest view lies in (lower, upper] metres.
+struct CompletenessBand {
+  double lower_m = 0, upper_m = 0;
+  std::size_t samples = 0;
+  double completeness = 0; ///< 0 without samples
+};
+
 /// Mesh quality against the true surface (protocol 3, docs/design.md).
 struct MeshAccuracy {
   std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated (sampled)
@@ -55,15 +62,26 @@ struct MeshAccuracy {
   double completeness = 0;             ///< share of them within `threshold_m` of the mesh
   double threshold_m = 0;
   double cap_m = 0;                    ///< distances are capped here for the mean
+  /// Completeness by the distance the samples were seen from at the nearest (when given).
+  std::vector<CompletenessBand> by_view_distance;
 };
+
+/// For each of `points` (the seen true surface, from every frame), the least of `depths` (the
+/// depth each was seen at) over the points in its cell of `cell_m`: the nearest distance any
+/// frame saw that piece of surface from. Throws InvalidInputError for sizes that differ or a
+/// cell that is not > 0.
+std::vector<float> nearestViewDistance(const std::vector<Eigen::Vector3f>& points, const std::vector<float>& depths,
+                                       float cell_m);
 
 /// Accuracy of `mesh` against `truth` (every vertex), and completeness of the seen true
 /// surface `seen_truth` (points on the truth, e.g. ground-truth depth pixels back-projected
 /// into the world) against `mesh`. Distances are exact point-to-triangle distances,
 /// capped at `cap_m`. Inputs larger than `max_samples` are taken at a regular stride.
-/// Throws InvalidInputError when `mesh` or `truth` has no triangle.
+/// With `view_distance_m` (one per seen_truth point, nearestViewDistance), completeness is also
+/// given in bands of that distance, 10 m wide up to the farthest. Throws InvalidInputError
+/// when `mesh` or `truth` has no triangle or view_distance_m's size is not seen_truth's.
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m = 1.0,
-                          std::size_t max_samples = 200000);
+                          std::size_t max_samples = 200000, const std::vector<float>* view_distance_m = nullptr);
 
 } // namespace msf

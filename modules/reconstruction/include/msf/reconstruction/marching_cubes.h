@@ -38,9 +38,9 @@ public:
 
   struct Config {
     /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
-    /// TsdfIntegrator::Weighting): 10 meshes what is known to sigma 0.32 m, which a LiDAR-backed
-    /// surface is after one frame and a stereo-only one at 20 m after a few.
-    float min_weight = 10.f;
+    /// TsdfIntegrator::Weighting): 7 meshes what is known to sigma 0.38 m, which a LiDAR-backed
+    /// surface is after one frame and a stereo-only one at 20 m after a few (docs/reconstruction.md).
+    float min_weight = 7.f;
     /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents); 0 keeps all.
     int min_component_triangles = 0;
 
