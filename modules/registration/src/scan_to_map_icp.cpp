@@ -1,4 +1,5 @@
 #include <msf/common/exceptions.h>
+#include <msf/registration/nearest_cache.h>
 #include <msf/registration/scan_to_map_icp.h>
 
 #include <Eigen/Cholesky>
@@ -32,6 +33,8 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
   result.T_world_sensor = initial_guess;
   const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
   LocalMap::Neighbor neighbor;
+  // After the first iteration the points move by millimetres: most keep their neighbour.
+  NearestCache neighbors(map, settings.max_correspondence_m, points_sensor.size());
   for (result.iterations = 1; result.iterations <= settings.max_iterations; ++result.iterations) {
     // Normal equations for a left update T <- exp(delta) T. A point w = T p moves by
     // delta_t + delta_r x w: the point residual's Jacobian is [I, -[w]x], the plane
@@ -42,9 +45,9 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     Matrix6d H_plane = Matrix6d::Zero();
     Vector6d g_plane = Vector6d::Zero();
     std::size_t pairs = 0, planes = 0;
-    for (const Eigen::Vector3d& p : points_sensor) {
-      const Eigen::Vector3d w = result.T_world_sensor * p;
-      if (!map.nearest(w, settings.max_correspondence_m, neighbor))
+    for (std::size_t i = 0; i < points_sensor.size(); ++i) {
+      const Eigen::Vector3d w = result.T_world_sensor * points_sensor[i];
+      if (!neighbors.nearest(i, w, neighbor))
         continue;
       ++pairs;
       if (settings.point_to_plane && neighbor.planar) {
