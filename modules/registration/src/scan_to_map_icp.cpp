@@ -55,7 +55,9 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
         const double weight = 1.0 / ((1.0 + e * e / scale2) * (1.0 + e * e / scale2));
         Vector6d J;
         J << neighbor.normal, w.cross(neighbor.normal);
-        H_plane.selfadjointView<Eigen::Upper>().rankUpdate(J, weight);
+        for (int c = 0; c < 6; ++c) // the upper triangle, by hand: Eigen's rankUpdate is a call per point
+          for (int r = 0; r <= c; ++r)
+            H_plane(r, c) += weight * J[r] * J[c];
         g_plane += weight * e * J;
         ++planes;
         continue;
