@@ -89,17 +89,25 @@ TEST(LocalMap, ClearanceIsTheSecondNearestWithinReach) {
 }
 
 // The ICP's queries: points moved a little (and now and then a lot) between calls. Every
-// answer must be the map's own; most must come without a search.
-TEST(NearestCache, AnswersAsTheMapDoesAndSearchesLess) {
+// answer must be the map's own; most must come without a search. A dense map with a short
+// reach (most queries find a point) and a sparse one with a long reach (many find none, or
+// have no map point around at all).
+struct CacheCase {
+  std::size_t map_points;
+  double max_distance;
+};
+class NearestCacheTest : public ::testing::TestWithParam<CacheCase> {};
+
+TEST_P(NearestCacheTest, AnswersAsTheMapDoesAndSearchesLess) {
   msf::LocalMap map(1.0, 10);
-  map.addPoints(randomPoints(4000, 5.0, 4));
-  const double max_distance = 0.8;
+  map.addPoints(randomPoints(GetParam().map_points, 5.0, 4));
+  const double max_distance = GetParam().max_distance;
   msf::PointList queries = randomPoints(400, 5.5, 5);
   msf::NearestCache cache(map, max_distance, queries.size());
   std::mt19937 rng(6);
   std::normal_distribution<double> small(0.0, 0.003);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::size_t calls = 0;
+  std::size_t calls = 0, found = 0;
   for (int round = 0; round < 10; ++round) {
     for (std::size_t i = 0; i < queries.size(); ++i) {
       if (round > 0) {
@@ -107,19 +115,25 @@ TEST(NearestCache, AnswersAsTheMapDoesAndSearchesLess) {
         queries[i] += scale * Eigen::Vector3d(small(rng), small(rng), small(rng));
       }
       msf::LocalMap::Neighbor expected, got;
-      const bool found = map.nearest(queries[i], max_distance, expected);
-      ASSERT_EQ(cache.nearest(i, queries[i], got), found) << "query " << i << " round " << round;
+      const bool in_reach = map.nearest(queries[i], max_distance, expected);
+      ASSERT_EQ(cache.nearest(i, queries[i], got), in_reach) << "query " << i << " round " << round;
       ++calls;
-      if (!found)
+      if (!in_reach)
         continue;
+      ++found;
       ASSERT_EQ(got.point, expected.point) << "query " << i << " round " << round;
       EXPECT_DOUBLE_EQ(got.distance2, expected.distance2);
       EXPECT_EQ(got.planar, expected.planar);
     }
   }
+  EXPECT_GT(found, calls / 10); // both cases, found and not, are exercised
+  EXPECT_LT(found, calls);
   EXPECT_GE(cache.searches(), queries.size()); // each searched once at least
-  EXPECT_LT(cache.searches(), calls / 2);
+  EXPECT_LT(cache.searches(), calls / 4);
 }
+
+INSTANTIATE_TEST_SUITE_P(DenseAndSparse, NearestCacheTest,
+                         ::testing::Values(CacheCase{4000, 0.8}, CacheCase{150, 2.0}));
 
 TEST(LocalMap, SpreadsPointsOverAVoxelAndFitsItsPlane) {
   msf::LocalMap map(1.0, 16);

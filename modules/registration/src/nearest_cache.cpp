@@ -2,6 +2,7 @@
 #include <msf/registration/voxel_table.h>
 
 #include <cmath>
+#include <limits>
 
 namespace msf {
 
@@ -12,7 +13,9 @@ NearestCache::NearestCache(const LocalMap& map, double max_distance, std::size_t
 bool NearestCache::nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap::Neighbor& neighbor) {
   Entry& e = entries_[query];
   const Eigen::Vector3i voxel = voxelOf(p, inv_voxel_size_);
-  if (e.reach2 >= 0.0 && (p - e.searched_at).squaredNorm() < e.reach2 && voxel == e.voxel) {
+  if ((p - e.searched_at).squaredNorm() < e.reach2 && voxel == e.voxel) {
+    if (!e.within)
+      return false;
     const double distance2 = (p - e.neighbor.point).squaredNorm();
     // Every other point is farther still, so none is within reach when this one is not.
     if (distance2 >= max_distance2_)
@@ -22,20 +25,23 @@ bool NearestCache::nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap
     return true;
   }
   ++searches_;
+  // Without a limit, so that a query with nothing within max_distance knows how far it is
+  // from being within it (the search prunes nothing more: 27 voxels reach a voxel or more).
   double clearance2 = 0.0;
-  const bool found = map_.nearest(p, max_distance_, e.neighbor, &clearance2);
+  const bool any = map_.nearest(p, std::numeric_limits<double>::infinity(), e.neighbor, &clearance2);
   e.searched_at = p;
   e.voxel = voxel;
-  e.reach2 = -1.0;
-  if (found) {
-    // A nanometre less, so that rounding never lets a tie through.
-    const double reach = 0.5 * (std::sqrt(clearance2) - std::sqrt(e.neighbor.distance2)) - 1e-9;
-    if (reach > 0.0)
-      e.reach2 = reach * reach;
+  e.within = any && e.neighbor.distance2 < max_distance2_;
+  // A nanometre less, so that rounding never lets a tie through.
+  double reach = std::numeric_limits<double>::infinity(); // no point around: none while in this voxel
+  if (e.within)
+    reach = 0.5 * (std::sqrt(clearance2) - std::sqrt(e.neighbor.distance2)) - 1e-9;
+  else if (any)
+    reach = std::sqrt(e.neighbor.distance2) - max_distance_ - 1e-9; // every point stays beyond max_distance
+  e.reach2 = reach > 0.0 ? reach * reach : -1.0;
+  if (e.within)
     neighbor = e.neighbor;
-  }
-  // Nothing within max_distance: something may come within it with any move, search again.
-  return found;
+  return e.within;
 }
 
 } // namespace msf

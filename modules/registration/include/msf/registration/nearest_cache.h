@@ -14,7 +14,9 @@ namespace msf {
 /// it moves by m < (c - d) / 2 from where it was searched (d: the distance to its nearest),
 /// no other point can have come nearer than that one (d + m < c - m), and while it stays in
 /// the same voxel the searched voxels are the same: the answer is the map's, without a search.
-/// Beyond that it searches again. The map must not change between the calls.
+/// A query with no map point within max_distance, the nearest at D, has none while it moves
+/// by less than D - max_distance, and none at all while it stays in a voxel whose neighbours
+/// are empty. Beyond that it searches again. The map must not change between the calls.
 class NearestCache {
 public:
   /// For queries 0 .. queries - 1, each within `max_distance` (LocalMap::nearest's).
@@ -31,6 +33,7 @@ private:
     Eigen::Vector3d searched_at = Eigen::Vector3d::Zero();
     Eigen::Vector3i voxel = Eigen::Vector3i::Zero();
     double reach2 = -1.0;  // squared distance it may move from searched_at; < 0: search
+    bool within = false;   // `neighbor` is within max_distance
     LocalMap::Neighbor neighbor;
   };
 
