@@ -6,9 +6,14 @@
 
 namespace msf {
 
-NearestCache::NearestCache(const LocalMap& map, double max_distance, std::size_t queries)
-    : map_(map), max_distance2_(max_distance * max_distance), max_distance_(max_distance),
-      inv_voxel_size_(1.0 / map.voxelSize()), entries_(queries) {}
+void NearestCache::reset(const LocalMap& map, double max_distance, std::size_t queries) {
+  map_ = &map;
+  max_distance_ = max_distance;
+  max_distance2_ = max_distance * max_distance;
+  inv_voxel_size_ = 1.0 / map.voxelSize();
+  entries_.assign(queries, Entry{});
+  searches_ = 0;
+}
 
 bool NearestCache::nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap::Neighbor& neighbor) {
   Entry& e = entries_[query];
@@ -28,7 +33,7 @@ bool NearestCache::nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap
   // Without a limit, so that a query with nothing within max_distance knows how far it is
   // from being within it (the search prunes nothing more: 27 voxels reach a voxel or more).
   double clearance2 = 0.0;
-  const bool any = map_.nearest(p, std::numeric_limits<double>::infinity(), e.neighbor, &clearance2);
+  const bool any = map_->nearest(p, std::numeric_limits<double>::infinity(), e.neighbor, &clearance2);
   e.searched_at = p;
   e.voxel = voxel;
   e.within = any && e.neighbor.distance2 < max_distance2_;

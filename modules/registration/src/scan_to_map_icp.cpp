@@ -1,5 +1,4 @@
 #include <msf/common/exceptions.h>
-#include <msf/registration/nearest_cache.h>
 #include <msf/registration/scan_to_map_icp.h>
 
 #include <Eigen/Cholesky>
@@ -28,13 +27,15 @@ Eigen::Isometry3d exponential(const Vector6d& delta) {
 } // namespace
 
 IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
-                         const IcpSettings& settings) {
+                         const IcpSettings& settings, NearestCache* neighbors) {
   IcpResult result;
   result.T_world_sensor = initial_guess;
   const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
   LocalMap::Neighbor neighbor;
   // After the first iteration the points move by millimetres: most keep their neighbour.
-  NearestCache neighbors(map, settings.max_correspondence_m, points_sensor.size());
+  NearestCache own;
+  NearestCache& cache = neighbors ? *neighbors : own;
+  cache.reset(map, settings.max_correspondence_m, points_sensor.size());
   for (result.iterations = 1; result.iterations <= settings.max_iterations; ++result.iterations) {
     // Normal equations for a left update T <- exp(delta) T. A point w = T p moves by
     // delta_t + delta_r x w: the point residual's Jacobian is [I, -[w]x], the plane
@@ -47,7 +48,7 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     std::size_t pairs = 0, planes = 0;
     for (std::size_t i = 0; i < points_sensor.size(); ++i) {
       const Eigen::Vector3d w = result.T_world_sensor * points_sensor[i];
-      if (!neighbors.nearest(i, w, neighbor))
+      if (!cache.nearest(i, w, neighbor))
         continue;
       ++pairs;
       if (settings.point_to_plane && neighbor.planar) {

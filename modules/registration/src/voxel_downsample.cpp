@@ -20,12 +20,19 @@ PointMoments PointMoments::rotated(const Eigen::Matrix3d& R) const {
 }
 
 PointList voxelDownsample(const PointList& points, double voxel_size, std::vector<PointMoments>* moments) {
+  PointList kept;
+  VoxelDownsampler().downsample(points, voxel_size, kept, moments);
+  return kept;
+}
+
+void VoxelDownsampler::downsample(const PointList& points, double voxel_size, PointList& kept,
+                                  std::vector<PointMoments>* moments) {
   if (!(voxel_size > 0.0))
     throw InvalidInputError("voxel downsampling: voxel size must be > 0, got " + std::to_string(voxel_size));
   const double inv = 1.0 / voxel_size;
-  VoxelTable seen;
-  seen.reserve(points.size() / 4);
-  PointList kept;
+  seen_.clear();
+  seen_.reserve(points.size() / 4);
+  kept.clear();
   kept.reserve(points.size() / 4);
   if (moments) {
     moments->clear();
@@ -39,7 +46,7 @@ PointList voxelDownsample(const PointList& points, double voxel_size, std::vecto
     const std::uint64_t key = voxelKey(voxelOf(p, inv));
     bool inserted = false;
     if (key != last_key) {
-      std::tie(k, inserted) = seen.insert(key, static_cast<int>(kept.size()));
+      std::tie(k, inserted) = seen_.insert(key, static_cast<int>(kept.size()));
       last_key = key;
     }
     if (inserted)
@@ -56,7 +63,6 @@ PointList voxelDownsample(const PointList& points, double voxel_size, std::vecto
           m.outer(r, c) += d[r] * d[c];
     }
   }
-  return kept;
 }
 
 } // namespace msf

@@ -19,8 +19,11 @@ namespace msf {
 /// are empty. Beyond that it searches again. The map must not change between the calls.
 class NearestCache {
 public:
+  NearestCache() = default;
   /// For queries 0 .. queries - 1, each within `max_distance` (LocalMap::nearest's).
-  NearestCache(const LocalMap& map, double max_distance, std::size_t queries);
+  NearestCache(const LocalMap& map, double max_distance, std::size_t queries) { reset(map, max_distance, queries); }
+  /// Forgets every answer, for a new map or new queries; keeps the memory.
+  void reset(const LocalMap& map, double max_distance, std::size_t queries);
 
   /// LocalMap::nearest(p, max_distance, neighbor) for query `query` now at `p`.
   bool nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap::Neighbor& neighbor);
@@ -37,8 +40,8 @@ private:
     LocalMap::Neighbor neighbor;
   };
 
-  const LocalMap& map_;
-  double max_distance2_, max_distance_, inv_voxel_size_;
+  const LocalMap* map_ = nullptr;
+  double max_distance2_ = 0, max_distance_ = 0, inv_voxel_size_ = 1;
   std::vector<Entry> entries_;
   std::size_t searches_ = 0;
 };
