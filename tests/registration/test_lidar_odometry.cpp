@@ -217,6 +217,31 @@ TEST(SweepDeskew, MovesEachPointByItsShareOfTheTurn) {
   EXPECT_NEAR(out[3].x(), -10.0 + 0.5 * 1.2, 1e-6); // behind: the end of the turn
 }
 
+TEST(SweepDeskew, TimesEachPointByItsAzimuthAllRoundTheTurn) {
+  // Points all round at 50 m, under a fast motion: each must move by atan2's share of it.
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  motion.linear() = Eigen::AngleAxisd(0.05, Eigen::Vector3d(0.1, 0.2, 1.0).normalized()).toRotationMatrix();
+  motion.translation() << 2.0, -0.5, 0.1;
+  const Eigen::AngleAxisd rotation(motion.linear());
+  const Eigen::Vector3d omega = rotation.angle() * rotation.axis();
+  msf::PointList points;
+  for (int k = -3600; k < 3600; ++k) { // 0.05 degree apart, past every octant's edge
+    const double a = k * M_PI / 3600.0 + 1e-4;
+    points.emplace_back(50.0 * std::cos(a), 50.0 * std::sin(a), 0.1 * (k % 7));
+  }
+  points.emplace_back(0.0, 0.0, 5.0); // straight up: no azimuth, no move
+  points.emplace_back(-50.0, 0.0, 0.0); // straight behind: half a turn
+  const msf::PointList out = msf::deskewSweep(points, motion);
+  ASSERT_EQ(out.size(), points.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    const double s = std::atan2(p.y(), p.x()) / (2.0 * M_PI);
+    worst = std::max(worst, (out[i] - (p + s * (omega.cross(p) + motion.translation()))).norm());
+  }
+  EXPECT_LT(worst, 1e-7); // metres
+}
+
 TEST(ScanConstraints, CountsTheDirectionsAScanPinsDown) {
   const std::vector<msf::test::Box> road{{{-100, -100, -1}, {100, 100, 0}}};
   const auto plane = msf::analyzeConstraints(msf::voxelDownsample(scanBoxes(road, sensorPose(0.0), 1), 0.5), 2.0);

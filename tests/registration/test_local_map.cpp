@@ -1,5 +1,6 @@
 #include <msf/common/exceptions.h>
 #include <msf/registration/local_map.h>
+#include <msf/registration/nearest_cache.h>
 #include <msf/registration/voxel_downsample.h>
 #include <msf/registration/voxel_table.h>
 
@@ -73,6 +74,66 @@ TEST(LocalMap, NearestIsTheBruteForceNearestWithinReach) {
     }
   }
 }
+
+TEST(LocalMap, ClearanceIsTheSecondNearestWithinReach) {
+  msf::LocalMap map(1.0, 20); // points 0.22 m apart and more are kept
+  map.addPoints({{0.5, 0.5, 0.5}, {0.5, 0.5, 0.9}, {1.6, 0.5, 0.5}});
+  ASSERT_EQ(map.size(), 3u);
+  msf::LocalMap::Neighbor n;
+  double clearance2 = 0.0;
+  ASSERT_TRUE(map.nearest(Eigen::Vector3d(0.5, 0.5, 0.6), 2.0, n, &clearance2));
+  EXPECT_NEAR(n.distance2, 0.01, 1e-12);
+  EXPECT_NEAR(clearance2, 0.09, 1e-12);  // (0.5, 0.5, 0.9), not the farther point in the next voxel
+  ASSERT_TRUE(map.nearest(Eigen::Vector3d(0.5, 0.5, 0.6), 0.2, n, &clearance2));
+  EXPECT_NEAR(clearance2, 0.04, 1e-12);  // none other within 0.2 m
+}
+
+// The ICP's queries: points moved a little (and now and then a lot) between calls. Every
+// answer must be the map's own; most must come without a search. A dense map with a short
+// reach (most queries find a point) and a sparse one with a long reach (many find none, or
+// have no map point around at all).
+struct CacheCase {
+  std::size_t map_points;
+  double max_distance;
+};
+class NearestCacheTest : public ::testing::TestWithParam<CacheCase> {};
+
+TEST_P(NearestCacheTest, AnswersAsTheMapDoesAndSearchesLess) {
+  msf::LocalMap map(1.0, 10);
+  map.addPoints(randomPoints(GetParam().map_points, 5.0, 4));
+  const double max_distance = GetParam().max_distance;
+  msf::PointList queries = randomPoints(400, 5.5, 5);
+  msf::NearestCache cache(map, max_distance, queries.size());
+  std::mt19937 rng(6);
+  std::normal_distribution<double> small(0.0, 0.003);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::size_t calls = 0, found = 0;
+  for (int round = 0; round < 10; ++round) {
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      if (round > 0) {
+        const double scale = unit(rng) < 0.05 ? 100.0 : 1.0; // a jump of ~0.3 m now and then
+        queries[i] += scale * Eigen::Vector3d(small(rng), small(rng), small(rng));
+      }
+      msf::LocalMap::Neighbor expected, got;
+      const bool in_reach = map.nearest(queries[i], max_distance, expected);
+      ASSERT_EQ(cache.nearest(i, queries[i], got), in_reach) << "query " << i << " round " << round;
+      ++calls;
+      if (!in_reach)
+        continue;
+      ++found;
+      ASSERT_EQ(got.point, expected.point) << "query " << i << " round " << round;
+      EXPECT_DOUBLE_EQ(got.distance2, expected.distance2);
+      EXPECT_EQ(got.planar, expected.planar);
+    }
+  }
+  EXPECT_GT(found, calls / 10); // both cases, found and not, are exercised
+  EXPECT_LT(found, calls);
+  EXPECT_GE(cache.searches(), queries.size()); // each searched once at least
+  EXPECT_LT(cache.searches(), calls / 4);
+}
+
+INSTANTIATE_TEST_SUITE_P(DenseAndSparse, NearestCacheTest,
+                         ::testing::Values(CacheCase{4000, 0.8}, CacheCase{150, 2.0}));
 
 TEST(LocalMap, SpreadsPointsOverAVoxelAndFitsItsPlane) {
   msf::LocalMap map(1.0, 16);

@@ -72,8 +72,8 @@ LidarOdometry::LidarOdometry(const Config& config)
 
 Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, const std::string& name) {
   Stats stats;
-  PointList in_range;
-  in_range.reserve(points_sensor.size());
+  PointList& in_range = in_range_;
+  in_range.clear();
   const double min2 = config_.min_range_m * config_.min_range_m, max2 = config_.max_range_m * config_.max_range_m;
   for (const Eigen::Vector3d& p : points_sensor) {
     const double r2 = p.squaredNorm();
@@ -94,9 +94,14 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
   const Eigen::Isometry3d motion =
       poses_.size() > 1 ? poses_[poses_.size() - 2].inverse() * poses_.back() : Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d prediction = poses_.empty() ? Eigen::Isometry3d::Identity() : poses_.back() * motion;
-  std::vector<PointMoments> moments; // the returns each frame point stands for, for the map's planes
-  PointList frame = voxelDownsample(sweeps_ && poses_.size() > 1 ? deskewSweep(in_range, motion) : in_range,
-                                    frame_voxel, &moments);
+  std::vector<PointMoments>& moments = moments_; // the returns each frame point stands for, for the map's planes
+  PointList& frame = frame_;
+  if (sweeps_ && poses_.size() > 1) {
+    deskewSweep(in_range, motion, deskewed_);
+    downsampler_.downsample(deskewed_, frame_voxel, frame, &moments);
+  } else {
+    downsampler_.downsample(in_range, frame_voxel, frame, &moments);
+  }
   const ScanConstraints constraints = analyzeConstraints(frame, 2.0 * config_.voxel_size_m);
   stats.constraint = constraints.weakest();
   if (constraints.unconstrained(config_.min_constraint) > 0)
@@ -124,22 +129,24 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
     icp.planes_only = config_.point_to_plane && poses_.size() == 1;
     auto align = [&](const PointList& source, const LocalMap& map, const Eigen::Isometry3d& guess) {
       try {
-        return alignScanToMap(source, map, guess, icp);
+        return alignScanToMap(source, map, guess, icp, &neighbors_);
       } catch (const InvalidInputError& e) {
         throw InvalidInputError(name + ": " + e.what() + " (the scan does not overlap the local map)");
       }
     };
-    PointList source = voxelDownsample(frame, source_voxel);
+    PointList& source = source_;
+    downsampler_.downsample(frame, source_voxel, source);
     IcpResult result = align(source, map_, prediction);
     if (sweeps_ && poses_.size() == 1) {
       // The motion is known now: the second scan, and the first one in the map, deskewed by it.
       const Eigen::Isometry3d estimated = last.inverse() * result.T_world_sensor;
-      frame = voxelDownsample(deskewSweep(in_range, estimated), frame_voxel, &moments);
+      deskewSweep(in_range, estimated, deskewed_);
+      downsampler_.downsample(deskewed_, frame_voxel, frame, &moments);
       std::vector<PointMoments> first_moments;
       const PointList first = voxelDownsample(deskewSweep(first_returns_, estimated), frame_voxel, &first_moments);
       LocalMap first_map(config_.voxel_size_m, config_.max_points_per_voxel);
       first_map.addScan(first, first_moments); // the first scan is the world frame
-      source = voxelDownsample(frame, source_voxel);
+      downsampler_.downsample(frame, source_voxel, source);
       result = align(source, first_map, result.T_world_sensor);
       map_ = std::move(first_map);
       first_returns_.clear();
@@ -152,7 +159,8 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
     stats.threshold_m = icp.max_correspondence_m;
   }
   stats.map_points_added = frame.size();
-  PointList frame_world(frame.size());
+  PointList& frame_world = frame_world_;
+  frame_world.resize(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
     frame_world[i] = pose * frame[i];
     moments[i] = moments[i].rotated(pose.linear());

@@ -130,13 +130,15 @@ void LocalMap::rebuildTable() {
     table_.insert(voxelKey(voxels_[v].index), static_cast<int>(v));
 }
 
-bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor) const {
+bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor, double* clearance2) const {
   const Eigen::Vector3i centre = voxelOf(p, inv_voxel_size_);
   // Where p lies in its voxel, to skip neighbours whose nearest face is already farther than
-  // the best point found: p's own voxel first, then its 26 neighbours.
+  // the best point found (the second best, for a clearance): p's own voxel first, then its
+  // 26 neighbours.
   const Eigen::Vector3d low = centre.cast<double>() * voxel_size_;
   const Eigen::Vector3d to_low = p - low, to_high = low + Eigen::Vector3d::Constant(voxel_size_) - p;
-  double best = max_distance * max_distance;
+  double best = max_distance * max_distance, second = best;
+  double& bound = clearance2 ? second : best;  // what a voxel must be nearer than to be searched
   const Eigen::Vector3d* best_point = nullptr;
   int best_voxel = VoxelTable::kAbsent;
   auto search = [&](const Eigen::Vector3i& offset) {
@@ -145,7 +147,7 @@ bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& 
       const double gap = offset[a] < 0 ? to_low[a] : offset[a] > 0 ? to_high[a] : 0.0;
       gap2 += gap * gap;
     }
-    if (gap2 >= best)
+    if (gap2 >= bound)
       return;
     const int v = table_.find(voxelKey(centre + offset));
     if (v == VoxelTable::kAbsent)
@@ -154,9 +156,12 @@ bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& 
     for (int k = 0; k < voxels_[static_cast<std::size_t>(v)].count; ++k) {
       const double d2 = (pts[k] - p).squaredNorm();
       if (d2 < best) {
+        second = best;
         best = d2;
         best_point = &pts[k];
         best_voxel = v;
+      } else if (d2 < second) {
+        second = d2;
       }
     }
   };
@@ -175,6 +180,8 @@ bool LocalMap::nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& 
   }();
   for (const Eigen::Vector3i& offset : kOrder)
     search(offset);
+  if (clearance2)
+    *clearance2 = second;
   if (!best_point)
     return false;
   const Voxel& voxel = voxels_[static_cast<std::size_t>(best_voxel)];

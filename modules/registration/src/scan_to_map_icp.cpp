@@ -27,11 +27,15 @@ Eigen::Isometry3d exponential(const Vector6d& delta) {
 } // namespace
 
 IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
-                         const IcpSettings& settings) {
+                         const IcpSettings& settings, NearestCache* neighbors) {
   IcpResult result;
   result.T_world_sensor = initial_guess;
   const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
   LocalMap::Neighbor neighbor;
+  // After the first iteration the points move by millimetres: most keep their neighbour.
+  NearestCache own;
+  NearestCache& cache = neighbors ? *neighbors : own;
+  cache.reset(map, settings.max_correspondence_m, points_sensor.size());
   for (result.iterations = 1; result.iterations <= settings.max_iterations; ++result.iterations) {
     // Normal equations for a left update T <- exp(delta) T. A point w = T p moves by
     // delta_t + delta_r x w: the point residual's Jacobian is [I, -[w]x], the plane
@@ -42,9 +46,9 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     Matrix6d H_plane = Matrix6d::Zero();
     Vector6d g_plane = Vector6d::Zero();
     std::size_t pairs = 0, planes = 0;
-    for (const Eigen::Vector3d& p : points_sensor) {
-      const Eigen::Vector3d w = result.T_world_sensor * p;
-      if (!map.nearest(w, settings.max_correspondence_m, neighbor))
+    for (std::size_t i = 0; i < points_sensor.size(); ++i) {
+      const Eigen::Vector3d w = result.T_world_sensor * points_sensor[i];
+      if (!cache.nearest(i, w, neighbor))
         continue;
       ++pairs;
       if (settings.point_to_plane && neighbor.planar) {
@@ -52,7 +56,9 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
         const double weight = 1.0 / ((1.0 + e * e / scale2) * (1.0 + e * e / scale2));
         Vector6d J;
         J << neighbor.normal, w.cross(neighbor.normal);
-        H_plane.selfadjointView<Eigen::Upper>().rankUpdate(J, weight);
+        for (int c = 0; c < 6; ++c) // the upper triangle, by hand: Eigen's rankUpdate is a call per point
+          for (int r = 0; r <= c; ++r)
+            H_plane(r, c) += weight * J[r] * J[c];
         g_plane += weight * e * J;
         ++planes;
         continue;

@@ -3,8 +3,10 @@
 #include <msf/io/sequence.h>
 #include <msf/registration/adaptive_threshold.h>
 #include <msf/registration/local_map.h>
+#include <msf/registration/nearest_cache.h>
 #include <msf/registration/point_list.h>
 #include <msf/registration/scan_constraints.h>
+#include <msf/registration/voxel_downsample.h>
 
 #include <Eigen/Geometry>
 #include <opencv2/core/persistence.hpp>
@@ -13,6 +15,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -91,11 +94,10 @@ public:
   /// overlap the map; the odometry is then unchanged.
   template <typename PointT>
   Eigen::Isometry3d registerScan(const pcl::PointCloud<PointT>& scan, const std::string& name = "scan") {
-    PointList points; // non-finite ones too: registerPoints counts them in its message
-    points.reserve(scan.size());
-    for (const PointT& p : scan)
-      points.emplace_back(p.x, p.y, p.z);
-    return registerPoints(points, name);
+    scan_.resize(scan.size()); // non-finite ones too: registerPoints counts them in its message
+    for (std::size_t i = 0; i < scan.size(); ++i)
+      scan_[i] = Eigen::Vector3d(scan[i].x, scan[i].y, scan[i].z);
+    return registerPoints(scan_, name);
   }
   Eigen::Isometry3d registerPoints(const PointList& points_sensor, const std::string& name = "scan");
 
@@ -113,6 +115,12 @@ private:
   bool sweeps_;               // deskew != none
   PointList first_returns_;  // the first scan, until the second tells the motion to deskew it
   Stats stats_;
+  // Buffers kept from scan to scan: a scan's 120000 returns allocated anew each time cost
+  // page faults (see VoxelDownsampler).
+  PointList scan_, in_range_, deskewed_, frame_, source_, frame_world_;
+  std::vector<PointMoments> moments_;
+  VoxelDownsampler downsampler_;
+  NearestCache neighbors_;
 };
 
 /// `config` with deskew auto resolved for `sequence`: none for a synthetic sequence (msf_synth's

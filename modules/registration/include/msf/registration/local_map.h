@@ -47,8 +47,11 @@ public:
   void clear();
 
   /// The map point nearest to `p` among the voxels within one voxel of p's and closer than
-  /// `max_distance`; false when there is none.
-  bool nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor) const;
+  /// `max_distance`; false when there is none. With `clearance2`, also the squared distance
+  /// from p to the second-nearest of those points (max_distance^2 when there is none that
+  /// near), so that a caller knows how far p may move before the answer could change
+  /// (NearestCache); the search then prunes with the second-nearest, not the nearest.
+  bool nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor, double* clearance2 = nullptr) const;
 
   std::size_t size() const { return points_; }
   std::size_t voxelCount() const { return voxels_.size(); }

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/registration/local_map.h>
+#include <msf/registration/nearest_cache.h>
 #include <msf/registration/point_list.h>
 
 #include <Eigen/Geometry>
@@ -36,7 +37,8 @@ struct IcpResult {
 
 /// Aligns `points_sensor` (a scan in its sensor's frame) to `map`, from `initial_guess`.
 /// Throws InvalidInputError when fewer than 6 points find a map point within reach.
+/// `neighbors`, when given, is the NearestCache used (its memory kept for the next call).
 IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
-                         const IcpSettings& settings);
+                         const IcpSettings& settings, NearestCache* neighbors = nullptr);
 
 } // namespace msf

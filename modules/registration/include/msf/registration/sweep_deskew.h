@@ -14,5 +14,7 @@ namespace msf {
 /// second the sensor moves 1.3 m during a turn: a scan left as it is has the road behind the
 /// car ~0.6 m off from the road ahead.
 PointList deskewSweep(const PointList& points_sensor, const Eigen::Isometry3d& motion_per_sweep);
+/// The same into `out` (its memory reused; not `points_sensor`).
+void deskewSweep(const PointList& points_sensor, const Eigen::Isometry3d& motion_per_sweep, PointList& out);
 
 } // namespace msf

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/registration/point_list.h>
+#include <msf/registration/voxel_table.h>
 
 #include <Eigen/Core>
 
@@ -25,5 +26,18 @@ struct PointMoments {
 /// points is their input order. With `moments`, also the moments of each kept point's voxel
 /// about it, in the same order. Throws InvalidInputError for a voxel size that is not > 0.
 PointList voxelDownsample(const PointList& points, double voxel_size, std::vector<PointMoments>* moments = nullptr);
+
+/// voxelDownsample into `kept` (and `moments`), with a table kept from call to call: a
+/// tracker downsamples 120000 returns a frame, and buffers of that size allocated anew each
+/// time cost page faults and zeroing (a tenth of the odometry's time) and contend with the
+/// other threads of the process for its memory map. `kept` must not be `points`.
+class VoxelDownsampler {
+public:
+  void downsample(const PointList& points, double voxel_size, PointList& kept,
+                  std::vector<PointMoments>* moments = nullptr);
+
+private:
+  VoxelTable seen_;
+};
 
 } // namespace msf
