@@ -10,6 +10,7 @@
 #include <msf/evaluation/holdout.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/sequence.h>
+#include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/stereo/sgbm_stereo.h>
 #include <msf/synthetic/ground_truth.h>
@@ -24,6 +25,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -39,14 +41,19 @@ struct MethodEntry {
   std::function<msf::HoldoutMethod(const msf::ConfigFile&)> make;
 };
 
+/// A stage's configuration: section `name` of `file`, defaults where a key is absent.
+template <typename Config>
+Config sectionOf(const msf::ConfigFile& file, const char* name) {
+  Config config;
+  config.read(file.section(name));
+  return config;
+}
+
 /// A LiDAR method: the input rings completed by `method` (projection on the canvas included).
 msf::HoldoutMethod lidar(const msf::ConfigFile& file, msf::CompletionMethod method) {
-  msf::ProjectionConfig projection;
-  projection.read(file.section("projection"));
-  msf::InterpolationConfig interpolation;
-  interpolation.read(file.section("interpolation"));
-  msf::IpBasicConfig ip_basic;
-  ip_basic.read(file.section("ip_basic"));
+  const auto projection = sectionOf<msf::ProjectionConfig>(file, "projection");
+  const auto interpolation = sectionOf<msf::InterpolationConfig>(file, "interpolation");
+  const auto ip_basic = sectionOf<msf::IpBasicConfig>(file, "ip_basic");
   std::shared_ptr<msf::LidarCompletion> completion; // made at the first frame, which has the calibration
   return [=](const msf::HoldoutInput& in) mutable {
     if (!completion)
@@ -66,11 +73,9 @@ enum class StereoInput {
 
 /// SGBM on the grey pair (section stereo); the time of the LiDAR it uses counts too.
 msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
-  msf::SgbmConfig config;
-  config.read(file.section("stereo"));
+  auto config = sectionOf<msf::SgbmConfig>(file, "stereo");
   config.guidance = input == StereoInput::Guided ? "lidar" : "none";
-  msf::ProjectionConfig projection;
-  projection.read(file.section("projection"));
+  const auto projection = sectionOf<msf::ProjectionConfig>(file, "projection");
   auto completion = lidar(file, msf::CompletionMethod::Compound);
   auto sgbm = std::make_shared<msf::SgbmStereo>(config);
   std::shared_ptr<msf::LidarProjector> projector;
@@ -90,19 +95,11 @@ msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
   };
 }
 
-/// Paper steps 1-4: compound interpolation of the input rings, SGBM narrowed by it (and
-/// guided by the projected input rings with stereo.guidance lidar), and the per-pixel
-/// fusion of the two (section fusion, its method forced to `method`).
-msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) {
-  msf::ProjectionConfig projection;
-  projection.read(file.section("projection"));
-  msf::InterpolationConfig interpolation;
-  interpolation.read(file.section("interpolation"));
-  msf::SgbmConfig stereo_config;
-  stereo_config.read(file.section("stereo"));
-  msf::DepthFusionConfig fusion;
-  fusion.read(file.section("fusion"));
-  fusion.method = method;
+/// Paper steps 1-4 with the stages' configurations: compound interpolation of the input
+/// rings, SGBM (narrowed by it with stereo.prior_search_range, guided by the projected input
+/// rings with stereo.guidance lidar), and the per-pixel fusion of the two.
+msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf::InterpolationConfig& interpolation,
+                             const msf::SgbmConfig& stereo_config, const msf::DepthFusionConfig& fusion) {
   std::shared_ptr<msf::LidarCompletion> completion;
   auto sgbm = std::make_shared<msf::SgbmStereo>(stereo_config);
   auto fuser = std::make_shared<msf::DepthImageFusion>(fusion);
@@ -126,6 +123,22 @@ msf::HoldoutMethod fused(const msf::ConfigFile& file, msf::FusionMethod method) 
   };
 }
 
+/// The same with the sections of `file` (section fusion, its method forced to `method` when given).
+msf::HoldoutMethod fused(const msf::ConfigFile& file, std::optional<msf::FusionMethod> method) {
+  auto fusion = sectionOf<msf::DepthFusionConfig>(file, "fusion");
+  fusion.method = method.value_or(fusion.method);
+  return fusedWith(sectionOf<msf::ProjectionConfig>(file, "projection"),
+                   sectionOf<msf::InterpolationConfig>(file, "interpolation"),
+                   sectionOf<msf::SgbmConfig>(file, "stereo"), fusion);
+}
+
+/// The paper as published (PipelineConfig::paper, config/paper.yaml), whatever -config says:
+/// its steps 1-4 beside ours on the same pixels.
+msf::HoldoutMethod paper() {
+  const msf::PipelineConfig c = msf::PipelineConfig::paper();
+  return fusedWith(c.projection, c.interpolation, c.stereo, c.fusion);
+}
+
 /// Add a method here (name -> function of the frame input) to get its row in the table.
 const std::vector<MethodEntry>& methodTable() {
   static const std::vector<MethodEntry> table{
@@ -145,10 +158,14 @@ const std::vector<MethodEntry>& methodTable() {
        [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Prior); }},
       {"sgbm_guided", "sgbm_prior guided by the projected input rings (stereo.guidance_*)",
        [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Guided); }},
+      {"fused", "steps 1-4 as the config says (fusion.method too): scripts/paper_additions.sh",
+       [](const msf::ConfigFile& f) { return fused(f, std::nullopt); }},
       {"fused_paper", "interpolated + SGBM fused by eq. 6 (section fusion; sgbm_guided with stereo.guidance lidar)",
        [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Paper); }},
       {"fused_uncertainty", "the same fused by inverse variance",
        [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Uncertainty); }},
+      {"paper", "the paper as published, steps 1-4 (config/paper.yaml, not -config; docs/paper.md)",
+       [](const msf::ConfigFile&) { return paper(); }},
   };
   return table;
 }
@@ -161,7 +178,7 @@ std::string methodNames() {
 }
 
 /// The paper's Table 1 rows, the default methods of full-image (synthetic ground truth) mode.
-const char* const kGroundTruthMethods = "sgbm,interpolated,fused_uncertainty,fused_paper,ipbasic_multiscale";
+const char* const kGroundTruthMethods = "sgbm,interpolated,fused_uncertainty,fused_paper,paper,ipbasic_multiscale";
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s <sequence_dir> [options]\n", name);

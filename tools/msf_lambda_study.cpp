@@ -21,7 +21,7 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-o", "-config", "-frames", "-voxel", "-trunc", "-sweeps"};
+const std::vector<std::string> kValueOptions = {"-o", "-config", "-frames", "-voxel", "-trunc", "-sweeps", "-solve"};
 
 void printHelp(const char* name) {
   print_error("Syntax is: %s -o DIR [options]\n", name);
@@ -33,6 +33,8 @@ void printHelp(const char* name) {
   print_info("    -voxel M       voxel size in metres (default "); print_value("0.05"); print_info(")\n");
   print_info("    -trunc M       truncation in metres (default "); print_value("0.25"); print_info(")\n");
   print_info("    -sweeps N      Gauss-Seidel sweeps per frame (default "); print_value("1"); print_info(")\n");
+  print_info("    -solve S       sweeps: -sweeps per frame, warm-started | argmin: eq. 7 solved to its minimizer\n"
+             "                   every frame, as the paper states it (default "); print_value("sweeps"); print_info(")\n");
 }
 
 int run(int argc, char** argv) {
@@ -53,6 +55,13 @@ int run(int argc, char** argv) {
   msf::tool::parseArgument(argc, argv, "-voxel", config.voxel_size_m);
   msf::tool::parseArgument(argc, argv, "-trunc", config.truncation_m);
   msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
+  std::string solve = msf::toString(config.solve);
+  msf::tool::parseArgument(argc, argv, "-solve", solve);
+  try {
+    config.solve = msf::parseSolve(solve);
+  } catch (const msf::ConfigError&) {
+    throw msf::InvalidInputError("-solve must be sweeps or argmin, not '" + solve + "'");
+  }
   const msf::LambdaStudy study(config); // validates: a bad value leaves no output folder
   msf::ensureOutputDirectory(out_dir);
   config.print(std::cout);

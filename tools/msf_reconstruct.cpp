@@ -95,8 +95,12 @@ void printHelp(const char* name) {
              "                   mesh, rendered at every frame's pose, is scored at them beside the fused depth\n");
   print_info("    -compare_sources  also integrate the interpolated LiDAR alone and SGBM alone into volumes of\n"
              "                   their own (mesh_lidar.ply, mesh_stereo.ply), scored as the mesh is\n");
+  print_info("    -compare_paper also run the paper as published (config/paper.yaml: docs/paper.md) on the same\n"
+             "                   frames into a map of its own (mesh_paper.ply); its per-frame depth (paper) and\n"
+             "                   mesh are scored beside ours\n");
   print_info("  With ground truth (-holdout, or a synthetic sequence's gt/), summary.json and report.md hold the\n"
-             "  protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo), within the map's depth range and all.\n"
+             "  protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo, mesh_paper, paper), within the map's\n"
+             "  depth range and all.\n"
              "  OUT/config.yaml is the configuration in full; -config OUT/config.yaml repeats the run.\n");
   print_info("  Ctrl-C stops after the frames under way and still writes the mesh and the summary.\n");
 }
@@ -111,17 +115,22 @@ struct GroundTruthScores {
   /// a frame, what a drive in bounded memory cannot keep.
   bool keep_surface = true;
 
+  /// One method's depth of frame `name` against its ground truth `gt`: all, background, foreground.
+  void addDepth(const std::string& method, const std::string& name, const cv::Mat& gt, const cv::Mat& estimate,
+                double focal_baseline) {
+    const std::size_t gt_index = truth->indexOf(name);
+    all[method].add(gt, estimate, focal_baseline);
+    background[method].add(gt, estimate, focal_baseline, truth->backgroundMask(gt_index));
+    foreground[method].add(gt, estimate, focal_baseline, truth->foregroundMask(gt_index));
+  }
+
   void add(const msf::FrameResult& r, const cv::Mat& gt, const msf::Calibration& calibration, double max_depth_m) {
     const std::size_t gt_index = truth->indexOf(r.name);
-    const cv::Mat fg = truth->foregroundMask(gt_index), bg = truth->backgroundMask(gt_index);
     const double fb = calibration.focalBaseline();
     const std::pair<const char*, cv::Mat> methods[] = {
         {"sgbm", r.stereo_depth}, {"interpolated", r.lidar_depth}, {"fused", r.fused.depth}};
-    for (const auto& [name, estimate] : methods) {
-      all[name].add(gt, estimate, fb);
-      background[name].add(gt, estimate, fb, bg);
-      foreground[name].add(gt, estimate, fb, fg);
-    }
+    for (const auto& [name, estimate] : methods)
+      addDepth(name, r.name, gt, estimate, fb);
     // Every 4th pixel of the true static surface in range, for the mesh's completeness against
     // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
     if (!keep_surface)
@@ -198,6 +207,23 @@ struct SourceMap {
     volume.setMaxMemoryMb(config.volume.max_memory_mb);
   }
   std::string name() const { return std::string("mesh_") + msf::toString(source); }
+};
+
+/// The paper as published beside the run (-compare_paper): PipelineConfig::paper() with the
+/// run's grid and rings, its own steps 1-5 on the same frames (loaded again, the same rings
+/// held out, at the same poses) and its own map.
+struct PaperRun {
+  msf::PipelineConfig config;
+  msf::Pipeline pipeline;
+  PaperRun(const msf::Calibration& calibration, const msf::PipelineConfig& ours)
+      : config(paperBeside(ours)), pipeline(calibration, config) {}
+  static msf::PipelineConfig paperBeside(const msf::PipelineConfig& ours) {
+    msf::PipelineConfig c = msf::PipelineConfig::paper();
+    c.volume = ours.volume;
+    c.rings = ours.rings;
+    c.validate();
+    return c;
+  }
 };
 
 /// The fused depth as msf_fuse writes it: an organized cloud with colour and weight.
@@ -390,14 +416,14 @@ int main(int argc, char** argv) {
   return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
     const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",    "-lambda",
                                                  "-panels", "-poses",  "-stream", "-max_memory"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources"});
+    msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources", "-compare_paper"});
     const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
     if (positional.size() > 1) {
       std::string extra;
       for (std::size_t k = 1; k < positional.size(); ++k)
         extra += (k > 1 ? "', '" : "") + positional[k];
       throw msf::InvalidInputError("expected at most one DATASET_DIR, got '" + positional.front() + "' and '" + extra +
-                                   "' too (-save_depth, -holdout and -compare_sources take no value; see -h)");
+                                   "' too (-save_depth, -holdout, -compare_sources and -compare_paper take no value; see -h)");
     }
 
     std::string out = "msf_out", config_path, frames_text = "0:", poses_option;
@@ -410,6 +436,7 @@ int main(int argc, char** argv) {
     const bool save_depth = find_switch(argc, argv, "-save_depth");
     const bool holdout = find_switch(argc, argv, "-holdout");
     const bool compare_sources = find_switch(argc, argv, "-compare_sources");
+    const bool compare_paper = find_switch(argc, argv, "-compare_paper");
     msf::PipelineConfig config = msf::PipelineConfig::load(config_path);
     if (find_argument(argc, argv, "-voxel") >= 0)
       msf::tool::parseArgument(argc, argv, "-voxel", config.volume.voxel_size_m);
@@ -422,8 +449,8 @@ int main(int argc, char** argv) {
     if (panels < 0 || panels > kMaxPanels)
       throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " + std::to_string(panels));
     const bool streaming = config.streaming.enabled();
-    if (streaming && (holdout || compare_sources))
-      throw msf::InvalidInputError(std::string(holdout ? "-holdout" : "-compare_sources") +
+    if (streaming && (holdout || compare_sources || compare_paper))
+      throw msf::InvalidInputError(std::string(holdout ? "-holdout" : compare_sources ? "-compare_sources" : "-compare_paper") +
                                    " needs the whole map in memory: not with a streamed map (-stream, " +
                                    "streaming.active_radius_m)");
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
@@ -496,6 +523,9 @@ int main(int argc, char** argv) {
     if (compare_sources)
       for (const msf::DepthSource source : {msf::DepthSource::Lidar, msf::DepthSource::Stereo})
         source_maps.push_back(std::make_unique<SourceMap>(source, config));
+    std::unique_ptr<PaperRun> paper;
+    if (compare_paper)
+      paper = std::make_unique<PaperRun>(calibration, config);
 
     print_highlight("Reconstructing ");
     print_value("%zu", frames.size());
@@ -544,6 +574,20 @@ int main(int argc, char** argv) {
                                          moving_split ? scores.truth->movingMask(scores.truth->indexOf(r.name))
                                                       : cv::Mat());
             evaluation->scoreDepth("fused", r.index, r.fused.depth);
+          }
+          if (paper) {
+            // On this thread, after ours: the paper's run does not share the stages' threads.
+            msf::Frame again = sequence.load(r.index);
+            if (holdout)
+              holdOutRings(again, sequence, holdout_config);
+            again.T_world_cam0 = r.T_world_cam0;
+            again.has_pose = true;
+            msf::FrameResult p = paper->pipeline.computeDepth(again);
+            paper->pipeline.integrate(p);
+            if (scores.truth)
+              scores.addDepth("paper", r.name, synthetic_depth, p.fused.depth, calibration.focalBaseline());
+            if (evaluation)
+              evaluation->scoreDepth("paper", r.index, p.fused.depth);
           }
           for (auto& map : source_maps)
             map->integrator.integrate(
@@ -597,6 +641,13 @@ int main(int argc, char** argv) {
       print_info("Streamed: %zu tiles written, %zu read back, %zu meshed again; %zu blocks freed; %.0f ms in all\n",
                  st.tiles_written, st.tiles_reloaded, st.tiles_remeshed, st.blocks_freed, st.stream_ms);
     }
+    const msf::TriangleMesh* paper_mesh = nullptr;
+    if (paper) {
+      tt.tic();
+      print_highlight("Meshing the paper's map ");
+      paper_mesh = &paper->pipeline.updateMesh();
+      msf::tool::printDone(tt.toc(), paper_mesh->triangles.size());
+    }
     for (auto& map : source_maps) {
       tt.tic();
       print_highlight("Meshing the %s map ", msf::toString(map->source));
@@ -625,6 +676,10 @@ int main(int argc, char** argv) {
         map->mesh.toPolygonMesh(source_polygons[map->name()]);
         msf::saveMesh((fs::path(stage) / (map->name() + ".ply")).string(), source_polygons[map->name()]);
       }
+    if (paper_mesh && !paper_mesh->triangles.empty()) {
+      paper_mesh->toPolygonMesh(source_polygons["mesh_paper"]);
+      msf::saveMesh((fs::path(stage) / "mesh_paper.ply").string(), source_polygons["mesh_paper"]);
+    }
     msf::writeAtomically((fs::path(stage) / report.config_file).string(), [&](const std::string& tmp) {
       std::ofstream file(tmp);
       file << report.config_yaml;
@@ -653,6 +708,8 @@ int main(int argc, char** argv) {
       meshes["mesh"] = {&mesh, &polygon_mesh};
     for (const auto& map : source_maps)
       meshes[map->name()] = {&map->mesh, source_polygons.count(map->name()) ? &source_polygons[map->name()] : nullptr};
+    if (paper_mesh)
+      meshes["mesh_paper"] = {paper_mesh, source_polygons.count("mesh_paper") ? &source_polygons["mesh_paper"] : nullptr};
     std::map<std::string, msf::MeshAccuracy> accuracy;
     std::map<std::string, msf::GhostMetrics> ghosts;
     if (scores.truth) {
@@ -665,7 +722,7 @@ int main(int argc, char** argv) {
       }
       const std::string scene = scores.truth->sceneMeshPath();
       tt.tic();
-      print_highlight("Scoring the mesh%s against ", source_maps.empty() ? "" : "es");
+      print_highlight("Scoring the mesh%s against ", meshes.size() > 1 ? "es" : "");
       print_value("%s ", scene.c_str());
       pcl::PolygonMesh truth;
       msf::loadMesh(scene, truth);
@@ -707,7 +764,7 @@ int main(int argc, char** argv) {
 
     if (evaluation) {
       tt.tic();
-      print_highlight("Rendering the mesh%s at every frame's pose ", source_maps.empty() ? "" : "es");
+      print_highlight("Rendering the mesh%s at every frame's pose ", meshes.size() > 1 ? "es" : "");
       for (const auto& [name, m] : meshes)
         evaluation->scoreMesh(name, *m.first);
       msf::tool::printDone(tt.toc(), evaluation->frames() * meshes.size());
@@ -722,7 +779,7 @@ int main(int argc, char** argv) {
       if (ghosts.empty())
         e.no_ghosts = noGhostsReason(scores.truth.get());
       const auto rows = evaluation->scores();
-      for (const char* source : {"mesh", "fused", "mesh_lidar", "mesh_stereo"})
+      for (const char* source : {"mesh", "fused", "mesh_lidar", "mesh_stereo", "mesh_paper", "paper"})
         for (const auto& score : rows)
           if (score.source == source) {
             msf::RunReport::MapEvaluation::Row row;

@@ -68,7 +68,7 @@ TEST_F(SyntheticGtTest, HoldoutFullImageTableHasRegionsAndFusionBeatsSgbm) {
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("region"), std::string::npos) << r.out;
   const auto rows = parseRegionTable(r.out);
-  for (const char* method : {"sgbm", "interpolated", "fused_uncertainty", "fused_paper", "ipbasic_multiscale"})
+  for (const char* method : {"sgbm", "interpolated", "fused_uncertainty", "fused_paper", "paper", "ipbasic_multiscale"})
     for (const char* region : {"all", "background", "foreground"}) {
       const std::string key = std::string(method) + "/" + region;
       ASSERT_TRUE(rows.count(key)) << "no row " << key << " in\n" << r.out;

@@ -153,6 +153,48 @@ TEST(DepthFusionPaper, PixelFunctionIsTheWeightedMean) {
   EXPECT_NEAR(msf::fusePaper(in, config).z, (w_S0 * 25.f + w_L * 30.f) / (w_S0 + w_L), 1e-4f);
 }
 
+TEST(DepthFusionPaper, AsWrittenTheStereoWeightCancels) {
+  // Eq. 6 with w1 = w_S and w2 = w_L: y = (y1 + w_L y2) / (1 + w_L) whatever stereo's confidence.
+  msf::DepthFusionConfig config;
+  config.paper_weights = msf::PaperWeights::AsWritten;
+  config.paper_lidar_gain = 1.f;
+  config.paper_lidar_distance_px = 4.f;
+  msf::FusionInputs in;
+  in.z_lidar = 30.f;
+  in.lidar_distance = 4.f; // w_L = 0.5
+  in.z_stereo = 24.f;
+  for (const float confidence : {0.f, 0.3f, 1.f}) {
+    in.stereo_confidence = confidence;
+    EXPECT_NEAR(msf::fusePaper(in, config).z, (24.f + 0.5f * 30.f) / 1.5f, 1e-4f) << confidence;
+  }
+  // Without LiDAR (w1 = 1, w2 = 0) stereo is used; without stereo (w1 = 0) the LiDAR.
+  msf::FusionInputs stereo_only = in, lidar_only = in;
+  stereo_only.z_lidar = 0.f;
+  lidar_only.z_stereo = 0.f;
+  EXPECT_FLOAT_EQ(msf::fusePaper(stereo_only, config).z, 24.f);
+  EXPECT_FLOAT_EQ(msf::fusePaper(lidar_only, config).z, 30.f);
+  // The project's reading weighs stereo by its confidence: a confident match pulls harder.
+  config.paper_weights = msf::PaperWeights::Relative;
+  in.stereo_confidence = 1.f;
+  const float confident = msf::fusePaper(in, config).z;
+  in.stereo_confidence = 0.1f;
+  EXPECT_LT(confident, msf::fusePaper(in, config).z);
+}
+
+TEST(DepthFusionPaper, PaperWeightsKeyIsNamedWhenWrong) {
+  cv::FileStorage fs("%YAML:1.0\nfusion:\n  paper_weights: literal\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  msf::DepthFusionConfig config;
+  try {
+    config.read(fs["fusion"]);
+    ADD_FAILURE() << "paper_weights: literal was accepted";
+  } catch (const msf::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("fusion.paper_weights"), std::string::npos) << e.what();
+  }
+  cv::FileStorage ok("%YAML:1.0\nfusion:\n  paper_weights: as_written\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  config.read(ok["fusion"]);
+  EXPECT_EQ(config.paper_weights, msf::PaperWeights::AsWritten);
+}
+
 // ---- uncertainty ---------------------------------------------------------------------------
 
 /// sigma_S = 0.3 + 3.7 (1 - c)^2 px, sigma_L = 0.3 + 0.05 distance + 0.7 range px.

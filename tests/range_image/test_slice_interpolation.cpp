@@ -136,6 +136,22 @@ TEST(SliceInterpolation, ADepthJumpIsAnEdgeAndStaysEmpty) {
     EXPECT_GT(s.out[i], 20.f) << "pixel " << i;
 }
 
+TEST(SliceInterpolation, WithoutTheEdgeTestEveryGapIsBridged) {
+  // The paper's slices: the gap between 10 m and 20 m is bridged like any other.
+  msf::SliceParams p = plain(msf::SliceInterpolant::Linear);
+  p.jump_abs_m = 0.5f;
+  p.jump_inv_per_m = 0.03f;
+  p.edge_test = false;
+  p.inverse_depth = false;
+  EXPECT_FALSE(msf::isDepthJump(10.f, 20.f, p));
+  std::vector<float> in(5, 0.f);
+  in[0] = 10.f;
+  in[4] = 20.f;
+  const Slice s = run(in, p);
+  for (int i = 1; i < 4; ++i)
+    EXPECT_FLOAT_EQ(s.out[i], 10.f + 2.5f * static_cast<float>(i)) << "pixel " << i; // linear in z
+}
+
 TEST(SliceInterpolation, EdgeTestNeedsEveryThresholdExceeded) {
   msf::SliceParams p;
   p.jump_abs_m = 1.f;

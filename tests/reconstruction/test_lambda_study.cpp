@@ -59,12 +59,28 @@ TEST(LambdaStudy, ToolWritesTheTableAndThePlot) {
   std::ifstream csv(dir.file("lambda_study.csv"));
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame");
+  EXPECT_EQ(line, "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame,sweeps_per_frame");
   int rows = 0;
-  while (std::getline(csv, line))
+  while (std::getline(csv, line)) {
     ++rows;
+    const double sweeps = std::stod(line.substr(line.rfind(',') + 1));
+    EXPECT_EQ(sweeps, line.find(",5.00,") != std::string::npos ? 1.0 : 0.0) << line; // one per frame, none at 0
+  }
   EXPECT_EQ(rows, 4);
   EXPECT_TRUE(test::fileExists(dir.file("lambda_study.png")));
+  // The paper's solve: eq. 7 to its minimizer, many sweeps a frame.
+  r = test::runTool("msf_lambda_study", "-o " + dir.path() + " -config " + dir.file("study.yaml") + " -solve argmin");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream argmin(dir.file("lambda_study.csv"));
+  std::getline(argmin, line);
+  while (std::getline(argmin, line)) {
+    if (line.find(",5.00,") != std::string::npos) {
+      EXPECT_GT(std::stod(line.substr(line.rfind(',') + 1)), 5.0) << line;
+    }
+  }
+  r = test::runTool("msf_lambda_study", "-o " + dir.path() + " -solve exact");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("-solve"), std::string::npos) << r.err;
   r = test::runTool("msf_lambda_study", "-o " + dir.file("missing/out"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("msf_lambda_study: error:"), std::string::npos) << r.err;

@@ -586,3 +586,76 @@ TEST(TsdfIntegrator, FarStereoNeitherOverwritesNearLidarGeometryNorLeavesSpecks)
   MarchingCubes().extract(far_only, mesh);
   EXPECT_GT(mesh.vertices.size(), 1000u);
 }
+
+namespace {
+
+/// The volume after one noisy frame of the sphere scene with lambda 5, solved as `config` says.
+TsdfVolume regularizedOnce(TsdfIntegrator::Config config, TsdfIntegrator::Stats* stats = nullptr) {
+  const AnalyticScene scene = test::makeScene(SceneKind::Sphere);
+  TsdfVolume volume(kVoxel, kTrunc);
+  config.lambda = 5.0;
+  config.weighting = TsdfIntegrator::Weighting::Constant;
+  TsdfIntegrator integrator(volume, config);
+  const auto pose = test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 15, 1).front();
+  integrator.integrate(test::renderFrame(scene, test::smallCamera(), pose, 0.02, 11), pose);
+  if (stats)
+    *stats = integrator.lastStats();
+  return volume;
+}
+
+/// The largest |sdf| difference of the voxels observed in both volumes.
+double largestDifference(const TsdfVolume& a, const TsdfVolume& b) {
+  double largest = 0;
+  for (const TsdfBlock* block : a.blocks()) {
+    const TsdfBlock* other = b.findBlock(block->index);
+    if (!other)
+      continue;
+    for (int j = 0; j < TsdfBlock::kVoxels; ++j)
+      if (block->voxels[j].weight > 0.f && other->voxels[j].weight > 0.f)
+        largest = std::max(largest, static_cast<double>(std::abs(block->voxels[j].sdf - other->voxels[j].sdf)));
+  }
+  return largest;
+}
+
+} // namespace
+
+TEST(TsdfIntegrator, ArgminSolveReachesTheMinimizerOfEquation7) {
+  // The minimizer does not depend on how it is reached: sweeping until nothing moves more than
+  // the tolerance lands where the most sweeps allowed land, and far from one sweep.
+  TsdfIntegrator::Config argmin;
+  argmin.solve = TsdfIntegrator::Solve::Argmin;
+  argmin.argmin_tolerance_m = 1e-6;
+  TsdfIntegrator::Stats stats;
+  const TsdfVolume solved = regularizedOnce(argmin, &stats);
+  EXPECT_TRUE(stats.regularize_converged);
+  EXPECT_GT(stats.regularize_sweeps, 10);
+  EXPECT_LT(stats.regularize_sweeps, argmin.argmin_max_sweeps);
+  TsdfIntegrator::Config many, one;
+  many.sweeps = TsdfIntegrator::Config::kMaxSweeps;
+  one.sweeps = 1;
+  const double to_many = largestDifference(solved, regularizedOnce(many));
+  const double to_one = largestDifference(solved, regularizedOnce(one));
+  std::printf("  argmin in %d sweeps: %.2g m from 100 sweeps, %.2g m from one\n", stats.regularize_sweeps, to_many,
+              to_one);
+  EXPECT_LT(to_many, 1e-4);
+  EXPECT_GT(to_one, 10 * to_many);
+  // A cap on the sweeps is reported as not converged.
+  argmin.argmin_max_sweeps = 2;
+  regularizedOnce(argmin, &stats);
+  EXPECT_FALSE(stats.regularize_converged);
+  EXPECT_EQ(stats.regularize_sweeps, 2);
+}
+
+TEST(TsdfIntegrator, SolveKeysAreNamedWhenWrong) {
+  for (const std::string key : {"solve: exact", "argmin_tolerance_m: 0", "argmin_max_sweeps: 0"}) {
+    cv::FileStorage fs("%YAML:1.0\ntsdf_integrator:\n  " + key + "\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
+    TsdfIntegrator::Config config;
+    try {
+      config.read(fs["tsdf_integrator"]);
+      ADD_FAILURE() << key << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("tsdf_integrator." + key.substr(0, key.find(':'))), std::string::npos)
+          << e.what();
+    }
+  }
+}

@@ -14,6 +14,16 @@ FusionMethod parseFusionMethod(const std::string& name) {
   throw ConfigError("fusion method must be paper or uncertainty, not '" + name + "'");
 }
 
+PaperWeights parsePaperWeights(const std::string& name) {
+  if (name == "relative")
+    return PaperWeights::Relative;
+  if (name == "as_written")
+    return PaperWeights::AsWritten;
+  throw ConfigError("config key 'fusion.paper_weights' must be relative or as_written, not '" + name + "'");
+}
+
+const char* toString(PaperWeights weights) { return weights == PaperWeights::AsWritten ? "as_written" : "relative"; }
+
 const char* toString(FusionMethod method) { return method == FusionMethod::Paper ? "paper" : "uncertainty"; }
 
 const char* toString(LidarEdgeCue cue) { return cue == LidarEdgeCue::Bend ? "bend" : "range"; }
@@ -37,6 +47,9 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   } catch (const ConfigError&) {
     throw ConfigError("config key 'fusion.method' must be paper or uncertainty, not '" + method_name + "'");
   }
+  std::string weights_name = toString(paper_weights);
+  readKey(node, "paper_weights", weights_name);
+  paper_weights = parsePaperWeights(weights_name);
   readKey(node, "paper_lidar_gain", paper_lidar_gain);
   readKey(node, "paper_lidar_distance_px", paper_lidar_distance_px);
   readKey(node, "paper_stereo_reference_depth_m", paper_stereo_reference_depth_m);
@@ -93,6 +106,7 @@ void DepthFusionConfig::validate() const {
 void DepthFusionConfig::print(std::ostream& out) const {
   out << "fusion:\n"
       << "  method: " << toString(method) << "\n"
+      << "  paper_weights: " << toString(paper_weights) << "\n"
       << "  paper_lidar_gain: " << configValue(paper_lidar_gain) << "\n"
       << "  paper_lidar_distance_px: " << configValue(paper_lidar_distance_px) << "\n"
       << "  paper_stereo_reference_depth_m: " << configValue(paper_stereo_reference_depth_m) << "\n"

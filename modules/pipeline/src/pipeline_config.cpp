@@ -48,6 +48,47 @@ void SchedulingConfig::print(std::ostream& out) const {
       << "  lidar_threads: " << configValue(lidar_threads) << "\n";
 }
 
+PipelineConfig PipelineConfig::paper() {
+  PipelineConfig c;
+  // Step 1: the scan into the image only (no canvas around it).
+  c.projection.margin_px = 0;
+  // Step 2 (§III-B): eq. 2-5 on depth z; rows and columns sliced independently and averaged
+  // where both bridge a pixel; every gap up to the maximum bridged (no edge test); one
+  // Gaussian pass over the result (the real returns kept).
+  c.interpolation.slice.interpolant = SliceInterpolant::Compound;
+  c.interpolation.slice.inverse_depth = false;
+  c.interpolation.slice.edge_test = false;
+  c.interpolation.slice.cubic_alpha = 2.f;
+  c.interpolation.slice.cubic_beta = 3.f;
+  c.interpolation.column_seed_gap_px = 0;
+  c.interpolation.combine = CombineRule::Average;
+  c.interpolation.gaussian = true;
+  c.interpolation.gaussian_smooth_valid = true;
+  // Step 3: OpenCV's SGBM on the grey pair alone, over the full disparity range.
+  c.stereo.engine = "opencv";
+  c.stereo.guidance = "none";
+  c.stereo.prior_search_range = false;
+  c.scheduling.stereo_prior = false;
+  // Step 4: eq. 6 with the paper's weights, nothing after it.
+  c.fusion.method = FusionMethod::Paper;
+  c.fusion.paper_weights = PaperWeights::AsWritten;
+  c.fusion.edge_support = false;
+  // Step 5 (§III-C): a projective TSDF, every depth weighing the same, updated within the
+  // truncation only, then eq. 7 solved to its minimizer with lambda 5 (the paper's KITTI value).
+  c.integrator.weighting = TsdfIntegrator::Weighting::Constant;
+  c.integrator.signed_distance = TsdfIntegrator::SignedDistance::Projective;
+  c.integrator.truncation_sigmas = 0.0;
+  c.integrator.min_pixel_weight = 0.f;
+  c.integrator.space_carving = false;
+  c.integrator.weight_dropoff = false;
+  c.integrator.interpolate_depth = false;
+  c.integrator.lambda = 5.0;
+  c.integrator.solve = TsdfIntegrator::Solve::Argmin;
+  c.mesher.min_weight = 0.f;
+  c.validate();
+  return c;
+}
+
 PipelineConfig PipelineConfig::load(const std::string& path) {
   PipelineConfig config;
   if (path.empty())

@@ -21,6 +21,11 @@ namespace msf {
 
 namespace {
 
+/// What the rows of msf_reconstruct -compare_paper are.
+constexpr const char* kPaperRows =
+    "`paper`, `mesh_paper`: the paper as published (config/paper.yaml, docs/paper.md), run on the same frames "
+    "at the same poses into a map of its own.";
+
 /// The stages reported, with how to read each from a frame row.
 struct StageColumn {
   const char* name;
@@ -348,6 +353,8 @@ void RunReport::writeMarkdown(const std::string& path) const {
       }
     }
     s << "\n";
+    if (depth.count("paper"))
+      s << kPaperRows << "\n\n";
   }
   if (has_mesh_accuracy) {
     const auto& m = mesh_accuracy;
@@ -422,6 +429,11 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
     table("source (moving objects)",
           [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_within_range; },
           [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_all; });
+  for (const auto& r : e.rows)
+    if (r.score.source == "paper") {
+      s << kPaperRows << "\n";
+      break;
+    }
   if (accuracy)
     s << "Accuracy: mean distance of the mesh's vertices to the true surface; completeness: share of the seen true "
          "surface within the threshold of the mesh (as above).\n";

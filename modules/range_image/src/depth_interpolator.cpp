@@ -45,6 +45,7 @@ void InterpolationConfig::print(std::ostream& out) const {
       << "  method: " << toString(slice.interpolant) << "\n"
       << "  short_gap_px: " << configValue(slice.short_gap_px) << "\n"
       << "  max_gap_px: " << configValue(slice.max_gap_px) << "\n"
+      << "  edge_test: " << configValue(slice.edge_test) << "\n"
       << "  jump_abs_m: " << configValue(slice.jump_abs_m) << "\n"
       << "  jump_rel: " << configValue(slice.jump_rel) << "\n"
       << "  jump_inv_per_m: " << configValue(slice.jump_inv_per_m) << "\n"
@@ -67,6 +68,7 @@ void InterpolationConfig::read(const cv::FileNode& node) {
   slice.interpolant = parseSliceInterpolant(method);
   readKey(node, "short_gap_px", slice.short_gap_px);
   readKey(node, "max_gap_px", slice.max_gap_px);
+  readKey(node, "edge_test", slice.edge_test);
   readKey(node, "jump_abs_m", slice.jump_abs_m);
   readKey(node, "jump_rel", slice.jump_rel);
   readKey(node, "cubic_alpha", slice.cubic_alpha);

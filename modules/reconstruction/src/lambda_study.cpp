@@ -43,6 +43,13 @@ void LambdaStudy::Config::read(const cv::FileNode& node) {
   readKey(node, "voxel_size_m", voxel_size_m);
   readKey(node, "truncation_m", truncation_m);
   readKey(node, "sweeps", sweeps);
+  std::string solve_name = toString(solve);
+  readKey(node, "solve", solve_name);
+  try {
+    solve = parseSolve(solve_name);
+  } catch (const ConfigError&) {
+    throw ConfigError("lambda_study.solve must be sweeps or argmin, not '" + solve_name + "'");
+  }
   readKey(node, "width", width);
   readKey(node, "height", height);
   readKey(node, "focal_px", focal_px);
@@ -61,6 +68,7 @@ void LambdaStudy::Config::print(std::ostream& out) const {
   };
   out << "lambda_study:\n  noise_mm: " << list(noise_mm) << "\n  lambdas: " << list(lambdas) << "\n  frames: " << frames
       << "\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m << "\n  sweeps: " << sweeps
+      << "\n  solve: " << toString(solve)
       << "\n  width: " << width << "\n  height: " << height << "\n  focal_px: " << focal_px << "\n  seed: " << seed
       << "\n";
 }
@@ -115,11 +123,12 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
   ic.weight_dropoff = false;
   ic.lambda = lambda;
   ic.sweeps = config_.sweeps;
+  ic.solve = config_.solve;
   TsdfIntegrator integrator(volume, ic);
   // The same noise for every lambda at a noise level: the lambdas are compared on equal data.
   std::mt19937 rng(config_.seed);
   std::normal_distribution<float> noise(0.f, static_cast<float>(noise_mm * 1e-3));
-  double integrate_ms = 0;
+  double integrate_ms = 0, sweeps = 0;
   for (int i = 0; i < config_.frames; ++i) {
     const Eigen::Isometry3d pose = arcPose(i, config_.frames);
     DepthFrame frame;
@@ -135,6 +144,7 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
     const auto t0 = std::chrono::steady_clock::now();
     integrator.integrate(frame, pose);
     integrate_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    sweeps += integrator.lastStats().regularize_sweeps;
   }
   TriangleMesh mesh;
   MarchingCubes::Config every_voxel;
@@ -145,6 +155,7 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
   cell.lambda = lambda;
   cell.vertices = mesh.vertices.size();
   cell.integrate_ms = integrate_ms / config_.frames;
+  cell.sweeps = sweeps / config_.frames;
   double sum = 0;
   for (const auto& p : mesh.vertices)
     sum += std::abs(scene_.signedDistance(p.cast<double>()));
@@ -163,10 +174,11 @@ std::vector<LambdaStudy::Cell> LambdaStudy::runAll() const {
 void LambdaStudy::writeCsv(const std::string& path, const std::vector<Cell>& cells) {
   writeAtomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp);
-    out << "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame\n" << std::fixed;
+    out << "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame,sweeps_per_frame\n" << std::fixed;
     for (const Cell& c : cells)
       out << std::setprecision(1) << c.noise_mm << ',' << std::setprecision(2) << c.lambda << ',' << std::setprecision(3)
-          << c.mae_mm << ',' << c.vertices << ',' << std::setprecision(2) << c.integrate_ms << '\n';
+          << c.mae_mm << ',' << c.vertices << ',' << std::setprecision(2) << c.integrate_ms << ',' << std::setprecision(1)
+          << c.sweeps << '\n';
     if (!out.flush())
       throw IOError("cannot write '" + path + "'");
   });

@@ -156,6 +156,16 @@ TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
   throw ConfigError("TSDF weighting '" + text + "' is not constant, inverse_square or per_pixel");
 }
 
+const char* toString(TsdfIntegrator::Solve solve) {
+  return solve == TsdfIntegrator::Solve::Argmin ? "argmin" : "sweeps";
+}
+
+TsdfIntegrator::Solve parseSolve(const std::string& text) {
+  if (text == "sweeps") return TsdfIntegrator::Solve::Sweeps;
+  if (text == "argmin") return TsdfIntegrator::Solve::Argmin;
+  throw ConfigError("tsdf_integrator.solve '" + text + "' is not sweeps or argmin");
+}
+
 void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   std::string w = toString(weighting);
   readKey(node, "weighting", w);
@@ -175,6 +185,11 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "plane_min_scale", plane.min_scale);
   readKey(node, "lambda", lambda);
   readKey(node, "sweeps", sweeps);
+  std::string solve_name = toString(solve);
+  readKey(node, "solve", solve_name);
+  solve = parseSolve(solve_name);
+  readKey(node, "argmin_tolerance_m", argmin_tolerance_m);
+  readKey(node, "argmin_max_sweeps", argmin_max_sweeps);
   readKey(node, "min_depth_m", min_depth_m);
   readKey(node, "max_depth_m", max_depth_m);
   readKey(node, "interpolate_depth", interpolate_depth);
@@ -206,6 +221,11 @@ void TsdfIntegrator::Config::validate() const {
   if (sweeps < 0 || sweeps > kMaxSweeps)
     throw ConfigError("tsdf_integrator.sweeps (-sweeps) must be 0.." + std::to_string(kMaxSweeps) + ", got " +
                       std::to_string(sweeps));
+  if (!(argmin_tolerance_m > 0.0) || !std::isfinite(argmin_tolerance_m))
+    throw ConfigError("tsdf_integrator.argmin_tolerance_m must be > 0, got " + std::to_string(argmin_tolerance_m));
+  if (argmin_max_sweeps < 1 || argmin_max_sweeps > kMaxArgminSweeps)
+    throw ConfigError("tsdf_integrator.argmin_max_sweeps must be 1.." + std::to_string(kMaxArgminSweeps) + ", got " +
+                      std::to_string(argmin_max_sweeps));
   if (!(max_depth_m <= kMaxDepthM))
     throw ConfigError("tsdf_integrator.max_depth_m must be at most " + std::to_string(kMaxDepthM) + " m, got " +
                       std::to_string(max_depth_m));
@@ -230,6 +250,9 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  plane_min_scale: " << configValue(plane.min_scale) << "\n"
       << "  lambda: " << configValue(lambda) << "\n"
       << "  sweeps: " << configValue(sweeps) << "\n"
+      << "  solve: " << toString(solve) << "\n"
+      << "  argmin_tolerance_m: " << configValue(argmin_tolerance_m) << "\n"
+      << "  argmin_max_sweeps: " << configValue(argmin_max_sweeps) << "\n"
       << "  min_depth_m: " << configValue(min_depth_m) << "\n"
       << "  max_depth_m: " << configValue(max_depth_m) << "\n"
       << "  interpolate_depth: " << configValue(interpolate_depth) << "\n"
@@ -466,7 +489,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
   const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
   const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
-  const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
+  const bool regularized = regularizes();
   // Changed voxels of each block (local indices), for the regularization.
   if (regularized) {
     changed_index_.resize(blocks.size() * TsdfBlock::kVoxels);
@@ -712,7 +735,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
   const float vs = static_cast<float>(volume_.voxelSize());
   const float trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.max_depth_m);
-  const bool regularized = config_.lambda > 0.0 && config_.sweeps > 0;
+  const bool regularized = regularizes();
   const std::uint8_t flag = regularized ? kUpdated : 0;
   const Eigen::Vector3f o = origin_world.cast<float>();
   const std::size_t blocks_before = volume_.numBlocks();
@@ -803,10 +826,14 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const GridIndex& b = touched[i]->index;
     colour[(b.x() + b.y() + b.z()) & 1].push_back(i);
   }
-  for (int sweep = 0; sweep < config_.sweeps; ++sweep) {
+  const bool argmin = config_.solve == Solve::Argmin;
+  const int max_sweeps = argmin ? config_.argmin_max_sweeps : config_.sweeps;
+  const auto tolerance = static_cast<float>(config_.argmin_tolerance_m);
+  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
     // The sweeps move values towards their neighbours' and can change signs: the last one
-    // records them.
-    const bool last = sweep + 1 == config_.sweeps;
+    // records them (every one when the last is not known in advance; the flags only add).
+    const bool last = argmin || sweep + 1 == max_sweeps;
+    std::atomic<float> largest_change{0.f};
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
       cv::parallel_for_(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
@@ -821,6 +848,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         TsdfBlock& block = *touched[i];
         const auto& nb = neighbours[i];
         std::uint8_t signs = 0, negative = 0;
+        float change = 0.f;
         for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
           const int j = changed_index_[k];
           const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
@@ -838,8 +866,10 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
           if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
           float& sdf = block.voxels[j].sdf;
+          const float before = sdf;
           if (count > 0.f)
             sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * count);
+          change = std::max(change, std::abs(sdf - before));
           signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
           negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
         }
@@ -847,8 +877,15 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           block.signs |= signs;
           block.negative_subblocks |= negative;
         }
+        for (float seen = largest_change.load(); change > seen && !largest_change.compare_exchange_weak(seen, change);)
+          ;
       }
       }, std::max(1.0, static_cast<double>(m) / 16));
+    }
+    stats_.regularize_sweeps = sweep + 1;
+    if (argmin && largest_change.load() <= tolerance) {
+      stats_.regularize_converged = true;
+      break;
     }
   }
 }

@@ -12,6 +12,16 @@ enum class FusionMethod {
   Uncertainty  ///< inverse-variance fusion with a k-sigma disagreement test
 };
 
+/// Which weights eq. 6 multiplies (fusion_model.h, fusePaper).
+enum class PaperWeights {
+  Relative, ///< w1 = 1, w2 = w_L / w_S: stereo's own weight enters the mean (the project's reading)
+  AsWritten ///< w1 = w_S, w2 = w_L as the paper defines them: w1 cancels, only w_L sets the mean
+};
+
+/// "relative" or "as_written"; throws ConfigError naming the key and the text otherwise.
+PaperWeights parsePaperWeights(const std::string& name);
+const char* toString(PaperWeights weights);
+
 /// "paper" or "uncertainty"; throws ConfigError naming the text otherwise.
 FusionMethod parseFusionMethod(const std::string& name);
 const char* toString(FusionMethod method);
@@ -29,7 +39,8 @@ const char* toString(LidarEdgeCue cue);
 struct DepthFusionConfig {
   FusionMethod method = FusionMethod::Uncertainty;
 
-  // --- paper (eq. 6): w2 = w_L / w_S, see fusion_model.h
+  // --- paper (eq. 6), see fusion_model.h
+  PaperWeights paper_weights = PaperWeights::Relative;
   float paper_lidar_gain = 4.f;               ///< w_L on a real return
   float paper_lidar_distance_px = 8.f;        ///< w_L halves this far from the nearest real return
   float paper_stereo_reference_depth_m = 20.f;///< w_S = confidence where z_stereo <= this, falls as 1/z^2 beyond

@@ -42,21 +42,24 @@ inline bool validDepth(float z) { return z > 0.f && std::isfinite(z); }
 ///   w_L = paper_lidar_gain / (1 + distance / paper_lidar_distance_px)   (0 without LiDAR)
 ///          trust in the LiDAR, halved paper_lidar_distance_px pixels from a real return;
 ///   w_S = max(confidence, paper_min_stereo_confidence) * min(1, (z_ref / z_stereo)^2)
-///          trust in stereo: its confidence, and its depth error growing as z^2 beyond z_ref;
-///   w2  = w_L / w_S, the LiDAR's weight relative to stereo's;
-///   w1  = 1 where stereo has a depth, in particular where the LiDAR sample is invalid
-///          (w2 = 0 there) so that the stereo depth is used unchanged.
-/// Wherever w1 != 0 it cancels: y = (y1 + w2 y2) / (1 + w2), the mean of the two depths
-/// weighted w_S : w_L. Where stereo has no depth (w1 = 0, eq. 6 is 0/0) the LiDAR depth is
-/// used. weight = min(1, w_L + w_S).
+///          trust in stereo: its confidence, and its depth error growing as z^2 beyond z_ref.
+/// paper_weights picks what eq. 6 multiplies:
+///   as_written: w1 = w_S, the stereo weight (1 where the LiDAR sample is invalid, so that the
+///          stereo depth is used unchanged there), and w2 = w_L. Wherever w1 != 0 it cancels:
+///          y = (y1 + w_L y2) / (1 + w_L), so stereo's confidence never moves the depth;
+///   relative (the project's reading): w1 = 1 and w2 = w_L / w_S, the LiDAR's weight relative
+///          to stereo's, so that y is the mean of the two depths weighted w_S : w_L.
+/// Where stereo has no depth (w1 = 0, eq. 6 is 0/0) the LiDAR depth is used.
+/// weight = min(1, w_L + w_S).
 inline FusionResult fusePaper(const FusionInputs& in, const DepthFusionConfig& c) {
   const bool lidar = in.z_lidar > 0.f, stereo = in.z_stereo > 0.f;
   const float w_L_any = c.paper_lidar_gain / (1.f + in.lidar_distance / c.paper_lidar_distance_px);
   const float w_L = lidar ? w_L_any : 0.f;
   const float ratio = c.paper_stereo_reference_depth_m / (stereo ? in.z_stereo : 1.f);
   const float w_S = std::max(in.stereo_confidence, c.paper_min_stereo_confidence) * std::min(1.f, ratio * ratio);
-  const float w1 = 1.f;
-  const float w2 = w_L / w_S;
+  const bool as_written = c.paper_weights == PaperWeights::AsWritten;
+  const float w1 = as_written && lidar ? w_S : 1.f; // > 0 wherever stereo has a depth
+  const float w2 = as_written ? w_L : w_L / w_S;
   const float y1 = in.z_stereo, y2 = lidar ? in.z_lidar : 0.f;
   const float y = (y1 * w1 + y2 * w2 * w1) / (w1 + w2 * w1);
   FusionResult r;

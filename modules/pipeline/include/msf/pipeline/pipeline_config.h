@@ -57,6 +57,10 @@ struct PipelineConfig {
   /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
   LidarOdometry::Config odometry;
 
+  /// The paper as published (Ali, Rajput et al. 2019), without the project's additions:
+  /// config/paper.yaml, and docs/paper.md for what each setting switches off and its effect.
+  static PipelineConfig paper();
+
   /// Defaults overridden by the sections present in `path` ("" = all defaults).
   /// Throws IOError for a missing file, ConfigError naming a bad key.
   static PipelineConfig load(const std::string& path);

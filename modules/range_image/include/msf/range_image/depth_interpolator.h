@@ -27,7 +27,7 @@ const char* toString(CombineRule rule);
 
 /// Section `interpolation` of the YAML config (paper step 2, compound interpolation).
 struct InterpolationConfig {
-  SliceParams slice;                        ///< keys method, short_gap_px, max_gap_px, jump_abs_m,
+  SliceParams slice;                        ///< keys method, short_gap_px, max_gap_px, edge_test, jump_abs_m,
                                             ///< jump_rel, jump_inv_per_m, cubic_alpha, cubic_beta,
                                             ///< inverse_depth
   CombineRule combine = CombineRule::ShorterGap;

@@ -21,6 +21,9 @@ struct SliceParams {
   SliceInterpolant interpolant = SliceInterpolant::Compound;
   int short_gap_px = 4;        ///< gaps of at most this many empty pixels take the cubic
   int max_gap_px = 64;         ///< longer gaps stay empty
+  /// Leave a gap open across an object edge (below); false bridges every gap up to
+  /// max_gap_px, as the paper does.
+  bool edge_test = true;
   /// A gap is an object edge when its ends z0, z1 differ by more than all three of:
   float jump_abs_m = 0.5f;     ///< an absolute jump |z1 - z0| in metres,
   float jump_rel = 0.f;        ///< a share of the nearer depth,
@@ -31,13 +34,13 @@ struct SliceParams {
                                ///< (false: plain depth, the paper's eq. 2-5 on z)
 };
 
-/// True when the ends z0, z1 of a gap are on two sides of an object edge.
+/// True when the ends z0, z1 of a gap are on two sides of an object edge (never without edge_test).
 /// Inverse depth is affine in the image along a plane, so the ground's inverse depth
 /// changes little across a gap even far away, where its depth changes a lot.
 inline bool isDepthJump(float z0, float z1, const SliceParams& p) {
   const float d = z1 > z0 ? z1 - z0 : z0 - z1;
   const float nearer = z1 < z0 ? z1 : z0;
-  return d > p.jump_abs_m && d > p.jump_rel * nearer && d > p.jump_inv_per_m * z0 * z1;
+  return p.edge_test && d > p.jump_abs_m && d > p.jump_rel * nearer && d > p.jump_inv_per_m * z0 * z1;
 }
 
 /// Calls emit(k, z) with the estimate z of the k-th (1..empty) of the `empty` pixels

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/reconstruction/analytic_scene.h>
+#include <msf/reconstruction/tsdf_integrator.h>
 
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/persistence.hpp>
@@ -26,12 +27,14 @@ public:
     double voxel_size_m = 0.05;
     double truncation_m = 0.25;  ///< 3 sigma of the largest noise, so noise is averaged, not clipped
     int sweeps = 1;
+    /// argmin: eq. 7 solved to its minimizer every frame (the paper), not `sweeps` sweeps
+    TsdfIntegrator::Solve solve = TsdfIntegrator::Solve::Sweeps;
     int width = 320, height = 240;
     double focal_px = 300.0;
     unsigned seed = 1;
 
     /// YAML section `lambda_study`: noise_mm and lambdas (sequences), frames, voxel_size_m,
-    /// truncation_m, sweeps, width, height, focal_px, seed.
+    /// truncation_m, sweeps, solve (sweeps | argmin), width, height, focal_px, seed.
     void read(const cv::FileNode& node);
     void print(std::ostream& out) const;
   };
@@ -41,6 +44,7 @@ public:
     double mae_mm = 0;           ///< mean |true signed distance| of the mesh vertices
     std::size_t vertices = 0;
     double integrate_ms = 0;     ///< per frame
+    double sweeps = 0;           ///< Gauss-Seidel sweeps of eq. 7 per frame, mean
   };
 
   explicit LambdaStudy(const Config& config);

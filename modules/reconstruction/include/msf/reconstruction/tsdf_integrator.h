@@ -30,7 +30,9 @@ struct PixelBand {
 ///   x = argmin ||x - y||^2 + lambda ||g(x)||^2,
 /// with y the mean just computed and g the differences between 6-neighbouring observed
 /// voxels. It is solved by Gauss-Seidel sweeps over the voxels this frame changed,
-/// warm-started from y, with the voxels around them held fixed; lambda = 0 is the plain mean.
+/// warm-started from y, with the voxels around them held fixed: a fixed number per frame
+/// (Solve::Sweeps) or until the argmin is reached (Solve::Argmin, the paper's eq. 7 as
+/// written); lambda = 0 is the plain mean.
 ///
 /// Organized input (a depth image as an organized cloud or a DepthFrame) is integrated
 /// voxel-centric: the blocks, and their 4^3 sub-blocks, that the truncation band of each
@@ -65,6 +67,12 @@ public:
     Plane       ///< distance to the observed surface's tangent plane (planeDistanceScale)
   };
 
+  /// How eq. 7 is solved each frame.
+  enum class Solve {
+    Sweeps, ///< `sweeps` Gauss-Seidel sweeps, warm-started: refined over frames (the project's)
+    Argmin  ///< sweeps until no voxel moves more than argmin_tolerance_m: the minimizer itself
+  };
+
   struct Config {
     Weighting weighting = Weighting::PerPixel;
     double depth_sigma_m = 0.05;    ///< sigma of a depth without its own weight (see Weighting)
@@ -91,6 +99,14 @@ public:
     /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
     int sweeps = 1;
     static constexpr int kMaxSweeps = 100;
+    Solve solve = Solve::Sweeps;
+    /// Solve::Argmin stops after the sweep in which no voxel's sdf changed by more (metres).
+    /// Gauss-Seidel on eq. 7 contracts by about (6 lambda / (1 + 6 lambda))^2 a sweep (0.94
+    /// at lambda 5), so the remaining error is about 16 times this.
+    double argmin_tolerance_m = 1e-5;
+    /// ... or after this many sweeps (Stats::regularize_converged tells which).
+    int argmin_max_sweeps = 1000;
+    static constexpr int kMaxArgminSweeps = 100000;
     static constexpr double kMaxDepthM = 1000.0; ///< max_depth_m's bound (the volume's reach)
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 40.0;
@@ -106,7 +122,8 @@ public:
     /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
     /// space_carving, carving_weight,
     /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
-    /// plane_min_scale, lambda, sweeps, min_depth_m, max_depth_m, interpolate_depth,
+    /// plane_min_scale, lambda, sweeps, solve (sweeps | argmin), argmin_tolerance_m,
+    /// argmin_max_sweeps, min_depth_m, max_depth_m, interpolate_depth,
     /// allocation_stride. Throws ConfigError naming a bad key.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the first value out of range.
@@ -121,6 +138,8 @@ public:
     std::size_t voxels_updated = 0;
     std::size_t voxels_projected = 0; ///< voxels of sub-blocks (4^3) that the depth range did not rule out
     double allocate_ms = 0, update_ms = 0, regularize_ms = 0;
+    int regularize_sweeps = 0;          ///< Gauss-Seidel sweeps of eq. 7 this frame
+    bool regularize_converged = false;  ///< Solve::Argmin: the tolerance was reached
   };
 
   /// The integrator writes into `volume`, which must outlive it.
@@ -164,6 +183,10 @@ private:
   float depthWeight(float depth) const;
   /// Per pixel, the weight of the frame's depth (see Weighting); 0 where there is no depth.
   void pixelWeights(const DepthFrame& frame, cv::Mat& weight);
+  /// Whether eq. 7 changes anything: lambda > 0 and at least one sweep.
+  bool regularizes() const {
+    return config_.lambda > 0.0 && (config_.solve == Solve::Argmin || config_.sweeps > 0);
+  }
   /// Eq. 7 over the voxels changed_index_[offsets[i] .. offsets[i + 1]) of touched[i].
   void regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets);
 
@@ -183,6 +206,9 @@ private:
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.
 const char* toString(TsdfIntegrator::Weighting weighting);
 TsdfIntegrator::Weighting parseWeighting(const std::string& text);
+/// "sweeps", "argmin"; parse throws ConfigError naming the key and the text.
+const char* toString(TsdfIntegrator::Solve solve);
+TsdfIntegrator::Solve parseSolve(const std::string& text);
 /// "projective", "plane"; parse throws ConfigError naming the text.
 const char* toString(TsdfIntegrator::SignedDistance distance);
 TsdfIntegrator::SignedDistance parseSignedDistance(const std::string& text);
