@@ -194,40 +194,127 @@ std::string plyHeader(std::size_t vertices, std::size_t faces) {
          std::to_string(faces) + "\nproperty list uchar uint vertex_indices\nend_header\n";
 }
 
-/// The union of the tile meshes `tiles` (existing files only) as one PLY at `path`, read one
-/// tile at a time: vertices in a first pass, triangles (renumbered) in a second. Returns the
+/// Welds the tiles of a union: the vertices that two tiles can share, those on a tile's lower
+/// border plane (x, y or z at a multiple of the tile's voxels, computed as the mesher does:
+/// float(index) * voxel size), are looked up by position; every other vertex is its tile's
+/// own. Only the border vertices are kept (a few % of the mesh).
+class TileWelder {
+public:
+  TileWelder(double voxel_size, int tile_voxels) : vs_(static_cast<float>(voxel_size)), tile_voxels_(tile_voxels) {}
+
+  /// Numbers the vertices of the next tile (`count` vertices of kVertexBytes at `data`), in
+  /// the order of the tiles: new vertices get the next numbers, a border vertex seen in an
+  /// earlier tile its number there. With `first` (what begin() returned for this tile
+  /// the first time), numbers it again the same way. Fills `index` and `fresh` (whether the
+  /// vertex is written with this tile).
+  void number(const char* data, std::size_t count, std::uint32_t first, std::vector<std::uint32_t>& index,
+              std::vector<char>& fresh) {
+    index.resize(count);
+    fresh.resize(count);
+    std::uint32_t next = first;
+    for (std::size_t i = 0; i < count; ++i) {
+      const char* v = data + i * kVertexBytes;
+      float p[3];
+      std::memcpy(p, v, 12);
+      if (!onBorder(p)) {
+        index[i] = next++;
+        fresh[i] = 1;
+        continue;
+      }
+      Key key;
+      std::memcpy(key.bits.data(), v, 12);
+      const auto [it, inserted] = border_.emplace(key, next);
+      index[i] = it->second;
+      fresh[i] = it->second == next; // first seen here (inserted now, or in the first numbering)
+      if (fresh[i])
+        ++next;
+    }
+    next_ = std::max(next_, next);
+  }
+  std::uint32_t next() const { return next_; }
+
+private:
+  bool onBorder(const float* p) const {
+    for (int k = 0; k < 3; ++k) {
+      const float g = std::nearbyint(p[k] / vs_);
+      if (static_cast<float>(g) * vs_ == p[k] && std::fabs(g) < 2e9f) {
+        const auto i = static_cast<std::int64_t>(g);
+        if (((i % tile_voxels_) + tile_voxels_) % tile_voxels_ == 0)
+          return true;
+      }
+    }
+    return false;
+  }
+  struct Key {
+    std::array<std::uint32_t, 3> bits;
+    bool operator==(const Key& o) const { return bits == o.bits; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return (static_cast<std::size_t>(k.bits[0]) * 73856093u) ^ (static_cast<std::size_t>(k.bits[1]) * 19349663u) ^
+             (static_cast<std::size_t>(k.bits[2]) * 83492791u);
+    }
+  };
+  float vs_;
+  std::int64_t tile_voxels_;
+  std::unordered_map<Key, std::uint32_t, Hash> border_;
+  std::uint32_t next_ = 0;
+};
+
+/// The union of the tile meshes `tiles` (existing files only) as one welded PLY at `path`
+/// (tiles of `tile_voxels` voxels of `voxel_size`), read one tile at a time: vertices numbered
+/// in a first pass, written in a second, triangles renumbered in a third. Returns the
 /// triangles; writes nothing when there are none.
-std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string& path) {
+std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string& path, double voxel_size,
+                       int tile_voxels) {
   std::vector<std::string> present;
   std::vector<PlyCounts> counts;
-  std::size_t vertices = 0, faces = 0;
+  std::size_t faces = 0;
   for (const std::string& tile : tiles) {
     std::ifstream in(tile, std::ios::binary);
     if (!in)
       continue;
     counts.push_back(readPlyHeader(in, tile));
     present.push_back(tile);
-    vertices += counts.back().vertices;
     faces += counts.back().faces;
   }
   if (faces == 0)
     return 0;
+  std::vector<char> buffer;
+  const auto readVertices = [&](std::size_t i) {
+    std::ifstream in(present[i], std::ios::binary);
+    in.seekg(counts[i].data);
+    buffer.resize(counts[i].vertices * kVertexBytes);
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    if (!in)
+      throw IOError("mesh '" + present[i] + "' ends inside its vertices");
+  };
+  TileWelder welder(voxel_size, tile_voxels);
+  std::vector<std::uint32_t> first(present.size()), index;
+  std::vector<char> fresh;
+  for (std::size_t i = 0; i < present.size(); ++i) {
+    readVertices(i);
+    first[i] = welder.next();
+    if (first[i] + counts[i].vertices > std::numeric_limits<std::uint32_t>::max())
+      throw IOError("mesh '" + path + "': more than 2^32 vertices");
+    welder.number(buffer.data(), counts[i].vertices, first[i], index, fresh);
+  }
   writeAtomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary);
-    const std::string header = plyHeader(vertices, faces);
+    const std::string header = plyHeader(welder.next(), faces);
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
-    std::vector<char> buffer;
     for (std::size_t i = 0; i < present.size(); ++i) {
-      std::ifstream in(present[i], std::ios::binary);
-      in.seekg(counts[i].data);
-      buffer.resize(counts[i].vertices * kVertexBytes);
-      in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      if (!in)
-        throw IOError("mesh '" + present[i] + "' ends inside its vertices");
-      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      readVertices(i);
+      welder.number(buffer.data(), counts[i].vertices, first[i], index, fresh);
+      std::size_t kept = 0;
+      for (std::size_t v = 0; v < counts[i].vertices; ++v)
+        if (fresh[v])
+          std::memmove(buffer.data() + kept++ * kVertexBytes, buffer.data() + v * kVertexBytes, kVertexBytes);
+      out.write(buffer.data(), static_cast<std::streamsize>(kept * kVertexBytes));
     }
-    std::uint32_t offset = 0;
     for (std::size_t i = 0; i < present.size(); ++i) {
+      readVertices(i);
+      welder.number(buffer.data(), counts[i].vertices, first[i], index, fresh);
       std::ifstream in(present[i], std::ios::binary);
       in.seekg(counts[i].data + static_cast<std::streamoff>(counts[i].vertices * kVertexBytes));
       buffer.resize(counts[i].faces * kFaceBytes);
@@ -239,12 +326,12 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
         for (int k = 0; k < 3; ++k) {
           std::uint32_t v;
           std::memcpy(&v, p + 4 * k, 4);
-          v += offset;
-          std::memcpy(p + 4 * k, &v, 4);
+          if (v >= counts[i].vertices)
+            throw IOError("mesh '" + present[i] + "': triangle " + std::to_string(f) + " is not 3 vertices of the mesh");
+          std::memcpy(p + 4 * k, &index[v], 4);
         }
       }
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-      offset += static_cast<std::uint32_t>(counts[i].vertices);
     }
     if (!out.flush())
       throw IOError("cannot write mesh '" + path + "': disk full?");
@@ -550,7 +637,7 @@ std::size_t StreamingMap::finish(const std::string& mesh_path) {
   std::vector<std::string> meshes;
   for (const TileKey k : keys)
     meshes.push_back(meshPath(tilesDirectory(), tileIndex(k)));
-  const std::size_t triangles = writeUnion(meshes, mesh_path);
+  const std::size_t triangles = writeUnion(meshes, mesh_path, volume_.voxelSize(), config_.tile_blocks * kSide);
   stats_.stream_ms += msSince(t0);
   return triangles;
 }
@@ -595,7 +682,7 @@ std::size_t StreamingMap::remesh(const std::string& directory, const MarchingCub
     meshTile(t, mine, nullptr, on_disk, cache, mesher, index.tile_blocks, index.voxel_size, index.truncation, tiles);
     meshes.push_back(meshPath(tiles, t));
   }
-  return writeUnion(meshes, mesh_path);
+  return writeUnion(meshes, mesh_path, index.voxel_size, index.tile_blocks * kSide);
 }
 
 void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) {

@@ -28,7 +28,8 @@ namespace msf {
 /// finish() writes the tiles still in memory the same way and the mesh of the whole drive as
 /// one PLY, the union of the tiles. Every file is written atomically, so a run that is killed
 /// leaves readable tiles. A tile's mesh is welded inside the tile; vertices on a tile's border
-/// are written by both tiles at the same position (bit for bit), see weldByPosition.
+/// are written by both tiles at the same position (bit for bit), and the union is welded by
+/// them: it has the in-memory mesh's vertices and open edges (no seams).
 class StreamingMap {
 public:
   /// The YAML section `streaming`.
@@ -89,8 +90,8 @@ public:
   static void readMesh(const std::string& path, TriangleMesh& mesh);
   /// Writes `mesh` as such a PLY, atomically.
   static void writeMesh(const std::string& path, const TriangleMesh& mesh);
-  /// Merges vertices at the same position (bit for bit), as a union of tiles needs to be
-  /// one surface; triangles keep their order.
+  /// Merges vertices at the same position (bit for bit), e.g. of tiles/*.ply put together
+  /// by another tool; triangles keep their order.
   static void weldByPosition(TriangleMesh& mesh);
 
 private:

@@ -49,6 +49,7 @@ public:
   /// The oriented boxes of the moving objects present at every frame, frame by frame
   /// (gt/moving_objects.txt).
   std::vector<MovingBox> movingBoxes() const;
+  const CameraRenderer& renderer() const { return renderer_; }
   const LidarSimulator& lidar() const { return lidar_; }
   std::size_t size() const { return poses_.size(); }
 
