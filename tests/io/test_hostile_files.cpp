@@ -62,6 +62,33 @@ TEST(HostileClouds, ValidFilesStillLoad) {
   }
 }
 
+TEST(HostileClouds, HeaderThatPclWouldReadOtherwiseIsRefusedBeforeItAllocates) {
+  // PCL's readHeader matches keywords as prefixes, reads on after DATA and sizes the data at
+  // POINTS (DATA or not): each of these made it allocate POINTS x the point step.
+  msf::test::TempDir dir;
+  const std::string fields = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {fields + "WIDTH 1000000000\nHEIGHT 1\nPOINTS 1000000000\n", "(bad header): no DATA line"},
+      {"FIELDS x y z\nSIZE` 8 8 8\nPOINTS 1000000000\nDATA binary\n" + std::string(100, '\0'),
+       "line 2 'SIZE` 8 8 8': not a header keyword"},
+      {pcdHeader("1", "ascii") + "POINTS 1000000000\n1 2 3\n",
+       "a line after DATA starts with 'POINTS 1000000000', which PCL would read as a header line"},
+      {pcdHeader("1", "binary") + "\n# comment\n\f HEIGHT 99\n" + std::string(12, '\0'),
+       "a line after DATA starts with 'HEIGHT 99'"},
+      {fields + "FIELDS a b c d e f g\nPOINTS 1\nDATA ascii\n1 2 3\n", "line 6 'FIELDS a b c d e f g': FIELDS given twice"},
+      {fields + "POINTS 1e9\nDATA ascii\n", "'1e9' is not a whole number 0 .. 2147483647"},
+      {"FIELDS x y\nSIZE 4 4\nTYPE F F\nCOUNT 1 3000000\nPOINTS 1\nDATA ascii\n1 2\n",
+       "count '3000000' is not a whole number 0 .. 1048576"},
+      {"FIELDS x y\nSIZE 4 4 4\nPOINTS 1\nDATA ascii\n1 2\n", "3 values for 2 fields"},
+  };
+  for (const auto& [text, expected] : cases) {
+    write(dir.file("h.pcd"), text);
+    pcl::PCLPointCloud2 blob;
+    const std::string e = errorOf([&] { msf::loadCloudBlob(dir.file("h.pcd"), blob); });
+    EXPECT_NE(e.find(expected), std::string::npos) << text << "\n -> " << e;
+  }
+}
+
 TEST(HostileClouds, AsciiValueThatIsNotANumberIsNamed) {
   msf::test::TempDir dir;
   write(dir.file("abc.pcd"), pcdHeader("2", "ascii") + "1 2 3\n1 2 abc\n");
@@ -248,6 +275,18 @@ TEST(FuzzRegressions, CloudReaders) {
       ADD_FAILURE() << f << ": " << e.what();
     }
   }
+}
+
+TEST(FuzzRegressions, CloudHeaderOfFourGigabytesIsRefusedByItsOwnCheck) {
+  // fuzz_cloud (make fuzz FUZZ_SECONDS=600, after ~2 min): a 1.2 KB .pcd whose header PCL reads as 14444444 points of 284
+  // bytes, allocated in readHeader (4.1 GB) before any check of ours saw it.
+  msf::test::TempDir dir;
+  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) /
+                                   "tests/io/fuzz_regressions/cloud/oom-12af5ddfa0561690bbe07b4073cc500b4bba8130");
+  write(dir.file("c.pcd"), bytes.substr(1));
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  const std::string e = errorOf([&] { msf::loadCloud(dir.file("c.pcd"), cloud); });
+  EXPECT_NE(e.find("c.pcd' is not a valid .pcd file (bad header): line "), std::string::npos) << e;
 }
 
 TEST(FuzzRegressions, CalibrationParsers) {
