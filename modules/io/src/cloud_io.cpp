@@ -230,9 +230,13 @@ void checkPcdHeader(const std::string& path) {
       }
     } else if (key == "TYPE") {
       onePerField("SIZE");
-      for (const auto& v : values)
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::string& v = values[i];
         if (v != "F" && v != "I" && v != "U")
           bad("type '" + shownLine(v) + "' is not F, I or U");
+        if (v == "F" && sizes[i] != 4 && sizes[i] != 8)
+          bad("field " + std::to_string(i + 1) + " is F of size " + std::to_string(sizes[i]) + " (4 or 8)");
+      }
     } else if (key == "COUNT") {
       onePerField("TYPE");
       for (const auto& v : values) {
@@ -256,8 +260,9 @@ void checkPcdHeader(const std::string& path) {
     } else if (key == "DATA") {
       if (values.size() != 1 || (values[0] != "ascii" && values[0] != "binary" && values[0] != "binary_compressed"))
         bad("DATA is ascii, binary or binary_compressed");
-      if (fields == 0)
-        bad("DATA before FIELDS");
+      if (!seen.count("SIZE") || !seen.count("TYPE"))
+        bad(std::string("DATA before ") + (seen.count("SIZE") ? "TYPE" : "SIZE") +
+            " (without both, PCL takes every field for a 4-byte float whatever its size)");
       data_type = values[0] == "ascii" ? 0 : values[0] == "binary" ? 1 : 2;
     }
   }
@@ -344,6 +349,21 @@ void checkPlyBody(const std::string& path) {
   }
 }
 
+/// Each field within the point as PCL laid it out from the header: a SIZE that disagreed with
+/// the TYPE (no TYPE: PCL takes 4-byte floats) made pcl::fromPCLPointCloud2 read past the
+/// cloud's data (fuzz/fuzz_cloud, a heap-buffer-overflow).
+void checkFieldLayout(const std::string& path, const pcl::PCLPointCloud2& blob) {
+  for (const auto& f : blob.fields) {
+    const std::uint64_t size = pcl::getFieldSize(f.datatype);
+    if (size == 0)
+      throw IOError("cloud '" + path + "': field '" + shownLine(f.name) + "' has no valid type");
+    if (f.offset + static_cast<std::uint64_t>(f.count) * size > blob.point_step)
+      throw IOError("cloud '" + path + "': field '" + shownLine(f.name) + "' (" + std::to_string(f.count) + " x " +
+                    std::to_string(size) + " bytes at byte " + std::to_string(f.offset) + ") does not fit in its " +
+                    std::to_string(blob.point_step) + "-byte point: SIZE and TYPE disagree");
+  }
+}
+
 } // namespace
 
 void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
@@ -366,6 +386,7 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
         throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header)");
       if (static_cast<std::size_t>(blob.width) * blob.height == 0)
         throw IOError("cloud '" + path + "' has no points");
+      checkFieldLayout(path, blob);
       checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
       result = reader.read(path, blob);
     } else if (ext == ".ply") {
