@@ -45,7 +45,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>     // AT_FDCWD
-#include <signal.h>    // kill
+#include <signal.h>    // kill, sigaction
 #include <stdio.h>     // renameat2, RENAME_EXCHANGE
 #include <unistd.h>
 
@@ -56,13 +56,49 @@ namespace {
 
 constexpr int kMaxPanels = 100;
 
+// Stop signals (SIGINT, SIGTERM). None ends the process before the mesh and the summary are
+// written: the first stops the run after the frames under way (the pipeline's stop flag); the
+// second also skips the optional work after the mesh (its scores, the renderings, the
+// single-source maps of -compare_sources), what can take minutes on a long drive; later ones
+// are only acknowledged. Ending at once is SIGKILL's job, and it leaves OUT as it was (the
+// staging folder is removed by the next run). A second Ctrl-C that killed the run, as it
+// did, lost the whole run's work and left no mesh and no summary.
 std::atomic<bool> g_stop{false};
+std::atomic<int> g_stop_signals{0};
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
+              "the signal handler needs lock-free atomics");
 
 void onSignal(int) {
+  const int saved_errno = errno;
+  const int n = ++g_stop_signals;
   g_stop = true;
-  // A second Ctrl-C ends at once.
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  // write(2) only: the one output that is safe in a signal handler.
+  static const char first[] = "\nmsf_reconstruct: stopping after the frames under way; the mesh and the summary are "
+                              "still written (again: also skip the mesh's scores and renderings)\n";
+  static const char second[] = "\nmsf_reconstruct: skipping the mesh's scores and renderings; writing the mesh and the "
+                               "summary (kill -9 ends at once and leaves the output folder as it was)\n";
+  static const char later[] = "\nmsf_reconstruct: still writing the mesh and the summary (kill -9 ends at once and "
+                              "leaves the output folder as it was)\n";
+  const char* text = n == 1 ? first : n == 2 ? second : later;
+  const std::size_t size = n == 1 ? sizeof first : n == 2 ? sizeof second : sizeof later;
+  if (::write(STDERR_FILENO, text, size - 1) < 0) {
+    // Nothing to do: the stop itself does not depend on the message.
+  }
+  errno = saved_errno;
+}
+
+/// After a second stop signal: the optional work after the mesh is skipped.
+bool hurried() { return g_stop_signals.load() >= 2; }
+
+void installStopHandler() {
+  struct sigaction action {};
+  action.sa_handler = onSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART; // a write under way when a signal comes goes on
+  for (int signal_number : {SIGINT, SIGTERM})
+    if (::sigaction(signal_number, &action, nullptr) != 0)
+      throw msf::IOError(std::string("cannot install the handler of ") + ::strsignal(signal_number) + ": " +
+                         std::strerror(errno));
 }
 
 void printHelp(const char* name) {
@@ -102,7 +138,9 @@ void printHelp(const char* name) {
              "  protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo, mesh_paper, paper), within the map's\n"
              "  depth range and all.\n"
              "  OUT/config.yaml is the configuration in full; -config OUT/config.yaml repeats the run.\n");
-  print_info("  Ctrl-C stops after the frames under way and still writes the mesh and the summary.\n");
+  print_info("  Ctrl-C (or SIGTERM) stops after the frames under way and still writes the mesh and the summary\n"
+             "  (exit code 130); a second one also skips the mesh's scores and renderings (summary.json lists\n"
+             "  them under \"skipped\"); later ones are ignored until the mesh and the summary are written.\n");
 }
 
 /// Ground truth of a synthetic sequence, accumulated over the run.
@@ -550,8 +588,7 @@ int main(int argc, char** argv) {
     if (poses.kind() == msf::PoseSource::Kind::Estimated) // after the hold-out: the scan the pipeline sees
       pipeline.setPoseEstimator([&](const msf::Frame& frame) { return poses.estimate(frame); });
     msf::PoseList used_poses;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
+    installStopHandler();
     Progress progress(frames.size());
 
     const auto stats = pipeline.run(
@@ -648,6 +685,11 @@ int main(int argc, char** argv) {
       paper_mesh = &paper->pipeline.updateMesh();
       msf::tool::printDone(tt.toc(), paper_mesh->triangles.size());
     }
+    if (!source_maps.empty() && hurried()) {
+      // Stopped twice: the single-source maps are not meshed (their volumes are lost).
+      report.skipped.push_back("compare_sources");
+      source_maps.clear();
+    }
     for (auto& map : source_maps) {
       tt.tic();
       print_highlight("Meshing the %s map ", msf::toString(map->source));
@@ -688,7 +730,9 @@ int main(int argc, char** argv) {
     });
     msf::tool::printDone(tt.toc(), mesh.vertices.size());
 
-    if (!mesh.triangles.empty()) {
+    if (!mesh.triangles.empty() && hurried()) {
+      report.skipped.push_back("mesh_preview");
+    } else if (!mesh.triangles.empty()) {
       // Preview: from above, and from the first frame's camera.
       const cv::Size size = calibration.requireImageSize();
       const Eigen::Isometry3d first_pose = used_poses.front();
@@ -720,6 +764,10 @@ int main(int argc, char** argv) {
         d.foreground = scores.foreground[name].metrics();
         d.has_split = true;
       }
+    }
+    if (scores.truth && hurried()) {
+      report.skipped.push_back("mesh_accuracy");
+    } else if (scores.truth) {
       const std::string scene = scores.truth->sceneMeshPath();
       tt.tic();
       print_highlight("Scoring the mesh%s against ", meshes.size() > 1 ? "es" : "");
@@ -762,7 +810,9 @@ int main(int argc, char** argv) {
       msf::tool::printDone(tt.toc(), accuracy.size());
     }
 
-    if (evaluation) {
+    if (evaluation && hurried()) {
+      report.skipped.push_back("reconstruction_evaluation");
+    } else if (evaluation) {
       tt.tic();
       print_highlight("Rendering the mesh%s at every frame's pose ", meshes.size() > 1 ? "es" : "");
       for (const auto& [name, m] : meshes)

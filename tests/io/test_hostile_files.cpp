@@ -62,6 +62,35 @@ TEST(HostileClouds, ValidFilesStillLoad) {
   }
 }
 
+TEST(HostileClouds, HeaderThatPclWouldReadOtherwiseIsRefusedBeforeItAllocates) {
+  // PCL's readHeader matches keywords as prefixes, reads on after DATA and sizes the data at
+  // POINTS (DATA or not): each of these made it allocate POINTS x the point step.
+  msf::test::TempDir dir;
+  const std::string fields = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {fields + "WIDTH 1000000000\nHEIGHT 1\nPOINTS 1000000000\n", "(bad header): no DATA line"},
+      {"FIELDS x y z\nSIZE` 8 8 8\nPOINTS 1000000000\nDATA binary\n" + std::string(100, '\0'),
+       "line 2 'SIZE` 8 8 8': not a header keyword"},
+      {pcdHeader("1", "ascii") + "POINTS 1000000000\n1 2 3\n",
+       "a line after DATA starts with 'POINTS 1000000000', which PCL would read as a header line"},
+      {pcdHeader("1", "binary") + "\n# comment\n\f HEIGHT 99\n" + std::string(12, '\0'),
+       "a line after DATA starts with 'HEIGHT 99'"},
+      {fields + "FIELDS a b c d e f g\nPOINTS 1\nDATA ascii\n1 2 3\n", "line 6 'FIELDS a b c d e f g': FIELDS given twice"},
+      {fields + "POINTS 1e9\nDATA ascii\n", "'1e9' is not a whole number 0 .. 2147483647"},
+      {"FIELDS x y\nSIZE 4 4\nTYPE F F\nCOUNT 1 3000000\nPOINTS 1\nDATA ascii\n1 2\n",
+       "count '3000000' is not a whole number 0 .. 1048576"},
+      {"FIELDS x y\nSIZE 4 4 4\nPOINTS 1\nDATA ascii\n1 2\n", "3 values for 2 fields"},
+      {"FIELDS x y\nSIZE 4 1\nPOINTS 1\nDATA binary\n12345", "DATA before TYPE"},
+      {"FIELDS x y\nSIZE 4 2\nTYPE F F\nPOINTS 1\nDATA binary\n123456", "field 2 is F of size 2 (4 or 8)"},
+  };
+  for (const auto& [text, expected] : cases) {
+    write(dir.file("h.pcd"), text);
+    pcl::PCLPointCloud2 blob;
+    const std::string e = errorOf([&] { msf::loadCloudBlob(dir.file("h.pcd"), blob); });
+    EXPECT_NE(e.find(expected), std::string::npos) << text << "\n -> " << e;
+  }
+}
+
 TEST(HostileClouds, AsciiValueThatIsNotANumberIsNamed) {
   msf::test::TempDir dir;
   write(dir.file("abc.pcd"), pcdHeader("2", "ascii") + "1 2 3\n1 2 abc\n");
@@ -248,6 +277,35 @@ TEST(FuzzRegressions, CloudReaders) {
       ADD_FAILURE() << f << ": " << e.what();
     }
   }
+}
+
+/// The error loading tests/io/fuzz_regressions/cloud/<name> gives, read as fuzz_cloud reads
+/// it (as c.pcd or c.ply).
+std::string cloudFindingError(const std::string& name) {
+  msf::test::TempDir dir;
+  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) / "tests/io/fuzz_regressions/cloud" / name);
+  const std::string path = dir.file(bytes.at(0) & 1 ? "c.ply" : "c.pcd");
+  write(path, bytes.substr(1));
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  return errorOf([&] { msf::loadCloud(path, cloud); });
+}
+
+TEST(FuzzRegressions, CloudHeaderOfFourGigabytesIsRefusedByItsOwnCheck) {
+  // fuzz_cloud (make fuzz FUZZ_SECONDS=600, after ~2 min): a 1.2 KB .pcd whose header PCL
+  // reads as 14444444 points of 284 bytes, allocated in readHeader (4.1 GB) before any check
+  // of ours saw it.
+  const std::string e = cloudFindingError("oom-12af5ddfa0561690bbe07b4073cc500b4bba8130");
+  EXPECT_NE(e.find("c.pcd' is not a valid .pcd file (bad header): line "), std::string::npos) << e;
+}
+
+TEST(FuzzRegressions, CloudFieldsBeyondThePointAreRefused) {
+  // fuzz_cloud (the 600 s run after the fix above, after ~15 s): SIZE 4 4 1 1 and no TYPE, so
+  // PCL laid out four 4-byte floats in a 10-byte point and pcl::fromPCLPointCloud2 read past
+  // the data (ASan: heap-buffer-overflow).
+  const std::string e = cloudFindingError("crash-d9dc1c7e5b5b383059c75f3b64745c85cb4909d6");
+  EXPECT_NE(e.find("c.pcd' is not a valid .pcd file (bad header): line 9 'DATA binary': DATA before TYPE"),
+            std::string::npos)
+      << e;
 }
 
 TEST(FuzzRegressions, CalibrationParsers) {

@@ -22,6 +22,7 @@
 #include <cstring>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <sys/wait.h>
@@ -143,43 +144,116 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
   EXPECT_GT(mesh.polygons.size(), 1000u);
 }
 
-TEST_F(PipelineTest, CtrlCStillWritesTheMeshAndTheSummary) {
-  msf::test::TempDir out;
+/// Runs msf_reconstruct on `dataset` into `out` (-panels 0), reading its stdout and stderr
+/// line by line: `on_line(line, pid)` may signal it. Returns its wait status.
+int runReconstructReading(const std::string& dataset, const std::string& out, const std::function<void(const std::string&, pid_t)>& on_line) {
   int pipe_fds[2];
-  ASSERT_EQ(::pipe(pipe_fds), 0);
+  if (::pipe(pipe_fds) != 0)
+    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
   const std::string tool = msf::test::binDir() + "/msf_reconstruct";
   const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
+  if (pid < 0)
+    throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
     ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::dup2(pipe_fds[1], STDERR_FILENO);
     ::close(pipe_fds[0]);
-    ::execl(tool.c_str(), tool.c_str(), dataset().c_str(), "-o", out.path().c_str(), "-panels", "0",
+    ::close(pipe_fds[1]);
+    ::execl(tool.c_str(), tool.c_str(), dataset.c_str(), "-o", out.c_str(), "-panels", "0",
             static_cast<char*>(nullptr));
     ::_exit(127);
   }
   ::close(pipe_fds[1]);
-  // Interrupt as soon as the first frame is integrated.
   FILE* child_out = ::fdopen(pipe_fds[0], "r");
-  char line[1024];
-  bool interrupted = false;
+  char line[4096];
   while (std::fgets(line, sizeof line, child_out))
-    if (!interrupted && std::strstr(line, "(1/4)")) {
-      ::kill(pid, SIGINT);
-      interrupted = true;
-    }
+    on_line(line, pid);
   std::fclose(child_out);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  ASSERT_TRUE(interrupted) << "the tool printed no progress line";
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 130);
-  const std::string json = readFile(out.file("summary.json"));
+  return status;
+}
+
+/// An interrupted run's outputs, beside nothing else in `dir`: a loadable mesh of at least
+/// one frame, a summary.json that parses and says so, and no staging folder or temporary.
+/// Returns the summary.
+std::string expectInterruptedOutputs(const msf::test::TempDir& dir, const std::string& out) {
+  std::vector<std::string> left;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"out"}) << "a staging folder or temporary is left beside OUT";
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    EXPECT_NE(e.path().filename().string()[0], '.') << "a temporary is left in OUT: " << e.path();
+  const std::string json = readFile(out + "/summary.json");
+  // Parsed by a JSON parser (Python's; OpenCV's takes no null), not only searched.
+  const auto parsed = msf::test::runCommand(
+      "python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); "
+      "print(s[\"interrupted\"], s[\"frames\"], \",\".join(s[\"skipped\"]))' " +
+      out + "/summary.json");
+  EXPECT_EQ(parsed.exit_code, 0) << parsed.err;
+  EXPECT_EQ(parsed.out.rfind("True ", 0), 0u) << parsed.out;
   EXPECT_NE(json.find("\"interrupted\": true"), std::string::npos) << json;
   EXPECT_GE(jsonNumber(json, "frames"), 1);
   EXPECT_LE(jsonNumber(json, "frames"), 3);
+  EXPECT_NE(readFile(out + "/report.md").find("(interrupted"), std::string::npos);
   pcl::PolygonMesh mesh;
-  msf::loadMesh(out.file("mesh.ply"), mesh);
+  EXPECT_NO_THROW(msf::loadMesh(out + "/mesh.ply", mesh));
   EXPECT_GT(mesh.polygons.size(), 100u);
+  return json;
+}
+
+TEST_F(PipelineTest, CtrlCStillWritesTheMeshAndTheSummary) {
+  msf::test::TempDir dir;
+  const std::string out = dir.file("out");
+  bool interrupted = false;
+  // Interrupt as soon as the first frame is integrated.
+  const int status = runReconstructReading(dataset(), out, [&](const std::string& line, pid_t pid) {
+    if (!interrupted && line.find("(1/4)") != std::string::npos) {
+      ::kill(pid, SIGINT);
+      interrupted = true;
+    }
+  });
+  ASSERT_TRUE(interrupted) << "the tool printed no progress line";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const std::string json = expectInterruptedOutputs(dir, out);
+  // One stop: the optional work is done (the street's mesh is scored).
+  EXPECT_NE(json.find("\"skipped\": []"), std::string::npos) << json;
+  EXPECT_GT(jsonNumber(json, "accuracy_mean_m"), 0.0);
+}
+
+TEST_F(PipelineTest, ASecondCtrlCStillLeavesAValidMeshAndSummary) {
+  msf::test::TempDir dir;
+  const std::string out = dir.file("out");
+  // The first SIGINT once the first frame is integrated; each next signal once the tool said
+  // it got the previous one (two pending SIGINTs would be delivered as one). The second
+  // SIGINT comes while the frames under way finish, well before the mesh is written; the
+  // third signal, a SIGTERM, during the rest.
+  const char* const acknowledgements[] = {"msf_reconstruct: stopping after the frames under way",
+                                          "msf_reconstruct: skipping the mesh's scores"};
+  int sent = 0;
+  std::string output;
+  const int status = runReconstructReading(dataset(), out, [&](const std::string& line, pid_t pid) {
+    output += line;
+    if (sent == 0 && line.find("(1/4)") != std::string::npos) {
+      ::kill(pid, SIGINT);
+      ++sent;
+    } else if ((sent == 1 || sent == 2) && line.find(acknowledgements[sent - 1]) != std::string::npos) {
+      ::kill(pid, sent == 1 ? SIGINT : SIGTERM);
+      ++sent;
+    }
+  });
+  ASSERT_EQ(sent, 3) << "the tool did not acknowledge each signal:\n" << output;
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status) << ":\n" << output;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << output;
+  const std::string json = expectInterruptedOutputs(dir, out);
+  // Stopped twice: the mesh is not scored, and the summary says what was skipped.
+  EXPECT_NE(json.find("\"skipped\": [\"mesh_preview\", \"mesh_accuracy\", \"reconstruction_evaluation\"]"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"mesh_accuracy\": null"), std::string::npos) << json;
+  EXPECT_FALSE(msf::test::fileExists(out + "/mesh_preview.png"));
+  EXPECT_NE(readFile(out + "/report.md").find("Stopped a second time: skipped `mesh_preview`"), std::string::npos);
 }
 
 TEST(Reconstruct, BadInputIsAClearError) {

@@ -6,12 +6,14 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -96,55 +98,191 @@ void checkPcdBody(const std::string& path, const pcl::PCLPointCloud2& header, in
     checkAsciiValues(path, data_index);
 }
 
-/// PCL's readHeader itself sizes the cloud's data from WIDTH x HEIGHT (12 GB for POINTS
-/// 1e9): the header is read here first, and its counts checked against the file's size.
-/// A header this cannot read is left to PCL, which rejects it.
+/// A header line for a message: printable, at most 60 characters.
+std::string shownLine(const std::string& line) {
+  std::string shown;
+  for (char c : line.substr(0, 60))
+    shown += c >= 0x20 && c < 0x7f ? c : '?';
+  return line.size() > 60 ? shown + "..." : shown;
+}
+
+/// The whole of `token` as an integer in [low, high], or -1.
+long long headerInteger(const std::string& token, long long low, long long high) {
+  if (token.empty() || token.size() > 19)
+    return -1;
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(token.c_str(), &end, 10);
+  return *end == '\0' && errno == 0 && v >= low && v <= high ? v : -1;
+}
+
+/// The keywords PCL's PCDReader::readHeader acts on. It matches them as prefixes of a line's
+/// first word ("SIZE`" is SIZE to it) and reads on after DATA; it sizes the cloud's data
+/// (POINTS x the point step, 4 GB for a 1.2 KB file found by fuzz/fuzz_cloud) as soon as it
+/// meets POINTS, DATA or not.
+constexpr const char* kPcdKeywords[] = {"VERSION", "FIELDS", "COLUMNS", "SIZE",   "TYPE", "COUNT",
+                                        "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+
+/// After the DATA line, PCL goes on reading lines as header lines until one is not: empty
+/// lines, comments and VERSION are passed over, a line starting with another keyword would
+/// change the header it checked. Returns that line's first characters ("" when PCL stops).
+/// Reads the lines by character, never a whole binary body into memory.
+std::string keywordLineAfterData(std::istream& in) {
+  std::streambuf& buf = *in.rdbuf();
+  using Traits = std::char_traits<char>;
+  for (;;) {
+    int c = buf.sgetc();
+    if (c == Traits::eof())
+      return "";
+    if (c == '\n') { // an empty line: PCL passes over it
+      buf.sbumpc();
+      continue;
+    }
+    std::string head;
+    while (c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f') // what PCL's trim removes
+      c = buf.snextc();
+    while (c != Traits::eof() && c != '\n' && head.size() < 32) {
+      head += static_cast<char>(c);
+      c = buf.snextc();
+    }
+    if (head.empty())
+      return ""; // a line of blanks: PCL stops
+    if (head[0] == '#' || head.rfind("VERSION", 0) == 0) {
+      while (c != Traits::eof() && c != '\n')
+        c = buf.snextc();
+      continue;
+    }
+    for (const char* keyword : kPcdKeywords)
+      if (head.rfind(keyword, 0) == 0)
+        return head;
+    return "";
+  }
+}
+
+/// PCL's readHeader sizes the cloud's data from the header before anything checks it (12 GB
+/// for POINTS 1e9): the header is read here first, strictly (each line one of the format's
+/// keywords, once, with whole numbers in range and one value per field), and its counts
+/// checked against the file's size, so that what PCL then reads is what was checked.
 void checkPcdHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string line, word;
+  std::string line;
+  std::size_t fields = 0, header_bytes = 0, line_no = 0;
   std::vector<std::uint64_t> sizes, counts;
-  double width = 1, height = 1, points = -1;
+  std::set<std::string> seen;
+  long long width = -1, height = -1, points = -1;
   int data_type = -1;
-  std::size_t header_bytes = 0;
-  while (header_bytes < (1u << 16) && std::getline(in, line)) {
+  auto bad = [&](const std::string& why) {
+    throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header): line " + std::to_string(line_no) +
+                  " '" + shownLine(line) + "': " + why);
+  };
+  while (data_type < 0) {
+    if (header_bytes >= (1u << 16) || !std::getline(in, line)) {
+      line_no = 0;
+      throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header): no DATA line" +
+                    (header_bytes >= (1u << 16) ? " in its first 65536 bytes" : std::string()));
+    }
+    ++line_no;
     header_bytes += line.size() + 1;
-    std::istringstream ss(line);
-    if (!(ss >> word) || word[0] == '#')
+    if (line.empty())
       continue;
-    auto numbers = [&](std::vector<std::uint64_t>& out) {
-      double v = 0;
-      while (ss >> v)
-        out.push_back(v > 0 && v < 1e6 ? static_cast<std::uint64_t>(v) : 1);
+    std::vector<std::string> words;
+    {
+      std::string word;
+      for (char c : line + ' ') {
+        if (c == ' ' || c == '\t' || c == '\r') {
+          if (!word.empty())
+            words.push_back(word);
+          word.clear();
+        } else {
+          word += c;
+        }
+      }
+    }
+    if (words.empty())
+      bad("a line of blanks");
+    std::string key = words[0];
+    if (key[0] == '#')
+      continue;
+    if (key == "COLUMNS")
+      key = "FIELDS";
+    if (std::find(std::begin(kPcdKeywords), std::end(kPcdKeywords), key) == std::end(kPcdKeywords))
+      bad("not a header keyword (VERSION, FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS, DATA)");
+    if (!seen.insert(key).second)
+      bad(key + " given twice");
+    const std::vector<std::string> values(words.begin() + 1, words.end());
+    auto onePerField = [&](const char* before) {
+      if (fields == 0 || (before && !seen.count(before)))
+        bad(key + " before " + (fields == 0 ? "FIELDS" : before));
+      if (values.size() != fields)
+        bad(std::to_string(values.size()) + " values for " + std::to_string(fields) + " fields");
     };
-    if (word == "SIZE")
-      numbers(sizes);
-    else if (word == "COUNT")
-      numbers(counts);
-    else if (word == "WIDTH")
-      ss >> width;
-    else if (word == "HEIGHT")
-      ss >> height;
-    else if (word == "POINTS")
-      ss >> points;
-    else if (word == "DATA") {
-      std::string kind;
-      ss >> kind;
-      data_type = kind == "ascii" ? 0 : kind == "binary" ? 1 : kind == "binary_compressed" ? 2 : -1;
-      break;
+    if (key == "FIELDS") {
+      if (values.empty())
+        bad("no field");
+      fields = values.size();
+    } else if (key == "SIZE") {
+      onePerField(nullptr);
+      for (const auto& v : values) {
+        const long long size = headerInteger(v, 1, 8);
+        if (size != 1 && size != 2 && size != 4 && size != 8)
+          bad("size '" + shownLine(v) + "' is not 1, 2, 4 or 8");
+        sizes.push_back(static_cast<std::uint64_t>(size));
+      }
+    } else if (key == "TYPE") {
+      onePerField("SIZE");
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::string& v = values[i];
+        if (v != "F" && v != "I" && v != "U")
+          bad("type '" + shownLine(v) + "' is not F, I or U");
+        if (v == "F" && sizes[i] != 4 && sizes[i] != 8)
+          bad("field " + std::to_string(i + 1) + " is F of size " + std::to_string(sizes[i]) + " (4 or 8)");
+      }
+    } else if (key == "COUNT") {
+      onePerField("TYPE");
+      for (const auto& v : values) {
+        const long long count = headerInteger(v, 0, 1 << 20);
+        if (count < 0)
+          bad("count '" + shownLine(v) + "' is not a whole number 0 .. 1048576");
+        counts.push_back(static_cast<std::uint64_t>(count));
+      }
+    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+      if (values.size() != 1)
+        bad(key + " takes one number");
+      const long long v = headerInteger(values[0], 0, std::numeric_limits<std::int32_t>::max());
+      if (v < 0)
+        bad("'" + shownLine(values[0]) + "' is not a whole number 0 .. 2147483647");
+      if (key == "POINTS" && fields == 0)
+        bad("POINTS before FIELDS");
+      (key == "WIDTH" ? width : key == "HEIGHT" ? height : points) = v;
+    } else if (key == "VIEWPOINT") {
+      if (values.size() != 7)
+        bad("VIEWPOINT takes 7 numbers (tx ty tz qw qx qy qz)");
+    } else if (key == "DATA") {
+      if (values.size() != 1 || (values[0] != "ascii" && values[0] != "binary" && values[0] != "binary_compressed"))
+        bad("DATA is ascii, binary or binary_compressed");
+      if (!seen.count("SIZE") || !seen.count("TYPE"))
+        bad(std::string("DATA before ") + (seen.count("SIZE") ? "TYPE" : "SIZE") +
+            " (without both, PCL takes every field for a 4-byte float whatever its size)");
+      data_type = values[0] == "ascii" ? 0 : values[0] == "binary" ? 1 : 2;
     }
   }
-  if (data_type < 0 || sizes.empty())
-    return;
+  const std::string after = keywordLineAfterData(in);
+  if (!after.empty())
+    throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header): a line after DATA starts with '" +
+                  shownLine(after) + "', which PCL would read as a header line");
+  // The most points any reading of the header gives, against the body's size.
+  const double n = std::max(static_cast<double>(std::max(width, 0LL)) * static_cast<double>(std::max(height, 1LL)),
+                            static_cast<double>(points));
   pcl::PCLPointCloud2 header;
-  const double n = std::max(width * height, points);
-  if (!(n >= 0) || n > 1e18)
-    throw IOError("cloud '" + path + "' declares " + std::to_string(n) + " points in its header");
   header.width = static_cast<std::uint32_t>(std::min(n, 4e9));
   header.height = 1;
-  for (std::size_t i = 0; i < sizes.size(); ++i) {
+  for (std::size_t i = 0; i < fields; ++i) {
+    const std::uint64_t size = i < sizes.size() ? sizes[i] : 4;
+    if (i < counts.size() && counts[i] == 0)
+      continue; // no value in the body (PCL drops the field)
     pcl::PCLPointField f;
-    f.datatype = sizes[i] == 1 ? pcl::PCLPointField::UINT8 : sizes[i] == 2 ? pcl::PCLPointField::UINT16
-               : sizes[i] == 8 ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
+    f.datatype = size == 1 ? pcl::PCLPointField::UINT8 : size == 2 ? pcl::PCLPointField::UINT16
+               : size == 8 ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
     f.count = static_cast<std::uint32_t>(i < counts.size() ? counts[i] : 1);
     header.fields.push_back(f);
   }
@@ -211,6 +349,21 @@ void checkPlyBody(const std::string& path) {
   }
 }
 
+/// Each field within the point as PCL laid it out from the header: a SIZE that disagreed with
+/// the TYPE (no TYPE: PCL takes 4-byte floats) made pcl::fromPCLPointCloud2 read past the
+/// cloud's data (fuzz/fuzz_cloud, a heap-buffer-overflow).
+void checkFieldLayout(const std::string& path, const pcl::PCLPointCloud2& blob) {
+  for (const auto& f : blob.fields) {
+    const std::uint64_t size = pcl::getFieldSize(f.datatype);
+    if (size == 0)
+      throw IOError("cloud '" + path + "': field '" + shownLine(f.name) + "' has no valid type");
+    if (f.offset + static_cast<std::uint64_t>(f.count) * size > blob.point_step)
+      throw IOError("cloud '" + path + "': field '" + shownLine(f.name) + "' (" + std::to_string(f.count) + " x " +
+                    std::to_string(size) + " bytes at byte " + std::to_string(f.offset) + ") does not fit in its " +
+                    std::to_string(blob.point_step) + "-byte point: SIZE and TYPE disagree");
+  }
+}
+
 } // namespace
 
 void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
@@ -233,6 +386,7 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
         throw IOError("cloud '" + path + "' is not a valid .pcd file (bad header)");
       if (static_cast<std::size_t>(blob.width) * blob.height == 0)
         throw IOError("cloud '" + path + "' has no points");
+      checkFieldLayout(path, blob);
       checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
       result = reader.read(path, blob);
     } else if (ext == ".ply") {

@@ -117,6 +117,16 @@ std::string accuracyJson(const MeshAccuracy& m) {
          std::to_string(m.truth_samples) + ", \"completeness_by_nearest_view\": [" + bands + "]}";
 }
 
+/// What a second stop signal left out, as a sentence of report.md ("" when nothing was).
+std::string skippedSentence(const std::vector<std::string>& skipped) {
+  if (skipped.empty())
+    return "";
+  std::string list;
+  for (std::size_t k = 0; k < skipped.size(); ++k)
+    list += (k ? ", `" : "`") + skipped[k] + "`";
+  return " Stopped a second time: skipped " + list + ".";
+}
+
 /// A value of a configuration as JSON: numbers as numbers, true / false as booleans, words
 /// as strings, sequences as arrays.
 std::string configValueJson(const cv::FileNode& node) {
@@ -215,6 +225,10 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     << "  \"frames\": " << frames.size() << ",\n"
     << "  \"frames_requested\": " << frames_requested << ",\n"
     << "  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n"
+    << "  \"skipped\": [";
+  for (std::size_t k = 0; k < skipped.size(); ++k)
+    s << (k ? ", " : "") << jsonString(skipped[k]);
+  s << "],\n"
     << "  \"wall_s\": " << num(wall_s, 3) << ",\n"
     << "  \"frames_per_second\": " << num(framesPerSecond(), 3) << ",\n"
     << "  \"first_frame_s\": " << num(first_frame_s, 3) << ",\n"
@@ -296,7 +310,7 @@ void RunReport::writeMarkdown(const std::string& path) const {
   s << "# msfusion reconstruction\n\n"
     << "Dataset `" << dataset << "` (" << layout << "), " << frames.size() << " of " << frames_requested
     << " frames" << (interrupted ? " (interrupted: the map holds the frames integrated before the stop)" : "")
-    << ". Voxel " << num(voxel_size_m) << " m, lambda " << num(lambda) << ".\n\n"
+    << "." << skippedSentence(skipped) << " Voxel " << num(voxel_size_m) << " m, lambda " << num(lambda) << ".\n\n"
     << "Trajectory: " << trajectory << ", [`" << poses_file << "`](" << poses_file << ")";
   if (!pose_ms.empty())
     s << "; the odometry took " << num(median(pose_ms), 1) << " ms per frame (median, p95 "

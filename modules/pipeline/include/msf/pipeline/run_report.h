@@ -62,6 +62,9 @@ public:
   std::string trajectory_reference;  ///< what they were compared with, in words
   std::size_t frames_requested = 0;
   bool interrupted = false;
+  /// Optional outputs a second stop signal left out (msf_reconstruct: "compare_sources",
+  /// "mesh_preview", "mesh_accuracy", "reconstruction_evaluation"), in the order skipped.
+  std::vector<std::string> skipped;
   double wall_s = 0;
   double first_frame_s = 0;       ///< when the first frame was done, from the start
   double mesh_ms = 0;
