@@ -1,8 +1,9 @@
 # ctest script: install the build tree into a scratch prefix, then configure, build and run a
 # consumer project made of the README's library example: its C++ block (example.cpp) and its
 # CMake block (CMakeLists.txt), between <!-- example:consumer:begin --> and ...:end -->.
-# In: BUILD_DIR, README, WORK_DIR, KITTI_DIR; CONSUMER_LINK_FLAGS, the build's own linker flags
-# (make test-sanitize's -fsanitize: the installed libraries need its runtime to link).
+# In: BUILD_DIR, README, WORK_DIR, KITTI_DIR; CONSUMER_CXX_FLAGS and CONSUMER_LINK_FLAGS, the
+# build's own (make test-sanitize's -fsanitize: the installed libraries need its runtime, and
+# the templates both sides instantiate must be compiled alike).
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run step)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -21,7 +22,8 @@ file(WRITE ${WORK_DIR}/src/example.cpp "#line ${source_line} \"${README}\"\n${so
 file(WRITE ${WORK_DIR}/src/CMakeLists.txt "${lists}")
 
 run("configure" ${CMAKE_COMMAND} -S ${WORK_DIR}/src -B ${WORK_DIR}/build -DCMAKE_BUILD_TYPE=Release
-    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_LINK_FLAGS}")
+    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}"
+    "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_LINK_FLAGS}")
 run("build" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 
 set(sequence ${KITTI_DIR}/odometry/sequences/04)
