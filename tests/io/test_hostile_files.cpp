@@ -308,6 +308,22 @@ TEST(FuzzRegressions, CloudFieldsBeyondThePointAreRefused) {
       << e;
 }
 
+TEST(FuzzRegressions, APlyOfNoVertexLoadsAsAnEmptyCloud) {
+  // fuzz_cloud (the third 600 s run, after ~4 min): a binary .ply with `element vertex 00`.
+  // PCL's conversion bound a reference to the first point of the empty cloud (UBSan); the
+  // loader now gives an empty cloud without converting.
+  msf::test::TempDir dir;
+  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) /
+                                   "tests/io/fuzz_regressions/cloud/crash-9c6e2c26854529edb4fb60c3e495ecbd0c554cab");
+  const std::string path = dir.file("c.ply");
+  write(path, bytes.substr(1));
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  cloud.push_back(pcl::PointXYZI(1.f));
+  EXPECT_EQ(errorOf([&] { msf::loadCloud(path, cloud); }), "(no error)");
+  EXPECT_TRUE(cloud.empty());
+  EXPECT_EQ(cloud.width * cloud.height, 0u);
+}
+
 TEST(FuzzRegressions, CalibrationParsers) {
   msf::test::TempDir dir;
   const auto files = regressions("calibration");

@@ -9,6 +9,7 @@
 #include <pcl/io/ply_io.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 
 namespace msf {
@@ -26,6 +27,12 @@ void loadCloud(const std::string& path, pcl::PointCloud<PointT>& cloud) {
     });
     if (!found)
       throw IOError("cloud '" + path + "' has no field '" + field.name + "'");
+  }
+  if (static_cast<std::uint64_t>(blob.width) * blob.height == 0) {
+    // PCL's conversion indexes each row's first point, which an empty cloud of rows has not.
+    cloud.clear();
+    cloud.header = blob.header;
+    return;
   }
   pcl::fromPCLPointCloud2(blob, cloud);
 }
