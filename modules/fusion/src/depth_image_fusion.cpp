@@ -70,14 +70,14 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   fused_depth.create(size, CV_32FC1);
   cv::Mat& weight = fused_weight ? *fused_weight : weight_;
   weight.create(size, CV_32FC1);
-  if (free_space_weight)
-    free_space_weight->create(size, CV_32FC1);
+  cv::Mat& free_weight = free_space_weight ? *free_space_weight : free_weight_;
+  free_weight.create(size, CV_32FC1);
   const float fB = static_cast<float>(focal_baseline_);
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v)
       fuseRow(config_, fB, parallax_, lidar, v, distance.ptr<float>(v), edge_.ptr<float>(v), stereo.ptr<float>(v),
               confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v),
-              free_space_weight ? free_space_weight->ptr<float>(v) : nullptr);
+              free_weight.ptr<float>(v));
   });
   if (config_.edge_support)
     supportAtDepthEdges(lidar, distance, fB, config_, fused_depth, edge_buffers_);

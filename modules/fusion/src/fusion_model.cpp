@@ -129,13 +129,10 @@ MSF_VECTOR_CLONES void fuseRow(const DepthFusionConfig& c, float focal_baseline,
       fused_z[u] = r.z;
       fused_weight[u] = r.weight * depthWeight(r.z, best_stereo, focal_baseline);
     }
-    if (fused_free_weight)
-      std::copy_n(fused_weight, width, fused_free_weight);
+    std::copy_n(fused_weight, width, fused_free_weight);
     return;
   }
-  // A local array when the caller wants no free-space weights: the loop stays branch-free.
-  std::vector<float> free_buffer(fused_free_weight ? 0 : static_cast<std::size_t>(width));
-  float* __restrict__ free_weight = fused_free_weight ? fused_free_weight : free_buffer.data();
+  float* __restrict__ free_weight = fused_free_weight;
   int candidates = 0; // pixels for the parallax check below
   for (int u = 0; u < width; ++u) {
     FusionInputs in;

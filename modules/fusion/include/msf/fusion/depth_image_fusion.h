@@ -47,7 +47,7 @@ private:
   Calibration calibration_;
   LidarParallax parallax_;
   cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames
-  cv::Mat weight_;                      ///< weights when the caller wants none
+  cv::Mat weight_, free_weight_;        ///< weights when the caller wants none
   cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none
   EdgeSupportBuffers edge_buffers_;
 };

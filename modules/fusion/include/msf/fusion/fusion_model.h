@@ -188,8 +188,8 @@ LidarParallax lidarParallax(const Calibration& calibration, const DepthFusionCon
 /// One image row of the fusion, the loop both DepthFusion and DepthImageFusion run: `width`
 /// pixels of row `v` of `lidar_depth` (CV_32FC1, not > 0 = none), with the row's LiDAR
 /// distances and edge cue (lidarEdgeCue; read by the uncertainty method only), stereo depths
-/// (not > 0 = none) and confidences; no input pointer may be null. Writes fused depth (0 =
-/// none), weight and, unless null, free-space weight (FusionResult). The per-pixel pass
+/// (not > 0 = none) and confidences; no pointer may be null. Writes fused depth (0 = none),
+/// weight and free-space weight (FusionResult). The per-pixel pass
 /// vectorises; the rare parallax checks follow it.
 void fuseRow(const DepthFusionConfig& c, float focal_baseline, const LidarParallax& parallax,
              const cv::Mat& lidar_depth, int v, const float* __restrict__ lidar_distance,

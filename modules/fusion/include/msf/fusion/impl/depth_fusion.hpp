@@ -100,7 +100,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   fused_depth_.create(rows, cols, CV_32FC1);
   fused_weight_.create(rows, cols, CV_32FC1);
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
-    std::vector<float> zeros(static_cast<std::size_t>(cols), 0.f), z_stereo(zeros), confidence(zeros);
+    std::vector<float> zeros(static_cast<std::size_t>(cols), 0.f), z_stereo(zeros), confidence(zeros), free(zeros);
     for (int v = range.start; v < range.end; ++v) {
       const std::size_t row = static_cast<std::size_t>(v) * cols;
       for (int u = 0; u < cols; ++u) {
@@ -113,7 +113,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
       }
       fuseRow(config, fB, parallax, lidar_depth_, v, lidar_distance_.empty() ? zeros.data() : lidar_distance_.ptr<float>(v),
               uncertainty ? lidar_edge_.ptr<float>(v) : zeros.data(), z_stereo.data(), confidence.data(),
-              fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v), nullptr);
+              fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v), free.data());
     }
   });
   if (config.edge_support)
