@@ -5,6 +5,7 @@
 #include <msf/io/organized_conversion.h>
 #include <msf/io/point_types.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/mesh_rasterizer.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <pcl/conversions.h>
@@ -485,6 +486,44 @@ TEST(TsdfIntegrator, GrazingGroundIsMeshedWithThePlaneDistance) {
   std::printf("  road 10-20 m within 0.1 m of the mesh: projective %.3f, plane %.3f\n", covered[0], covered[1]);
   EXPECT_GE(covered[1], 0.98);
   EXPECT_LT(covered[0], 0.5);
+}
+
+TEST(TsdfIntegrator, AStreetAtAnAngleToTheGridIsMeshedWithoutHoles) {
+  // A street at an angle to the volume's grid, its road cambered: the corners of a cube that a
+  // plane of normal n crosses lie up to (|n_x| + |n_y| + |n_z|) voxels from it, more than one.
+  // A band of one voxel behind the plane left the farther ones unobserved, and marching cubes,
+  // which needs all 8, left holes: 3.4 % of the pixels (0.6 % with a voxel and a half, the
+  // rest along the wall's top edge and its foot).
+  const double yaw = 40.0 * M_PI / 180.0, camber = 3.0 * M_PI / 180.0;
+  const Eigen::Isometry3d turn(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()));
+  const Eigen::Vector3d up = turn.linear() * Eigen::Vector3d(std::sin(camber), -std::cos(camber), 0.0);
+  AnalyticScene scene;
+  scene.addHalfSpace(up, up.dot(Eigen::Vector3d(0, 1.65, 0)));
+  scene.addBox(turn * Eigen::Vector3d(4.2, 0, 20), Eigen::Vector3d(0.2, 3, 30), turn.linear());
+  const PinholeCamera camera = streetCamera();
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume, TsdfIntegrator::Config{});
+  const int frames = 3;
+  for (int i = 0; i < frames; ++i)
+    integrator.integrate(test::renderFrame(scene, camera, turn * streetPose(i)), turn * streetPose(i));
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  MeshRasterizer rasterizer;
+  std::size_t seen = 0, missed = 0;
+  for (int i = 0; i < frames; ++i) {
+    const cv::Mat truth = scene.renderDepth(camera, turn * streetPose(i), 20.0);
+    cv::Mat rendered;
+    rasterizer.render(mesh, camera, turn * streetPose(i), rendered);
+    for (int v = 0; v < truth.rows - 20; ++v) // the map ends a voxel inside the view
+      for (int u = 20; u < truth.cols - 20; ++u)
+        if (truth.at<float>(v, u) >= 5.f && truth.at<float>(v, u) <= 18.f) {
+          ++seen;
+          missed += !(rendered.at<float>(v, u) > 0.f);
+        }
+  }
+  const double missing = static_cast<double>(missed) / static_cast<double>(seen);
+  std::printf("  street at 40 degrees to the grid, road cambered 3 degrees, 5-18 m: %.4f of the pixels without a surface\n", missing);
+  EXPECT_LT(missing, 0.01);
 }
 
 TEST(TsdfIntegrator, CarvingRemovesTheGhostOfACarAheadAndKeepsTheStreet) {

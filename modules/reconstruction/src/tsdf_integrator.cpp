@@ -316,10 +316,12 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   //    along the ray within which voxels are updated, widened to truncation_sigmas standard
   //    deviations so that noisy depth is averaged over frames rather than clipped:
   //    - in front, the truncation along the ray, or a voxel and a half above the plane;
-  //    - behind, the truncation along the ray, or one voxel below the plane (enough for marching
-  //      cubes to see the sign change at a grazing angle) but not the plane's full length:
-  //      beyond the surface's edge the plane is free space, and a box seen edge-on would grow a
-  //      skirt behind it.
+  //    - behind, the truncation along the ray, or a voxel and a half below the plane (marching
+  //      cubes needs all 8 corners of a cube the surface crosses, which lie up to
+  //      |n_x| + |n_y| + |n_z| voxels from a plane of normal n: a road's camber or a street at
+  //      an angle to the grid puts some of them more than one voxel below it) but not the
+  //      plane's full length: beyond the surface's edge the plane is free space, and a box seen
+  //      edge-on would grow a skirt behind it.
   if (config_.signed_distance == SignedDistance::Plane) {
     planeDistanceScale(depth_image, cam, config_.plane, scale_);
     smoothSurfaceExtent(depth_image, config_.plane.max_curvature, extent_);
@@ -330,10 +332,11 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // One record per pixel, so that a voxel's update reads them from one cache line.
   pixels_.resize(static_cast<std::size_t>(width) * height);
   const float sigmas = static_cast<float>(config_.truncation_sigmas);
-  // How far from a plane its band reaches along a grazing ray: a voxel and a half above it
-  // (beyond, free space holds it at +truncation: the full truncation cost 12 % more time for
-  // the same maps), a voxel below it (enough for the sign change marching cubes needs).
-  const float above_plane = std::min(trunc, 1.5f * vs), below_plane = std::min(trunc, vs);
+  // How far from a plane its band reaches along a grazing ray: a voxel and a half either side
+  // (above it, free space holds the voxels beyond at +truncation: the full truncation cost 12 %
+  // more time for the same maps; below it, one voxel left holes wherever a cube's far corner
+  // lay a little deeper: protocol 4 coverage 0.957 against 0.967 on raw 0009).
+  const float plane_band = std::min(trunc, 1.5f * vs);
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
   const bool own_free = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
   const cv::Mat& free_weight = own_free ? frame.free_space_weight : cv::Mat();
@@ -347,8 +350,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       PixelBand* out = &pixels_[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
         const float noise = w[u] > 0.f ? sigmas / std::sqrt(w[u]) : 0.f;
-        const float front = std::max({trunc, above_plane / s[u], noise});
-        const float below = std::min(below_plane / s[u], e[u]); // not past where the surface is seen
+        const float front = std::max({trunc, plane_band / s[u], noise});
+        const float below = std::min(plane_band / s[u], e[u]); // not past where the surface is seen
         out[u] = {s[u], front, std::min(front, std::max({trunc, below, noise})), w[u], carving_weight * f[u]};
       }
     }
