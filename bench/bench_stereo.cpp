@@ -32,6 +32,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cstdlib>
 #include <ctime>
 #include <memory>
@@ -136,6 +137,50 @@ void BM_PostFilter(benchmark::State& state, bool parallel) {
   msf::setParallelPostFilterEnabled(true);
 }
 
+/// cv::medianBlur(src, dst, 3) on row bands in parallel: each band with the row above and
+/// below it (the window's reach), of which only its own rows are kept.
+void openCvMedianOnBands(const cv::Mat& src, cv::Mat& dst) {
+  constexpr int kRows = 16;
+  dst.create(src.size(), src.type());
+  cv::parallel_for_(cv::Range(0, (src.rows + kRows - 1) / kRows), [&](const cv::Range& range) {
+    const int begin = range.start * kRows, end = std::min(range.end * kRows, src.rows);
+    const int top = std::max(begin - 1, 0), bottom = std::min(end + 1, src.rows);
+    cv::Mat band;
+    cv::medianBlur(src.rowRange(top, bottom), band, 3);
+    band.rowRange(begin - top, end - top).copyTo(dst.rowRange(begin, end));
+  });
+}
+
+/// The 3x3 median of the matcher's output (1226 x 370 CV_16S disparities of the 10 frames)
+/// alone, side by side: msf::medianBlur3x3 (ours, row bands in parallel), cv::medianBlur
+/// (serial) and cv::medianBlur on row bands in parallel; on all threads, or on one
+/// (`one_thread`: the per-core cost). Each result is checked against cv::medianBlur's.
+void BM_Median3x3(benchmark::State& state, const char* engine, bool one_thread) {
+  const std::vector<cv::Mat>& input = medianOnlyDisparities();
+  const std::string name = engine;
+  std::unique_ptr<msf::bench::OneThread> single;
+  if (one_thread)
+    single = std::make_unique<msf::bench::OneThread>();
+  cv::Mat median, expected;
+  std::size_t i = 0;
+  const std::clock_t cpu_start = std::clock();
+  for (auto _ : state) {
+    const cv::Mat& raw = input[i++ % input.size()];
+    if (name == "msf")
+      msf::medianBlur3x3(raw, median);
+    else if (name == "opencv")
+      cv::medianBlur(raw, median, 3);
+    else
+      openCvMedianOnBands(raw, median);
+    benchmark::DoNotOptimize(median.data);
+  }
+  state.counters["cpu_ms_all_threads"] =
+      1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
+  cv::medianBlur(input[(i - 1) % input.size()], expected, 3);
+  if (cv::countNonZero(median != expected) != 0)
+    state.SkipWithError("the median differs from cv::medianBlur's");
+}
+
 void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, msf::SgbmConfig{}, false, engine); }
 
 void BM_Sgbm3WayLidarRange(benchmark::State& state, const char* engine) {
@@ -214,5 +259,25 @@ BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, native, "native")
 
 BENCHMARK_CAPTURE(BM_PostFilter, opencv, false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
 BENCHMARK_CAPTURE(BM_PostFilter, parallel, true)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
+
+// The medians one after the other, all threads then one thread.
+BENCHMARK_CAPTURE(BM_Median3x3, msf, "msf", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
+BENCHMARK_CAPTURE(BM_Median3x3, opencv, "opencv", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
+BENCHMARK_CAPTURE(BM_Median3x3, opencv_bands, "opencv_bands", false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(200);
+BENCHMARK_CAPTURE(BM_Median3x3, msf_one_thread, "msf", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(200);
+BENCHMARK_CAPTURE(BM_Median3x3, opencv_one_thread, "opencv", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(200);
+BENCHMARK_CAPTURE(BM_Median3x3, opencv_bands_one_thread, "opencv_bands", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(200);
 
 BENCHMARK_MAIN();
