@@ -7,9 +7,9 @@
 // BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
 // SemiGlobalMatcher with its AVX2 and its AVX-512 kernel): per-core cost, steadier than wall
 // time on a machine shared with other work.
-// Post-processing, side by side: the native rows again with OpenCV's serial median, speckle
-// filter and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)),
-// and BM_PostFilter, that tail alone (median, speckle filter, conversion to float,
+// Post-processing, side by side: the native rows again with OpenCV's serial speckle filter
+// and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)), and
+// BM_PostFilter, that tail alone (OpenCV's median, speckle filter, conversion to float,
 // confidence) on the matcher's output of the 10 frames, with OpenCV's routines and ours.
 //
 //   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
@@ -19,7 +19,6 @@
 #include <msf/io/sequence.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
-#include <msf/stereo/median_blur_3x3.h>
 #include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_stereo.h>
@@ -32,7 +31,6 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
 #include <cstdlib>
 #include <ctime>
 #include <memory>
@@ -122,63 +120,17 @@ void BM_PostFilter(benchmark::State& state, bool parallel) {
   const std::clock_t cpu_start = std::clock();
   for (auto _ : state) {
     const cv::Mat& raw = input[i++ % input.size()];
-    if (parallel) {
-      msf::medianBlur3x3(raw, median);
+    cv::medianBlur(raw, median, 3);
+    if (parallel)
       msf::filterSpecklesParallel(median, -16, 100, 32, speckle_buffer);
-    } else {
-      cv::medianBlur(raw, median, 3);
+    else
       cv::filterSpeckles(median, -16, 100, 32, speckle_buffer);
-    }
     median.convertTo(disparity, CV_32F, 1.0 / 16);
     benchmark::DoNotOptimize(msf::stereoConfidence(disparity).data);
   }
   state.counters["cpu_ms_all_threads"] =
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
   msf::setParallelPostFilterEnabled(true);
-}
-
-/// cv::medianBlur(src, dst, 3) on row bands in parallel: each band with the row above and
-/// below it (the window's reach), of which only its own rows are kept.
-void openCvMedianOnBands(const cv::Mat& src, cv::Mat& dst) {
-  constexpr int kRows = 16;
-  dst.create(src.size(), src.type());
-  cv::parallel_for_(cv::Range(0, (src.rows + kRows - 1) / kRows), [&](const cv::Range& range) {
-    const int begin = range.start * kRows, end = std::min(range.end * kRows, src.rows);
-    const int top = std::max(begin - 1, 0), bottom = std::min(end + 1, src.rows);
-    cv::Mat band;
-    cv::medianBlur(src.rowRange(top, bottom), band, 3);
-    band.rowRange(begin - top, end - top).copyTo(dst.rowRange(begin, end));
-  });
-}
-
-/// The 3x3 median of the matcher's output (1226 x 370 CV_16S disparities of the 10 frames)
-/// alone, side by side: msf::medianBlur3x3 (ours, row bands in parallel), cv::medianBlur
-/// (serial) and cv::medianBlur on row bands in parallel; on all threads, or on one
-/// (`one_thread`: the per-core cost). Each result is checked against cv::medianBlur's.
-void BM_Median3x3(benchmark::State& state, const char* engine, bool one_thread) {
-  const std::vector<cv::Mat>& input = medianOnlyDisparities();
-  const std::string name = engine;
-  std::unique_ptr<msf::bench::OneThread> single;
-  if (one_thread)
-    single = std::make_unique<msf::bench::OneThread>();
-  cv::Mat median, expected;
-  std::size_t i = 0;
-  const std::clock_t cpu_start = std::clock();
-  for (auto _ : state) {
-    const cv::Mat& raw = input[i++ % input.size()];
-    if (name == "msf")
-      msf::medianBlur3x3(raw, median);
-    else if (name == "opencv")
-      cv::medianBlur(raw, median, 3);
-    else
-      openCvMedianOnBands(raw, median);
-    benchmark::DoNotOptimize(median.data);
-  }
-  state.counters["cpu_ms_all_threads"] =
-      1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
-  cv::medianBlur(input[(i - 1) % input.size()], expected, 3);
-  if (cv::countNonZero(median != expected) != 0)
-    state.SkipWithError("the median differs from cv::medianBlur's");
 }
 
 void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, msf::SgbmConfig{}, false, engine); }
@@ -259,25 +211,5 @@ BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, native, "native")
 
 BENCHMARK_CAPTURE(BM_PostFilter, opencv, false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
 BENCHMARK_CAPTURE(BM_PostFilter, parallel, true)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(20);
-
-// The medians one after the other, all threads then one thread.
-BENCHMARK_CAPTURE(BM_Median3x3, msf, "msf", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
-BENCHMARK_CAPTURE(BM_Median3x3, opencv, "opencv", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(200);
-BENCHMARK_CAPTURE(BM_Median3x3, opencv_bands, "opencv_bands", false)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(200);
-BENCHMARK_CAPTURE(BM_Median3x3, msf_one_thread, "msf", true)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(200);
-BENCHMARK_CAPTURE(BM_Median3x3, opencv_one_thread, "opencv", true)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(200);
-BENCHMARK_CAPTURE(BM_Median3x3, opencv_bands_one_thread, "opencv_bands", true)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(200);
 
 BENCHMARK_MAIN();
