@@ -7,9 +7,9 @@
 // BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
 // SemiGlobalMatcher with its AVX2 and its AVX-512 kernel): per-core cost, steadier than wall
 // time on a machine shared with other work.
-// Post-processing, side by side: the native rows again with OpenCV's serial median, speckle
-// filter and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)),
-// and BM_PostFilter, that tail alone (median, speckle filter, conversion to float,
+// Post-processing, side by side: the native rows again with OpenCV's serial speckle filter
+// and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)), and
+// BM_PostFilter, that tail alone (OpenCV's median, speckle filter, conversion to float,
 // confidence) on the matcher's output of the 10 frames, with OpenCV's routines and ours.
 //
 //   bench_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
@@ -19,7 +19,6 @@
 #include <msf/io/sequence.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
-#include <msf/stereo/median_blur_3x3.h>
 #include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/semi_global_matcher.h>
 #include <msf/stereo/sgbm_stereo.h>
@@ -121,13 +120,11 @@ void BM_PostFilter(benchmark::State& state, bool parallel) {
   const std::clock_t cpu_start = std::clock();
   for (auto _ : state) {
     const cv::Mat& raw = input[i++ % input.size()];
-    if (parallel) {
-      msf::medianBlur3x3(raw, median);
+    cv::medianBlur(raw, median, 3);
+    if (parallel)
       msf::filterSpecklesParallel(median, -16, 100, 32, speckle_buffer);
-    } else {
-      cv::medianBlur(raw, median, 3);
+    else
       cv::filterSpeckles(median, -16, 100, 32, speckle_buffer);
-    }
     median.convertTo(disparity, CV_32F, 1.0 / 16);
     benchmark::DoNotOptimize(msf::stereoConfidence(disparity).data);
   }

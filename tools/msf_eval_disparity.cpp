@@ -8,8 +8,6 @@
 #include <msf/io/image_io.h>
 
 #include <opencv2/imgcodecs.hpp>
-#include <pcl/console/parse.h>
-#include <pcl/console/print.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -17,26 +15,7 @@
 #include <string>
 #include <vector>
 
-using namespace pcl::console;
-
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <gt.png> <est.png> [options]\n", name);
-  print_error("       or: %s <gt_dir> <est_dir> [options]\n", name);
-  print_info("  KITTI 16-bit disparity PNGs (pixels x 256, 0 = none): D1 outliers (error > 3 px and > 5 %%),\n");
-  print_info("  mean absolute error (eq. 8) and density, per region when an object map is given.\n");
-  print_info("  With folders: every NNNNNN.png of est_dir against gt_dir/NNNNNN.png (a missing one is an error),\n");
-  print_info("  the pixels of all frames summed into one table. The object maps come from a sibling folder of\n");
-  print_info("  gt_dir named obj_map_0 (synthetic gt/disp_0) or obj_map (KITTI 2015 disp_*), or -obj_map_dir.\n");
-  print_info("  where options are:\n");
-  print_info("    -obj_map PATH     object map (0 = background, else foreground), e.g. KITTI obj_map/*.png\n");
-  print_info("    -obj_map_dir DIR  folder mode: object maps DIR/NNNNNN.png\n");
-  print_info("    -interpolate      fill missing estimates as the devkit does (background interpolation);\n");
-  print_info("                      without it a missing estimate counts as bad in D1\n");
-  print_info("    -abs_px X         absolute threshold in pixels (default 3)\n");
-  print_info("    -rel X            relative threshold (default 0.05)\n");
-}
 
 void printRow(const char* name, const msf::DisparityRegionErrors& r) {
   std::printf("%-11s %8.2f %%  %8.2f %%  %8.2f %%  %8.3f  %9zu  %9zu\n", name, 100.0 * r.d1(), 100.0 * r.d1Estimated(),
@@ -121,21 +100,27 @@ msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::s
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_eval_disparity", 3, printHelp, [&] {
-    const std::vector<std::string> value_options{"-obj_map", "-obj_map_dir", "-abs_px", "-rel"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-interpolate"});
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+  msf::DisparityEvalOptions options;
+  std::string obj_map_path, obj_map_dir;
+  msf::tool::CommandLine cli(
+      "msf_eval_disparity", "<gt.png> <est.png> [options]\n<gt_dir> <est_dir> [options]",
+      "KITTI 16-bit disparity PNGs (pixels x 256, 0 = none): D1 outliers (error > 3 px and > 5 %), mean absolute "
+      "error (eq. 8) and density, per region when an object map is given. With folders: every NNNNNN.png of est_dir "
+      "against gt_dir/NNNNNN.png (a missing one is an error), the pixels of all frames summed into one table. The "
+      "object maps come from a sibling folder of gt_dir named obj_map_0 (synthetic gt/disp_0) or obj_map (KITTI 2015 "
+      "disp_*), or -obj_map_dir.");
+  cli.value("-obj_map", "PATH", obj_map_path, "object map (0 = background, else foreground), e.g. KITTI obj_map/*.png")
+      .value("-obj_map_dir", "DIR", obj_map_dir, "folder mode: object maps DIR/NNNNNN.png")
+      .flag("-interpolate", options.interpolate_background,
+            "fill missing estimates as the devkit does (background interpolation); without it a missing estimate "
+            "counts as bad in D1")
+      .value("-abs_px", "X", options.abs_threshold_px, "absolute threshold in pixels (default {default})")
+      .value("-rel", "X", options.rel_threshold, "relative threshold (default {default})");
+  return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <gt.png> <est.png> or <gt_dir> <est_dir> (see -h)");
-    msf::DisparityEvalOptions options;
-    options.interpolate_background = find_switch(argc, argv, "-interpolate");
-    msf::tool::parseArgument(argc, argv, "-abs_px", options.abs_threshold_px);
-    msf::tool::parseArgument(argc, argv, "-rel", options.rel_threshold);
     if (!(options.abs_threshold_px >= 0.f) || !(options.rel_threshold >= 0.f))
       throw msf::InvalidInputError("-abs_px and -rel must be >= 0");
-    std::string obj_map_path, obj_map_dir;
-    msf::tool::parseArgument(argc, argv, "-obj_map", obj_map_path);
-    msf::tool::parseArgument(argc, argv, "-obj_map_dir", obj_map_dir);
 
     const bool folders = isDirectory(files[0]);
     if (folders != isDirectory(files[1]))

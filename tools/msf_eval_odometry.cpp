@@ -20,26 +20,6 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions{"-plot", "-frames"};
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s est.txt REFERENCE [options]\n", name);
-  print_info("  Scores an estimated trajectory (KITTI poses format: T_world_cam0, a 3x4 row-major matrix a\n"
-             "  line, one line per frame) against REFERENCE: a poses file of the same frames, or a dataset\n"
-             "  folder whose poses are the reference (KITTI odometry poses, a raw drive's OXTS, a synthetic\n"
-             "  sequence's ground truth). Evaluation protocol 5:\n"
-             "    KITTI devkit translation error (%%) and rotation error (deg/m) over segments of 100..800 m\n"
-             "    from every 10th frame, or, on a path shorter than 100 m, of k/8 of its length (k = 1..7)\n"
-             "    from every frame; absolute trajectory error (RMSE of the positions) and end-point drift\n"
-             "    (in m and in %% of the path length), both after moving the estimate so that its first\n"
-             "    pose is the reference's (no other alignment, as KITTI).\n");
-  print_info("  where options are:\n");
-  print_info("    -frames a:b    the reference's frames a..b (its file's lines, 0-based), when the estimate\n"
-             "                   covers part of the sequence (msf_odometry -frames a:b)\n");
-  print_info("    -plot FILE     PNG of both trajectories from above, in the reference's first camera frame\n"
-             "                   (default: next to est.txt, <name>_trajectory.png)\n");
-}
-
 msf::PoseList loadReference(const std::string& path, const std::string& frames_text) {
   msf::PoseList all;
   if (fs::is_directory(path)) {
@@ -63,16 +43,28 @@ msf::PoseList loadReference(const std::string& path, const std::string& frames_t
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_eval_odometry", 3, printHelp, [&] {
-    msf::tool::checkOptions(argc, argv, kValueOptions, {});
-    const auto positional = msf::tool::positionalArguments(argc, argv, kValueOptions);
+  std::string plot_path, frames_text;
+  msf::tool::CommandLine cli(
+      "msf_eval_odometry", "est.txt REFERENCE [options]",
+      "Scores an estimated trajectory (KITTI poses format: T_world_cam0, a 3x4 row-major matrix a line, one line per "
+      "frame) against REFERENCE: a poses file of the same frames, or a dataset folder whose poses are the reference "
+      "(KITTI odometry poses, a raw drive's OXTS, a synthetic sequence's ground truth). Evaluation protocol 5:\n"
+      "  KITTI devkit translation error (%) and rotation error (deg/m) over segments of 100..800 m from every 10th "
+      "frame, or, on a path shorter than 100 m, of k/8 of its length (k = 1..7) from every frame; absolute "
+      "trajectory error (RMSE of the positions) and end-point drift (in m and in % of the path length), both after "
+      "moving the estimate so that its first pose is the reference's (no other alignment, as KITTI).");
+  cli.value("-frames", "a:b", frames_text,
+            "the reference's frames a..b (its file's lines, 0-based), when the estimate covers part of the sequence "
+            "(msf_odometry -frames a:b)")
+      .value("-plot", "FILE", plot_path,
+             "PNG of both trajectories from above, in the reference's first camera frame (default: next to est.txt, "
+             "<name>_trajectory.png)");
+  return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 2)
       throw msf::InvalidInputError("expected est.txt and a reference, got " + std::to_string(positional.size()) +
                                    " positional arguments (see -h)");
     const std::string estimate_path = positional[0], reference_path = positional[1];
-    std::string plot_path, frames_text;
-    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
-    if (msf::tool::parseArgument(argc, argv, "-plot", plot_path) < 0) {
+    if (!cli.given("-plot")) {
       const fs::path est(estimate_path);
       plot_path = (est.parent_path() / (est.stem().string() + "_trajectory.png")).string();
     }

@@ -13,7 +13,6 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <pcl/common/io.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <pcl/conversions.h>
@@ -23,22 +22,6 @@
 using namespace pcl::console;
 
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]\n", name);
-  print_info("  Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one\n"
-             "  organized cloud with fields x y z rgb weight (NaN where neither has depth).\n"
-             "  lidar.pcd: interpolated LiDAR, ideally with the field 'distance' (pixels to the nearest real\n"
-             "  return; without it every point counts as a real return). stereo.pcd: msf_stereo's output,\n"
-             "  ideally with 'confidence' (without it every match counts as confident) and 'rgb'.\n");
-  print_info("  where options are:\n");
-  print_info("    -calib PATH        KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)\n");
-  print_info("    -image_size WxH    image size where no image lies beside the calibration\n");
-  print_info("    -method NAME       paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)\n");
-  print_info("    -config FILE       YAML config, section fusion\n");
-  print_info("    -color PATH        colour camera image (image_2) to colour every fused point by projection\n");
-  print_info("    -print_config      print the fusion settings in use\n");
-}
 
 bool hasField(const pcl::PCLPointCloud2& blob, const char* name) { return pcl::getFieldIndex(blob, name) >= 0; }
 
@@ -83,32 +66,33 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_fuse", 4, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-image_size", "-method", "-config", "-color"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-print_config"});
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string calib_path, image_size_text, color_path;
+  bool print_config = false;
+  msf::DepthFusionConfig config;
+  msf::tool::CommandLine cli(
+      "msf_fuse", "<lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]",
+      "Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one organized cloud with "
+      "fields x y z rgb weight (NaN where neither has depth). lidar.pcd: interpolated LiDAR, ideally with the field "
+      "'distance' (pixels to the nearest real return; without it every point counts as a real return). stereo.pcd: "
+      "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
+  cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
+      .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "fusion", config); },
+             "YAML config, section fusion")
+      .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
+             "paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)")
+      .value("-color", "PATH", color_path, "colour camera image (image_2) to colour every fused point by projection")
+      .flag("-print_config", print_config, "print the fusion settings in use");
+  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
     if (files.size() != 3)
       throw msf::InvalidInputError("expected <lidar.pcd> <stereo.pcd> <out.pcd> (see -h)");
     const std::string ext = msf::fileExtension(files[2]);
     if (ext != ".pcd" && ext != ".ply")
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
-    std::string calib_path, method, config_path, color_path;
-    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
-    std::string image_size_text;
-    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
     const cv::Size image_size = msf::parseImageSize(image_size_text);
-    msf::tool::parseArgument(argc, argv, "-method", method);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-color", color_path);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
-
-    msf::DepthFusionConfig config;
-    if (!config_path.empty())
-      msf::readConfigSection(config_path, "fusion", config);
-    if (!method.empty())
-      config.method = msf::parseFusionMethod(method);
-    if (find_switch(argc, argv, "-print_config"))
+    if (print_config)
       config.print(std::cout);
     const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
 

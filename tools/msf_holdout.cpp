@@ -16,7 +16,6 @@
 #include <msf/synthetic/ground_truth.h>
 
 #include <pcl/common/time.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
 #include <array>
@@ -180,35 +179,6 @@ std::string methodNames() {
 /// The paper's Table 1 rows, the default methods of full-image (synthetic ground truth) mode.
 const char* const kGroundTruthMethods = "sgbm,interpolated,fused_uncertainty,fused_paper,paper,ipbasic_multiscale";
 
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <sequence_dir> [options]\n", name);
-  print_info("  Ring hold-out (evaluation protocol 2): rings with id %% 4 == 2 of each scan are ground truth in\n"
-             "  camera 0, the others are the only LiDAR input. Prints one row per method: coverage, D1 with a\n"
-             "  missing estimate counted as bad, D1 over estimates, mean disparity error, depth MAE, RMSE, iMAE,\n"
-             "  iRMSE (1/km) and the median time of a method per frame (projection included).\n");
-  print_info("  Full-image mode (protocol 3), automatic when the sequence has synthetic ground truth (gt/, as\n"
-             "  msf_synth writes): the whole scan is the LiDAR input, every pixel of gt/depth_0 is ground truth,\n"
-             "  and each method has rows for all, background and foreground pixels (gt/obj_map_0).\n");
-  print_info("  where options are:\n");
-  print_info("    -frames a:b      frames to use (default: all)\n");
-  print_info("    -gt              full-image mode; an error when the sequence has no gt/\n");
-  print_info("    -holdout         ring hold-out even when the sequence has gt/\n");
-  print_info("    -methods a,b,..  methods, in this order (default: all; with gt/: %s):\n", kGroundTruthMethods);
-  for (const auto& m : methodTable())
-    print_info("                       %-19s %s\n", m.name, m.description);
-  print_info("    -config FILE     YAML config (sections projection, rings, interpolation, ip_basic, stereo,\n"
-             "                     fusion)\n");
-  print_info("    -bounds A,B      ring hold-out: also the rows a per-pixel fusion of methods A and B cannot beat, found\n"
-             "                     with the ground truth: bound_select (per pixel the input nearer the truth: the\n"
-             "                     least MAE of choosing one) and bound_blend (the value between the two nearest the\n"
-             "                     truth: the least error of a weighted mean); e.g. -bounds interpolated,sgbm_guided\n");
-  print_info("    -csv FILE        also write the rows as CSV\n");
-  print_info("    -breakdown       ring hold-out: also each method's rows for the ground truth that camera 0 sees\n"
-             "                     (visible) and cannot see (hidden: an input return within 1 px in front of it),\n"
-             "                     and for the depth bands < 20, 20-40, >= 40 m; 'MAE part' adds up to the MAE;\n"
-             "                     and the share of estimates off by >= 10 m (another surface) with their part of it\n");
-}
-
 std::vector<std::string> split(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream ss(text);
@@ -319,13 +289,44 @@ void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& r
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_holdout", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-frames", "-methods", "-config", "-csv", "-bounds"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-gt", "-holdout", "-breakdown"});
-    const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string frames_text = "0:", methods_text, config_path, csv_path, bounds_text;
+  bool gt_switch = false, holdout_switch = false, breakdown = false;
+  std::string methods_help =
+      std::string("methods, in this order (default: all; with gt/: ") + kGroundTruthMethods + "):";
+  for (const auto& m : methodTable()) {
+    char line[256];
+    std::snprintf(line, sizeof line, "\n  %-19s %s", m.name, m.description);
+    methods_help += line;
+  }
+  msf::tool::CommandLine cli(
+      "msf_holdout", "<sequence_dir> [options]",
+      "Ring hold-out (evaluation protocol 2): rings with id % 4 == 2 of each scan are ground truth in camera 0, the "
+      "others are the only LiDAR input. Prints one row per method: coverage, D1 with a missing estimate counted as "
+      "bad, D1 over estimates, mean disparity error, depth MAE, RMSE, iMAE, iRMSE (1/km) and the median time of a "
+      "method per frame (projection included).\n"
+      "Full-image mode (protocol 3), automatic when the sequence has synthetic ground truth (gt/, as msf_synth "
+      "writes): the whole scan is the LiDAR input, every pixel of gt/depth_0 is ground truth, and each method has "
+      "rows for all, background and foreground pixels (gt/obj_map_0).");
+  cli.value("-frames", "a:b", frames_text, "frames to use (default: all)")
+      .flag("-gt", gt_switch, "full-image mode; an error when the sequence has no gt/")
+      .flag("-holdout", holdout_switch, "ring hold-out even when the sequence has gt/")
+      .value("-methods", "a,b,..", methods_text, methods_help)
+      .value("-config", "FILE", config_path,
+             "YAML config (sections projection, rings, interpolation, ip_basic, stereo, fusion)")
+      .value("-bounds", "A,B", bounds_text,
+             "ring hold-out: also the rows a per-pixel fusion of methods A and B cannot beat, found with the ground "
+             "truth: bound_select (per pixel the input nearer the truth: the least MAE of choosing one) and "
+             "bound_blend (the value between the two nearest the truth: the least error of a weighted mean); e.g. "
+             "-bounds interpolated,sgbm_guided")
+      .value("-csv", "FILE", csv_path, "also write the rows as CSV")
+      .flag("-breakdown", breakdown,
+            "ring hold-out: also each method's rows for the ground truth that camera 0 sees (visible) and cannot see "
+            "(hidden: an input return within 1 px in front of it), and for the depth bands < 20, 20-40, >= 40 m; "
+            "'MAE part' adds up to the MAE; and the share of estimates off by >= 10 m (another surface) with their "
+            "part of it");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 1)
       throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
-    const bool gt_switch = find_switch(argc, argv, "-gt"), holdout_switch = find_switch(argc, argv, "-holdout");
     if (gt_switch && holdout_switch)
       throw msf::InvalidInputError("-gt and -holdout exclude each other");
     const msf::Sequence sequence(positional[0]);
@@ -334,20 +335,14 @@ int main(int argc, char** argv) {
                                    "' has no synthetic ground truth (no gt/depth_0 beside its sequences/, as msf_synth "
                                    "writes); without -gt it is evaluated by ring hold-out");
     const bool gt_mode = !holdout_switch && !sequence.groundTruthDir().empty();
-    const bool breakdown = find_switch(argc, argv, "-breakdown");
     if (breakdown && gt_mode)
       throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
                                    "regions (add -holdout to evaluate '" + positional[0] + "' by ring hold-out)");
-    std::string frames_text = "0:", methods_text = gt_mode ? kGroundTruthMethods : methodNames(), config_path, csv_path,
-                bounds_text;
-    msf::tool::parseArgument(argc, argv, "-bounds", bounds_text);
+    if (!cli.given("-methods"))
+      methods_text = gt_mode ? kGroundTruthMethods : methodNames();
     if (!bounds_text.empty() && gt_mode)
       throw msf::InvalidInputError("-bounds is a ring hold-out option (add -holdout to evaluate '" + positional[0] +
                                    "' by ring hold-out)");
-    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
-    msf::tool::parseArgument(argc, argv, "-methods", methods_text);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-csv", csv_path);
     if (!csv_path.empty() && msf::fileExtension(csv_path) != ".csv")
       throw msf::InvalidInputError("-csv '" + csv_path + "' must end in .csv");
 

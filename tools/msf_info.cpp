@@ -4,7 +4,6 @@
 #include <msf/io/cloud_io.h>
 
 #include <pcl/PCLPointCloud2.h>
-#include <pcl/console/print.h>
 #include <pcl/common/io.h>
 #include <pcl/conversions.h>
 #include <pcl/point_types.h>
@@ -13,14 +12,7 @@
 #include <cstdio>
 #include <limits>
 
-using namespace pcl::console;
-
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <file.pcd|.ply> [more ...]\n", name);
-  print_info("  Prints size, organization, fields, valid (finite) points and the depth range of each cloud.\n");
-}
 
 const char* typeName(std::uint8_t datatype) {
   switch (datatype) {
@@ -75,9 +67,11 @@ void describe(const std::string& path) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_info", 2, printHelp, [&] {
-    msf::tool::checkOptions(argc, argv, {}, {});
-    for (const auto& path : msf::tool::positionalArguments(argc, argv, {}))
+  msf::tool::CommandLine cli(
+      "msf_info", "<file.pcd|.ply> [more ...]",
+      "Prints size, organization, fields, valid (finite) points and the depth range of each cloud.");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& paths) {
+    for (const auto& path : paths)
       describe(path);
     return 0;
   });

@@ -13,7 +13,6 @@
 #include <msf/range_image/point_types.h>
 
 #include <pcl/common/time.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
 #include <cmath>
@@ -23,26 +22,6 @@
 using namespace pcl::console;
 
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <in.pcd> <out.pcd> [options]\n", name);
-  print_error("       or: %s <scan.bin|scan.pcd> <out.pcd> -calib PATH [options]\n", name);
-  print_info("  Densifies a sparse organized LiDAR cloud (msf_project's output) into an organized\n"
-             "  msf::PointXYZID cloud (x y z intensity distance): every pixel with an estimate is a point on\n"
-             "  its pixel's ray; `distance` is the distance in pixels to the nearest real return. Given a raw\n"
-             "  scan (.bin, or an unorganized .pcd) and -calib, it projects the scan itself, with the returns\n"
-             "  just outside the image (projection.margin_px) that bridge the gaps at the image's edges.\n");
-  print_info("  where options are:\n");
-  print_info("    -method NAME     compound (default, paper step 2) | linear | cubic | ipbasic | ipbasic_multiscale\n");
-  print_info("    -config FILE     YAML config, sections interpolation, projection, ip_basic\n");
-  print_info("    -calib PATH      calibration: camera of the cloud (else recovered from its points); needed for a scan\n");
-  print_info("    -image_size WxH  image size where no image lies beside the calibration\n");
-  print_info("    -camera N        rectified camera 0..3 of -calib (default 0)\n");
-  print_info("    -short_gap N     gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)\n");
-  print_info("    -max_gap N       longer gaps stay empty (interpolation.max_gap_px)\n");
-  print_info("    -no_gaussian     no Gaussian hole filling after the slices (interpolation.gaussian: false)\n");
-  print_info("    -threads N       OpenMP threads (0: all)\n");
-}
 
 std::size_t countValid(const pcl::PointCloud<msf::PointXYZID>& cloud) {
   std::size_t n = 0;
@@ -54,11 +33,39 @@ std::size_t countValid(const pcl::PointCloud<msf::PointXYZID>& cloud) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_interpolate", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-method", "-config", "-calib", "-image_size", "-camera",
-                                                 "-short_gap", "-max_gap", "-threads"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-no_gaussian"});
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string method_name = "compound", calib_path, image_size_text;
+  msf::ProjectionConfig projection;
+  msf::InterpolationConfig interpolation;
+  msf::IpBasicConfig ip_basic;
+  bool no_gaussian = false;
+  msf::tool::CommandLine cli(
+      "msf_interpolate", "<in.pcd> <out.pcd> [options]\n<scan.bin|scan.pcd> <out.pcd> -calib PATH [options]",
+      "Densifies a sparse organized LiDAR cloud (msf_project's output) into an organized msf::PointXYZID cloud (x y "
+      "z intensity distance): every pixel with an estimate is a point on its pixel's ray; `distance` is the distance "
+      "in pixels to the nearest real return. Given a raw scan (.bin, or an unorganized .pcd) and -calib, it projects "
+      "the scan itself, with the returns just outside the image (projection.margin_px) that bridge the gaps at the "
+      "image's edges.");
+  cli.value("-method", "NAME", method_name,
+            "compound (default, paper step 2) | linear | cubic | ipbasic | ipbasic_multiscale")
+      .value("-config", "FILE",
+             [&](const std::string& path) {
+               const msf::ConfigFile file(path);
+               projection.read(file.section("projection"));
+               interpolation.read(file.section("interpolation"));
+               ip_basic.read(file.section("ip_basic"));
+               file.rejectUnknownKeys();
+             },
+             "YAML config, sections interpolation, projection, ip_basic")
+      .value("-calib", "PATH", calib_path,
+             "calibration: camera of the cloud (else recovered from its points); needed for a scan")
+      .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
+      .value("-camera", "N", projection.camera, "rectified camera 0..3 of -calib (default {default})")
+      .value("-short_gap", "N", interpolation.slice.short_gap_px,
+             "gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)")
+      .value("-max_gap", "N", interpolation.slice.max_gap_px, "longer gaps stay empty (interpolation.max_gap_px)")
+      .flag("-no_gaussian", no_gaussian, "no Gaussian hole filling after the slices (interpolation.gaussian: false)")
+      .value("-threads", "N", interpolation.threads, "OpenMP threads (0: all)");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <in.pcd> <out.pcd> (see -h)");
     const std::string in = files[0], out = files[1];
@@ -68,34 +75,16 @@ int main(int argc, char** argv) {
     if (msf::fileExtension(out) != ".pcd")
       throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
 
-    std::string method_name = "compound", config_path, calib_path;
-    msf::tool::parseArgument(argc, argv, "-method", method_name);
     const msf::CompletionMethod method = msf::parseCompletionMethod(method_name);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
-    std::string image_size_text;
-    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
     const cv::Size image_size = msf::parseImageSize(image_size_text);
-    const msf::ConfigFile file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
-    msf::ProjectionConfig projection;
-    projection.read(file.section("projection"));
-    msf::tool::parseArgument(argc, argv, "-camera", projection.camera);
     projection.validate();
-    msf::InterpolationConfig interpolation;
-    interpolation.read(file.section("interpolation"));
-    msf::tool::parseArgument(argc, argv, "-short_gap", interpolation.slice.short_gap_px);
-    msf::tool::parseArgument(argc, argv, "-max_gap", interpolation.slice.max_gap_px);
-    msf::tool::parseArgument(argc, argv, "-threads", interpolation.threads);
-    if (find_switch(argc, argv, "-no_gaussian"))
+    if (no_gaussian)
       interpolation.gaussian = false;
     if (method == msf::CompletionMethod::Linear)
       interpolation.slice.interpolant = msf::SliceInterpolant::Linear;
     else if (method == msf::CompletionMethod::Cubic)
       interpolation.slice.interpolant = msf::SliceInterpolant::Cubic;
     interpolation.validate();
-    msf::IpBasicConfig ip_basic;
-    ip_basic.read(file.section("ip_basic"));
-    file.rejectUnknownKeys();
     ip_basic.variant = method == msf::CompletionMethod::IpBasicFast ? msf::IpBasicVariant::Fast
                                                                     : msf::IpBasicVariant::Multiscale;
 

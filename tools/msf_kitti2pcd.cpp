@@ -8,7 +8,6 @@
 #include <pcl/io/pcd_io.h>
 
 #include <pcl/console/time.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
 #include <algorithm>
@@ -19,17 +18,6 @@ namespace fs = std::filesystem;
 using namespace pcl::console;
 
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <scan.bin> <out.pcd> [options]\n", name);
-  print_error("       or: %s -input_dir DIR -output_dir DIR [options]\n", name);
-  print_info("  Reads KITTI Velodyne scans (float32 x, y, z, reflectance) into pcl::PointXYZI clouds,\n"
-             "  in file order (which carries the ring structure). Records with NaN or Inf are dropped.\n");
-  print_info("  where options are:\n");
-  print_info("    -input_dir DIR   convert every *.bin of DIR ...\n");
-  print_info("    -output_dir DIR  ... into DIR/<name>.pcd (the folder must exist)\n");
-  print_info("    -ascii           write ASCII .pcd instead of binary compressed\n");
-}
 
 std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
   pcl::PointCloud<pcl::PointXYZI> cloud;
@@ -62,14 +50,16 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_kitti2pcd", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-input_dir", "-output_dir"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-ascii"});
-    const bool ascii = find_switch(argc, argv, "-ascii");
-    std::string input_dir, output_dir;
-    msf::tool::parseArgument(argc, argv, "-input_dir", input_dir);
-    msf::tool::parseArgument(argc, argv, "-output_dir", output_dir);
-
+  std::string input_dir, output_dir;
+  bool ascii = false;
+  msf::tool::CommandLine cli(
+      "msf_kitti2pcd", "<scan.bin> <out.pcd> [options]\n-input_dir DIR -output_dir DIR [options]",
+      "Reads KITTI Velodyne scans (float32 x, y, z, reflectance) into pcl::PointXYZI clouds, in file order (which "
+      "carries the ring structure). Records with NaN or Inf are dropped.");
+  cli.value("-input_dir", "DIR", input_dir, "convert every *.bin of DIR ...")
+      .value("-output_dir", "DIR", output_dir, "... into DIR/<name>.pcd (the folder must exist)")
+      .flag("-ascii", ascii, "write ASCII .pcd instead of binary compressed");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (!input_dir.empty() || !output_dir.empty()) {
       if (input_dir.empty() || output_dir.empty())
         throw msf::InvalidInputError("batch mode needs both -input_dir and -output_dir");
@@ -108,7 +98,6 @@ int main(int argc, char** argv) {
       return 0;
     }
 
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <scan.bin> <out.pcd> (see -h)");
     if (msf::fileExtension(files[1]) != ".pcd")

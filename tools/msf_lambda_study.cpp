@@ -7,7 +7,6 @@
 #include <msf/io/image_io.h>
 #include <msf/reconstruction/lambda_study.h>
 
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
@@ -21,47 +20,8 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-o", "-config", "-frames", "-voxel", "-trunc", "-sweeps", "-solve"};
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s -o DIR [options]\n", name);
-  print_info("  Fuses noisy depth of a synthetic scene (smooth parts, edges, sharp boundaries) with each\n"
-             "  lambda of eq. 7 and writes DIR/lambda_study.csv and DIR/lambda_study.png (paper Fig. 5).\n"
-             "  Options:\n");
-  print_info("    -config FILE   YAML with a section lambda_study (noise_mm, lambdas, frames, ...)\n");
-  print_info("    -frames N      frames fused per cell (default "); print_value("10"); print_info(")\n");
-  print_info("    -voxel M       voxel size in metres (default "); print_value("0.05"); print_info(")\n");
-  print_info("    -trunc M       truncation in metres (default "); print_value("0.25"); print_info(")\n");
-  print_info("    -sweeps N      Gauss-Seidel sweeps per frame (default "); print_value("1"); print_info(")\n");
-  print_info("    -solve S       sweeps: -sweeps per frame, warm-started | argmin: eq. 7 solved to its minimizer\n"
-             "                   every frame, as the paper states it (default "); print_value("sweeps"); print_info(")\n");
-}
-
-int run(int argc, char** argv) {
-  msf::tool::checkOptions(argc, argv, kValueOptions, {});
-  if (!msf::tool::positionalArguments(argc, argv, kValueOptions).empty())
-    throw msf::InvalidInputError("unexpected argument '" + msf::tool::positionalArguments(argc, argv, kValueOptions)[0] +
-                                 "' (see -h)");
-  std::string out_dir;
-  if (msf::tool::parseArgument(argc, argv, "-o", out_dir) < 0) {
-    printHelp(argv[0]);
-    throw msf::InvalidInputError("need -o DIR");
-  }
-  msf::LambdaStudy::Config config;
-  std::string config_path;
-  if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0)
-    msf::readConfigSection(config_path, "lambda_study", config);
-  msf::tool::parseArgument(argc, argv, "-frames", config.frames);
-  msf::tool::parseArgument(argc, argv, "-voxel", config.voxel_size_m);
-  msf::tool::parseArgument(argc, argv, "-trunc", config.truncation_m);
-  msf::tool::parseArgument(argc, argv, "-sweeps", config.sweeps);
-  std::string solve = msf::toString(config.solve);
-  msf::tool::parseArgument(argc, argv, "-solve", solve);
-  try {
-    config.solve = msf::parseSolve(solve);
-  } catch (const msf::ConfigError&) {
-    throw msf::InvalidInputError("-solve must be sweeps or argmin, not '" + solve + "'");
-  }
+/// The study of `config` into `out_dir`: the table on the console, the CSV and the figure.
+int run(const msf::LambdaStudy::Config& config, const std::string& out_dir) {
   const msf::LambdaStudy study(config); // validates: a bad value leaves no output folder
   msf::ensureOutputDirectory(out_dir);
   config.print(std::cout);
@@ -102,5 +62,36 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_lambda_study", 2, printHelp, [&] { return run(argc, argv); });
+  std::string out_dir;
+  msf::LambdaStudy::Config config;
+  msf::tool::CommandLine cli(
+      "msf_lambda_study", "-o DIR [options]",
+      "Fuses noisy depth of a synthetic scene (smooth parts, edges, sharp boundaries) with each lambda of eq. 7 and "
+      "writes DIR/lambda_study.csv and DIR/lambda_study.png (paper Fig. 5).");
+  cli.value("-o", "DIR", out_dir, "output folder")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "lambda_study", config); },
+             "YAML with a section lambda_study (noise_mm, lambdas, frames, ...)")
+      .value("-frames", "N", config.frames, "frames fused per cell (default {default})")
+      .value("-voxel", "M", config.voxel_size_m, "voxel size in metres (default {default})")
+      .value("-trunc", "M", config.truncation_m, "truncation in metres (default {default})")
+      .value("-sweeps", "N", config.sweeps, "Gauss-Seidel sweeps per frame (default {default})")
+      .value("-solve", "S",
+             [&](const std::string& solve) {
+               try {
+                 config.solve = msf::parseSolve(solve);
+               } catch (const msf::ConfigError&) {
+                 throw msf::InvalidInputError("-solve must be sweeps or argmin, not '" + solve + "'");
+               }
+             },
+             std::string("sweeps: -sweeps per frame, warm-started | argmin: eq. 7 solved to its minimizer every frame, "
+                         "as the paper states it (default ") + msf::toString(config.solve) + ")");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
+    if (!positional.empty())
+      throw msf::InvalidInputError("unexpected argument '" + positional[0] + "' (see -h)");
+    if (!cli.given("-o")) {
+      cli.printHelp(argv[0]);
+      throw msf::InvalidInputError("need -o DIR");
+    }
+    return run(config, out_dir);
+  });
 }

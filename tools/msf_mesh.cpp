@@ -10,7 +10,6 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <pcl/console/time.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 
 #include <cmath>
@@ -25,39 +24,26 @@ using namespace pcl::console;
 
 namespace {
 
-const std::vector<std::string> kValueOptions = {"-min_weight", "-min_component_triangles", "-config", "-voxel", "-trunc",
-                                                 "-region"};
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <volume.pcd | STORE_DIR> <mesh.ply|mesh.obj|mesh.vtk> [options]\n", name);
-  print_info("  Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. STORE_DIR is the\n"
-             "  output folder of msf_reconstruct -stream (its tsdf/index.txt and block files): meshed tile by tile\n"
-             "  in bounded memory into mesh.ply (a PLY only) and its tiles into mesh.ply.tiles/. Options:\n");
-  const msf::MarchingCubes::Config defaults; // the help says what the code does
-  print_info("    -min_weight W   voxels with weight <= W (m^-2, an inverse variance) make no triangles (default ");
-  print_value("%s", msf::configValue(defaults.min_weight).c_str()); print_info(")\n");
-  print_info("    -min_component_triangles N\n"
-             "                    remove connected pieces of fewer than N triangles (default ");
-  print_value("%s", msf::configValue(defaults.min_component_triangles).c_str()); print_info("; 0 keeps all)\n");
-  print_info("    -config FILE    YAML with a section marching_cubes; flags override it\n");
-  print_info("    -voxel V -trunc T\n"
-             "                    voxel size and truncation (m) of a volume whose header comment a PCL\n"
-             "                    rewrite dropped (otherwise read from the file, and checked if given)\n");
-  print_info("    -region x0,y0,z0,x1,y1,z1  a store's tiles within this box only (metres, world frame)\n");
-}
+/// What the command line sets.
+struct Settings {
+  msf::MarchingCubes::Config config;
+  double voxel = 0, trunc = 0;
+  std::string region;
+};
 
 /// A streamed store: tile by tile (the small-piece filter is not applied across tiles).
-int remeshStore(const std::string& store, const std::string& output, const msf::MarchingCubes::Config& config,
-                int argc, char** argv) {
+int remeshStore(const std::string& store, const std::string& output, const Settings& settings,
+                const msf::tool::CommandLine& cli) {
+  const msf::MarchingCubes::Config& config = settings.config;
+  const std::string& region = settings.region;
   if (msf::fileExtension(output) != ".ply")
     throw msf::InvalidInputError("output mesh '" + output + "': a store is meshed into a .ply");
   if (config.min_component_triangles > 0)
     throw msf::InvalidInputError("-min_component_triangles: a store is meshed tile by tile, pieces cross tiles");
-  if (find_argument(argc, argv, "-voxel") >= 0 || find_argument(argc, argv, "-trunc") >= 0)
+  if (cli.given("-voxel") || cli.given("-trunc"))
     throw msf::InvalidInputError("-voxel and -trunc are for a volume .pcd: a store's index gives them");
   Eigen::Vector3d lo = Eigen::Vector3d::Ones(), hi = Eigen::Vector3d::Zero();
-  std::string region;
-  if (msf::tool::parseArgument(argc, argv, "-region", region) >= 0) {
+  if (cli.given("-region")) {
     std::vector<double> v;
     std::stringstream ss(region);
     std::string item;
@@ -89,36 +75,28 @@ int remeshStore(const std::string& store, const std::string& output, const msf::
   return 0;
 }
 
-int run(int argc, char** argv) {
-  msf::tool::checkOptions(argc, argv, kValueOptions, {});
-  const auto files = msf::tool::positionalArguments(argc, argv, kValueOptions);
+int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& files, const Settings& settings,
+        const char* program) {
   if (files.size() != 2) {
-    printHelp(argv[0]);
+    cli.printHelp(program);
     throw msf::InvalidInputError("need one input volume and one output mesh, got " + std::to_string(files.size()) +
                                  " file arguments");
   }
   const std::string ext = msf::fileExtension(files[1]);
   if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
     throw msf::InvalidInputError("output mesh '" + files[1] + "' must end in .ply, .obj or .vtk");
-  msf::MarchingCubes::Config config;
-  std::string config_path;
-  if (msf::tool::parseArgument(argc, argv, "-config", config_path) >= 0)
-    msf::readConfigSection(config_path, "marching_cubes", config);
-  msf::tool::parseArgument(argc, argv, "-min_weight", config.min_weight);
-  msf::tool::parseArgument(argc, argv, "-min_component_triangles", config.min_component_triangles);
+  const msf::MarchingCubes::Config& config = settings.config;
   msf::MarchingCubes mesher(config);
   if (std::filesystem::is_directory(files[0]))
-    return remeshStore(files[0], files[1], config, argc, argv);
-  if (find_argument(argc, argv, "-region") >= 0)
+    return remeshStore(files[0], files[1], settings, cli);
+  if (cli.given("-region"))
     throw msf::InvalidInputError("-region applies to a store folder (msf_reconstruct -stream), not to a volume .pcd");
 
   pcl::console::TicToc tt;
   print_highlight("Loading ");
   print_value("%s ", files[0].c_str());
   tt.tic();
-  double voxel = 0, trunc = 0;
-  msf::tool::parseArgument(argc, argv, "-voxel", voxel);
-  msf::tool::parseArgument(argc, argv, "-trunc", trunc);
+  const double voxel = settings.voxel, trunc = settings.trunc;
   if (voxel < 0 || trunc < 0 || !std::isfinite(voxel) || !std::isfinite(trunc))
     throw msf::InvalidInputError("-voxel and -trunc must be > 0 m");
   const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0], voxel, trunc);
@@ -163,5 +141,25 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_mesh", 2, printHelp, [&] { return run(argc, argv); });
+  Settings settings;
+  msf::MarchingCubes::Config& config = settings.config;
+  msf::tool::CommandLine cli(
+      "msf_mesh", "<volume.pcd | STORE_DIR> <mesh.ply|mesh.obj|mesh.vtk> [options]",
+      "Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. STORE_DIR is the output folder "
+      "of msf_reconstruct -stream (its tsdf/index.txt and block files): meshed tile by tile in bounded memory into "
+      "mesh.ply (a PLY only) and its tiles into mesh.ply.tiles/.");
+  cli.value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "marching_cubes", config); },
+            "YAML with a section marching_cubes; the options below override it")
+      .value("-min_weight", "W", config.min_weight,
+             "voxels with weight <= W (m^-2, an inverse variance) make no triangles (default {default})")
+      .value("-min_component_triangles", "N", config.min_component_triangles,
+             "remove connected pieces of fewer than N triangles (default {default}; 0 keeps all)")
+      .value("-voxel", "V", settings.voxel,
+             "voxel size (m) of a volume whose header comment a PCL rewrite dropped (otherwise read from the file, "
+             "and checked if given)")
+      .value("-trunc", "T", settings.trunc, "its truncation (m), as -voxel")
+      .value("-region", "x0,y0,z0,x1,y1,z1", settings.region,
+             "a store's tiles within this box only (metres, world frame)");
+  return cli.run(argc, argv, 1,
+                 [&](const msf::tool::Arguments& files) { return run(cli, files, settings, argv[0]); });
 }

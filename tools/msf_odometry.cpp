@@ -10,7 +10,6 @@
 #include <msf/io/velodyne_io.h>
 #include <msf/registration/lidar_odometry.h>
 
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
@@ -24,23 +23,6 @@
 using namespace pcl::console;
 
 namespace {
-
-const std::vector<std::string> kValueOptions{"-o", "-frames", "-config"};
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s DATASET_DIR -o poses.txt [options]\n", name);
-  print_info("  Estimates camera 0's pose of every frame from the LiDAR scans alone (LidarOdometry: each scan\n"
-             "  registered to a local map of the scans before it) and writes T_world_cam0 in KITTI's poses\n"
-             "  format, a 3x4 row-major matrix a line, one line per frame run. DATASET_DIR: a KITTI odometry\n"
-             "  sequence, a KITTI raw drive or a synthetic sequence (msf_synth). The first frame is at the\n"
-             "  dataset's pose when it has poses (the identity on KITTI), else at the identity; with\n"
-             "  poses, the estimate is also scored against them (evaluation protocol 5, msf_eval_odometry).\n");
-  print_info("  where options are:\n");
-  print_info("    -o FILE        output poses file (written whole or not at all)\n");
-  print_info("    -frames a:b    frame range, inclusive (default: all)\n");
-  print_info("    -config FILE   YAML configuration; its `odometry` section (config/kitti.yaml)\n");
-  print_info("    -print_config  print the configuration in effect\n");
-}
 
 void printMetrics(const msf::OdometryMetrics& m) {
   print_info("  ATE (first poses aligned) ");
@@ -58,22 +40,30 @@ void printMetrics(const msf::OdometryMetrics& m) {
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_odometry", 2, printHelp, [&] {
-    msf::tool::checkOptions(argc, argv, kValueOptions, {"-print_config"});
-    const auto positional = msf::tool::positionalArguments(argc, argv, kValueOptions);
+  std::string output, config_path, frames_text = "0:";
+  bool print_config = false;
+  msf::tool::CommandLine cli(
+      "msf_odometry", "DATASET_DIR -o poses.txt [options]",
+      "Estimates camera 0's pose of every frame from the LiDAR scans alone (LidarOdometry: each scan registered to a "
+      "local map of the scans before it) and writes T_world_cam0 in KITTI's poses format, a 3x4 row-major matrix a "
+      "line, one line per frame run. DATASET_DIR: a KITTI odometry sequence, a KITTI raw drive or a synthetic "
+      "sequence (msf_synth). The first frame is at the dataset's pose when it has poses (the identity on KITTI), "
+      "else at the identity; with poses, the estimate is also scored against them (evaluation protocol 5, "
+      "msf_eval_odometry).");
+  cli.value("-o", "FILE", output, "output poses file (written whole or not at all)")
+      .value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)")
+      .value("-config", "FILE", config_path, "YAML configuration; its `odometry` section (config/kitti.yaml)")
+      .flag("-print_config", print_config, "print the configuration in effect");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 1)
       throw msf::InvalidInputError("expected one DATASET_DIR, got " + std::to_string(positional.size()) +
                                    " positional arguments (see -h)");
-    std::string output, config_path, frames_text = "0:";
-    msf::tool::parseArgument(argc, argv, "-o", output);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
     if (output.empty())
       throw msf::InvalidInputError("no output file: give -o poses.txt");
     msf::LidarOdometry::Config config;
     if (!config_path.empty())
       msf::readConfigSection(config_path, "odometry", config);
-    if (find_switch(argc, argv, "-print_config"))
+    if (print_config)
       config.print(std::cout);
 
     const msf::Sequence sequence(positional.front());

@@ -9,50 +9,43 @@
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
 
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <opencv2/core.hpp>
 #include <pcl/point_types.h>
 
+#include <cmath>
+#include <cstdio>
+
 using namespace pcl::console;
 
-namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <organized.pcd> <out.png> [options]\n", name);
-  print_info("  Writes the z of each pixel of an organized cloud (NaN = no depth) as a picture.\n");
-  print_info("  where options are:\n");
-  print_info("    (default)            KITTI 16-bit depth PNG: metres x 256, 0 = none\n");
-  print_info("    -disparity           KITTI 16-bit disparity PNG (pixels x 256), needs -calib\n");
-  print_info("    -calib PATH          KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
-  print_info("    -color               8-bit false-colour picture with a legend in metres\n");
-  print_info("    -range MIN,MAX       colour range in metres for -color (default: 2nd-98th percentile)\n");
-}
-
-} // namespace
-
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_pcd2png", 3, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-range"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-disparity", "-color"});
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string calib_path;
+  bool disparity = false, colour = false;
+  double range_min = 0, range_max = 0;
+  msf::tool::CommandLine cli("msf_pcd2png", "<organized.pcd> <out.png> [options]",
+                             "Writes the z of each pixel of an organized cloud (NaN = no depth) as a picture: by "
+                             "default a KITTI 16-bit depth PNG (metres x 256, 0 = none).");
+  cli.flag("-disparity", disparity, "KITTI 16-bit disparity PNG (pixels x 256), needs -calib")
+      .value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
+      .flag("-color", colour, "8-bit false-colour picture with a legend in metres")
+      .value("-range", "MIN,MAX",
+             [&](const std::string& text) {
+               char rest = 0;
+               if (std::sscanf(text.c_str(), "%lf,%lf%c", &range_min, &range_max, &rest) != 2 ||
+                   !std::isfinite(range_min) || !std::isfinite(range_max) || range_max <= range_min)
+                 throw msf::InvalidInputError("-range must be MIN,MAX in metres with MIN < MAX");
+             },
+             "colour range in metres for -color (default: 2nd-98th percentile)");
+  return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <organized.pcd> <out.png> (see -h)");
     if (msf::fileExtension(files[1]) != ".png")
       throw msf::InvalidInputError("output '" + files[1] + "' must end in .png");
-    const bool disparity = find_switch(argc, argv, "-disparity");
-    const bool colour = find_switch(argc, argv, "-color");
     if (disparity && colour)
       throw msf::InvalidInputError("-disparity and -color exclude each other");
-    std::string calib_path;
-    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
     if (disparity && calib_path.empty())
       throw msf::InvalidInputError("-disparity needs -calib PATH (the focal length and baseline)");
-    double range_min = 0, range_max = 0;
-    if (find_argument(argc, argv, "-range") >= 0 &&
-        (parse_2x_arguments(argc, argv, "-range", range_min, range_max) < 0 || range_max <= range_min))
-      throw msf::InvalidInputError("-range must be MIN,MAX in metres with MIN < MAX");
 
     TicToc tt;
     tt.tic();

@@ -24,7 +24,6 @@
 #include <msf/synthetic/synthetic_generator.h>
 
 #include <opencv2/core.hpp>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
@@ -99,48 +98,6 @@ void installStopHandler() {
     if (::sigaction(signal_number, &action, nullptr) != 0)
       throw msf::IOError(std::string("cannot install the handler of ") + ::strsignal(signal_number) + ": " +
                          std::strerror(errno));
-}
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s [DATASET_DIR] [options]\n", name);
-  print_info("  Reconstructs a KITTI odometry sequence, a KITTI raw drive or a synthetic sequence (msf_synth)\n"
-             "  into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per\n"
-             "  pixel, integrated into a regularized TSDF, meshed by marching cubes. Without DATASET_DIR it\n"
-             "  generates the default synthetic street (20 frames) in a temporary folder and reconstructs it.\n");
-  print_info("  where options are:\n");
-  print_info("    -o DIR         output folder (default msf_out): mesh.ply, volume.pcd, summary.json,\n"
-             "                   frames.csv, runtime.png, depth_NNNNNN.png, mesh_preview.png, report.md,\n"
-             "                   config.yaml, poses.txt\n");
-  print_info("    -config FILE   YAML configuration (config/kitti.yaml); flags below override it\n");
-  print_info("    -frames a:b    frame range, inclusive (default: all)\n");
-  print_info("    -poses P       dataset: the dataset's poses (the default when it has them) | estimate: LiDAR\n"
-             "                   odometry as each frame is loaded (the default without them; section odometry)\n"
-             "                   | a KITTI poses file, line i for frame i. OUT/poses.txt holds the poses used\n");
-  print_info("    -voxel V       voxel size in metres (tsdf_volume.voxel_size_m)\n");
-  print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
-  print_info("    -panels N      depth panels to draw, spread over the frames (default 3, at most 100)\n");
-  print_info("    -stream R      keep only R metres around the camera in memory (streaming.active_radius_m;\n"
-             "                   at least the integrator's max_depth_m + truncation + 2 m + a tile): the rest\n"
-             "                   is meshed into OUT/tiles/X_Y_Z.ply and its TSDF written to OUT/tsdf/ as it\n"
-             "                   leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview;\n"
-             "                   msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md\n");
-  print_info("    -max_memory MB memory budget of the volume (tsdf_volume.max_memory_mb; 0: 3/4 of RAM)\n");
-  print_info("    -save_depth    also write each frame's fused depth as OUT/depth/NNNNNN.pcd\n");
-  print_info("    -holdout       evaluation protocol 4: the held-out rings (config section rings) are removed\n"
-             "                   from every scan before the pipeline sees it and become the ground truth; the\n"
-             "                   mesh, rendered at every frame's pose, is scored at them beside the fused depth\n");
-  print_info("    -compare_sources  also integrate the interpolated LiDAR alone and SGBM alone into volumes of\n"
-             "                   their own (mesh_lidar.ply, mesh_stereo.ply), scored as the mesh is\n");
-  print_info("    -compare_paper also run the paper as published (config/paper.yaml: docs/paper.md) on the same\n"
-             "                   frames into a map of its own (mesh_paper.ply); its per-frame depth (paper) and\n"
-             "                   mesh are scored beside ours\n");
-  print_info("  With ground truth (-holdout, or a synthetic sequence's gt/), summary.json and report.md hold the\n"
-             "  protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo, mesh_paper, paper), within the map's\n"
-             "  depth range and all.\n"
-             "  OUT/config.yaml is the configuration in full; -config OUT/config.yaml repeats the run.\n");
-  print_info("  Ctrl-C (or SIGTERM) stops after the frames under way and still writes the mesh and the summary\n"
-             "  (exit code 130); a second one also skips the mesh's scores and renderings (summary.json lists\n"
-             "  them under \"skipped\"); later ones are ignored until the mesh and the summary are written.\n");
 }
 
 /// Ground truth of a synthetic sequence, accumulated over the run.
@@ -451,38 +408,67 @@ constexpr double kGhostDistanceM = 0.2; // farther than this from the static sur
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_reconstruct", 1, printHelp, [&] {
-    const std::vector<std::string> value_options{"-o",     "-config", "-frames", "-voxel",    "-lambda",
-                                                 "-panels", "-poses",  "-stream", "-max_memory"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-save_depth", "-holdout", "-compare_sources", "-compare_paper"});
-    const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string out = "msf_out", frames_text = "0:", poses_option;
+  int panels = 3;
+  bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
+  msf::PipelineConfig config;
+  msf::tool::CommandLine cli(
+      "msf_reconstruct", "[DATASET_DIR] [options]",
+      "Reconstructs a KITTI odometry sequence, a KITTI raw drive or a synthetic sequence (msf_synth) into a coloured "
+      "mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
+      "(20 frames) in a temporary folder and reconstructs it.");
+  cli.value("-o", "DIR", out,
+            "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
+            "depth_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt")
+      .value("-config", "FILE", [&](const std::string& path) { config = msf::PipelineConfig::load(path); },
+             "YAML configuration (config/kitti.yaml); the options below override it")
+      .value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)")
+      .value("-poses", "P", poses_option,
+             "dataset: the dataset's poses (the default when it has them) | estimate: LiDAR odometry as each frame is "
+             "loaded (the default without them; section odometry) | a KITTI poses file, line i for frame i. "
+             "OUT/poses.txt holds the poses used")
+      .value("-voxel", "V", config.volume.voxel_size_m, "voxel size in metres (tsdf_volume.voxel_size_m)")
+      .value("-lambda", "L", config.integrator.lambda, "regularization of eq. 7 (tsdf_integrator.lambda)")
+      .value("-panels", "N", panels,
+             "depth panels to draw, spread over the frames (default {default}, at most " + std::to_string(kMaxPanels) +
+                 ")")
+      .value("-stream", "R", config.streaming.active_radius_m,
+             "keep only R metres around the camera in memory (streaming.active_radius_m; at least the integrator's "
+             "max_depth_m + truncation + 2 m + a tile): the rest is meshed into OUT/tiles/X_Y_Z.ply and its TSDF "
+             "written to OUT/tsdf/ as it leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview; "
+             "msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md")
+      .value("-max_memory", "MB", config.volume.max_memory_mb,
+             "memory budget of the volume (tsdf_volume.max_memory_mb; 0: 3/4 of RAM)")
+      .flag("-save_depth", save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
+      .flag("-holdout", holdout,
+            "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
+            "pipeline sees it and become the ground truth; the mesh, rendered at every frame's pose, is scored at "
+            "them beside the fused depth")
+      .flag("-compare_sources", compare_sources,
+            "also integrate the interpolated LiDAR alone and SGBM alone into volumes of their own (mesh_lidar.ply, "
+            "mesh_stereo.ply), scored as the mesh is")
+      .flag("-compare_paper", compare_paper,
+            "also run the paper as published (config/paper.yaml: docs/paper.md) on the same frames into a map of its "
+            "own (mesh_paper.ply); its per-frame depth (paper) and mesh are scored beside ours")
+      .note("With ground truth (-holdout, or a synthetic sequence's gt/), summary.json and report.md hold the "
+            "protocol 4 rows: mesh, fused (and mesh_lidar, mesh_stereo, mesh_paper, paper), within the map's depth "
+            "range and all.\n"
+            "OUT/config.yaml is the configuration in full; -config OUT/config.yaml repeats the run.")
+      .note("Ctrl-C (or SIGTERM) stops after the frames under way and still writes the mesh and the summary (exit "
+            "code 130); a second one also skips the mesh's scores and renderings (summary.json lists them under "
+            "\"skipped\"); later ones are ignored until the mesh and the summary are written.");
+  return cli.run(argc, argv, 0, [&](const msf::tool::Arguments& positional) {
     if (positional.size() > 1) {
       std::string extra;
       for (std::size_t k = 1; k < positional.size(); ++k)
         extra += (k > 1 ? "', '" : "") + positional[k];
+      std::string flags;
+      for (const std::string& flag : cli.flags())
+        flags += (flags.empty() ? "" : ", ") + flag;
       throw msf::InvalidInputError("expected at most one DATASET_DIR, got '" + positional.front() + "' and '" + extra +
-                                   "' too (-save_depth, -holdout, -compare_sources and -compare_paper take no value; see -h)");
+                                   "' too (" + flags + " take no value; see -h)");
     }
-
-    std::string out = "msf_out", config_path, frames_text = "0:", poses_option;
-    int panels = 3;
-    msf::tool::parseArgument(argc, argv, "-o", out);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-frames", frames_text);
-    msf::tool::parseArgument(argc, argv, "-panels", panels);
-    msf::tool::parseArgument(argc, argv, "-poses", poses_option);
-    const bool save_depth = find_switch(argc, argv, "-save_depth");
-    const bool holdout = find_switch(argc, argv, "-holdout");
-    const bool compare_sources = find_switch(argc, argv, "-compare_sources");
-    const bool compare_paper = find_switch(argc, argv, "-compare_paper");
-    msf::PipelineConfig config = msf::PipelineConfig::load(config_path);
-    if (find_argument(argc, argv, "-voxel") >= 0)
-      msf::tool::parseArgument(argc, argv, "-voxel", config.volume.voxel_size_m);
-    if (find_argument(argc, argv, "-lambda") >= 0)
-      msf::tool::parseArgument(argc, argv, "-lambda", config.integrator.lambda);
-    if (find_argument(argc, argv, "-stream") >= 0)
-      msf::tool::parseArgument(argc, argv, "-stream", config.streaming.active_radius_m);
-    msf::tool::parseArgument(argc, argv, "-max_memory", config.volume.max_memory_mb);
     config.validate();
     if (panels < 0 || panels > kMaxPanels)
       throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " + std::to_string(panels));

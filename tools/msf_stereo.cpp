@@ -16,7 +16,6 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <pcl/common/io.h>
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 #include <pcl/conversions.h>
@@ -28,27 +27,6 @@
 using namespace pcl::console;
 
 namespace {
-
-void printHelp(const char* name) {
-  print_error("Syntax is: %s <left.png> <right.png> <out.pcd> -calib PATH [options]\n", name);
-  print_info("  Matches a rectified pair (KITTI image_0, image_1) with 3-way SGBM (stereo.engine: the native\n"
-             "  AVX2 kernel or OpenCV's StereoSGBM) and writes the organized cloud of camera 0\n"
-             "  (fields x y z rgb confidence; NaN where there is no match).\n");
-  print_info("  where options are:\n");
-  print_info("    -calib PATH            KITTI odometry calib.txt, raw date folder, object calib or YAML\n");
-  print_info("    -image_size WxH        image size where no image lies beside the calibration\n");
-  print_info("    -color PATH            colour camera image (image_2), projected for each point's colour;\n");
-  print_info("                           without it the colour is the left image's grey\n");
-  print_info("    -disparity_png PATH    also write the disparity as a KITTI 16-bit PNG (pixels x 256)\n");
-  print_info("    -prior PATH            organized depth cloud (the interpolated LiDAR) that narrows the search;\n");
-  print_info("                           with stereo.guidance lidar its real returns (distance 0) guide it\n");
-  print_info("    -config FILE           YAML config, section stereo (every SGBM parameter)\n");
-  print_info("    -num_disparities N     search range without a prior (multiple of 16; default 128)\n");
-  print_info("    -block_size N          odd block size (default 5)\n");
-  print_info("    -mode NAME             sgbm_3way (default) | sgbm | hh | hh4\n");
-  print_info("    -lr_check              drop matches that fail a left-right check (twice the time)\n");
-  print_info("    -print_config          print the stereo settings in use\n");
-}
 
 /// The prior's depth and, for guided matching, its real returns: the points whose `distance`
 /// to the nearest real return is 0 (msf_interpolate writes that field).
@@ -84,42 +62,44 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_stereo", 4, printHelp, [&] {
-    const std::vector<std::string> value_options{"-calib", "-image_size", "-color", "-disparity_png", "-prior", "-config",
-                                                 "-num_disparities", "-block_size", "-mode"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-lr_check", "-print_config"});
-    const auto files = msf::tool::positionalArguments(argc, argv, value_options);
+  std::string calib_path, image_size_text, color_path, disparity_path, prior_path;
+  bool print_config = false;
+  msf::SgbmConfig config;
+  msf::tool::CommandLine cli(
+      "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
+      "Matches a rectified pair (KITTI image_0, image_1) with 3-way SGBM (stereo.engine: the native AVX2 kernel or "
+      "OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
+      "is no match).");
+  cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
+      .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
+      .value("-color", "PATH", color_path,
+             "colour camera image (image_2), projected for each point's colour; without it the colour is the left "
+             "image's grey")
+      .value("-disparity_png", "PATH", disparity_path, "also write the disparity as a KITTI 16-bit PNG (pixels x 256)")
+      .value("-prior", "PATH", prior_path,
+             "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
+             "real returns (distance 0) guide it")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "stereo", config); },
+             "YAML config, section stereo (every SGBM parameter); the options below override it")
+      .value("-num_disparities", "N", config.num_disparities_px,
+             "search range without a prior (multiple of 16; default {default})")
+      .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
+      .value("-mode", "NAME", config.mode, "sgbm_3way (default) | sgbm | hh | hh4")
+      .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
+      .flag("-print_config", print_config, "print the stereo settings in use");
+  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
     if (files.size() != 3)
       throw msf::InvalidInputError("expected <left.png> <right.png> <out.pcd> (see -h)");
     const std::string ext = msf::fileExtension(files[2]);
     if (ext != ".pcd" && ext != ".ply")
       throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
-    std::string calib_path, color_path, disparity_path, prior_path, config_path, mode;
-    msf::tool::parseArgument(argc, argv, "-calib", calib_path);
-    std::string image_size_text;
-    msf::tool::parseArgument(argc, argv, "-image_size", image_size_text);
     const cv::Size image_size = msf::parseImageSize(image_size_text);
-    msf::tool::parseArgument(argc, argv, "-color", color_path);
-    msf::tool::parseArgument(argc, argv, "-disparity_png", disparity_path);
-    msf::tool::parseArgument(argc, argv, "-prior", prior_path);
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-mode", mode);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
     if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
-
-    msf::SgbmConfig config;
-    if (!config_path.empty())
-      msf::readConfigSection(config_path, "stereo", config);
-    msf::tool::parseArgument(argc, argv, "-num_disparities", config.num_disparities_px);
-    msf::tool::parseArgument(argc, argv, "-block_size", config.block_size_px);
-    if (!mode.empty())
-      config.mode = mode;
-    if (find_switch(argc, argv, "-lr_check"))
-      config.left_right_check = true;
     config.validate();
-    if (find_switch(argc, argv, "-print_config"))
+    if (print_config)
       config.print(std::cout);
 
     TicToc tt;

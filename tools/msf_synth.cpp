@@ -5,7 +5,6 @@
 #include <msf/common/tool.h>
 #include <msf/synthetic/synthetic_generator.h>
 
-#include <pcl/console/parse.h>
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
@@ -18,62 +17,49 @@ using namespace pcl::console;
 
 namespace {
 
-void printHelp(const char* name) {
-  print_error("Syntax is: %s -o DIR [options]\n", name);
-  print_info("  Renders a synthetic street with KITTI's sensor rig and writes it in KITTI's odometry\n"
-             "  layout with exact ground truth:\n"
-             "    DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
-             "    DIR/poses/00.txt\n"
-             "    DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
-             "      synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
-             "  Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.\n");
-  print_info("  where options are:\n");
-  print_info("    -o DIR         output folder (absent, empty, or an earlier synthetic dataset, replaced)\n");
-  print_info("    -frames N      number of frames (default 10)\n");
-  print_info("    -seed S        random seed, a whole number >= 0 (default 1)\n");
-  print_info("    -scene NAME    scene to render: street (default)\n");
-  print_info("    -loop          drive out, turn round across the road and drive back in the other lane to\n"
-             "                   the start (synthetic.loop): the way back revisits the street\n");
-  print_info("    -config FILE   YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)\n");
-  print_info("    -print_config  print the configuration in effect\n");
-}
-
-/// The value of integer option `option` (strictly parsed), within lo..hi; `fallback` when absent.
-int intOption(int argc, char** argv, const char* option, int fallback, int lo, int hi) {
-  int value = fallback;
-  if (msf::tool::parseArgument(argc, argv, option, value) >= 0 && (value < lo || value > hi))
+/// Throws when `option` was given with a value outside lo..hi.
+void checkRange(const msf::tool::CommandLine& cli, const char* option, int value, int lo, int hi) {
+  if (cli.given(option) && (value < lo || value > hi))
     throw msf::InvalidInputError(std::string("option ") + option + ": " + std::to_string(value) +
                                  " is out of range " + std::to_string(lo) + ".." + std::to_string(hi));
-  return value;
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
-  return msf::tool::runWithHelp(argc, argv, "msf_synth", 2, printHelp, [&] {
-    const std::vector<std::string> value_options{"-o", "-frames", "-seed", "-scene", "-config"};
-    msf::tool::checkOptions(argc, argv, value_options, {"-print_config", "-loop"});
-    const auto positional = msf::tool::positionalArguments(argc, argv, value_options);
+  msf::synthetic::SyntheticConfig config;
+  std::string output;
+  bool print_config = false;
+  msf::tool::CommandLine cli(
+      "msf_synth", "-o DIR [options]",
+      "Renders a synthetic street with KITTI's sensor rig and writes it in KITTI's odometry layout with exact ground "
+      "truth:\n"
+      "  DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
+      "  DIR/poses/00.txt\n"
+      "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
+      "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
+      "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.");
+  cli.value("-o", "DIR", output, "output folder (absent, empty, or an earlier synthetic dataset, replaced)")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
+             "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
+      .value("-frames", "N", config.frames, "number of frames (default {default})")
+      .value("-seed", "S", config.seed, "random seed, a whole number >= 0 (default {default})")
+      .value("-scene", "NAME", config.scene, "scene to render: street (default)")
+      .flag("-loop", config.loop,
+            "drive out, turn round across the road and drive back in the other lane to the start (synthetic.loop): "
+            "the way back revisits the street")
+      .flag("-print_config", print_config, "print the configuration in effect");
+  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (!positional.empty())
       throw msf::InvalidInputError("unexpected argument '" + positional.front() + "' (the output folder goes after -o)");
-
-    msf::synthetic::SyntheticConfig config;
-    std::string config_path, output;
-    msf::tool::parseArgument(argc, argv, "-config", config_path);
-    msf::tool::parseArgument(argc, argv, "-o", output);
-    if (!config_path.empty())
-      msf::readConfigSection(config_path, "synthetic", config);
-    config.frames = intOption(argc, argv, "-frames", config.frames, 1, 999999);
-    config.seed = intOption(argc, argv, "-seed", config.seed, 0, 2147483647);
-    msf::tool::parseArgument(argc, argv, "-scene", config.scene);
-    if (find_switch(argc, argv, "-loop"))
-      config.loop = true;
+    checkRange(cli, "-frames", config.frames, 1, 999999);
+    checkRange(cli, "-seed", config.seed, 0, 2147483647);
     if (config.scene != "street")
       throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
     config.validate();
     if (output.empty())
       throw msf::InvalidInputError("no output folder: give -o DIR");
-    if (find_switch(argc, argv, "-print_config"))
+    if (print_config)
       config.print(std::cout);
 
     TicToc tt;

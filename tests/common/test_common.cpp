@@ -189,54 +189,121 @@ TEST(Statistics, MedianAndPercentile) {
   EXPECT_DOUBLE_EQ(msf::median({}), 0.0);
 }
 
+/// argv of `args` for the parser (the strings outlive the call).
+struct Argv {
+  explicit Argv(std::vector<std::string> a) : args(std::move(a)) {
+    for (auto& s : args)
+      pointers.push_back(s.data());
+  }
+  int argc() const { return static_cast<int>(pointers.size()); }
+  char** argv() { return pointers.data(); }
+  std::vector<std::string> args;
+  std::vector<char*> pointers;
+};
+
 TEST(Tool, UnknownOptionIsRejectedAndValuesAreNotOptions) {
-  const char* args[] = {"tool", "a.pcd", "-voxel", "-0.5", "-ascii", "b.pcd"};
-  auto argv = const_cast<char**>(args);
-  EXPECT_NO_THROW(msf::tool::checkOptions(6, argv, {"-voxel"}, {"-ascii"}));
-  const auto positional = msf::tool::positionalArguments(6, argv, {"-voxel"});
+  double voxel = 0;
+  bool ascii = false;
+  msf::tool::CommandLine cli("msf_test", "<a> <b>", "Test.");
+  cli.value("-voxel", "V", voxel, "voxel").flag("-ascii", ascii, "ascii");
+  Argv args({"tool", "a.pcd", "-voxel", "-0.5", "-ascii", "b.pcd"});
+  const auto positional = cli.parse(args.argc(), args.argv());
   ASSERT_EQ(positional.size(), 2u);
   EXPECT_EQ(positional[1], "b.pcd");
-  EXPECT_THROW(msf::tool::checkOptions(6, argv, {"-voxel"}, {}), msf::InvalidInputError);
-  const char* missing[] = {"tool", "-voxel"};
-  EXPECT_THROW(msf::tool::checkOptions(2, const_cast<char**>(missing), {"-voxel"}, {}), msf::InvalidInputError);
-}
-
-TEST(Tool, ParseArgumentReadsNumbersStrictly) {
-  const char* args[] = {"tool", "-n", "42", "-x", "2.5e1", "-name", "cubic", "-bad", "2x", "-empty", ""};
-  auto argv = const_cast<char**>(args);
-  const int argc = 11;
-  int n = 0;
-  double x = 0;
-  float xf = 0;
-  std::string name;
-  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-n", n), 1);
-  EXPECT_EQ(n, 42);
-  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-x", x), 3);
-  EXPECT_DOUBLE_EQ(x, 25.0);
-  msf::tool::parseArgument(argc, argv, "-x", xf);
-  EXPECT_FLOAT_EQ(xf, 25.f);
-  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-name", name), 5);
-  EXPECT_EQ(name, "cubic");
-  int untouched = 7;
-  EXPECT_EQ(msf::tool::parseArgument(argc, argv, "-absent", untouched), -1);
-  EXPECT_EQ(untouched, 7);
-  const auto expectRejected = [&](const char* option, auto value, const std::string& message) {
+  EXPECT_DOUBLE_EQ(voxel, -0.5);
+  EXPECT_TRUE(ascii);
+  EXPECT_TRUE(cli.given("-voxel"));
+  EXPECT_EQ(cli.flags(), std::vector<std::string>{"-ascii"});
+  const auto rejected = [&](std::vector<std::string> a, const std::string& message) {
+    Argv bad(std::move(a));
     try {
-      msf::tool::parseArgument(argc, argv, option, value);
-      FAIL() << option;
+      cli.parse(bad.argc(), bad.argv());
+      ADD_FAILURE() << message;
     } catch (const msf::InvalidInputError& e) {
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
     }
   };
-  expectRejected("-bad", 0.0, "-bad needs a number, not '2x'");
-  expectRejected("-empty", 0.f, "-empty needs a number, not ''");
-  expectRejected("-x", 0, "-x needs a whole number, not '2.5e1'");
-  expectRejected("-name", 0, "-name needs a whole number, not 'cubic'");
-  const char* big[] = {"tool", "-n", "99999999999", "-inf", "inf"};
-  int b = 0;
-  double d = 0;
-  EXPECT_THROW(msf::tool::parseArgument(5, const_cast<char**>(big), "-n", b), msf::InvalidInputError);
-  EXPECT_THROW(msf::tool::parseArgument(5, const_cast<char**>(big), "-inf", d), msf::InvalidInputError);
+  rejected({"tool", "a.pcd", "-voxl", "3"}, "unknown option '-voxl' (see -h)");
+  rejected({"tool", "-voxel"}, "option '-voxel' needs a value");
+}
+
+TEST(Tool, NumbersAreReadStrictly) {
+  int n = 0, untouched = 7;
+  double x = 0;
+  float xf = 0;
+  std::string name;
+  msf::tool::CommandLine cli("msf_test", "", "Test.");
+  cli.value("-n", "N", n, "").value("-x", "X", x, "").value("-xf", "X", xf, "").value("-name", "S", name, "");
+  cli.value("-absent", "N", untouched, "");
+  Argv args({"tool", "-n", "42", "-x", "2.5e1", "-xf", "2.5e1", "-name", "cubic"});
+  cli.parse(args.argc(), args.argv());
+  EXPECT_EQ(n, 42);
+  EXPECT_DOUBLE_EQ(x, 25.0);
+  EXPECT_FLOAT_EQ(xf, 25.f);
+  EXPECT_EQ(name, "cubic");
+  EXPECT_EQ(untouched, 7);
+  EXPECT_FALSE(cli.given("-absent"));
+  const auto rejected = [&](const std::string& option, const std::string& value, const std::string& message) {
+    Argv bad({"tool", option, value});
+    try {
+      cli.parse(bad.argc(), bad.argv());
+      ADD_FAILURE() << option;
+    } catch (const msf::InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  rejected("-x", "2x", "-x needs a number, not '2x'");
+  rejected("-x", "", "-x needs a number, not ''");
+  rejected("-x", "inf", "-x needs a number, not 'inf'");
+  rejected("-n", "2.5e1", "-n needs a whole number, not '2.5e1'");
+  rejected("-n", "cubic", "-n needs a whole number, not 'cubic'");
+  rejected("-n", "99999999999", "-n needs a whole number");
+}
+
+TEST(Tool, OptionsApplyInTheOrderDeclaredAndTheFirstOfARepeatedOneStays) {
+  // A -config declared first is overridden by the options declared after it, wherever given.
+  int level = 1;
+  std::string order;
+  msf::tool::CommandLine cli("msf_test", "", "Test.");
+  cli.value("-config", "FILE",
+            [&](const std::string& v) {
+              level = 10;
+              order += "config " + v + ";";
+            },
+            "")
+      .value("-level", "N", level, "");
+  Argv args({"tool", "-level", "3", "-config", "c.yaml", "-level", "4"});
+  cli.parse(args.argc(), args.argv());
+  EXPECT_EQ(level, 3);
+  EXPECT_EQ(order, "config c.yaml;");
+}
+
+TEST(Tool, TheHelpListsEveryOptionWithItsDefault) {
+  int frames = 10;
+  float voxel = 0.1f;
+  bool loop = false;
+  std::string long_help;
+  for (int i = 0; i < 40; ++i)
+    long_help += "word ";
+  msf::tool::CommandLine cli("msf_test", "-o DIR [options]\n<in> [options]", "What it does.");
+  cli.value("-frames", "N", frames, "number of frames (default {default})")
+      .value("-voxel", "M", voxel, "voxel size in metres (default {default})")
+      .flag("-loop", loop, long_help)
+      .value("-a_very_long_option_name", "VALUE", frames, "help")
+      .note("A note.");
+  testing::internal::CaptureStdout();
+  testing::internal::CaptureStderr();
+  cli.printHelp("msf_test");
+  const std::string out = testing::internal::GetCapturedStdout(), err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("Syntax is: msf_test -o DIR [options]\n       or: msf_test <in> [options]\n"), std::string::npos)
+      << err;
+  EXPECT_NE(out.find("  What it does.\n  where options are:\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("    -frames N  number of frames (default 10)\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("    -voxel M   voxel size in metres (default 0.1)\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("    -a_very_long_option_name VALUE\n               help\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  A note.\n"), std::string::npos) << out;
+  for (std::size_t from = 0, to; (to = out.find('\n', from)) != std::string::npos; from = to + 1)
+    EXPECT_LE(to - from, 100u) << out.substr(from, to - from); // the long help is wrapped
 }
 
 TEST(Tool, RunTurnsExceptionsIntoExitCodeOne) {
@@ -244,26 +311,26 @@ TEST(Tool, RunTurnsExceptionsIntoExitCodeOne) {
   EXPECT_EQ(msf::tool::run("msf_test", []() -> int { throw msf::IOError("boom"); }), 1);
 }
 
-int help_calls = 0;
-void countHelp(const char*) { ++help_calls; }
-
-TEST(Tool, RunWithHelpShowsTheHelpOrRunsTheBody) {
-  const char* help[] = {"tool", "a.pcd", "-h"};
-  const char* few[] = {"tool"};
-  const char* enough[] = {"tool", "a.pcd", "b.pcd"};
+TEST(Tool, RunShowsTheHelpOrRunsTheBody) {
+  msf::tool::CommandLine cli("msf_test", "<a> <b>", "Test.");
   int ran = 0;
-  const auto body = [&] { return ++ran, 7; };
-  help_calls = 0;
-  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(help), "msf_test", 5, countHelp, body), 0);
-  EXPECT_EQ(msf::tool::runWithHelp(1, const_cast<char**>(few), "msf_test", 3, countHelp, body), 1);
-  EXPECT_EQ(help_calls, 2);
+  std::size_t positional = 0;
+  const auto body = [&](const msf::tool::Arguments& files) { return positional = files.size(), ++ran, 7; };
+  Argv help({"tool", "a.pcd", "-h"}), few({"tool"}), enough({"tool", "a.pcd", "b.pcd"});
+  testing::internal::CaptureStdout();
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(cli.run(help.argc(), help.argv(), 4, body), 0);
+  EXPECT_EQ(cli.run(few.argc(), few.argv(), 2, body), 1);
+  const std::string shown = testing::internal::GetCapturedStderr();
+  testing::internal::GetCapturedStdout();
+  EXPECT_NE(shown.find("Syntax is: tool <a> <b>"), std::string::npos) << shown;
   EXPECT_EQ(ran, 0);
-  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(enough), "msf_test", 3, countHelp, body), 7);
+  EXPECT_EQ(cli.run(enough.argc(), enough.argv(), 2, body), 7);
   EXPECT_EQ(ran, 1);
-  EXPECT_EQ(msf::tool::runWithHelp(3, const_cast<char**>(enough), "msf_test", 3, countHelp,
-                                   []() -> int { throw msf::IOError("boom"); }),
+  EXPECT_EQ(positional, 2u);
+  EXPECT_EQ(cli.run(enough.argc(), enough.argv(), 2,
+                    [](const msf::tool::Arguments&) -> int { throw msf::IOError("boom"); }),
             1);
-  EXPECT_EQ(help_calls, 2);
 }
 
 } // namespace

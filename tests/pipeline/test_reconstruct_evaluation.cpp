@@ -1,5 +1,6 @@
 // msf_reconstruct's evaluation protocol 4: -holdout on real KITTI frames, the synthetic
-// ground truth with moving objects marked, -compare_sources, and clear errors that leave no output.
+// ground truth with moving objects marked, -compare_sources, -compare_paper, and clear errors
+// that leave no output.
 #include <msf/io/image_io.h>
 #include <msf/io/velodyne_io.h>
 #include <msf/synthetic/ground_truth.h>
@@ -132,6 +133,55 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_LT(ghosts, 0.5);
   EXPECT_GT(jsonNumber(mesh, "vertices", "ghosts"), 1000.0);
   EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
+}
+
+TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {
+  // -compare_paper runs config/paper.yaml on the same frames at the same poses into a map of its
+  // own: its per-frame depth ("paper") and its mesh ("mesh_paper") are scored as ours are.
+  msf::test::TempDir out;
+  const auto r =
+      msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:1 -panels 0 -compare_paper -o " + out.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(msf::test::fileExists(out.file("mesh_paper.ply")));
+  const std::string json = readFile(out.file("summary.json"));
+
+  // The per-frame depth against the synthetic ground truth: the paper's row beside ours.
+  const std::size_t depth_at = json.find("\"depth\": {"), depth_end = json.find("\"mesh_accuracy\"");
+  ASSERT_NE(depth_at, std::string::npos) << json;
+  const std::string depth = json.substr(depth_at, depth_end - depth_at);
+  ASSERT_NE(depth.find("\"paper\": {"), std::string::npos) << depth;
+  const double pixels = jsonNumber(depth, "gt_pixels", "fused");
+  EXPECT_GT(pixels, 10000);
+  EXPECT_EQ(jsonNumber(depth, "gt_pixels", "paper"), pixels); // the same pixels
+  const double paper_coverage = jsonNumber(depth, "coverage", "paper");
+  const double paper_d1 = jsonNumber(depth, "d1_all", "paper"), ours_d1 = jsonNumber(depth, "d1_all", "fused");
+  EXPECT_GT(paper_coverage, 0.8); // steps 1-4 fill most of the image, as ours (0.916 and 0.920 when written)
+  EXPECT_LE(paper_coverage, 1.0);
+  EXPECT_GT(paper_d1, 0.0);
+  EXPECT_LT(paper_d1, 0.5);
+  EXPECT_GT(paper_d1, ours_d1); // what our additions add (docs/paper.md; 19.5 against 11.8 % when written)
+  const double paper_mae = jsonNumber(depth, "mae_m", "paper");
+  EXPECT_GT(paper_mae, 0.0);
+  EXPECT_LT(paper_mae, 10.0);
+
+  // Protocol 4: the paper's map and depth, rendered and scored at the same pixels as ours.
+  const double gt_pixels = jsonNumber(json, "gt_pixels", "reconstruction_evaluation");
+  for (const char* source : {"mesh", "fused", "mesh_paper", "paper"}) {
+    const std::string row = rowOf(json, source);
+    ASSERT_FALSE(row.empty()) << source << " row missing:\n" << json;
+    EXPECT_EQ(jsonNumber(row, "gt_pixels", "all") + jsonNumber(row, "gt_pixels", "moving_all"), gt_pixels) << source;
+    const double coverage = jsonNumber(row, "coverage", "within_range"), d1 = jsonNumber(row, "d1_all", "within_range");
+    EXPECT_GT(coverage, 0.05) << source;
+    EXPECT_LE(coverage, 1.0) << source;
+    EXPECT_GE(d1, 0.0) << source;
+    EXPECT_LE(d1, 1.0) << source;
+    EXPECT_GE(jsonNumber(row, "mae_m", "within_range"), 0.0) << source;
+  }
+  EXPECT_GT(jsonNumber(rowOf(json, "mesh_paper"), "completeness", "accuracy"), 0.0); // scored against gt/scene.ply
+  const std::string report = readFile(out.file("report.md"));
+  for (const char* row : {"| paper |", "| mesh_paper |", "the paper as published (config/paper.yaml"})
+    EXPECT_NE(report.find(row), std::string::npos) << row << " not in report.md:\n" << report;
+  EXPECT_NE(r.out.find("mesh_paper"), std::string::npos) << r.out; // the console's table
 }
 
 TEST(ReconstructEvaluation, BadInputIsAClearErrorAndLeavesNoOutput) {

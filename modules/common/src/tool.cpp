@@ -7,11 +7,13 @@
 #include <cerrno>
 #include <climits>
 #include <cmath>
-#include <cstdlib>
-#include <type_traits>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <map>
+#include <sstream>
+#include <type_traits>
 
 namespace msf::tool {
 
@@ -36,106 +38,214 @@ bool wantsHelp(int argc, char** argv) {
   return false;
 }
 
-int runWithHelp(int argc, char** argv, const char* name, int min_argc, void (*print_help)(const char*),
-                const std::function<int()>& body) {
-  const bool help = wantsHelp(argc, argv);
-  if (help || argc < min_argc) {
-    print_help(argv[0]);
-    return help ? 0 : 1;
-  }
-  return run(name, body);
-}
-
 namespace {
-/// Index of the value after the first `option`, or -1.
-int valueIndex(int argc, char** argv, const char* option) {
-  for (int i = 1; i + 1 < argc; ++i)
-    if (!std::strcmp(argv[i], option))
-      return i + 1;
-  return -1;
-}
 
-[[noreturn]] void notANumber(const char* option, const char* text, const char* kind) {
-  throw InvalidInputError(std::string(option) + " needs " + kind + ", not '" + text + "'");
+[[noreturn]] void notANumber(const std::string& option, const std::string& text, const char* kind) {
+  throw InvalidInputError(option + " needs " + kind + ", not '" + text + "'");
 }
 
 template <typename T>
-int parseNumber(int argc, char** argv, const char* option, T& value) {
-  const int i = valueIndex(argc, argv, option);
-  if (i < 0)
-    return -1;
-  const char* text = argv[i];
+T parseNumber(const std::string& option, const std::string& text) {
+  const char* begin = text.c_str();
   char* end = nullptr;
   errno = 0;
   if constexpr (std::is_same_v<T, int>) {
-    const long v = std::strtol(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX)
+    const long v = std::strtol(begin, &end, 10);
+    if (end == begin || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX)
       notANumber(option, text, "a whole number");
-    value = static_cast<int>(v);
+    return static_cast<int>(v);
   } else {
-    const double v = std::strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+    const double v = std::strtod(begin, &end);
+    if (end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(v))
       notANumber(option, text, "a number");
-    value = static_cast<T>(v);
+    return static_cast<T>(v);
   }
-  return i - 1;
-}
-} // namespace
-
-int parseArgument(int argc, char** argv, const char* option, std::string& value) {
-  const int i = valueIndex(argc, argv, option);
-  if (i < 0)
-    return -1;
-  value = argv[i];
-  return i - 1;
-}
-int parseArgument(int argc, char** argv, const char* option, int& value) {
-  return parseNumber(argc, argv, option, value);
-}
-int parseArgument(int argc, char** argv, const char* option, float& value) {
-  return parseNumber(argc, argv, option, value);
-}
-int parseArgument(int argc, char** argv, const char* option, double& value) {
-  return parseNumber(argc, argv, option, value);
 }
 
-namespace {
-bool contains(const std::vector<std::string>& list, const char* arg) {
-  return std::find(list.begin(), list.end(), std::string(arg)) != list.end();
+template <typename T>
+std::function<void(const std::string&)> numberInto(const std::string& option, T& target) {
+  return [option, &target](const std::string& text) { target = parseNumber<T>(option, text); };
 }
+
+template <typename T>
+std::string defaultText(const T& value) {
+  std::ostringstream s;
+  s << value; // 6 significant digits, as %g
+  return s.str();
+}
+
 bool isOption(const char* arg) {
   // "-5" or "-0.3" are values, not options.
   return arg[0] == '-' && arg[1] != '\0' && !(arg[1] >= '0' && arg[1] <= '9') && arg[1] != '.';
 }
-} // namespace
 
-void checkOptions(int argc, char** argv, const std::vector<std::string>& value_options,
-                  const std::vector<std::string>& switches) {
-  for (int i = 1; i < argc; ++i) {
-    if (!isOption(argv[i]))
-      continue;
-    if (contains(value_options, argv[i])) {
-      if (i + 1 >= argc)
-        throw InvalidInputError(std::string("option '") + argv[i] + "' needs a value");
-      ++i;
-    } else if (!contains(switches, argv[i])) {
-      throw InvalidInputError(std::string("unknown option '") + argv[i] + "' (see -h)");
-    }
-  }
-}
+constexpr std::size_t kWidth = 100; // columns of the help
+constexpr std::size_t kLabelWidth = 22; // longer "-option METAVAR" put their help on the next line
 
-std::vector<std::string> positionalArguments(int argc, char** argv,
-                                             const std::vector<std::string>& value_options) {
-  std::vector<std::string> out;
-  for (int i = 1; i < argc; ++i) {
-    if (isOption(argv[i])) {
-      if (contains(value_options, argv[i]))
-        ++i;
+/// `text` wrapped to kWidth columns, every line indented by `indent` spaces. A line break in
+/// it is kept; a line that fits is kept as written (a table keeps its columns), and a longer
+/// one continues under its first word, or under the text after its first run of two spaces
+/// (a table's second column).
+std::string wrap(const std::string& text, std::size_t indent) {
+  std::string out;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const std::size_t lead = std::min(line.find_first_not_of(' '), line.size());
+    if (lead == line.size()) {
+      out += "\n";
       continue;
     }
-    out.emplace_back(argv[i]);
+    std::string margin(indent + lead, ' ');
+    if (margin.size() + line.size() - lead <= kWidth) {
+      out += margin + line.substr(lead) + "\n";
+      continue;
+    }
+    std::size_t body = lead;
+    const std::size_t gap = line.find("  ", lead);
+    if (gap != std::string::npos && line.find_first_not_of(' ', gap) != std::string::npos)
+      body = line.find_first_not_of(' ', gap);
+    std::string current = line.substr(lead, body - lead); // the first column as written
+    bool has_word = false;
+    std::istringstream words(line.substr(body));
+    std::string word;
+    while (words >> word) {
+      if (has_word && margin.size() + current.size() + 1 + word.size() > kWidth) {
+        out += margin + current + "\n";
+        margin.assign(indent + body, ' ');
+        current.clear();
+        has_word = false;
+      }
+      current += (has_word ? " " : "") + word;
+      has_word = true;
+    }
+    out += margin + current + "\n";
   }
   return out;
+}
+
+} // namespace
+
+CommandLine::CommandLine(std::string name, std::string usage, std::string about)
+    : name_(std::move(name)), usage_(std::move(usage)), about_(std::move(about)) {}
+
+CommandLine& CommandLine::add(const std::string& option, const std::string& metavar,
+                              std::function<void(const std::string&)> apply, const std::string& help,
+                              const std::string& default_text) {
+  std::string text = help;
+  for (std::size_t at; (at = text.find("{default}")) != std::string::npos;)
+    text.replace(at, 9, default_text);
+  options_.push_back({option, metavar, text, std::move(apply)});
+  return *this;
+}
+
+CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, std::string& target,
+                                const std::string& help) {
+  return add(option, metavar, [&target](const std::string& text) { target = text; }, help, target);
+}
+CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, int& target,
+                                const std::string& help) {
+  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+}
+CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, float& target,
+                                const std::string& help) {
+  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+}
+CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, double& target,
+                                const std::string& help) {
+  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+}
+CommandLine& CommandLine::value(const std::string& option, const std::string& metavar,
+                                std::function<void(const std::string&)> apply, const std::string& help) {
+  return add(option, metavar, std::move(apply), help, "");
+}
+CommandLine& CommandLine::flag(const std::string& option, bool& target, const std::string& help) {
+  return add(option, "", [&target](const std::string&) { target = true; }, help, target ? "on" : "off");
+}
+
+CommandLine& CommandLine::note(const std::string& text) {
+  notes_.push_back(text);
+  return *this;
+}
+
+void CommandLine::printHelp(const char* program) const {
+  std::istringstream forms(usage_);
+  std::string form;
+  for (bool first = true; std::getline(forms, form); first = false)
+    pcl::console::print_error("%s %s %s\n", first ? "Syntax is:" : "       or:", program, form.c_str());
+  pcl::console::print_info("%s", wrap(about_, 2).c_str());
+  if (!options_.empty()) {
+    pcl::console::print_info("  where options are:\n");
+    std::size_t label_width = 0;
+    for (const Option& o : options_) {
+      const std::size_t label = o.name.size() + (o.metavar.empty() ? 0 : 1 + o.metavar.size());
+      if (label <= kLabelWidth)
+        label_width = std::max(label_width, label);
+    }
+    const std::size_t column = 4 + label_width + 2;
+    for (const Option& o : options_) {
+      std::string label = "    " + o.name + (o.metavar.empty() ? "" : " " + o.metavar);
+      std::string help = wrap(o.help, column);
+      if (label.size() + 2 <= column && help.size() > column)
+        help.replace(0, label.size(), label);
+      else
+        help = label + "\n" + help;
+      pcl::console::print_info("%s", help.c_str());
+    }
+  }
+  for (const std::string& note : notes_)
+    pcl::console::print_info("%s", wrap(note, 2).c_str());
+}
+
+Arguments CommandLine::parse(int argc, char** argv) {
+  Arguments positional;
+  std::map<std::string, std::string> values;
+  given_.clear();
+  for (int i = 1; i < argc; ++i) {
+    if (!isOption(argv[i])) {
+      positional.emplace_back(argv[i]);
+      continue;
+    }
+    const auto o = std::find_if(options_.begin(), options_.end(), [&](const Option& d) { return d.name == argv[i]; });
+    if (o == options_.end())
+      throw InvalidInputError(std::string("unknown option '") + argv[i] + "' (see -h)");
+    std::string text;
+    if (!o->metavar.empty()) {
+      if (i + 1 >= argc)
+        throw InvalidInputError(std::string("option '") + argv[i] + "' needs a value");
+      text = argv[++i];
+    }
+    values.emplace(o->name, text); // the first one stays
+  }
+  for (const Option& o : options_) {
+    const auto v = values.find(o.name);
+    if (v == values.end())
+      continue;
+    given_.push_back(o.name);
+    o.apply(v->second);
+  }
+  return positional;
+}
+
+bool CommandLine::given(const std::string& option) const {
+  return std::find(given_.begin(), given_.end(), option) != given_.end();
+}
+
+std::vector<std::string> CommandLine::flags() const {
+  std::vector<std::string> names;
+  for (const Option& o : options_)
+    if (o.metavar.empty())
+      names.push_back(o.name);
+  return names;
+}
+
+int CommandLine::run(int argc, char** argv, int min_arguments, const std::function<int(const Arguments&)>& body) {
+  const bool help = wantsHelp(argc, argv);
+  if (help || argc - 1 < min_arguments) {
+    printHelp(argv[0]);
+    return help ? 0 : 1;
+  }
+  return tool::run(name_.c_str(), [&] { return body(parse(argc, argv)); });
 }
 
 void printDone(double milliseconds, std::size_t points) {

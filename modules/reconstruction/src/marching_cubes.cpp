@@ -26,7 +26,7 @@ double msSince(Clock::time_point t0) {
 constexpr int kSide = TsdfBlock::kSide;
 constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +x, +y, +z neighbours
 
-// Bourke's corner numbering and edges (see marching_cubes_tables.cpp).
+// Bourke's corner numbering and edges, those of PCL's tables (see marching_cubes_tables.cpp).
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 

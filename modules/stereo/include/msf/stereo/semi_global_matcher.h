@@ -16,8 +16,8 @@ namespace msf {
 /// pre_filter_cap) plus a quarter of that of the raw images, summed over block_size^2;
 /// paths left-to-right, right-to-left and top-to-bottom with penalties p1, p2; winner with
 /// the uniqueness ratio, parabolic sub-pixel, OpenCV's pseudo left-right check
-/// (disp12_max_diff), a 3x3 median and the speckle filter (on row bands in parallel, the
-/// results of cv::medianBlur and cv::filterSpeckles: parallel_post_filter.h). Rows run in 4 strips on
+/// (disp12_max_diff), cv::medianBlur's 3x3 median and the speckle filter (on row bands in
+/// parallel, cv::filterSpeckles' result: parallel_post_filter.h). Rows run in 4 strips on
 /// cv::parallel_for_ (each strip warms its top-to-bottom path up on rows above it, as
 /// OpenCV does), so the result does not depend on the number of threads.
 ///
