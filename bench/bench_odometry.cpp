@@ -33,7 +33,7 @@ const Data& data() {
 void odometry(benchmark::State& state, const msf::LidarOdometry::Config& config) {
   const Data& d = data();
   std::unique_ptr<msf::LidarOdometry> odometry;
-  std::size_t i = 0, iterations = 0, source_points = 0;
+  std::size_t i = 0, iterations = 0, source_points = 0, searches = 0;
   for (auto _ : state) {
     if (i % d.scans.size() == 0) {
       state.PauseTiming();
@@ -43,9 +43,11 @@ void odometry(benchmark::State& state, const msf::LidarOdometry::Config& config)
     benchmark::DoNotOptimize(odometry->registerScan(d.scans[i++ % d.scans.size()]));
     iterations += static_cast<std::size_t>(odometry->lastStats().iterations);
     source_points += odometry->lastStats().source_points;
+    searches += odometry->lastStats().searches;
   }
   state.counters["icp_iterations"] = static_cast<double>(iterations) / static_cast<double>(i);
   state.counters["source_points"] = static_cast<double>(source_points) / static_cast<double>(i);
+  state.counters["searches"] = static_cast<double>(searches) / static_cast<double>(i);
 }
 
 /// The defaults: point-to-plane where the map is planar, scans deskewed as sweeps.
