@@ -49,7 +49,12 @@ void LocalMap::addScan(const PointList& points_world, const std::vector<PointMom
   if (!moments.empty() && moments.size() != points_world.size())
     throw InvalidInputError("local map: " + std::to_string(moments.size()) + " moments for " +
                             std::to_string(points_world.size()) + " points");
+  // The table's slot of the point kAhead places on is fetched while this one is added: a
+  // scan's voxels are all over a table larger than the cache.
+  constexpr std::size_t kAhead = 16;
   for (std::size_t i = 0; i < points_world.size(); ++i) {
+    if (i + kAhead < points_world.size())
+      table_.prefetch(voxelKey(voxelOf(points_world[i + kAhead], inv_voxel_size_)));
     const Eigen::Vector3d& p = points_world[i];
     const int v = voxelFor(p);
     Voxel& voxel = voxels_[static_cast<std::size_t>(v)];
