@@ -11,6 +11,7 @@
 #include <msf/io/velodyne_io.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/registration/sweep_deskew.h>
+#include <msf/registration/voxel_downsample.h>
 
 #include <benchmark/benchmark.h>
 
@@ -33,7 +34,7 @@ const Data& data() {
 void odometry(benchmark::State& state, const msf::LidarOdometry::Config& config) {
   const Data& d = data();
   std::unique_ptr<msf::LidarOdometry> odometry;
-  std::size_t i = 0, iterations = 0, source_points = 0;
+  std::size_t i = 0, iterations = 0, source_points = 0, searches = 0;
   for (auto _ : state) {
     if (i % d.scans.size() == 0) {
       state.PauseTiming();
@@ -43,9 +44,11 @@ void odometry(benchmark::State& state, const msf::LidarOdometry::Config& config)
     benchmark::DoNotOptimize(odometry->registerScan(d.scans[i++ % d.scans.size()]));
     iterations += static_cast<std::size_t>(odometry->lastStats().iterations);
     source_points += odometry->lastStats().source_points;
+    searches += odometry->lastStats().searches;
   }
   state.counters["icp_iterations"] = static_cast<double>(iterations) / static_cast<double>(i);
   state.counters["source_points"] = static_cast<double>(source_points) / static_cast<double>(i);
+  state.counters["searches"] = static_cast<double>(searches) / static_cast<double>(i);
 }
 
 /// The defaults: point-to-plane where the map is planar, scans deskewed as sweeps.
@@ -58,16 +61,35 @@ void BM_OdometryPointToPoint(benchmark::State& state) {
   odometry(state, config);
 }
 
+/// The first scan as the odometry's points, and a sweep's motion at KITTI's speed.
+struct SweepCase {
+  msf::PointList points;
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  SweepCase() {
+    for (const auto& p : data().scans.front())
+      points.emplace_back(p.x, p.y, p.z);
+    motion.translation() << 1.3, 0.0, 0.0;
+  }
+};
+
 /// The motion compensation alone, of a whole scan.
 void BM_Deskew(benchmark::State& state) {
-  const Data& d = data();
-  msf::PointList points;
-  for (const auto& p : d.scans.front())
-    points.emplace_back(p.x, p.y, p.z);
-  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  motion.translation() << 1.3, 0.0, 0.0;
+  const SweepCase c;
   for (auto _ : state)
-    benchmark::DoNotOptimize(msf::deskewSweep(points, motion));
+    benchmark::DoNotOptimize(msf::deskewSweep(c.points, c.motion));
+}
+
+/// A scan's returns in range, deskewed and downsampled to the map's half voxel with their
+/// moments (LidarOdometry's first step; VoxelDownsampler::downsampleScan).
+void BM_DownsampleScan(benchmark::State& state) {
+  const SweepCase c;
+  const msf::SweepDeskew deskew(c.motion);
+  msf::VoxelDownsampler downsampler;
+  msf::PointList kept;
+  std::vector<msf::PointMoments> moments;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(downsampler.downsampleScan(c.points, 3.0, 100.0, &deskew, 0.5, kept, &moments));
+  state.counters["kept"] = static_cast<double>(kept.size());
 }
 
 double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
@@ -85,5 +107,6 @@ double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(
 MSF_ODOMETRY_BENCH(BM_Odometry);
 MSF_ODOMETRY_BENCH(BM_OdometryPointToPoint);
 MSF_ODOMETRY_BENCH(BM_Deskew);
+MSF_ODOMETRY_BENCH(BM_DownsampleScan);
 
 BENCHMARK_MAIN();

@@ -72,23 +72,9 @@ LidarOdometry::LidarOdometry(const Config& config)
 
 Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, const std::string& name) {
   Stats stats;
-  PointList& in_range = in_range_;
-  in_range.clear();
-  const double min2 = config_.min_range_m * config_.min_range_m, max2 = config_.max_range_m * config_.max_range_m;
-  for (const Eigen::Vector3d& p : points_sensor) {
-    const double r2 = p.squaredNorm();
-    if (r2 >= min2 && r2 <= max2 && p.allFinite())
-      in_range.push_back(p);
-  }
-  stats.input_points = in_range.size();
   if (points_sensor.empty())
     throw InvalidInputError(name + ": no points (an empty scan, or one whose every return was NaN or infinite: "
                                    "the scan reader drops those)");
-  if (in_range.empty())
-    throw InvalidInputError(name + ": none of its " + std::to_string(points_sensor.size()) +
-                            " points is a finite return between odometry.min_range_m " +
-                            std::to_string(config_.min_range_m) + " and max_range_m " +
-                            std::to_string(config_.max_range_m) + " m");
   const double frame_voxel = 0.5 * config_.voxel_size_m, source_voxel = 1.5 * config_.voxel_size_m;
   // Constant velocity: the last motion again, in the sensor's frame; the scan deskewed by it.
   const Eigen::Isometry3d motion =
@@ -96,12 +82,17 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
   const Eigen::Isometry3d prediction = poses_.empty() ? Eigen::Isometry3d::Identity() : poses_.back() * motion;
   std::vector<PointMoments>& moments = moments_; // the returns each frame point stands for, for the map's planes
   PointList& frame = frame_;
-  if (sweeps_ && poses_.size() > 1) {
-    deskewSweep(in_range, motion, deskewed_);
-    downsampler_.downsample(deskewed_, frame_voxel, frame, &moments);
-  } else {
-    downsampler_.downsample(in_range, frame_voxel, frame, &moments);
-  }
+  // The returns in range, deskewed and downsampled in one pass over the scan (no copy of its
+  // 120000 returns at each step).
+  const SweepDeskew predicted(motion);
+  stats.input_points =
+      downsampler_.downsampleScan(points_sensor, config_.min_range_m, config_.max_range_m,
+                                  sweeps_ && poses_.size() > 1 ? &predicted : nullptr, frame_voxel, frame, &moments);
+  if (stats.input_points == 0)
+    throw InvalidInputError(name + ": none of its " + std::to_string(points_sensor.size()) +
+                            " points is a finite return between odometry.min_range_m " +
+                            std::to_string(config_.min_range_m) + " and max_range_m " +
+                            std::to_string(config_.max_range_m) + " m");
   const ScanConstraints constraints = analyzeConstraints(frame, 2.0 * config_.voxel_size_m);
   stats.constraint = constraints.weakest();
   if (constraints.unconstrained(config_.min_constraint) > 0)
@@ -113,8 +104,15 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
 
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   if (poses_.empty()) {
-    if (sweeps_)
-      first_returns_ = in_range; // deskewed once the second scan tells the motion
+    if (sweeps_) { // deskewed once the second scan tells the motion
+      const double min2 = config_.min_range_m * config_.min_range_m, max2 = config_.max_range_m * config_.max_range_m;
+      first_returns_.clear();
+      for (const Eigen::Vector3d& p : points_sensor) {
+        const double r2 = p.squaredNorm();
+        if (r2 >= min2 && r2 <= max2 && p.allFinite())
+          first_returns_.push_back(p);
+      }
+    }
   } else {
     const Eigen::Isometry3d& last = poses_.back();
     IcpSettings icp;
@@ -140,8 +138,9 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
     if (sweeps_ && poses_.size() == 1) {
       // The motion is known now: the second scan, and the first one in the map, deskewed by it.
       const Eigen::Isometry3d estimated = last.inverse() * result.T_world_sensor;
-      deskewSweep(in_range, estimated, deskewed_);
-      downsampler_.downsample(deskewed_, frame_voxel, frame, &moments);
+      const SweepDeskew deskew(estimated);
+      downsampler_.downsampleScan(points_sensor, config_.min_range_m, config_.max_range_m, &deskew, frame_voxel, frame,
+                                  &moments);
       std::vector<PointMoments> first_moments;
       const PointList first = voxelDownsample(deskewSweep(first_returns_, estimated), frame_voxel, &first_moments);
       LocalMap first_map(config_.voxel_size_m, config_.max_points_per_voxel);
@@ -155,6 +154,8 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
     threshold_.update(prediction.inverse() * pose);
     stats.source_points = source.size();
     stats.iterations = result.iterations;
+    stats.searches = neighbors_.searches();
+    stats.searches = neighbors_.searches();
     stats.correspondences = result.correspondences;
     stats.threshold_m = icp.max_correspondence_m;
   }

@@ -36,6 +36,8 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
   NearestCache own;
   NearestCache& cache = neighbors ? *neighbors : own;
   cache.reset(map, settings.max_correspondence_m, points_sensor.size());
+  const std::size_t n = points_sensor.size();
+  PointList world(n);  // the points in the world at the iteration's pose
   for (result.iterations = 1; result.iterations <= settings.max_iterations; ++result.iterations) {
     // Normal equations for a left update T <- exp(delta) T. A point w = T p moves by
     // delta_t + delta_r x w: the point residual's Jacobian is [I, -[w]x], the plane
@@ -46,8 +48,15 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     Matrix6d H_plane = Matrix6d::Zero();
     Vector6d g_plane = Vector6d::Zero();
     std::size_t pairs = 0, planes = 0;
-    for (std::size_t i = 0; i < points_sensor.size(); ++i) {
-      const Eigen::Vector3d w = result.T_world_sensor * points_sensor[i];
+    for (std::size_t i = 0; i < n; ++i)
+      world[i] = result.T_world_sensor * points_sensor[i];
+    // The table's slots that the search of the point kAhead places on will read are fetched
+    // while this one is searched.
+    constexpr std::size_t kAhead = 12;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i + kAhead < n)
+        cache.prefetch(i + kAhead, world[i + kAhead]);
+      const Eigen::Vector3d& w = world[i];
       if (!cache.nearest(i, w, neighbor))
         continue;
       ++pairs;

@@ -78,6 +78,7 @@ public:
     std::size_t source_points = 0;  ///< the scan registered, at 1.5 voxels
     std::size_t map_points = 0;     ///< the local map after the scan
     int iterations = 0;
+    std::size_t searches = 0;       ///< searches of the map (NearestCache: the other queries reused an answer)
     std::size_t correspondences = 0;
     double threshold_m = 0;         ///< correspondence distance used
     double constraint = 0;          ///< ScanConstraints::weakest of the scan
@@ -117,7 +118,7 @@ private:
   Stats stats_;
   // Buffers kept from scan to scan: a scan's 120000 returns allocated anew each time cost
   // page faults (see VoxelDownsampler).
-  PointList scan_, in_range_, deskewed_, frame_, source_, frame_world_;
+  PointList scan_, frame_, source_, frame_world_;
   std::vector<PointMoments> moments_;
   VoxelDownsampler downsampler_;
   NearestCache neighbors_;

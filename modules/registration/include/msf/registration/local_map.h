@@ -52,6 +52,11 @@ public:
   /// near), so that a caller knows how far p may move before the answer could change
   /// (NearestCache); the search then prunes with the second-nearest, not the nearest.
   bool nearest(const Eigen::Vector3d& p, double max_distance, Neighbor& neighbor, double* clearance2 = nullptr) const;
+  /// Asks the processor to fetch what nearest(p) will look up first (the table's slots of the
+  /// 8 voxels nearest to p), for a search a few queries later: the map is larger than the
+  /// cache, and a search that waits for memory voxel after voxel is the registration's
+  /// largest cost.
+  void prefetch(const Eigen::Vector3d& p) const;
 
   std::size_t size() const { return points_; }
   std::size_t voxelCount() const { return voxels_.size(); }
@@ -61,18 +66,17 @@ public:
   PointList points() const;
 
 private:
-  // What a search reads, apart from what only adding a scan reads, so that a search touches
-  // one cache line per voxel.
+  // What a search reads of the voxels it looks at is their number of points (counts_, a few
+  // tens of kilobytes that stay in the cache) and their points; a Voxel, only for the answer's.
   struct Voxel {
     Eigen::Vector3i index = Eigen::Vector3i::Zero();
-    int count = 0;  // points
+    bool fitted = false;  // the plane is that of the voxel's returns (none added since it was fitted)
     bool planar = false;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
   };
   // A voxel's returns, about its low corner (small numbers far from the origin).
   struct Moments {
     PointMoments returns;
-    bool changed = false;  // returns added since the plane was fitted
   };
   const Eigen::Vector3d* voxelPoints(int v) const { return &pool_[static_cast<std::size_t>(v) * max_points_]; }
   int voxelFor(const Eigen::Vector3d& p);  // its index, created when absent
@@ -81,10 +85,15 @@ private:
 
   double voxel_size_, inv_voxel_size_, min_spacing2_;
   int max_points_;
-  std::vector<Voxel> voxels_;
+  // Mutable for the planes only: a voxel's plane is fitted when a search first answers with
+  // one of its points (a scan changes thousands of voxels' returns, and a registration asks
+  // for the planes of a few hundred), so nearest() is not to be called from two threads at once.
+  mutable std::vector<Voxel> voxels_;
+  std::vector<int> counts_;  // points of each voxel, in voxels_' order
   std::vector<Moments> moments_;  // in voxels_' order
   PointList pool_;  // max_points_ slots per voxel, in voxels_' order
   VoxelTable table_;
+  VoxelBits occupied_;  // the voxels of table_, for searches to skip empty space
   std::size_t points_ = 0;
 };
 

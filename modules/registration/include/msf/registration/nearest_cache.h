@@ -28,6 +28,14 @@ public:
   /// LocalMap::nearest(p, max_distance, neighbor) for query `query` now at `p`.
   bool nearest(std::size_t query, const Eigen::Vector3d& p, LocalMap::Neighbor& neighbor);
 
+  /// For a call nearest(query, p, ...) a few queries later: LocalMap::prefetch(p) when that
+  /// call will search the map.
+  void prefetch(std::size_t query, const Eigen::Vector3d& p) const {
+    const Entry& e = entries_[query];
+    if (!((p - e.searched_at).squaredNorm() < e.reach2))
+      map_->prefetch(p);
+  }
+
   /// Calls that searched the map (the others reused an answer).
   std::size_t searches() const { return searches_; }
 

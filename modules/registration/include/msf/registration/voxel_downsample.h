@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/registration/point_list.h>
+#include <msf/registration/sweep_deskew.h>
 #include <msf/registration/voxel_table.h>
 
 #include <Eigen/Core>
@@ -35,6 +36,12 @@ class VoxelDownsampler {
 public:
   void downsample(const PointList& points, double voxel_size, PointList& kept,
                   std::vector<PointMoments>* moments = nullptr);
+  /// downsample of a raw scan in one pass, without a copy of it: only the finite returns
+  /// whose distance from the sensor is in [min_range, max_range], each deskewed by `deskew`
+  /// when given (the points and moments of deskewSweep of the returns in range, then
+  /// downsample). Returns the number of returns in range.
+  std::size_t downsampleScan(const PointList& scan, double min_range, double max_range, const SweepDeskew* deskew,
+                             double voxel_size, PointList& kept, std::vector<PointMoments>* moments = nullptr);
 
 private:
   VoxelTable seen_;
