@@ -415,7 +415,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         if (!(d >= min_d && d <= max_d))
           continue;
         const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
-        const float z0 = std::max(d - band_row[u].behind, min_d), z1 = d + band_row[u].front;
+        // The band along the ray: `front` nearer than the surface, `behind` beyond it.
+        const float z0 = std::max(d - band_row[u].front, min_d), z1 = d + band_row[u].behind;
         traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
           const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
           const std::uint64_t k =
