@@ -120,7 +120,7 @@ void printHelp(const char* name) {
   print_info("    -lambda L      regularization of eq. 7 (tsdf_integrator.lambda)\n");
   print_info("    -panels N      depth panels to draw, spread over the frames (default 3, at most 100)\n");
   print_info("    -stream R      keep only R metres around the camera in memory (streaming.active_radius_m;\n"
-             "                   at least the integrator's max_depth_m + truncation + 2 m + a tile): the rest\n"
+             "                   at least the integrator's reach + a tile, 73 m with the shipped configs): the rest\n"
              "                   is meshed into OUT/tiles/X_Y_Z.ply and its TSDF written to OUT/tsdf/ as it\n"
              "                   leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview;\n"
              "                   msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md\n");
@@ -675,8 +675,10 @@ int main(int argc, char** argv) {
     report.triangles_removed = pipeline.meshStats().triangles_removed;
     if (streaming) {
       const msf::StreamingMap::Stats& st = pipeline.streaming()->stats();
-      print_info("Streamed: %zu tiles written, %zu read back, %zu meshed again; %zu blocks freed; %.0f ms in all\n",
-                 st.tiles_written, st.tiles_reloaded, st.tiles_remeshed, st.blocks_freed, st.stream_ms);
+      print_info("Streamed: %zu tiles written, %zu read back (%zu on allocation), %zu meshed again; %zu blocks freed; "
+                 "%.0f ms in all\n",
+                 st.tiles_written, st.tiles_reloaded, st.tiles_reloaded_on_allocation, st.tiles_remeshed,
+                 st.blocks_freed, st.stream_ms);
     }
     const msf::TriangleMesh* paper_mesh = nullptr;
     if (paper) {
