@@ -435,7 +435,7 @@ int main(int argc, char** argv) {
                  ")")
       .value("-stream", "R", config.streaming.active_radius_m,
              "keep only R metres around the camera in memory (streaming.active_radius_m; at least the integrator's "
-             "max_depth_m + truncation + 2 m + a tile): the rest is meshed into OUT/tiles/X_Y_Z.ply and its TSDF "
+             "reach + a tile, 73 m with the shipped configs): the rest is meshed into OUT/tiles/X_Y_Z.ply and its TSDF "
              "written to OUT/tsdf/ as it leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview; "
              "msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md")
       .value("-max_memory", "MB", config.volume.max_memory_mb,
@@ -661,8 +661,10 @@ int main(int argc, char** argv) {
     report.triangles_removed = pipeline.meshStats().triangles_removed;
     if (streaming) {
       const msf::StreamingMap::Stats& st = pipeline.streaming()->stats();
-      print_info("Streamed: %zu tiles written, %zu read back, %zu meshed again; %zu blocks freed; %.0f ms in all\n",
-                 st.tiles_written, st.tiles_reloaded, st.tiles_remeshed, st.blocks_freed, st.stream_ms);
+      print_info("Streamed: %zu tiles written, %zu read back (%zu on allocation), %zu meshed again; %zu blocks freed; "
+                 "%.0f ms in all\n",
+                 st.tiles_written, st.tiles_reloaded, st.tiles_reloaded_on_allocation, st.tiles_remeshed,
+                 st.blocks_freed, st.stream_ms);
     }
     const msf::TriangleMesh* paper_mesh = nullptr;
     if (paper) {

@@ -270,7 +270,7 @@ TEST(Reconstruct, BadInputIsAClearError) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("tsdf_volume.voxel_size_m"), std::string::npos) << r.err;
   std::ofstream(dir.file("pieces.yaml")) << "%YAML:1.0\nmarching_cubes:\n  min_component_triangles: 50\n";
-  r = msf::test::runTool("msf_reconstruct", dir.path() + " -stream 60 -config " + dir.file("pieces.yaml"));
+  r = msf::test::runTool("msf_reconstruct", dir.path() + " -stream 80 -config " + dir.file("pieces.yaml"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("min_component_triangles is 50"), std::string::npos) << r.err;
   std::ofstream(dir.file("camera2.yaml")) << "%YAML:1.0\nprojection:\n  camera: 2\n";

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,14 +22,14 @@ namespace {
 
 // A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
 // either side every few metres, each a little different, so that no two tiles look alike.
-AnalyticScene corridor(double length) {
+AnalyticScene corridor(double length, double wall = 4.0) {
   AnalyticScene scene;
-  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5); // floor: y >= 1.5
-  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -4.0); // x >= 4
-  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -4.0);  // x <= -4
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5);  // floor: y >= 1.5
+  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -wall); // x >= wall
+  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -wall);  // x <= -wall
   for (int i = 0; i * 3.0 < length; ++i) {
     const double side = i % 2 ? 1.0 : -1.0;
-    scene.addBox(Eigen::Vector3d(side * (2.8 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
+    scene.addBox(Eigen::Vector3d(side * (wall - 1.2 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
                  Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
                  Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
   }
@@ -36,8 +37,18 @@ AnalyticScene corridor(double length) {
 }
 
 constexpr double kVoxel = 0.2, kTruncation = 0.5, kMaxDepth = 8.0;
-// Reach as the pipeline sets it: maximum depth, truncation and a margin.
-constexpr double kReach = kMaxDepth + kTruncation + 2.0;
+constexpr double kTile = 2 * TsdfBlock::kSide * kVoxel; // tile_blocks 2
+
+/// The integrator of the drives. A least plane scale of 0.25 and constant weights (sigma 5 cm)
+/// bound the band behind a surface to 0.8 m, so that the reach (13.6 m with the camera of 40 px
+/// focal length) leaves a 60 m corridor room to stream.
+TsdfIntegrator::Config integratorConfig() {
+  TsdfIntegrator::Config config;
+  config.max_depth_m = kMaxDepth;
+  config.plane.min_scale = 0.25f;
+  config.weighting = TsdfIntegrator::Weighting::Constant; // the frames have no weights: the same
+  return config;
+}
 
 /// Poses along the corridor at `step` metres: forward from z = 0 to `length`, then (when
 /// `back_to` >= 0) turned around and driven back to z = back_to.
@@ -58,15 +69,28 @@ struct DriveResult {
   StreamingMap::Stats stats;
 };
 
+/// The corridor and the camera that drives it.
+struct Corridor {
+  double wall = 4.0;   ///< the walls' distance from the axis
+  double focal = 40.0; ///< of the 64x48 camera
+  double reach = 0.0;  ///< > 0: what the streaming map is told instead of the integrator's reach
+  PinholeCamera camera() const { return test::centredCamera(64, 48, focal); }
+};
+
+/// The least radius of a streamed map of the drive, as the pipeline checks it: the
+/// integrator's reach and a tile.
+double minimumRadius(const Corridor& setup = Corridor()) {
+  TsdfVolume volume(kVoxel, kTruncation);
+  return TsdfIntegrator(volume, integratorConfig()).reach(setup.camera()) + kTile;
+}
+
 /// Integrates the drive; with `directory`, streamed with radius `radius` and the mesh read
 /// back from the union the map writes (as written: welded by the map), else meshed in memory.
 DriveResult integrateDrive(const std::vector<Eigen::Isometry3d>& poses, double length, const std::string& directory = "",
-                   double radius = 0.0) {
-  const AnalyticScene scene = corridor(length + 10);
+                   double radius = 0.0, const Corridor& setup = Corridor()) {
+  const AnalyticScene scene = corridor(length + 10, setup.wall);
   TsdfVolume volume(kVoxel, kTruncation);
-  TsdfIntegrator::Config config;
-  config.max_depth_m = kMaxDepth;
-  TsdfIntegrator integrator(volume, config);
+  TsdfIntegrator integrator(volume, integratorConfig());
   MarchingCubes::Config mesher;
   mesher.min_weight = 0.f;
   std::unique_ptr<StreamingMap> map;
@@ -74,11 +98,12 @@ DriveResult integrateDrive(const std::vector<Eigen::Isometry3d>& poses, double l
     StreamingMap::Config streaming;
     streaming.active_radius_m = radius;
     streaming.tile_blocks = 2;
-    map = std::make_unique<StreamingMap>(volume, streaming, mesher, kReach, directory);
+    const double reach = setup.reach > 0.0 ? setup.reach : integrator.reach(setup.camera());
+    map = std::make_unique<StreamingMap>(volume, streaming, mesher, reach, directory);
   }
   DriveResult run;
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    DepthFrame frame = test::renderFrame(scene, test::centredCamera(64, 48, 40.0), poses[i]);
+    DepthFrame frame = test::renderFrame(scene, setup.camera(), poses[i]);
     frame.depth.setTo(0.f, frame.depth > kMaxDepth - 0.5); // the far end of the corridor is not a surface
     frame.color = cv::Mat(frame.depth.size(), CV_8UC3, cv::Scalar(static_cast<double>(i % 200), 90, 200));
     if (map)
@@ -198,7 +223,7 @@ TEST(StreamingMap, StreamedMeshIsTheInMemoryMeshWithNoSeams) {
   const auto poses = drive(length, 0.5);
   const DriveResult memory = integrateDrive(poses, length);
   test::TempDir dir;
-  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), minimumRadius() + 0.2);
   EXPECT_GT(streamed.stats.blocks_freed, 0u);
   EXPECT_GT(streamed.stats.tiles_written, 10u);
   EXPECT_EQ(streamed.stats.tiles_reloaded, 0u);
@@ -225,7 +250,7 @@ TEST(StreamingMap, StoreReloadsAndMeshesAgainToTheSameMesh) {
   const auto poses = drive(length, 0.5);
   const DriveResult memory = integrateDrive(poses, length);
   test::TempDir dir;
-  integrateDrive(poses, length, dir.path(), 14.0);
+  integrateDrive(poses, length, dir.path(), minimumRadius() + 0.2);
   MarchingCubes::Config mesher;
   mesher.min_weight = 0.f;
   // Tile by tile from the block files.
@@ -253,7 +278,7 @@ TEST(StreamingMap, ALoopBackIntoStreamedSpaceReadsItBackAndDoublesNoSurface) {
   const auto poses = drive(length, 0.5, 25.0);
   const DriveResult memory = integrateDrive(poses, length);
   test::TempDir dir;
-  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), minimumRadius() + 0.2);
   EXPECT_GT(streamed.stats.tiles_reloaded, 0u);
   EXPECT_GT(streamed.stats.blocks_reloaded, 0u);
   EXPECT_GT(streamed.stats.tiles_remeshed, 0u);
@@ -262,11 +287,71 @@ TEST(StreamingMap, ALoopBackIntoStreamedSpaceReadsItBackAndDoublesNoSurface) {
   expectWelded(streamed.mesh, memory.mesh);
 }
 
+TEST(StreamingMap, ALoopPastSurfacesAtTheCornersOfTheViewIsTheInMemoryMesh) {
+  // A wide camera (127 degrees across) in a wide corridor: the walls and boxes near the edges
+  // of the view, at up to 8 m depth, are 12-15 m from the camera. Driving back, the integrator
+  // reaches tiles on disk there. With a reach of max_depth_m + truncation + 2 m (10.5 m, what
+  // the pipeline told the map before the reach was the integrator's) and no reading back on
+  // allocation, the bands started blocks afresh in tiles still on disk, whose stored blocks
+  // were then dropped when the tiles were read back: 155 943 triangles against 157 078.
+  const double length = 40.0;
+  const auto poses = drive(length, 0.5, 5.0);
+  Corridor setup;
+  setup.wall = 12.0;
+  setup.focal = 16.0;
+  const DriveResult memory = integrateDrive(poses, length, "", 0.0, setup);
+  ASSERT_GT(memory.mesh.triangles.size(), 1000u);
+  const double radius = minimumRadius(setup) + 0.2; // 29 m
+  for (const double reach : {0.0, kMaxDepth + kTruncation + 2.0}) {
+    SCOPED_TRACE(reach > 0.0 ? "reach 10.5 m" : "the integrator's reach");
+    setup.reach = reach;
+    test::TempDir dir;
+    const DriveResult streamed = integrateDrive(poses, length, dir.path(), radius, setup);
+    EXPECT_GT(streamed.stats.tiles_reloaded, 0u);
+    // Told too small a reach, the map reads tiles back when the integrator allocates blocks
+    // in them (here that suffices: carving reaches no stored block beyond 10.5 m).
+    if (reach > 0.0)
+      EXPECT_GT(streamed.stats.tiles_reloaded_on_allocation, 0u);
+    else
+      EXPECT_EQ(streamed.stats.tiles_reloaded_on_allocation, 0u);
+    EXPECT_EQ(streamed.mesh.triangles.size(), memory.mesh.triangles.size());
+    EXPECT_TRUE(triangleSet(streamed.mesh) == triangleSet(memory.mesh));
+    expectWelded(streamed.mesh, memory.mesh);
+  }
+}
+
+TEST(TsdfIntegratorReach, IsTheFarthestCornerOfTheViewAtMaxDepthAndTwiceTheBandBehind) {
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator::Config config;
+  config.max_depth_m = 40.0;
+  config.truncation_sigmas = 0.0;
+  config.signed_distance = TsdfIntegrator::SignedDistance::Projective;
+  PinholeCamera camera = test::centredCamera(201, 101, 100.0); // corners at (1.005, 0.505) per metre of depth
+  const double corner = std::sqrt(1.0 + 1.005 * 1.005 + 0.505 * 0.505);
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(camera), (40.0 + 2 * 0.3) * corner, 1e-9);
+  camera.cx = 0.f; // the far corner is now (200.5, 50.5) px off the centre
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(camera),
+              (40.0 + 2 * 0.3) * std::sqrt(1.0 + 2.005 * 2.005 + 0.505 * 0.505), 1e-9);
+  // The band grows with the depth's sigma, up to that of the least weight integrated.
+  config.truncation_sigmas = 2.0;
+  config.min_pixel_weight = 0.25f;
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(test::centredCamera(201, 101, 100.0)),
+              (40.0 + 2 * 4.0) * corner, 1e-9);
+  config.min_pixel_weight = 0.f;
+  EXPECT_FALSE(std::isfinite(TsdfIntegrator(volume, config).reach(camera)));
+  // A plane's band behind it: a voxel over the least scale.
+  config.truncation_sigmas = 0.0;
+  config.signed_distance = TsdfIntegrator::SignedDistance::Plane;
+  config.plane.min_scale = 0.05f;
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(test::centredCamera(201, 101, 100.0)),
+              (40.0 + 2 * 0.1 / 0.05f) * corner, 1e-6);
+}
+
 TEST(StreamingMap, MemoryStaysBoundedOnALongDrive) {
   const double length = 240.0;
   const auto poses = drive(length, 0.6);
   test::TempDir dir;
-  const DriveResult streamed = integrateDrive(poses, length, dir.path(), 14.0);
+  const DriveResult streamed = integrateDrive(poses, length, dir.path(), minimumRadius() + 0.2);
   const std::size_t n = streamed.blocks.size();
   const auto peak = [&](std::size_t a, std::size_t b) {
     return *std::max_element(streamed.blocks.begin() + static_cast<long>(a), streamed.blocks.begin() + static_cast<long>(b));
@@ -282,7 +367,7 @@ TEST(StreamingMap, BadRadiusAndBadStoreAreClearErrors) {
   config.active_radius_m = 5.0;
   test::TempDir dir;
   try {
-    StreamingMap map(volume, config, MarchingCubes::Config(), kReach, dir.path());
+    StreamingMap map(volume, config, MarchingCubes::Config(), 10.0, dir.path());
     FAIL() << "a radius below the reach was accepted";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("active_radius_m"), std::string::npos) << e.what();

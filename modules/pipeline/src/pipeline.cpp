@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <future>
 #include <mutex>
@@ -148,9 +149,12 @@ void Pipeline::integrate(FrameResult& result) {
 void Pipeline::setStreamingDirectory(const std::string& directory) {
   if (!config_.streaming.enabled())
     throw ConfigError("streaming.active_radius_m is 0: the map is not streamed, no folder is needed");
-  // All the integrator can touch around the camera: its depth range, the band behind a
-  // surface, and a margin for the canvas's and the LiDAR's rays.
-  const double reach = config_.integrator.max_depth_m + config_.volume.truncation_m + 2.0;
+  // How far from the camera integration changes blocks that exist, over the LiDAR's canvas
+  // (the image and its margin: the frames integrated are at most that).
+  const double reach = integrator_->reach(stages_->lidar.projector().canvasCamera());
+  if (!std::isfinite(reach))
+    throw ConfigError("a streamed map needs a bound on the band behind a surface: tsdf_integrator.min_pixel_weight > 0 "
+                      "or truncation_sigmas 0 (with per-pixel weights the band grows as a pixel's weight falls)");
   streaming_ = std::make_unique<StreamingMap>(*volume_, config_.streaming, config_.mesher, reach, directory);
 }
 

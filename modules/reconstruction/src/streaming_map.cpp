@@ -13,6 +13,7 @@
 #include <map>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <tuple>
 
 namespace msf {
@@ -451,7 +452,7 @@ StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const March
   if (config_.active_radius_m < minimumRadius())
     throw ConfigError("streaming.active_radius_m " + number(config_.active_radius_m) + " is below " +
                       number(minimumRadius()) + " m, the integrator's reach (" + number(reach_m_) +
-                      " m: maximum depth, truncation and a margin) plus a tile (" +
+                      " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
                       number(config_.tile_blocks * kSide * volume_.voxelSize()) + " m)");
   ensureOutputDirectory(directory_);
   for (const char* sub : {"tsdf", "tiles"}) {
@@ -463,7 +464,10 @@ StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const March
       throw IOError("cannot create folder '" + p.string() + "': " + e.message());
   }
   writeIndex();
+  volume_.setBlockSource([this](const std::vector<GridIndex>& blocks) { readBackAround(blocks); });
 }
+
+StreamingMap::~StreamingMap() { volume_.setBlockSource(nullptr); }
 
 std::string StreamingMap::tilesDirectory() const { return (fs::path(directory_) / "tiles").string(); }
 
@@ -492,18 +496,59 @@ void StreamingMap::beforeIntegration(const Eigen::Vector3d& sensor) {
   for (const TileKey t : evicted_)
     if (distanceToTile(t, sensor, 1) <= reach_m_)
       back.push_back(t);
+  readBack(std::move(back));
+}
+
+void StreamingMap::readBackAround(const std::vector<GridIndex>& blocks) {
+  if (evicted_.empty() || moving_blocks_)
+    return; // the blocks this map puts in itself are not the integrator's
+  // The tiles whose box grown by one block holds the block: its own and, for a block on its
+  // tile's border, the tiles across it (those whose cubes or regularization read it).
+  const int n = config_.tile_blocks;
+  std::vector<TileKey> back;
+  GridIndex last(std::numeric_limits<int>::min(), 0, 0);
+  for (const GridIndex& b : blocks) {
+    const GridIndex t = tileOfBlock(b, n);
+    const GridIndex local = b - t * n;
+    int lo[3], hi[3];
+    bool inner = true;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = local[a] == 0 ? -1 : 0;
+      hi[a] = local[a] == n - 1 ? 1 : 0;
+      inner = inner && lo[a] == 0 && hi[a] == 0;
+    }
+    if (inner && t == last)
+      continue; // blocks come in runs of a tile
+    last = inner ? t : GridIndex(std::numeric_limits<int>::min(), 0, 0);
+    for (int dz = lo[2]; dz <= hi[2]; ++dz)
+      for (int dy = lo[1]; dy <= hi[1]; ++dy)
+        for (int dx = lo[0]; dx <= hi[0]; ++dx) {
+          const TileKey k = tileOf((t + GridIndex(dx, dy, dz)) * n);
+          if (evicted_.count(k))
+            back.push_back(k);
+        }
+  }
+  std::sort(back.begin(), back.end());
+  back.erase(std::unique(back.begin(), back.end()), back.end());
+  stats_.tiles_reloaded_on_allocation += back.size();
+  readBack(std::move(back));
+}
+
+void StreamingMap::readBack(std::vector<TileKey> back) {
   if (back.empty())
     return;
   const auto t0 = Clock::now();
   std::sort(back.begin(), back.end());
   const std::uint64_t stamp = volume_.beginGeneration();
+  const MovingBlocks moving(moving_blocks_);
   for (const TileKey t : back) {
     readBlocks(blockPath(directory_, tileIndex(t)), volume_.voxelSize(), volume_.truncation(),
                [&](const GridIndex& b, const TsdfBlock& voxels) {
-                 if (!volume_.findBlock(b)) {
-                   putBlock(volume_, b, voxels, stamp);
-                   ++stats_.blocks_reloaded;
-                 }
+                 // A block of an evicted tile is never in memory: allocating one reads its tile first.
+                 if (volume_.findBlock(b))
+                   throw std::logic_error("StreamingMap: block " + tileName(b) + " of a tile on disk is in memory");
+                 putBlock(volume_, b, voxels, stamp);
+                 ++stats_.blocks_reloaded;
                });
     evicted_.erase(t);
     ++stats_.tiles_reloaded;
@@ -561,18 +606,8 @@ void StreamingMap::evict(const std::vector<TileKey>& tiles_in) {
   for (const TileKey t : tiles) {
     std::vector<GridIndex>& mine = blocks[t];
     const GridIndex ti = tileIndex(t);
-    if (evicted_.count(t)) {
-      // Blocks made in a tile on disk (a radius below what the integrator reaches): the
-      // stored ones join them, so that the file keeps both.
-      const std::uint64_t stamp = volume_.beginGeneration();
-      readBlocks(blockPath(directory_, ti), vs, trunc,
-                 [&](const GridIndex& b, const TsdfBlock& voxels) {
-                   if (!volume_.findBlock(b)) {
-                     putBlock(volume_, b, voxels, stamp);
-                     mine.push_back(b);
-                   }
-                 });
-    }
+    if (evicted_.count(t)) // allocating a block of a tile on disk reads the tile back first
+      throw std::logic_error("StreamingMap: tile " + tileName(ti) + " is on disk and has blocks in memory");
     std::sort(mine.begin(), mine.end(), [](const GridIndex& a, const GridIndex& b) {
       return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
     });

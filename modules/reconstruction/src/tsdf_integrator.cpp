@@ -286,6 +286,36 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
                             std::to_string(volume_.voxelSize()) + " m voxels");
 }
 
+double TsdfIntegrator::reach(const PinholeCamera& camera) const {
+  // The band behind a surface (see integrate's step 0): at most max(truncation, a voxel over
+  // the least plane scale, the depth's sigmas), the sigma from the least weight a pixel can
+  // have and still be integrated.
+  const double trunc = volume_.truncation(), vs = volume_.voxelSize();
+  const double below = config_.signed_distance == SignedDistance::Plane
+                           ? std::min(trunc, vs) / static_cast<double>(config_.plane.min_scale)
+                           : 0.0;
+  double least_weight = static_cast<double>(config_.min_pixel_weight); // the mask
+  const double sigma = config_.depth_sigma_m;
+  if (config_.weighting == Weighting::Constant)
+    least_weight = std::max(least_weight, 1.0 / (sigma * sigma));
+  else if (config_.weighting == Weighting::InverseSquare)
+    least_weight = std::max(least_weight, 1.0 / (sigma * sigma * config_.max_depth_m * config_.max_depth_m));
+  double noise = 0.0;
+  if (config_.truncation_sigmas > 0.0)
+    noise = least_weight > 0.0 ? config_.truncation_sigmas / std::sqrt(least_weight)
+                               : std::numeric_limits<double>::infinity();
+  // A voxel is updated up to its pixel's band behind the depth, and the depth may be the
+  // bilinear one of 4 pixels that agree within that band: up to twice the band behind the
+  // nearest pixel's depth, itself at most max_depth_m.
+  const double behind = 2.0 * std::max({trunc, below, noise});
+  // The longest ray per metre of depth: through a corner of the image (pixel edges at -0.5
+  // and size - 0.5, as the projection's inside test).
+  const double du = std::max(std::abs(-0.5 - camera.cx), std::abs(camera.width - 0.5 - camera.cx)) / camera.fx;
+  const double dv = std::max(std::abs(-0.5 - camera.cy), std::abs(camera.height - 0.5 - camera.cy)) / camera.fy;
+  const double corner = std::sqrt(1.0 + du * du + dv * dv);
+  return std::max((config_.max_depth_m + behind) * corner, config_.max_depth_m + trunc);
+}
+
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");

@@ -166,7 +166,22 @@ const TsdfBlock* TsdfVolume::findBlock(const GridIndex& index) const {
   return const_cast<TsdfVolume*>(this)->findBlock(index);
 }
 
+void TsdfVolume::askSource(const std::vector<GridIndex>& indices) {
+  if (!source_ || in_source_ || indices.empty())
+    return;
+  in_source_ = true;
+  try {
+    source_(indices);
+  } catch (...) {
+    in_source_ = false;
+    throw;
+  }
+  in_source_ = false;
+}
+
 TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
+  if (source_ && !in_source_ && !findBlock(index))
+    askSource({index});
   reserve(blocks_.size() + 1); // may throw: before anything changes
   Slot& slot = table_[slotOf(index)];
   if (slot.block < 0) {
@@ -180,6 +195,7 @@ TsdfBlock& TsdfVolume::allocateBlock(const GridIndex& index) {
 }
 
 void TsdfVolume::allocateBlocks(const std::vector<GridIndex>& indices, std::vector<TsdfBlock*>& blocks) {
+  askSource(indices);
   std::size_t missing = 0;
   for (const GridIndex& index : indices)
     missing += findBlock(index) == nullptr;

@@ -1,9 +1,14 @@
 #include <msf/synthetic/scene.h>
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 
 namespace msf::synthetic {
+
+namespace {
+using Float4 = float __attribute__((vector_size(16))); // GCC and Clang vector extensions
+} // namespace
 
 std::uint16_t Scene::addMaterial(const Material& material) {
   materials.push_back(material);
@@ -24,6 +29,14 @@ void Scene::buildIndex() {
   nodes_.reserve(2 * static_cast<std::size_t>(n) + 1);
   if (n > 0)
     build(0, n, lo, hi, centroid);
+  children_.assign(nodes_.size(), ChildBoxes{});
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i].count > 0)
+      continue;
+    const Node& l = nodes_[i + 1];
+    const Node& r = nodes_[static_cast<std::size_t>(nodes_[i].index)];
+    children_[i] = {{l.lo.x, r.lo.x, l.hi.x, r.hi.x}, {l.lo.y, r.lo.y, l.hi.y, r.hi.y}, {l.lo.z, r.lo.z, l.hi.z, r.hi.z}};
+  }
 }
 
 namespace {
@@ -180,12 +193,24 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
       continue;
     }
     const std::int32_t left = current + 1, right = node.index;
-    float t_left = 0.f, t_right = 0.f;
-    const bool hit_left = rayEntersBox(nodes_[static_cast<std::size_t>(left)].lo,
-                                       nodes_[static_cast<std::size_t>(left)].hi, ray.origin, inv, tmin, hit.t, t_left);
-    const bool hit_right =
-        rayEntersBox(nodes_[static_cast<std::size_t>(right)].lo, nodes_[static_cast<std::size_t>(right)].hi, ray.origin,
-                     inv, tmin, hit.t, t_right);
+    // rayEntersBox for both children in SIMD lanes, the same operations in the same order
+    // per lane (so the same results): lanes 0 and 1 are the children's slab distances.
+    const ChildBoxes& c = children_[static_cast<std::size_t>(current)];
+    Float4 t0 = {tmin, tmin, tmin, tmin}, t1 = {hit.t, hit.t, hit.t, hit.t};
+    auto slab = [&](const float* bounds, float o, float i) {
+      Float4 v;
+      std::memcpy(&v, bounds, sizeof v);
+      const Float4 a = (v - o) * i;
+      const Float4 b = __builtin_shufflevector(a, a, 2, 3, 0, 1); // each lane's hi with its lo
+      const Float4 near = a < b ? a : b, far = a < b ? b : a;
+      t0 = near > t0 ? near : t0;
+      t1 = far < t1 ? far : t1;
+    };
+    slab(c.x, ray.origin.x, inv.x);
+    slab(c.y, ray.origin.y, inv.y);
+    slab(c.z, ray.origin.z, inv.z);
+    const float t_left = t0[0], t_right = t0[1];
+    const bool hit_left = t0[0] <= t1[0], hit_right = t0[1] <= t1[1];
     if (hit_left && hit_right) {
       if (t_left <= t_right) {
         push(right, t_right);

@@ -14,6 +14,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <unistd.h>
 
@@ -36,7 +39,7 @@ SyntheticConfig validated(const SyntheticConfig& config) {
 }
 
 std::string frameName(std::size_t i) {
-  char name[16];
+  char name[24]; // 20 digits at most
   std::snprintf(name, sizeof name, "%06zu", i);
   return name;
 }
@@ -215,22 +218,47 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     saveMesh((gt / "scene.ply").string(), mesh());
     writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
 
-    for (std::size_t i = 0; i < poses_.size(); ++i) {
-      const auto start = std::chrono::steady_clock::now();
-      const SyntheticFrame f = renderFrame(i);
-      const std::string png = frameName(i) + ".png";
-      std::vector<std::function<void()>> jobs;
-      for (int c = 0; c < 4; ++c)
-        jobs.emplace_back([&, c] { writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f.images[c]); });
-      jobs.emplace_back([&] { saveVelodyneBin((seq / "velodyne" / (frameName(i) + ".bin")).string(), f.scan); });
-      jobs.emplace_back([&] { writeKittiDepthPng((gt / "depth_0" / png).string(), f.depth); });
-      jobs.emplace_back([&] { writeKittiDisparityPng((gt / "disp_0" / png).string(), f.disparity); });
-      jobs.emplace_back([&] { writeImage((gt / "obj_map_0" / png).string(), f.objects); });
-      jobs.emplace_back([&] { writeImage((gt / "moving_0" / png).string(), f.moving); });
-      runAll(jobs);
+    // Frame i's files are written (PNG compression, a tenth of a frame's time) on a thread of
+    // their own while frame i + 1 renders: they fill the renderer's idle moments instead of
+    // following them. A frame's writes end before the next frame's begin.
+    struct Pending {
+      std::future<void> written;
+      std::size_t frame, points;
+      std::chrono::steady_clock::time_point start;
+    };
+    std::optional<Pending> pending; // its future waits for the writes when an error unwinds
+    using Clock = std::chrono::steady_clock;
+    const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+    // A frame's time: from its start to the next frame's, plus any wait for its writes.
+    const auto finishPending = [&](Clock::time_point next_start) {
+      const auto wait_start = Clock::now();
+      pending->written.get();
       if (progress)
-        progress(i, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), f.scan.size());
+        progress(pending->frame, seconds(next_start - pending->start) + seconds(Clock::now() - wait_start),
+                 pending->points);
+      pending.reset();
+    };
+    for (std::size_t i = 0; i < poses_.size(); ++i) {
+      const auto start = Clock::now();
+      auto f = std::make_shared<const SyntheticFrame>(renderFrame(i));
+      if (pending)
+        finishPending(start);
+      const std::string png = frameName(i) + ".png", bin = frameName(i) + ".bin";
+      auto write = [&seq, &gt, f, png, bin] {
+        std::vector<std::function<void()>> jobs;
+        for (int c = 0; c < 4; ++c)
+          jobs.emplace_back([&, c] { writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f->images[c]); });
+        jobs.emplace_back([&] { saveVelodyneBin((seq / "velodyne" / bin).string(), f->scan); });
+        jobs.emplace_back([&] { writeKittiDepthPng((gt / "depth_0" / png).string(), f->depth); });
+        jobs.emplace_back([&] { writeKittiDisparityPng((gt / "disp_0" / png).string(), f->disparity); });
+        jobs.emplace_back([&] { writeImage((gt / "obj_map_0" / png).string(), f->objects); });
+        jobs.emplace_back([&] { writeImage((gt / "moving_0" / png).string(), f->moving); });
+        runAll(jobs);
+      };
+      pending = Pending{std::async(std::launch::async, write), i, f->scan.size(), start};
     }
+    if (pending)
+      finishPending(Clock::now());
 
     // Move into place: the old dataset (if any) aside, the new one in, the old one away.
     const fs::path old = target.parent_path() / ("." + target.filename().string() + ".msf_synth_old." +

@@ -19,11 +19,13 @@ namespace msf {
 /// (grown by one block, the +x/+y/+z layer its cubes read) lies farther than the active radius
 /// from the sensor is meshed, its mesh written to DIR/tiles/X_Y_Z.ply, its blocks to
 /// DIR/tsdf/X_Y_Z.blk (listed in DIR/tsdf/index.txt), and freed. Before each frame, a tile on
-/// disk within `reach` of the sensor (all the integrator can touch: its maximum depth, the
-/// truncation and a margin) is read back, so that integration always finds the voxels a map
-/// in memory would hold, and a revisit adds to the surface instead of doubling it; the tiles
-/// whose meshes read the blocks read back are meshed again at the end. The active radius
-/// must be at least reach + one tile, so that a tile is not freed and read back at once.
+/// disk within `reach` of the sensor (how far the integrator changes blocks that exist:
+/// TsdfIntegrator::reach) is read back; and a tile on disk within a block of a block that
+/// the integrator is about to allocate is read back first (the volume's BlockSource), so that
+/// integration always finds the voxels a map in memory would hold, and a revisit adds to the
+/// surface instead of doubling it; the tiles whose meshes read the blocks read back are meshed
+/// again at the end. The active radius must be at least reach + one tile, so that a tile is
+/// not freed and read back at once.
 ///
 /// finish() writes the tiles still in memory the same way and the mesh of the whole drive as
 /// one PLY, the union of the tiles. Every file is written atomically, so a run that is killed
@@ -49,6 +51,9 @@ public:
   struct Stats {
     std::size_t tiles_written = 0;   ///< tile meshes and block files written (again, for revisits)
     std::size_t tiles_reloaded = 0;  ///< tiles read back from disk
+    /// of which read back only when the integrator allocated a block within a block of them
+    /// (a band beyond `reach`, in front of a surface)
+    std::size_t tiles_reloaded_on_allocation = 0;
     std::size_t tiles_remeshed = 0;  ///< tiles on disk meshed again by finish() after a revisit
     std::size_t blocks_freed = 0;
     std::size_t blocks_reloaded = 0;
@@ -60,6 +65,10 @@ public:
   /// below reach_m plus a tile, IOError when the folder cannot be made.
   StreamingMap(TsdfVolume& volume, const Config& config, const MarchingCubes::Config& mesher, double reach_m,
                const std::string& directory);
+  /// Detaches from the volume (its BlockSource).
+  ~StreamingMap();
+  StreamingMap(const StreamingMap&) = delete;
+  StreamingMap& operator=(const StreamingMap&) = delete;
 
   /// Before integrating a frame seen from `sensor` (metres, world frame): reads back the tiles
   /// on disk within reach.
@@ -102,6 +111,10 @@ private:
   double distanceToTile(TileKey key, const Eigen::Vector3d& p, int grow_blocks) const;
   /// Meshes, writes and frees the tiles `tiles` (whose blocks are in memory).
   void evict(const std::vector<TileKey>& tiles);
+  /// Reads the stored tiles `tiles` (evicted) back into the volume.
+  void readBack(std::vector<TileKey> tiles);
+  /// The volume's BlockSource: reads back the evicted tiles within a block of `blocks`.
+  void readBackAround(const std::vector<GridIndex>& blocks);
   void writeIndex() const;
   std::string tilesDirectory() const;
 
@@ -114,6 +127,13 @@ private:
   std::unordered_set<TileKey> evicted_;  ///< stored tiles whose blocks are not in memory
   std::unordered_set<TileKey> stale_;    ///< evicted tiles whose mesh read blocks that were read back since
   Eigen::Vector3d last_check_{Eigen::Vector3d::Constant(1e300)};
+  /// While this map puts blocks into the volume or frees them (readBackAround ignores it).
+  bool moving_blocks_ = false;
+  struct MovingBlocks {
+    explicit MovingBlocks(bool& flag) : flag_(flag) { flag_ = true; }
+    ~MovingBlocks() { flag_ = false; }
+    bool& flag_;
+  };
   Stats stats_;
 };
 

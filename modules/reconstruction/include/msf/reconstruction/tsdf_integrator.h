@@ -176,6 +176,16 @@ public:
   void integrateRays(const std::vector<Eigen::Vector3f>& points_world, const std::vector<cv::Vec3b>& colors_bgr,
                      const Eigen::Vector3d& origin_world);
 
+  /// How far from the sensor (metres) integration can change blocks that exist: a frame of
+  /// `camera` updates voxels up to a depth of max_depth_m plus twice the widest band behind a
+  /// surface (a bilinear depth within the band of the nearest pixel's), along rays that are
+  /// longest through the image's corners (x 1.36 the depth on KITTI's 1242 x 375 image); a
+  /// scan's rays reach max_depth_m + truncation. Blocks that the bands
+  /// reach farther, in front of a surface, are allocated, which the volume's BlockSource
+  /// sees first. Infinite when the band behind a surface has no bound: per-pixel weights
+  /// with truncation_sigmas > 0 and min_pixel_weight 0 (the band grows as a weight falls).
+  double reach(const PinholeCamera& camera) const;
+
 private:
   /// Throws InvalidInputError when the frame's band would reach beyond the volume's index range.
   void checkReach(const Eigen::Isometry3d& T_world_cam) const;

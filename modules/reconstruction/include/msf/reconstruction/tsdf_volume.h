@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <string>
@@ -75,6 +76,14 @@ public:
   /// allocateBlock for each index, the new blocks constructed in parallel: `blocks[i]` is
   /// the block at `indices[i]`. Not thread-safe (it runs its own threads).
   void allocateBlocks(const std::vector<GridIndex>& indices, std::vector<TsdfBlock*>& blocks);
+
+  /// Where blocks not in memory may be (StreamingMap: tiles on disk). Called before blocks
+  /// are allocated, with their indices: all that allocateBlocks is given, the one that
+  /// allocateBlock is given when it is absent. It may put blocks in (allocateBlock), which
+  /// the allocation then finds, so that an integrator never starts a block afresh where the
+  /// map has one on disk. Its own allocations do not call it again. Empty: none.
+  using BlockSource = std::function<void(const std::vector<GridIndex>& indices)>;
+  void setBlockSource(BlockSource source) { source_ = std::move(source); }
   /// Every allocated block (stable addresses until removeBlocks).
   const std::vector<TsdfBlock*>& blocks() const { return blocks_; }
   /// Frees the blocks at `indices` (absent ones are ignored) and the memory they held: the
@@ -137,6 +146,8 @@ private:
   void reserve(std::size_t blocks);
   /// Where block number `block` (position in blocks_) lives.
   void* storage(std::size_t block) const;
+  /// Calls source_ with `indices` unless there is none or it is running.
+  void askSource(const std::vector<GridIndex>& indices);
 
   std::vector<Slot> table_;
   std::size_t mask_ = 0;
@@ -148,6 +159,8 @@ private:
   };
   std::vector<std::unique_ptr<void, ChunkFree>> chunks_; ///< block b is in chunk b / (blocks per chunk)
   std::vector<TsdfBlock*> blocks_;
+  BlockSource source_;
+  bool in_source_ = false;
 };
 
 } // namespace msf

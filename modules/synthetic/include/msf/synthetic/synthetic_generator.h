@@ -60,8 +60,9 @@ public:
   /// The true static surface (see sceneMesh in scene_mesh.h), without the moving objects.
   pcl::PolygonMesh mesh() const;
 
-  /// Called after each written frame with its index, the seconds it took (render and
-  /// write) and its number of LiDAR points.
+  /// Called after each written frame with its index, the seconds it took (from its start to
+  /// the next frame's, and any wait for its files: they are written while the next frame
+  /// renders) and its number of LiDAR points.
   using Progress = std::function<void(std::size_t frame, double seconds, std::size_t points)>;
 
   /// Writes the dataset under `root` (see README: KITTI odometry layout plus gt/). The
