@@ -19,6 +19,10 @@ namespace msf {
 
 namespace {
 
+/// How far from a surface's plane its band reaches along a grazing ray, either side: a voxel
+/// and a half (see integrate's step 0), never more than the truncation.
+float planeBand(float truncation, float voxel_size) { return std::min(truncation, 1.5f * voxel_size); }
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -292,7 +296,8 @@ double TsdfIntegrator::reach(const PinholeCamera& camera) const {
   // have and still be integrated.
   const double trunc = volume_.truncation(), vs = volume_.voxelSize();
   const double below = config_.signed_distance == SignedDistance::Plane
-                           ? std::min(trunc, vs) / static_cast<double>(config_.plane.min_scale)
+                           ? planeBand(static_cast<float>(trunc), static_cast<float>(vs)) /
+                                 static_cast<double>(config_.plane.min_scale)
                            : 0.0;
   double least_weight = static_cast<double>(config_.min_pixel_weight); // the mask
   const double sigma = config_.depth_sigma_m;
@@ -366,7 +371,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // (above it, free space holds the voxels beyond at +truncation: the full truncation cost 12 %
   // more time for the same maps; below it, one voxel left holes wherever a cube's far corner
   // lay a little deeper: protocol 4 coverage 0.957 against 0.967 on raw 0009).
-  const float plane_band = std::min(trunc, 1.5f * vs);
+  const float plane_band = planeBand(trunc, vs);
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
   const bool own_free = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
   const cv::Mat& free_weight = own_free ? frame.free_space_weight : cv::Mat();
