@@ -106,6 +106,9 @@ def depth_rows(z_of):
 pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
 pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
+inf_rows = depth_rows(lambda u, v: 5.0)
+inf_rows[3][2] = "inf"
+pcd(f + "/inf.pcd", inf_rows)
 pcd(f + "/allnan.pcd", depth_rows(lambda u, v: None))
 pcd(f + "/wrong_fields.pcd", [["1", "2", "3"]] * (W * H), fields="a b c")
 rows = depth_rows(lambda u, v: 5.0)
@@ -118,6 +121,11 @@ with open(f + "/bomb.pcd", "w") as o:
     o.write("\0" * 1300)
 with open(f + "/bomb.ply", "w") as o:
     o.write("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n")
+    o.write("\0" * 1300)
+# PCL's parser reads the count -7 as 2^64 - 7 (fuzz_cloud: it sized the cloud at ~52 GB).
+with open(f + "/negative.ply", "w") as o:
+    o.write("ply\nformat binary_little_endian 1.0\nelement vertex -7\nproperty float x\n"
             "property float y\nproperty float z\nend_header\n")
     o.write("\0" * 1300)
 # A PNG whose header says 30000 x 20000 (the pixels are never read).
@@ -207,6 +215,9 @@ check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_
 check "interpolate: POINTS 1e9 in a 1.4 KB .pcd" 1 "bomb.pcd' declares 1000000000 points" -- \
   msf_interpolate "$F/bomb.pcd" o.pcd
 check "info: element vertex 1e9 in a .ply" 1 "declares 1000000000 vertex" -- msf_info "$F/bomb.ply"
+check "info: element vertex -7 in a .ply" 1 "negative.ply' is not a valid .ply file \(bad header\): line 3 'element vertex -7': count '-7' is not a whole number" -- \
+  msf_info "$F/negative.ply"
+check "info: a point at z = inf is not valid" 0 "valid: +47 \(97.9 %\)" -- msf_info "$F/inf.pcd"
 check "integrate -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1e-06" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e-6
 check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 64 voxels" -- \
