@@ -273,6 +273,8 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
+  check "reconstruct -max_memory 1" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
   check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \
     msf_reconstruct "$K/odo/sequences/04" -o out
@@ -310,7 +312,7 @@ if [ $have_kitti = 1 ]; then
   fi
 else
   for c in project-huge-calib interpolate-scaled-tr stereo-num-disparities stereo-prior stereo-color p1x \
-           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-voxel-small reconstruct-scans \
+           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out; do
     skip "$c"
   done
