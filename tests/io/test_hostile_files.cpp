@@ -442,4 +442,20 @@ TEST(FuzzRegressions, CalibrationParsers) {
   }
 }
 
+TEST(FuzzRegressions, AYamlCalibrationWhoseTopLevelIsIndentedIsRefusedBeforeOpenCvLoops) {
+  // fuzz_calibration (600 s run at 3cf9cc6, after ~35 s; the earlier 600 s run had not met
+  // it): a 0.8 KB camera.yaml whose first key is indented by 3 and a later one not, with a value
+  // starting with '-': OpenCV 4.6's cv::FileStorage::open never returned (msf_project -calib
+  // looped until killed).
+  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) /
+                                   "tests/io/fuzz_regressions/calibration/timeout-96c63e39dc2d02d384c70be46d69677daf853527");
+  ASSERT_EQ(bytes.at(0) % 4, 3); // fuzz_calibration reads it as camera.yaml
+  msf::test::TempDir dir;
+  write(dir.file("camera.yaml"), bytes.substr(1));
+  const std::string e = errorOf([&] { msf::loadCalibration(dir.file("camera.yaml")); });
+  EXPECT_NE(e.find("camera.yaml' is not valid YAML: line 3: the top level is indented by 3 characters"),
+            std::string::npos)
+      << e;
+}
+
 } // namespace

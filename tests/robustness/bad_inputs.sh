@@ -151,6 +151,8 @@ yaml(f + "/fx0.yaml", fx=0.0)
 yaml(f + "/baseline0.yaml", tx1=0.0)
 yaml(f + "/nan.yaml", nan=True)
 yaml(f + "/huge.yaml", w=100000, h=100000)
+# OpenCV 4.6's YAML parser loops forever on an indented top level (fuzz_calibration).
+open(f + "/indented.yaml", "w").write("%YAML:1.0\n k: 4\na: -\n")
 # Poses: one line each.
 I = "1 0 0 0 0 1 0 0 0 0 1 0"
 open(f + "/pose.txt", "w").write(I + "\n")
@@ -240,6 +242,8 @@ check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not f
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/nan.yaml"
 check "pcd2png -disparity, baseline 0" 1 "baseline0.yaml': the grey pair's focal length x baseline is 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/baseline0.yaml"
+check "pcd2png -calib with an indented top level" 1 "indented.yaml' is not valid YAML: line 2: the top level is indented" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/indented.yaml"
 check "pcd2png: a depth of 1e30 m saturates, said" 0 "1 pixel of the depth beyond the format.s largest value \(255.996\) saturate" -- \
   msf_pcd2png "$F/far.pcd" d.png
 check "stereo: 30000x20000 PNG header" 1 "huge.png': image size 30000x20000 is outside 1x1 .. 8192x8192" -- \
@@ -275,6 +279,8 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
   check "reconstruct -max_memory 1" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
+    msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
   check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \
     msf_reconstruct "$K/odo/sequences/04" -o out
@@ -312,7 +318,7 @@ if [ $have_kitti = 1 ]; then
   fi
 else
   for c in project-huge-calib interpolate-scaled-tr stereo-num-disparities stereo-prior stereo-color p1x \
-           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-voxel-small reconstruct-scans \
+           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out; do
     skip "$c"
   done
