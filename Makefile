@@ -61,13 +61,15 @@ test: deps
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
 
 # Third-party reports are suppressed by name in tests/sanitize/*.supp (each with its reason).
+# PCL's vtk2mesh alloc-dealloc mismatch, which GCC 12's ASan cannot suppress by name, is let
+# through for the two tests that load a .vtk mesh only (tests/sanitize/per_test_options.cmake.in).
 # -Wno-maybe-uninitialized: GCC 12 warns inside libstdc++'s std::regex under -fsanitize (a
 # false positive that -Werror would make fatal).
 SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
   -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
   -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
 SANITIZE_CTEST = cd $(SANITIZE_BUILD_DIR) && \
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:alloc_dealloc_mismatch=0:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
   ctest --output-on-failure -j$(JOBS) --timeout 1500

@@ -180,6 +180,25 @@ TEST(Config, ProjectConfigFilesHaveNoRepeatedKeys) {
     EXPECT_NO_THROW(msf::ConfigFile(msf::test::sourceDir() + "/config/" + name)) << name;
 }
 
+TEST(Config, AnIndentedTopLevelIsRefusedBeforeOpenCvReadsIt) {
+  // OpenCV 4.6's YAML parser loops forever on these (fuzz/fuzz_calibration's timeout finding,
+  // reduced; msf_reconstruct -config hung the same way).
+  msf::test::TempDir dir;
+  const std::pair<const char*, const char*> hostile[] = {
+      {"%YAML:1.0\n k: 4\na: -\n", "line 2: the top level is indented by 1 character"},
+      {"%YAML:1.0\n---\n# c\n\n   k: 4\na: -5\n", "line 5: the top level is indented by 3 characters"},
+      {"%YAML:1.0\n--- k: 4\na: -\n", "line 2: content on the '---' line"},
+  };
+  for (const auto& [text, why] : hostile) {
+    writeText(dir.file("c.yaml"), text);
+    const std::string e = msf::test::errorOf([&] { msf::ConfigFile config(dir.file("c.yaml")); });
+    EXPECT_NE(e.find("config '" + dir.file("c.yaml") + "' is not valid YAML: " + why), std::string::npos) << e;
+  }
+  // Directives, ---, comments (indented too), blank and CR LF lines before a top level at column 0.
+  writeText(dir.file("c.yaml"), "%YAML:1.0\r\n---\r\n  # c\r\n\r\nstage:\r\n  gap_px: 7\r\n");
+  EXPECT_EQ(msf::test::errorOf([&] { msf::ConfigFile config(dir.file("c.yaml")); }), "(no error)");
+}
+
 TEST(Config, MissingFileIsAnError) { EXPECT_THROW(msf::ConfigFile("/nonexistent.yaml"), msf::IOError); }
 
 TEST(Statistics, MedianAndPercentile) {

@@ -311,17 +311,117 @@ TEST(FuzzRegressions, CloudFieldsBeyondThePointAreRefused) {
 TEST(FuzzRegressions, APlyOfNoVertexLoadsAsAnEmptyCloud) {
   // fuzz_cloud (the third 600 s run, after ~4 min): a binary .ply with `element vertex 00`.
   // PCL's conversion bound a reference to the first point of the empty cloud (UBSan); the
-  // loader now gives an empty cloud without converting.
+  // loader now gives an empty cloud without converting. The finding itself has a damaged
+  // property line (`property float inte<binary> z`) that the strict header check of the next
+  // finding refuses; the same header without it loads as an empty cloud.
+  EXPECT_NE(cloudFindingError("crash-9c6e2c26854529edb4fb60c3e495ecbd0c554cab")
+                .find("c.ply' is not a valid .ply file (bad header): line 7 'property float inte"),
+            std::string::npos);
   msf::test::TempDir dir;
-  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) /
-                                   "tests/io/fuzz_regressions/cloud/crash-9c6e2c26854529edb4fb60c3e495ecbd0c554cab");
   const std::string path = dir.file("c.ply");
-  write(path, bytes.substr(1));
+  write(path, "ply\nformat binary_little_endian 1.0\nelement vertex 00\nproperty float x\nproperty float y\n"
+              "property float z\nproperty float intensity\nend_header\n");
   pcl::PointCloud<pcl::PointXYZI> cloud;
   cloud.push_back(pcl::PointXYZI(1.f));
   EXPECT_EQ(errorOf([&] { msf::loadCloud(path, cloud); }), "(no error)");
   EXPECT_TRUE(cloud.empty());
   EXPECT_EQ(cloud.width * cloud.height, 0u);
+}
+
+TEST(FuzzRegressions, APlyElementCountThatIsNotAWholeNumberIsRefusedBeforePclSizesTheCloud) {
+  // fuzz_cloud (the fourth 600 s run): a binary .ply with `element vertex -7`, which PCL's
+  // parser reads into a std::size_t as 2^64 - 7 and sized the cloud from (~52 GB). Its second
+  // line ("\x01ply") is no header keyword: PCL passed over it, the strict check refuses it.
+  // Without that line, the count itself is refused (HostileClouds.PlyHeadersAreReadStrictly).
+  const std::string e = cloudFindingError("crash-49553d3f70fb08fbec9f97d3a5cba192487efcc5");
+  EXPECT_NE(e.find("c.ply' is not a valid .ply file (bad header): line 2 '?ply': not a header keyword (format, "
+                   "element, property, comment, obj_info, end_header)"),
+            std::string::npos)
+      << e;
+}
+
+/// The error loading a .ply of this header and `body` bytes, as a cloud.
+std::string plyError(const std::string& header, const std::string& body = std::string(64, '\0')) {
+  msf::test::TempDir dir;
+  write(dir.file("h.ply"), header + body);
+  pcl::PCLPointCloud2 blob;
+  return errorOf([&] { msf::loadCloudBlob(dir.file("h.ply"), blob); });
+}
+
+TEST(HostileClouds, PlyHeadersAreReadStrictly) {
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const std::string binary = "ply\nformat binary_little_endian 1.0\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {binary + "element vertex -7\n" + xyz + "end_header\n",
+       "line 3 'element vertex -7': count '-7' is not a whole number 0 .. 2147483647"},
+      {binary + "element vertex +7\n" + xyz + "end_header\n",
+       "line 3 'element vertex +7': count '+7' is not a whole number 0 .. 2147483647"},
+      {binary + "element vertex 3000000000\n" + xyz + "end_header\n", "count '3000000000' is not a whole number"},
+      {binary + "element vertex 1e3\n" + xyz + "end_header\n", "count '1e3' is not a whole number"},
+      {binary + "element vertex 2 3\n" + xyz + "end_header\n", "element takes a name and a count"},
+      {binary + "element vertex 2\n" + xyz + "element vertex 2\n" + xyz + "end_header\n",
+       "element 'vertex' given twice"},
+      {binary + "element vertex 2\nproperty float x\nproperty float x\nend_header\n",
+       "property 'x' given twice in element 'vertex'"},
+      {binary + "element vertex 2\nproperty float128 x\nend_header\n", "type 'float128' is not a PLY scalar type"},
+      {binary + "element face 2\nproperty list float int vertex_indices\nend_header\n",
+       "type 'float' is not a list's count type"},
+      {binary + "property float x\nelement vertex 2\nend_header\n", "property before any element"},
+      {binary + "element vertex 1000000\nend_header\n", "element 'vertex' has 1000000 items but no property"},
+      {binary + "elemnt vertex 2\n" + xyz + "end_header\n", "'elemnt vertex 2': not a header keyword"},
+      {binary + "format ascii 1.0\nend_header\n", "format given twice"},
+      {"ply\nformat binary_little_endian 2.0\nend_header\n", "format is ascii, binary_little_endian or"},
+      {"ply\nelement vertex 2\n" + xyz + "end_header\n", "line 6 'end_header': no format line before end_header"},
+      {"plyX\nformat ascii 1.0\nend_header\n", "line 1 'plyX': the first line is not 'ply'"},
+      {"ply\r\nformat ascii 1.0\nend_header\r\n", "line 2 'format ascii 1.0': a line that does not end in CR LF"},
+      // Counts against the file's size: 20 vertices of 12 bytes are 240 bytes; the body has 64.
+      {binary + "element vertex 20\n" + xyz + "end_header\n",
+       "declares 20 vertex elements in its header, which need at least 240 bytes, but the file has 64"},
+      // Lists hold at least their count: 100 faces of a uchar count need 100 bytes.
+      {binary + "element vertex 0\n" + xyz + "element face 100\nproperty list uchar int vertex_indices\n"
+                "end_header\n",
+       "declares 100 face elements in its header, which need at least 100 bytes, but the file has 64"},
+      // ascii: each vertex is a line of 3 values, at least 6 bytes.
+      {"ply\nformat ascii 1.0\nelement vertex 11\n" + xyz + "end_header\n",
+       "declares 11 vertex elements in its header, which need at least 66 bytes, but the file has 64"},
+  };
+  for (const auto& [header, expected] : cases) {
+    const std::string e = plyError(header);
+    EXPECT_NE(e.find("h.ply'"), std::string::npos) << header << "\n" << e;
+    EXPECT_NE(e.find(expected), std::string::npos) << header << "\n" << e;
+  }
+  EXPECT_NE(plyError(binary + "element vertex 2\n" + xyz, "").find("h.ply' is not a valid .ply file (bad header): "
+                                                                  "no end_header line"),
+            std::string::npos);
+  // The same header check for a mesh, named as one.
+  msf::test::TempDir dir;
+  write(dir.file("m.ply"), binary + "element vertex -7\n" + xyz + "end_header\n");
+  pcl::PolygonMesh mesh;
+  EXPECT_NE(errorOf([&] { msf::loadMesh(dir.file("m.ply"), mesh); }).find("mesh '"), std::string::npos);
+}
+
+TEST(HostileClouds, PlyFilesOfEveryAcceptedFormLoad) {
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  std::string two(24, '\0');
+  const std::pair<std::string, std::string> files[] = {
+      {"ply\nformat binary_little_endian 1.0\ncomment c\nobj_info o\n\nelement vertex 2\n" + xyz + "end_header\n",
+       two},
+      {"ply\nformat ascii 1.0\nelement vertex 2\n" + xyz + "end_header\n", "1 2 3\n4 5 6\n"},
+      {"ply\nformat ascii 1.0\nelement vertex 2\n" + xyz + "end_header\n", "1 2 3\n4 5 6"}, // no last LF
+      {"ply\r\nformat ascii 1.0\r\nelement vertex 2\r\nproperty float x\r\nproperty float y\r\n"
+       "property float z\r\nend_header\r\n",
+       "1 2 3\r\n4 5 6\r\n"},
+      {"ply\nformat binary_little_endian 1.0\nelement vertex 2\n" + xyz +
+           "element face 0\nproperty list uchar int vertex_indices\nend_header\n",
+       two},
+  };
+  for (const auto& [header, body] : files) {
+    msf::test::TempDir dir;
+    write(dir.file("ok.ply"), header + body);
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    EXPECT_EQ(errorOf([&] { msf::loadCloud(dir.file("ok.ply"), cloud); }), "(no error)") << header;
+    EXPECT_EQ(cloud.size(), 2u) << header;
+  }
 }
 
 TEST(FuzzRegressions, CalibrationParsers) {
@@ -340,6 +440,22 @@ TEST(FuzzRegressions, CalibrationParsers) {
       ADD_FAILURE() << f << ": " << e.what();
     }
   }
+}
+
+TEST(FuzzRegressions, AYamlCalibrationWhoseTopLevelIsIndentedIsRefusedBeforeOpenCvLoops) {
+  // fuzz_calibration (600 s run at 3cf9cc6, after ~35 s; the earlier 600 s run had not met
+  // it): a 0.8 KB camera.yaml whose first key is indented by 3 and a later one not, with a value
+  // starting with '-': OpenCV 4.6's cv::FileStorage::open never returned (msf_project -calib
+  // looped until killed).
+  const std::string bytes = bodyOf(fs::path(msf::test::sourceDir()) /
+                                   "tests/io/fuzz_regressions/calibration/timeout-96c63e39dc2d02d384c70be46d69677daf853527");
+  ASSERT_EQ(bytes.at(0) % 4, 3); // fuzz_calibration reads it as camera.yaml
+  msf::test::TempDir dir;
+  write(dir.file("camera.yaml"), bytes.substr(1));
+  const std::string e = errorOf([&] { msf::loadCalibration(dir.file("camera.yaml")); });
+  EXPECT_NE(e.find("camera.yaml' is not valid YAML: line 3: the top level is indented by 3 characters"),
+            std::string::npos)
+      << e;
 }
 
 } // namespace

@@ -106,6 +106,9 @@ def depth_rows(z_of):
 pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
 pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
+inf_rows = depth_rows(lambda u, v: 5.0)
+inf_rows[3][2] = "inf"
+pcd(f + "/inf.pcd", inf_rows)
 pcd(f + "/allnan.pcd", depth_rows(lambda u, v: None))
 pcd(f + "/wrong_fields.pcd", [["1", "2", "3"]] * (W * H), fields="a b c")
 rows = depth_rows(lambda u, v: 5.0)
@@ -118,6 +121,11 @@ with open(f + "/bomb.pcd", "w") as o:
     o.write("\0" * 1300)
 with open(f + "/bomb.ply", "w") as o:
     o.write("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n")
+    o.write("\0" * 1300)
+# PCL's parser reads the count -7 as 2^64 - 7 (fuzz_cloud: it sized the cloud at ~52 GB).
+with open(f + "/negative.ply", "w") as o:
+    o.write("ply\nformat binary_little_endian 1.0\nelement vertex -7\nproperty float x\n"
             "property float y\nproperty float z\nend_header\n")
     o.write("\0" * 1300)
 # A PNG whose header says 30000 x 20000 (the pixels are never read).
@@ -143,6 +151,8 @@ yaml(f + "/fx0.yaml", fx=0.0)
 yaml(f + "/baseline0.yaml", tx1=0.0)
 yaml(f + "/nan.yaml", nan=True)
 yaml(f + "/huge.yaml", w=100000, h=100000)
+# OpenCV 4.6's YAML parser loops forever on an indented top level (fuzz_calibration).
+open(f + "/indented.yaml", "w").write("%YAML:1.0\n k: 4\na: -\n")
 # Poses: one line each.
 I = "1 0 0 0 0 1 0 0 0 0 1 0"
 open(f + "/pose.txt", "w").write(I + "\n")
@@ -207,6 +217,9 @@ check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_
 check "interpolate: POINTS 1e9 in a 1.4 KB .pcd" 1 "bomb.pcd' declares 1000000000 points" -- \
   msf_interpolate "$F/bomb.pcd" o.pcd
 check "info: element vertex 1e9 in a .ply" 1 "declares 1000000000 vertex" -- msf_info "$F/bomb.ply"
+check "info: element vertex -7 in a .ply" 1 "negative.ply' is not a valid .ply file \(bad header\): line 3 'element vertex -7': count '-7' is not a whole number" -- \
+  msf_info "$F/negative.ply"
+check "info: a point at z = inf is not valid" 0 "valid: +47 \(97.9 %\)" -- msf_info "$F/inf.pcd"
 check "integrate -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1e-06" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e-6
 check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 64 voxels" -- \
@@ -229,6 +242,8 @@ check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not f
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/nan.yaml"
 check "pcd2png -disparity, baseline 0" 1 "baseline0.yaml': the grey pair's focal length x baseline is 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/baseline0.yaml"
+check "pcd2png -calib with an indented top level" 1 "indented.yaml' is not valid YAML: line 2: the top level is indented" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/indented.yaml"
 check "pcd2png: a depth of 1e30 m saturates, said" 0 "1 pixel of the depth beyond the format.s largest value \(255.996\) saturate" -- \
   msf_pcd2png "$F/far.pcd" d.png
 check "stereo: 30000x20000 PNG header" 1 "huge.png': image size 30000x20000 is outside 1x1 .. 8192x8192" -- \
@@ -262,6 +277,10 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
+  check "reconstruct -max_memory 1" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
+    msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
   check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \
     msf_reconstruct "$K/odo/sequences/04" -o out
@@ -299,7 +318,7 @@ if [ $have_kitti = 1 ]; then
   fi
 else
   for c in project-huge-calib interpolate-scaled-tr stereo-num-disparities stereo-prior stereo-color p1x \
-           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-voxel-small reconstruct-scans \
+           reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out; do
     skip "$c"
   done

@@ -1,4 +1,5 @@
 #include <msf/common/atomic_file.h>
+#include <msf/common/yaml_check.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
@@ -239,6 +240,7 @@ cv::Mat readMatrixYaml(const cv::FileStorage& in, const std::string& key, int ro
 Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path);
 
 Calibration fromYaml(const std::string& path) {
+  requireYamlTopLevelAtColumnZero(path, "calibration");
   cv::FileStorage in;
   try {
     in.open(path, cv::FileStorage::READ);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -23,14 +24,24 @@ namespace {
 /// LZF's largest ratio is a 264-byte match in 3 bytes; 100 bounds it.
 constexpr std::uint64_t kMaxCompressionRatio = 100;
 
+/// The bytes of a PLY scalar type PCL's parser knows, 0 for any other word.
 std::uint64_t plyTypeSize(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8")
-    return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16")
-    return 2;
-  if (type == "double" || type == "float64")
-    return 8;
-  return 4; // int, uint, float and their sized names
+  static const std::pair<const char*, std::uint64_t> kTypes[] = {
+      {"char", 1},   {"int8", 1},   {"uchar", 1},  {"uint8", 1},  {"short", 2},   {"int16", 2},
+      {"ushort", 2}, {"uint16", 2}, {"int", 4},    {"int32", 4},  {"uint", 4},    {"uint32", 4},
+      {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
+  for (const auto& t : kTypes)
+    if (type == t.first)
+      return t.second;
+  return 0;
+}
+
+/// The count types of a PLY list PCL's parser takes.
+bool plyListCountType(const std::string& type) {
+  for (const char* t : {"uchar", "uint8", "ushort", "uint16", "uint", "uint32", "int", "int32"})
+    if (type == t)
+      return true;
+  return false;
 }
 } // namespace
 
@@ -44,11 +55,13 @@ std::uintmax_t fileSize(const std::string& path) {
   return size;
 }
 
+/// `needed` counts what the header declares up to and with these `count` items; `noun` is
+/// what the file is to the caller ("cloud", "mesh").
 [[noreturn]] void tooManyPoints(const std::string& path, const std::string& what, std::uint64_t count,
-                                double needed, std::uintmax_t available) {
+                                double needed, std::uintmax_t available, const std::string& noun = "cloud") {
   char bytes[32];
   std::snprintf(bytes, sizeof bytes, "%.0f", needed);
-  throw IOError("cloud '" + path + "' declares " + std::to_string(count) + " " + what + " in its header, " +
+  throw IOError(noun + " '" + path + "' declares " + std::to_string(count) + " " + what + " in its header, " +
                 "which need at least " + bytes + " bytes, but the file has " +
                 std::to_string(available) + " after the header (a wrong or truncated file)");
 }
@@ -104,6 +117,22 @@ std::string shownLine(const std::string& line) {
   for (char c : line.substr(0, 60))
     shown += c >= 0x20 && c < 0x7f ? c : '?';
   return line.size() > 60 ? shown + "..." : shown;
+}
+
+/// The words of a header line, split at any of `separators`.
+std::vector<std::string> wordsOf(const std::string& line, const char* separators) {
+  std::vector<std::string> words;
+  std::string word;
+  for (char c : line + ' ') {
+    if (c == ' ' || (c != '\0' && std::strchr(separators, c))) { // strchr finds the NUL that ends `separators`
+      if (!word.empty())
+        words.push_back(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  return words;
 }
 
 /// The whole of `token` as an integer in [low, high], or -1.
@@ -185,19 +214,7 @@ void checkPcdHeader(const std::string& path) {
     header_bytes += line.size() + 1;
     if (line.empty())
       continue;
-    std::vector<std::string> words;
-    {
-      std::string word;
-      for (char c : line + ' ') {
-        if (c == ' ' || c == '\t' || c == '\r') {
-          if (!word.empty())
-            words.push_back(word);
-          word.clear();
-        } else {
-          word += c;
-        }
-      }
-    }
+    const std::vector<std::string> words = wordsOf(line, " \t\r"); // PCL's separators
     if (words.empty())
       bad("a line of blanks");
     std::string key = words[0];
@@ -289,63 +306,118 @@ void checkPcdHeader(const std::string& path) {
   checkPcdBody(path, header, data_type, static_cast<unsigned int>(header_bytes), true);
 }
 
-/// The same for a .ply: its elements' counts (vertices, faces) against the file's size.
-/// A header that cannot be read this way is left to PCL's reader.
-void checkPlyBody(const std::string& path) {
+/// PCL's PLY parser reads an element's count into a std::size_t with operator>>, which takes
+/// "-7" for 2^64 - 7 and sizes the cloud's data from it (52 GB for `element vertex -7`, found
+/// by fuzz/fuzz_cloud), and passes over lines it does not know. The header is read here first,
+/// strictly (the magic line, each line one of the format's keywords, one format, counts whole
+/// numbers, known property types, no duplicates), and the elements' smallest body checked
+/// against the file's size, so that what PCL then reads is what was checked. `what` is "cloud"
+/// or "mesh", for the messages.
+void checkPlyHeader(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
-  std::string line, format;
+  std::string line;
+  std::size_t header_bytes = 0, line_no = 0;
+  auto bad = [&](const std::string& why) {
+    throw IOError(what + " '" + path + "' is not a valid .ply file (bad header): line " + std::to_string(line_no) +
+                  " '" + shownLine(line) + "': " + why);
+  };
   struct Element {
     std::string name;
-    std::uint64_t count = 0, bytes = 0, properties = 0;
+    std::uint64_t count = 0;
+    std::uint64_t bytes = 0;  // of one item in a binary body, each list empty
+    std::uint64_t values = 0; // of one item in an ascii body, each list empty
+    std::set<std::string> properties;
   };
   std::vector<Element> elements;
-  std::size_t header_bytes = 0;
-  bool ended = false;
-  while (header_bytes < (1u << 16) && std::getline(in, line)) {
+  std::string format;
+  bool crlf = false, ended = false;
+  while (!ended) {
+    if (header_bytes >= (1u << 16) || !std::getline(in, line)) {
+      line_no = 0;
+      throw IOError(what + " '" + path + "' is not a valid .ply file (bad header): no end_header line" +
+                    (header_bytes >= (1u << 16) ? " in its first 65536 bytes" : std::string()));
+    }
+    ++line_no;
     header_bytes += line.size() + 1;
-    std::istringstream ss(line);
-    std::string word;
-    ss >> word;
-    if (word == "format") {
-      ss >> format;
-    } else if (word == "element") {
-      Element e;
-      std::string count;
-      ss >> e.name >> count;
-      try {
-        std::size_t used = 0;
-        const double c = std::stod(count, &used);
-        if (used != count.size() || !(c >= 0))
-          return;
-        e.count = c > 1e18 ? std::uint64_t(1e18) : static_cast<std::uint64_t>(c);
-      } catch (const std::exception&) {
-        return;
-      }
-      elements.push_back(e);
-    } else if (word == "property" && !elements.empty()) {
-      std::string type;
-      ss >> type;
-      if (type == "list")
-        ss >> type; // the count's type: a list holds at least its count
-      elements.back().bytes += plyTypeSize(type);
-      ++elements.back().properties;
-    } else if (word == "end_header") {
+    if (line_no == 1) {
+      // PCL takes "ply\r" for a file of CR LF lines, and then every line ends in CR LF.
+      crlf = line == "ply\r";
+      if (line != "ply" && !crlf)
+        bad("the first line is not 'ply'");
+      continue;
+    }
+    if (crlf) {
+      if (line.empty() || line.back() != '\r')
+        bad("a line that does not end in CR LF as the first line does");
+      line.pop_back();
+    }
+    if (line.find('\r') != std::string::npos)
+      bad(crlf ? "a CR inside a line" : "a CR in a file whose first line ends in LF only");
+    const std::vector<std::string> words = wordsOf(line, " \t\v\f"); // isspace, less the CR taken off above
+    if (words.empty())
+      continue; // PCL passes over a line of blanks
+    const std::string& key = words[0];
+    if (key == "comment" || key == "obj_info")
+      continue;
+    if (key == "end_header") {
+      if (words.size() != 1)
+        bad("end_header takes nothing after it");
       ended = true;
-      break;
+    } else if (key == "format") {
+      if (!format.empty())
+        bad("format given twice");
+      if (words.size() != 3 ||
+          (words[1] != "ascii" && words[1] != "binary_little_endian" && words[1] != "binary_big_endian") ||
+          words[2] != "1.0")
+        bad("format is ascii, binary_little_endian or binary_big_endian, version 1.0");
+      format = words[1];
+    } else if (key == "element") {
+      if (words.size() != 3)
+        bad("element takes a name and a count");
+      const long long count = headerInteger(words[2], 0, std::numeric_limits<std::int32_t>::max());
+      if (count < 0 || words[2].find_first_not_of("0123456789") != std::string::npos)
+        bad("count '" + shownLine(words[2]) + "' is not a whole number 0 .. 2147483647");
+      for (const auto& e : elements)
+        if (e.name == words[1])
+          bad("element '" + shownLine(words[1]) + "' given twice");
+      elements.push_back({words[1], static_cast<std::uint64_t>(count), 0, 0, {}});
+    } else if (key == "property") {
+      if (elements.empty())
+        bad("property before any element");
+      Element& e = elements.back();
+      const bool list = words.size() > 1 && words[1] == "list";
+      if (words.size() != (list ? 5u : 3u))
+        bad(list ? "property list takes a count type, a value type and a name" : "property takes a type and a name");
+      const std::string& type = words[list ? 2 : 1];
+      if (list && !plyListCountType(type))
+        bad("type '" + shownLine(type) + "' is not a list's count type (uchar, ushort, uint, int or their sized names)");
+      const std::string& scalar = words[list ? 3 : 1];
+      if (plyTypeSize(scalar) == 0)
+        bad("type '" + shownLine(scalar) + "' is not a PLY scalar type (char, uchar, short, ushort, int, uint, float, "
+            "double or their sized names)");
+      const std::uint64_t size = plyTypeSize(type);
+      if (!e.properties.insert(words.back()).second)
+        bad("property '" + shownLine(words.back()) + "' given twice in element '" + shownLine(e.name) + "'");
+      e.bytes += size; // a list holds at least its count
+      ++e.values;
+    } else {
+      bad("not a header keyword (format, element, property, comment, obj_info, end_header)");
     }
   }
-  if (!ended)
-    return;
+  if (format.empty())
+    bad("no format line before end_header");
   const std::uintmax_t size = fileSize(path);
   const std::uintmax_t available = size > header_bytes ? size - header_bytes : 0;
   const bool ascii = format == "ascii";
+  double needed = 0;
   for (const auto& e : elements) {
-    const std::uint64_t per = ascii ? 2 * e.properties : e.bytes;
-    if (per == 0)
-      continue;
-    const double needed = static_cast<double>(e.count) * static_cast<double>(per);
-    if (needed > static_cast<double>(available) + 1)
-      tooManyPoints(path, e.name + " elements", e.count, needed, available);
+    if (e.count > 0 && e.properties.empty())
+      throw IOError(what + " '" + path + "' is not a valid .ply file (bad header): element '" + shownLine(e.name) +
+                    "' has " + std::to_string(e.count) + " items but no property");
+    // An ascii item is a line of its values, each followed by a blank or the line's end.
+    needed += static_cast<double>(e.count) * static_cast<double>(ascii ? 2 * e.values : e.bytes);
+    if (needed > static_cast<double>(available) + (ascii ? 1 : 0)) // the last line may lack its end
+      tooManyPoints(path, e.name + " elements", e.count, needed, available, what);
   }
 }
 
@@ -390,7 +462,7 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
       checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
       result = reader.read(path, blob);
     } else if (ext == ".ply") {
-      checkPlyBody(path);
+      checkPlyHeader(path, "cloud");
       result = pcl::PLYReader().read(path, blob);
     } else {
       throw IOError("cloud '" + path + "' is neither .pcd nor .ply");
@@ -426,7 +498,7 @@ void loadMesh(const std::string& path, pcl::PolygonMesh& mesh) {
   const std::string ext = fileExtension(path);
   int result = -1;
   if (ext == ".ply") {
-    checkPlyBody(path);
+    checkPlyHeader(path, "mesh");
     result = pcl::io::loadPLYFile(path, mesh);
   }
   else if (ext == ".obj")
