@@ -291,7 +291,7 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
 }
 
 double TsdfIntegrator::reach(const PinholeCamera& camera) const {
-  // The band behind a surface (see integrate's step 0): at most max(truncation, a voxel over
+  // The band behind a surface (see integrate's step 0): at most max(truncation, planeBand over
   // the least plane scale, the depth's sigmas), the sigma from the least weight a pixel can
   // have and still be integrated.
   const double trunc = volume_.truncation(), vs = volume_.voxelSize();
