@@ -133,3 +133,60 @@ TEST(SmoothSurfaceExtent, HowFarTheSurfaceGoesOnAlongItsRowAndColumn) {
   EXPECT_EQ(extent.at<float>(230, 300), 0.f);
   EXPECT_THROW(smoothSurfaceExtent(cv::Mat(4, 4, CV_16UC1), 0.05f, extent), InvalidInputError);
 }
+
+namespace {
+
+/// Whether 1/z bends by more than `curvature` of itself at sample i of a line (0 = no depth).
+bool bendsAt(const std::vector<float>& line, int i, float curvature) {
+  auto inverse = [&](int k) { return k >= 0 && k < static_cast<int>(line.size()) && line[k] > 0.f ? 1.f / line[k] : 0.f; };
+  const float a = inverse(i - 1), b = inverse(i), c = inverse(i + 1);
+  return a > 0.f && b > 0.f && c > 0.f && std::abs(a + c - 2.f * b) > curvature * b;
+}
+
+/// The largest depth of sample i's run along a line, walking out from it one sample at a time.
+float runLargest(const std::vector<float>& line, int i, float curvature) {
+  if (!(line[i] > 0.f))
+    return 0.f;
+  auto joined = [&](int k) { // sample k continues the run of sample k - 1
+    return line[k - 1] > 0.f && line[k] > 0.f && !bendsAt(line, k, curvature) && !bendsAt(line, k - 1, curvature);
+  };
+  float largest = line[i];
+  for (int k = i; k > 0 && joined(k); --k)
+    largest = std::max(largest, line[k - 1]);
+  for (int k = i + 1; k < static_cast<int>(line.size()) && joined(k); ++k)
+    largest = std::max(largest, line[k]);
+  return largest;
+}
+
+} // namespace
+
+TEST(SmoothSurfaceExtent, EqualsItsDefinitionPixelByPixel) {
+  // Sizes that are no multiple of the SIMD width or of the column strips, depth with holes,
+  // NaN, negative values, smooth stretches and noise: the run-length passes must give, bit for
+  // bit, the extent walked out from each pixel along its row and its column.
+  cv::RNG rng(11);
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(3, 2), cv::Size(37, 5), cv::Size(130, 17), cv::Size(67, 66)}) {
+    cv::Mat depth(size, CV_32FC1);
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u) {
+        const double kind = rng.uniform(0.0, 1.0);
+        depth.at<float>(v, u) = kind < 0.1   ? 0.f
+                                : kind < 0.13 ? std::nanf("")
+                                : kind < 0.15 ? -1.f
+                                : kind < 0.6  ? 5.f + 0.01f * u + 0.02f * v // a smooth surface
+                                              : static_cast<float>(rng.uniform(1.0, 30.0));
+      }
+    const float curvature = 0.05f;
+    cv::Mat extent;
+    smoothSurfaceExtent(depth, curvature, extent);
+    for (int v = 0; v < size.height; ++v)
+      for (int u = 0; u < size.width; ++u) {
+        std::vector<float> row(depth.ptr<float>(v), depth.ptr<float>(v) + size.width), column;
+        for (int k = 0; k < size.height; ++k)
+          column.push_back(depth.at<float>(k, u));
+        const float d = depth.at<float>(v, u);
+        const float expected = d > 0.f ? std::max(runLargest(row, u, curvature), runLargest(column, v, curvature)) - d : 0.f;
+        ASSERT_EQ(extent.at<float>(v, u), expected) << size << " at " << u << "," << v;
+      }
+  }
+}
