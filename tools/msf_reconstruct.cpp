@@ -612,9 +612,12 @@ int main(int argc, char** argv) {
             if (evaluation)
               evaluation->scoreDepth("paper", r.index, p.fused.depth);
           }
-          for (auto& map : source_maps)
-            map->integrator.integrate(
-                msf::sourceDepthFrame(r, map->source, config.fusion, calibration.focalBaseline()), r.T_world_cam0);
+          for (auto& map : source_maps) {
+            const msf::DepthFrame frame = msf::sourceDepthFrame(r, map->source, config.fusion, calibration.focalBaseline());
+            map->integrator.integrate(frame, r.T_world_cam0);
+            if (map->source == msf::DepthSource::Lidar) // the LiDAR's own free space; SGBM alone has none
+              msf::carveWithScan(map->integrator, r, frame.camera, config.fusion, calibration);
+          }
           if (save_depth)
             msf::saveCloud((fs::path(stage) / "depth" / (r.name + ".pcd")).string(), fusedCloud(r.fused, calibration));
           if (panel_frames.count(r.index)) {

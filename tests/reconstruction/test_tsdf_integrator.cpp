@@ -6,6 +6,7 @@
 #include <msf/io/point_types.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/mesh_rasterizer.h>
+#include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <pcl/conversions.h>
@@ -456,6 +457,45 @@ std::vector<Eigen::Vector3d> roadSeen(const AnalyticScene& scene, const PinholeC
   return points;
 }
 
+/// The LiDAR's frame (x forward, y left, z up) at a camera-like pose of the street (x right,
+/// y down, z forward) at `position`.
+Eigen::Isometry3d lidarPose(const Eigen::Vector3d& position) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear().col(0) = Eigen::Vector3d::UnitZ();
+  T.linear().col(1) = -Eigen::Vector3d::UnitX();
+  T.linear().col(2) = -Eigen::Vector3d::UnitY();
+  T.translation() = position;
+  return T;
+}
+
+/// A 64-ring scan of `scene` (HDL-64's elevations, -24.8 to +2 degrees; 0.2 degrees of
+/// azimuth) from T_world_lidar, by sphere tracing, in the LiDAR's frame; rays that hit nothing
+/// within 80 m give no return.
+pcl::PointCloud<pcl::PointXYZI> ringScan(const AnalyticScene& scene, const Eigen::Isometry3d& T_world_lidar) {
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  for (int ring = 0; ring < 64; ++ring) {
+    const double elevation = (-24.8 + 26.8 * ring / 63.0) * M_PI / 180.0;
+    for (double azimuth = -180.0; azimuth < 180.0; azimuth += 0.2) {
+      const double a = azimuth * M_PI / 180.0;
+      const Eigen::Vector3d d(std::cos(elevation) * std::cos(a), std::cos(elevation) * std::sin(a), std::sin(elevation));
+      const Eigen::Vector3d d_world = T_world_lidar.linear() * d;
+      double t = 0.05;
+      for (int step = 0; step < 400 && t < 80.0; ++step) {
+        const double s = scene.signedDistance(T_world_lidar.translation() + t * d_world);
+        if (s < 1e-4) {
+          pcl::PointXYZI p;
+          p.getVector3fMap() = (t * d).cast<float>();
+          p.intensity = 0.f;
+          scan.push_back(p);
+          break;
+        }
+        t += s;
+      }
+    }
+  }
+  return scan;
+}
+
 } // namespace
 
 TEST(TsdfIntegrator, GrazingGroundIsMeshedWithThePlaneDistance) {
@@ -696,5 +736,122 @@ TEST(TsdfIntegrator, SolveKeysAreNamedWhenWrong) {
       EXPECT_NE(std::string(e.what()).find("tsdf_integrator." + key.substr(0, key.find(':'))), std::string::npos)
           << e.what();
     }
+  }
+}
+
+TEST(ScanFreeSpace, TheNearestReturnAroundADirection) {
+  // Returns on a sphere 10 m around the sensor, one nearer return at 6 m straight ahead.
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  for (double el = -20; el <= 10; el += 0.25)
+    for (double az = -180; az < 180; az += 0.2) {
+      const double e = el * M_PI / 180, a = az * M_PI / 180;
+      pcl::PointXYZI p;
+      p.x = static_cast<float>(10 * std::cos(e) * std::cos(a));
+      p.y = static_cast<float>(10 * std::cos(e) * std::sin(a));
+      p.z = static_cast<float>(10 * std::sin(e));
+      scan.push_back(p);
+    }
+  pcl::PointXYZI near;
+  near.x = 6.f;
+  near.y = near.z = 0.f;
+  scan.push_back(near);
+  pcl::PointXYZI bad;
+  bad.x = bad.y = bad.z = std::nanf("");
+  scan.push_back(bad);
+  const ScanFreeSpace free_space(scan);
+  ASSERT_FALSE(free_space.empty());
+  EXPECT_NEAR(free_space.nearestAround(Eigen::Vector3f(0, 5, 0.5f)), 10.f, 1e-3f);
+  EXPECT_NEAR(free_space.nearestAround(Eigen::Vector3f(-3, -2, -1)), 10.f, 1e-3f);
+  // The near return lowers its bin and the 8 around it, not farther ones.
+  EXPECT_NEAR(free_space.nearestAround(Eigen::Vector3f(3, 0, 0)), 6.f, 1e-3f);
+  const float beside = std::tan(0.5f * static_cast<float>(M_PI) / 180.f); // 0.5 degrees: the next bin
+  EXPECT_NEAR(free_space.nearestAround(Eigen::Vector3f(1, beside, 0)), 6.f, 1e-3f);
+  EXPECT_NEAR(free_space.nearestAround(Eigen::Vector3f(1, 4 * beside, 0)), 10.f, 1e-3f);
+  // Above every return (no return in the bin) and beyond the elevations kept: nothing known.
+  EXPECT_EQ(free_space.nearestAround(Eigen::Vector3f(1, 0, 0.5f)), 0.f);
+  EXPECT_EQ(free_space.nearestAround(Eigen::Vector3f(0, 0, 1)), 0.f);
+  EXPECT_TRUE(ScanFreeSpace().empty());
+  EXPECT_EQ(ScanFreeSpace().nearestAround(Eigen::Vector3f(1, 0, 0)), 0.f);
+}
+
+TEST(TsdfIntegrator, ScanCarvingClearsWhatDroveAwayOutOfViewAndKeepsTheStreet) {
+  // An oncoming car 8 m ahead in the other lane at frame 0; it has passed by frame 1, when the
+  // camera is 12 m on and never sees its place again. The camera's own free space cannot clear
+  // it; the LiDAR's scans, all around, see the road behind through it.
+  const PinholeCamera camera = streetCamera();
+  AnalyticScene with_car = street(0, -1);
+  with_car.addBox(Eigen::Vector3d(-2.5, 1.65 - 0.75, 8.0), Eigen::Vector3d(0.9, 0.75, 2.2));
+  const AnalyticScene static_street = street(0, -1);
+  std::size_t ghosts[2] = {0, 0};
+  double road[2] = {0, 0}, wall[2] = {0, 0};
+  for (const bool scan_carving : {false, true}) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator::Config c;
+    c.scan_carving_m = scan_carving ? 20.0 : 0.0;
+    TsdfIntegrator integrator(volume, c);
+    for (const int z : {0, 12, 16}) {
+      const AnalyticScene& scene = z == 0 ? with_car : static_street;
+      const DepthFrame frame = test::renderFrame(scene, camera, streetPose(z), 0.0);
+      integrator.integrate(frame, streetPose(z));
+      const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d(0, 0, z));
+      integrator.carveWithScan(ScanFreeSpace(ringScan(scene, T_world_lidar)), T_world_lidar, 1111.f, frame.camera,
+                               streetPose(z));
+    }
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    // The car's sides and top, half a metre and more above the road.
+    for (const auto& v : mesh.vertices)
+      ghosts[scan_carving] += v.x() > -3.5f && v.x() < -1.5f && v.y() < 1.15f && v.z() > 5.7f && v.z() < 10.3f;
+    // The road and the wall that frame 0 saw behind where the camera ends.
+    std::vector<Eigen::Vector3d> road_points, wall_points;
+    for (double z = 7; z < 10; z += 0.25) {
+      for (double x = -1; x < 3; x += 0.25)
+        road_points.push_back(Eigen::Vector3d(x, 1.65, z));
+      for (double y = 0; y < 1.5; y += 0.25)
+        wall_points.push_back(Eigen::Vector3d(4.0, y, z));
+    }
+    road[scan_carving] = coveredShare(mesh, road_points, 0.1);
+    wall[scan_carving] = coveredShare(mesh, wall_points, 0.1);
+    std::printf("  scan carving %d: %zu ghost vertices, road %.3f, wall %.3f\n", scan_carving, ghosts[scan_carving],
+                road[scan_carving], wall[scan_carving]);
+  }
+  EXPECT_GT(ghosts[0], 500u);
+  EXPECT_LT(ghosts[1], ghosts[0] / 10);
+  // The static street out of view stays, the road at the LiDAR's grazing angles too.
+  EXPECT_GE(road[0], 0.98);
+  EXPECT_GE(road[1], road[0] - 0.005);
+  EXPECT_GE(wall[1], wall[0] - 0.005);
+}
+
+TEST(TsdfIntegrator, ScanCarvingLeavesWhatTheCameraSeesToTheCamera) {
+  // The car stays in view; a scan that sees through it (it is not in the scan's world) must
+  // not carve it: in view, the frame's own depth decides.
+  const PinholeCamera camera = streetCamera();
+  AnalyticScene with_car = street(0, -1);
+  with_car.addBox(Eigen::Vector3d(0, 1.65 - 0.75, 10.0), Eigen::Vector3d(0.9, 0.75, 2.2));
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  const DepthFrame frame = test::renderFrame(with_car, camera, streetPose(0), 0.0);
+  integrator.integrate(frame, streetPose(0));
+  TriangleMesh before, after;
+  MarchingCubes().extract(volume, before);
+  const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d::Zero());
+  integrator.carveWithScan(ScanFreeSpace(ringScan(street(0, -1), T_world_lidar)), T_world_lidar, 1111.f, frame.camera,
+                           streetPose(0));
+  MarchingCubes().extract(volume, after);
+  EXPECT_EQ(after.vertices.size(), before.vertices.size());
+  EXPECT_THROW(integrator.carveWithScan(ScanFreeSpace(ringScan(street(0, -1), T_world_lidar)), T_world_lidar, 0.f,
+                                        frame.camera, streetPose(0)),
+               InvalidInputError);
+}
+
+TEST(TsdfIntegrator, ScanCarvingRangeIsAValidatedKey) {
+  TsdfIntegrator::Config c;
+  c.scan_carving_m = -1.0;
+  try {
+    c.validate();
+    FAIL() << "a negative scan_carving_m was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("scan_carving_m"), std::string::npos) << e.what();
   }
 }

@@ -70,6 +70,8 @@ void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
+  if (config_.integrator.scan_carving_m > 0.0 && config_.integrator.space_carving)
+    result.scan_free_space = ScanFreeSpace(*frame.scan);
   result.times.lidar_ms = msSince(start);
   if (keep_sparse_)
     stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);
@@ -129,6 +131,15 @@ FrameResult Pipeline::computeDepth(const Frame& frame) {
   return result;
 }
 
+void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
+                   const DepthFusionConfig& fusion, const Calibration& calibration) {
+  if (!integrator.getConfig().space_carving || result.scan_free_space.empty())
+    return;
+  const double sigma = fusion.lidar_range_sigma_m;
+  integrator.carveWithScan(result.scan_free_space, result.T_world_cam0 * calibration.T_cam0_velo,
+                           static_cast<float>(1.0 / (sigma * sigma)), camera, result.T_world_cam0);
+}
+
 void Pipeline::integrate(FrameResult& result) {
   if (!result.has_pose)
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
@@ -136,7 +147,9 @@ void Pipeline::integrate(FrameResult& result) {
   const auto start = Clock::now();
   if (streaming_)
     streaming_->beforeIntegration(result.T_world_cam0.translation());
-  integrator_->integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), result.T_world_cam0);
+  const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
+  integrator_->integrate(frame, result.T_world_cam0);
+  carveWithScan(*integrator_, result, frame.camera, config_.fusion, calibration_);
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
     streaming_->afterIntegration(result.T_world_cam0.translation());

@@ -118,6 +118,18 @@ void traverseCells(const Eigen::Vector3f& a, const Eigen::Vector3f& b, Visit&& v
   }
 }
 
+/// Whether a sphere (centre in the camera frame) may appear in the camera's image: in front of
+/// min_depth and its projection, grown by its radius in pixels, overlapping the image.
+bool sphereInView(const Eigen::Vector3f& c, float radius, const PinholeCamera& cam, float min_d) {
+  if (c.z() + radius < min_d)
+    return false;
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float z = std::max(c.z(), min_d);
+  const float r_px = std::max(fx, fy) * radius / z;
+  const float u = fx * c.x() / z + static_cast<float>(cam.cx), v = fy * c.y() / z + static_cast<float>(cam.cy);
+  return u >= -r_px && v >= -r_px && u <= cam.width + r_px && v <= cam.height + r_px;
+}
+
 /// Running weighted mean of one observation into a voxel.
 inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight, float trunc) {
   const float total = voxel.weight + w;
@@ -180,6 +192,7 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "truncation_sigmas", truncation_sigmas);
   readKey(node, "space_carving", space_carving);
   readKey(node, "carving_weight", carving_weight);
+  readKey(node, "scan_carving_m", scan_carving_m);
   readKey(node, "weight_dropoff", weight_dropoff);
   std::string distance = toString(signed_distance);
   readKey(node, "signed_distance", distance);
@@ -216,6 +229,9 @@ void TsdfIntegrator::Config::validate() const {
     throw ConfigError("tsdf_integrator.truncation_sigmas must be >= 0, got " + std::to_string(truncation_sigmas));
   if (!(carving_weight >= 0.0) || !std::isfinite(carving_weight))
     throw ConfigError("tsdf_integrator.carving_weight must be >= 0, got " + std::to_string(carving_weight));
+  if (!(scan_carving_m >= 0.0) || !(scan_carving_m <= kMaxDepthM))
+    throw ConfigError("tsdf_integrator.scan_carving_m must be in [0, " + std::to_string(kMaxDepthM) + "] (0 = off), got " +
+                      std::to_string(scan_carving_m));
   if (plane.step_px < 1 || plane.step_px > 64)
     throw ConfigError("tsdf_integrator.plane_step_px must be in 1..64, got " + std::to_string(plane.step_px));
   if (!(plane.max_curvature >= 0.f) || !std::isfinite(plane.max_curvature))
@@ -247,6 +263,7 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  truncation_sigmas: " << configValue(truncation_sigmas) << "\n"
       << "  space_carving: " << configValue(space_carving) << "\n"
       << "  carving_weight: " << configValue(carving_weight) << "\n"
+      << "  scan_carving_m: " << configValue(scan_carving_m) << "\n"
       << "  weight_dropoff: " << configValue(weight_dropoff) << "\n"
       << "  signed_distance: " << toString(signed_distance) << "\n"
       << "  plane_step_px: " << configValue(plane.step_px) << "\n"
@@ -504,13 +521,10 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       if (block->stamp == mark || !block->negative_subblocks)
         continue;
       const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
-      if (c.z() + radius < min_d)
+      if (!sphereInView(c, radius, cam, min_d))
         continue;
       const float z = std::max(c.z(), min_d);
-      const float r_px = std::max(fx, fy) * radius / z;
       const float u = fx * c.x() / z + cx, v = fy * c.y() / z + cy;
-      if (u < -r_px || v < -r_px || u > width + r_px || v > height + r_px)
-        continue;
       const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, width - 1);
       const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
       const float d = depth_image.at<float>(vi, ui);
@@ -736,6 +750,66 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   if (regularized)
     regularize(touched, offsets);
   stats_.regularize_ms = msSince(t_reg);
+}
+
+void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
+                                   const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam) {
+  if (!(config_.scan_carving_m > 0.0) || free_space.empty())
+    return;
+  if (!(weight > 0.f) || !std::isfinite(weight))
+    throw InvalidInputError("carveWithScan: the LiDAR's weight must be positive and finite, got " + std::to_string(weight));
+  limits::checkRigid(T_world_lidar, "T_world_lidar (the scan's pose)");
+  limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
+  const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
+  const float min_d = static_cast<float>(config_.min_depth_m), max_range = static_cast<float>(config_.scan_carving_m);
+  const float margin = trunc + vs, w = weight * static_cast<float>(config_.carving_weight);
+  if (!(w > 0.f))
+    return;
+  const Eigen::Isometry3f T_lidar_world = T_world_lidar.inverse().cast<float>();
+  const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
+  const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
+  std::vector<TsdfBlock*> blocks;
+  for (const auto& block : volume_.blocks()) {
+    if (!block->negative_subblocks)
+      continue;
+    const Eigen::Vector3f centre = (block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs;
+    if ((T_lidar_world * centre).norm() - radius > max_range || sphereInView(T_cam_world * centre, radius, camera, min_d))
+      continue;
+    blocks.push_back(block);
+  }
+  const std::uint64_t stamp = volume_.beginGeneration();
+  const float max_weight = config_.max_weight;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+    for (int n = range.start; n < range.end; ++n) {
+      TsdfBlock& block = *blocks[static_cast<std::size_t>(n)];
+      const Eigen::Vector3f origin = T_lidar_world * (block.origin().cast<float>() * vs);
+      const Eigen::Matrix3f axes = T_lidar_world.linear() * vs;
+      bool changed = false;
+      for (int sub = 0; sub < 8; ++sub) {
+        if (!(block.negative_subblocks & (1u << sub)))
+          continue;
+        const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = sub & 4;
+        for (int z = sz; z < sz + 4; ++z)
+          for (int y = sy; y < sy + 4; ++y)
+            for (int x = sx; x < sx + 4; ++x) {
+              TsdfVoxel& voxel = block.at(x, y, z);
+              if (!(voxel.sdf < 0.f && voxel.weight > 0.f))
+                continue;
+              const Eigen::Vector3f p = origin + axes * Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
+                                                                        static_cast<float>(z));
+              const float nearest = free_space.nearestAround(p);
+              if (nearest > 0.f && p.norm() < nearest - margin) {
+                updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                changed = true;
+              }
+            }
+      }
+      if (changed) {
+        block.updateSigns();
+        block.stamp = stamp;
+      }
+    }
+  });
 }
 
 float TsdfIntegrator::depthWeight(float depth) const {

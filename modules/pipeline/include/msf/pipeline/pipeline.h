@@ -37,6 +37,9 @@ struct FrameResult {
   /// what the map takes beyond the image's border (fusedDepthFrame).
   cv::Mat lidar_canvas_depth, lidar_canvas_distance;
   PinholeCamera lidar_canvas_camera;
+  /// The scan's free space all around (tsdf_integrator.scan_carving_m): what the map clears
+  /// outside the camera's view (TsdfIntegrator::carveWithScan).
+  ScanFreeSpace scan_free_space;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
@@ -44,6 +47,13 @@ struct FrameResult {
   DepthFrame fused;
   StageTimes times;
 };
+
+/// Free space from the frame's whole scan, after its depth is integrated (see
+/// TsdfIntegrator::carveWithScan; nothing when tsdf_integrator.scan_carving_m is 0 or
+/// space_carving is off): a return weighs as the fusion weighs a LiDAR-backed pixel, its range noise
+/// (fusion.lidar_range_sigma_m). `camera` is the integrated frame's.
+void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
+                   const DepthFusionConfig& fusion, const Calibration& calibration);
 
 /// The whole method (the README's data flow) for a sequence: per frame, LiDAR projection and
 /// compound interpolation (LidarCompletion: the scan is projected onto the image grown by

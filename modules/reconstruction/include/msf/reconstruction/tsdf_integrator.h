@@ -1,6 +1,7 @@
 #pragma once
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/plane_distance.h>
+#include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Geometry>
@@ -88,6 +89,11 @@ public:
     /// through is weaker evidence than the surface it hit, so a surface seen from many frames
     /// outlasts a few wrong rays while one seen once (a car that drove on) is cleared.
     double carving_weight = 1.0;
+    /// Also carve with the LiDAR's whole scan outside the camera's view (carveWithScan), up to
+    /// this distance from the LiDAR (0 = off): an oncoming car that passed the camera is never
+    /// seen by it again, and stayed a ghost. Farther, a bin of the scan (0.4 degrees, 14 cm at
+    /// 20 m) grows wider than a voxel and the conservative test carves less and less.
+    double scan_carving_m = 20.0;
     /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
     /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
     bool weight_dropoff = true;
@@ -120,7 +126,7 @@ public:
 
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
     /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
-    /// space_carving, carving_weight,
+    /// space_carving, carving_weight, scan_carving_m,
     /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
     /// plane_min_scale, lambda, sweeps, solve (sweeps | argmin), argmin_tolerance_m,
     /// argmin_max_sweeps, min_depth_m, max_depth_m, interpolate_depth,
@@ -156,6 +162,17 @@ public:
   /// Integrates a depth frame seen from T_world_cam (camera to world).
   /// Throws InvalidInputError (see DepthFrame::validate).
   void integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
+
+  /// Free space that a LiDAR scan saw outside the camera's view (Config::scan_carving_m > 0):
+  /// in blocks that hold a surface (a voxel with sdf < 0) within scan_carving_m of the LiDAR,
+  /// wholly outside `camera`'s view from T_world_cam (there the frame's own depth carves), each
+  /// such voxel that lies in front of every return around its direction by more than the
+  /// truncation and a voxel takes a free-space update of `weight` (m^-2, the LiDAR's inverse
+  /// variance) times carving_weight. Conservative: only where the scan has returns, and only
+  /// voxels behind a surface (the ones that make it), so that a road seen at a grazing angle,
+  /// whose returns lie around it, is left alone.
+  void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
+                     const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are

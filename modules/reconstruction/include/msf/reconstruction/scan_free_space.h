@@ -1,0 +1,38 @@
+#pragma once
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+namespace msf {
+
+/// What one LiDAR scan says is free space, all around the sensor: per direction (bins of 0.4
+/// degrees of azimuth by 0.5 of elevation, about the spacing of a 64-ring scanner's rings),
+/// the nearest return in the bin and its 8 neighbours. A point nearer than that, in a bin that
+/// holds a return, lies in front of every return around its direction: the laser passed
+/// through it. A bin without a return (sky, glass, black paint) says nothing.
+///
+/// The camera sees a quarter of what the LiDAR sees; TsdfIntegrator::carveWithScan uses the
+/// rest to clear what moved away out of the camera's view (an oncoming car that passed).
+/// (pcl::RangeImageSpherical keeps the nearest return per cell too, but its lookups and its
+/// construction are several times slower, and the 3 x 3 minimum is what a lookup needs.)
+class ScanFreeSpace {
+public:
+  static constexpr float kAzimuthBinDeg = 0.4f, kElevationBinDeg = 0.5f;
+  static constexpr float kMinElevationDeg = -30.f, kMaxElevationDeg = 15.f;
+
+  ScanFreeSpace() = default;
+  /// From the returns of one scan, in the sensor's frame (x forward, z up); non-finite points
+  /// and points at the sensor are skipped.
+  explicit ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan);
+
+  bool empty() const { return nearest_.empty(); }
+  /// The nearest return around the direction of `p` (sensor frame), or 0 where the direction's
+  /// own bin holds no return or lies outside the elevations kept.
+  float nearestAround(const Eigen::Vector3f& p) const;
+
+private:
+  cv::Mat nearest_; // CV_32FC1, elevation rows x azimuth columns, 0 = nothing known
+};
+
+} // namespace msf

@@ -1,0 +1,71 @@
+#include <msf/reconstruction/scan_free_space.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <limits>
+
+namespace msf {
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+constexpr float kToDeg = 180.f / kPi;
+constexpr int kColumns = static_cast<int>(360.f / ScanFreeSpace::kAzimuthBinDeg + 0.5f);
+constexpr int kRows =
+    static_cast<int>((ScanFreeSpace::kMaxElevationDeg - ScanFreeSpace::kMinElevationDeg) / ScanFreeSpace::kElevationBinDeg +
+                     0.5f);
+
+/// atan2 within 0.1 degree (a fifth of a bin), several times faster than std::atan2.
+inline float fastAtan2(float y, float x) {
+  const float ax = std::abs(x), ay = std::abs(y);
+  const float a = std::min(ax, ay) / std::max(std::max(ax, ay), 1e-30f);
+  const float s = a * a;
+  float r = ((-0.0464964749f * s + 0.15931422f) * s - 0.327622764f) * s * a + a;
+  if (ay > ax)
+    r = 0.5f * kPi - r;
+  if (x < 0.f)
+    r = kPi - r;
+  return y < 0.f ? -r : r;
+}
+
+/// The bin of a direction, false outside the elevations kept.
+inline bool binOf(float x, float y, float z, int& row, int& column) {
+  const float azimuth = fastAtan2(y, x) * kToDeg + 180.f; // [0, 360]
+  const float elevation = fastAtan2(z, std::sqrt(x * x + y * y)) * kToDeg;
+  row = static_cast<int>((elevation - ScanFreeSpace::kMinElevationDeg) / ScanFreeSpace::kElevationBinDeg);
+  column = static_cast<int>(azimuth / ScanFreeSpace::kAzimuthBinDeg) % kColumns;
+  return elevation >= ScanFreeSpace::kMinElevationDeg && row < kRows;
+}
+
+} // namespace
+
+ScanFreeSpace::ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan) {
+  constexpr float kNone = std::numeric_limits<float>::infinity();
+  cv::Mat nearest(kRows, kColumns, CV_32FC1, cv::Scalar(kNone));
+  for (const auto& p : scan) {
+    const float range = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    int row, column;
+    if (!(range > 1e-3f) || !std::isfinite(range) || !binOf(p.x, p.y, p.z, row, column))
+      continue;
+    float& bin = nearest.at<float>(row, column);
+    bin = std::min(bin, range);
+  }
+  // The minimum over each bin's 3 x 3 neighbourhood, azimuth wrapping round; empty bins hold
+  // infinity, so they do not lower it, and give 0 where the bin itself is empty.
+  cv::Mat wrapped;
+  cv::copyMakeBorder(nearest, wrapped, 0, 0, 1, 1, cv::BORDER_WRAP);
+  cv::Mat eroded;
+  cv::erode(wrapped, eroded, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(kNone));
+  nearest_ = eroded.colRange(1, kColumns + 1).clone();
+  nearest_.setTo(0.f, nearest == kNone);
+}
+
+float ScanFreeSpace::nearestAround(const Eigen::Vector3f& p) const {
+  int row, column;
+  if (nearest_.empty() || !binOf(p.x(), p.y(), p.z(), row, column))
+    return 0.f;
+  return nearest_.at<float>(row, column);
+}
+
+} // namespace msf
