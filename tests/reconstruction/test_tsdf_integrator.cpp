@@ -823,6 +823,39 @@ TEST(TsdfIntegrator, ScanCarvingClearsWhatDroveAwayOutOfViewAndKeepsTheStreet) {
   EXPECT_GE(wall[1], wall[0] - 0.005);
 }
 
+TEST(TsdfIntegrator, ScanCarvingKeepsAThinBoardSeenFromBehindByASkewedSweep) {
+  // A board 10 cm thick, seen from the front at frame 0, is behind the camera at frame 1,
+  // where the LiDAR sees its back. The sweep is not motion-compensated: its returns lie half a
+  // metre beyond the board. The board's front surface, a few centimetres behind its back from
+  // the LiDAR, must stay.
+  const PinholeCamera camera = streetCamera();
+  AnalyticScene scene = street(0, -1);
+  scene.addBox(Eigen::Vector3d(-1.5, 0.5, 6.0), Eigen::Vector3d(1.0, 1.0, 0.05));
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  integrator.integrate(test::renderFrame(scene, camera, streetPose(0), 0.0), streetPose(0));
+  auto board = [&] {
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    std::size_t n = 0;
+    for (const auto& v : mesh.vertices)
+      n += v.x() > -2.4f && v.x() < -0.6f && v.y() > -0.4f && v.y() < 1.4f && std::abs(v.z() - 6.f) < 0.3f;
+    return n;
+  };
+  const std::size_t before = board();
+  const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d(0, 0, 12));
+  pcl::PointCloud<pcl::PointXYZI> scan = ringScan(scene, T_world_lidar);
+  for (auto& p : scan)
+    p.getVector3fMap() *= (p.getVector3fMap().norm() + 0.5f) / p.getVector3fMap().norm();
+  const DepthFrame frame = test::renderFrame(scene, camera, streetPose(12), 0.0);
+  integrator.integrate(frame, streetPose(12));
+  integrator.carveWithScan(ScanFreeSpace(scan), T_world_lidar, 1111.f, frame.camera, streetPose(12));
+  const std::size_t after = board();
+  std::printf("  board vertices %zu before the skewed scan, %zu after\n", before, after);
+  EXPECT_GT(before, 200u);
+  EXPECT_GE(after, before * 95 / 100);
+}
+
 TEST(TsdfIntegrator, ScanCarvingLeavesWhatTheCameraSeesToTheCamera) {
   // The car stays in view; a scan that sees through it (it is not in the scan's world) must
   // not carve it: in view, the frame's own depth decides.

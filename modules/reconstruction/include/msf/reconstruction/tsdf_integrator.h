@@ -167,7 +167,8 @@ public:
   /// in blocks that hold a surface (a voxel with sdf < 0) within scan_carving_m of the LiDAR,
   /// wholly outside `camera`'s view from T_world_cam (there the frame's own depth carves), each
   /// such voxel that lies in front of every return around its direction by more than the
-  /// truncation and a voxel takes a free-space update of `weight` (m^-2, the LiDAR's inverse
+  /// truncation, a voxel and 0.6 m (a sweep's skew: scans are not motion-compensated) takes a
+  /// free-space update of `weight` (m^-2, the LiDAR's inverse
   /// variance) times carving_weight. Conservative: only where the scan has returns, and only
   /// voxels behind a surface (the ones that make it), so that a road seen at a grazing angle,
   /// whose returns lie around it, is left alone.
