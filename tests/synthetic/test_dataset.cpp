@@ -265,11 +265,12 @@ TEST_F(SyntheticDataset, SameSeedGivesByteIdenticalFilesAndAnotherSeedDoesNot) {
   EXPECT_GT(cv::norm(image, different.renderFrame(0, false).images[0], cv::NORM_L1), 10.0 * image.total());
 }
 
-TEST(SyntheticRendering, ColourImagesArePixelForPixelThoseOfTheBinaryHierarchy) {
+TEST(SyntheticRendering, ColourImagesWithTiedSolidsArePixelForPixelAsBefore) {
   // Frames of the default 40-frame loop (msf_synth -frames 40 -loop) whose pixels, hashed
   // (FNV-1a 64 of the rows), are those b42915f rendered: each holds one ray whose nearest
-  // solids tie (coplanar faces), where the 4-wide hierarchy must keep the binary one's pick
-  // (in frame 8, solid 346 over 345: not the lower index).
+  // solids tie (coplanar faces; in frame 8, solid 346 over 345, not the lower index). A ray
+  // caster that meets solids in another order (a 4-wide hierarchy by lowest index did)
+  // changes them, and so the datasets a seed gives.
   SyntheticConfig config;
   config.frames = 40;
   config.loop = true;

@@ -142,7 +142,7 @@ TEST(SyntheticScene, SolidsAtTheSameDistanceGiveOneOfThemTheSameEveryTime) {
   // Boxes on a grid, and copies of some of them (the same floats, so every ray meeting one
   // meets its copy at exactly the same t) before and after the original: the hit is at the
   // distance testing every solid gives, on one of the solids there, the same one every time
-  // (the binary hierarchy's order, which the renderings pinned in test_dataset.cpp hold).
+  // (the hierarchy's order; SyntheticRendering pins which, on the street).
   Scene scene;
   std::vector<Primitive> grid;
   for (int i = 0; i < 60; ++i)

@@ -1,12 +1,8 @@
-#include <msf/common/exceptions.h>
 #include <msf/synthetic/scene.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
-#include <functional>
 #include <limits>
-#include <string>
 
 namespace msf::synthetic {
 
@@ -33,38 +29,14 @@ void Scene::buildIndex() {
   nodes_.reserve(2 * static_cast<std::size_t>(n) + 1);
   if (n > 0)
     build(0, n, lo, hi, centroid);
-  wide_.clear();
-  leaves_.clear();
-  if (n == 0)
-    return;
-  parent_.assign(nodes_.size(), -1);
-  position_.assign(static_cast<std::size_t>(n), 0);
-  leaf_.assign(static_cast<std::size_t>(n), 0);
+  children_.assign(nodes_.size(), ChildBoxes{});
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    const Node& node = nodes_[i];
-    if (node.count > 0) {
-      for (std::int32_t k = node.index; k < node.index + node.count; ++k) {
-        position_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])] = k;
-        leaf_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])] = static_cast<std::int32_t>(i);
-      }
-    } else {
-      parent_[i + 1] = static_cast<std::int32_t>(i);
-      parent_[static_cast<std::size_t>(node.index)] = static_cast<std::int32_t>(i);
-    }
+    if (nodes_[i].count > 0)
+      continue;
+    const Node& l = nodes_[i + 1];
+    const Node& r = nodes_[static_cast<std::size_t>(nodes_[i].index)];
+    children_[i] = {{l.lo.x, r.lo.x, l.hi.x, r.hi.x}, {l.lo.y, r.lo.y, l.hi.y, r.hi.y}, {l.lo.z, r.lo.z, l.hi.z, r.hi.z}};
   }
-  collapse(0); // the root is wide_[0]
-  // A visit pushes at most 4 and pops 1: the stack holds 3 per level and the root.
-  std::function<int(std::int32_t)> depth = [&](std::int32_t i) {
-    int below = 0;
-    const WideNode& node = wide_[static_cast<std::size_t>(i)];
-    for (int k = 0; k < node.count; ++k)
-      if (node.child[k] >= 0)
-        below = std::max(below, depth(node.child[k]));
-    return below + 1;
-  };
-  if (3 * depth(0) + 1 > kStackSize)
-    throw InvalidInputError("scene hierarchy too deep for the ray caster's stack (" + std::to_string(depth(0)) +
-                            " levels)");
 }
 
 namespace {
@@ -172,103 +144,6 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
   return id;
 }
 
-std::int32_t Scene::collapse(std::int32_t binary) {
-  // The children: the binary node's two, then the inner one of largest area split into its
-  // two while there are fewer than 4 (a leaf root is a node with one leaf child).
-  std::int32_t kids[4] = {binary, 0, 0, 0};
-  int count = 1;
-  if (nodes_[static_cast<std::size_t>(binary)].count == 0) {
-    kids[0] = binary + 1;
-    kids[1] = nodes_[static_cast<std::size_t>(binary)].index;
-    count = 2;
-  }
-  while (count < 4) {
-    int widest = -1;
-    float widest_area = -1.f;
-    for (int k = 0; k < count; ++k) {
-      const Node& node = nodes_[static_cast<std::size_t>(kids[k])];
-      const float area = surfaceArea(node.lo, node.hi);
-      if (node.count == 0 && area > widest_area) {
-        widest = k;
-        widest_area = area;
-      }
-    }
-    if (widest < 0)
-      break;
-    const std::int32_t split = kids[widest];
-    kids[widest] = split + 1;
-    kids[count++] = nodes_[static_cast<std::size_t>(split)].index;
-  }
-  const auto id = static_cast<std::int32_t>(wide_.size());
-  wide_.emplace_back();
-  for (int k = 0; k < 4; ++k) { // lanes past count repeat the first child, never read
-    const Node& node = nodes_[static_cast<std::size_t>(kids[k < count ? k : 0])];
-    WideNode& w = wide_[static_cast<std::size_t>(id)];
-    w.lo_x[k] = node.lo.x;
-    w.lo_y[k] = node.lo.y;
-    w.lo_z[k] = node.lo.z;
-    w.hi_x[k] = node.hi.x;
-    w.hi_y[k] = node.hi.y;
-    w.hi_z[k] = node.hi.z;
-  }
-  wide_[static_cast<std::size_t>(id)].count = count;
-  for (int k = 0; k < count; ++k) {
-    const Node& node = nodes_[static_cast<std::size_t>(kids[k])];
-    std::int32_t child;
-    if (node.count > 0) {
-      child = ~static_cast<std::int32_t>(leaves_.size());
-      leaves_.push_back({node.index, node.count});
-    } else {
-      child = collapse(kids[k]); // grows wide_: index it afresh
-    }
-    wide_[static_cast<std::size_t>(id)].child[k] = child;
-  }
-  return id;
-}
-
-bool Scene::metBefore(std::int32_t p, std::int32_t q, const Ray& ray, float tmin) const {
-  const std::int32_t pos_p = position_[static_cast<std::size_t>(p)], pos_q = position_[static_cast<std::size_t>(q)];
-  // Each solid's path from the root to its leaf, and where the two part.
-  auto path = [&](std::int32_t solid) {
-    std::vector<std::int32_t> nodes;
-    for (std::int32_t i = leaf_[static_cast<std::size_t>(solid)]; i >= 0; i = parent_[static_cast<std::size_t>(i)])
-      nodes.push_back(i);
-    std::reverse(nodes.begin(), nodes.end());
-    return nodes;
-  };
-  const std::vector<std::int32_t> a = path(p), b = path(q);
-  std::size_t k = 0;
-  while (k < a.size() && k < b.size() && a[k] == b[k])
-    ++k;
-  if (k == a.size() || k == b.size()) // the same leaf
-    return pos_p < pos_q;
-  const Node& parting = nodes_[static_cast<std::size_t>(a[k - 1])];
-  const Node &left = nodes_[static_cast<std::size_t>(a[k - 1]) + 1], &right = nodes_[static_cast<std::size_t>(parting.index)];
-  const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
-  const float far = std::numeric_limits<float>::infinity();
-  float entry_left = 0.f, entry_right = 0.f;
-  rayEntersBox(left.lo, left.hi, ray.origin, inv, tmin, far, entry_left);
-  rayEntersBox(right.lo, right.hi, ray.origin, inv, tmin, far, entry_right);
-  return (a[k] == a[k - 1] + 1) == (entry_left <= entry_right);
-}
-
-inline bool Scene::test(std::int32_t p, const Ray& ray, float tmin, Hit& hit) const {
-  // Primitive::intersect takes only t < hit.t: it is asked for t <= hit.t, and a tie is
-  // then settled by the binary traversal's order (the road plane, tested first, wins).
-  const Hit before = hit;
-  hit.t = std::nextafter(before.t, std::numeric_limits<float>::infinity());
-  if (!primitives[static_cast<std::size_t>(p)].intersect(ray, tmin, hit)) {
-    hit.t = before.t;
-    return false;
-  }
-  if (hit.t == before.t && (before.primitive < 0 || !metBefore(p, before.primitive, ray, tmin))) {
-    hit = before;
-    return false;
-  }
-  hit.primitive = p;
-  return true;
-}
-
 bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
   hit = Hit();
   hit.t = tmax;
@@ -284,62 +159,70 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
       found = true;
     }
   }
-  if (wide_.empty())
+  float entry = 0.f;
+  if (nodes_.empty() || !rayEntersBox(nodes_[0].lo, nodes_[0].hi, ray.origin,
+                                      {1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z}, tmin, hit.t, entry))
     return found;
   const V3 inv{1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z};
-  // Nodes and leaves whose box the ray enters, with the entry distance: one is skipped when a
-  // hit found meanwhile lies before it; the nearest is visited first. Node and distance in
-  // two arrays: an {int, float} pair written as two 4-byte stores and read back as one 8-byte
-  // load missed the store forwarding.
-  std::int32_t stack_node[kStackSize];
-  float stack_t[kStackSize];
+  // Nodes whose box the ray enters, with the entry distance: a node is skipped when a hit
+  // found meanwhile lies before it; of two children the nearer is visited first. Node and
+  // distance in two arrays: an {int, float} pair written as two 4-byte stores and read back as
+  // one 8-byte load missed the store forwarding, a quarter of the renderer's time.
+  std::int32_t stack_node[64];
+  float stack_t[64];
   int top = 0;
-  stack_node[top] = 0;
-  stack_t[top++] = tmin;
-  const Float4 origin_x = {ray.origin.x, ray.origin.x, ray.origin.x, ray.origin.x};
-  const Float4 origin_y = {ray.origin.y, ray.origin.y, ray.origin.y, ray.origin.y};
-  const Float4 origin_z = {ray.origin.z, ray.origin.z, ray.origin.z, ray.origin.z};
-  const Float4 inv_x = {inv.x, inv.x, inv.x, inv.x}, inv_y = {inv.y, inv.y, inv.y, inv.y};
-  const Float4 inv_z = {inv.z, inv.z, inv.z, inv.z};
+  auto push = [&](std::int32_t node, float t) {
+    stack_node[top] = node;
+    stack_t[top++] = t;
+  };
+  push(0, entry);
   while (top > 0) {
     --top;
     const std::int32_t current = stack_node[top];
     if (stack_t[top] > hit.t)
       continue;
-    if (current < 0) {
-      const Leaf& leaf = leaves_[static_cast<std::size_t>(~current)];
-      for (std::int32_t i = leaf.first; i < leaf.first + leaf.count; ++i)
-        found |= test(order_[static_cast<std::size_t>(i)], ray, tmin, hit);
+    const Node& node = nodes_[static_cast<std::size_t>(current)];
+    if (node.count > 0) {
+      for (std::int32_t i = node.index; i < node.index + node.count; ++i) {
+        const std::int32_t p = order_[static_cast<std::size_t>(i)];
+        if (primitives[static_cast<std::size_t>(p)].intersect(ray, tmin, hit)) {
+          hit.primitive = p;
+          found = true;
+        }
+      }
       continue;
     }
-    // rayEntersBox for the 4 children in SIMD lanes, the same operations per lane.
-    const WideNode& node = wide_[static_cast<std::size_t>(current)];
+    const std::int32_t left = current + 1, right = node.index;
+    // rayEntersBox for both children in SIMD lanes, the same operations in the same order
+    // per lane (so the same results): lanes 0 and 1 are the children's slab distances.
+    const ChildBoxes& c = children_[static_cast<std::size_t>(current)];
     Float4 t0 = {tmin, tmin, tmin, tmin}, t1 = {hit.t, hit.t, hit.t, hit.t};
-    auto slab = [&](const float* lo, const float* hi, Float4 o, Float4 i) {
-      Float4 l, h;
-      std::memcpy(&l, lo, sizeof l);
-      std::memcpy(&h, hi, sizeof h);
-      const Float4 a = (l - o) * i, b = (h - o) * i;
+    auto slab = [&](const float* bounds, float o, float i) {
+      Float4 v;
+      std::memcpy(&v, bounds, sizeof v);
+      const Float4 a = (v - o) * i;
+      const Float4 b = __builtin_shufflevector(a, a, 2, 3, 0, 1); // each lane's hi with its lo
       const Float4 near = a < b ? a : b, far = a < b ? b : a;
       t0 = near > t0 ? near : t0;
       t1 = far < t1 ? far : t1;
     };
-    slab(node.lo_x, node.hi_x, origin_x, inv_x);
-    slab(node.lo_y, node.hi_y, origin_y, inv_y);
-    slab(node.lo_z, node.hi_z, origin_z, inv_z);
-    // The children entered, inserted above the stack's top by entry, farthest lowest, so the
-    // nearest pops next.
-    const int base = top;
-    for (int k = 0; k < node.count; ++k) {
-      if (!(t0[k] <= t1[k]))
-        continue;
-      int j = top++;
-      for (; j > base && stack_t[j - 1] < t0[k]; --j) {
-        stack_node[j] = stack_node[j - 1];
-        stack_t[j] = stack_t[j - 1];
+    slab(c.x, ray.origin.x, inv.x);
+    slab(c.y, ray.origin.y, inv.y);
+    slab(c.z, ray.origin.z, inv.z);
+    const float t_left = t0[0], t_right = t0[1];
+    const bool hit_left = t0[0] <= t1[0], hit_right = t0[1] <= t1[1];
+    if (hit_left && hit_right) {
+      if (t_left <= t_right) {
+        push(right, t_right);
+        push(left, t_left);
+      } else {
+        push(left, t_left);
+        push(right, t_right);
       }
-      stack_node[j] = node.child[k];
-      stack_t[j] = t0[k];
+    } else if (hit_left) {
+      push(left, t_left);
+    } else if (hit_right) {
+      push(right, t_right);
     }
   }
   return found;

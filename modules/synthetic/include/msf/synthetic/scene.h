@@ -54,8 +54,7 @@ public:
   /// Builds the hierarchy; call after the last primitive is added.
   void buildIndex();
 
-  /// Nearest static surface with t in (tmin, tmax); false for the sky. Of surfaces at the same
-  /// distance, the road plane, else the solid the binary hierarchy meets first (see test()).
+  /// Nearest static surface with t in (tmin, tmax); false for the sky.
   bool intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const;
 
   /// True when p lies inside a static solid other than primitives[skip], or below the road
@@ -75,37 +74,16 @@ private:
   std::int32_t build(std::int32_t begin, std::int32_t end, const std::vector<V3>& lo, const std::vector<V3>& hi,
                      const std::vector<V3>& centroid);
 
-  /// The hierarchy collapsed to 4 children a node (each binary node's children, an inner one
-  /// replaced by its own two while there is room): a ray tests a node's 4 boxes at once in
-  /// SIMD lanes, by axis from two cache lines, and goes through about half the levels. Lanes
-  /// past `count` are unused.
-  struct alignas(64) WideNode {
-    float lo_x[4], lo_y[4], lo_z[4], hi_x[4], hi_y[4], hi_z[4];
-    std::int32_t child[4] = {}; ///< >= 0: a wide node; < 0: the leaf ~child of leaves_
-    std::int32_t count = 0;
+  /// The boxes of an inner node's two children, by axis, so that a ray tests both at once in
+  /// 4 SIMD lanes (left lo, right lo, left hi, right hi), from one cache line: the right
+  /// child's node is elsewhere in nodes_, and on a long street the hierarchy is not in cache.
+  struct alignas(64) ChildBoxes {
+    float x[4], y[4], z[4];
   };
-  struct Leaf {
-    std::int32_t first, count; ///< a range of order_
-  };
-  std::int32_t collapse(std::int32_t binary);
-  /// A candidate solid against the hit so far: the nearer wins; of two at the same distance
-  /// (coplanar faces of overlapping solids) the one the binary hierarchy's nearest-first
-  /// traversal met first, which was the rule before the 4-wide hierarchy: datasets stay
-  /// byte for byte what they were.
-  bool test(std::int32_t p, const Ray& ray, float tmin, Hit& hit) const;
-  /// True when the binary traversal of `ray` tests solid p before solid q: at the node where
-  /// their paths part, it descends first into the child the ray enters first (the left one
-  /// on a tie); within a leaf, in order_.
-  bool metBefore(std::int32_t p, std::int32_t q, const Ray& ray, float tmin) const;
 
   static constexpr std::int32_t kMaxLeafSize = 8;
-  static constexpr int kStackSize = 256;
-  std::vector<Node> nodes_; ///< binary, for building, occupied() and metBefore()
-  std::vector<std::int32_t> parent_;   ///< per binary node; -1 for the root
-  std::vector<std::int32_t> position_; ///< per solid, its entry in order_
-  std::vector<std::int32_t> leaf_;     ///< per solid, its binary leaf
-  std::vector<WideNode> wide_;
-  std::vector<Leaf> leaves_;
+  std::vector<Node> nodes_;
+  std::vector<ChildBoxes> children_; ///< per node; unused for leaves
   std::vector<std::int32_t> order_;
 };
 
