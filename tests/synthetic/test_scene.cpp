@@ -10,7 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace {
 
@@ -23,6 +25,20 @@ Primitive makeBox(V3 center, V3 half, float yaw = 0.f) {
   p.half = half;
   p.setYaw(yaw);
   return p;
+}
+
+/// The road plane's hit within 1000 m (or none), where testing every solid in turn starts.
+Hit roadPlane(const Scene& scene, const Ray& ray) {
+  Hit hit;
+  hit.t = 1000.f;
+  if (ray.dir.y > 0.f) {
+    const float t = (scene.layout.ground_y - ray.origin.y) / ray.dir.y;
+    if (t > 0.f && t < hit.t) {
+      hit.t = t;
+      hit.primitive = Hit::kGround;
+    }
+  }
+  return hit;
 }
 
 TEST(SyntheticGeometry, BoxHitFaceNormalAndLocalPoint) {
@@ -108,15 +124,7 @@ TEST(SyntheticScene, HierarchyFindsTheSameHitsAsTestingEverySolid) {
                               static_cast<float>(rng.uniform(-1, 1))})};
     Hit fast;
     const bool found = scene.intersect(ray, 0.f, 1000.f, fast);
-    Hit brute;
-    brute.t = 1000.f;
-    if (ray.dir.y > 0.f) {
-      const float t = (scene.layout.ground_y - ray.origin.y) / ray.dir.y;
-      if (t > 0.f && t < brute.t) {
-        brute.t = t;
-        brute.primitive = Hit::kGround;
-      }
-    }
+    Hit brute = roadPlane(scene, ray);
     for (std::size_t i = 0; i < scene.primitives.size(); ++i)
       if (scene.primitives[i].intersect(ray, 0.f, brute))
         brute.primitive = static_cast<int>(i);
@@ -128,6 +136,58 @@ TEST(SyntheticScene, HierarchyFindsTheSameHitsAsTestingEverySolid) {
     }
   }
   EXPECT_GT(agreed, 2500); // the street is enclosed: almost every ray hits something
+}
+
+TEST(SyntheticScene, SolidsAtTheSameDistanceGiveOneOfThemTheSameEveryTime) {
+  // Boxes on a grid, and copies of some of them (the same floats, so every ray meeting one
+  // meets its copy at exactly the same t) before and after the original: the hit is at the
+  // distance testing every solid gives, on one of the solids there, the same one every time
+  // (the hierarchy's order; SyntheticRendering pins which, on the street).
+  Scene scene;
+  std::vector<Primitive> grid;
+  for (int i = 0; i < 60; ++i)
+    grid.push_back(makeBox({static_cast<float>(i % 6) * 3.f - 7.5f, -1.f, static_cast<float>(i / 6) * 4.f + 5.f},
+                           {0.6f + 0.05f * static_cast<float>(i % 5), 0.8f, 0.7f}, 0.3f * static_cast<float>(i % 3)));
+  const std::vector<int> copied = {7, 23, 41, 7, 50, 12};
+  for (std::size_t k = 0; k < 3; ++k)
+    scene.add(grid[static_cast<std::size_t>(copied[k])]); // indices 0-2
+  for (const Primitive& p : grid)
+    scene.add(p); // indices 3-62: grid[i] is index i + 3
+  for (std::size_t k = 3; k < copied.size(); ++k)
+    scene.add(grid[static_cast<std::size_t>(copied[k])]); // indices 63-65
+  scene.buildIndex();
+  SequentialRng rng(17);
+  int ties = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const Ray ray{{static_cast<float>(rng.uniform(-12, 12)), static_cast<float>(rng.uniform(-4, 0)),
+                   static_cast<float>(rng.uniform(-5, 0))},
+                  normalized({static_cast<float>(rng.uniform(-0.6, 0.6)), static_cast<float>(rng.uniform(-0.1, 0.2)),
+                              1.f})};
+    Hit fast, again;
+    const bool found = scene.intersect(ray, 0.f, 1000.f, fast);
+    scene.intersect(ray, 0.f, 1000.f, again);
+    Hit brute = roadPlane(scene, ray);
+    std::vector<int> at_t; // every solid hit at brute.t
+    for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
+      Hit h;
+      if (scene.primitives[i].intersect(ray, 0.f, h) && h.t <= brute.t) {
+        if (h.t < brute.t)
+          at_t.clear();
+        brute.t = h.t;
+        brute.primitive = static_cast<int>(i);
+        at_t.push_back(static_cast<int>(i));
+      }
+    }
+    ASSERT_EQ(found, brute.primitive != -1) << "ray " << n;
+    ASSERT_EQ(fast.t, brute.t) << "ray " << n;
+    ASSERT_EQ(fast.primitive, again.primitive) << "ray " << n;
+    if (brute.primitive == Hit::kGround || !found)
+      continue;
+    ASSERT_NE(std::find(at_t.begin(), at_t.end(), fast.primitive), at_t.end()) << "ray " << n;
+    ties += at_t.size() > 1 ? 1 : 0;
+  }
+  EXPECT_GT(ties, 50); // 93 of the 4000 rays
+
 }
 
 TEST(SyntheticScene, StreetHasEveryKindOfObjectAndIsDeterministic) {
@@ -257,6 +317,13 @@ TEST(SyntheticRandom, CounterHashesGiveStandardNormals) {
   EXPECT_NEAR(fast_sum2 / n, 1.0, 0.02);
   EXPECT_EQ(hashKey(1, 2, 3), hashKey(1, 2, 3));
   EXPECT_NE(hashKey(1, 2, 3), hashKey(1, 3, 2));
+  // The values datasets were made with (a seed gives the same files as before).
+  EXPECT_EQ(hashKey(1, 2, 3, 4, 5), 0x0d3c90b0c030a276ULL);
+  EXPECT_EQ(hashKey(7), 0xb06b4a62b750107bULL);
+  // A prefix hashed once, the rest per key: the same values.
+  const HashPrefix image = HashPrefix(1).then(20).then(0);
+  EXPECT_EQ(image.then(466000).then(2).value(), 0x3fd146a03a28c2f1ULL);
+  EXPECT_EQ(image.then(466000).value(), hashKey(1, 20, 0, 466000));
   SequentialRng a(5), b(5);
   for (int i = 0; i < 10; ++i)
     EXPECT_EQ(a.next(), b.next());

@@ -120,8 +120,20 @@ private:
   std::array<float, kSize + 1> table_;
 };
 
+/// std::lround (halves away from zero) for |x| < 2^23 without the library call: x minus its
+/// truncation is exact there.
+inline long roundHalfAway(float x) {
+  long r = static_cast<long>(x);
+  const float fraction = x - static_cast<float>(r);
+  if (fraction >= 0.5f)
+    ++r;
+  else if (fraction <= -0.5f)
+    --r;
+  return r;
+}
+
 inline std::uint8_t toByte(const GammaTable& gamma, float linear, float noise) {
-  return static_cast<std::uint8_t>(std::clamp(std::lround(gamma(linear) + noise), 0L, 255L));
+  return static_cast<std::uint8_t>(std::clamp(roundHalfAway(gamma(linear) + noise), 0L, 255L));
 }
 
 } // namespace
@@ -147,7 +159,9 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
   const float inv_ss = 1.f / static_cast<float>(ss);
   const V3 sub_x = pixel_x * inv_ss, sub_y = pixel_y * inv_ss;
   const float sigma = static_cast<float>(config_.image_noise_sigma);
-  const auto seed = static_cast<std::uint64_t>(config_.seed);
+  // The noise of pixel i, channel c: hashKey(seed, noise_key, camera, i, c).
+  const HashPrefix image_key =
+      HashPrefix(static_cast<std::uint64_t>(config_.seed)).then(noise_key).then(static_cast<std::uint64_t>(camera));
   static const GammaTable gamma;
 
   // Pass 1: the ray through each pixel centre, its texture filtered over the whole pixel.
@@ -197,11 +211,9 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
         const float w = inv_ss * inv_ss;
         r = {r.r * w, r.g * w, r.b * w};
       }
-      const auto pixel = static_cast<std::uint64_t>(i);
+      const HashPrefix pixel_key = image_key.then(static_cast<std::uint64_t>(i));
       auto noise = [&](std::uint64_t channel) {
-        return sigma > 0.f
-                   ? sigma * gaussianFast(hashKey(seed, noise_key, static_cast<std::uint64_t>(camera), pixel, channel))
-                   : 0.f;
+        return sigma > 0.f ? sigma * gaussianFast(pixel_key.then(channel).value()) : 0.f;
       };
       if (color) {
         // OpenCV's BGR order.

@@ -45,6 +45,8 @@ pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const SceneSnapshot& scene,
 #pragma omp parallel for schedule(dynamic, 1)
   for (int ring = 0; ring < rings; ++ring) {
     const double elevation = elevations_deg_[static_cast<std::size_t>(ring)] * kPi / 180.0;
+    // hashKey(seed, frame_key, 0x11da7, ring, j) with the first four counters hashed once.
+    const HashPrefix ring_key = HashPrefix(seed).then(frame_key).then(0x11da7ULL).then(static_cast<std::uint64_t>(ring));
     for (int j = 0; j < steps; ++j) {
       Sample& out = samples[static_cast<std::size_t>(ring) * static_cast<std::size_t>(steps) + static_cast<std::size_t>(j)];
       out.valid = false;
@@ -56,7 +58,7 @@ pcl::PointCloud<pcl::PointXYZI> LidarSimulator::scan(const SceneSnapshot& scene,
       Hit hit;
       if (!scene.intersect(ray, 0.f, max_range, hit) || hit.t < min_range)
         continue;
-      const auto key = hashKey(seed, frame_key, 0x11da7ULL, static_cast<std::uint64_t>(ring), static_cast<std::uint64_t>(j));
+      const auto key = ring_key.then(static_cast<std::uint64_t>(j)).value();
       const SurfaceResponse s = scene.shade(hit, ray.origin + ray.dir * hit.t, Footprint{});
       const double keep = (1.0 - config_.lidar_dropout) * (1.0 - 0.5 * s.glass);
       if (uniform01(mix64(key ^ 1)) >= keep)

@@ -100,16 +100,16 @@ void checkOutput(const fs::path& root) {
   }
 }
 
-/// Runs independent file writes in parallel; rethrows the first failure after all end.
+/// Runs independent file writes one after the other (on the writer thread, beside the
+/// renderer's threads: a team of its own only added spin-waits); rethrows the first failure
+/// after all end.
 void runAll(const std::vector<std::function<void()>>& jobs) {
   std::string error;
   bool failed = false;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int i = 0; i < static_cast<int>(jobs.size()); ++i) {
+  for (const auto& job : jobs) {
     try {
-      jobs[static_cast<std::size_t>(i)]();
+      job();
     } catch (const std::exception& e) {
-#pragma omp critical(msf_synth_error)
       if (!failed) {
         failed = true;
         error = e.what();

@@ -14,15 +14,31 @@ inline std::uint64_t mix64(std::uint64_t z) {
   return z ^ (z >> 31);
 }
 
+/// hashKey's state after its first counters: keys that share them (an image's pixels, a
+/// pixel's channels) hash only the rest. hashKey(a, b, c, d, e) ==
+/// HashPrefix(a).then(b).then(c).then(d).then(e).value().
+class HashPrefix {
+public:
+  explicit HashPrefix(std::uint64_t a) : h_(mix64(a + kGolden)), next_(2) {}
+  HashPrefix then(std::uint64_t x) const { return {mix64(h_ ^ (x + next_ * kGolden)), next_ + 1}; }
+  /// The hash of the counters given, the missing ones (up to five) zero.
+  std::uint64_t value() const {
+    std::uint64_t h = h_;
+    for (std::uint64_t i = next_; i <= 5; ++i)
+      h = mix64(h ^ (i * kGolden));
+    return h;
+  }
+
+private:
+  static constexpr std::uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
+  HashPrefix(std::uint64_t h, std::uint64_t next) : h_(h), next_(next) {}
+  std::uint64_t h_, next_;
+};
+
 /// Hash of up to five counters; order matters.
 inline std::uint64_t hashKey(std::uint64_t a, std::uint64_t b = 0, std::uint64_t c = 0, std::uint64_t d = 0,
                              std::uint64_t e = 0) {
-  constexpr std::uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
-  std::uint64_t h = mix64(a + kGolden);
-  h = mix64(h ^ (b + 2 * kGolden));
-  h = mix64(h ^ (c + 3 * kGolden));
-  h = mix64(h ^ (d + 4 * kGolden));
-  return mix64(h ^ (e + 5 * kGolden));
+  return HashPrefix(a).then(b).then(c).then(d).then(e).value();
 }
 
 /// Uniform in [0, 1) from the top 53 bits.
