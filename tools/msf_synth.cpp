@@ -8,13 +8,11 @@
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
-#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
 
-#include <unistd.h>
 
 using namespace pcl::console;
 
@@ -30,12 +28,6 @@ void checkRange(const msf::tool::CommandLine& cli, const char* option, int value
 } // namespace
 
 int main(int argc, char** argv) {
-  // OpenMP threads that wait (between a frame's passes, for the other thread's last rows)
-  // sleep instead of spinning: on a shared host the spinning was 5-10 % of msf_synth's CPU
-  // time. libgomp reads the policy when it loads, so it is set by running again; a policy the
-  // user set is kept.
-  if (std::getenv("OMP_WAIT_POLICY") == nullptr && ::setenv("OMP_WAIT_POLICY", "passive", 1) == 0)
-    ::execv("/proc/self/exe", argv); // returns only on failure: then run as we are
   msf::synthetic::SyntheticConfig config;
   std::string output;
   bool print_config = false;
