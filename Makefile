@@ -10,8 +10,8 @@ DEMO_OUT ?= out/demo
 # Every Debian package the project needs to build, test and view its results (pcl_viewer).
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools
-# Only `make fuzz` needs these: clang's libFuzzer and its OpenMP runtime.
-FUZZ_PACKAGES := clang libomp-dev
+# Only `make fuzz` needs this: clang's libFuzzer.
+FUZZ_PACKAGES := clang
 # Only the Open3D baseline of `make bench` needs these.
 BENCH_PACKAGES := python3-open3d python3-numpy
 

@@ -2,7 +2,7 @@
 // steps 1 + 2 (projection and compound interpolation) beside the IP-Basic baseline on the
 // same projection, in the same run. Each benchmark is 20 repetitions of the 10 frames;
 // the median and the minimum over repetitions are reported (the minimum is the least
-// disturbed by other processes on a shared machine). Wall-clock time, all OpenMP threads.
+// disturbed by other processes on a shared machine). Wall-clock time, all the threads of OpenCV's pool.
 //
 //   bench_lidar [--benchmark_filter=Compound]   (MSF_KITTI_DIR overrides the compiled-in path)
 #include "kitti_sample.h"
@@ -16,7 +16,6 @@
 #include <msf/range_image/lidar_projector.h>
 
 #include <benchmark/benchmark.h>
-#include <omp.h>
 #include <opencv2/core.hpp>
 
 #include <algorithm>
@@ -48,9 +47,9 @@ void depth(benchmark::State& state, msf::CompletionMethod method, bool with_dist
   msf::InterpolationConfig interpolation;
   interpolation.threads = threads;
   msf::LidarCompletion completion(d.calibration, method, msf::ProjectionConfig(), interpolation);
-  const int saved = omp_get_max_threads();
+  const int saved = cv::getNumThreads();
   if (threads > 0)
-    omp_set_num_threads(threads); // the projection's loops too
+    cv::setNumThreads(threads); // the projection's loops too
   cv::Mat dense, distance;
   std::size_t i = 0, estimates = 0, pixels = 0;
   for (auto _ : state) {
@@ -59,7 +58,7 @@ void depth(benchmark::State& state, msf::CompletionMethod method, bool with_dist
     estimates += static_cast<std::size_t>(cv::countNonZero(dense));
     pixels += dense.total();
   }
-  omp_set_num_threads(saved);
+  cv::setNumThreads(saved);
   state.counters["estimated_share"] = pixels ? static_cast<double>(estimates) / pixels : 0.0;
 }
 

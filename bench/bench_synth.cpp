@@ -8,7 +8,7 @@
 #include <msf/synthetic/synthetic_generator.h>
 
 #include <benchmark/benchmark.h>
-#include <omp.h>
+#include <opencv2/core/utility.hpp>
 
 #include <cstddef>
 
@@ -27,7 +27,7 @@ constexpr std::size_t kFrames[] = {100, 500, 900};
 
 void camera(benchmark::State& state, int camera) {
   const auto& g = generator();
-  omp_set_num_threads(1);
+  cv::setNumThreads(1);
   std::size_t k = 0;
   cv::Mat depth, ids;
   for (auto _ : state) {
@@ -41,7 +41,7 @@ void camera(benchmark::State& state, int camera) {
 
 void lidar(benchmark::State& state) {
   const auto& g = generator();
-  omp_set_num_threads(1);
+  cv::setNumThreads(1);
   std::size_t k = 0, points = 0;
   for (auto _ : state) {
     const std::size_t i = kFrames[k++ % 3];

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
              "gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)")
       .value("-max_gap", "N", interpolation.slice.max_gap_px, "longer gaps stay empty (interpolation.max_gap_px)")
       .flag("-no_gaussian", no_gaussian, "no Gaussian hole filling after the slices (interpolation.gaussian: false)")
-      .value("-threads", "N", interpolation.threads, "OpenMP threads (0: all)");
+      .value("-threads", "N", interpolation.threads, "at most N threads of OpenCV's pool (0: all)");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <in.pcd> <out.pcd> (see -h)");

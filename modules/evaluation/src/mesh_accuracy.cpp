@@ -2,6 +2,7 @@
 #include <msf/common/statistics.h>
 #include <msf/evaluation/mesh_accuracy.h>
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/conversions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -160,9 +161,10 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   // A regular stride over large inputs: deterministic, and the statistics barely move.
   const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
   std::vector<double> distances((vertices.size() + vertex_step - 1) / vertex_step);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < distances.size(); ++i)
-    distances[i] = to_truth.distance(vertices[i * vertex_step], cap);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(distances.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i)
+      distances[i] = to_truth.distance(vertices[static_cast<std::size_t>(i) * vertex_step], cap);
+  });
   result.vertices = distances.size();
   double sum = 0;
   std::size_t near = 0;
@@ -178,9 +180,10 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   const std::size_t truth_step = std::max<std::size_t>(1, (seen_truth.size() + max_samples - 1) / max_samples);
   const std::size_t samples = (seen_truth.size() + truth_step - 1) / truth_step;
   std::vector<std::uint8_t> is_covered(samples);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < samples; ++i)
-    is_covered[i] = to_mesh.distance(seen_truth[i * truth_step], threshold) < threshold;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i)
+      is_covered[i] = to_mesh.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], threshold) < threshold;
+  });
   const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
   result.truth_samples = samples;
   result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);

@@ -9,8 +9,6 @@
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
-#include <omp.h>
-
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -209,9 +207,6 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   std::thread loader([&] {
     try {
       for (std::size_t i : frames) {
-        // The first frame has the machine to itself; later ones share it with the other stages.
-        if (i != frames.front() && config_.scheduling.lidar_threads > 0)
-          omp_set_num_threads(config_.scheduling.lidar_threads); // this thread's parallel regions only
         if (stop && stop->load()) {
           interrupted = true;
           break;

@@ -1,6 +1,5 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
-#include <msf/common/limits.h>
 #include <msf/pipeline/pipeline_config.h>
 
 #include <cmath>
@@ -28,7 +27,10 @@ void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
   readKey(node, "stereo_prior", stereo_prior);
-  readKey(node, "lidar_threads", lidar_threads);
+  // Removed with OpenMP (issue 18): said so rather than "not a key", for configs printed before.
+  if (node.isMap() && !node["lidar_threads"].empty())
+    throw ConfigError("pipeline.lidar_threads was removed: the LiDAR steps run on OpenCV's pool like the other "
+                      "stages (serially on the loader while another stage's loop holds it); delete the key");
   validate();
 }
 
@@ -37,15 +39,13 @@ void SchedulingConfig::validate() const {
     throw ConfigError("pipeline.queue_capacity must be >= 1, got " + std::to_string(queue_capacity));
   if (mesh_every_n_frames < 0)
     throw ConfigError("pipeline.mesh_every_n_frames must be >= 0, got " + std::to_string(mesh_every_n_frames));
-  limits::checkThreads(lidar_threads, "pipeline.lidar_threads");
 }
 
 void SchedulingConfig::print(std::ostream& out) const {
   out << "pipeline:\n"
       << "  queue_capacity: " << configValue(queue_capacity) << "\n"
       << "  stereo_prior: " << configValue(stereo_prior) << "\n"
-      << "  mesh_every_n_frames: " << configValue(mesh_every_n_frames) << "\n"
-      << "  lidar_threads: " << configValue(lidar_threads) << "\n";
+      << "  mesh_every_n_frames: " << configValue(mesh_every_n_frames) << "\n";
 }
 
 PipelineConfig PipelineConfig::paper() {

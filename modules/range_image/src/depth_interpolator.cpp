@@ -6,7 +6,7 @@
 
 #include <ostream>
 
-#include <omp.h>
+#include <opencv2/core/utility.hpp>
 
 #include <algorithm>
 #include <cstring>
@@ -252,7 +252,7 @@ void DepthInterpolator::interpolate(const cv::Mat& depth, cv::Mat& out) {
   if (out.data == depth.data)
     throw InvalidInputError("interpolation: the output may not be the input image");
   const int H = depth.rows, W = depth.cols;
-  const int nthreads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
+  const double stripes = config_.threads > 0 ? config_.threads : -1; // at most that many threads at once
   const SliceParams& slice = config_.slice;
   out.create(H, W, CV_32FC1);
   row_gap_.create(H, W, CV_8UC1);
@@ -261,25 +261,24 @@ void DepthInterpolator::interpolate(const cv::Mat& depth, cv::Mat& out) {
   row_has_.assign(static_cast<std::size_t>(H), 0);
   prepareHoleFill(W);
 
-  // Slices are independent, so every pass splits them over the threads (one parallel
-  // region, few barriers) and the result does not depend on their number.
-#pragma omp parallel num_threads(nthreads)
-  {
-#pragma omp for schedule(static)
-    for (int r = 0; r < H; ++r)
+  // Slices are independent, so every pass splits them over OpenCV's pool and the result
+  // does not depend on the number of threads.
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r)
       row_has_[r] = rowPass(depth.ptr<float>(r), W, slice, out.ptr<float>(r), row_gap_.ptr<std::uint8_t>(r));
-    const int bands = omp_get_num_threads();
-#pragma omp for schedule(static)
-    for (int b = 0; b < bands; ++b) {
-      // Bands of whole cache lines (16 floats) per thread.
+  }, stripes);
+  // One band of columns per thread, of whole cache lines (16 floats).
+  const int bands = config_.threads > 0 ? config_.threads : cv::getNumThreads();
+  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
       const int c0 = std::min(W, (W * b / bands + 15) / 16 * 16);
       const int c1 = b + 1 == bands ? W : std::min(W, (W * (b + 1) / bands + 15) / 16 * 16);
       columnPass(H, W, c0, c1, slice, config_.column_seed_gap_px, config_.combine, out.ptr<float>(),
                  row_gap_.ptr<std::uint8_t>(), last_.data(), z_last_.data());
     }
-    if (config_.gaussian)
-      fillHoles(depth, out);
-  }
+  });
+  if (config_.gaussian)
+    fillHoles(depth, out, stripes);
 }
 
 void DepthInterpolator::prepareHoleFill(int width) {
@@ -296,13 +295,12 @@ void DepthInterpolator::prepareHoleFill(int width) {
   weights_.create(static_cast<int>(row_has_.size()), width + 2 * k, CV_32FC1);
 }
 
-void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
+void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out, double stripes) {
   // Normalized convolution (Knutsson and Westin 1993): the Gaussian average of the
   // estimates around a hole, empty pixels weighing 0. Separable: a vectorized vertical
   // pass into rows padded by k zeros, around the holes only, then the horizontal pass at
   // the holes.
-  // Called by every thread of the parallel region; rows beyond reach of any sample (the
-  // sky above the top ring) are skipped.
+  // Rows beyond reach of any sample (the sky above the top ring) are skipped.
   const int H = out.rows, W = out.cols, k = config_.gaussian_size_px / 2;
   int first = H, last = -1;
   for (int r = 0; r < H; ++r)
@@ -311,57 +309,61 @@ void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out) {
       last = r;
     }
   const int r0 = std::max(0, first - k), r1 = std::min(H - 1, last + k);
+  if (r0 > r1)
+    return; // no sample
   const float* g = kernel_.data();
   const float min_weight = config_.gaussian_min_weight;
   const bool smooth = config_.gaussian_smooth_valid;
-#pragma omp for schedule(static)
-  for (int r = r0; r <= r1; ++r) {
-    // The targets of this row (holes; with smooth_valid, every pixel but the samples), as
-    // a byte mask made by a vectorized loop, then gathered into spans of targets +- k:
-    // vertical sums are made only there (most of a row within the rings is estimated).
-    std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
-    markTargets(out.ptr<float>(r), depth.ptr<float>(r), smooth, mask, W);
-    std::fill(mask + W, mask + W + 8, std::uint8_t{0}); // stops the word scan below
-    float* v = values_.ptr<float>(r) + k;
-    float* m = weights_.ptr<float>(r) + k;
-    std::fill(v - k, v, 0.f); // the padding beyond the image's sides reads as empty
-    std::fill(m - k, m, 0.f);
-    std::fill(v + W, v + W + k, 0.f);
-    std::fill(m + W, m + W + k, 0.f);
-    int u = nextTarget(mask, 0, W);
-    while (u < W) {
-      const int a = std::max(0, u - k);
-      int last_target = u, next = nextTarget(mask, u + 1, W);
-      while (next < W && next <= last_target + 2 * k + 1) {
-        last_target = next;
-        next = nextTarget(mask, next + 1, W);
+  cv::parallel_for_(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r) {
+      // The targets of this row (holes; with smooth_valid, every pixel but the samples), as
+      // a byte mask made by a vectorized loop, then gathered into spans of targets +- k:
+      // vertical sums are made only there (most of a row within the rings is estimated).
+      std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
+      markTargets(out.ptr<float>(r), depth.ptr<float>(r), smooth, mask, W);
+      std::fill(mask + W, mask + W + 8, std::uint8_t{0}); // stops the word scan below
+      float* v = values_.ptr<float>(r) + k;
+      float* m = weights_.ptr<float>(r) + k;
+      std::fill(v - k, v, 0.f); // the padding beyond the image's sides reads as empty
+      std::fill(m - k, m, 0.f);
+      std::fill(v + W, v + W + k, 0.f);
+      std::fill(m + W, m + W + k, 0.f);
+      int u = nextTarget(mask, 0, W);
+      while (u < W) {
+        const int a = std::max(0, u - k);
+        int last_target = u, next = nextTarget(mask, u + 1, W);
+        while (next < W && next <= last_target + 2 * k + 1) {
+          last_target = next;
+          next = nextTarget(mask, next + 1, W);
+        }
+        const int b = std::min(W, last_target + k + 1);
+        std::fill(v + a, v + b, 0.f);
+        std::fill(m + a, m + b, 0.f);
+        for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
+          accumulateRow(out.ptr<float>(r + i) + a, g[i + k], v + a, m + a, b - a);
+        u = next;
       }
-      const int b = std::min(W, last_target + k + 1);
-      std::fill(v + a, v + b, 0.f);
-      std::fill(m + a, m + b, 0.f);
-      for (int i = std::max(-k, -r); i <= std::min(k, H - 1 - r); ++i)
-        accumulateRow(out.ptr<float>(r + i) + a, g[i + k], v + a, m + a, b - a);
-      u = next;
     }
-  }
-  // (The implicit barrier above: every vertical sum is made before any hole is written.)
-#pragma omp for schedule(static)
-  for (int r = r0; r <= r1; ++r) {
-    // The horizontal pass at the targets only.
-    const std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
-    const float* v = values_.ptr<float>(r);
-    const float* m = weights_.ptr<float>(r);
-    float* o = out.ptr<float>(r);
-    for (int u = nextTarget(mask, 0, W); u < W; u = nextTarget(mask, u + 1, W)) {
-      float sv = 0.f, sm = 0.f;
-      for (int i = 0; i <= 2 * k; ++i) {
-        sv += g[i] * v[u + i];
-        sm += g[i] * m[u + i];
+  }, stripes);
+  // Every vertical sum is made (the call above has returned) before any hole is written.
+  cv::parallel_for_(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r) {
+      // The horizontal pass at the targets only.
+      const std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);
+      const float* v = values_.ptr<float>(r);
+      const float* m = weights_.ptr<float>(r);
+      float* o = out.ptr<float>(r);
+      for (int u = nextTarget(mask, 0, W); u < W; u = nextTarget(mask, u + 1, W)) {
+        float sv = 0.f, sm = 0.f;
+        for (int i = 0; i <= 2 * k; ++i) {
+          sv += g[i] * v[u + i];
+          sm += g[i] * m[u + i];
+        }
+        if (sm >= min_weight)
+          o[u] = sv / sm;
       }
-      if (sm >= min_weight)
-        o[u] = sv / sm;
     }
-  }
+  }, stripes);
 }
 
 } // namespace msf

@@ -2,7 +2,7 @@
 #include <msf/common/vector_clones.h>
 #include <msf/range_image/distance_transform.h>
 
-#include <omp.h>
+#include <opencv2/core/utility.hpp>
 #ifdef __SSE2__
 #include <immintrin.h>
 #endif
@@ -97,30 +97,29 @@ void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest
   if (H > kMaxSide || W > kMaxSide)
     throw InvalidInputError("distanceToSamples: the image is " + std::to_string(W) + "x" + std::to_string(H) +
                             ", more than " + std::to_string(kMaxSide) + " px on a side");
-  const int nthreads = threads > 0 ? threads : omp_get_max_threads();
+  const double stripes = threads > 0 ? threads : -1; // at most that many threads at once
   cv::Mat h2(H, W, CV_32SC1), column(H, W, CV_32SC1);
   std::vector<std::uint8_t> row_has_sample(static_cast<std::size_t>(H));
   distance.create(H, W, CV_32FC1);
   if (nearest)
     nearest->create(H, W, CV_32SC1);
 
-#pragma omp parallel num_threads(nthreads)
-  {
-    // Pass 1, rows: the distance along each row (LiDAR samples lie on rows).
-#pragma omp for schedule(static)
-    for (int r = 0; r < H; ++r) {
+  // Pass 1, rows: the distance along each row (LiDAR samples lie on rows).
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+    for (int r = rows.start; r < rows.end; ++r) {
       rowDistances(depth.ptr<float>(r), W, h2.ptr<std::int32_t>(r), column.ptr<std::int32_t>(r));
       row_has_sample[static_cast<std::size_t>(r)] = column.ptr<std::int32_t>(r)[0] >= 0;
     }
+  }, stripes);
 
-    // Pass 2: a pixel's squared distance is min over rows r' of (r - r')^2 + h2(r', c). Rows
-    // are visited outwards from r, a span of columns at a time, until (r - r')^2 reaches the
-    // span's largest distance so far: between the rings of a scan that is a few rows, where
-    // the lower envelope of parabolas (exact in any case) branches on every column.
-    constexpr int kSpan = 64;
+  // Pass 2: a pixel's squared distance is min over rows r' of (r - r')^2 + h2(r', c). Rows
+  // are visited outwards from r, a span of columns at a time, until (r - r')^2 reaches the
+  // span's largest distance so far: between the rings of a scan that is a few rows, where
+  // the lower envelope of parabolas (exact in any case) branches on every column.
+  constexpr int kSpan = 64;
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
     std::vector<std::int32_t> best(static_cast<std::size_t>(W));
-#pragma omp for schedule(static)
-    for (int r = 0; r < H; ++r) {
+    for (int r = rows.start; r < rows.end; ++r) {
       std::int32_t* b = best.data();
       int* idx = nearest ? nearest->ptr<int>(r) : nullptr;
       std::copy_n(h2.ptr<std::int32_t>(r), W, b);
@@ -144,7 +143,7 @@ void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest
       }
       toDistances(b, distance.ptr<float>(r), W);
     }
-  }
+  }, stripes);
 }
 
 } // namespace msf

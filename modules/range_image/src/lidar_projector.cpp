@@ -5,6 +5,9 @@
 
 #include <ostream>
 
+#include <opencv2/core/utility.hpp>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -97,27 +100,28 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
 
   // Transform and project in parallel; the z-buffer below is serial over the points kept
   // (the quarter of the scan in front of the camera).
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
-    pixel_[i] = -1;
-    const float z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
-    if (!(z > 0.f))
-      continue; // behind the camera (or NaN)
-    const float r2 = p.x * p.x + p.y * p.y + p.z * p.z;
-    if (r2 < r2min || r2 > r2max)
-      continue;
-    const float x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
-    const float y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
-    const float inv_z = 1.f / z;
-    const float u = (fx * x + skew * y) * inv_z + cx;
-    const float v = fy * y * inv_z + cy;
-    if (!(u > -0.5f && u < umax && v > -0.5f && v < vmax))
-      continue;
-    // Pixel centres are integers (as in depthImageToCloud): round to nearest, u + 0.5 > 0.
-    pixel_[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
-    depth_[i] = z;
-  }
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
+      pixel_[i] = -1;
+      const float z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
+      if (!(z > 0.f))
+        continue; // behind the camera (or NaN)
+      const float r2 = p.x * p.x + p.y * p.y + p.z * p.z;
+      if (r2 < r2min || r2 > r2max)
+        continue;
+      const float x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
+      const float y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
+      const float inv_z = 1.f / z;
+      const float u = (fx * x + skew * y) * inv_z + cx;
+      const float v = fy * y * inv_z + cy;
+      if (!(u > -0.5f && u < umax && v > -0.5f && v < vmax))
+        continue;
+      // Pixel centres are integers (as in depthImageToCloud): round to nearest, u + 0.5 > 0.
+      pixel_[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
+      depth_[i] = z;
+    }
+  });
 
   depth.create(H, W, CV_32FC1);
   depth.setTo(0.f);
@@ -151,9 +155,10 @@ void LidarProjector::projectDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   const int* w = winner_.ptr<int>();
   float* out = intensity->ptr<float>();
   const int total = static_cast<int>(depth.total());
-#pragma omp parallel for schedule(static)
-  for (int k = 0; k < total; ++k)
-    out[k] = w[k] >= 0 ? scan[static_cast<std::size_t>(w[k])].intensity : 0.f;
+  cv::parallel_for_(cv::Range(0, total), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k)
+      out[k] = w[k] >= 0 ? scan[static_cast<std::size_t>(w[k])].intensity : 0.f;
+  });
 }
 
 void LidarProjector::projectToImage(const pcl::PointCloud<pcl::PointXYZI>& scan, cv::Mat& depth,
@@ -193,24 +198,28 @@ void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
   const int* w = winner_.ptr<int>();
-  bool dense = true;
-#pragma omp parallel for schedule(static) reduction(&& : dense)
-  for (int k = 0; k < W * H; ++k) {
-    PointT& out = cloud[static_cast<std::size_t>(k)];
-    if (w[k] < 0) {
-      out.x = out.y = out.z = nan;
-      setReflectance(out, 0.f);
-      setDistance(out, inf);
-      dense = false;
-      continue;
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, W * H), [&](const cv::Range& range) {
+    bool all = true;
+    for (int k = range.start; k < range.end; ++k) {
+      PointT& out = cloud[static_cast<std::size_t>(k)];
+      if (w[k] < 0) {
+        out.x = out.y = out.z = nan;
+        setReflectance(out, 0.f);
+        setDistance(out, inf);
+        all = false;
+        continue;
+      }
+      const pcl::PointXYZI& p = scan[static_cast<std::size_t>(w[k])];
+      out.x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
+      out.y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
+      out.z = depth.ptr<float>()[k]; // the same float as the z-buffer
+      setReflectance(out, p.intensity);
+      setDistance(out, 0.f);
     }
-    const pcl::PointXYZI& p = scan[static_cast<std::size_t>(w[k])];
-    out.x = T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2) * p.z + T(0, 3);
-    out.y = T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2) * p.z + T(1, 3);
-    out.z = depth.ptr<float>()[k]; // the same float as the z-buffer
-    setReflectance(out, p.intensity);
-    setDistance(out, 0.f);
-  }
+    if (!all)
+      dense = false;
+  });
   cloud.is_dense = dense;
 }
 

@@ -1,5 +1,7 @@
 #include <msf/reconstruction/analytic_scene.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -82,18 +84,19 @@ cv::Mat AnalyticScene::renderDepth(const PinholeCamera& camera, const Eigen::Iso
   cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0));
   const Eigen::Vector3d o = T_world_cam.translation();
   const Eigen::Matrix3d R = T_world_cam.linear();
-#pragma omp parallel for schedule(static)
-  for (int v = 0; v < camera.height; ++v) {
-    float* row = depth.ptr<float>(v);
-    for (int u = 0; u < camera.width; ++u) {
-      // Direction with unit z in the camera, so the ray parameter is the depth.
-      const Eigen::Vector3d d = R * Eigen::Vector3d((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
-      double t = kInf;
-      for (const Solid& s : solids_)
-        t = std::min(t, hit(s, o, d));
-      row[u] = t <= max_depth ? static_cast<float>(t) : 0.f;
+  cv::parallel_for_(cv::Range(0, camera.height), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      float* row = depth.ptr<float>(v);
+      for (int u = 0; u < camera.width; ++u) {
+        // Direction with unit z in the camera, so the ray parameter is the depth.
+        const Eigen::Vector3d d = R * Eigen::Vector3d((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0);
+        double t = kInf;
+        for (const Solid& s : solids_)
+          t = std::min(t, hit(s, o, d));
+        row[u] = t <= max_depth ? static_cast<float>(t) : 0.f;
+      }
     }
-  }
+  });
   return depth;
 }
 

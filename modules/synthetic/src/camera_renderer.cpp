@@ -2,6 +2,8 @@
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/counter_rng.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -167,64 +169,66 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
   // Pass 1: the ray through each pixel centre, its texture filtered over the whole pixel.
   std::vector<Radiance> radiance(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
   std::vector<std::int32_t> surface(radiance.size());
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int v = 0; v < H; ++v) {
-    float* d = depth ? depth->ptr<float>(v) : nullptr;
-    std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
-    for (int u = 0; u < W; ++u) {
-      const Sample s = trace(scene, {cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))}, pixel_x,
-                             pixel_y);
-      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
-      radiance[i] = s.radiance;
-      surface[i] = s.surface;
-      if (d)
-        d[u] = s.depth;
-      if (o)
-        o[u] = s.object;
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      float* d = depth ? depth->ptr<float>(v) : nullptr;
+      std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
+      for (int u = 0; u < W; ++u) {
+        const Sample s =
+            trace(scene, {cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))}, pixel_x, pixel_y);
+        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
+        radiance[i] = s.radiance;
+        surface[i] = s.surface;
+        if (d)
+          d[u] = s.depth;
+        if (o)
+          o[u] = s.object;
+      }
     }
-  }
+  });
 
   // Pass 2: pixels on a geometric edge (a neighbour sees another surface) get ss x ss
   // samples; then gamma, noise and quantization.
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int v = 0; v < H; ++v) {
-    std::uint8_t* row = image.ptr<std::uint8_t>(v);
-    for (int u = 0; u < W; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
-      Radiance r = radiance[i];
-      const std::int32_t k = surface[i];
-      const bool edge = (u > 0 && surface[i - 1] != k) || (u + 1 < W && surface[i + 1] != k) ||
-                        (v > 0 && surface[i - static_cast<std::size_t>(W)] != k) ||
-                        (v + 1 < H && surface[i + static_cast<std::size_t>(W)] != k);
-      if (edge && ss > 1) {
-        r = Radiance();
-        for (int sy = 0; sy < ss; ++sy)
-          for (int sx = 0; sx < ss; ++sx) {
-            // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
-            const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
-            const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
-            const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y).radiance;
-            r.r += q.r;
-            r.g += q.g;
-            r.b += q.b;
-          }
-        const float w = inv_ss * inv_ss;
-        r = {r.r * w, r.g * w, r.b * w};
-      }
-      const HashPrefix pixel_key = image_key.then(static_cast<std::uint64_t>(i));
-      auto noise = [&](std::uint64_t channel) {
-        return sigma > 0.f ? sigma * gaussianFast(pixel_key.then(channel).value()) : 0.f;
-      };
-      if (color) {
-        // OpenCV's BGR order.
-        row[3 * u + 0] = toByte(gamma, r.b, noise(0));
-        row[3 * u + 1] = toByte(gamma, r.g, noise(1));
-        row[3 * u + 2] = toByte(gamma, r.r, noise(2));
-      } else {
-        row[u] = toByte(gamma, 0.30f * r.r + 0.59f * r.g + 0.11f * r.b, noise(0));
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      std::uint8_t* row = image.ptr<std::uint8_t>(v);
+      for (int u = 0; u < W; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
+        Radiance r = radiance[i];
+        const std::int32_t k = surface[i];
+        const bool edge = (u > 0 && surface[i - 1] != k) || (u + 1 < W && surface[i + 1] != k) ||
+                          (v > 0 && surface[i - static_cast<std::size_t>(W)] != k) ||
+                          (v + 1 < H && surface[i + static_cast<std::size_t>(W)] != k);
+        if (edge && ss > 1) {
+          r = Radiance();
+          for (int sy = 0; sy < ss; ++sy)
+            for (int sx = 0; sx < ss; ++sx) {
+              // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
+              const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
+              const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
+              const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y).radiance;
+              r.r += q.r;
+              r.g += q.g;
+              r.b += q.b;
+            }
+          const float w = inv_ss * inv_ss;
+          r = {r.r * w, r.g * w, r.b * w};
+        }
+        const HashPrefix pixel_key = image_key.then(static_cast<std::uint64_t>(i));
+        auto noise = [&](std::uint64_t channel) {
+          return sigma > 0.f ? sigma * gaussianFast(pixel_key.then(channel).value()) : 0.f;
+        };
+        if (color) {
+          // OpenCV's BGR order.
+          row[3 * u + 0] = toByte(gamma, r.b, noise(0));
+          row[3 * u + 1] = toByte(gamma, r.g, noise(1));
+          row[3 * u + 2] = toByte(gamma, r.r, noise(2));
+        } else {
+          row[u] = toByte(gamma, 0.30f * r.r + 0.59f * r.g + 0.11f * r.b, noise(0));
+        }
       }
     }
-  }
+  });
   return image;
 }
 

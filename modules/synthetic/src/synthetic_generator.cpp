@@ -100,26 +100,6 @@ void checkOutput(const fs::path& root) {
   }
 }
 
-/// Runs independent file writes one after the other (on the writer thread, beside the
-/// renderer's threads: a team of its own only added spin-waits); rethrows the first failure
-/// after all end.
-void runAll(const std::vector<std::function<void()>>& jobs) {
-  std::string error;
-  bool failed = false;
-  for (const auto& job : jobs) {
-    try {
-      job();
-    } catch (const std::exception& e) {
-      if (!failed) {
-        failed = true;
-        error = e.what();
-      }
-    }
-  }
-  if (failed)
-    throw IOError(error);
-}
-
 } // namespace
 
 SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
@@ -244,16 +224,16 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
       if (pending)
         finishPending(start);
       const std::string png = frameName(i) + ".png", bin = frameName(i) + ".bin";
+      // One after another: a parallel loop here would run serially while the renderer holds
+      // OpenCV's pool (or make the renderer's run serially).
       auto write = [&seq, &gt, f, png, bin] {
-        std::vector<std::function<void()>> jobs;
         for (int c = 0; c < 4; ++c)
-          jobs.emplace_back([&, c] { writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f->images[c]); });
-        jobs.emplace_back([&] { saveVelodyneBin((seq / "velodyne" / bin).string(), f->scan); });
-        jobs.emplace_back([&] { writeKittiDepthPng((gt / "depth_0" / png).string(), f->depth); });
-        jobs.emplace_back([&] { writeKittiDisparityPng((gt / "disp_0" / png).string(), f->disparity); });
-        jobs.emplace_back([&] { writeImage((gt / "obj_map_0" / png).string(), f->objects); });
-        jobs.emplace_back([&] { writeImage((gt / "moving_0" / png).string(), f->moving); });
-        runAll(jobs);
+          writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f->images[c]);
+        saveVelodyneBin((seq / "velodyne" / bin).string(), f->scan);
+        writeKittiDepthPng((gt / "depth_0" / png).string(), f->depth);
+        writeKittiDisparityPng((gt / "disp_0" / png).string(), f->disparity);
+        writeImage((gt / "obj_map_0" / png).string(), f->objects);
+        writeImage((gt / "moving_0" / png).string(), f->moving);
       };
       pending = Pending{std::async(std::launch::async, write), i, f->scan.size(), start};
     }

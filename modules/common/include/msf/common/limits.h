@@ -10,7 +10,7 @@
 /// running away or writing a silently wrong result (issue 19).
 namespace msf::limits {
 
-/// OpenMP threads a `threads` option may ask for (0 = all the cores).
+/// Threads a `threads` option may ask for (0 = all the cores).
 inline constexpr int kMaxThreads = 256;
 /// Side of an image, canvas or calibration in pixels: KITTI's is 1242, 8192 leaves room for
 /// any camera of the field and keeps every pixel index, area and offset within an int.

@@ -31,10 +31,6 @@ struct SchedulingConfig {
   int queue_capacity = 2;        ///< frames waiting between two stages
   bool stereo_prior = true;      ///< SGBM narrowed by the interpolated LiDAR (stereo.prior_search_range)
   int mesh_every_n_frames = 0;   ///< > 0: refresh the mesh incrementally every n frames
-  /// OpenMP threads of steps 1-2 on the loader thread (0 = all). 1 by default: the three
-  /// stage threads already keep the cores busy, and a statically scheduled parallel loop
-  /// waits for its slowest thread when another stage holds a core.
-  int lidar_threads = 1;
   void read(const cv::FileNode& node);
   void validate() const;
   void print(std::ostream& out) const;

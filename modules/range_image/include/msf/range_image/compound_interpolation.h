@@ -48,7 +48,7 @@ public:
   CombineRule getCombineRule() const { return config_.combine; }
   void setGaussianFill(bool enabled) { config_.gaussian = enabled; }
   bool getGaussianFill() const { return config_.gaussian; }
-  /// 0 = OpenMP's default; the result is the same for any number.
+  /// At most this many threads of OpenCV's pool (0: all of them); the result is the same for any number.
   void setNumberOfThreads(int threads) { config_.threads = threads; }
   int getNumberOfThreads() const { return config_.threads; }
 

@@ -35,7 +35,7 @@ protected:
   void applyFilter(PointCloud& output) override;
   /// sparse: CV_32FC1 (0 = none) -> dense: CV_32FC1 (0 = none), same size.
   virtual void completeDepth(const cv::Mat& sparse, cv::Mat& dense) = 0;
-  /// OpenMP threads for the write-back (0 = default).
+  /// At most this many threads of OpenCV's pool (0: all of them).
   virtual int threads() const { return 0; }
 
   using pcl::Filter<PointT>::input_;

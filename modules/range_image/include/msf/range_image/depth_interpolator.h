@@ -40,7 +40,7 @@ struct InterpolationConfig {
   float gaussian_sigma_px = 2.0f;
   float gaussian_min_weight = 0.1f;         ///< share of the kernel's mass that must hold estimates
   bool gaussian_smooth_valid = false;       ///< also smooth interpolated pixels (real returns never)
-  int threads = 0;                          ///< OpenMP threads, 0 = default
+  int threads = 0;                          ///< at most this many threads of OpenCV's pool, 0 = all of them
 
   /// The section as YAML, every key (configValue).
   void print(std::ostream& out) const;
@@ -72,8 +72,8 @@ public:
 
 private:
   void prepareHoleFill(int width);
-  /// The normalized Gaussian pass over the holes of `out`, inside the parallel region.
-  void fillHoles(const cv::Mat& depth, cv::Mat& out);
+  /// The normalized Gaussian pass over the holes of `out`, in `stripes` pieces (cv::parallel_for_).
+  void fillHoles(const cv::Mat& depth, cv::Mat& out, double stripes);
 
   InterpolationConfig config_;
   cv::Mat row_gap_, values_, weights_, targets_;

@@ -9,8 +9,8 @@ namespace msf {
 /// on rows a few pixels apart) that search is a few rows deep and vectorised across columns.
 /// `distance` is CV_32FC1 (0 on a sample, +inf everywhere when there is none). When
 /// `nearest` is given it receives, as CV_32SC1, the row-major index of a nearest sample
-/// (-1 when there is none). `threads` 0 uses OpenMP's default. The result does not depend
-/// on the number of threads. Images up to 8192 px on a side (InvalidInputError beyond).
+/// (-1 when there is none). At most `threads` threads of OpenCV's pool run it (0: all of
+/// them); the result does not depend on their number. Images up to 8192 px on a side (InvalidInputError beyond).
 void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest = nullptr, int threads = 0);
 
 } // namespace msf

@@ -2,6 +2,9 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
 
+#include <opencv2/core/utility.hpp>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -25,24 +28,28 @@ void depthImageToCloud(const cv::Mat& depth, const Calibration& calibration, int
   cloud.width = static_cast<std::uint32_t>(depth.cols);
   cloud.height = static_cast<std::uint32_t>(depth.rows);
   cloud.header.frame_id = cameraFrameId(camera);
-  bool dense = true;
-#pragma omp parallel for reduction(&& : dense)
-  for (int v = 0; v < depth.rows; ++v) {
-    const float* row = depth.ptr<float>(v);
-    PointT* out = &cloud[static_cast<std::size_t>(v) * depth.cols];
-    for (int u = 0; u < depth.cols; ++u) {
-      const float z = row[u];
-      PointT& p = out[u];
-      if (std::isfinite(z) && z > 0.f) {
-        p.x = (static_cast<float>(u) - cx) * z / fx;
-        p.y = (static_cast<float>(v) - cy) * z / fy;
-        p.z = z;
-      } else {
-        p.x = p.y = p.z = nan;
-        dense = false;
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+    bool all = true;
+    for (int v = range.start; v < range.end; ++v) {
+      const float* row = depth.ptr<float>(v);
+      PointT* out = &cloud[static_cast<std::size_t>(v) * depth.cols];
+      for (int u = 0; u < depth.cols; ++u) {
+        const float z = row[u];
+        PointT& p = out[u];
+        if (std::isfinite(z) && z > 0.f) {
+          p.x = (static_cast<float>(u) - cx) * z / fx;
+          p.y = (static_cast<float>(v) - cy) * z / fy;
+          p.z = z;
+        } else {
+          p.x = p.y = p.z = nan;
+          all = false;
+        }
       }
     }
-  }
+    if (!all)
+      dense = false;
+  });
   cloud.is_dense = dense;
 }
 
@@ -52,13 +59,14 @@ cv::Mat cloudToDepthImage(const pcl::PointCloud<PointT>& cloud) {
     throw InvalidInputError("expected an organized cloud (height > 1), got " + std::to_string(cloud.width) + "x" +
                             std::to_string(cloud.height));
   cv::Mat depth(static_cast<int>(cloud.height), static_cast<int>(cloud.width), CV_32FC1);
-#pragma omp parallel for
-  for (int v = 0; v < depth.rows; ++v) {
-    float* row = depth.ptr<float>(v);
-    const PointT* in = &cloud[static_cast<std::size_t>(v) * cloud.width];
-    for (int u = 0; u < depth.cols; ++u)
-      row[u] = (std::isfinite(in[u].z) && in[u].z > 0.f) ? in[u].z : 0.f;
-  }
+  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      float* row = depth.ptr<float>(v);
+      const PointT* in = &cloud[static_cast<std::size_t>(v) * cloud.width];
+      for (int u = 0; u < depth.cols; ++u)
+        row[u] = (std::isfinite(in[u].z) && in[u].z > 0.f) ? in[u].z : 0.f;
+    }
+  });
   return depth;
 }
 

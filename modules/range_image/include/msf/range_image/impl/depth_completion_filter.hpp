@@ -3,8 +3,9 @@
 #include <msf/range_image/depth_completion_filter.h>
 #include <msf/range_image/distance_transform.h>
 
-#include <omp.h>
+#include <opencv2/core/utility.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -33,53 +34,58 @@ void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
     throw InvalidInputError(filter_name_ + ": cloud is " + std::to_string(W) + "x" + std::to_string(H) +
                             " but the camera is " + std::to_string(camera.width) + "x" +
                             std::to_string(camera.height));
-  const int nthreads = threads() > 0 ? threads() : omp_get_max_threads();
+  const double stripes = threads() > 0 ? threads() : -1; // at most that many threads at once
 
   sparse_.create(H, W, CV_32FC1);
-#pragma omp parallel for schedule(static) num_threads(nthreads)
-  for (int v = 0; v < H; ++v) {
-    float* d = sparse_.ptr<float>(v);
-    const PointT* p = &in[static_cast<std::size_t>(v) * W];
-    for (int u = 0; u < W; ++u)
-      d[u] = (std::isfinite(p[u].z) && p[u].z > 0.f) ? p[u].z : 0.f;
-  }
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      float* d = sparse_.ptr<float>(v);
+      const PointT* p = &in[static_cast<std::size_t>(v) * W];
+      for (int u = 0; u < W; ++u)
+        d[u] = (std::isfinite(p[u].z) && p[u].z > 0.f) ? p[u].z : 0.f;
+    }
+  }, stripes);
   completeDepth(sparse_, dense_);
   if (dense_.size() != sparse_.size() || dense_.type() != CV_32FC1)
     throw InvalidInputError(filter_name_ + ": completion returned an image of another size or type");
-  distanceToSamples(sparse_, distance_, &nearest_, nthreads);
+  distanceToSamples(sparse_, distance_, &nearest_, threads());
 
   output.resize(in.size());
   output.width = in.width;
   output.height = in.height;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inv_fx = 1.f / camera.fx, inv_fy = 1.f / camera.fy;
-  bool dense = true;
-#pragma omp parallel for schedule(static) num_threads(nthreads) reduction(&& : dense)
-  for (int v = 0; v < H; ++v) {
-    const float* s = sparse_.ptr<float>(v);
-    const float* z = dense_.ptr<float>(v);
-    const float* dist = distance_.ptr<float>(v);
-    const int* near = nearest_.ptr<int>(v);
-    const std::size_t row = static_cast<std::size_t>(v) * W;
-    const float ry = (static_cast<float>(v) - camera.cy) * inv_fy;
-    for (int u = 0; u < W; ++u) {
-      PointT& p = output[row + u];
-      if (s[u] > 0.f && z[u] == s[u]) {
-        p = in[row + u]; // a real return keeps its exact point
-      } else if (z[u] > 0.f) {
-        p = in[near[u] >= 0 ? static_cast<std::size_t>(near[u]) : row + u]; // other fields: nearest return's
-        p.x = (static_cast<float>(u) - camera.cx) * inv_fx * z[u];
-        p.y = ry * z[u];
-        p.z = z[u];
-      } else {
-        p = in[row + u];
-        p.x = p.y = p.z = nan;
-        dense = false;
+  std::atomic<bool> dense{true};
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+    bool all = true;
+    for (int v = range.start; v < range.end; ++v) {
+      const float* s = sparse_.ptr<float>(v);
+      const float* z = dense_.ptr<float>(v);
+      const float* dist = distance_.ptr<float>(v);
+      const int* near = nearest_.ptr<int>(v);
+      const std::size_t row = static_cast<std::size_t>(v) * W;
+      const float ry = (static_cast<float>(v) - camera.cy) * inv_fy;
+      for (int u = 0; u < W; ++u) {
+        PointT& p = output[row + u];
+        if (s[u] > 0.f && z[u] == s[u]) {
+          p = in[row + u]; // a real return keeps its exact point
+        } else if (z[u] > 0.f) {
+          p = in[near[u] >= 0 ? static_cast<std::size_t>(near[u]) : row + u]; // other fields: nearest return's
+          p.x = (static_cast<float>(u) - camera.cx) * inv_fx * z[u];
+          p.y = ry * z[u];
+          p.z = z[u];
+        } else {
+          p = in[row + u];
+          p.x = p.y = p.z = nan;
+          all = false;
+        }
+        if constexpr (detail::HasDistance<PointT>::value)
+          p.distance = dist[u];
       }
-      if constexpr (detail::HasDistance<PointT>::value)
-        p.distance = dist[u];
     }
-  }
+    if (!all)
+      dense = false;
+  }, stripes);
   output.is_dense = dense;
 }
 

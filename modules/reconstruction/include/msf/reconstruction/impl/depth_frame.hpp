@@ -4,6 +4,7 @@
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/point_types.h>
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/type_traits.h>
 
 #include <cmath>
@@ -32,27 +33,28 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
     frame.color.create(rows, cols, CV_8UC3);
   if constexpr (kHasWeight)
     frame.weight.create(rows, cols, CV_32FC1);
-#pragma omp parallel for
-  for (int v = 0; v < rows; ++v) {
-    const PointT* in = &cloud[static_cast<std::size_t>(v) * cols];
-    float* depth = frame.depth.ptr<float>(v);
-    for (int u = 0; u < cols; ++u) {
-      const PointT& p = in[u];
-      depth[u] = (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && p.z > 0.f) ? p.z : 0.f;
-      if constexpr (kHasRgb) {
-        std::uint8_t* bgr = frame.color.ptr<std::uint8_t>(v) + 3 * u;
-        bgr[0] = p.b;
-        bgr[1] = p.g;
-        bgr[2] = p.r;
-      }
-      if constexpr (kHasWeight) {
-        using WeightT = typename pcl::traits::datatype<PointT, pcl::fields::weight>::type;
-        const float w = static_cast<float>(*reinterpret_cast<const WeightT*>(
-            reinterpret_cast<const std::uint8_t*>(&p) + pcl::traits::offset<PointT, pcl::fields::weight>::value));
-        frame.weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      const PointT* in = &cloud[static_cast<std::size_t>(v) * cols];
+      float* depth = frame.depth.ptr<float>(v);
+      for (int u = 0; u < cols; ++u) {
+        const PointT& p = in[u];
+        depth[u] = (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && p.z > 0.f) ? p.z : 0.f;
+        if constexpr (kHasRgb) {
+          std::uint8_t* bgr = frame.color.ptr<std::uint8_t>(v) + 3 * u;
+          bgr[0] = p.b;
+          bgr[1] = p.g;
+          bgr[2] = p.r;
+        }
+        if constexpr (kHasWeight) {
+          using WeightT = typename pcl::traits::datatype<PointT, pcl::fields::weight>::type;
+          const float w = static_cast<float>(*reinterpret_cast<const WeightT*>(
+              reinterpret_cast<const std::uint8_t*>(&p) + pcl::traits::offset<PointT, pcl::fields::weight>::value));
+          frame.weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
+        }
       }
     }
-  }
+  });
   frame.validate();
   return frame;
 }
