@@ -7,11 +7,13 @@ PREFIX ?= /usr/local
 KITTI_DIR ?= $(abspath ../shared/data/kitti)
 DEMO_OUT ?= out/demo
 
-# Every Debian package the project needs to build, test and view its results (pcl_viewer).
+# Every Debian package the project needs to build, test and view its results (pcl_viewer);
+# time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
-                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools
-# Only `make fuzz` needs this: clang's libFuzzer.
-FUZZ_PACKAGES := clang
+                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time
+# Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
+# project's code no longer uses OpenMP, but the fuzz build was not tried without it).
+FUZZ_PACKAGES := clang libomp-dev
 # Only the Open3D baseline of `make bench` needs these.
 BENCH_PACKAGES := python3-open3d python3-numpy
 

@@ -35,14 +35,25 @@ put("velodyne", "cut.bin", scan[:1602])
 
 # Clouds: 64 points of that scan as ASCII and binary .pcd (organized 8x8 and not) and .ply.
 pts = [struct.unpack_from("<4f", scan, 16 * i) for i in range(64)]
-def pcd(data, width, height):
-    head = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+def pcd_header(data, width, height):
+    return ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
             "WIDTH %d\nHEIGHT %d\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA %s\n" % (width, height, width * height, data))
+def pcd(data, width, height):
+    head = pcd_header(data, width, height)
     if data == "ascii":
         return head.encode() + "".join("%g %g %g %g\n" % p for p in pts).encode()
     return head.encode() + b"".join(struct.pack("<4f", *p) for p in pts)
 put("cloud", "ascii.pcd", b"\0" + pcd("ascii", 64, 1))
 put("cloud", "binary.pcd", b"\0" + pcd("binary", 8, 8))
+# binary_compressed (what saveCloud writes): sizes, then the fields one after the other
+# (all x, all y, ...) in LZF, here literal runs only (a control byte n < 32, then n + 1
+# bytes); the fuzzer's mutations of the control bytes make the back references.
+def lzf_literals(data):
+    return b"".join(bytes([len(data[i:i + 32]) - 1]) + data[i:i + 32] for i in range(0, len(data), 32))
+soa = b"".join(struct.pack("<64f", *(p[k] for p in pts)) for k in range(4))
+packed = lzf_literals(soa)
+put("cloud", "compressed.pcd", b"\0" + pcd_header("binary_compressed", 8, 8).encode() +
+    struct.pack("<II", len(packed), len(soa)) + packed)
 def ply(fmt):
     head = ("ply\nformat %s 1.0\nelement vertex 64\nproperty float x\nproperty float y\nproperty float z\n"
             "property float intensity\nend_header\n" % fmt)

@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <pcl/point_types.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -338,6 +339,42 @@ TEST(FuzzRegressions, APlyElementCountThatIsNotAWholeNumberIsRefusedBeforePclSiz
                    "element, property, comment, obj_info, end_header)"),
             std::string::npos)
       << e;
+}
+
+TEST(FuzzRegressions, ACompressedBodyWhoseSizesDisagreeWithTheHeaderIsRefused) {
+  // fuzz_cloud (make fuzz FUZZ_SECONDS=600, the first run with a binary_compressed seed, after
+  // ~6 min): a binary_compressed .pcd of 64 points of 8 bytes whose body says it unpacks to
+  // 0 bytes. PCL resized the cloud to that size and copied 64 points out of an empty buffer
+  // (SEGV in PCDReader::readBodyBinary).
+  const std::string e = cloudFindingError("crash-4b835f08d95ba59075cbc02443a421dcdc87d7de");
+  EXPECT_NE(e.find("c.pcd': its binary_compressed body says it unpacks to 0 bytes, but the header's 64 points "
+                   "of 8 bytes make 512 (a damaged file)"),
+            std::string::npos)
+      << e;
+  // The compressed size beyond the file, and a body shorter than the two sizes.
+  msf::test::TempDir dir;
+  const auto sizes = [](std::uint32_t compressed, std::uint32_t uncompressed) {
+    std::string bytes(8, '\0');
+    std::memcpy(&bytes[0], &compressed, 4);
+    std::memcpy(&bytes[4], &uncompressed, 4);
+    return bytes;
+  };
+  pcl::PCLPointCloud2 blob;
+  write(dir.file("c.pcd"), pcdHeader("2", "binary_compressed") + sizes(1000, 24) + std::string(30, '\0'));
+  EXPECT_NE(errorOf([&] { msf::loadCloudBlob(dir.file("c.pcd"), blob); })
+                .find("says 1000 bytes of compressed data, but the file has 30 after the sizes"),
+            std::string::npos);
+  write(dir.file("c.pcd"), pcdHeader("2", "binary_compressed") + "abcd");
+  EXPECT_NE(errorOf([&] { msf::loadCloudBlob(dir.file("c.pcd"), blob); })
+                .find("its binary_compressed body has 4 bytes, not even the 8 of its two sizes"),
+            std::string::npos);
+  // What saveCloud writes (binary_compressed) still loads.
+  pcl::PointCloud<pcl::PointXYZI> cloud, back;
+  for (int i = 0; i < 20; ++i)
+    cloud.push_back(pcl::PointXYZI(float(i)));
+  msf::saveCloud(dir.file("saved.pcd"), cloud);
+  EXPECT_EQ(errorOf([&] { msf::loadCloud(dir.file("saved.pcd"), back); }), "(no error)");
+  EXPECT_EQ(back.size(), 20u);
 }
 
 /// The error loading a .ply of this header and `body` bytes, as a cloud.

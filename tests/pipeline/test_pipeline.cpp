@@ -15,6 +15,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <csignal>
 #include <fcntl.h>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
+#include <vector>
 
 namespace {
 
@@ -174,14 +176,20 @@ int runReconstructReading(const std::string& dataset, const std::string& out, co
   return status;
 }
 
+/// The names in a folder, sorted.
+std::vector<std::string> entriesOf(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
 /// An interrupted run's outputs, beside nothing else in `dir`: a loadable mesh of at least
 /// one frame, a summary.json that parses and says so, and no staging folder or temporary.
 /// Returns the summary.
 std::string expectInterruptedOutputs(const msf::test::TempDir& dir, const std::string& out) {
-  std::vector<std::string> left;
-  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
-    left.push_back(e.path().filename().string());
-  EXPECT_EQ(left, std::vector<std::string>{"out"}) << "a staging folder or temporary is left beside OUT";
+  EXPECT_EQ(entriesOf(dir.path()), std::vector<std::string>{"out"}) << "a staging folder or temporary is left beside OUT";
   for (const auto& e : std::filesystem::directory_iterator(out))
     EXPECT_NE(e.path().filename().string()[0], '.') << "a temporary is left in OUT: " << e.path();
   const std::string json = readFile(out + "/summary.json");
@@ -254,6 +262,35 @@ TEST_F(PipelineTest, ASecondCtrlCStillLeavesAValidMeshAndSummary) {
   EXPECT_NE(json.find("\"mesh_accuracy\": null"), std::string::npos) << json;
   EXPECT_FALSE(msf::test::fileExists(out + "/mesh_preview.png"));
   EXPECT_NE(readFile(out + "/report.md").find("Stopped a second time: skipped `mesh_preview`"), std::string::npos);
+}
+
+TEST_F(PipelineTest, AKilledRunLeavesThePreviousOutputAndTheNextRunRemovesItsStaging) {
+  msf::test::TempDir dir;
+  const std::string out = dir.file("out");
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/summary.json") << "{\"previous\": true}\n";
+  // SIGKILL once the first frame is integrated: the run's files are in its staging folder.
+  bool killed = false;
+  const int status = runReconstructReading(dataset(), out, [&](const std::string& line, pid_t pid) {
+    if (!killed && line.find("(1/4)") != std::string::npos) {
+      ::kill(pid, SIGKILL);
+      killed = true;
+    }
+  });
+  ASSERT_TRUE(killed) << "the tool printed no progress line";
+  ASSERT_TRUE(WIFSIGNALED(status));
+  const std::vector<std::string> beside = entriesOf(dir.path());
+  ASSERT_EQ(beside.size(), 2u) << "expected OUT and the killed run's staging folder";
+  EXPECT_EQ(beside[0].rfind(".out.partial.", 0), 0u) << beside[0];
+  EXPECT_EQ(entriesOf(out), std::vector<std::string>{"summary.json"}) << "the killed run changed OUT";
+  EXPECT_EQ(readFile(out + "/summary.json"), "{\"previous\": true}\n");
+  // The next run replaces OUT as a whole and removes the dead run's staging folder.
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:0 -panels 0 -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(entriesOf(dir.path()), std::vector<std::string>{"out"}) << "a staging folder is left beside OUT";
+  EXPECT_EQ(readFile(out + "/summary.json").find("previous"), std::string::npos);
+  pcl::PolygonMesh mesh;
+  EXPECT_NO_THROW(msf::loadMesh(out + "/mesh.ply", mesh));
 }
 
 TEST(Reconstruct, BadInputIsAClearError) {

@@ -111,6 +111,37 @@ void checkPcdBody(const std::string& path, const pcl::PCLPointCloud2& header, in
     checkAsciiValues(path, data_index);
 }
 
+/// A binary_compressed body starts with two sizes that PCL's reader takes on trust: an
+/// uncompressed size other than the header's points x point step resizes the cloud, and the
+/// header's worth of points is then copied out of the smaller buffer (fuzz_cloud: a SEGV
+/// for a size of 0); a compressed size beyond the file makes LZF read past it.
+void checkCompressedSizes(const std::string& path, const pcl::PCLPointCloud2& header, unsigned int data_index) {
+  const std::uintmax_t size = fileSize(path);
+  const std::uintmax_t available = size > data_index ? size - data_index : 0;
+  if (available < 8)
+    throw IOError("cloud '" + path + "': its binary_compressed body has " + std::to_string(available) +
+                  " bytes, not even the 8 of its two sizes (a truncated file)");
+  char bytes[8];
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(data_index);
+  if (!in.read(bytes, sizeof bytes))
+    throw IOError("'" + path + "' cannot be read");
+  std::uint32_t compressed = 0, uncompressed = 0; // in the host's order, as PCL reads them
+  std::memcpy(&compressed, bytes, 4);
+  std::memcpy(&uncompressed, bytes + 4, 4);
+  if (compressed > available - 8)
+    throw IOError("cloud '" + path + "': its binary_compressed body says " + std::to_string(compressed) +
+                  " bytes of compressed data, but the file has " + std::to_string(available - 8) +
+                  " after the sizes (a truncated file)");
+  const std::uint64_t expected = static_cast<std::uint64_t>(header.width) * header.height * header.point_step;
+  if (uncompressed != expected)
+    throw IOError("cloud '" + path + "': its binary_compressed body says it unpacks to " +
+                  std::to_string(uncompressed) + " bytes, but the header's " +
+                  std::to_string(static_cast<std::uint64_t>(header.width) * header.height) + " points of " +
+                  std::to_string(header.point_step) + " bytes make " + std::to_string(expected) +
+                  " (a damaged file)");
+}
+
 /// A header line for a message: printable, at most 60 characters.
 std::string shownLine(const std::string& line) {
   std::string shown;
@@ -460,6 +491,8 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
         throw IOError("cloud '" + path + "' has no points");
       checkFieldLayout(path, blob);
       checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
+      if (data_type == 2)
+        checkCompressedSizes(path, blob, data_index);
       result = reader.read(path, blob);
     } else if (ext == ".ply") {
       checkPlyHeader(path, "cloud");
