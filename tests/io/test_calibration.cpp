@@ -176,8 +176,14 @@ TEST_F(CalibrationErrors, CamerasOnlyLoadsAndTheLidarStagesSayWhatIsMissing) {
 TEST(Calibration, ImageSizeText) {
   EXPECT_EQ(msf::parseImageSize("1242x375"), cv::Size(1242, 375));
   EXPECT_EQ(msf::parseImageSize(""), cv::Size(0, 0));
-  for (const char* bad : {"1242", "1242x", "x375", "0x375", "-5x3", "12x3x4", "1242*375", "12.5x3"})
+  for (const char* bad : {"1242", "1242x", "x375", "0x375", "-5x3", "12x3x4", "1242*375", "12.5x3", " 12x3", "+12x3"})
     EXPECT_THROW(msf::parseImageSize(bad), msf::InvalidInputError) << bad;
+  // Beyond an int, and beyond the limit: the message names the size given, not a wrapped one.
+  EXPECT_NE(msf::test::errorOf([] { msf::parseImageSize("99999999999x5"); })
+                .find("image size 99999999999x5 is outside 1x1 .. 8192x8192"),
+            std::string::npos);
+  EXPECT_THROW(msf::parseImageSize("8193x375"), msf::InvalidInputError);
+  EXPECT_EQ(msf::parseImageSize("8192x8192"), cv::Size(8192, 8192));
 }
 
 TEST_F(CalibrationErrors, WrongMatrixSizeNamesKeyAndCount) {

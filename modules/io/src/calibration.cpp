@@ -384,12 +384,20 @@ std::string cameraFrameId(int camera) { return "camera_" + std::to_string(camera
 cv::Size parseImageSize(const std::string& text) {
   if (text.empty())
     return {0, 0};
-  int width = 0, height = 0;
-  char x = 0, rest = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &rest) != 3 || x != 'x' || width <= 0 ||
-      height <= 0)
+  // Each side digits only, read without overflow: sscanf's %d read 99999999999 as 1215752191
+  // (undefined behaviour), and the message named a size no one gave.
+  const auto side = [](const std::string& digits) -> long long {
+    if (digits.empty() || digits.size() > 18 || digits.find_first_not_of("0123456789") != std::string::npos)
+      return 0;
+    return std::stoll(digits);
+  };
+  const std::size_t x = text.find('x');
+  const long long width = x == std::string::npos ? 0 : side(text.substr(0, x));
+  const long long height = x == std::string::npos ? 0 : side(text.substr(x + 1));
+  if (width <= 0 || height <= 0)
     throw InvalidInputError("image size '" + text + "' is not WIDTHxHEIGHT with both > 0 (e.g. 1242x375)");
-  return {width, height};
+  limits::checkImageSize(width, height, "the image size given");
+  return {static_cast<int>(width), static_cast<int>(height)};
 }
 
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path) {
