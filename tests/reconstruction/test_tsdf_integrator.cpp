@@ -30,10 +30,10 @@ struct SceneResult {
   double coverage = 0; // share of seen surface points within one voxel of a vertex
 };
 
-SceneResult reconstruct(SceneKind kind, double sigma, double lambda, int frames = 5) {
+SceneResult reconstruct(SceneKind kind, double sigma, double lambda, int frames = 5,
+                        TsdfIntegrator::Config config = {}) {
   const AnalyticScene scene = test::makeScene(kind);
   TsdfVolume volume(kVoxel, kTrunc);
-  TsdfIntegrator::Config config;
   config.lambda = lambda;
   TsdfIntegrator integrator(volume, config);
   const auto camera = test::smallCamera();
@@ -107,6 +107,30 @@ TEST(TsdfIntegrator, LambdaReducesTheErrorOfNoisyDepth) {
   const double regularized = reconstruct(SceneKind::Sphere, 0.03, 5.0).error;
   std::printf("  sigma 30 mm: lambda 0 -> %.2f mm, lambda 5 -> %.2f mm\n", plain * 1e3, regularized * 1e3);
   EXPECT_LT(regularized, 0.8 * plain);
+}
+
+TEST(TsdfIntegrator, InverseVarianceLambdaSmoothsWhatIsUncertainAndKeepsWhatIsKnown) {
+  // The same 30 mm noise on the sphere, once said to be known to 1 cm (weight 1e4 a frame,
+  // LiDAR-like) and once to 0.5 m (weight 4, far-stereo-like). With the data term weighed by
+  // the voxel's weight, lambda 5 leaves the first where the plain mean puts it and smooths the
+  // second; the paper's uniform data term smooths both alike.
+  const auto error = [](double sigma_m, double lambda, TsdfIntegrator::LambdaData data) {
+    TsdfIntegrator::Config config;
+    config.weighting = TsdfIntegrator::Weighting::Constant;
+    config.depth_sigma_m = sigma_m;
+    config.truncation_sigmas = 0.0; // the same band (kTrunc) for both
+    config.lambda_data = data;
+    return reconstruct(SceneKind::Sphere, 0.03, lambda, 5, config).error;
+  };
+  const auto by_weight = TsdfIntegrator::LambdaData::InverseVariance;
+  const double known = error(0.01, 0.0, by_weight), known_smoothed = error(0.01, 5.0, by_weight);
+  const double unsure = error(0.5, 0.0, by_weight), unsure_smoothed = error(0.5, 5.0, by_weight);
+  std::printf("  known to 1 cm: %.2f -> %.2f mm; to 0.5 m: %.2f -> %.2f mm\n", known * 1e3, known_smoothed * 1e3,
+              unsure * 1e3, unsure_smoothed * 1e3);
+  EXPECT_NEAR(known_smoothed, known, 0.03 * known);
+  EXPECT_LT(unsure_smoothed, 0.8 * unsure);
+  const auto uniform = TsdfIntegrator::LambdaData::Uniform;
+  EXPECT_LT(error(0.01, 5.0, uniform), 0.8 * known);
 }
 
 TEST(TsdfIntegrator, PlainWeightedMeanWithSignsAndWeights) {
@@ -726,7 +750,8 @@ TEST(TsdfIntegrator, ArgminSolveReachesTheMinimizerOfEquation7) {
 }
 
 TEST(TsdfIntegrator, SolveKeysAreNamedWhenWrong) {
-  for (const std::string key : {"solve: exact", "argmin_tolerance_m: 0", "argmin_max_sweeps: 0"}) {
+  for (const std::string key :
+       {"solve: exact", "argmin_tolerance_m: 0", "argmin_max_sweeps: 0", "lambda_data: weighted"}) {
     cv::FileStorage fs("%YAML:1.0\ntsdf_integrator:\n  " + key + "\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
     TsdfIntegrator::Config config;
     try {

@@ -172,6 +172,16 @@ TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
   throw ConfigError("TSDF weighting '" + text + "' is not constant, inverse_square or per_pixel");
 }
 
+const char* toString(TsdfIntegrator::LambdaData data) {
+  return data == TsdfIntegrator::LambdaData::InverseVariance ? "inverse_variance" : "uniform";
+}
+
+TsdfIntegrator::LambdaData parseLambdaData(const std::string& text) {
+  if (text == "uniform") return TsdfIntegrator::LambdaData::Uniform;
+  if (text == "inverse_variance") return TsdfIntegrator::LambdaData::InverseVariance;
+  throw ConfigError("tsdf_integrator.lambda_data '" + text + "' is not uniform or inverse_variance");
+}
+
 const char* toString(TsdfIntegrator::Solve solve) {
   return solve == TsdfIntegrator::Solve::Argmin ? "argmin" : "sweeps";
 }
@@ -201,6 +211,9 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "plane_max_curvature", plane.max_curvature);
   readKey(node, "plane_min_scale", plane.min_scale);
   readKey(node, "lambda", lambda);
+  std::string data = toString(lambda_data);
+  readKey(node, "lambda_data", data);
+  lambda_data = parseLambdaData(data);
   readKey(node, "sweeps", sweeps);
   std::string solve_name = toString(solve);
   readKey(node, "solve", solve_name);
@@ -270,6 +283,7 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  plane_max_curvature: " << configValue(plane.max_curvature) << "\n"
       << "  plane_min_scale: " << configValue(plane.min_scale) << "\n"
       << "  lambda: " << configValue(lambda) << "\n"
+      << "  lambda_data: " << toString(lambda_data) << "\n"
       << "  sweeps: " << configValue(sweeps) << "\n"
       << "  solve: " << toString(solve) << "\n"
       << "  argmin_tolerance_m: " << configValue(argmin_tolerance_m) << "\n"
@@ -923,6 +937,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
 void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets) {
   const std::size_t n = touched.size();
   const float lambda = static_cast<float>(config_.lambda);
+  const bool by_weight = config_.lambda_data == LambdaData::InverseVariance;
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
@@ -933,7 +948,8 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         neighbours[i][k] = volume_.findBlock(touched[i]->index + steps[k]);
   }, 16);
 
-  // x_i = (y_i + lambda * sum_j x_j) / (1 + lambda * n_i) over observed 6-neighbours j: the
+  // x_i = (W_i y_i + lambda * sum_j x_j) / (W_i + lambda * n_i) over observed 6-neighbours j
+  // (W_i = 1 for LambdaData::Uniform): the
   // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
   // fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
   // share no face (face neighbours differ by one in one coordinate), so each colour's blocks
@@ -984,8 +1000,9 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
           float& sdf = block.voxels[j].sdf;
           const float before = sdf;
+          const float data = by_weight ? block.voxels[j].weight : 1.f;
           if (count > 0.f)
-            sdf = (data_term_[k] + lambda * sum) / (1.f + lambda * count);
+            sdf = (data * data_term_[k] + lambda * sum) / (data + lambda * count);
           change = std::max(change, std::abs(sdf - before));
           signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
           negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;

@@ -68,6 +68,12 @@ public:
     Plane       ///< distance to the observed surface's tangent plane (planeDistanceScale)
   };
 
+  /// How much each voxel's own mean counts against lambda's pull towards its neighbours.
+  enum class LambdaData {
+    Uniform,        ///< eq. 7 as the paper writes it: every mean counts once
+    InverseVariance ///< by the voxel's weight (1 / sigma^2): what is uncertain is smoothed
+  };
+
   /// How eq. 7 is solved each frame.
   enum class Solve {
     Sweeps, ///< `sweeps` Gauss-Seidel sweeps, warm-started: refined over frames (the project's)
@@ -100,6 +106,11 @@ public:
     SignedDistance signed_distance = SignedDistance::Plane;
     PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
     double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
+    /// Uniform: lambda is a pure number. InverseVariance: x = argmin sum_i W_i (x_i - y_i)^2 +
+    /// lambda sum_ij (x_i - x_j)^2, W_i the voxel's weight, lambda in m^-2: a LiDAR-backed voxel
+    /// (W ~ 1000) barely moves, a far stereo-only one (W ~ 10) takes its neighbours' mean, so
+    /// that noisy façades are smoothed and the edges the LiDAR saw are not.
+    LambdaData lambda_data = LambdaData::Uniform;
     /// Gauss-Seidel sweeps per frame over the changed voxels. 1: the solution is warm-started
     /// from the last frame, so it is refined over frames; solving each frame to convergence
     /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
@@ -128,7 +139,8 @@ public:
     /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
     /// space_carving, carving_weight, scan_carving_m,
     /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
-    /// plane_min_scale, lambda, sweeps, solve (sweeps | argmin), argmin_tolerance_m,
+    /// plane_min_scale, lambda, lambda_data (uniform | inverse_variance), sweeps, solve (sweeps |
+    /// argmin), argmin_tolerance_m,
     /// argmin_max_sweeps, min_depth_m, max_depth_m, interpolate_depth,
     /// allocation_stride. Throws ConfigError naming a bad key.
     void read(const cv::FileNode& node);
@@ -235,6 +247,8 @@ private:
 const char* toString(TsdfIntegrator::Weighting weighting);
 TsdfIntegrator::Weighting parseWeighting(const std::string& text);
 /// "sweeps", "argmin"; parse throws ConfigError naming the key and the text.
+const char* toString(TsdfIntegrator::LambdaData data);
+TsdfIntegrator::LambdaData parseLambdaData(const std::string& text);
 const char* toString(TsdfIntegrator::Solve solve);
 TsdfIntegrator::Solve parseSolve(const std::string& text);
 /// "projective", "plane"; parse throws ConfigError naming the text.
