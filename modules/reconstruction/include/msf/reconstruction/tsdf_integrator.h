@@ -227,6 +227,8 @@ private:
   bool regularizes() const {
     return config_.lambda > 0.0 && (config_.solve == Solve::Argmin || config_.sweeps > 0);
   }
+  /// |sdf| below which a changed voxel is regularized (infinite: all of them).
+  float smoothingBand() const;
   /// Eq. 7 over the voxels changed_index_[offsets[i] .. offsets[i + 1]) of touched[i].
   void regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets);
 
