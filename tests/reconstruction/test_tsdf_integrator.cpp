@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 using namespace msf;
 using test::SceneKind;
@@ -911,5 +912,63 @@ TEST(TsdfIntegrator, ScanCarvingRangeIsAValidatedKey) {
     FAIL() << "a negative scan_carving_m was accepted";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("scan_carving_m"), std::string::npos) << e.what();
+  }
+}
+
+namespace {
+
+/// Whether two volumes hold the same blocks with bit-identical voxels.
+bool sameVolumes(const TsdfVolume& a, const TsdfVolume& b) {
+  if (a.numBlocks() != b.numBlocks())
+    return false;
+  for (const TsdfBlock* block : a.blocks()) {
+    const TsdfBlock* other = b.findBlock(block->index);
+    if (!other)
+      return false;
+    for (int i = 0; i < TsdfBlock::kVoxels; ++i) {
+      const TsdfVoxel &x = block->voxels[i], &y = other->voxels[i];
+      if (std::memcmp(&x.sdf, &y.sdf, sizeof x.sdf) || std::memcmp(&x.weight, &y.weight, sizeof x.weight) ||
+          x.r != y.r || x.g != y.g || x.b != y.b)
+        return false;
+    }
+  }
+  return true;
+}
+
+} // namespace
+
+TEST(TsdfIntegrator, ADepthImageInsideAWiderOneAndFramesOfChangingSizesGiveTheSameVolume) {
+  // The integrator indexes its depth as rows of the image's width (a view into a wider image is
+  // copied first) and keeps its buffers from frame to frame: a frame whose depth is such a view,
+  // and frames of two sizes in turn, give bit for bit the volume of plain images integrated
+  // by a fresh integrator each time.
+  const AnalyticScene scene = test::makeScene(SceneKind::Box);
+  const PinholeCamera small = test::smallCamera();
+  PinholeCamera large = small;
+  large.width = 2 * small.width;
+  large.height = small.height + 40;
+  large.cx += small.width / 2.0;
+  large.cy += 20.0;
+  const auto poses = test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 15, 4);
+  for (const float min_pixel_weight : {0.f, 0.25f}) {
+    TsdfIntegrator::Config config;
+    config.min_pixel_weight = min_pixel_weight;
+    TsdfVolume reused(0.04, 0.12), fresh(0.04, 0.12);
+    TsdfIntegrator integrator(reused, config);
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const PinholeCamera& camera = i % 2 ? large : small;
+      DepthFrame frame = test::renderFrame(scene, camera, poses[i], 0.01, 11 + static_cast<unsigned>(i));
+      frame.weight = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(100.f + 10.f * static_cast<float>(i)));
+      // The same depth as a view into an image 7 columns wider.
+      cv::Mat wider(frame.depth.rows, frame.depth.cols + 7, CV_32FC1, cv::Scalar(5.f));
+      frame.depth.copyTo(wider.colRange(3, 3 + frame.depth.cols));
+      DepthFrame view = frame;
+      view.depth = wider.colRange(3, 3 + frame.depth.cols);
+      ASSERT_FALSE(view.depth.isContinuous());
+      integrator.integrate(i % 2 ? view : frame, poses[i]);
+      TsdfIntegrator(fresh, config).integrate(frame, poses[i]);
+    }
+    EXPECT_GT(reused.numObservedVoxels(), 1000u);
+    EXPECT_TRUE(sameVolumes(reused, fresh)) << "min_pixel_weight " << min_pixel_weight;
   }
 }

@@ -363,11 +363,15 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // min_pixel_weight are no depth, for every step below.
   pixelWeights(frame, weight_);
   const bool masked = config_.min_pixel_weight > 0.f;
-  if (masked) {
+  // The depth the voxels are tested against is continuous, rows of `width` floats like the pixel
+  // records below, so that one index finds a pixel in both (a frame's depth may be a view into a
+  // wider image: then a copy).
+  const bool copied = masked || !frame.depth.isContinuous();
+  if (copied)
     frame.depth.copyTo(masked_depth_);
+  if (masked)
     masked_depth_.setTo(0.f, weight_ < config_.min_pixel_weight);
-  }
-  const cv::Mat& depth_image = masked ? masked_depth_ : frame.depth;
+  const cv::Mat& depth_image = copied ? masked_depth_ : frame.depth;
 
   const PinholeCamera& cam = frame.camera;
   const int width = cam.width, height = cam.height;
@@ -642,9 +646,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         // Clamped before the conversion (equal to converting, then clamping, inside the image).
         const Int4 pixel_u = __builtin_convertvector(clamp4(pu + 0.5f, 0.f, static_cast<float>(width - 1)), Int4);
         const Int4 pixel_v = __builtin_convertvector(clamp4(pv + 0.5f, 0.f, static_cast<float>(height - 1)), Int4);
-        const Int4 at = pixel_v * static_cast<int>(depth_step) + pixel_u;
-        const Float4 nearest = {depth_data[at[0]], depth_data[at[1]], depth_data[at[2]], depth_data[at[3]]};
-        const Int4 at_pixel = pixel_v * width + pixel_u;
+        const Int4 at_pixel = pixel_v * width + pixel_u; // the depth's and the records' (see depth_image)
+        const Float4 nearest = {depth_data[at_pixel[0]], depth_data[at_pixel[1]], depth_data[at_pixel[2]],
+                                depth_data[at_pixel[3]]};
         const PixelBand* p[4] = {&pixel_data[at_pixel[0]], &pixel_data[at_pixel[1]], &pixel_data[at_pixel[2]],
                                  &pixel_data[at_pixel[3]]};
         const Float4 behind = {p[0]->behind, p[1]->behind, p[2]->behind, p[3]->behind};

@@ -1,0 +1,93 @@
+// The stages of msf_reconstruct on KITTI odometry 04 frames 0-9 with config/kitti.yaml, each
+// alone on the pipeline's own input (the fused depth and the scans of Pipeline::computeDepth,
+// the dataset's poses), in process CPU time per frame: the figure that tells whether a change
+// makes the whole pipeline cheaper, with less noise than msf_reconstruct's frame rate on a
+// shared machine (bench/bench_pipeline.sh).
+//
+//   bench_pipeline_stages [--benchmark_repetitions=9]   (MSF_KITTI_DIR overrides the sample's
+//                                                        path, MSF_CONFIG the configuration)
+//
+// BM_StageIntegrate: the 10 fused frames and each scan's free space into a fresh volume
+// (Pipeline::integrate's work: TsdfIntegrator::integrate, then carveWithScan), per frame.
+// BM_StageDepth: steps 1-4 of one frame (Pipeline::computeDepth), per frame.
+#include "kitti_sample.h"
+
+#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/source_depth_frame.h>
+
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace msf;
+
+namespace {
+
+std::string configPath() {
+  const char* env = std::getenv("MSF_CONFIG");
+  return env ? env : MSF_SOURCE_DIR "/config/kitti.yaml";
+}
+
+struct Data {
+  Sequence sequence = msf::bench::kittiSequence();
+  PipelineConfig config = PipelineConfig::load(configPath());
+  std::unique_ptr<Pipeline> pipeline;
+  std::vector<FrameResult> results;
+  std::vector<DepthFrame> frames;
+  Data() {
+    pipeline = std::make_unique<Pipeline>(sequence.calibration(), config);
+    for (std::size_t i = 0; i < msf::bench::kFrames; ++i) {
+      FrameResult r = pipeline->computeDepth(sequence.load(i));
+      frames.push_back(fusedDepthFrame(r, config.fusion, sequence.calibration().focalBaseline()));
+      results.push_back(std::move(r));
+    }
+  }
+};
+
+Data& data() {
+  static Data d;
+  return d;
+}
+
+void BM_StageIntegrate(benchmark::State& state) {
+  Data& d = data();
+  double projected = 0, updated = 0, blocks = 0;
+  for (auto _ : state) {
+    TsdfVolume volume(d.config.volume.voxel_size_m, d.config.volume.truncation_m);
+    TsdfIntegrator integrator(volume, d.config.integrator);
+    projected = updated = 0;
+    for (std::size_t i = 0; i < d.frames.size(); ++i) {
+      integrator.integrate(d.frames[i], d.results[i].T_world_cam0);
+      projected += static_cast<double>(integrator.lastStats().voxels_projected);
+      updated += static_cast<double>(integrator.lastStats().voxels_updated);
+      carveWithScan(integrator, d.results[i], d.frames[i].camera, d.config.fusion, d.sequence.calibration());
+    }
+    blocks = static_cast<double>(volume.numBlocks());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(d.frames.size()));
+  // Per frame: voxels projected and updated; the map's blocks after the 10 frames.
+  state.counters["projected"] = projected / static_cast<double>(d.frames.size());
+  state.counters["updated"] = updated / static_cast<double>(d.frames.size());
+  state.counters["blocks"] = blocks;
+}
+BENCHMARK(BM_StageIntegrate)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_StageDepth(benchmark::State& state) {
+  Data& d = data();
+  std::vector<Frame> frames;
+  for (std::size_t i = 0; i < msf::bench::kFrames; ++i)
+    frames.push_back(d.sequence.load(i));
+  for (auto _ : state)
+    for (const Frame& frame : frames)
+      benchmark::DoNotOptimize(d.pipeline->computeDepth(frame).fused.depth.data);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
+}
+BENCHMARK(BM_StageDepth)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+
+} // namespace
+
+BENCHMARK_MAIN();
