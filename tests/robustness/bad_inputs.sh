@@ -311,8 +311,15 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
-  check "reconstruct -max_memory 1" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB .* over the memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  # Estimated poses: nothing to predict from; the volume stops the run at its first growth.
+  check "reconstruct -max_memory 1 -poses estimate" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -poses estimate -o out
+  # Millimetre voxels to 44 m: too many block columns to list; the views' boxes are counted.
+  printf '%%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.001\n  truncation_m: 0.003\n' >"$F/mm_voxels.yaml"
+  check "reconstruct: 1 mm voxels, -max_memory 1000" 1 "predicted to need up to [0-9]+ MiB .* over the memory budget of 1000 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -config "$F/mm_voxels.yaml" -max_memory 1000 -o out
   check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
     msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
