@@ -4,16 +4,16 @@
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
 #include <msf/pipeline/run_report.h>
-#include <msf/reconstruction/block_footprint.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
+#include <msf/reconstruction/block_footprint.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <future>
 #include <mutex>
@@ -375,9 +375,8 @@ MemoryPrediction Pipeline::predictMemory(const PoseList& T_world_cam0, int maps,
     const double tile_m = config_.streaming.tile_blocks * block_m;
     const double radius = config_.streaming.active_radius_m + std::sqrt(3.0) * (tile_m + block_m);
     const double step = std::max(tile_m, radius / 8.0);
-    std::size_t most = 0;
     Eigen::Vector3d last = T_world_cam0.front().translation();
-    most = footprint.blocksWithin(last, radius + step);
+    std::size_t most = footprint.blocksWithin(last, radius + step);
     for (const Eigen::Isometry3d& T : T_world_cam0)
       if ((T.translation() - last).norm() >= step) {
         last = T.translation();
