@@ -29,7 +29,7 @@ BlockFootprint::BlockFootprint(double voxel_size_m) : voxel_size_(voxel_size_m) 
 
 int BlockFootprint::blockOf(double p) const {
   // As the integrator's sub-block keys: block floor((p / vs + 1/2) / kSide).
-  return static_cast<int>(std::floor((p / voxel_size_ + 0.5) / kSide));
+  return static_cast<int>(std::floor(std::clamp((p / voxel_size_ + 0.5) / kSide, -1e9, 1e9)));
 }
 
 void BlockFootprint::addView(const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, double near_m,
@@ -102,11 +102,13 @@ void BlockFootprint::addView(const PinholeCamera& camera, const Eigen::Isometry3
             run_first = run_last + 1;
           continue;
         }
-        const double bound = (rhs / (nk * vs) - 0.5 * kSide + 0.5) / kSide;
+        // Clamped both ways before the cast: a plane nearly parallel to the axis gives a bound
+        // of either sign far beyond an int (UBSan's float-cast-overflow found 2.6e11).
+        const double bound = std::clamp((rhs / (nk * vs) - 0.5 * kSide + 0.5) / kSide, -1e9, 1e9);
         if (nk > 0.0)
-          run_last = std::min(run_last, static_cast<int>(std::floor(std::min(bound, 1e9))));
+          run_last = std::min(run_last, static_cast<int>(std::floor(bound)));
         else
-          run_first = std::max(run_first, static_cast<int>(std::ceil(std::max(bound, -1e9))));
+          run_first = std::max(run_first, static_cast<int>(std::ceil(bound)));
         if (run_first > run_last)
           break;
       }
@@ -169,8 +171,9 @@ std::size_t BlockFootprint::blocksWithin(const Eigen::Vector3d& c, double radius
     // Blocks along k whose box meets [c_k - L, c_k + L], L the ball's half chord: their
     // centres within L + half of c_k.
     const double reach = std::sqrt(rest) + half;
-    const int from = static_cast<int>(std::ceil(((c[k] - reach) / vs - 0.5 * kSide + 0.5) / kSide));
-    const int to = static_cast<int>(std::floor(((c[k] + reach) / vs - 0.5 * kSide + 0.5) / kSide));
+    auto block = [&](double p) { return std::clamp((p / vs - 0.5 * kSide + 0.5) / kSide, -1e9, 1e9); };
+    const int from = static_cast<int>(std::ceil(block(c[k] - reach)));
+    const int to = static_cast<int>(std::floor(block(c[k] + reach)));
     for (const auto& run : runs) {
       const int a = std::max(run.first, from), b = std::min(run.second, to);
       if (a <= b)
