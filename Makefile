@@ -70,10 +70,14 @@ test: deps
 SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
   -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
   -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
+# A report goes to stderr (no log_path), where the tests look for it in every tool they run
+# (runCommand in tests/support, bad_inputs.sh) and fail quoting it; abort_on_error=1 for ASan and
+# UBSan (whose first report is fatal, -fno-sanitize-recover=all), so that a stopped tool dies of
+# SIGABRT instead of exiting 1 as a clear error does.
 SANITIZE_CTEST = cd $(SANITIZE_BUILD_DIR) && \
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:suppressions=$(CURDIR)/tests/sanitize/asan.supp \
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp \
-  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:abort_on_error=1:suppressions=$(CURDIR)/tests/sanitize/ubsan.supp \
   ctest --output-on-failure -j$(JOBS) --timeout 1500
 
 test-sanitize: deps

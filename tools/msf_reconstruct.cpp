@@ -41,6 +41,7 @@
 #include <set>
 #include <sstream>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>     // AT_FDCWD
@@ -407,6 +408,39 @@ constexpr double kGhostDistanceM = 0.2; // farther than this from the static sur
 
 } // namespace
 
+/// The memory budget against the run's predicted peak, before any frame is read: an explicit
+/// budget (tsdf_volume.max_memory_mb, -max_memory > 0) refuses a run predicted to exceed it;
+/// the default one (three quarters of RAM) warns, since the prediction is an upper bound that
+/// grows with the space the cameras swept, not with the surface they saw. With estimated
+/// poses nothing is known before the run: the volume's own check at each growth stays.
+void checkMemoryBudget(const msf::Pipeline& pipeline, const msf::PoseList& poses, int maps, bool scores_every_frame,
+                       double max_memory_mb, msf::RunReport& report) {
+  const double budget_mb = static_cast<double>(pipeline.volume().maxMemoryBytes()) / (1024.0 * 1024.0);
+  if (poses.empty()) {
+    print_info("Memory: the poses are estimated as the run goes, so its peak is not predicted; the TSDF volume "
+               "stops the run at the first frame whose blocks would exceed the budget (%.0f MiB)\n",
+               budget_mb);
+    return;
+  }
+  const msf::MemoryPrediction p = pipeline.predictMemory(poses, maps, scores_every_frame);
+  report.predicted_memory_mb = p.total_mb;
+  print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
+             p.describe().c_str(), budget_mb,
+             max_memory_mb > 0 ? "" : " (three quarters of RAM)", p.ms);
+  if (p.total_mb <= budget_mb)
+    return;
+  if (max_memory_mb > 0)
+    throw msf::InvalidInputError(
+        "the run is predicted to need up to " + std::to_string(static_cast<long long>(std::ceil(p.total_mb))) +
+        " MiB at its peak (" + p.describe() + "), over the memory budget of " +
+        std::to_string(static_cast<long long>(budget_mb)) +
+        " MiB (tsdf_volume.max_memory_mb, -max_memory): use fewer frames, larger voxels, a streamed map (-stream R) "
+        "or a larger budget");
+  print_warn("the run is predicted to need up to %.0f MiB at its peak, over three quarters of RAM (%.0f MiB): the "
+             "prediction is an upper bound; the run stops at the first frame whose blocks would not fit\n",
+             p.total_mb, budget_mb);
+}
+
 int main(int argc, char** argv) {
   std::string out = "msf_out", frames_text = "0:", poses_option;
   int panels = 3;
@@ -439,7 +473,9 @@ int main(int argc, char** argv) {
              "written to OUT/tsdf/ as it leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview; "
              "msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md")
       .value("-max_memory", "MB", config.volume.max_memory_mb,
-             "memory budget of the volume (tsdf_volume.max_memory_mb; 0: 3/4 of RAM)")
+             "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
+            "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "
+            "the TSDF volume also stops the run at the first frame whose blocks would not fit")
       .flag("-save_depth", save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
       .flag("-holdout", holdout,
             "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
@@ -551,6 +587,11 @@ int main(int argc, char** argv) {
     if (compare_paper)
       paper = std::make_unique<PaperRun>(calibration, config);
 
+    // Before any frame is read: a run predicted over an explicit budget does not start.
+    msf::Pipeline pipeline(calibration, config);
+    checkMemoryBudget(pipeline, poses.knownPoses(frames), 1 + (compare_sources ? 2 : 0) + (compare_paper ? 1 : 0),
+                      evaluation != nullptr, config.volume.max_memory_mb, report);
+
     print_highlight("Reconstructing ");
     print_value("%zu", frames.size());
     print_info(" frames of ");
@@ -560,7 +601,6 @@ int main(int argc, char** argv) {
     print_info("%s%s; poses: %s\n", holdout ? ", held-out rings removed from every scan" : "",
                compare_sources ? ", with a map of each source alone" : "", poses.description().c_str());
 
-    msf::Pipeline pipeline(calibration, config);
     if (streaming)
       pipeline.setStreamingDirectory(stage);
     const std::set<std::size_t> panel_frames = spread(frames, panels);

@@ -168,11 +168,15 @@ int runReconstructReading(const std::string& dataset, const std::string& out, co
   ::close(pipe_fds[1]);
   FILE* child_out = ::fdopen(pipe_fds[0], "r");
   char line[4096];
-  while (std::fgets(line, sizeof line, child_out))
+  std::string output;
+  while (std::fgets(line, sizeof line, child_out)) {
+    output += line;
     on_line(line, pid);
+  }
   std::fclose(child_out);
   int status = 0;
   ::waitpid(pid, &status, 0);
+  msf::test::expectNoSanitizerReport(output, tool + " " + dataset + " -o " + out + " -panels 0");
   return status;
 }
 

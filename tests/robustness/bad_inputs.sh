@@ -9,7 +9,25 @@
 # Prints one line a case and a summary; exits 1 when any case fails. KITTI_DIR is the
 # KITTI sample (../shared/data/kitti); the cases that need it are skipped without it unless
 # CI=true.
+#
+#   tests/robustness/bad_inputs.sh --sanitizer-report FILE
+#
+# prints the sanitizer report in FILE and exits 1, or exits 0 when it holds none: the check
+# each case's stderr goes through, tested on real reports (tests/common/test_sanitizer_reports.cpp).
 set -uo pipefail
+
+# The first sanitizer report in a file, 12 lines from the line that opens it (AddressSanitizer,
+# LeakSanitizer, UndefinedBehaviorSanitizer, UBSan's "file:line:col: runtime error:",
+# ThreadSanitizer), as sanitizerReport in tests/support/test_support.cpp; nothing when none.
+sanitizer_report() {
+  grep -E -m 1 -A 11 -- '==[0-9]+==ERROR: [A-Za-z]*Sanitizer|: runtime error: |WARNING: ThreadSanitizer: ' "$1"
+}
+if [ "${1:-}" = --sanitizer-report ]; then
+  report=$(sanitizer_report "${2:?usage: bad_inputs.sh --sanitizer-report FILE}") || exit 0
+  printf '%s\n' "$report"
+  exit 1
+fi
+
 BIN=$(cd "${1:?usage: bad_inputs.sh BIN_DIR KITTI_DIR}" && pwd)
 KITTI=${2:-}
 MAX_SECONDS=5
@@ -41,7 +59,8 @@ failures=0 cases=0 skipped=0 slowest=0 largest=0
 # check NAME EXPECTED_EXIT PATTERN -- TOOL ARGS...
 # Runs the tool in $T/run (its outputs go there); the case passes when the exit code is
 # EXPECTED_EXIT, stderr (or stdout) matches PATTERN (grep -E), the run took < MAX_SECONDS
-# and < MAX_KB, and, for an error, the run folder holds no file.
+# and < MAX_KB, stderr holds no sanitizer report (an ASan build's tool that a sanitizer stops
+# exits 1, as an error does), and, for an error, the run folder holds no file.
 check() {
   local name=$1 expected=$2 pattern=$3
   shift 4
@@ -64,8 +83,10 @@ check() {
   ms=$(((end - start) / 1000000))
   [ $ms -gt $slowest ] && slowest=$ms
   [ "$kb" -gt $largest ] && largest=$kb
-  local why=""
-  [ "$code" = "$expected" ] || why="exit $code, expected $expected;"
+  local why="" report
+  report=$(sanitizer_report "$T/err")
+  [ -z "$report" ] || why="a sanitizer report in stderr;"
+  [ "$code" = "$expected" ] || why="$why exit $code, expected $expected;"
   grep -Eq -- "$pattern" "$T/err" "$T/out" || why="$why message does not match '$pattern';"
   [ $ms -lt $((MAX_SECONDS * 1000)) ] || why="$why took $ms ms;"
   [ "$kb" -lt $MAX_KB ] || why="$why used $((kb / 1024)) MB;"
@@ -77,7 +98,11 @@ check() {
   else
     failures=$((failures + 1))
     printf 'FAIL  %-44s %s\n' "$name" "$why"
-    sed 's/^/      | /' "$T/err" | tail -n 5
+    if [ -n "$report" ]; then
+      printf '%s\n' "$report" | sed 's/^/      | /'
+    else
+      sed 's/^/      | /' "$T/err" | tail -n 5
+    fi
   fi
 }
 
@@ -286,8 +311,15 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
-  check "reconstruct -max_memory 1" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB .* over the memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  # Estimated poses: nothing to predict from; the volume stops the run at its first growth.
+  check "reconstruct -max_memory 1 -poses estimate" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -poses estimate -o out
+  # Millimetre voxels to 44 m: too many block columns to list; the views' boxes are counted.
+  printf '%%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.001\n  truncation_m: 0.003\n' >"$F/mm_voxels.yaml"
+  check "reconstruct: 1 mm voxels, -max_memory 1000" 1 "predicted to need up to [0-9]+ MiB .* over the memory budget of 1000 MiB" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -config "$F/mm_voxels.yaml" -max_memory 1000 -o out
   check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
     msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -74,7 +75,33 @@ CommandResult runCommand(const std::string& command_line) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = slurp(out);
   r.err = slurp(err);
+  expectNoSanitizerReport(r.err, command_line);
   return r;
+}
+
+std::string sanitizerReport(const std::string& output, std::size_t max_lines) {
+  // The lines that open a report of GCC's and Clang's sanitizers (compiler-rt's formats).
+  static const std::regex opening(
+      R"(==[0-9]+==ERROR: [A-Za-z]*Sanitizer|: runtime error: |WARNING: ThreadSanitizer: )");
+  std::istringstream in(output);
+  std::string line, report;
+  std::size_t lines = 0;
+  while (std::getline(in, line)) {
+    if (lines == 0 && !std::regex_search(line, opening))
+      continue;
+    report += line + "\n";
+    if (++lines == max_lines)
+      break;
+  }
+  while (report.size() > 1 && report[report.size() - 2] == '\n') // no blank lines at the end
+    report.pop_back();
+  return report;
+}
+
+void expectNoSanitizerReport(const std::string& output, const std::string& what) {
+  const std::string report = sanitizerReport(output);
+  if (!report.empty())
+    ADD_FAILURE() << "a sanitizer report in the output of `" << what << "`:\n" << report;
 }
 
 CommandResult runTool(const std::string& tool, const std::string& arguments) {

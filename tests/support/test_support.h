@@ -1,6 +1,7 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <functional>
 #include <string>
 
@@ -38,11 +39,24 @@ struct CommandResult {
   std::string err;  // stderr
 };
 
-/// Runs a shell command line; captures its exit code, stdout and stderr.
+/// Runs a shell command line; captures its exit code, stdout and stderr. A sanitizer report
+/// in its stderr (see sanitizerReport) fails the calling test, quoting the report, whatever
+/// the exit code: under `make test-sanitize` a sanitizer that stops a tool exits as an error
+/// does, which a test that expects a failure would otherwise accept.
 CommandResult runCommand(const std::string& command_line);
 
-/// Runs build/bin/<tool> with `arguments` (already quoted as needed).
+/// Runs build/bin/<tool> with `arguments` (already quoted as needed); as runCommand.
 CommandResult runTool(const std::string& tool, const std::string& arguments);
+
+/// The first sanitizer report in a process's output: from the line that opens it
+/// ("==PID==ERROR: AddressSanitizer: ...", "... LeakSanitizer: ...", "...
+/// UndefinedBehaviorSanitizer: ...", UBSan's "file:line:col: runtime error: ...", "WARNING:
+/// ThreadSanitizer: ...") up to `max_lines` lines; "" when there is none.
+std::string sanitizerReport(const std::string& output, std::size_t max_lines = 12);
+
+/// Fails the calling test (ADD_FAILURE) when `output` holds a sanitizer report, quoting it and
+/// naming `what` (the command that printed it).
+void expectNoSanitizerReport(const std::string& output, const std::string& what);
 
 bool fileExists(const std::string& path);
 

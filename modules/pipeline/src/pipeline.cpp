@@ -3,14 +3,17 @@
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/run_report.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
+#include <msf/reconstruction/block_footprint.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <future>
 #include <mutex>
@@ -21,6 +24,23 @@ namespace msf {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+// The memory model of predictMemory beside the TSDF volume's bound, from msf_reconstruct's RSS
+// per frame (frames.csv) and peak (summary.json) on KITTI odometry 04 (frames 0-9), raw 0009
+// (0-4) and the synthetic street (40 frames); docs/robustness.md, "Memory budget".
+// The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas:
+// ~200 measured (RSS after the first frame, less the process, the frames in flight and the volume).
+constexpr double kStageBytesPerPixel = 240;
+// A frame in flight (images, scan, depth images): 17 measured (queue_capacity 1 to 4 on 04:
+// 6 more frames in flight, +50 MiB).
+constexpr double kFrameBytesPerPixel = 24;
+// A frame whose ground truth the run keeps to score the mesh at the end (protocol 4): 7.6
+// measured on the street (the RSS growth per frame beyond the volume's).
+constexpr double kScoredFrameBytesPerPixel = 12;
+// What the end of an in-memory run adds, in units of the footprint's volume bytes: the mesh,
+// its per-block cache, the copy written and the volume.pcd cloud took 2.6 to 3.2 times the
+// real volume's bytes, and the real volume was 1/10 to 1/12 of the footprint on the three runs
+// (a view's frustum holds free space as well as surfaces): 0.27 to 0.32 of the footprint's.
+constexpr double kEndOfRunFraction = 0.5;
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -317,6 +337,70 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   stats.wall_s = msSince(run_start) / 1000.0;
   stats.interrupted = interrupted;
   return stats;
+}
+
+std::string MemoryPrediction::describe() const {
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "TSDF volume %.0f MiB for %zu blocks%s, frames and stage buffers %.0f MiB, mesh and files at the "
+                "end %.0f MiB, the process before the run %.0f MiB",
+                volume_mb, blocks_in_memory,
+                blocks_in_memory == footprint_blocks ? "" : " in memory at once", frames_mb, mesh_mb, process_mb);
+  return text;
+}
+
+MemoryPrediction Pipeline::predictMemory(const PoseList& T_world_cam0, int maps, bool scores_every_frame) const {
+  const auto start = Clock::now();
+  MemoryPrediction p;
+  p.frames = T_world_cam0.size();
+  constexpr double kMiB = 1024.0 * 1024.0;
+  // The frames integrated are at most the LiDAR's canvas (the image and its margin), and a
+  // frame allocates blocks only in its view, from min_depth_m to allocationDepth().
+  const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
+  const double far_m = integrator_->allocationDepth();
+  if (!std::isfinite(far_m))
+    throw ConfigError("the run's memory cannot be predicted: the band behind a surface has no bound "
+                      "(tsdf_integrator.min_pixel_weight 0 with per-pixel weights and truncation_sigmas > 0)");
+  BlockFootprint footprint(config_.volume.voxel_size_m);
+  for (const Eigen::Isometry3d& T : T_world_cam0)
+    footprint.addView(canvas, T, config_.integrator.min_depth_m, far_m);
+  p.footprint_blocks = footprint.blocks();
+  p.blocks_in_memory = p.footprint_blocks;
+  if (config_.streaming.enabled() && !T_world_cam0.empty()) {
+    // A tile stays while its box grown by a block is within the active radius of the camera:
+    // its blocks are within the radius plus the box's diagonal. The cameras are taken every
+    // `step` metres or more, the radius grown by the step, so that the frames between are
+    // covered; the step keeps 1000 frames to a few hundred balls.
+    const double block_m = TsdfBlock::kSide * config_.volume.voxel_size_m;
+    const double tile_m = config_.streaming.tile_blocks * block_m;
+    const double radius = config_.streaming.active_radius_m + std::sqrt(3.0) * (tile_m + block_m);
+    const double step = std::max(tile_m, radius / 8.0);
+    Eigen::Vector3d last = T_world_cam0.front().translation();
+    std::size_t most = footprint.blocksWithin(last, radius + step);
+    for (const Eigen::Isometry3d& T : T_world_cam0)
+      if ((T.translation() - last).norm() >= step) {
+        last = T.translation();
+        most = std::max(most, footprint.blocksWithin(last, radius + step));
+      }
+    p.blocks_in_memory = std::min(most, p.footprint_blocks);
+  }
+  p.volume_mb = maps * static_cast<double>(TsdfVolume::bytesFor(p.blocks_in_memory)) / kMiB;
+  // The frames in flight: one in each of the three stages (loading, depth, integration) and
+  // queue_capacity in each of the two queues between them, over the stages' own buffers; and
+  // the frames whose ground truth the caller keeps.
+  const double pixels = static_cast<double>(canvas.width) * canvas.height;
+  const double in_flight = 3.0 + 2.0 * config_.scheduling.queue_capacity;
+  p.frames_mb = pixels *
+                (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel +
+                 (scores_every_frame ? kScoredFrameBytesPerPixel * static_cast<double>(p.frames) : 0.0)) /
+                kMiB;
+  // The end of the run: an in-memory map is meshed and written whole (a streamed one tile by
+  // tile as the camera moves on, within the window's volume).
+  p.mesh_mb = config_.streaming.enabled() ? 0.0 : kEndOfRunFraction * p.volume_mb;
+  p.process_mb = residentMemoryMb();
+  p.total_mb = p.process_mb + p.volume_mb + p.frames_mb + p.mesh_mb;
+  p.ms = msSince(start);
+  return p;
 }
 
 const TriangleMesh& Pipeline::updateMesh() {

@@ -42,6 +42,16 @@ void PoseSource::apply(Frame& frame) const {
   frame.has_pose = true;
 }
 
+PoseList PoseSource::knownPoses(const std::vector<std::size_t>& frames) const {
+  PoseList known;
+  if (kind_ == Kind::Estimated)
+    return known;
+  const PoseList& all = kind_ == Kind::File ? file_poses_ : sequence_.poses();
+  for (std::size_t i : frames)
+    known.push_back(all.at(i));
+  return known;
+}
+
 Eigen::Isometry3d PoseSource::estimate(const Frame& frame) {
   if (!odometry_)
     throw InvalidInputError("PoseSource::estimate: the poses are " + description_ + ", not estimated");

@@ -235,6 +235,8 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     << "  \"frames_per_second_after_first\": " << num(framesPerSecondAfterFirst(), 3) << ",\n"
     << "  \"peak_memory_mb\": " << num(peakMemoryMb() > peak_memory_mb ? peakMemoryMb() : peak_memory_mb, 1)
     << ",\n"
+    << "  \"predicted_memory_mb\": " << (predicted_memory_mb >= 0 ? num(predicted_memory_mb, 1) : std::string("null"))
+    << ",\n"
     << "  \"stage_ms\": {\n";
   const auto& columns = stageColumns();
   for (std::size_t k = 0; k < columns.size(); ++k) {

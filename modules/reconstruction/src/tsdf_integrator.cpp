@@ -321,7 +321,7 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
                             std::to_string(volume_.voxelSize()) + " m voxels");
 }
 
-double TsdfIntegrator::reach(const PinholeCamera& camera) const {
+double TsdfIntegrator::widestBandBehind() const {
   // The band behind a surface (see integrate's step 0): at most max(truncation, planeBand over
   // the least plane scale, the depth's sigmas), the sigma from the least weight a pixel can
   // have and still be integrated.
@@ -340,10 +340,21 @@ double TsdfIntegrator::reach(const PinholeCamera& camera) const {
   if (config_.truncation_sigmas > 0.0)
     noise = least_weight > 0.0 ? config_.truncation_sigmas / std::sqrt(least_weight)
                                : std::numeric_limits<double>::infinity();
+  return std::max({trunc, below, noise});
+}
+
+double TsdfIntegrator::allocationDepth() const {
+  // A ray's band is allocated from the depth less its front band to the depth plus its band
+  // behind (at most the widest), along the optical axis, for depths up to max_depth_m.
+  return config_.max_depth_m + widestBandBehind();
+}
+
+double TsdfIntegrator::reach(const PinholeCamera& camera) const {
+  const double trunc = volume_.truncation();
   // A voxel is updated up to its pixel's band behind the depth, and the depth may be the
   // bilinear one of 4 pixels that agree within that band: up to twice the band behind the
   // nearest pixel's depth, itself at most max_depth_m.
-  const double behind = 2.0 * std::max({trunc, below, noise});
+  const double behind = 2.0 * widestBandBehind();
   // The longest ray per metre of depth: through a corner of the image (pixel edges at -0.5
   // and size - 0.5, as the projection's inside test).
   const double du = std::max(std::abs(-0.5 - camera.cx), std::abs(camera.width - 0.5 - camera.cx)) / camera.fx;

@@ -101,6 +101,15 @@ std::size_t TsdfVolume::memoryBytes() const {
   return chunks_.size() * kChunkBytes + blocks_.capacity() * sizeof(void*) + table_.capacity() * sizeof(Slot);
 }
 
+std::size_t TsdfVolume::bytesFor(std::size_t blocks) {
+  // As reserve() grows: the map's slots a power of two from 1024 with load <= 1/2, whole chunks.
+  std::size_t table = 1024;
+  while (2 * blocks > table)
+    table *= 2;
+  const std::size_t chunks = (blocks + kBlocksPerChunk - 1) / kBlocksPerChunk;
+  return chunks * kChunkBytes + table * sizeof(Slot) + blocks * sizeof(void*);
+}
+
 std::size_t TsdfVolume::slotOf(const GridIndex& index) const {
   std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(index.x())) * 0x9E3779B97F4A7C15ull ^
                     static_cast<std::uint64_t>(static_cast<std::uint32_t>(index.y())) * 0xC2B2AE3D27D4EB4Full ^

@@ -15,6 +15,26 @@
 
 namespace msf {
 
+/// What a run is predicted to hold at its peak, before it starts (Pipeline::predictMemory), in
+/// MiB: an upper bound on the TSDF volume from the poses alone (the blocks of every frame's
+/// view up to the integrator's allocation depth, BlockFootprint), plus a model of the rest
+/// (per pixel of the frames in flight, and a fraction of the volume for the mesh and files
+/// written at the end) measured on KITTI and the synthetic street (docs/robustness.md,
+/// "Memory budget").
+struct MemoryPrediction {
+  std::size_t frames = 0;
+  std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all
+  std::size_t blocks_in_memory = 0;  ///< at once: all of them, or with -stream the most within the window
+  double process_mb = 0;  ///< the process when predicting (libraries, calibration, config)
+  double volume_mb = 0;   ///< the TSDF volume's blocks, map and block list at blocks_in_memory
+  double frames_mb = 0;   ///< images, scans, depth and stage buffers of the frames in flight
+  double mesh_mb = 0;     ///< the end of an in-memory run: the mesh, its cache, the copies written
+  double total_mb = 0;    ///< the sum: the predicted peak
+  double ms = 0;          ///< time the prediction took
+  /// The terms in words, one line: "TSDF volume 800 MiB for 120000 blocks, frames and stage ...".
+  std::string describe() const;
+};
+
 /// Milliseconds each stage spent on one frame. lidar = projection + interpolation;
 /// depth_ms = steps 1-3 (lidar + stereo, or their wall time when they run side by side).
 struct StageTimes {
@@ -144,6 +164,16 @@ public:
   /// Writes the tiles still in memory and the union of all as `mesh_path`; the volume is
   /// empty afterwards. Returns the triangles written.
   std::size_t finishStreaming(const std::string& mesh_path);
+  /// The peak memory of run() over frames seen from `T_world_cam0` (their poses, known before
+  /// the run: a dataset's or a file's; not estimated ones), predicted without reading the
+  /// frames: see MemoryPrediction. With streaming, the volume term is the most blocks of the
+  /// footprint within the active radius (grown by a tile) of any frame's camera. `maps` is the
+  /// number of volumes the caller fills from the same frames (msf_reconstruct
+  /// -compare_sources: 3); `scores_every_frame`: the caller keeps each frame's ground truth
+  /// to the end (protocol 4). Throws ConfigError when the integrator's band has no bound
+  /// (reach() is infinite), InvalidInputError for views too large to enumerate.
+  MemoryPrediction predictMemory(const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false) const;
+
   /// The streaming map, or nullptr when the map stays in memory.
   const StreamingMap* streaming() const { return streaming_.get(); }
 

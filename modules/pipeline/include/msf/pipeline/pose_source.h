@@ -35,6 +35,10 @@ public:
   /// Throws what LidarOdometry throws, naming the frame's scan; InvalidInputError unless Estimated.
   Eigen::Isometry3d estimate(const Frame& frame);
 
+  /// The poses T_world_cam0 of `frames` when they are known before the run (the dataset's or a
+  /// file's), in order; empty for estimated ones, which exist only as the frames are tracked.
+  PoseList knownPoses(const std::vector<std::size_t>& frames) const;
+
   Kind kind() const { return kind_; }
   /// In words, for the report: "the dataset's: ...", "file '...'" or "estimated (LiDAR odometry)".
   const std::string& description() const { return description_; }

@@ -215,8 +215,16 @@ public:
   /// sees first. Infinite when the band behind a surface has no bound: per-pixel weights
   /// with truncation_sigmas > 0 and min_pixel_weight 0 (the band grows as a weight falls).
   double reach(const PinholeCamera& camera) const;
+  /// The largest depth along the optical axis (metres) at which integrating a depth frame can
+  /// allocate a block: max_depth_m plus the widest band behind a surface. Blocks are allocated
+  /// only there, in the camera's view from min_depth_m (carveWithScan and space carving only
+  /// update blocks that exist); a scan (integrateScan, integrateRays) allocates along its rays
+  /// instead. Infinite as reach() is.
+  double allocationDepth() const;
 
 private:
+  /// The widest band behind a surface that a pixel can have (metres; see reach).
+  double widestBandBehind() const;
   /// Throws InvalidInputError when the frame's band would reach beyond the volume's index range.
   void checkReach(const Eigen::Isometry3d& T_world_cam) const;
   /// The weight of a depth without its own (Constant, InverseSquare), in m^-2.

@@ -31,8 +31,10 @@ public:
   struct Config {
     double voxel_size_m = 0.1;  ///< edge of a voxel
     double truncation_m = 0.3;  ///< |sdf| is clamped here; observations update voxels within it
-    /// Memory the volume's blocks and map may take (MiB); 0 = three quarters of the
-    /// machine's RAM. A run that would exceed it stops with an error before allocating.
+    /// The memory budget (MiB); 0 = three quarters of the machine's RAM. The volume's blocks
+    /// and map may not exceed it: a growth that would stops with an error before allocating.
+    /// msf_reconstruct also refuses, before it starts, a run whose predicted peak (the whole
+    /// process: Pipeline::predictMemory) exceeds a budget given here or with -max_memory.
     double max_memory_mb = 0.0;
     /// Overrides the keys present (voxel_size_m, truncation_m, max_memory_mb); throws
     /// ConfigError naming a bad one (see validate).
@@ -67,6 +69,9 @@ public:
   std::size_t numObservedVoxels() const;
   /// Bytes held by blocks and the hash map.
   std::size_t memoryBytes() const;
+  /// Bytes a volume of `blocks` blocks holds when it grew to them (its chunks of blocks, map
+  /// and block list, as the memory budget counts them): what a run that allocates them needs.
+  static std::size_t bytesFor(std::size_t blocks);
 
   /// The block at `index`, or nullptr when it is not allocated.
   TsdfBlock* findBlock(const GridIndex& index);
