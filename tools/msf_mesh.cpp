@@ -152,6 +152,8 @@ int main(int argc, char** argv) {
             "YAML with a section marching_cubes; the options below override it")
       .value("-min_weight", "W", config.min_weight,
              "voxels with weight <= W (m^-2, an inverse variance) make no triangles (default {default})")
+      .value("-smoothing_lambda", "L", config.smoothing_lambda,
+             "eq. 7 at meshing, each voxel's data term weighed by its weight (m^-2; default {default}, 0 = off)")
       .value("-min_component_triangles", "N", config.min_component_triangles,
              "remove connected pieces of fewer than N triangles (default {default}; 0 keeps all)")
       .value("-voxel", "V", settings.voxel,

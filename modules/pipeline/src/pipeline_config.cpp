@@ -85,6 +85,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.lambda = 5.0;
   c.integrator.solve = TsdfIntegrator::Solve::Argmin;
   c.mesher.min_weight = 0.f;
+  c.mesher.smoothing_lambda = 0.f;
   c.validate();
   return c;
 }

@@ -25,6 +25,7 @@ double msSince(Clock::time_point t0) {
 
 constexpr int kSide = TsdfBlock::kSide;
 constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +x, +y, +z neighbours
+constexpr int kHalo = kSide + 3; // smoothed, those grid points read one voxel more on every side
 
 // Bourke's corner numbering and edges, those of PCL's tables (see marching_cubes_tables.cpp).
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
@@ -59,6 +60,8 @@ struct Scratch {
   std::array<std::uint16_t, kPad * kPad> valid; // weight > min_weight
   std::array<std::uint16_t, kPad * kPad> negative; // sdf < 0
   std::array<std::array<const TsdfVoxel*, 2>, kPad * kPad> row;
+  std::array<float, kPad * kPad * kPad> sdf; // of the 9^3 grid points (x + 9 (y + 9 z)), smoothed or not
+  std::array<float, kHalo * kHalo * kHalo> halo_sdf, halo_weight; // -1..9 on each axis, for smoothing
   std::array<std::int32_t, kPad * kPad * kPad * 4> slot; // local vertex of (grid point, code), -1 = none
   std::vector<int> used;
   MarchingCubes::BlockMesh mesh; // grows once per thread, then copied out at its exact size
@@ -67,9 +70,49 @@ struct Scratch {
   const TsdfVoxel& voxel(int x, int y, int z) const { return row[y + kPad * z][x >> 3][x & 7]; }
 };
 
-void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
-                   Scratch& s) {
+/// The sdf of the block's 9^3 grid points after one Jacobi step of eq. 7 with each voxel's
+/// data term weighed by its weight: x_i = (W_i y_i + lambda sum_j y_j) / (W_i + lambda n_i) over
+/// the observed 6-neighbours j, for observed voxels within `band` of their surface (the others
+/// keep y_i). `around` holds the 27 blocks at offsets -1..1 (x fastest), or null.
+void smoothGridPoints(const TsdfBlock* const* around, float lambda, float band, Scratch& s) {
+  for (int z = -1; z <= kSide + 1; ++z)
+    for (int y = -1; y <= kSide + 1; ++y) {
+      const int bz = z < 0 ? 0 : z < kSide ? 1 : 2, by = y < 0 ? 0 : y < kSide ? 1 : 2;
+      float* hs = &s.halo_sdf[static_cast<std::size_t>(kHalo) * ((y + 1) + kHalo * (z + 1))];
+      float* hw = &s.halo_weight[static_cast<std::size_t>(kHalo) * ((y + 1) + kHalo * (z + 1))];
+      for (int x = -1; x <= kSide + 1; ++x) {
+        const int bx = x < 0 ? 0 : x < kSide ? 1 : 2;
+        const TsdfBlock* b = around[bx + 3 * (by + 3 * bz)];
+        const TsdfVoxel* v = b ? &b->at(x - kSide * (bx - 1), y - kSide * (by - 1), z - kSide * (bz - 1)) : nullptr;
+        hs[x + 1] = v ? v->sdf : 0.f;
+        hw[x + 1] = v ? v->weight : 0.f;
+      }
+    }
+  constexpr int sy = kHalo, sz = kHalo * kHalo;
+  for (int z = 0; z < kPad; ++z)
+    for (int y = 0; y < kPad; ++y)
+      for (int x = 0; x < kPad; ++x) {
+        const int q = (x + 1) + kHalo * ((y + 1) + kHalo * (z + 1));
+        const float w = s.halo_weight[q], sdf = s.halo_sdf[q];
+        float value = sdf;
+        if (w > 0.f && std::abs(sdf) < band) {
+          float sum = 0.f, count = 0.f;
+          for (const int d : {-1, 1, -sy, sy, -sz, sz}) {
+            const bool observed = s.halo_weight[q + d] > 0.f; // without branches: unpredictable
+            sum += observed ? s.halo_sdf[q + d] : 0.f;
+            count += observed ? 1.f : 0.f;
+          }
+          value = (w * sdf + lambda * sum) / (w + lambda * count);
+        }
+        s.sdf[x + kPad * (y + kPad * z)] = value;
+      }
+}
+
+void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const MarchingCubes::Config& config,
+                   MarchingCubes::BlockMesh& out, Scratch& s) {
   const float vs = static_cast<float>(volume.voxelSize());
+  const float min_weight = config.min_weight;
+  const bool smooth = config.smoothing_lambda > 0.f;
 
   if (block.signs == 0)
     return; // never observed: every cube has this block's unobserved corner
@@ -79,8 +122,18 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
     nb[i] = i == 0 ? &block : volume.findBlock(block.index + GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1));
     signs |= nb[i] ? nb[i]->signs : 0;
   }
+  // Smoothed, a grid point also reads the -x, -y, -z layer around the block.
+  const TsdfBlock* around[27] = {};
+  if (smooth)
+    for (int i = 0; i < 27; ++i) {
+      const GridIndex d(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
+      around[i] = d.isZero() ? &block : volume.findBlock(block.index + d);
+      signs |= around[i] ? around[i]->signs : 0;
+    }
   if (signs != (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative))
     return; // no sign change within reach of this block's cubes
+  if (smooth)
+    smoothGridPoints(around, config.smoothing_lambda, 0.5f * static_cast<float>(volume.truncation()), s);
 
   // Bit masks of the 9^3 grid points (a missing neighbour block's points are unobserved).
   std::uint16_t any_negative = 0, any_positive = 0;
@@ -95,9 +148,12 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
         if (!b)
           continue;
         const TsdfVoxel* src = s.row[r][part];
+        float* sdf = &s.sdf[static_cast<std::size_t>(kPad) * r];
         for (int x = part * kSide, n = part ? 1 : kSide, k = 0; k < n; ++k, ++x) {
+          if (!smooth)
+            sdf[x] = src[k].sdf;
           valid |= static_cast<std::uint16_t>((src[k].weight > min_weight) << x);
-          negative |= static_cast<std::uint16_t>((src[k].sdf < 0.f) << x);
+          negative |= static_cast<std::uint16_t>((sdf[x] < 0.f) << x);
         }
       }
       negative &= valid;
@@ -155,8 +211,12 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
                                           ((n11 >> x) & 1) << 7);
         const unsigned int edges = detail::kEdgeTable[cube];
         const TsdfVoxel* c[8];
-        for (int i = 0; i < 8; ++i)
-          c[i] = &s.voxel(x + kCorner[i][0], y + kCorner[i][1], z + kCorner[i][2]);
+        float d[8];
+        for (int i = 0; i < 8; ++i) {
+          const int px = x + kCorner[i][0], py = y + kCorner[i][1], pz = z + kCorner[i][2];
+          c[i] = &s.voxel(px, py, pz);
+          d[i] = s.sdf[px + kPad * (py + kPad * pz)];
+        }
         std::uint32_t vert[12];
         for (int e = 0; e < 12; ++e) {
           if (!(edges & (1u << e)))
@@ -169,14 +229,15 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
             std::swap(ia, ib); // interpolate from the lower end, so every block computes the same vertex
           const TsdfVoxel& a = *c[ia];
           const TsdfVoxel& b = *c[ib];
+          const float da = d[ia], db = d[ib];
           const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
           // A voxel with sdf exactly 0 is the vertex of all its edges (no duplicate positions).
-          if (a.sdf == 0.f)
+          if (da == 0.f)
             vert[e] = vertexOf(px, py, pz, 3, 0.f, a, a);
-          else if (b.sdf == 0.f)
+          else if (db == 0.f)
             vert[e] = vertexOf(px + (axis == 0), py + (axis == 1), pz + (axis == 2), 3, 0.f, b, b);
           else
-            vert[e] = vertexOf(px, py, pz, axis, a.sdf / (a.sdf - b.sdf), a, b);
+            vert[e] = vertexOf(px, py, pz, axis, da / (da - db), a, b);
         }
         const int* tri = detail::kTriTable[cube];
         for (int t = 0; tri[t] != -1; t += 3) {
@@ -192,14 +253,14 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, float min_w
   s.used.clear();
 }
 
-void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, float min_weight, MarchingCubes::BlockMesh& out,
-               Scratch& s) {
+void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, const MarchingCubes::Config& config,
+               MarchingCubes::BlockMesh& out, Scratch& s) {
   MarchingCubes::BlockMesh& m = s.mesh;
   m.vertices.clear();
   m.colors.clear();
   m.keys.clear();
   m.triangles.clear();
-  meshBlockInto(volume, block, min_weight, m, s);
+  meshBlockInto(volume, block, config, m, s);
   out.vertices.assign(m.vertices.begin(), m.vertices.end());
   out.colors.assign(m.colors.begin(), m.colors.end());
   out.keys.assign(m.keys.begin(), m.keys.end());
@@ -322,6 +383,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
 
 void MarchingCubes::Config::read(const cv::FileNode& node) {
   readKey(node, "min_weight", min_weight);
+  readKey(node, "smoothing_lambda", smoothing_lambda);
   readKey(node, "min_component_triangles", min_component_triangles);
   validate();
 }
@@ -329,6 +391,9 @@ void MarchingCubes::Config::read(const cv::FileNode& node) {
 void MarchingCubes::Config::validate() const {
   if (!(min_weight >= 0.f))
     throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(min_weight));
+  if (!(smoothing_lambda >= 0.f) || !std::isfinite(smoothing_lambda))
+    throw ConfigError("marching_cubes.smoothing_lambda must be >= 0 (m^-2; 0: off), got " +
+                      std::to_string(smoothing_lambda));
   if (min_component_triangles < 0)
     throw ConfigError("marching_cubes.min_component_triangles must be >= 0, got " +
                       std::to_string(min_component_triangles));
@@ -336,6 +401,7 @@ void MarchingCubes::Config::validate() const {
 
 void MarchingCubes::Config::print(std::ostream& out) const {
   out << "marching_cubes:\n  min_weight: " << configValue(min_weight)
+      << "\n  smoothing_lambda: " << configValue(smoothing_lambda)
       << "\n  min_component_triangles: " << configValue(min_component_triangles) << "\n";
 }
 
@@ -343,7 +409,7 @@ MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
 
 void MarchingCubes::setConfig(const Config& config) {
   config.validate();
-  if (config.min_weight != config_.min_weight)
+  if (config.min_weight != config_.min_weight || config.smoothing_lambda != config_.smoothing_lambda)
     reset();
   config_ = config;
 }
@@ -352,6 +418,19 @@ void MarchingCubes::setMinWeight(float min_weight) {
   Config c = config_;
   c.min_weight = min_weight;
   setConfig(c);
+}
+
+const std::vector<GridIndex>& MarchingCubes::readNeighbours() const {
+  static const std::vector<GridIndex> upper = {{1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1},
+                                               {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+  static const std::vector<GridIndex> all = [] {
+    std::vector<GridIndex> v;
+    for (int i = 0; i < 27; ++i)
+      if (i != 13)
+        v.emplace_back(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
+    return v;
+  }();
+  return config_.smoothing_lambda > 0.f ? all : upper;
 }
 
 void MarchingCubes::reset() {
@@ -369,7 +448,8 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     generation_ = 0;
   }
 
-  // Blocks to mesh again: the changed ones and those whose cubes read them (-x, -y, -z side).
+  // Blocks to mesh again: the changed ones and those whose cubes read them.
+  const std::vector<GridIndex>& readers = readNeighbours();
   std::vector<std::uint64_t> dirty_keys;
   std::vector<const TsdfBlock*> dirty;
   for (const auto& block : volume.blocks()) {
@@ -379,11 +459,10 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       dirty_keys.push_back(blockKey(block->index));
       continue;
     }
-    for (int i = 0; i < 8; ++i) {
-      const GridIndex b = block->index - GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-      if (i == 0 || volume.findBlock(b))
-        dirty_keys.push_back(blockKey(b));
-    }
+    dirty_keys.push_back(blockKey(block->index));
+    for (const GridIndex& d : readers)
+      if (volume.findBlock(block->index - d))
+        dirty_keys.push_back(blockKey(block->index - d));
   }
   std::sort(dirty_keys.begin(), dirty_keys.end());
   dirty_keys.erase(std::unique(dirty_keys.begin(), dirty_keys.end()), dirty_keys.end());
@@ -393,12 +472,11 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       dirty.push_back(block);
       targets.push_back(&cache_[block->index]);
     }
-  const float min_weight = config_.min_weight;
   // cv::parallel_for_ (TBB) as the integrator: one pool shared with the other stages.
   cv::parallel_for_(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
     Scratch scratch;
     for (int i = range.start; i < range.end; ++i)
-      meshBlock(volume, *dirty[i], min_weight, *targets[i], scratch);
+      meshBlock(volume, *dirty[i], config_, *targets[i], scratch);
   }, std::max(1.0, static_cast<double>(dirty.size()) / 16));
   generation_ = volume.generation();
   stats_.blocks_meshed = dirty.size();
@@ -431,11 +509,10 @@ void MarchingCubes::extractBlocks(const TsdfVolume& volume, const std::vector<Gr
     if (const TsdfBlock* block = volume.findBlock(index))
       present.push_back(block);
   std::vector<BlockMesh> parts(present.size());
-  const float min_weight = config_.min_weight;
   cv::parallel_for_(cv::Range(0, static_cast<int>(present.size())), [&](const cv::Range& range) {
     Scratch scratch;
     for (int i = range.start; i < range.end; ++i)
-      meshBlock(volume, *present[i], min_weight, parts[i], scratch);
+      meshBlock(volume, *present[i], config_, parts[i], scratch);
   }, std::max(1.0, static_cast<double>(present.size()) / 16));
   std::vector<std::pair<GridIndex, const BlockMesh*>> order;
   order.reserve(present.size());

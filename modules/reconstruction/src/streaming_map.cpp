@@ -340,9 +340,7 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
   return faces;
 }
 
-const GridIndex kUpper[7] = {{1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
-
-/// Blocks of tiles on disk, read on demand for the +x/+y/+z layer of the tiles being meshed.
+/// Blocks of tiles on disk, read on demand for the layer around the tiles being meshed.
 class TileCache {
 public:
   TileCache(std::string directory, double voxel_size, double truncation)
@@ -381,9 +379,9 @@ GridIndex tileOfBlock(const GridIndex& b, int tile_blocks) {
   return {floorDiv(b.x(), tile_blocks), floorDiv(b.y(), tile_blocks), floorDiv(b.z(), tile_blocks)};
 }
 
-/// Meshes tile `tile` whose blocks are `blocks` (indices) with the +x/+y/+z layer around it,
-/// each block taken from `memory` when there, else from the store through `cache` when its
-/// tile `on_disk` says so. Writes TILES/X_Y_Z.ply (removes it when the tile has no
+/// Meshes tile `tile` whose blocks are `blocks` (indices) with the layer around it that its
+/// cubes read (MarchingCubes::readNeighbours), each block taken from `memory` when there, else
+/// from the store through `cache` when its tile `on_disk` says so. Writes TILES/X_Y_Z.ply (removes it when the tile has no
 /// triangle). Returns the triangles.
 template <typename OnDisk>
 std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks, const TsdfVolume* memory,
@@ -407,7 +405,7 @@ std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks
   for (const GridIndex& b : blocks)
     copy(b);
   for (const GridIndex& b : blocks)
-    for (const GridIndex& d : kUpper)
+    for (const GridIndex& d : mesher.readNeighbours())
       if (tileOfBlock(b + d, tile_blocks) != tile)
         copy(b + d);
   TriangleMesh mesh;
@@ -552,9 +550,9 @@ void StreamingMap::readBack(std::vector<TileKey> back) {
                });
     evicted_.erase(t);
     ++stats_.tiles_reloaded;
-    // The tiles whose cubes read this tile's blocks (their +x/+y/+z layer) may change their mesh.
+    // The tiles whose cubes read this tile's blocks (MarchingCubes::readNeighbours) may change their mesh.
     const GridIndex ti = tileIndex(t);
-    for (const GridIndex& d : kUpper) {
+    for (const GridIndex& d : mesher_.readNeighbours()) {
       const GridIndex n = ti - d;
       const TileKey nk = tileOf(n * config_.tile_blocks);
       if (evicted_.count(nk))

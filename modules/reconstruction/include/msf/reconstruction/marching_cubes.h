@@ -38,13 +38,21 @@ public:
 
   struct Config {
     /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
-    /// TsdfIntegrator::Weighting): 7 meshes what is known to sigma 0.38 m, which a LiDAR-backed
-    /// surface is after one frame and a stereo-only one at 20 m after a few (docs/reconstruction.md).
-    float min_weight = 7.f;
+    /// TsdfIntegrator::Weighting): 4 meshes what is known to sigma 0.5 m on its own, a LiDAR-backed
+    /// surface after one frame, a stereo-only one at 20 m after a few; smoothing_lambda pools the
+    /// neighbours' evidence in (without it, 7 was best; docs/reconstruction.md).
+    float min_weight = 4.f;
+    /// Eq. 7 at meshing (m^-2; 0: off): each grid point within half a truncation of its surface
+    /// is meshed at (W y + lambda sum_j y_j) / (W + lambda n) over its observed 6-neighbours j,
+    /// one Jacobi step on the volume's weighted means y with weights W. A LiDAR-backed voxel
+    /// (W ~ 1000) keeps its value; a far stereo-only one (W ~ 10) takes much of its neighbours'.
+    /// The volume is not changed, so meshing again gives the same mesh.
+    float smoothing_lambda = 10.f;
     /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents); 0 keeps all.
     int min_component_triangles = 0;
 
-    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight, min_component_triangles.
+    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight, smoothing_lambda,
+    /// min_component_triangles.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
@@ -63,7 +71,7 @@ public:
   explicit MarchingCubes(const Config& config);
 
   const Config& getConfig() const { return config_; }
-  /// Changing min_weight empties the cache.
+  /// Changing min_weight or smoothing_lambda empties the cache.
   void setConfig(const Config& config);
   void setMinWeight(float min_weight);
   float getMinWeight() const { return config_.min_weight; }
@@ -77,6 +85,9 @@ public:
   /// which `volume` must hold for the block's mesh to be the one extract() gives. StreamingMap
   /// meshes a tile this way.
   void extractBlocks(const TsdfVolume& volume, const std::vector<GridIndex>& blocks, TriangleMesh& mesh) const;
+  /// The offsets of the blocks whose voxels a block's mesh reads: the +x, +y, +z side, and all
+  /// 26 around it when smoothing.
+  const std::vector<GridIndex>& readNeighbours() const;
   /// Forgets the cached block meshes: the next call meshes everything.
   void reset();
 

@@ -16,7 +16,7 @@ namespace msf {
 
 /// A TsdfVolume that keeps in memory only the space around the sensor (docs/streaming.md).
 /// The volume is cut into tiles of tile_blocks^3 blocks. After each frame, a tile whose box
-/// (grown by one block, the +x/+y/+z layer its cubes read) lies farther than the active radius
+/// (grown by one block, the layer its cubes read) lies farther than the active radius
 /// from the sensor is meshed, its mesh written to DIR/tiles/X_Y_Z.ply, its blocks to
 /// DIR/tsdf/X_Y_Z.blk (listed in DIR/tsdf/index.txt), and freed. Before each frame, a tile on
 /// disk within `reach` of the sensor (how far the integrator changes blocks that exist:
