@@ -569,9 +569,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const float* depth_data = depth_image.ptr<float>(0);
   const std::size_t depth_step = depth_image.step1();
   const detail::SubBlockTest test_sub_block = detail::subBlockTest();
-  const detail::VoxelTestFrame test_frame{fx, fy, cx, cy, width, height, min_d, max_d, carving, depth_data, pixel_data,
-                                          has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
-                                          has_color ? frame.color.step[0] : 0};
+  const detail::VoxelTestFrame test_frame{fx, fy, cx, cy, width, height, min_d, max_d, carving, depth_data, pixel_data};
   cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
@@ -625,6 +623,9 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       projected += 64;
       n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
     }
+    if (has_color) // the voxels were prefetched by the test
+      for (int c = 0; c < n_candidates; ++c)
+        __builtin_prefetch(frame.color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
 
     std::size_t updated = 0, listed = 0;
     std::uint8_t signs = 0, negative = 0;

@@ -83,8 +83,6 @@ int subBlockTestPortable(const VoxelTestFrame& f, const VoxelTestBlock& b, int s
           out.ui[count] = pixel_u[k];
           out.vi[count] = pixel_v[k];
           out.voxel[count] = first + k;
-          if (f.color)
-            __builtin_prefetch(f.color + static_cast<std::size_t>(pixel_v[k]) * f.color_step + 3 * pixel_u[k]);
           ++count;
         }
     }

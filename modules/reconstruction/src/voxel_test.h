@@ -21,8 +21,6 @@ struct VoxelTestFrame {
   bool carving;             ///< space carving: every voxel in front of the band passes
   const float* depth;
   const PixelBand* pixels;
-  const std::uint8_t* color; ///< BGR rows of color_step bytes, prefetched for candidates; or null
-  std::size_t color_step;
 };
 
 /// A block in the camera frame: its voxel (0, 0, 0) at `base`, one voxel along x, y, z.

@@ -46,15 +46,15 @@ int testSubBlock(const VoxelTestFrame& f, const VoxelTestBlock& b, int sx, int s
                      V::and_(V::ge(nearest, min_d), V::le(nearest, max_d)));
       if (!f.carving)
         ok = V::and_(ok, V::le(diff, V::add(V::gather(front_base, at_band), behind)));
+      // No branch on the outcome (about half the voxels pass, unpredictably): a vector without
+      // candidates stores nothing that counts, and prefetches its first row again.
       const unsigned lanes = V::bits(ok);
-      if (!lanes)
-        continue;
       const int first = TsdfBlock::linear(sx, y, z);
-      for (int r = 0; r < V::kRows; ++r)
-        if ((lanes >> (4 * r)) & 15u) {
-          __builtin_prefetch(&b.voxels[first + TsdfBlock::kSide * r], 1);
-          __builtin_prefetch(&b.voxels[first + TsdfBlock::kSide * r + 3], 1);
-        }
+      for (int r = 0; r < V::kRows; ++r) {
+        const int row = (lanes >> (4 * r)) & 15u ? first + TsdfBlock::kSide * r : first;
+        __builtin_prefetch(&b.voxels[row], 1);
+        __builtin_prefetch(&b.voxels[row + 3], 1);
+      }
       const typename V::Compress keep(lanes);
       keep.store(out.u + count, pu);
       keep.store(out.v + count, pv);
@@ -64,11 +64,7 @@ int testSubBlock(const VoxelTestFrame& f, const VoxelTestBlock& b, int sx, int s
       keep.store(out.ui + count, pixel_u);
       keep.store(out.vi + count, pixel_v);
       keep.store(out.voxel + count, V::addi(V::set1i(first), V::voxelLanes()));
-      const int end = count + __builtin_popcount(lanes);
-      if (f.color)
-        for (int k = count; k < end; ++k)
-          __builtin_prefetch(f.color + static_cast<std::size_t>(out.vi[k]) * f.color_step + 3 * out.ui[k]);
-      count = end;
+      count += __builtin_popcount(lanes);
     }
   }
   return count;
