@@ -9,6 +9,7 @@
 #include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
+#include <opencv2/core.hpp>
 #include <pcl/conversions.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
@@ -975,4 +976,53 @@ TEST(TsdfIntegrator, ADepthImageInsideAWiderOneAndFramesOfChangingSizesGiveTheSa
     EXPECT_GT(reused.numObservedVoxels(), 1000u);
     EXPECT_TRUE(sameVolumes(reused, fresh)) << "min_pixel_weight " << min_pixel_weight;
   }
+}
+
+TEST(TsdfIntegrator, EveryVoxelTestKernelGivesTheSameVolume) {
+  // The voxel test runs 16 (AVX-512), 8 (AVX2) or 4 (portable) voxels at a time, picked by the
+  // CPU: each width must give bit for bit the portable kernel's volume, colours and all. Noisy
+  // depth, cameras near enough that blocks straddle min_depth_m and the image's edges, and the
+  // settings that change the test (space carving: no band in front) or read its candidates
+  // (bilinear depth, the plane distance).
+  const int widest = TsdfIntegrator::voxelTestLanes();
+  if (widest == 4)
+    GTEST_SKIP() << "no wide voxel test on this CPU or build";
+  const AnalyticScene scene = test::makeScene(SceneKind::Box);
+  const PinholeCamera camera = test::smallCamera();
+  const auto poses = test::arcPoses(Eigen::Vector3d(0, 0, 1.2), 1.6, 25, 4);
+  std::vector<DepthFrame> frames;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    frames.push_back(test::renderFrame(scene, camera, poses[i], 0.02, 31 + static_cast<unsigned>(i)));
+    frames.back().color.create(camera.height, camera.width, CV_8UC3);
+    cv::randu(frames.back().color, 0, 255);
+  }
+  struct Restore {
+    ~Restore() { TsdfIntegrator::setMaxVoxelTestLanes(16); }
+  } restore;
+  for (const bool carving : {false, true})
+    for (const bool bilinear : {false, true})
+      for (const auto distance : {TsdfIntegrator::SignedDistance::Plane, TsdfIntegrator::SignedDistance::Projective}) {
+        TsdfIntegrator::Config config;
+        config.space_carving = carving;
+        config.interpolate_depth = bilinear;
+        config.signed_distance = distance;
+        config.min_depth_m = 0.6;
+        TsdfIntegrator::setMaxVoxelTestLanes(4);
+        ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), 4);
+        TsdfVolume portable(0.03, 0.09);
+        TsdfIntegrator reference(portable, config);
+        for (std::size_t i = 0; i < frames.size(); ++i)
+          reference.integrate(frames[i], poses[i]);
+        ASSERT_GT(portable.numObservedVoxels(), 10000u);
+        for (int lanes = 8; lanes <= widest; lanes *= 2) {
+          TsdfIntegrator::setMaxVoxelTestLanes(lanes);
+          ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), lanes);
+          TsdfVolume wide(0.03, 0.09);
+          TsdfIntegrator integrator(wide, config);
+          for (std::size_t i = 0; i < frames.size(); ++i)
+            integrator.integrate(frames[i], poses[i]);
+          EXPECT_TRUE(sameVolumes(wide, portable))
+              << lanes << " lanes, carving " << carving << ", bilinear " << bilinear << ", " << toString(distance);
+        }
+      }
 }

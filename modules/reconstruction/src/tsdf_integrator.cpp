@@ -4,6 +4,8 @@
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
+#include "voxel_test.h"
+
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
@@ -32,32 +34,6 @@ using detail::PixelBand;
 
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
-
-// 4 lanes of SIMD (GCC and Clang vector extensions: SSE2 on x86-64, NEON on ARM), for the
-// row of 4 voxels that the update projects at once. Comparisons give 0 or -1 per lane.
-using Float4 = float __attribute__((vector_size(16)));
-using Int4 = std::int32_t __attribute__((vector_size(16)));
-
-inline Float4 clamp4(Float4 v, float lo, float hi) {
-  v = v > lo ? v : lo;
-  return v < hi ? v : hi;
-}
-/// A voxel that passed the nearest-pixel test: its projection, depth and nearest pixel.
-struct Candidate {
-  float u, v, z, nearest;
-  const PixelBand* pixel;
-  std::int32_t ui, vi;
-  std::uint16_t voxel; ///< index in the block
-};
-
-/// Bit k set when lane k is true (-1).
-inline int laneMask(Int4 m) {
-#ifdef __SSE__
-  return __builtin_ia32_movmskps(reinterpret_cast<Float4>(m)); // one instruction
-#else
-  return (m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8);
-#endif
-}
 
 // 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
 std::uint64_t packKey(const Eigen::Vector3i& b) {
@@ -592,17 +568,21 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   std::atomic<std::size_t> projected_total{0};
   const float* depth_data = depth_image.ptr<float>(0);
   const std::size_t depth_step = depth_image.step1();
+  const detail::SubBlockTest test_sub_block = detail::subBlockTest();
+  const detail::VoxelTestFrame test_frame{fx, fy, cx, cy, width, height, min_d, max_d, carving, depth_data, pixel_data};
   cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
   // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
-  std::array<Candidate, TsdfBlock::kVoxels> candidates;
+  detail::VoxelCandidates candidates;
   std::size_t projected = 0;
   for (int n = range.start; n < range.end; ++n) {
     const auto i = static_cast<std::size_t>(n);
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
-    std::size_t n_candidates = 0;
+    const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
+                                            {ey.x(), ey.y(), ey.z()}, {ez.x(), ez.y(), ez.z()}, block.voxels.data()};
+    int n_candidates = 0;
     for (int sub = 0; sub < 8; ++sub) {
       if (!(masks[i] & (1u << sub)))
         continue; // no sampled ray's band crosses this sub-block
@@ -641,59 +621,21 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
         }
       }
       projected += 64;
-      for (int z = sz; z < sz + 4; ++z)
-      for (int y = sy; y < sy + 4; ++y) {
-        // A row of 4 voxels, projected and tested on its nearest pixels in SIMD lanes without
-        // branches (most voxels fail, unpredictably); a bilinear value differs from the nearest
-        // by less than the pixel's band behind (the 4 pixels must agree within it), so twice
-        // the bands is a safe bound. Same float operations as one voxel at a time, so the same
-        // results.
-        const Eigen::Vector3f row = base + ez * static_cast<float>(z) + ey * static_cast<float>(y);
-        const Float4 xs = Float4{0.f, 1.f, 2.f, 3.f} + static_cast<float>(sx);
-        const Float4 X = row.x() + ex.x() * xs, Y = row.y() + ex.y() * xs, Z = row.z() + ex.z() * xs;
-        const Float4 inv_z = 1.f / (Z > 1e-6f ? Z : 1e-6f);
-        const Float4 pu = fx * X * inv_z + cx, pv = fy * Y * inv_z + cy;
-        const Int4 inside = (Z >= min_d) & (pu > -0.5f) & (pv > -0.5f) & (pu < width - 0.5f) & (pv < height - 0.5f);
-        // Clamped before the conversion (equal to converting, then clamping, inside the image).
-        const Int4 pixel_u = __builtin_convertvector(clamp4(pu + 0.5f, 0.f, static_cast<float>(width - 1)), Int4);
-        const Int4 pixel_v = __builtin_convertvector(clamp4(pv + 0.5f, 0.f, static_cast<float>(height - 1)), Int4);
-        const Int4 at_pixel = pixel_v * width + pixel_u; // the depth's and the records' (see depth_image)
-        const Float4 nearest = {depth_data[at_pixel[0]], depth_data[at_pixel[1]], depth_data[at_pixel[2]],
-                                depth_data[at_pixel[3]]};
-        const PixelBand* p[4] = {&pixel_data[at_pixel[0]], &pixel_data[at_pixel[1]], &pixel_data[at_pixel[2]],
-                                 &pixel_data[at_pixel[3]]};
-        const Float4 behind = {p[0]->behind, p[1]->behind, p[2]->behind, p[3]->behind};
-        const Float4 diff = nearest - Z;
-        Int4 ok = inside & (nearest >= min_d) & (nearest <= max_d) & (diff >= -2.f * behind);
-        if (!carving) { // with free space, every voxel in front is updated
-          const Float4 front = {p[0]->front, p[1]->front, p[2]->front, p[3]->front};
-          ok &= diff <= front + behind;
-        }
-        const int lanes = laneMask(ok);
-        if (!lanes)
-          continue;
-        const int first = TsdfBlock::linear(sx, y, z);
-        __builtin_prefetch(&block.voxels[first], 1);
-        __builtin_prefetch(&block.voxels[first + 3], 1);
-        for (int k = 0; k < 4; ++k)
-          if (lanes & (1 << k)) {
-            candidates[n_candidates++] = {pu[k], pv[k], Z[k], nearest[k], p[k], pixel_u[k], pixel_v[k],
-                                          static_cast<std::uint16_t>(first + k)};
-            if (has_color)
-              __builtin_prefetch(frame.color.ptr<std::uint8_t>(pixel_v[k]) + 3 * pixel_u[k]);
-          }
-      }
+      n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
     }
+    if (has_color) // the voxels were prefetched by the test
+      for (int c = 0; c < n_candidates; ++c)
+        __builtin_prefetch(frame.color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
 
     std::size_t updated = 0, listed = 0;
     std::uint8_t signs = 0, negative = 0;
-    for (std::size_t c = 0; c < n_candidates; ++c) {
-      const Candidate& cand = candidates[c];
-      const float u = cand.u, v = cand.v;
-      const int ui = cand.ui, vi = cand.vi;
-      float d = cand.nearest;
+    for (int c = 0; c < n_candidates; ++c) {
+      const float u = candidates.u[c], v = candidates.v[c], z = candidates.z[c];
+      const int ui = candidates.ui[c], vi = candidates.vi[c];
+      const auto voxel_index = static_cast<std::uint16_t>(candidates.voxel[c]);
+      float d = candidates.nearest[c];
       float quad_min = d; // the least depth of the 4 pixels around the projection
-      const PixelBand& pixel = *cand.pixel;
+      const PixelBand& pixel = pixel_data[candidates.pixel[c]];
       const float scale = pixel.scale;
       const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
       if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
@@ -709,13 +651,13 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
           d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
         }
       }
-      const float diff = d - cand.z, band = pixel.front, behind = pixel.behind;
+      const float diff = d - z, band = pixel.front, behind = pixel.behind;
       if (diff < -behind)
         continue;
       const bool in_band = diff <= band;
       // Free space only where all 4 pixels around the projection see past the band: beside a
       // depth edge the nearest pixel may see the background through a foreground voxel.
-      if (!in_band && !(carving && quad_min > 0.f && quad_min - cand.z > band))
+      if (!in_band && !(carving && quad_min > 0.f && quad_min - z > band))
         continue;
       // In front of the band: free space. A band widened for noise reaches beyond the
       // truncation, the values stay within it (what a truncated distance is).
@@ -734,12 +676,12 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       // Colour only near the surface: the mesh's vertices take it from the voxels on either side.
       const bool coloured = has_color && in_band && std::abs(sdf) < colour_band;
       const std::uint8_t* bgr = coloured ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
-      TsdfVoxel& voxel = block.voxels[cand.voxel];
+      TsdfVoxel& voxel = block.voxels[voxel_index];
       updateVoxel(voxel, sdf, w, bgr, max_weight, trunc);
       signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-      negative |= voxel.sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(cand.voxel)) : 0;
+      negative |= voxel.sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(voxel_index)) : 0;
       if (regularized && std::abs(voxel.sdf) < smooth_band) {
-        changed_index_[i * TsdfBlock::kVoxels + listed] = cand.voxel;
+        changed_index_[i * TsdfBlock::kVoxels + listed] = voxel_index;
         data_term_[i * TsdfBlock::kVoxels + listed] = voxel.sdf;
         ++listed;
       }

@@ -222,6 +222,13 @@ public:
   /// instead. Infinite as reach() is.
   double allocationDepth() const;
 
+  /// Voxels that integrate() tests at once on their nearest pixels: 16 (AVX-512), 8 (AVX2) or 4,
+  /// the widest that the CPU runs, at most setMaxVoxelTestLanes'. Every width gives the same volume.
+  static int voxelTestLanes();
+  /// Caps voxelTestLanes process-wide (4: the portable kernel), so that tests and benchmarks
+  /// can compare the kernels; 16 (the default) lifts the cap.
+  static void setMaxVoxelTestLanes(int lanes);
+
 private:
   /// The widest band behind a surface that a pixel can have (metres; see reach).
   double widestBandBehind() const;
