@@ -147,8 +147,9 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
     sweeps += integrator.lastStats().regularize_sweeps;
   }
   TriangleMesh mesh;
-  MarchingCubes::Config every_voxel;
+  MarchingCubes::Config every_voxel; // and eq. 7 in the integration alone: no smoothing at meshing
   every_voxel.min_weight = 0.f;
+  every_voxel.smoothing_lambda = 0.f;
   MarchingCubes(every_voxel).extract(volume, mesh);
   Cell cell;
   cell.noise_mm = noise_mm;
