@@ -1,13 +1,17 @@
 // msf_integrate: fuses organized depth clouds (camera frame, NaN = no depth) seen from known
-// poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud.
+// poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
+// -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
+#include <msf/fusion/fusion_config.h>
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
@@ -25,25 +29,38 @@ using namespace pcl::console;
 
 namespace {
 
-/// Every .pcd of `dir`, in name order.
-std::vector<std::string> cloudsIn(const std::string& dir) {
-  msf::requireDirectory(dir, "input folder");
+/// Every file of `dir` whose extension is one of `extensions`, in name order.
+std::vector<std::string> filesIn(const std::string& dir, const std::vector<std::string>& extensions,
+                                 const std::string& what) {
+  msf::requireDirectory(dir, what);
   std::vector<std::string> found;
   for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file() && msf::fileExtension(e.path().string()) == ".pcd")
+    if (e.is_regular_file() &&
+        std::find(extensions.begin(), extensions.end(), msf::fileExtension(e.path().string())) != extensions.end())
       found.push_back(e.path().string());
   std::sort(found.begin(), found.end());
   if (found.empty())
-    throw msf::IOError("input folder '" + dir + "' has no .pcd file");
+    throw msf::IOError(what + " '" + dir + "' has no " + extensions.front() + " file");
   return found;
+}
+
+/// A LiDAR scan in its own frame: a KITTI .bin or a .pcd (msf_kitti2pcd's).
+pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  if (msf::fileExtension(path) == ".bin")
+    msf::loadVelodyneBin(path, scan);
+  else
+    msf::loadCloud(path, scan);
+  return scan;
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
-  std::string poses_path, output, input_dir, frames, calib;
+  std::string poses_path, output, input_dir, frames, calib, scans_dir;
   msf::TsdfVolume::Config volume_config;
   msf::TsdfIntegrator::Config config;
+  msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
   bool carving = false, no_carving = false, print_config = false;
   msf::tool::CommandLine cli(
       "msf_integrate", "<depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]",
@@ -54,6 +71,11 @@ int main(int argc, char** argv) {
       .value("-o", "FILE", output, "the volume (.pcd)")
       .value("-input_dir", "DIR", input_dir, "also every .pcd of DIR, in name order")
       .value("-frames", "a:b", frames, "the poses of these lines (0-based) only, when the file has more")
+      .value("-scans", "DIR", scans_dir,
+             "every .bin (KITTI velodyne) or .pcd scan of DIR in name order, one per cloud, in the LiDAR's frame: each "
+             "clears what lies in front of its returns outside the camera's view, within "
+             "tsdf_integrator.scan_carving_m of the LiDAR, as msf_reconstruct does (needs -calib with the LiDAR's "
+             "extrinsics, and space carving)")
       .value("-calib", "PATH", calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
@@ -62,9 +84,11 @@ int main(int argc, char** argv) {
                const msf::ConfigFile file(path);
                volume_config.read(file.section("tsdf_volume"));
                config.read(file.section("tsdf_integrator"));
+               fusion.read(file.section("fusion"));
                file.rejectUnknownKeys();
              },
-             "YAML with sections tsdf_volume and tsdf_integrator; the options below override it")
+             "YAML with sections tsdf_volume, tsdf_integrator and fusion (the LiDAR's range noise); the options "
+             "below override it")
       .value("-voxel", "M", volume_config.voxel_size_m, "voxel size in metres (default {default})")
       .value("-trunc", "M", volume_config.truncation_m, "truncation distance in metres (default {default})")
       .value("-lambda", "L", config.lambda, "eq. 7 regularization (default {default}, the paper's KITTI value is 5)")
@@ -83,7 +107,7 @@ int main(int argc, char** argv) {
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     std::vector<std::string> clouds = positional;
     if (!input_dir.empty()) {
-      const std::vector<std::string> found = cloudsIn(input_dir);
+      const std::vector<std::string> found = filesIn(input_dir, {".pcd"}, "input folder");
       clouds.insert(clouds.end(), found.begin(), found.end());
     }
     if (clouds.empty() || poses_path.empty() || output.empty()) {
@@ -117,8 +141,25 @@ int main(int argc, char** argv) {
                                    " poses in '" + poses_path + "' (one pose per cloud; -frames a:b selects poses)");
 
     msf::PinholeCamera camera;
-    if (cli.given("-calib"))
-      camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib));
+    msf::Calibration calibration;
+    if (cli.given("-calib")) {
+      calibration = msf::loadCalibration(calib);
+      camera = msf::PinholeCamera::fromCalibration(calibration);
+    }
+    std::vector<std::string> scans;
+    if (cli.given("-scans")) {
+      if (!cli.given("-calib"))
+        throw msf::InvalidInputError("-scans needs -calib: the LiDAR's pose is the camera's times its extrinsics");
+      calibration.requireVelodyne();
+      if (!config.space_carving || !(config.scan_carving_m > 0.0))
+        throw msf::InvalidInputError("-scans carves free space: it needs space carving and "
+                                     "tsdf_integrator.scan_carving_m > 0");
+      scans = filesIn(scans_dir, {".bin", ".pcd"}, "scan folder");
+      if (scans.size() != clouds.size())
+        throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " +
+                                     std::to_string(scans.size()) + " scans in '" + scans_dir + "' (one per cloud)");
+    }
+    const float scan_weight = 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m);
 
     pcl::console::TicToc tt;
     double integrate_ms = 0;
@@ -131,6 +172,9 @@ int main(int argc, char** argv) {
       const msf::DepthFrame frame =
           msf::toDepthFrame(blob, camera.valid() ? &camera : nullptr, "cloud '" + clouds[i] + "'");
       integrator.integrate(frame, poses[i]);
+      if (!scans.empty())
+        integrator.carveWithScan(msf::ScanFreeSpace(loadScan(scans[i])), poses[i] * calibration.T_cam0_velo,
+                                 scan_weight, frame.camera, poses[i]);
       integrate_ms += integrator.lastStats().allocate_ms + integrator.lastStats().update_ms +
                       integrator.lastStats().regularize_ms;
       msf::tool::printDone(tt.toc(), integrator.lastStats().voxels_updated);

@@ -5,12 +5,15 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/poses.h>
+#include <msf/io/velodyne_io.h>
+#include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +22,17 @@ using namespace msf;
 
 namespace {
 
+/// test::smallCamera as a stereo rig (0.5 m baseline) with the LiDAR at the camera.
+Calibration smallCalibration() {
+  const PinholeCamera camera = test::smallCamera();
+  Calibration calibration;
+  for (auto& P : calibration.P)
+    P << camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0;
+  calibration.P[1](0, 3) = -camera.fx * 0.5;
+  calibration.image_size = cv::Size(camera.width, camera.height);
+  return calibration;
+}
+
 /// Three depth clouds of the sphere scene with their poses and calibration, as files.
 struct SphereFiles {
   test::TempDir dir;
@@ -26,11 +40,7 @@ struct SphereFiles {
   AnalyticScene scene = test::makeScene(test::SceneKind::Sphere);
   SphereFiles() {
     const PinholeCamera camera = test::smallCamera();
-    Calibration calibration;
-    for (auto& P : calibration.P)
-      P << camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0;
-    calibration.P[1](0, 3) = -camera.fx * 0.5;
-    calibration.image_size = cv::Size(camera.width, camera.height);
+    const Calibration calibration = smallCalibration();
     saveCalibrationYaml(calibration, dir.file("camera.yaml"));
     PoseList poses;
     const auto arc = test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 15, 3);
@@ -173,6 +183,86 @@ TEST(Tools, IntegrateRejectsBadInputAndLeavesNoFile) {
                                                     " -no_carving -print_config");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("space_carving: false"), std::string::npos) << r.out;
+}
+
+TEST(Tools, IntegrateWithScansClearsWhatMovedAwayOutOfTheCamerasView) {
+  // Frame 0 sees a patch 4 m ahead. Frame 1, from the same place turned round, does not see it,
+  // but its LiDAR scan (returns 15 m away all around) passes through where the patch was: with
+  // -scans the patch is carved away, as msf_reconstruct's scan carving does; without, it stays.
+  test::TempDir dir;
+  const PinholeCamera camera = test::smallCamera();
+  Calibration calibration = smallCalibration();
+  // KITTI's axes: the LiDAR's x (forward) is the camera's z, its y (left) -x, its z (up) -y.
+  calibration.T_cam0_velo.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  saveCalibrationYaml(calibration, dir.file("camera.yaml"));
+
+  cv::Mat patch(camera.height, camera.width, CV_32FC1, cv::Scalar(0.f));
+  patch(cv::Rect(camera.width / 2 - 40, camera.height / 2 - 40, 80, 80)).setTo(4.f);
+  const cv::Mat wall(camera.height, camera.width, CV_32FC1, cv::Scalar(8.f));
+  PoseList poses(2, Eigen::Isometry3d::Identity());
+  poses[1].linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  saveOdometryPoses(dir.file("poses.txt"), poses);
+  std::string clouds;
+  for (int i = 0; i < 2; ++i) {
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    depthImageToCloud(i == 0 ? patch : wall, calibration, 0, cloud);
+    saveCloud(dir.file("depth_" + std::to_string(i) + ".pcd"), cloud);
+    clouds += dir.file("depth_" + std::to_string(i) + ".pcd") + " ";
+  }
+  // Returns 15 m away at -10..10 degrees of elevation all around; scan 0 none ahead (the patch
+  // is there, inside the camera's view, where scans do not carve).
+  std::filesystem::create_directories(dir.file("scans"));
+  for (int i = 0; i < 2; ++i) {
+    pcl::PointCloud<pcl::PointXYZI> scan;
+    for (double el = -10.0; el <= 10.0; el += 0.4)
+      for (double az = -180.0; az < 180.0; az += 0.2) {
+        if (i == 0 && std::abs(az) < 40.0)
+          continue;
+        const double e = el * M_PI / 180.0, a = az * M_PI / 180.0;
+        pcl::PointXYZI p;
+        p.x = static_cast<float>(15.0 * std::cos(e) * std::cos(a));
+        p.y = static_cast<float>(15.0 * std::cos(e) * std::sin(a));
+        p.z = static_cast<float>(15.0 * std::sin(e));
+        p.intensity = 0.5f;
+        scan.push_back(p);
+      }
+    saveVelodyneBin(dir.file("scans/" + std::to_string(i) + ".bin"), scan);
+  }
+
+  const std::string common = clouds + "-poses " + dir.file("poses.txt") + " -calib " + dir.file("camera.yaml");
+  auto patchVertices = [&](const std::string& volume) {
+    TriangleMesh mesh;
+    MarchingCubes().extract(TsdfVolume::load(volume), mesh);
+    std::size_t n = 0;
+    for (const auto& v : mesh.vertices)
+      n += std::abs(v.x()) < 0.5f && std::abs(v.y()) < 0.5f && std::abs(v.z() - 4.f) < 0.3f;
+    return n;
+  };
+  auto r = test::runTool("msf_integrate", common + " -o " + dir.file("plain.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::runTool("msf_integrate", common + " -scans " + dir.file("scans") + " -o " + dir.file("carved.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::size_t plain = patchVertices(dir.file("plain.pcd")), carved = patchVertices(dir.file("carved.pcd"));
+  std::printf("  patch vertices: %zu without the scans, %zu with them\n", plain, carved);
+  EXPECT_GT(plain, 50u); // the 1.07 m square at 0.1 m voxels
+  EXPECT_EQ(carved, 0u);
+
+  // Bad input: a clear error, no volume.
+  const std::string out = dir.file("bad.pcd");
+  expectToolError(test::runTool("msf_integrate", clouds + "-poses " + dir.file("poses.txt") + " -scans " +
+                                                     dir.file("scans") + " -o " + out),
+                  "msf_integrate", "-scans needs -calib");
+  expectToolError(test::runTool("msf_integrate", common + " -scans " + dir.file("scans") + " -no_carving -o " + out),
+                  "msf_integrate", "space carving");
+  std::filesystem::remove(dir.file("scans/1.bin"));
+  expectToolError(test::runTool("msf_integrate", common + " -scans " + dir.file("scans") + " -o " + out),
+                  "msf_integrate", "2 depth clouds but 1 scans");
+  std::ofstream(dir.file("scans/1.bin"), std::ios::binary) << "truncated";
+  expectToolError(test::runTool("msf_integrate", common + " -scans " + dir.file("scans") + " -o " + out),
+                  "msf_integrate", "1.bin");
+  expectToolError(test::runTool("msf_integrate", common + " -scans " + dir.file("nowhere") + " -o " + out),
+                  "msf_integrate", "nowhere");
+  EXPECT_FALSE(test::fileExists(out));
 }
 
 TEST(Tools, MeshRejectsBadInput) {
