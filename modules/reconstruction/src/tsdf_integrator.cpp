@@ -564,6 +564,24 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       width, height, depth_data, pixel_data, has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
       has_color ? static_cast<int>(frame.color.step[0]) : 0, bilinear, carving, dropoff, regularized, trunc, vs,
       colour_band, max_weight, smooth_band};
+  // Blocks visited in the image's order (their centres' 32x32-pixel tiles along a Z-order curve)
+  // rather than the keys', so that neighbouring blocks' tests read the same depth and pixel
+  // records from the cache. Each block's work is its own: the order changes no result.
+  std::vector<std::uint64_t> order(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const Eigen::Vector3d centre = (blocks[i]->origin().cast<double>() + Eigen::Vector3d::Constant(3.5)) * vs;
+    const Eigen::Vector3f c = (T_cam_world * centre).cast<float>();
+    std::uint64_t tile = 0xffffffffu; // behind the camera: last
+    if (c.z() > min_d) {
+      const auto tu = static_cast<std::uint32_t>(std::clamp(fx * c.x() / c.z() + cx, 0.f, width - 1.f)) >> 5;
+      const auto tv = static_cast<std::uint32_t>(std::clamp(fy * c.y() / c.z() + cy, 0.f, height - 1.f)) >> 5;
+      tile = 0;
+      for (int b = 0; b < 16; ++b)
+        tile |= static_cast<std::uint64_t>(((tu >> b) & 1u) | (((tv >> b) & 1u) << 1)) << (2 * b);
+    }
+    order[i] = tile << 32 | i;
+  }
+  std::sort(order.begin(), order.end());
   cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
@@ -571,7 +589,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   detail::VoxelCandidates candidates;
   std::size_t projected = 0;
   for (int n = range.start; n < range.end; ++n) {
-    const auto i = static_cast<std::size_t>(n);
+    const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(n)] & 0xffffffffu);
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
     const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
