@@ -41,11 +41,10 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
   for (int k = 0; k < count; k += V::kLanes) {
     const M valid = V::firstLanes(count - k);
     const F u = V::load(c.u + k), v = V::load(c.v + k), z = V::load(c.z + k), nearest = V::load(c.nearest + k);
-    const I at_band = V::times5(V::loadi(c.pixel + k));
-    const F scale = V::gatherm(pixel_base, at_band, valid), band = V::gatherm(pixel_base + 1, at_band, valid);
-    const F behind = V::gatherm(pixel_base + 2, at_band, valid);
-    const F pixel_weight = V::gatherm(pixel_base + 3, at_band, valid);
-    const F pixel_free = V::gatherm(pixel_base + 4, at_band, valid);
+    const I pixel = V::loadi(c.pixel + k);
+    F scale, band, behind, pixel_weight;
+    V::records4(pixel_base, pixel, valid, scale, band, behind, pixel_weight);
+    const F pixel_free = V::gatherm(pixel_base + 4, V::times5(pixel), valid);
     // The 4 pixels around the projection, where all lie in the image.
     const I u0 = V::cvtt(u), v0 = V::cvtt(v);
     const M quad = V::and_(V::and_(valid, V::and_(V::ge(u, zero), V::ge(v, zero))),
