@@ -933,9 +933,11 @@ bool sameVolumes(const TsdfVolume& a, const TsdfVolume& b) {
     for (int i = 0; i < TsdfBlock::kVoxels; ++i) {
       const TsdfVoxel &x = block->voxels[i], &y = other->voxels[i];
       if (std::memcmp(&x.sdf, &y.sdf, sizeof x.sdf) || std::memcmp(&x.weight, &y.weight, sizeof x.weight) ||
-          x.r != y.r || x.g != y.g || x.b != y.b)
+          x.r != y.r || x.g != y.g || x.b != y.b || x.flags != y.flags)
         return false;
     }
+    if (block->signs != other->signs || block->negative_subblocks != other->negative_subblocks)
+      return false;
   }
   return true;
 }
@@ -979,11 +981,12 @@ TEST(TsdfIntegrator, ADepthImageInsideAWiderOneAndFramesOfChangingSizesGiveTheSa
 }
 
 TEST(TsdfIntegrator, EveryVoxelTestKernelGivesTheSameVolume) {
-  // The voxel test runs 16 (AVX-512), 8 (AVX2) or 4 (portable) voxels at a time, picked by the
-  // CPU: each width must give bit for bit the portable kernel's volume, colours and all. Noisy
-  // depth, cameras near enough that blocks straddle min_depth_m and the image's edges, and the
-  // settings that change the test (space carving: no band in front) or read its candidates
-  // (bilinear depth, the plane distance).
+  // The voxel test and the update of its candidates run 16 (AVX-512), 8 (AVX2) or 4 and 1
+  // (portable) voxels at a time, picked by the CPU: each width must give bit for bit the
+  // portable kernels' volume, colours and all. Noisy depth, cameras near enough that blocks
+  // straddle min_depth_m and the image's edges, and the settings that change the test (space
+  // carving: no band in front) or the update (bilinear depth, the plane distance, the weight's
+  // drop-off, per-pixel and free-space weights, the regularization's list of changed voxels).
   const int widest = TsdfIntegrator::voxelTestLanes();
   if (widest == 4)
     GTEST_SKIP() << "no wide voxel test on this CPU or build";
@@ -999,30 +1002,45 @@ TEST(TsdfIntegrator, EveryVoxelTestKernelGivesTheSameVolume) {
   struct Restore {
     ~Restore() { TsdfIntegrator::setMaxVoxelTestLanes(16); }
   } restore;
+  for (std::size_t i = 0; i < frames.size(); ++i) { // per-pixel weights, some below min_pixel_weight
+    frames[i].weight.create(camera.height, camera.width, CV_32FC1);
+    cv::randu(frames[i].weight, 0.f, 400.f);
+    frames[i].free_space_weight.create(camera.height, camera.width, CV_32FC1);
+    cv::randu(frames[i].free_space_weight, 0.f, 200.f);
+  }
   for (const bool carving : {false, true})
     for (const bool bilinear : {false, true})
-      for (const auto distance : {TsdfIntegrator::SignedDistance::Plane, TsdfIntegrator::SignedDistance::Projective}) {
-        TsdfIntegrator::Config config;
-        config.space_carving = carving;
-        config.interpolate_depth = bilinear;
-        config.signed_distance = distance;
-        config.min_depth_m = 0.6;
-        TsdfIntegrator::setMaxVoxelTestLanes(4);
-        ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), 4);
-        TsdfVolume portable(0.03, 0.09);
-        TsdfIntegrator reference(portable, config);
-        for (std::size_t i = 0; i < frames.size(); ++i)
-          reference.integrate(frames[i], poses[i]);
-        ASSERT_GT(portable.numObservedVoxels(), 10000u);
-        for (int lanes = 8; lanes <= widest; lanes *= 2) {
-          TsdfIntegrator::setMaxVoxelTestLanes(lanes);
-          ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), lanes);
-          TsdfVolume wide(0.03, 0.09);
-          TsdfIntegrator integrator(wide, config);
+      for (const auto distance : {TsdfIntegrator::SignedDistance::Plane, TsdfIntegrator::SignedDistance::Projective})
+        for (const bool per_pixel : {false, true}) {
+          TsdfIntegrator::Config config;
+          config.space_carving = carving;
+          config.interpolate_depth = bilinear;
+          config.signed_distance = distance;
+          config.min_depth_m = 0.6;
+          if (per_pixel) { // and regularized: the list of changed voxels near a surface, in order
+            config.weighting = TsdfIntegrator::Weighting::PerPixel;
+            config.min_pixel_weight = 50.f;
+            config.weight_dropoff = false;
+            config.lambda = 2.0;
+            config.lambda_data = TsdfIntegrator::LambdaData::InverseVariance;
+          }
+          TsdfIntegrator::setMaxVoxelTestLanes(4);
+          ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), 4);
+          TsdfVolume portable(0.03, 0.09);
+          TsdfIntegrator reference(portable, config);
           for (std::size_t i = 0; i < frames.size(); ++i)
-            integrator.integrate(frames[i], poses[i]);
-          EXPECT_TRUE(sameVolumes(wide, portable))
-              << lanes << " lanes, carving " << carving << ", bilinear " << bilinear << ", " << toString(distance);
+            reference.integrate(frames[i], poses[i]);
+          ASSERT_GT(portable.numObservedVoxels(), 10000u);
+          for (int lanes = 8; lanes <= widest; lanes *= 2) {
+            TsdfIntegrator::setMaxVoxelTestLanes(lanes);
+            ASSERT_EQ(TsdfIntegrator::voxelTestLanes(), lanes);
+            TsdfVolume wide(0.03, 0.09);
+            TsdfIntegrator integrator(wide, config);
+            for (std::size_t i = 0; i < frames.size(); ++i)
+              integrator.integrate(frames[i], poses[i]);
+            EXPECT_TRUE(sameVolumes(wide, portable))
+                << lanes << " lanes, carving " << carving << ", bilinear " << bilinear << ", " << toString(distance)
+                << ", per pixel " << per_pixel;
+          }
         }
-      }
 }

@@ -4,7 +4,7 @@
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
-#include "voxel_test.h"
+#include "voxel_update.h"
 
 #include <opencv2/core/utility.hpp>
 
@@ -31,6 +31,7 @@ double msSince(Clock::time_point t0) {
 }
 
 using detail::PixelBand;
+using detail::updateVoxel;
 
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
@@ -104,20 +105,6 @@ bool sphereInView(const Eigen::Vector3f& c, float radius, const PinholeCamera& c
   const float r_px = std::max(fx, fy) * radius / z;
   const float u = fx * c.x() / z + static_cast<float>(cam.cx), v = fy * c.y() / z + static_cast<float>(cam.cy);
   return u >= -r_px && v >= -r_px && u <= cam.width + r_px && v <= cam.height + r_px;
-}
-
-/// Running weighted mean of one observation into a voxel.
-inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight, float trunc) {
-  const float total = voxel.weight + w;
-  const float inv = 1.f / total;
-  // Clamped: rounding may carry a mean of values at the truncation a hair past it.
-  voxel.sdf = std::clamp((voxel.sdf * voxel.weight + sdf * w) * inv, -trunc, trunc);
-  if (bgr) {
-    voxel.r = static_cast<std::uint8_t>((voxel.r * voxel.weight + bgr[2] * w) * inv + 0.5f);
-    voxel.g = static_cast<std::uint8_t>((voxel.g * voxel.weight + bgr[1] * w) * inv + 0.5f);
-    voxel.b = static_cast<std::uint8_t>((voxel.b * voxel.weight + bgr[0] * w) * inv + 0.5f);
-  }
-  voxel.weight = std::min(total, max_weight);
 }
 
 } // namespace
@@ -550,7 +537,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const bool regularized = regularizes();
   // Changed voxels of each block (local indices), for the regularization.
   if (regularized) {
-    changed_index_.resize(blocks.size() * TsdfBlock::kVoxels);
+    changed_index_.resize(blocks.size() * detail::kListStride);
     data_term_.resize(changed_index_.size());
   }
   std::vector<std::uint16_t> changed_count(blocks.size(), 0), listed_count(blocks.size(), 0);
@@ -567,9 +554,34 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
 
   std::atomic<std::size_t> projected_total{0};
   const float* depth_data = depth_image.ptr<float>(0);
-  const std::size_t depth_step = depth_image.step1();
   const detail::SubBlockTest test_sub_block = detail::subBlockTest();
   const detail::VoxelTestFrame test_frame{fx, fy, cx, cy, width, height, min_d, max_d, carving, depth_data, pixel_data};
+  // The wide kernels read a colour as 4 bytes, one before the pixel's (or after, at pixel 0).
+  const bool color_wide = has_color && frame.color.cols >= 2;
+  const detail::BlockUpdate update_block =
+      !has_color || color_wide ? detail::blockUpdate() : detail::blockUpdatePortable;
+  const detail::VoxelUpdateFrame update_frame{
+      width, height, depth_data, pixel_data, has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
+      has_color ? static_cast<int>(frame.color.step[0]) : 0, bilinear, carving, dropoff, regularized, trunc, vs,
+      colour_band, max_weight, smooth_band};
+  // Blocks visited in the image's order (their centres' 32x32-pixel tiles along a Z-order curve)
+  // rather than the keys', so that neighbouring blocks' tests read the same depth and pixel
+  // records from the cache. Each block's work is its own: the order changes no result.
+  std::vector<std::uint64_t> order(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const Eigen::Vector3d centre = (blocks[i]->origin().cast<double>() + Eigen::Vector3d::Constant(3.5)) * vs;
+    const Eigen::Vector3f c = (T_cam_world * centre).cast<float>();
+    std::uint64_t tile = 0xffffffffu; // behind the camera: last
+    if (c.z() > min_d) {
+      const auto tu = static_cast<std::uint32_t>(std::clamp(fx * c.x() / c.z() + cx, 0.f, width - 1.f)) >> 5;
+      const auto tv = static_cast<std::uint32_t>(std::clamp(fy * c.y() / c.z() + cy, 0.f, height - 1.f)) >> 5;
+      tile = 0;
+      for (int b = 0; b < 16; ++b)
+        tile |= static_cast<std::uint64_t>(((tu >> b) & 1u) | (((tv >> b) & 1u) << 1)) << (2 * b);
+    }
+    order[i] = tile << 32 | i;
+  }
+  std::sort(order.begin(), order.end());
   cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
@@ -577,7 +589,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   detail::VoxelCandidates candidates;
   std::size_t projected = 0;
   for (int n = range.start; n < range.end; ++n) {
-    const auto i = static_cast<std::size_t>(n);
+    const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(n)] & 0xffffffffu);
     TsdfBlock& block = *blocks[i];
     const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
     const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
@@ -627,73 +639,18 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       for (int c = 0; c < n_candidates; ++c)
         __builtin_prefetch(frame.color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
 
-    std::size_t updated = 0, listed = 0;
-    std::uint8_t signs = 0, negative = 0;
-    for (int c = 0; c < n_candidates; ++c) {
-      const float u = candidates.u[c], v = candidates.v[c], z = candidates.z[c];
-      const int ui = candidates.ui[c], vi = candidates.vi[c];
-      const auto voxel_index = static_cast<std::uint16_t>(candidates.voxel[c]);
-      float d = candidates.nearest[c];
-      float quad_min = d; // the least depth of the 4 pixels around the projection
-      const PixelBand& pixel = pixel_data[candidates.pixel[c]];
-      const float scale = pixel.scale;
-      const int u0 = static_cast<int>(u), v0 = static_cast<int>(v); // u, v > -0.5: floor for >= 0
-      if (u >= 0.f && v >= 0.f && u0 + 1 < width && v0 + 1 < height) {
-        const float* r0 = depth_data + v0 * depth_step + u0;
-        const float* r1 = r0 + depth_step;
-        const float d00 = r0[0], d10 = r0[1], d01 = r1[0], d11 = r1[1];
-        const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
-        const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
-        quad_min = lo;
-        // Only where the 4 agree: across a depth edge, a blend would be a phantom surface.
-        if (bilinear && lo > 0.f && hi - lo < pixel.behind) {
-          const float a = u - static_cast<float>(u0), b = v - static_cast<float>(v0);
-          d = (d00 * (1 - a) + d10 * a) * (1 - b) + (d01 * (1 - a) + d11 * a) * b;
-        }
-      }
-      const float diff = d - z, band = pixel.front, behind = pixel.behind;
-      if (diff < -behind)
-        continue;
-      const bool in_band = diff <= band;
-      // Free space only where all 4 pixels around the projection see past the band: beside a
-      // depth edge the nearest pixel may see the background through a foreground voxel.
-      if (!in_band && !(carving && quad_min > 0.f && quad_min - z > band))
-        continue;
-      // In front of the band: free space. A band widened for noise reaches beyond the
-      // truncation, the values stay within it (what a truncated distance is).
-      const float sdf = std::clamp((in_band ? diff : band) * scale, -trunc, trunc);
-      // The pixel's inverse variance of the depth along the ray. (The plane distance's is
-      // 1 / scale^2 times larger, but weighting by it let grazing views of noisy far stereo
-      // outweigh the rest: on the synthetic street, 0.145 m mesh accuracy against 0.043 m at
-      // the same min_weight, and a worse accuracy at every completeness.)
-      if (!(pixel.weight > 0.f))
-        continue;
-      float w = in_band ? pixel.weight : pixel.free; // free space: carving_weight of the evidence
-      if (in_band && dropoff && sdf < -vs && behind * scale > vs)
-        w *= (behind * scale + sdf) / (behind * scale - vs); // behind the surface the observation is a guess
-      if (!(w > 0.f))
-        continue; // at the band's far end the drop-off leaves nothing
-      // Colour only near the surface: the mesh's vertices take it from the voxels on either side.
-      const bool coloured = has_color && in_band && std::abs(sdf) < colour_band;
-      const std::uint8_t* bgr = coloured ? frame.color.ptr<std::uint8_t>(vi) + 3 * ui : nullptr;
-      TsdfVoxel& voxel = block.voxels[voxel_index];
-      updateVoxel(voxel, sdf, w, bgr, max_weight, trunc);
-      signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-      negative |= voxel.sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(voxel_index)) : 0;
-      if (regularized && std::abs(voxel.sdf) < smooth_band) {
-        changed_index_[i * TsdfBlock::kVoxels + listed] = voxel_index;
-        data_term_[i * TsdfBlock::kVoxels + listed] = voxel.sdf;
-        ++listed;
-      }
-      ++updated;
-    }
+    const detail::VoxelUpdateResult r =
+        update_block(update_frame, candidates, n_candidates, block.voxels.data(),
+                     regularized ? &changed_index_[i * detail::kListStride] : nullptr,
+                     regularized ? &data_term_[i * detail::kListStride] : nullptr);
+    const int updated = r.updated, listed = r.listed;
     changed_count[i] = static_cast<std::uint16_t>(updated);
     listed_count[i] = static_cast<std::uint16_t>(listed);
     if (updated) {
       block.stamp = stamp;
       // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
-      block.signs |= signs;
-      block.negative_subblocks |= negative;
+      block.signs |= r.signs;
+      block.negative_subblocks |= r.negative;
       changed[i] = 1;
     }
   }
@@ -709,8 +666,8 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       updated_total += changed_count[i];
       if (regularized) {
         // Compact the lists in place: the source is at or after the destination.
-        std::copy_n(&changed_index_[i * TsdfBlock::kVoxels], listed_count[i], &changed_index_[offsets.back()]);
-        std::copy_n(&data_term_[i * TsdfBlock::kVoxels], listed_count[i], &data_term_[offsets.back()]);
+        std::copy_n(&changed_index_[i * detail::kListStride], listed_count[i], &changed_index_[offsets.back()]);
+        std::copy_n(&data_term_[i * detail::kListStride], listed_count[i], &data_term_[offsets.back()]);
         offsets.push_back(offsets.back() + listed_count[i]);
       }
     } else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())

@@ -223,7 +223,8 @@ public:
   double allocationDepth() const;
 
   /// Voxels that integrate() tests at once on their nearest pixels: 16 (AVX-512), 8 (AVX2) or 4,
-  /// the widest that the CPU runs, at most setMaxVoxelTestLanes'. Every width gives the same volume.
+  /// the widest that the CPU runs, at most setMaxVoxelTestLanes'; the update of those that pass
+  /// runs as wide (1 with the portable test). Every width gives the same volume.
   static int voxelTestLanes();
   /// Caps voxelTestLanes process-wide (4: the portable kernel), so that tests and benchmarks
   /// can compare the kernels; 16 (the default) lifts the cap.
