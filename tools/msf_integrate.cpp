@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
       .value("-input_dir", "DIR", input_dir, "also every .pcd of DIR, in name order")
       .value("-frames", "a:b", frames, "the poses of these lines (0-based) only, when the file has more")
       .value("-scans", "DIR", scans_dir,
-             "every .bin (KITTI velodyne) or .pcd scan of DIR in name order, one per cloud, in the LiDAR's frame: each "
+             "every .bin (KITTI velodyne) or .pcd scan of DIR in name order, one per cloud (or the whole sequence's, "
+             "picked by -frames as the poses are), in the LiDAR's frame: each "
              "clears what lies in front of its returns outside the camera's view, within "
              "tsdf_integrator.scan_carving_m of the LiDAR, as msf_reconstruct does (needs -calib with the LiDAR's "
              "extrinsics, and space carving)")
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
     }
 
     msf::PoseList poses = msf::loadOdometryPoses(poses_path);
+    std::size_t first_frame = 0;
     if (cli.given("-frames")) {
       const msf::FrameRange range = msf::FrameRange::parse(frames);
       const int last = range.last < 0 ? static_cast<int>(poses.size()) - 1 : range.last;
@@ -135,6 +137,7 @@ int main(int argc, char** argv) {
         throw msf::InvalidInputError("frames '" + frames + "' is beyond the " + std::to_string(poses.size()) +
                                      " poses of '" + poses_path + "'");
       poses = msf::PoseList(poses.begin() + range.first, poses.begin() + last + 1);
+      first_frame = static_cast<std::size_t>(range.first);
     }
     if (poses.size() != clouds.size())
       throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " + std::to_string(poses.size()) +
@@ -155,9 +158,14 @@ int main(int argc, char** argv) {
         throw msf::InvalidInputError("-scans carves free space: it needs space carving and "
                                      "tsdf_integrator.scan_carving_m > 0");
       scans = filesIn(scans_dir, {".bin", ".pcd"}, "scan folder");
+      // A whole sequence's folder (KITTI's velodyne/): -frames picks the scans as it picks the poses.
+      if (cli.given("-frames") && scans.size() >= first_frame + clouds.size() && scans.size() > clouds.size())
+        scans = std::vector<std::string>(scans.begin() + static_cast<std::ptrdiff_t>(first_frame),
+                                         scans.begin() + static_cast<std::ptrdiff_t>(first_frame + clouds.size()));
       if (scans.size() != clouds.size())
         throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " +
-                                     std::to_string(scans.size()) + " scans in '" + scans_dir + "' (one per cloud)");
+                                     std::to_string(scans.size()) + " scans in '" + scans_dir +
+                                     "' (one per cloud, or the whole sequence's with -frames a:b)");
     }
     const float scan_weight = 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m);
 

@@ -247,6 +247,12 @@ TEST(Tools, IntegrateWithScansClearsWhatMovedAwayOutOfTheCamerasView) {
   EXPECT_GT(plain, 50u); // the 1.07 m square at 0.1 m voxels
   EXPECT_EQ(carved, 0u);
 
+  // A whole sequence's scan folder: -frames picks scan 1 for the pose of line 1.
+  r = test::runTool("msf_integrate", dir.file("depth_1.pcd") + " -poses " + dir.file("poses.txt") + " -frames 1:1 -calib " +
+                                         dir.file("camera.yaml") + " -scans " + dir.file("scans") + " -o " +
+                                         dir.file("one.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
   // Bad input: a clear error, no volume.
   const std::string out = dir.file("bad.pcd");
   expectToolError(test::runTool("msf_integrate", clouds + "-poses " + dir.file("poses.txt") + " -scans " +
