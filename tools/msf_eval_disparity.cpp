@@ -2,6 +2,7 @@
 // background, foreground and all pixels, the paper's eq. 8 mean absolute error, density.
 // Given two folders, every frame of the estimate folder against its ground truth, summed
 // over the pixels of all frames (a synthetic sequence's gt/disp_0, split by gt/obj_map_0).
+#include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/disparity_metrics.h>
@@ -71,12 +72,8 @@ msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::s
                                          std::size_t& frames) {
   namespace fs = std::filesystem;
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(est_dir))
-    if (e.is_regular_file() && e.path().extension() == ".png")
-      names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  if (names.empty())
-    throw msf::InvalidInputError("estimate folder '" + est_dir + "' has no *.png");
+  for (const std::string& path : msf::filesIn(est_dir, {".png"}, "estimate folder"))
+    names.push_back(fs::path(path).filename().string());
   msf::DisparityEvaluation sum;
   for (const auto& name : names) {
     const std::string gt_path = (fs::path(gt_dir) / name).string();

@@ -29,21 +29,6 @@ using namespace pcl::console;
 
 namespace {
 
-/// Every file of `dir` whose extension is one of `extensions`, in name order.
-std::vector<std::string> filesIn(const std::string& dir, const std::vector<std::string>& extensions,
-                                 const std::string& what) {
-  msf::requireDirectory(dir, what);
-  std::vector<std::string> found;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file() &&
-        std::find(extensions.begin(), extensions.end(), msf::fileExtension(e.path().string())) != extensions.end())
-      found.push_back(e.path().string());
-  std::sort(found.begin(), found.end());
-  if (found.empty())
-    throw msf::IOError(what + " '" + dir + "' has no " + extensions.front() + " file");
-  return found;
-}
-
 /// A LiDAR scan in its own frame: a KITTI .bin or a .pcd (msf_kitti2pcd's).
 pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
   pcl::PointCloud<pcl::PointXYZI> scan;
@@ -108,7 +93,7 @@ int main(int argc, char** argv) {
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     std::vector<std::string> clouds = positional;
     if (!input_dir.empty()) {
-      const std::vector<std::string> found = filesIn(input_dir, {".pcd"}, "input folder");
+      const std::vector<std::string> found = msf::filesIn(input_dir, {".pcd"}, "input folder");
       clouds.insert(clouds.end(), found.begin(), found.end());
     }
     if (clouds.empty() || poses_path.empty() || output.empty()) {
@@ -157,7 +142,7 @@ int main(int argc, char** argv) {
       if (!config.space_carving || !(config.scan_carving_m > 0.0))
         throw msf::InvalidInputError("-scans carves free space: it needs space carving and "
                                      "tsdf_integrator.scan_carving_m > 0");
-      scans = filesIn(scans_dir, {".bin", ".pcd"}, "scan folder");
+      scans = msf::filesIn(scans_dir, {".bin", ".pcd"}, "scan folder");
       // A whole sequence's folder (KITTI's velodyne/): -frames picks the scans as it picks the poses.
       if (cli.given("-frames") && scans.size() >= first_frame + clouds.size() && scans.size() > clouds.size())
         scans = std::vector<std::string>(scans.begin() + static_cast<std::ptrdiff_t>(first_frame),

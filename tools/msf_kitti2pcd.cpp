@@ -63,15 +63,10 @@ int main(int argc, char** argv) {
     if (!input_dir.empty() || !output_dir.empty()) {
       if (input_dir.empty() || output_dir.empty())
         throw msf::InvalidInputError("batch mode needs both -input_dir and -output_dir");
-      msf::requireDirectory(input_dir, "input folder");
-      msf::requireDirectory(output_dir, "output folder");
       std::vector<fs::path> scans;
-      for (const auto& e : fs::directory_iterator(input_dir))
-        if (e.is_regular_file() && msf::fileExtension(e.path().string()) == ".bin")
-          scans.push_back(e.path());
-      if (scans.empty())
-        throw msf::IOError("input folder '" + input_dir + "' has no .bin scan");
-      std::sort(scans.begin(), scans.end());
+      for (const std::string& scan : msf::filesIn(input_dir, {".bin"}, "input folder"))
+        scans.emplace_back(scan);
+      msf::requireDirectory(output_dir, "output folder");
       // The batch is a unit: a truncated scan is found before anything is written, and a
       // failure later removes the clouds this run wrote.
       for (const auto& scan : scans)

@@ -6,6 +6,7 @@
 
 #include "test_support.h"
 
+#include <filesystem>
 #include <fstream>
 
 namespace {
@@ -65,6 +66,29 @@ TEST(AtomicFile, OutputFolderIsCreatedOnlyUnderAnExistingParent) {
   }
   std::ofstream(dir.file("file")) << "x";
   EXPECT_THROW(msf::ensureOutputDirectory(dir.file("file")), msf::IOError);
+}
+
+TEST(AtomicFile, FilesInListsAFoldersFilesOfTheGivenExtensionsInNameOrder) {
+  msf::test::TempDir dir;
+  for (const char* name : {"2.bin", "1.PCD", "0.txt", "10.bin"})
+    std::ofstream(dir.file(name)) << "x";
+  std::filesystem::create_directories(dir.file("3.bin")); // a folder, not a file
+  const std::vector<std::string> found = msf::filesIn(dir.file(""), {".bin", ".pcd"}, "scan folder");
+  EXPECT_EQ(found, (std::vector<std::string>{dir.file("1.PCD"), dir.file("10.bin"), dir.file("2.bin")}));
+  for (const std::string& bad : {dir.file("nowhere"), dir.file("3.bin")}) {
+    try {
+      msf::filesIn(bad, {".png"}, "estimate folder");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const msf::IOError& e) {
+      EXPECT_NE(std::string(e.what()).find("estimate folder '" + bad + "'"), std::string::npos) << e.what();
+    }
+  }
+  try {
+    msf::filesIn(dir.file(""), {".png", ".jpg"}, "image folder");
+    ADD_FAILURE() << "a folder without .png or .jpg was accepted";
+  } catch (const msf::IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no .png or .jpg file"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Config, ReadsKeysOfASectionAndKeepsDefaults) {

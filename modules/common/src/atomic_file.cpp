@@ -31,6 +31,24 @@ void requireDirectory(const std::string& path, const std::string& what) {
     throw IOError(what + " '" + path + "' does not exist or is not a directory");
 }
 
+std::vector<std::string> filesIn(const std::string& dir, const std::vector<std::string>& extensions,
+                                 const std::string& what) {
+  requireDirectory(dir, what);
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() &&
+        std::find(extensions.begin(), extensions.end(), fileExtension(e.path().string())) != extensions.end())
+      found.push_back(e.path().string());
+  std::sort(found.begin(), found.end());
+  if (found.empty()) {
+    std::string list;
+    for (const auto& ext : extensions)
+      list += (list.empty() ? "" : " or ") + ext;
+    throw IOError(what + " '" + dir + "' has no " + list + " file");
+  }
+  return found;
+}
+
 void ensureOutputDirectory(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec))

@@ -1,6 +1,7 @@
 #pragma once
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -25,5 +26,11 @@ void ensureOutputDirectory(const std::string& path);
 
 /// Lower-case extension of `path` with its dot (".pcd"), or "" when there is none.
 std::string fileExtension(const std::string& path);
+
+/// The regular files of folder `dir` whose fileExtension is one of `extensions` (".pcd"), in
+/// name order. Throws IOError naming `what` ("input folder") when `dir` is not a folder or
+/// holds no such file.
+std::vector<std::string> filesIn(const std::string& dir, const std::vector<std::string>& extensions,
+                                 const std::string& what = "folder");
 
 } // namespace msf
