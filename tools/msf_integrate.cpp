@@ -84,7 +84,11 @@ int main(int argc, char** argv) {
       .value("-weighting", "W", [&](const std::string& name) { config.weighting = msf::parseWeighting(name); },
              std::string("constant | inverse_square | per_pixel (default ") + msf::toString(config.weighting) + ")")
       .value("-max_weight", "W", config.max_weight, "weight (m^-2) at which a voxel saturates (default {default})")
-      .value("-max_depth", "M", config.max_depth_m, "ignore depth beyond M metres (default {default})")
+      .value("-max_depth", "M", config.max_depth_m,
+             "ignore depth beyond M metres (default {default}), but for -precise_max_depth's")
+      .value("-precise_max_depth", "M", config.precise_max_depth_m,
+             "depth whose weight field says it is known to within the truncation is integrated up to M metres "
+             "(default {default}; 0: -max_depth for all)")
       .flag("-carving", carving,
             std::string("space carving on: voxels seen in front of the surface become free (default ") +
                 (config.space_carving ? "on" : "off") + "; tsdf_integrator.space_carving)")

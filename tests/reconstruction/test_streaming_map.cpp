@@ -324,6 +324,7 @@ TEST(TsdfIntegratorReach, IsTheFarthestCornerOfTheViewAtMaxDepthAndTwiceTheBandB
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator::Config config;
   config.max_depth_m = 40.0;
+  config.precise_max_depth_m = 0.0; // below: the precise depth's reach
   config.truncation_sigmas = 0.0;
   config.signed_distance = TsdfIntegrator::SignedDistance::Projective;
   PinholeCamera camera = test::centredCamera(201, 101, 100.0); // corners at (1.005, 0.505) per metre of depth
@@ -343,6 +344,14 @@ TEST(TsdfIntegratorReach, IsTheFarthestCornerOfTheViewAtMaxDepthAndTwiceTheBandB
   config.truncation_sigmas = 0.0;
   config.signed_distance = TsdfIntegrator::SignedDistance::Plane;
   config.plane.min_scale = 0.05f;
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(test::centredCamera(201, 101, 100.0)),
+              (40.0 + 2 * 0.15f / 0.05f) * corner, 1e-5);
+  // Depth known to within the truncation goes on to precise_max_depth_m with per-pixel weights
+  // (the default weighting) only.
+  config.precise_max_depth_m = 60.0;
+  EXPECT_NEAR(TsdfIntegrator(volume, config).reach(test::centredCamera(201, 101, 100.0)),
+              (60.0 + 2 * 0.15f / 0.05f) * corner, 1e-5);
+  config.weighting = TsdfIntegrator::Weighting::Constant;
   EXPECT_NEAR(TsdfIntegrator(volume, config).reach(test::centredCamera(201, 101, 100.0)),
               (40.0 + 2 * 0.15f / 0.05f) * corner, 1e-5);
 }

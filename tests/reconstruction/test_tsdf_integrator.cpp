@@ -696,6 +696,64 @@ TEST(TsdfIntegrator, FarStereoNeitherOverwritesNearLidarGeometryNorLeavesSpecks)
   EXPECT_GT(mesh.vertices.size(), 1000u);
 }
 
+TEST(TsdfIntegrator, PreciseDepthIsIntegratedBeyondMaxDepthAndTheRestIsNot) {
+  // Two walls beyond max_depth_m (40 m), left and right halves of the image at 50 m: one known
+  // to 3 cm (a LiDAR return: 1111 m^-2), one to 0.5 m (far stereo: 4 m^-2, three frames
+  // above marching cubes' minimum). precise_max_depth_m (60 m) keeps the first and drops the
+  // second; 0 drops both; a pixel known to within the truncation (0.3 m: >= 11.1 m^-2) counts.
+  const PinholeCamera camera = test::smallCamera();
+  auto wallVertices = [&](TsdfIntegrator::Config config, float right_weight, bool weighted = true) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator integrator(volume, config);
+    DepthFrame frame;
+    frame.camera = camera;
+    frame.depth = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(50.f));
+    frame.weight = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(1111.f));
+    frame.weight.colRange(camera.width / 2, camera.width).setTo(right_weight);
+    if (!weighted)
+      frame.weight.release();
+    for (int i = 0; i < 3; ++i)
+      integrator.integrate(frame, Eigen::Isometry3d::Identity());
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    std::array<std::size_t, 2> sides{0, 0}; // left, right of the optical axis (a voxel's margin)
+    for (const auto& v : mesh.vertices) {
+      EXPECT_NEAR(v.z(), 50.f, 0.05f);
+      if (std::abs(v.x()) > 0.5f)
+        sides[v.x() > 0.f] += 1;
+    }
+    return sides;
+  };
+  TsdfIntegrator::Config config;
+  ASSERT_EQ(config.max_depth_m, 40.0);
+  ASSERT_EQ(config.precise_max_depth_m, 60.0);
+  const auto shipped = wallVertices(config, 4.f);
+  EXPECT_GT(shipped[0], 2000u); // the left half of the wall seen at 50 m, 26 m x 40 m
+  EXPECT_EQ(shipped[1], 0u);
+  const auto within_truncation = wallVertices(config, 11.2f);
+  EXPECT_GT(within_truncation[1], 2000u);
+  // Depth without weights of its own (depth_sigma_m, 5 cm) is cut at max_depth_m.
+  const auto unweighted = wallVertices(config, 1111.f, false);
+  EXPECT_EQ(unweighted[0] + unweighted[1], 0u);
+  config.precise_max_depth_m = 45.0; // nearer than the wall
+  EXPECT_EQ(wallVertices(config, 1111.f)[0], 0u);
+  config.precise_max_depth_m = 0.0;
+  EXPECT_EQ(wallVertices(config, 1111.f)[0], 0u);
+  // Its reach covers the precise depth.
+  TsdfVolume volume(0.1, 0.3);
+  config.precise_max_depth_m = 60.0;
+  EXPECT_GT(TsdfIntegrator(volume, config).allocationDepth(), 60.0);
+  for (const double bad : {-1.0, 2000.0, std::nan("")}) {
+    config.precise_max_depth_m = bad;
+    try {
+      config.validate();
+      ADD_FAILURE() << "accepted precise_max_depth_m " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("tsdf_integrator.precise_max_depth_m"), std::string::npos) << e.what();
+    }
+  }
+}
+
 namespace {
 
 /// The volume after one noisy frame of the sphere scene with lambda 5, solved as `config` says.

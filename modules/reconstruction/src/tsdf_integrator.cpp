@@ -185,6 +185,7 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "argmin_max_sweeps", argmin_max_sweeps);
   readKey(node, "min_depth_m", min_depth_m);
   readKey(node, "max_depth_m", max_depth_m);
+  readKey(node, "precise_max_depth_m", precise_max_depth_m);
   readKey(node, "interpolate_depth", interpolate_depth);
   readKey(node, "allocation_stride", allocation_stride);
   validate();
@@ -225,9 +226,16 @@ void TsdfIntegrator::Config::validate() const {
   if (!(max_depth_m <= kMaxDepthM))
     throw ConfigError("tsdf_integrator.max_depth_m must be at most " + std::to_string(kMaxDepthM) + " m, got " +
                       std::to_string(max_depth_m));
+  if (!(precise_max_depth_m >= 0.0) || !(precise_max_depth_m <= kMaxDepthM))
+    throw ConfigError("tsdf_integrator.precise_max_depth_m must be in [0, " + std::to_string(kMaxDepthM) +
+                      "] m (0: max_depth_m for all depth), got " + std::to_string(precise_max_depth_m));
   if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
     throw ConfigError("tsdf_integrator: need 0 <= min_depth_m < max_depth_m, got " + std::to_string(min_depth_m) +
                       " and " + std::to_string(max_depth_m));
+}
+
+double TsdfIntegrator::Config::farthestDepth() const {
+  return weighting == Weighting::PerPixel ? std::max(max_depth_m, precise_max_depth_m) : max_depth_m;
 }
 
 void TsdfIntegrator::Config::print(std::ostream& out) const {
@@ -253,6 +261,7 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  argmin_max_sweeps: " << configValue(argmin_max_sweeps) << "\n"
       << "  min_depth_m: " << configValue(min_depth_m) << "\n"
       << "  max_depth_m: " << configValue(max_depth_m) << "\n"
+      << "  precise_max_depth_m: " << configValue(precise_max_depth_m) << "\n"
       << "  interpolate_depth: " << configValue(interpolate_depth) << "\n"
       << "  allocation_stride: " << configValue(allocation_stride) << "\n";
 }
@@ -276,7 +285,8 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
   // Block keys hold 20 bits an axis (packKey), and voxel coordinates are ints: a camera
   // whose band reaches beyond that would alias blocks, or overflow a float -> int cast.
   const double reach_m = 0.99 * double(1 << 19) * TsdfBlock::kSide * volume_.voxelSize();
-  const double far_m = T_world_cam.translation().cwiseAbs().maxCoeff() + config_.max_depth_m + volume_.truncation();
+  const double far_m =
+      T_world_cam.translation().cwiseAbs().maxCoeff() + config_.farthestDepth() + volume_.truncation();
   if (!(far_m < reach_m))
     throw InvalidInputError("the frame's pose (translation " + std::to_string(T_world_cam.translation().norm()) +
                             " m) with max_depth_m reaches " + std::to_string(far_m) +
@@ -308,22 +318,23 @@ double TsdfIntegrator::widestBandBehind() const {
 
 double TsdfIntegrator::allocationDepth() const {
   // A ray's band is allocated from the depth less its front band to the depth plus its band
-  // behind (at most the widest), along the optical axis, for depths up to max_depth_m.
-  return config_.max_depth_m + widestBandBehind();
+  // behind (at most the widest), along the optical axis, for depths up to farthestDepth().
+  return config_.farthestDepth() + widestBandBehind();
 }
 
 double TsdfIntegrator::reach(const PinholeCamera& camera) const {
   const double trunc = volume_.truncation();
   // A voxel is updated up to its pixel's band behind the depth, and the depth may be the
   // bilinear one of 4 pixels that agree within that band: up to twice the band behind the
-  // nearest pixel's depth, itself at most max_depth_m.
+  // nearest pixel's depth, itself at most farthestDepth().
   const double behind = 2.0 * widestBandBehind();
+  const double far = config_.farthestDepth();
   // The longest ray per metre of depth: through a corner of the image (pixel edges at -0.5
   // and size - 0.5, as the projection's inside test).
   const double du = std::max(std::abs(-0.5 - camera.cx), std::abs(camera.width - 0.5 - camera.cx)) / camera.fx;
   const double dv = std::max(std::abs(-0.5 - camera.cy), std::abs(camera.height - 0.5 - camera.cy)) / camera.fy;
   const double corner = std::sqrt(1.0 + du * du + dv * dv);
-  return std::max((config_.max_depth_m + behind) * corner, config_.max_depth_m + trunc);
+  return std::max((far + behind) * corner, config_.max_depth_m + trunc);
 }
 
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
@@ -336,22 +347,29 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // Each pixel's weight, the inverse variance of its depth (m^-2); pixels weighing less than
   // min_pixel_weight are no depth, for every step below.
   pixelWeights(frame, weight_);
-  const bool masked = config_.min_pixel_weight > 0.f;
+  const float trunc = static_cast<float>(volume_.truncation());
+  // Beyond max_depth_m only depth known to within the truncation is integrated, by its own
+  // weight: a depth without one is max_depth_m's (depth_sigma_m is no measure of it).
+  const bool own_weights = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
+  const bool precise_only = own_weights && config_.precise_max_depth_m > config_.max_depth_m;
+  const bool masked = config_.min_pixel_weight > 0.f || precise_only;
   // The depth the voxels are tested against is continuous, rows of `width` floats like the pixel
   // records below, so that one index finds a pixel in both (a frame's depth may be a view into a
   // wider image: then a copy).
   const bool copied = masked || !frame.depth.isContinuous();
   if (copied)
     frame.depth.copyTo(masked_depth_);
-  if (masked)
+  if (config_.min_pixel_weight > 0.f)
     masked_depth_.setTo(0.f, weight_ < config_.min_pixel_weight);
+  if (precise_only)
+    masked_depth_.setTo(0.f, (masked_depth_ > config_.max_depth_m) & (weight_ < 1.f / (trunc * trunc)));
   const cv::Mat& depth_image = copied ? masked_depth_ : frame.depth;
 
   const PinholeCamera& cam = frame.camera;
   const int width = cam.width, height = cam.height;
   const float vs = static_cast<float>(volume_.voxelSize());
-  const float trunc = static_cast<float>(volume_.truncation());
-  const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.max_depth_m);
+  const float min_d = static_cast<float>(config_.min_depth_m);
+  const float max_d = static_cast<float>(precise_only ? config_.precise_max_depth_m : config_.max_depth_m);
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
 
@@ -382,8 +400,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // lay a little deeper: protocol 4 coverage 0.957 against 0.967 on raw 0009).
   const float plane_band = planeBand(trunc, vs);
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
-  const bool own_free = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
-  const cv::Mat& free_weight = own_free ? frame.free_space_weight : cv::Mat();
+  const cv::Mat& free_weight = own_weights ? frame.free_space_weight : cv::Mat();
   const float carving_weight = static_cast<float>(config_.carving_weight);
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {

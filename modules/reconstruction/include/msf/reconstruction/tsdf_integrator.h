@@ -127,6 +127,16 @@ public:
     static constexpr double kMaxDepthM = 1000.0; ///< max_depth_m's bound (the volume's reach)
     double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
     double max_depth_m = 40.0;
+    /// Depth known to within the truncation by its own weight (per-pixel weighting, weight >=
+    /// 1 / truncation^2: a LiDAR return or LiDAR-backed fused depth; stereo beyond ~17 m on KITTI
+    /// is not) is integrated up to this depth, the rest up to max_depth_m; 0 (or below
+    /// max_depth_m): max_depth_m for all, as for depth without weights. What the
+    /// camera sees 35-40 m ahead at its last frame was seen from beyond 40 m by the frames before,
+    /// and a map cut at 40 m held it from one or two frames only (docs/reconstruction.md).
+    double precise_max_depth_m = 60.0;
+    /// The largest depth a pixel is integrated at: max(max_depth_m, precise_max_depth_m) with
+    /// per-pixel weights, else max_depth_m.
+    double farthestDepth() const;
     bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
     /// Blocks and sub-blocks are found along the rays of every n-th pixel in each direction
     /// (rows staggered): rays 3 px apart are 0.17 m apart at 40 m on KITTI, under the 0.4 m of
@@ -141,7 +151,7 @@ public:
     /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
     /// plane_min_scale, lambda, lambda_data (uniform | inverse_variance), sweeps, solve (sweeps |
     /// argmin), argmin_tolerance_m,
-    /// argmin_max_sweeps, min_depth_m, max_depth_m, interpolate_depth,
+    /// argmin_max_sweeps, min_depth_m, max_depth_m, precise_max_depth_m, interpolate_depth,
     /// allocation_stride. Throws ConfigError naming a bad key.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the first value out of range.
@@ -207,7 +217,7 @@ public:
                      const Eigen::Vector3d& origin_world);
 
   /// How far from the sensor (metres) integration can change blocks that exist: a frame of
-  /// `camera` updates voxels up to a depth of max_depth_m plus twice the widest band behind a
+  /// `camera` updates voxels up to a depth of farthestDepth() plus twice the widest band behind a
   /// surface (a bilinear depth within the band of the nearest pixel's), along rays that are
   /// longest through the image's corners (x 1.36 the depth on KITTI's 1242 x 375 image); a
   /// scan's rays reach max_depth_m + truncation. Blocks that the bands
@@ -216,7 +226,7 @@ public:
   /// with truncation_sigmas > 0 and min_pixel_weight 0 (the band grows as a weight falls).
   double reach(const PinholeCamera& camera) const;
   /// The largest depth along the optical axis (metres) at which integrating a depth frame can
-  /// allocate a block: max_depth_m plus the widest band behind a surface. Blocks are allocated
+  /// allocate a block: farthestDepth() plus the widest band behind a surface. Blocks are allocated
   /// only there, in the camera's view from min_depth_m (carveWithScan and space carving only
   /// update blocks that exist); a scan (integrateScan, integrateRays) allocates along its rays
   /// instead. Infinite as reach() is.
