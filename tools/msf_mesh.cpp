@@ -38,8 +38,11 @@ int remeshStore(const std::string& store, const std::string& output, const Setti
   const std::string& region = settings.region;
   if (msf::fileExtension(output) != ".ply")
     throw msf::InvalidInputError("output mesh '" + output + "': a store is meshed into a .ply");
-  if (config.min_component_triangles > 0)
+  if (cli.given("-min_component_triangles") && config.min_component_triangles > 0)
     throw msf::InvalidInputError("-min_component_triangles: a store is meshed tile by tile, pieces cross tiles");
+  if (config.min_component_triangles > 0)
+    print_info("A store keeps its small pieces (marching_cubes.min_component_triangles is not applied): it is "
+               "meshed tile by tile, and a piece may cross tiles\n");
   if (cli.given("-voxel") || cli.given("-trunc"))
     throw msf::InvalidInputError("-voxel and -trunc are for a volume .pcd: a store's index gives them");
   Eigen::Vector3d lo = Eigen::Vector3d::Ones(), hi = Eigen::Vector3d::Zero();
@@ -156,6 +159,8 @@ int main(int argc, char** argv) {
              "eq. 7 at meshing, each voxel's data term weighed by its weight (m^-2; default {default}, 0 = off)")
       .value("-min_component_triangles", "N", config.min_component_triangles,
              "remove connected pieces of fewer than N triangles (default {default}; 0 keeps all)")
+      .value("-component_keep_weight", "W", config.component_keep_weight,
+             "... but keep a piece with a vertex of weight >= W (m^-2; default {default}; 0: none is kept for it)")
       .value("-voxel", "V", settings.voxel,
              "voxel size (m) of a volume whose header comment a PCL rewrite dropped (otherwise read from the file, "
              "and checked if given)")

@@ -509,6 +509,9 @@ int main(int argc, char** argv) {
     if (panels < 0 || panels > kMaxPanels)
       throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " + std::to_string(panels));
     const bool streaming = config.streaming.enabled();
+    if (streaming && config.mesher.min_component_triangles > 0)
+      std::printf("Note: a streamed map keeps its small pieces (marching_cubes.min_component_triangles is not "
+                  "applied): its tiles are meshed apart, and a piece may cross them\n");
     if (streaming && (holdout || compare_sources || compare_paper))
       throw msf::InvalidInputError(std::string(holdout ? "-holdout" : compare_sources ? "-compare_sources" : "-compare_paper") +
                                    " needs the whole map in memory: not with a streamed map (-stream, " +

@@ -133,8 +133,10 @@ TEST(Tools, IntegrateThenMeshTheSphere) {
   r = test::runTool("msf_mesh", volume + " " + f.dir.file("out/empty.ply") + " -min_weight 1e6");
   expectToolError(r, "msf_mesh", "no surface");
   EXPECT_FALSE(test::fileExists(f.dir.file("out/empty.ply")));
-  // So does a piece size above the whole sphere's, with its own message.
-  r = test::runTool("msf_mesh", volume + " " + f.dir.file("out/empty.ply") + " -min_component_triangles 100000000");
+  // So does a piece size above the whole sphere's, with its own message (the sphere, known to 5 cm,
+  // would be kept for its weight but for -component_keep_weight 0).
+  r = test::runTool("msf_mesh", volume + " " + f.dir.file("out/empty.ply") +
+                                    " -min_component_triangles 100000000 -component_keep_weight 0");
   expectToolError(r, "msf_mesh", "every piece of its surface has fewer than 100000000 triangles");
   EXPECT_FALSE(test::fileExists(f.dir.file("out/empty.ply")));
 }

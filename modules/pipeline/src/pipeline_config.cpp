@@ -128,11 +128,6 @@ void PipelineConfig::validate() const {
   mesher.validate();
   scheduling.validate();
   streaming.validate();
-  // Tiles are meshed apart: a piece that crosses a tile's border cannot be counted whole.
-  if (streaming.enabled() && mesher.min_component_triangles > 0)
-    throw ConfigError("marching_cubes.min_component_triangles is " + std::to_string(mesher.min_component_triangles) +
-                      ": small pieces cannot be removed from a streamed map (streaming.active_radius_m), whose "
-                      "tiles are meshed apart; set it to 0");
   odometry.validate();
 }
 

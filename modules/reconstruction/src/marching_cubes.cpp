@@ -182,6 +182,7 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
     for (int k = 0; k < 3; ++k)
       c[k] = static_cast<std::uint8_t>(ca[k] + t * (static_cast<float>(cb[k]) - ca[k]) + 0.5f);
     out.colors.push_back(c);
+    out.weights.push_back(std::min(a.weight, b.weight));
     // Interior: every cube around this edge (or voxel) belongs to this block, so no other
     // block makes this vertex.
     const int q[3] = {px, py, pz};
@@ -258,11 +259,13 @@ void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, const MarchingC
   MarchingCubes::BlockMesh& m = s.mesh;
   m.vertices.clear();
   m.colors.clear();
+  m.weights.clear();
   m.keys.clear();
   m.triangles.clear();
   meshBlockInto(volume, block, config, m, s);
   out.vertices.assign(m.vertices.begin(), m.vertices.end());
   out.colors.assign(m.colors.begin(), m.colors.end());
+  out.weights.assign(m.weights.begin(), m.weights.end());
   out.keys.assign(m.keys.begin(), m.keys.end());
   out.triangles.assign(m.triangles.begin(), m.triangles.end());
 }
@@ -352,6 +355,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
   const std::size_t n_vertices = n_shared + interior_offset[parts];
   mesh.vertices.resize(n_vertices);
   mesh.colors.resize(n_vertices);
+  mesh.weights.resize(n_vertices);
   mesh.triangles.resize(triangle_offset[parts]);
   cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
   for (int i = range.start; i < range.end; ++i) {
@@ -363,6 +367,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
         map[v] = next;
         mesh.vertices[next] = part.vertices[v];
         mesh.colors[next] = part.colors[v];
+        mesh.weights[next] = part.weights[v];
         ++next;
       }
     std::array<std::uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
@@ -375,6 +380,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
       const MarchingCubes::BlockMesh& part = *order[shared_source[k].first].second;
       mesh.vertices[k] = part.vertices[shared_source[k].second];
       mesh.colors[k] = part.colors[shared_source[k].second];
+      mesh.weights[k] = part.weights[shared_source[k].second];
     }
   }, 8);
 }
@@ -385,6 +391,7 @@ void MarchingCubes::Config::read(const cv::FileNode& node) {
   readKey(node, "min_weight", min_weight);
   readKey(node, "smoothing_lambda", smoothing_lambda);
   readKey(node, "min_component_triangles", min_component_triangles);
+  readKey(node, "component_keep_weight", component_keep_weight);
   validate();
 }
 
@@ -394,6 +401,9 @@ void MarchingCubes::Config::validate() const {
   if (!(smoothing_lambda >= 0.f) || !std::isfinite(smoothing_lambda))
     throw ConfigError("marching_cubes.smoothing_lambda must be >= 0 (m^-2; 0: off), got " +
                       std::to_string(smoothing_lambda));
+  if (!(component_keep_weight >= 0.f) || !std::isfinite(component_keep_weight))
+    throw ConfigError("marching_cubes.component_keep_weight must be >= 0 (m^-2; 0: no piece is kept for its "
+                      "weight), got " + std::to_string(component_keep_weight));
   if (min_component_triangles < 0)
     throw ConfigError("marching_cubes.min_component_triangles must be >= 0, got " +
                       std::to_string(min_component_triangles));
@@ -402,7 +412,8 @@ void MarchingCubes::Config::validate() const {
 void MarchingCubes::Config::print(std::ostream& out) const {
   out << "marching_cubes:\n  min_weight: " << configValue(min_weight)
       << "\n  smoothing_lambda: " << configValue(smoothing_lambda)
-      << "\n  min_component_triangles: " << configValue(min_component_triangles) << "\n";
+      << "\n  min_component_triangles: " << configValue(min_component_triangles)
+      << "\n  component_keep_weight: " << configValue(component_keep_weight) << "\n";
 }
 
 MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
@@ -495,7 +506,8 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     // On the assembled mesh only: a piece may span many blocks, and the cache stays whole.
     const auto t2 = Clock::now();
     const ComponentFilterStats removed =
-        removeSmallComponents(mesh, static_cast<std::size_t>(config_.min_component_triangles));
+        removeSmallComponents(mesh, static_cast<std::size_t>(config_.min_component_triangles),
+                              config_.component_keep_weight);
     stats_.components_removed = removed.components_removed;
     stats_.triangles_removed = removed.triangles_removed;
     stats_.filter_ms = msSince(t2);

@@ -1,6 +1,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/mesh_components.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <numeric>
 #include <string>
@@ -34,11 +35,15 @@ private:
 };
 } // namespace
 
-ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles) {
+ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight) {
   const std::size_t n = mesh.vertices.size();
   if (mesh.colors.size() != n)
     throw InvalidInputError("mesh has " + std::to_string(n) + " vertices but " + std::to_string(mesh.colors.size()) +
                             " colours");
+  const bool weighted = !mesh.weights.empty();
+  if (weighted && mesh.weights.size() != n)
+    throw InvalidInputError("mesh has " + std::to_string(n) + " vertices but " + std::to_string(mesh.weights.size()) +
+                            " weights");
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (const std::uint32_t v : mesh.triangles[t])
       if (v >= n)
@@ -50,10 +55,17 @@ ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_t
     sets.join(t[0], t[1]);
     sets.join(t[0], t[2]);
   }
-  // Triangles per piece, counted at the piece's root.
+  // Triangles per piece, counted at the piece's root; a piece with a vertex of keep_weight or
+  // more counts as large.
   std::vector<std::uint32_t> size(n, 0);
   for (const auto& t : mesh.triangles)
     ++size[sets.find(t[0])];
+  if (weighted && keep_weight > 0.f)
+    for (std::size_t v = 0; v < n; ++v)
+      if (mesh.weights[v] >= keep_weight) {
+        std::uint32_t& s = size[sets.find(static_cast<std::uint32_t>(v))];
+        s = s > 0 ? std::max<std::uint32_t>(s, static_cast<std::uint32_t>(min_triangles)) : 0;
+      }
 
   ComponentFilterStats stats;
   for (std::size_t v = 0; v < n; ++v)
@@ -73,11 +85,15 @@ ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_t
       index[v] = kept;
       mesh.vertices[kept] = mesh.vertices[v];
       mesh.colors[kept] = mesh.colors[v];
+      if (weighted)
+        mesh.weights[kept] = mesh.weights[v];
       ++kept;
     }
   stats.vertices_removed = n - kept;
   mesh.vertices.resize(kept);
   mesh.colors.resize(kept);
+  if (weighted)
+    mesh.weights.resize(kept);
 
   std::size_t out = 0;
   for (const auto& t : mesh.triangles)

@@ -19,6 +19,9 @@ namespace msf {
 struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;          ///< metres, world frame
   std::vector<std::array<std::uint8_t, 3>> colors; ///< r, g, b per vertex
+  /// Per vertex, the lesser weight (m^-2) of the two voxels whose zero crossing made it: how
+  /// precisely the surface there is known. Filled by MarchingCubes; empty for other meshes.
+  std::vector<float> weights;
   std::vector<std::array<std::uint32_t, 3>> triangles; ///< counter-clockwise seen from outside (sdf > 0)
 
   /// As a pcl::PolygonMesh whose cloud has fields x y z rgb (what saveMesh writes).
@@ -38,21 +41,30 @@ public:
 
   struct Config {
     /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
-    /// TsdfIntegrator::Weighting): 4 meshes what is known to sigma 0.5 m on its own, a LiDAR-backed
-    /// surface after one frame, a stereo-only one at 20 m after a few; smoothing_lambda pools the
-    /// neighbours' evidence in (without it, 7 was best; docs/reconstruction.md).
-    float min_weight = 4.f;
+    /// TsdfIntegrator::Weighting): 2 meshes what is known to sigma 0.7 m on its own, a LiDAR-backed
+    /// surface after one frame, a stereo-only one at 20 m after one or two; smoothing_lambda pools
+    /// the neighbours' evidence in, and the floating pieces such a bar lets through (matches in
+    /// the sky) are removed below (docs/reconstruction.md: 4 without the piece filter, 7 without
+    /// the smoothing).
+    float min_weight = 2.f;
     /// Eq. 7 at meshing (m^-2; 0: off): each grid point within half a truncation of its surface
     /// is meshed at (W y + lambda sum_j y_j) / (W + lambda n) over its observed 6-neighbours j,
     /// one Jacobi step on the volume's weighted means y with weights W. A LiDAR-backed voxel
     /// (W ~ 1000) keeps its value; a far stereo-only one (W ~ 10) takes much of its neighbours'.
     /// The volume is not changed, so meshing again gives the same mesh.
     float smoothing_lambda = 10.f;
-    /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents); 0 keeps all.
-    int min_component_triangles = 0;
+    /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents) unless
+    /// precise depth holds them (component_keep_weight); 0 keeps all. 2000 triangles are about
+    /// 10 m^2 at 0.1 m voxels: a piece smaller than that which no LiDAR return holds floats, as
+    /// stereo's matches in the sky do, while a canopy hangs on its trunk and an upper façade on
+    /// the lower one the LiDAR saw. Not applied to a streamed map, whose tiles are meshed apart.
+    int min_component_triangles = 2000;
+    /// A piece with a vertex of at least this weight (m^-2; 300: sigma 6 cm, a LiDAR return or
+    /// near stereo) is kept whatever its size. 0: no piece is kept for its weight.
+    float component_keep_weight = 300.f;
 
     /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight, smoothing_lambda,
-    /// min_component_triangles.
+    /// min_component_triangles, component_keep_weight.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
@@ -97,6 +109,7 @@ public:
   struct BlockMesh {
     std::vector<Eigen::Vector3f> vertices;
     std::vector<std::array<std::uint8_t, 3>> colors;
+    std::vector<float> weights;
     std::vector<std::uint64_t> keys; ///< grid edge of a vertex other blocks may also make; kInterior otherwise
     std::vector<std::array<std::uint32_t, 3>> triangles; ///< indices into this block's vertices
   };
