@@ -289,6 +289,13 @@ TEST(Tools, MeshRejectsBadInput) {
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
                                                 " -min_component_triangles 2O"),
                   "msf_mesh", "-min_component_triangles needs a whole number, not '2O'");
+  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
+                                                " -component_keep_weight -1"),
+                  "msf_mesh", "marching_cubes.component_keep_weight must be >= 0");
+  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
+                                                " -component_keep_weight nan"),
+                  "msf_mesh", "-component_keep_weight needs a number, not 'nan'");
+  EXPECT_FALSE(test::fileExists(dir.file("mesh.ply")));
   std::ofstream(dir.file("typo.yaml")) << "%YAML:1.0\nmarching_cubes:\n  min_weigth: 2\n";
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " -config " +
                                                 dir.file("typo.yaml")),
