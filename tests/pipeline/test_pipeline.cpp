@@ -312,6 +312,14 @@ TEST_F(PipelineTest, AStreamedMapKeepsItsSmallPiecesAndSaysSo) {
   pcl::PolygonMesh mesh;
   EXPECT_NO_THROW(msf::loadMesh(out + "/mesh.ply", mesh));
   EXPECT_GT(mesh.polygons.size(), 1000u);
+  // In memory the same frames lose their floating pieces, and the report says how many.
+  const std::string whole = dir.file("whole");
+  const auto w = msf::test::runTool("msf_reconstruct", dataset() + " -o " + whole + " -frames 0:1 -panels 0");
+  ASSERT_EQ(w.exit_code, 0) << w.err;
+  EXPECT_EQ(w.out.find("Note: a streamed map"), std::string::npos) << w.out;
+  EXPECT_TRUE(std::regex_search(readFile(whole + "/report.md"),
+                                std::regex("[1-9][0-9]* pieces of fewer than `marching_cubes.min_component_triangles` "
+                                           "triangles that no vertex of `marching_cubes.component_keep_weight` holds")));
 }
 
 TEST(Reconstruct, BadInputIsAClearError) {

@@ -347,8 +347,8 @@ void RunReport::writeMarkdown(const std::string& path) const {
     << vertices << " vertices, " << triangles << " triangles: [`" << mesh_file << "`](" << mesh_file << "), volume [`"
     << volume_file << "`](" << volume_file << ").";
   if (pieces_removed > 0)
-    s << " " << pieces_removed << " pieces of fewer than `marching_cubes.min_component_triangles` triangles ("
-      << triangles_removed << " triangles) were removed.";
+    s << " " << pieces_removed << " pieces of fewer than `marching_cubes.min_component_triangles` triangles that no "
+      << "vertex of `marching_cubes.component_keep_weight` holds (" << triangles_removed << " triangles) were removed.";
   s << "\n\n";
   if (!preview_file.empty())
     s << "![mesh from above and from the first camera](" << preview_file << ")\n\n";
