@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 using namespace msf;
 
@@ -283,18 +284,15 @@ TEST(Tools, MeshRejectsBadInput) {
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply")), "msf_mesh",
                   "plain.pcd");
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.stl")), "msf_mesh", ".stl");
-  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
-                                                " -min_component_triangles -1"),
-                  "msf_mesh", "marching_cubes.min_component_triangles must be >= 0");
-  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
-                                                " -min_component_triangles 2O"),
-                  "msf_mesh", "-min_component_triangles needs a whole number, not '2O'");
-  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
-                                                " -component_keep_weight -1"),
-                  "msf_mesh", "marching_cubes.component_keep_weight must be >= 0");
-  expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") +
-                                                " -component_keep_weight nan"),
-                  "msf_mesh", "-component_keep_weight needs a number, not 'nan'");
+  // A bad value of a mesher flag: the message names the flag or the key it sets.
+  const std::pair<std::string, std::string> bad_flags[] = {
+      {"-min_component_triangles -1", "marching_cubes.min_component_triangles must be >= 0"},
+      {"-min_component_triangles 2O", "-min_component_triangles needs a whole number, not '2O'"},
+      {"-component_keep_weight -1", "marching_cubes.component_keep_weight must be >= 0"},
+      {"-component_keep_weight nan", "-component_keep_weight needs a number, not 'nan'"}};
+  for (const auto& [flags, message] : bad_flags)
+    expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " " + flags),
+                    "msf_mesh", message);
   EXPECT_FALSE(test::fileExists(dir.file("mesh.ply")));
   std::ofstream(dir.file("typo.yaml")) << "%YAML:1.0\nmarching_cubes:\n  min_weigth: 2\n";
   expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " -config " +
