@@ -289,8 +289,8 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
       T_world_cam.translation().cwiseAbs().maxCoeff() + config_.farthestDepth() + volume_.truncation();
   if (!(far_m < reach_m))
     throw InvalidInputError("the frame's pose (translation " + std::to_string(T_world_cam.translation().norm()) +
-                            " m) with its farthest depth (max_depth_m, precise_max_depth_m) reaches " + std::to_string(far_m) +
-                            " m from the origin, beyond the volume's " + std::to_string(reach_m) + " m at " +
+                            " m) with its farthest depth (max_depth_m, precise_max_depth_m) reaches " +
+                            std::to_string(far_m) + " m from the origin, beyond the volume's " + std::to_string(reach_m) + " m at " +
                             std::to_string(volume_.voxelSize()) + " m voxels");
 }
 
