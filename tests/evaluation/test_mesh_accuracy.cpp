@@ -99,6 +99,86 @@ TEST(MeshAccuracy, CompletenessByTheNearestDistanceASurfaceWasSeenFrom) {
   EXPECT_THROW(msf::evaluateMesh(mesh, truth, seen, 0.05, 1.0, 200000, &depth), msf::InvalidInputError);
 }
 
+/// Two strips over the square [0, 4]^2 as one mesh: x in [0, 2] on the plane z = 0, and x in
+/// [2, 4] at z = 0.1; each n x 2n cells of two triangles.
+pcl::PolygonMesh twoStrips(int n) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::PolygonMesh mesh;
+  using Index = decltype(pcl::Vertices::vertices)::value_type;
+  for (int strip = 0; strip < 2; ++strip) {
+    const auto first = static_cast<Index>(cloud.size());
+    for (int j = 0; j <= 2 * n; ++j)
+      for (int i = 0; i <= n; ++i)
+        cloud.push_back(pcl::PointXYZ(2.f * strip + 2.f * i / n, 4.f * j / (2 * n), 0.1f * strip));
+    auto id = [&](int i, int j) { return static_cast<Index>(first + j * (n + 1) + i); };
+    for (int j = 0; j < 2 * n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& corners : {std::array<Index, 3>{id(i, j), id(i + 1, j), id(i + 1, j + 1)},
+                                    std::array<Index, 3>{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
+          pcl::Vertices triangle;
+          triangle.vertices.assign(corners.begin(), corners.end());
+          mesh.polygons.push_back(triangle);
+        }
+  }
+  pcl::toPCLPointCloud2(cloud, mesh.cloud);
+  return mesh;
+}
+
+TEST(MeshAccuracy, TheWeightCurveKeepsTheSurestSurface) {
+  // The strip on the truth weighs 500 (LiDAR-like), the one 10 cm off it 3 (far stereo): as
+  // the bar passes 3 the mesh keeps the exact strip only, half as complete, with no error.
+  const pcl::PolygonMesh truth = gridSquare(4.f, 8, 0.f), mesh = twoStrips(10);
+  const std::size_t strip_vertices = 11 * 21;
+  std::vector<float> weights(2 * strip_vertices, 500.f);
+  std::fill(weights.begin() + static_cast<std::ptrdiff_t>(strip_vertices), weights.end(), 3.f);
+  std::vector<Eigen::Vector3f> seen;
+  for (int j = 0; j < 40; ++j)
+    for (int i = 0; i < 40; ++i)
+      seen.emplace_back(4.f * (i + 0.5f) / 40, 4.f * (j + 0.5f) / 40, 0.f);
+  const msf::MeshAccuracy a = msf::evaluateMesh(mesh, truth, seen, 0.12, 1.0, 200000, nullptr, &weights);
+  ASSERT_FALSE(a.by_weight.empty());
+  // The whole mesh: what evaluateMesh gives.
+  const msf::WeightLevel whole = a.by_weight.atWeight(0.0);
+  EXPECT_EQ(whole.vertices, 2 * strip_vertices);
+  EXPECT_NEAR(whole.accuracy_mean_m, a.accuracy_mean_m, 1e-9);
+  EXPECT_NEAR(whole.accuracy_mean_m, 0.05, 1e-6);
+  EXPECT_DOUBLE_EQ(whole.completeness, a.completeness);
+  EXPECT_DOUBLE_EQ(whole.completeness, 1.0);
+  EXPECT_EQ(a.by_weight.atWeight(3.0).vertices, 2 * strip_vertices); // a bar keeps what weighs it
+  // Above 3: the exact strip, and the samples within 12 cm of it (x < 2.12: 21 of 40 columns).
+  for (const double bar : {3.5, 100.0, 500.0}) {
+    const msf::WeightLevel sure = a.by_weight.atWeight(bar);
+    EXPECT_EQ(sure.vertices, strip_vertices) << bar;
+    EXPECT_NEAR(sure.accuracy_mean_m, 0.0, 1e-6) << bar;
+    EXPECT_DOUBLE_EQ(sure.completeness, 21.0 / 40.0) << bar;
+  }
+  const msf::WeightLevel none = a.by_weight.atWeight(501.0);
+  EXPECT_EQ(none.vertices, 0u);
+  EXPECT_EQ(none.accuracy_mean_m, 0.0);
+  EXPECT_EQ(none.completeness, 0.0);
+  // The highest bar at a completeness: 500 up to 21 / 40, then 3, then the whole mesh.
+  EXPECT_EQ(a.by_weight.atCompleteness(0.5).min_weight, 500.0);
+  EXPECT_EQ(a.by_weight.atCompleteness(21.0 / 40.0).min_weight, 500.0);
+  EXPECT_EQ(a.by_weight.atCompleteness(0.6).min_weight, 3.0);
+  EXPECT_NEAR(a.by_weight.atCompleteness(0.6).accuracy_mean_m, 0.05, 1e-6);
+  EXPECT_EQ(a.by_weight.atCompleteness(1.0).min_weight, 3.0);
+  // A triangle goes with its lightest vertex; a vertex stays with its surest triangle.
+  std::vector<float> one_light = std::vector<float>(2 * strip_vertices, 500.f);
+  one_light[0] = 3.f; // the corner (0, 0): one triangle of the exact strip holds it
+  const msf::MeshAccuracy b = msf::evaluateMesh(mesh, truth, seen, 0.12, 1.0, 200000, nullptr, &one_light);
+  EXPECT_EQ(b.by_weight.atWeight(100.0).vertices, 2 * strip_vertices - 1);
+  EXPECT_EQ(b.by_weight.atWeight(0.0).vertices, 2 * strip_vertices);
+
+  // Weights that are not one per vertex are refused by name.
+  weights.pop_back();
+  EXPECT_EQ(msf::test::errorOf([&] { msf::evaluateMesh(mesh, truth, seen, 0.12, 1.0, 200000, nullptr, &weights); }),
+            "mesh evaluation: 461 vertex weights for 462 vertices");
+  const msf::SurfaceDistance surface(truth);
+  EXPECT_EQ(msf::test::errorOf([&] { surface.highestWithin({1.f, 1.f, 0.f}, 0.1f, {1.f}, -1.f); }),
+            "surface distance: 1 values for 128 triangles");
+  EXPECT_THROW(msf::WeightCurve({1.f}, {1.f, 2.f}, {0.0}), msf::InvalidInputError);
+}
+
 TEST(MeshAccuracy, EmptyMeshIsAnError) {
   EXPECT_THROW(msf::evaluateMesh(pcl::PolygonMesh(), gridSquare(1.f, 1, 0.f), {}, 0.1), msf::InvalidInputError);
   EXPECT_THROW(msf::SurfaceDistance(pcl::PolygonMesh()), msf::InvalidInputError);

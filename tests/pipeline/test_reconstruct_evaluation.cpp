@@ -127,6 +127,13 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_EQ(static_pixels + moving_pixels, pixels);
   EXPECT_EQ(jsonNumber(fused, "gt_pixels", "moving_all"), moving_pixels);
   EXPECT_GT(jsonNumber(mesh, "completeness", "accuracy"), 0.3); // the mesh's own accuracy row
+  // Its weight curve starts with the whole mesh, and a higher bar keeps less of it.
+  EXPECT_EQ(jsonNumber(mesh, "min_weight", "by_min_weight"), 0.0);
+  EXPECT_EQ(jsonNumber(mesh, "accuracy_mean_m", "by_min_weight"), jsonNumber(mesh, "accuracy_mean_m", "accuracy"));
+  EXPECT_EQ(jsonNumber(mesh, "completeness", "by_min_weight"), jsonNumber(mesh, "completeness", "accuracy"));
+  const std::size_t top_bar = mesh.find("\"min_weight\": 1000");
+  ASSERT_NE(top_bar, std::string::npos) << mesh;
+  EXPECT_LT(jsonNumber(mesh.substr(top_bar), "completeness"), jsonNumber(mesh, "completeness", "accuracy"));
   // Two frames: the cars are where the last frame saw them, which the figure counts.
   const double ghosts = jsonNumber(mesh, "share", "ghosts");
   EXPECT_GT(ghosts, 0.0);
@@ -178,8 +185,15 @@ TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {
     EXPECT_GE(jsonNumber(row, "mae_m", "within_range"), 0.0) << source;
   }
   EXPECT_GT(jsonNumber(rowOf(json, "mesh_paper"), "completeness", "accuracy"), 0.0); // scored against gt/scene.ply
+  // Our mesh kept at the highest bar on its weights that is as complete as the paper's mesh.
+  const std::string mesh = rowOf(json, "mesh");
+  const double paper_completeness = jsonNumber(rowOf(json, "mesh_paper"), "completeness", "accuracy");
+  EXPECT_GE(jsonNumber(mesh, "completeness", "at_completeness_of"), paper_completeness);
+  EXPECT_LE(jsonNumber(mesh, "completeness", "at_completeness_of"), jsonNumber(mesh, "completeness", "accuracy"));
+  EXPECT_GT(jsonNumber(mesh, "min_weight", "at_completeness_of"), 0.0);
   const std::string report = readFile(out.file("report.md"));
-  for (const char* row : {"| paper |", "| mesh_paper |", "the paper as published (config/paper.yaml"})
+  for (const char* row : {"| paper |", "| mesh_paper |", "the paper as published (config/paper.yaml",
+                          "at the completeness of each other mesh", "| bar | vertices | accuracy m | completeness |"})
     EXPECT_NE(report.find(row), std::string::npos) << row << " not in report.md:\n" << report;
   EXPECT_NE(r.out.find("mesh_paper"), std::string::npos) << r.out; // the console's table
 }

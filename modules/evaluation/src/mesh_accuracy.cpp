@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <unordered_map>
 
@@ -139,9 +140,81 @@ float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) 
   return std::sqrt(best2);
 }
 
+float SurfaceDistance::highestWithin(const Eigen::Vector3f& p, float radius_m, const std::vector<float>& values,
+                                     float none) const {
+  if (values.size() != triangles_.size())
+    throw InvalidInputError("surface distance: " + std::to_string(values.size()) + " values for " +
+                            std::to_string(triangles_.size()) + " triangles");
+  float best = none;
+  const float radius2 = radius_m * radius_m;
+  const Cell a = cellOf(p - Eigen::Vector3f::Constant(radius_m));
+  const Cell b = cellOf(p + Eigen::Vector3f::Constant(radius_m));
+  for (int x = a.x(); x <= b.x(); ++x)
+    for (int y = a.y(); y <= b.y(); ++y)
+      for (int z = a.z(); z <= b.z(); ++z) {
+        const auto it = grid_.find(Cell(x, y, z));
+        if (it == grid_.end())
+          continue;
+        for (std::uint32_t t : it->second) {
+          if (!(values[t] > best))
+            continue; // cannot raise the answer: no distance needed
+          const auto& tri = triangles_[t];
+          if ((closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p).squaredNorm() < radius2)
+            best = values[t];
+        }
+      }
+  return best;
+}
+
+WeightCurve::WeightCurve(std::vector<float> sample_levels, const std::vector<float>& vertex_levels,
+                         const std::vector<double>& vertex_distances)
+    : sample_levels_(std::move(sample_levels)) {
+  if (vertex_levels.size() != vertex_distances.size())
+    throw InvalidInputError("weight curve: " + std::to_string(vertex_distances.size()) + " distances for " +
+                            std::to_string(vertex_levels.size()) + " vertices");
+  std::sort(sample_levels_.begin(), sample_levels_.end(), std::greater<float>());
+  std::vector<std::size_t> order(vertex_levels.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return vertex_levels[a] > vertex_levels[b]; });
+  vertex_levels_.reserve(order.size());
+  distance_sums_.assign(1, 0.0);
+  for (std::size_t i : order) {
+    vertex_levels_.push_back(vertex_levels[i]);
+    distance_sums_.push_back(distance_sums_.back() + vertex_distances[i]);
+  }
+}
+
+WeightLevel WeightCurve::atWeight(double min_weight) const {
+  // Counts of the descending levels at or above the bar.
+  auto atOrAbove = [min_weight](const std::vector<float>& levels) {
+    return static_cast<std::size_t>(std::partition_point(levels.begin(), levels.end(), [&](float l) {
+                                      return l >= min_weight;
+                                    }) - levels.begin());
+  };
+  WeightLevel level;
+  level.min_weight = min_weight;
+  level.vertices = atOrAbove(vertex_levels_);
+  level.accuracy_mean_m = level.vertices ? distance_sums_[level.vertices] / static_cast<double>(level.vertices) : 0.0;
+  level.completeness = sample_levels_.empty()
+                           ? 0.0
+                           : static_cast<double>(atOrAbove(sample_levels_)) / static_cast<double>(sample_levels_.size());
+  return level;
+}
+
+WeightLevel WeightCurve::atCompleteness(double completeness) const {
+  // The k-th highest sample level keeps at least k samples complete.
+  const double needed = std::ceil(completeness * static_cast<double>(sample_levels_.size()) - 1e-9);
+  const std::size_t k = static_cast<std::size_t>(std::max(1.0, needed));
+  if (sample_levels_.empty() || k > sample_levels_.size() || sample_levels_[k - 1] < 0.f)
+    return atWeight(0.0);
+  return atWeight(sample_levels_[k - 1]);
+}
+
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m,
-                          std::size_t max_samples, const std::vector<float>* view_distance_m) {
+                          std::size_t max_samples, const std::vector<float>* view_distance_m,
+                          const std::vector<float>* vertex_weights) {
   if (view_distance_m && view_distance_m->size() != seen_truth.size())
     throw InvalidInputError("mesh evaluation: " + std::to_string(view_distance_m->size()) + " view distances for " +
                             std::to_string(seen_truth.size()) + " samples of the seen surface");
@@ -157,6 +230,22 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   std::vector<Eigen::Vector3f> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   meshArrays(mesh, vertices, triangles);
+  if (vertex_weights && vertex_weights->size() != vertices.size())
+    throw InvalidInputError("mesh evaluation: " + std::to_string(vertex_weights->size()) + " vertex weights for " +
+                            std::to_string(vertices.size()) + " vertices");
+  // By weight: a triangle stays while its lightest vertex passes the bar, a vertex while its
+  // surest triangle does.
+  std::vector<float> triangle_levels, vertex_levels;
+  if (vertex_weights) {
+    vertex_levels.assign(vertices.size(), -1.f);
+    triangle_levels.reserve(triangles.size());
+    for (const auto& t : triangles) {
+      const float level = std::min({(*vertex_weights)[t[0]], (*vertex_weights)[t[1]], (*vertex_weights)[t[2]]});
+      triangle_levels.push_back(level);
+      for (std::uint32_t i : t)
+        vertex_levels[i] = std::max(vertex_levels[i], level);
+    }
+  }
   const SurfaceDistance to_truth(truth, std::max(cap, 0.25f));
   // A regular stride over large inputs: deterministic, and the statistics barely move.
   const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
@@ -180,10 +269,24 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   const std::size_t truth_step = std::max<std::size_t>(1, (seen_truth.size() + max_samples - 1) / max_samples);
   const std::size_t samples = (seen_truth.size() + truth_step - 1) / truth_step;
   std::vector<std::uint8_t> is_covered(samples);
+  std::vector<float> sample_levels(vertex_weights ? samples : 0);
   cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i)
-      is_covered[i] = to_mesh.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], threshold) < threshold;
+    for (int i = range.start; i < range.end; ++i) {
+      const Eigen::Vector3f& p = seen_truth[static_cast<std::size_t>(i) * truth_step];
+      if (vertex_weights) {
+        sample_levels[i] = to_mesh.highestWithin(p, threshold, triangle_levels, -1.f);
+        is_covered[i] = sample_levels[i] >= 0.f;
+      } else {
+        is_covered[i] = to_mesh.distance(p, threshold) < threshold;
+      }
+    }
   });
+  if (vertex_weights) {
+    std::vector<float> sampled_levels(distances.size());
+    for (std::size_t i = 0; i < sampled_levels.size(); ++i)
+      sampled_levels[i] = vertex_levels[i * vertex_step];
+    result.by_weight = WeightCurve(std::move(sample_levels), sampled_levels, distances);
+  }
   const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
   result.truth_samples = samples;
   result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);

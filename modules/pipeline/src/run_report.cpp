@@ -104,7 +104,28 @@ std::string metricsJson(const DepthMetrics& m, const std::string& indent) {
   return s.str();
 }
 
+/// The bars (m^-2) at which summary.json and report.md give a mesh's weight curve: the whole
+/// mesh, then sigma 0.45 m, 0.32 m, 0.18 m, 10 cm, 6 cm (a LiDAR return), 3 cm.
+constexpr double kWeightBars[] = {0, 5, 10, 30, 100, 300, 1000};
+
+std::string levelJson(const WeightLevel& l) {
+  return "{\"min_weight\": " + num(l.min_weight) + ", \"vertices\": " + std::to_string(l.vertices) +
+         ", \"accuracy_mean_m\": " + num(l.accuracy_mean_m) + ", \"completeness\": " + num(l.completeness) + "}";
+}
+
+/// The fused mesh's row with a weight curve, if any.
+const RunReport::MapEvaluation::Row* fusedCurveRow(const RunReport::MapEvaluation& e) {
+  for (const auto& r : e.rows)
+    if (r.score.source == "mesh" && r.has_accuracy && !r.accuracy.by_weight.empty())
+      return &r;
+  return nullptr;
+}
+
 std::string accuracyJson(const MeshAccuracy& m) {
+  std::string curve;
+  if (!m.by_weight.empty())
+    for (double bar : kWeightBars)
+      curve += std::string(curve.empty() ? "" : ", ") + levelJson(m.by_weight.atWeight(bar));
   std::string bands;
   for (const auto& b : m.by_view_distance)
     bands += std::string(bands.empty() ? "" : ", ") + "{\"lower_m\": " + num(b.lower_m) + ", \"upper_m\": " +
@@ -114,7 +135,8 @@ std::string accuracyJson(const MeshAccuracy& m) {
          ", \"precision\": " + num(m.precision) + ", \"completeness\": " + num(m.completeness) +
          ", \"threshold_m\": " + num(m.threshold_m) + ", \"cap_m\": " + num(m.cap_m) +
          ", \"mesh_vertices\": " + std::to_string(m.vertices) + ", \"truth_samples\": " +
-         std::to_string(m.truth_samples) + ", \"completeness_by_nearest_view\": [" + bands + "]}";
+         std::to_string(m.truth_samples) + ", \"completeness_by_nearest_view\": [" + bands + "]" +
+         (curve.empty() ? "" : ", \"by_min_weight\": [" + curve + "]") + "}";
 }
 
 /// What a second stop signal left out, as a sentence of report.md ("" when nothing was).
@@ -281,6 +303,16 @@ void RunReport::writeSummaryJson(const std::string& path) const {
           << in << "\"moving_all\": " << metricsJson(r.score.moving_all, in);
       if (r.has_accuracy)
         s << ",\n" << in << "\"accuracy\": " << accuracyJson(r.accuracy);
+      if (&r == fusedCurveRow(e)) {
+        // The fused mesh's surest surface that is as complete as each other mesh.
+        std::string matched;
+        for (const auto& other : e.rows)
+          if (&other != &r && other.has_accuracy)
+            matched += std::string(matched.empty() ? "" : ", ") + "{\"mesh\": " + jsonString(other.score.source) +
+                       ", \"kept\": " + levelJson(r.accuracy.by_weight.atCompleteness(other.accuracy.completeness)) +
+                       "}";
+        s << ",\n" << in << "\"at_completeness_of\": [" << matched << "]";
+      }
       if (r.has_ghosts)
         s << ",\n" << in << "\"ghosts\": {\"share\": " << num(r.ghosts.share, 6) << ", \"ghost_vertices\": "
           << r.ghosts.ghost_vertices << ", \"vertices\": " << r.ghosts.vertices << ", \"distance_m\": "
@@ -388,6 +420,15 @@ void RunReport::writeMarkdown(const std::string& path) const {
           << " % of the samples)";
       s << ".\n";
     }
+    if (!m.by_weight.empty()) {
+      s << "\nKept at a bar on the vertices' weights (m^-2; the triangles whose three vertices weigh at least it):\n\n"
+           "| bar | vertices | accuracy m | completeness |\n|---|---|---|---|\n";
+      for (double bar : kWeightBars) {
+        const WeightLevel l = m.by_weight.atWeight(bar);
+        s << "| " << num(bar) << " | " << l.vertices << " | " << num(l.accuracy_mean_m, 3) << " | "
+          << num(100 * l.completeness, 1) << " % |\n";
+      }
+    }
     s << "\n";
   }
   if (!map_evaluation.rows.empty())
@@ -453,6 +494,21 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
   if (accuracy)
     s << "Accuracy: mean distance of the mesh's vertices to the true surface; completeness: share of the seen true "
          "surface within the threshold of the mesh (as above).\n";
+  if (const MapEvaluation::Row* fused = fusedCurveRow(e)) {
+    std::string rows;
+    for (const auto& other : e.rows)
+      if (&other != fused && other.has_accuracy) {
+        const WeightLevel l = fused->accuracy.by_weight.atCompleteness(other.accuracy.completeness);
+        rows += "| " + other.score.source + " | " + num(100 * other.accuracy.completeness, 1) + " % | " +
+                num(other.accuracy.accuracy_mean_m, 3) + " | " + num(l.min_weight, 1) + " | " +
+                num(100 * l.completeness, 1) + " % | " + num(l.accuracy_mean_m, 3) + " |\n";
+      }
+    if (!rows.empty())
+      s << "\nThe fused mesh kept at a bar on its vertices' weights (its surest surface), at the completeness of each "
+           "other mesh:\n\n| other mesh | its completeness | its accuracy m | fused mesh's bar m^-2 | completeness | "
+           "accuracy m |\n|---|---|---|---|---|---|\n"
+        << rows << "\n";
+  }
   if (!e.no_ghosts.empty())
     s << "No ghost figure: " << e.no_ghosts << ".\n";
   else if (ghosts)

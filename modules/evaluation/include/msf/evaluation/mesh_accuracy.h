@@ -22,6 +22,9 @@ public:
 
   /// Distance from p to the nearest triangle, or `max_distance_m` when none is nearer.
   float distance(const Eigen::Vector3f& p, float max_distance_m) const;
+  /// The largest of `values` (one per triangle) over the triangles nearer to p than
+  /// `radius_m`, or `none` when no triangle is that near.
+  float highestWithin(const Eigen::Vector3f& p, float radius_m, const std::vector<float>& values, float none) const;
 
   std::size_t numTriangles() const { return triangles_.size(); }
 
@@ -52,6 +55,41 @@ struct CompletenessBand {
   double completeness = 0; ///< 0 without samples
 };
 
+/// A mesh kept at a bar on its weights: the triangles whose three vertices weigh at least
+/// `min_weight` (m^-2), scored as the whole mesh is.
+struct WeightLevel {
+  double min_weight = 0;
+  std::size_t vertices = 0;     ///< evaluated vertices of the kept triangles
+  double accuracy_mean_m = 0;   ///< 0 without vertices
+  double completeness = 0;
+};
+
+/// Accuracy against completeness as the bar on a mesh's vertex weights (TriangleMesh::weights,
+/// the inverse variance of the surface there) rises: what meshing only the surest surface
+/// gives. A vertex stays while one of its triangles does; a sample of the true surface is
+/// complete while a kept triangle lies within the threshold.
+class WeightCurve {
+public:
+  WeightCurve() = default;
+  /// Per sample of the seen true surface, the highest bar that keeps a triangle within the
+  /// threshold of it (< 0: none at any bar); per evaluated vertex, the highest bar that keeps
+  /// it and its distance to the truth (capped).
+  WeightCurve(std::vector<float> sample_levels, const std::vector<float>& vertex_levels,
+              const std::vector<double>& vertex_distances);
+
+  bool empty() const { return sample_levels_.empty(); }
+  /// The mesh kept at `min_weight` (0 keeps every triangle).
+  WeightLevel atWeight(double min_weight) const;
+  /// The mesh kept at the highest bar whose completeness is at least `completeness`: the
+  /// surest surface that covers as much of the truth. The whole mesh when no bar reaches it.
+  WeightLevel atCompleteness(double completeness) const;
+
+private:
+  std::vector<float> sample_levels_;  ///< descending
+  std::vector<float> vertex_levels_;  ///< descending
+  std::vector<double> distance_sums_; ///< of the vertices' distances in that order, from 0
+};
+
 /// Mesh quality against the true surface (protocol 3, docs/design.md).
 struct MeshAccuracy {
   std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated (sampled)
@@ -64,6 +102,8 @@ struct MeshAccuracy {
   double cap_m = 0;                    ///< distances are capped here for the mean
   /// Completeness by the distance the samples were seen from at the nearest (when given).
   std::vector<CompletenessBand> by_view_distance;
+  /// Accuracy and completeness as the bar on the vertices' weights rises (when given).
+  WeightCurve by_weight;
 };
 
 /// For each of `points` (the seen true surface, from every frame), the least of `depths` (the
@@ -78,10 +118,13 @@ std::vector<float> nearestViewDistance(const std::vector<Eigen::Vector3f>& point
 /// into the world) against `mesh`. Distances are exact point-to-triangle distances,
 /// capped at `cap_m`. Inputs larger than `max_samples` are taken at a regular stride.
 /// With `view_distance_m` (one per seen_truth point, nearestViewDistance), completeness is also
-/// given in bands of that distance, 10 m wide up to the farthest. Throws InvalidInputError
-/// when `mesh` or `truth` has no triangle or view_distance_m's size is not seen_truth's.
+/// given in bands of that distance, 10 m wide up to the farthest. With `vertex_weights` (one
+/// per mesh vertex, TriangleMesh::weights), also by_weight. Throws InvalidInputError when
+/// `mesh` or `truth` has no triangle, or view_distance_m's size is not seen_truth's or
+/// vertex_weights' not the mesh's vertices'.
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m = 1.0,
-                          std::size_t max_samples = 200000, const std::vector<float>* view_distance_m = nullptr);
+                          std::size_t max_samples = 200000, const std::vector<float>* view_distance_m = nullptr,
+                          const std::vector<float>* vertex_weights = nullptr);
 
 } // namespace msf
