@@ -66,7 +66,7 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
 } // namespace
 
 int main(int argc, char** argv) {
-  std::string calib_path, image_size_text, color_path;
+  std::string calib_path, image_size_text, color_path, left_path;
   bool print_config = false;
   msf::DepthFusionConfig config;
   msf::tool::CommandLine cli(
@@ -82,6 +82,9 @@ int main(int argc, char** argv) {
       .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
              "paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)")
       .value("-color", "PATH", color_path, "colour camera image (image_2) to colour every fused point by projection")
+      .value("-left", "PATH", left_path,
+             "camera 0's grey image (image_0): a LiDAR-backed wall goes on upward over the blank pixels above it "
+             "(fusion.facade_extension), as in msf_reconstruct")
       .flag("-print_config", print_config, "print the fusion settings in use");
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
     if (files.size() != 3)
@@ -104,9 +107,16 @@ int main(int argc, char** argv) {
     pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr stereo(new pcl::PointCloud<msf::PointXYZRGBConfidence>);
     loadLidar(files[0], *lidar);
     loadStereo(files[1], *stereo);
-    cv::Mat color;
+    cv::Mat color, left;
     if (!color_path.empty())
       color = msf::readImage(color_path, cv::IMREAD_COLOR);
+    if (!left_path.empty()) {
+      left = msf::readImage(left_path, cv::IMREAD_GRAYSCALE);
+      if (left.cols != static_cast<int>(stereo->width) || left.rows != static_cast<int>(stereo->height))
+        throw msf::InvalidInputError("-left image '" + left_path + "' is " + std::to_string(left.cols) + "x" +
+                                     std::to_string(left.rows) + ", the clouds are " + std::to_string(stereo->width) +
+                                     "x" + std::to_string(stereo->height));
+    }
     msf::tool::printDone(tt.toc(), lidar->size() + stereo->size());
 
     tt.tic();
@@ -117,6 +127,7 @@ int main(int argc, char** argv) {
     fusion.setInputLidar(lidar);
     fusion.setInputStereo(stereo);
     fusion.setInputColor(color);
+    fusion.setInputImage(left);
     pcl::PointCloud<msf::PointXYZRGBWeight> fused;
     fusion.fuse(fused);
     std::size_t valid = 0;

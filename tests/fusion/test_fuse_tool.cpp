@@ -6,9 +6,11 @@
 
 #include "test_support.h"
 
+#include <opencv2/imgcodecs.hpp>
 #include <pcl/point_types.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace {
@@ -105,6 +107,51 @@ TEST(FuseTool, AcceptsCloudsWithoutDistanceOrConfidence) {
   pcl::PointCloud<pcl::PointXYZ> fused;
   msf::loadCloud(f.out, fused);
   EXPECT_FLOAT_EQ(fused.at(3, 3).z, 10.f);
+}
+
+TEST(FuseTool, TheLeftImageContinuesABlankWallUpward) {
+  // A blank wall 10 m away: LiDAR returns on rows 30-59 of a 40x60 image, no stereo match.
+  // With -left the fused cloud has the wall on every row, each point on its pixel's ray;
+  // without it, nothing above the LiDAR.
+  constexpr int w = 40, h = 60;
+  Files f;
+  auto lidar = cloudAt<msf::PointXYZID>(w, h, 10.f, 0);
+  for (std::size_t i = 0; i < lidar.size(); ++i) {
+    lidar[i].distance = 0.f;
+    if (i < static_cast<std::size_t>(30 * w))
+      lidar[i].x = lidar[i].y = lidar[i].z = std::numeric_limits<float>::quiet_NaN();
+  }
+  lidar.is_dense = false;
+  msf::saveCloud(f.dir.file("wall_lidar.pcd"), lidar);
+  auto stereo = cloudAt<msf::PointXYZRGBConfidence>(w, h, 10.f, 1); // (u + v) % 1 == 0: no point valid
+  msf::saveCloud(f.dir.file("wall_stereo.pcd"), stereo);
+  const std::string left = f.dir.file("left.png");
+  ASSERT_TRUE(cv::imwrite(left, cv::Mat(h, w, CV_8UC1, cv::Scalar(120))));
+  const std::string inputs = f.dir.file("wall_lidar.pcd") + " " + f.dir.file("wall_stereo.pcd") + " " + f.out;
+  auto r = msf::test::runTool("msf_fuse", inputs + " -calib " + f.calib + " -left " + left);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  pcl::PointCloud<msf::PointXYZRGBWeight> fused;
+  msf::loadCloud(f.out, fused);
+  for (int v = 0; v < 30; ++v)
+    for (int u = 0; u < w; u += 13) {
+      const auto& p = fused.at(u, v);
+      ASSERT_NEAR(p.z, 10.f, 1e-4f) << u << "," << v;
+      EXPECT_NEAR(p.x, (u - kW / 2.f) * 10.f / 500.f, 1e-4f); // the calibration's principal point
+      EXPECT_NEAR(p.y, (v - kH / 2.f) * 10.f / 500.f, 1e-4f);
+      EXPECT_GT(p.weight, 0.f);
+      EXPECT_LT(p.weight, fused.at(u, 45).weight); // less sure than the LiDAR
+    }
+  r = msf::test::runTool("msf_fuse", inputs + " -calib " + f.calib);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  msf::loadCloud(f.out, fused);
+  EXPECT_FALSE(std::isfinite(fused.at(5, 10).z));
+  // An image of another size than the clouds is refused, and nothing is written.
+  ASSERT_TRUE(cv::imwrite(left, cv::Mat(h, w - 1, CV_8UC1, cv::Scalar(120))));
+  std::remove(f.out.c_str());
+  r = msf::test::runTool("msf_fuse", inputs + " -calib " + f.calib + " -left " + left);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("-left image '" + left + "' is 39x60, the clouds are 40x60"), std::string::npos) << r.err;
+  EXPECT_FALSE(msf::test::fileExists(f.out));
 }
 
 TEST(FuseTool, BadInputFailsAndLeavesNoOutput) {

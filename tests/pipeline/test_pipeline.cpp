@@ -45,7 +45,8 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
       {"msf_interpolate", sequence.scanPath(1) + " " + out.file("lidar.pcd") + " -calib " + calib},
       {"msf_stereo", sequence.imagePath(0, 1) + " " + sequence.imagePath(1, 1) + " " + out.file("stereo.pcd") +
                          " -calib " + calib + " -color " + sequence.imagePath(2, 1) + " -prior " + out.file("lidar.pcd")},
-      {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + " -calib " + calib},
+      {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + " -calib " + calib +
+                       " -left " + sequence.imagePath(0, 1)},
   };
   for (const auto& step : steps) {
     const auto r = msf::test::runTool(step[0], step[1]);

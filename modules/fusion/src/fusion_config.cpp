@@ -74,6 +74,12 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   readKey(node, "edge_window_cols", edge_window_cols);
   readKey(node, "edge_jump_px", edge_jump_px);
   readKey(node, "edge_tolerance_px", edge_tolerance_px);
+  readKey(node, "facade_extension", facade_extension);
+  readKey(node, "facade_anchor_sigma_m", facade_anchor_sigma_m);
+  readKey(node, "facade_grey_tolerance", facade_grey_tolerance);
+  readKey(node, "facade_max_texture", facade_max_texture);
+  readKey(node, "facade_sigma_per_m", facade_sigma_per_m);
+  readKey(node, "facade_max_normal_y", facade_max_normal_y);
   validate();
 }
 
@@ -101,6 +107,12 @@ void DepthFusionConfig::validate() const {
                         std::to_string(value));
   positive(edge_jump_px, "edge_jump_px");
   nonNegative(edge_tolerance_px, "edge_tolerance_px");
+  positive(facade_anchor_sigma_m, "facade_anchor_sigma_m");
+  nonNegative(facade_grey_tolerance, "facade_grey_tolerance");
+  nonNegative(facade_max_texture, "facade_max_texture");
+  nonNegative(facade_sigma_per_m, "facade_sigma_per_m");
+  if (!(facade_max_normal_y >= 0.f && facade_max_normal_y <= 1.f))
+    throw ConfigError("config key 'fusion.facade_max_normal_y' must be within [0, 1]");
 }
 
 void DepthFusionConfig::print(std::ostream& out) const {
@@ -126,7 +138,13 @@ void DepthFusionConfig::print(std::ostream& out) const {
       << "  edge_window_rows: " << configValue(edge_window_rows) << "\n"
       << "  edge_window_cols: " << configValue(edge_window_cols) << "\n"
       << "  edge_jump_px: " << configValue(edge_jump_px) << "\n"
-      << "  edge_tolerance_px: " << configValue(edge_tolerance_px) << "\n";
+      << "  edge_tolerance_px: " << configValue(edge_tolerance_px) << "\n"
+      << "  facade_extension: " << configValue(facade_extension) << "\n"
+      << "  facade_anchor_sigma_m: " << configValue(facade_anchor_sigma_m) << "\n"
+      << "  facade_grey_tolerance: " << configValue(facade_grey_tolerance) << "\n"
+      << "  facade_max_texture: " << configValue(facade_max_texture) << "\n"
+      << "  facade_sigma_per_m: " << configValue(facade_sigma_per_m) << "\n"
+      << "  facade_max_normal_y: " << configValue(facade_max_normal_y) << "\n";
 }
 
 } // namespace msf

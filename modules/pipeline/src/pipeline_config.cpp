@@ -73,6 +73,7 @@ PipelineConfig PipelineConfig::paper() {
   c.fusion.method = FusionMethod::Paper;
   c.fusion.paper_weights = PaperWeights::AsWritten;
   c.fusion.edge_support = false;
+  c.fusion.facade_extension = false;
   // Step 5 (§III-C): a projective TSDF, every depth weighing the same, updated within the
   // truncation only, then eq. 7 solved to its minimizer with lambda 5 (the paper's KITTI value).
   c.integrator.weighting = TsdfIntegrator::Weighting::Constant;

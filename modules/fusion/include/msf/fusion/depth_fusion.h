@@ -69,6 +69,10 @@ public:
   /// Optional image of the colour camera (BGR) to colour every fused point by projection,
   /// also where only the LiDAR has depth. Empty: colour from the stereo points.
   void setInputColor(const cv::Mat& image) { color_ = image; }
+  /// Optional grey image of camera 0 (CV_8UC1, the clouds' width x height): with it and
+  /// fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank pixels above
+  /// it (extendFacades), as in the pipeline. Empty: nothing after the fusion but edge support.
+  void setInputImage(const cv::Mat& left) { left_ = left; }
   void setColorCamera(int camera) { color_camera_ = camera; }
   int getColorCamera() const { return color_camera_; }
 
@@ -83,7 +87,7 @@ private:
   bool has_calibration_{false};
   PointCloudLidarConstPtr lidar_;
   PointCloudStereoConstPtr stereo_;
-  cv::Mat color_;
+  cv::Mat color_, left_;
   int color_camera_{2};
   cv::Mat lidar_depth_, lidar_distance_, lidar_edge_; ///< work buffers, kept between frames
   cv::Mat fused_depth_, fused_weight_;

@@ -69,6 +69,14 @@ struct DepthFusionConfig {
   float edge_jump_px = 8.f;                   ///< an edge: the window's returns differ by more (disparity)
   float edge_tolerance_px = 2.f;              ///< a fused disparity this near a return is on its surface
 
+  // --- after both: a LiDAR-backed wall goes on upward where the image stays blank (facade_extension.h)
+  bool facade_extension = true;
+  float facade_anchor_sigma_m = 0.1f;         ///< anchors: fused pixels known to within this (LiDAR-backed)
+  float facade_grey_tolerance = 8.f;          ///< grey levels from the anchors' run (5x5 box-filtered image)
+  float facade_max_texture = 4.f;             ///< blank: grey levels of standard deviation over 5x5 pixels
+  float facade_sigma_per_m = 0.1f;            ///< sigma's growth per metre above the last anchor
+  float facade_max_normal_y = 0.3f;           ///< near vertical surfaces only (|n_y| of the unit normal)
+
   /// Overrides the keys present in `node` (the `fusion` section), then validates.
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the key of the first value out of range.

@@ -3,6 +3,7 @@
 #include <msf/common/limits.h>
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/fusion_model.h>
+#include <msf/fusion/facade_extension.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
 
@@ -118,6 +119,18 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   });
   if (config.edge_support)
     supportAtDepthEdges(lidar_depth_, lidar_distance_, fB, config, fused_depth_, edge_buffers_);
+  // Where neither input has a point (a wall the extension continued), the pixel's own ray.
+  PinholeCamera camera;
+  camera.fx = static_cast<float>(calibration_.fx());
+  camera.fy = static_cast<float>(calibration_.fy());
+  camera.cx = static_cast<float>(calibration_.cx());
+  camera.cy = static_cast<float>(calibration_.cy());
+  camera.width = cols;
+  camera.height = rows;
+  if (config.facade_extension && !left_.empty()) {
+    cv::Mat no_free_space;
+    extendFacades(left_, camera, config, fused_depth_, fused_weight_, no_free_space);
+  }
 
   // 2. The points, on the rays of the input points.
   std::atomic<bool> dense{true};
@@ -136,9 +149,14 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
           // within half a pixel of it.
           const bool from_stereo = detail::validDepth(s.z);
           const PointLidarT& l = (*lidar_)[row + u];
-          const float scale = z / (from_stereo ? s.z : l.z);
-          p.x = (from_stereo ? s.x : l.x) * scale;
-          p.y = (from_stereo ? s.y : l.y) * scale;
+          if (from_stereo || detail::validDepth(l.z)) {
+            const float scale = z / (from_stereo ? s.z : l.z);
+            p.x = (from_stereo ? s.x : l.x) * scale;
+            p.y = (from_stereo ? s.y : l.y) * scale;
+          } else {
+            p.x = (static_cast<float>(u) - camera.cx) * z / camera.fx;
+            p.y = (static_cast<float>(v) - camera.cy) * z / camera.fy;
+          }
           p.z = z;
         } else {
           p.x = p.y = p.z = nan;

@@ -1,0 +1,38 @@
+#pragma once
+#include <msf/fusion/fusion_config.h>
+#include <msf/io/pinhole_camera.h>
+
+#include <opencv2/core/mat.hpp>
+
+#include <cstddef>
+
+namespace msf {
+
+/// After the fusion (fusion.facade_extension): a wall the LiDAR saw up to its top ring goes on
+/// above it, where the image still shows the same blank surface. A blank wall gives stereo no
+/// texture to match, so above the LiDAR's reach it has no depth, or SGBM's guesses; this
+/// continues each column's LiDAR-backed surface upward instead.
+///
+/// Each column is walked from the bottom up. Its anchors are fused pixels known to within
+/// facade_anchor_sigma_m (LiDAR-backed); the last run of them is fitted with a line in inverse
+/// depth against the row (exact on any plane), its nearest rows weighing most. Above the run the
+/// line goes on, while
+/// - the surface is near vertical: the normal's component along the image's y axis is at most
+///   facade_max_normal_y (a wall, not the road or a car's roof, whose line leads into the sky);
+/// - the image looks the same and blank: the grey's mean over 5x5 pixels stays within
+///   facade_grey_tolerance of the run's, and its standard deviation there within
+///   facade_max_texture (about twice the image noise: a window, the wall's top edge against the
+///   sky, another object or a texture stereo can match stops it).
+/// A pixel on the way takes the line's depth with the sigma of the run's last anchor plus
+/// facade_sigma_per_m per metre above it (a wall leaning by ~6 degrees), as its weight and free
+/// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the line's):
+/// then it is kept. Stereo that disagrees on a blank surface is a guess, and is replaced.
+///
+/// left: CV_8UC1, the grey image of camera 0 (the fused depth's pixels); depth, weight (and
+/// free_space_weight, if not empty): CV_32FC1 of its size, changed in place. Columns run in
+/// parallel. Returns the number of pixels given a depth. Throws InvalidInputError for images of
+/// another type or size, or an invalid camera.
+std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, const DepthFusionConfig& config,
+                          cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight);
+
+} // namespace msf

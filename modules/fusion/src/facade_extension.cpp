@@ -1,0 +1,149 @@
+#include <msf/common/exceptions.h>
+#include <msf/fusion/facade_extension.h>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+namespace {
+
+/// A column's fit of inverse depth i = c + b v over its last run of anchors, each older row's
+/// weight decayed by kDecay (about the nearest 5 rows count), with the run's grey and its last
+/// anchor.
+struct ColumnFit {
+  double sw = 0, sv = 0, svv = 0, si = 0, svi = 0;
+  float grey = 0;                    ///< the run's grey (a running mean)
+  int anchor_row = -1;               ///< row of the run's last anchor, -1: no run to go on from
+  float anchor_depth = 0, anchor_sigma = 0;
+  bool anchor_below = false;         ///< the row below was an anchor (the run goes on)
+
+  static constexpr double kDecay = 0.8;
+
+  void stop() { *this = ColumnFit(); }
+  bool solve(double& b, double& c) const {
+    const double det = sw * svv - sv * sv;
+    if (sw < 3.0 || !(std::abs(det) > 1e-9)) // fewer than 5 anchors in the run, or one row
+      return false;
+    b = (sw * svi - sv * si) / det;
+    c = (si - b * sv) / sw;
+    return true;
+  }
+  void add(int v, float z, float sigma, float g) {
+    const double inv = 1.0 / z;
+    double b, c;
+    // A new run where the column's last was not just below, or where its line misses this
+    // anchor by more than 5 % (a depth edge between two LiDAR-backed surfaces).
+    if (!anchor_below || (solve(b, c) && std::abs(c + b * v - inv) > 0.05 * inv))
+      *this = ColumnFit();
+    grey = sw > 0 ? 0.7f * grey + 0.3f * g : g;
+    sw = kDecay * sw + 1;
+    sv = kDecay * sv + v;
+    svv = kDecay * svv + static_cast<double>(v) * v;
+    si = kDecay * si + inv;
+    svi = kDecay * svi + v * inv;
+    anchor_row = v;
+    anchor_depth = z;
+    anchor_sigma = sigma;
+    anchor_below = true;
+  }
+};
+
+void checkImage(const cv::Mat& image, int type, const cv::Size& size, const std::string& what) {
+  if (image.type() != type || image.size() != size)
+    throw InvalidInputError("facade extension: " + what + " is a " + std::to_string(image.cols) + "x" +
+                            std::to_string(image.rows) + " image of type " + std::to_string(image.type()) +
+                            ", expected type " + std::to_string(type) + " of " + std::to_string(size.width) + "x" +
+                            std::to_string(size.height));
+}
+
+} // namespace
+
+std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, const DepthFusionConfig& config,
+                          cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight) {
+  const cv::Size size = depth.size();
+  checkImage(depth, CV_32FC1, size, "the depth");
+  checkImage(left, CV_8UC1, size, "the grey image");
+  checkImage(weight, CV_32FC1, size, "the weight");
+  if (!free_space_weight.empty())
+    checkImage(free_space_weight, CV_32FC1, size, "the free space weight");
+  if (!camera.valid() || camera.width != size.width || camera.height != size.height)
+    throw InvalidInputError("facade extension: the camera (" + std::to_string(camera.width) + "x" +
+                            std::to_string(camera.height) + ", fx " + std::to_string(camera.fx) +
+                            ") does not fit the " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                            " depth");
+  // The grey's mean and variance over 5x5 pixels: a blank surface's is its noise's.
+  cv::Mat grey, mean, mean_square;
+  left.convertTo(grey, CV_32F);
+  cv::blur(grey, mean, cv::Size(5, 5));
+  cv::blur(grey.mul(grey), mean_square, cv::Size(5, 5));
+  const float anchor_weight = 1.f / (config.facade_anchor_sigma_m * config.facade_anchor_sigma_m);
+  const float tolerance = config.facade_grey_tolerance;
+  const float max_variance = config.facade_max_texture * config.facade_max_texture;
+  std::atomic<std::size_t> extended{0};
+  constexpr int kStrip = 128; // columns of one task, walked bottom-up together: rows stay contiguous
+  cv::parallel_for_(cv::Range(0, (size.width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
+    const int u0 = strips.start * kStrip, u1 = std::min(size.width, strips.end * kStrip);
+    std::vector<ColumnFit> fits(static_cast<std::size_t>(u1 - u0));
+    std::size_t count = 0;
+    for (int v = size.height - 1; v >= 0; --v) {
+      float* z = depth.ptr<float>(v);
+      float* w = weight.ptr<float>(v);
+      float* f = free_space_weight.empty() ? nullptr : free_space_weight.ptr<float>(v);
+      const float* g = mean.ptr<float>(v);
+      const float* g2 = mean_square.ptr<float>(v);
+      const float y = (static_cast<float>(v) - camera.cy) / camera.fy;
+      for (int u = u0; u < u1; ++u) {
+        ColumnFit& fit = fits[static_cast<std::size_t>(u - u0)];
+        const bool has_depth = z[u] > 0.f && std::isfinite(z[u]);
+        const float grey_here = g[u];
+        if (has_depth && w[u] >= anchor_weight) {
+          fit.add(v, z[u], 1.f / std::sqrt(w[u]), grey_here);
+          continue;
+        }
+        fit.anchor_below = false;
+        if (fit.anchor_row < 0)
+          continue;
+        const bool same_surface =
+            std::abs(grey_here - fit.grey) <= tolerance && g2[u] - grey_here * grey_here <= max_variance;
+        double b, c;
+        if (!same_surface || !fit.solve(b, c)) {
+          fit.stop();
+          continue;
+        }
+        // On a plane n . X = d, 1/z = n . ray / d, so d(1/z)/dv = n_y / (fy d) and, with
+        // d <= |X| at the anchor, |n_y| <= |b| fy |X_anchor|.
+        const double inverse = c + b * v;
+        const float x = (static_cast<float>(u) - camera.cx) / camera.fx;
+        const double ray = std::sqrt(1.0 + x * x + y * y);
+        if (!(inverse > 0.0) || std::abs(b) * camera.fy * fit.anchor_depth * ray > config.facade_max_normal_y) {
+          fit.stop();
+          continue;
+        }
+        const float line_depth = static_cast<float>(1.0 / inverse);
+        const float height = static_cast<float>(fit.anchor_row - v) * line_depth / camera.fy;
+        const float sigma = fit.anchor_sigma + config.facade_sigma_per_m * height;
+        if (has_depth) {
+          const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
+          if (std::abs(z[u] - line_depth) <= 3.f * std::max(sigma, own_sigma))
+            continue; // it agrees: kept as it is
+        }
+        z[u] = line_depth;
+        w[u] = 1.f / (sigma * sigma);
+        if (f)
+          f[u] = w[u];
+        ++count;
+      }
+    }
+    extended += count;
+  });
+  return extended;
+}
+
+} // namespace msf

@@ -1,0 +1,164 @@
+// extendFacades: a LiDAR-backed wall goes on upward over the blank pixels above it, and nothing
+// else does: not the road, not a textured surface, not the sky.
+#include <msf/common/exceptions.h>
+#include <msf/fusion/facade_extension.h>
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include <cmath>
+
+namespace {
+
+constexpr int kWidth = 200, kHeight = 120;
+constexpr float kWall = 10.f;     // a wall facing the camera 10 m away
+constexpr int kWallTop = 20;      // rows above it are sky
+constexpr int kLidarTop = 70;     // the LiDAR's depth reaches up to this row
+constexpr float kLidarWeight = 1000.f; // sigma 3.2 cm
+
+msf::PinholeCamera camera() {
+  msf::PinholeCamera c;
+  c.fx = c.fy = 500.f;
+  c.cx = 100.f;
+  c.cy = 60.f;
+  c.width = kWidth;
+  c.height = kHeight;
+  return c;
+}
+
+/// The fused depth of a blank wall (grey 120 with noise of 2 levels) under a sky (grey 200):
+/// LiDAR-backed up to kLidarTop, nothing above.
+struct Wall {
+  cv::Mat grey, depth, weight, free_weight;
+  Wall()
+      : grey(kHeight, kWidth, CV_8UC1), depth(kHeight, kWidth, CV_32FC1, cv::Scalar(0)),
+        weight(kHeight, kWidth, CV_32FC1, cv::Scalar(0)) {
+    cv::Mat noise(kHeight, kWidth, CV_32FC1);
+    cv::RNG rng(7);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 2);
+    for (int v = 0; v < kHeight; ++v)
+      for (int u = 0; u < kWidth; ++u)
+        grey.at<std::uint8_t>(v, u) = cv::saturate_cast<std::uint8_t>((v < kWallTop ? 200.f : 120.f) + noise.at<float>(v, u));
+    depth.rowRange(kLidarTop, kHeight).setTo(kWall);
+    weight.rowRange(kLidarTop, kHeight).setTo(kLidarWeight);
+    free_weight = weight.clone();
+  }
+  std::size_t run(const msf::DepthFusionConfig& config = {}) {
+    return msf::extendFacades(grey, camera(), config, depth, weight, free_weight);
+  }
+};
+
+TEST(FacadeExtension, ABlankWallGoesOnUpToItsTopEdge) {
+  Wall wall;
+  const std::size_t extended = wall.run();
+  // Up each column to the wall's top edge, give or take the box filter's 2 rows.
+  int lowest_top = kHeight, highest_top = 0;
+  for (int u = 0; u < kWidth; ++u) {
+    int v = kLidarTop - 1;
+    while (v >= 0 && wall.depth.at<float>(v, u) > 0.f)
+      --v;
+    lowest_top = std::min(lowest_top, v + 1);
+    highest_top = std::max(highest_top, v + 1);
+  }
+  EXPECT_GE(lowest_top, kWallTop - 2);
+  EXPECT_LE(highest_top, kWallTop + 2);
+  for (int v = kWallTop + 3; v < kLidarTop; ++v)
+    for (int u = 0; u < kWidth; u += 7) {
+      ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
+      // Sigma: the last anchor's, plus 0.1 per metre above it.
+      const float height = (kLidarTop - v) * kWall / 500.f;
+      const float sigma = 1.f / std::sqrt(kLidarWeight) + 0.1f * height;
+      ASSERT_NEAR(wall.weight.at<float>(v, u), 1.f / (sigma * sigma), 1e-2f) << v;
+      ASSERT_EQ(wall.free_weight.at<float>(v, u), wall.weight.at<float>(v, u));
+    }
+  EXPECT_EQ(extended, static_cast<std::size_t>(cv::countNonZero(wall.depth.rowRange(0, kLidarTop))));
+  // The sky keeps no depth, the LiDAR's rows are unchanged.
+  EXPECT_EQ(cv::countNonZero(wall.depth.rowRange(0, kWallTop - 2)), 0);
+  EXPECT_EQ(cv::countNonZero(wall.depth.rowRange(kLidarTop, kHeight) != kWall), 0);
+}
+
+TEST(FacadeExtension, AWindowStopsItsColumns) {
+  // A dark window (grey 40) over rows 40-49 of columns 50-79: those columns go up to the
+  // window, not past it; the others go on to the top.
+  Wall wall;
+  wall.grey(cv::Rect(50, 40, 30, 10)).setTo(40);
+  wall.run();
+  for (int u = 55; u < 75; ++u) {
+    EXPECT_NEAR(wall.depth.at<float>(55, u), kWall, 1e-3f) << u;
+    EXPECT_EQ(cv::countNonZero(wall.depth(cv::Rect(u, 0, 1, 45))), 0) << u;
+  }
+  EXPECT_NEAR(wall.depth.at<float>(30, 20), kWall, 1e-3f);
+  EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
+}
+
+TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
+  Wall wall;
+  wall.depth.at<float>(50, 30) = 10.05f; // within 3 sigmas of the wall
+  wall.weight.at<float>(50, 30) = 25.f;
+  wall.depth.at<float>(50, 60) = 14.f; // SGBM's guess on a blank wall
+  wall.weight.at<float>(50, 60) = 4.f;
+  wall.run();
+  EXPECT_EQ(wall.depth.at<float>(50, 30), 10.05f);
+  EXPECT_EQ(wall.weight.at<float>(50, 30), 25.f);
+  EXPECT_NEAR(wall.depth.at<float>(50, 60), kWall, 1e-3f);
+  EXPECT_GT(wall.weight.at<float>(50, 60), 25.f);
+  EXPECT_NEAR(wall.depth.at<float>(40, 30), kWall, 1e-3f); // and the column goes on above both
+  EXPECT_NEAR(wall.depth.at<float>(40, 60), kWall, 1e-3f);
+}
+
+TEST(FacadeExtension, NotTheRoadNorATexturedSurface) {
+  // The road 1.65 m below the camera, LiDAR-backed from row 80 down, blank above it up to the
+  // horizon: its line leads into the sky, and it stays where it is.
+  Wall road;
+  road.depth.setTo(0);
+  road.weight.setTo(0);
+  road.grey.setTo(100);
+  for (int v = 80; v < kHeight; ++v) {
+    road.depth.row(v).setTo(500.f * 1.65f / (v - 60.f));
+    road.weight.row(v).setTo(kLidarWeight);
+  }
+  EXPECT_EQ(road.run(), 0u);
+  EXPECT_EQ(cv::countNonZero(road.depth.rowRange(0, 80)), 0);
+  // A wall with a texture of 4-pixel squares (grey 80 and 160) above the LiDAR: stereo's business.
+  Wall textured;
+  for (int v = 0; v < kLidarTop; ++v)
+    for (int u = 0; u < kWidth; ++u)
+      textured.grey.at<std::uint8_t>(v, u) = ((u / 4 + v / 4) % 2) ? 160 : 80;
+  textured.run();
+  EXPECT_LT(cv::countNonZero(textured.depth.rowRange(0, kLidarTop - 3)), kWidth / 10);
+}
+
+TEST(FacadeExtension, BadInputIsAClearError) {
+  Wall wall;
+  cv::Mat wrong_type;
+  wall.depth.convertTo(wrong_type, CV_64FC1);
+  EXPECT_EQ(msf::test::errorOf([&] {
+              msf::extendFacades(wall.grey, camera(), {}, wrong_type, wall.weight, wall.free_weight);
+            }),
+            "facade extension: the depth is a 200x120 image of type 6, expected type 5 of 200x120");
+  cv::Mat small_grey = wall.grey.rowRange(0, 100).clone();
+  EXPECT_THROW(msf::extendFacades(small_grey, camera(), {}, wall.depth, wall.weight, wall.free_weight),
+               msf::InvalidInputError);
+  cv::Mat no_weight;
+  EXPECT_THROW(msf::extendFacades(wall.grey, camera(), {}, wall.depth, no_weight, wall.free_weight),
+               msf::InvalidInputError);
+  msf::PinholeCamera other = camera();
+  other.width = 100;
+  EXPECT_THROW(msf::extendFacades(wall.grey, other, {}, wall.depth, wall.weight, wall.free_weight),
+               msf::InvalidInputError);
+  // Keys out of range are refused by name.
+  msf::DepthFusionConfig config;
+  config.facade_max_normal_y = 2.f;
+  EXPECT_EQ(msf::test::errorOf([&] { config.validate(); }),
+            "config key 'fusion.facade_max_normal_y' must be within [0, 1]");
+  config = {};
+  config.facade_anchor_sigma_m = 0.f;
+  EXPECT_THROW(config.validate(), msf::ConfigError);
+  config = {};
+  config.facade_max_texture = std::nanf("");
+  EXPECT_THROW(config.validate(), msf::ConfigError);
+}
+
+} // namespace
