@@ -93,6 +93,15 @@ TEST(FacadeExtension, AWindowStopsItsColumns) {
   EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
 }
 
+TEST(FacadeExtension, AnOverexposedSkyIsNoWall) {
+  // A white wall in the sun (grey 252, blank) under a sky as white: both are blank and alike,
+  // but a saturated pixel shows no surface, so nothing goes on above the LiDAR.
+  Wall wall;
+  wall.grey.setTo(252);
+  EXPECT_EQ(wall.run(), 0u);
+  EXPECT_EQ(cv::countNonZero(wall.depth.rowRange(0, kLidarTop)), 0);
+}
+
 TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
   Wall wall;
   wall.depth.at<float>(50, 30) = 10.05f; // within 3 sigmas of the wall

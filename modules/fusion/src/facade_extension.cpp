@@ -55,6 +55,10 @@ struct ColumnFit {
   }
 };
 
+/// An overexposed pixel (a bright sky, a glare; 30 % of raw 0009's top rows) shows no surface,
+/// however blank: a white wall's column stops there.
+constexpr float kOverexposed = 250.f;
+
 void checkImage(const cv::Mat& image, int type, const cv::Size& size, const std::string& what) {
   if (image.type() != type || image.size() != size)
     throw InvalidInputError("facade extension: " + what + " is a " + std::to_string(image.cols) + "x" +
@@ -110,8 +114,8 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         fit.anchor_below = false;
         if (fit.anchor_row < 0)
           continue;
-        const bool same_surface =
-            std::abs(grey_here - fit.grey) <= tolerance && g2[u] - grey_here * grey_here <= max_variance;
+        const bool same_surface = std::abs(grey_here - fit.grey) <= tolerance &&
+                                  g2[u] - grey_here * grey_here <= max_variance && grey_here < kOverexposed;
         double b, c;
         if (!same_surface || !fit.solve(b, c)) {
           fit.stop();

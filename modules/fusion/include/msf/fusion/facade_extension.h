@@ -22,7 +22,8 @@ namespace msf {
 /// - the image looks the same and blank: the grey's mean over 5x5 pixels stays within
 ///   facade_grey_tolerance of the run's, and its standard deviation there within
 ///   facade_max_texture (about twice the image noise: a window, the wall's top edge against the
-///   sky, another object or a texture stereo can match stops it).
+///   sky, another object or a texture stereo can match stops it), and not overexposed (a mean of
+///   250 or more: a bright sky is blank too).
 /// A pixel on the way takes the line's depth with the sigma of the run's last anchor plus
 /// facade_sigma_per_m per metre above it (a wall leaning by ~6 degrees), as its weight and free
 /// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the line's):
