@@ -1,6 +1,7 @@
 // Per-pixel depth fusion per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370):
 // the cloud class DepthFusion<PointXYZID, PointXYZRGBConfidence, PointXYZRGBWeight> and the
-// image-level DepthImageFusion, for both methods. Inputs (interpolated LiDAR with distances,
+// image-level DepthImageFusion, for both methods, and the facade extension after it
+// (extendFacades on the fused depth, its copy not timed). Inputs (interpolated LiDAR with distances,
 // SGBM with confidence) are made once before timing; cpu_ms_all_threads is the process CPU
 // time per frame (all threads).
 //
@@ -10,6 +11,7 @@
 
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/facade_extension.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/compound_interpolation.h>
@@ -30,7 +32,7 @@ struct Data {
   msf::Calibration calibration;
   std::vector<pcl::PointCloud<msf::PointXYZID>::Ptr> lidar;
   std::vector<pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr> stereo;
-  std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence;
+  std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence, left;
   Data() {
     const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
@@ -61,6 +63,7 @@ struct Data {
       lidar_distance.push_back(distance);
       stereo_depth.push_back(sgbm.getDepth());
       stereo_confidence.push_back(sgbm.getConfidence().clone());
+      left.push_back(f.left);
     }
   }
 };
@@ -109,6 +112,30 @@ void imageFusion(benchmark::State& state, msf::FusionMethod method, bool edge_su
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
 }
 
+void BM_FacadeExtension(benchmark::State& state) {
+  const Data& d = data();
+  const msf::DepthFusionConfig config;
+  msf::DepthImageFusion fusion(config);
+  fusion.setCalibration(d.calibration);
+  std::vector<cv::Mat> depth(d.lidar.size()), weight(d.lidar.size()), free(d.lidar.size());
+  for (std::size_t f = 0; f < d.lidar.size(); ++f)
+    fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], depth[f], &weight[f],
+                &free[f]);
+  const msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(d.calibration);
+  cv::Mat z, w, fw;
+  std::size_t i = 0, extended = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    state.PauseTiming();
+    depth[f].copyTo(z);
+    weight[f].copyTo(w);
+    free[f].copyTo(fw);
+    state.ResumeTiming();
+    extended += msf::extendFacades(d.left[f], camera, config, z, w, fw);
+  }
+  state.counters["pixels_extended"] = static_cast<double>(extended) / static_cast<double>(state.iterations());
+}
+
 void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Paper); }
 void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
 void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
@@ -125,5 +152,6 @@ BENCHMARK(BM_FusionCloudUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime
 BENCHMARK(BM_FusionImagePaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImageUncertaintyNoEdgeSupport)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_FacadeExtension)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
 
 BENCHMARK_MAIN();

@@ -19,10 +19,11 @@ namespace {
 /// anchor.
 struct ColumnFit {
   double sw = 0, sv = 0, svv = 0, si = 0, svi = 0;
-  float grey = 0;                    ///< the run's grey (a running mean)
-  int anchor_row = -1;               ///< row of the run's last anchor, -1: no run to go on from
-  float anchor_depth = 0, anchor_sigma = 0;
-  bool anchor_below = false;         ///< the row below was an anchor (the run goes on)
+  float grey = 0;            ///< the run's grey (a running mean)
+  float last_inverse = 0;    ///< 1 / depth of the run's last anchor
+  float anchor_weight = 0;
+  int anchor_row = -1;       ///< row of the run's last anchor, -1: no run to go on from
+  bool anchor_below = false; ///< the row below was an anchor (the run goes on)
 
   static constexpr double kDecay = 0.8;
 
@@ -35,22 +36,24 @@ struct ColumnFit {
     c = (si - b * sv) / sw;
     return true;
   }
-  void add(int v, float z, float sigma, float g) {
-    const double inv = 1.0 / z;
-    double b, c;
-    // A new run where the column's last was not just below, or where its line misses this
-    // anchor by more than 5 % (a depth edge between two LiDAR-backed surfaces).
-    if (!anchor_below || (solve(b, c) && std::abs(c + b * v - inv) > 0.05 * inv))
+  void add(int v, float z, float weight, float g) {
+    const float inverse = 1.f / z;
+    // A new run where the column's last was not just below, or where the depth jumps by more
+    // than 5 % from the row below (an edge between two LiDAR-backed surfaces).
+    if (!anchor_below || std::abs(inverse - last_inverse) > 0.05f * inverse) {
       *this = ColumnFit();
-    grey = sw > 0 ? 0.7f * grey + 0.3f * g : g;
+      grey = g;
+    } else {
+      grey = 0.7f * grey + 0.3f * g;
+    }
     sw = kDecay * sw + 1;
     sv = kDecay * sv + v;
     svv = kDecay * svv + static_cast<double>(v) * v;
-    si = kDecay * si + inv;
-    svi = kDecay * svi + v * inv;
+    si = kDecay * si + inverse;
+    svi = kDecay * svi + v * static_cast<double>(inverse);
+    last_inverse = inverse;
+    anchor_weight = weight;
     anchor_row = v;
-    anchor_depth = z;
-    anchor_sigma = sigma;
     anchor_below = true;
   }
 };
@@ -82,11 +85,10 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
                             std::to_string(camera.height) + ", fx " + std::to_string(camera.fx) +
                             ") does not fit the " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                             " depth");
-  // The grey's mean and variance over 5x5 pixels: a blank surface's is its noise's.
-  cv::Mat grey, mean, mean_square;
-  left.convertTo(grey, CV_32F);
-  cv::blur(grey, mean, cv::Size(5, 5));
-  cv::blur(grey.mul(grey), mean_square, cv::Size(5, 5));
+  // The grey's mean and mean square over 5x5 pixels: a blank surface's variance is its noise's.
+  cv::Mat mean, mean_square;
+  cv::boxFilter(left, mean, CV_32F, cv::Size(5, 5));
+  cv::sqrBoxFilter(left, mean_square, CV_32F, cv::Size(5, 5));
   const float anchor_weight = 1.f / (config.facade_anchor_sigma_m * config.facade_anchor_sigma_m);
   const float tolerance = config.facade_grey_tolerance;
   const float max_variance = config.facade_max_texture * config.facade_max_texture;
@@ -108,7 +110,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         const bool has_depth = z[u] > 0.f && std::isfinite(z[u]);
         const float grey_here = g[u];
         if (has_depth && w[u] >= anchor_weight) {
-          fit.add(v, z[u], 1.f / std::sqrt(w[u]), grey_here);
+          fit.add(v, z[u], w[u], grey_here);
           continue;
         }
         fit.anchor_below = false;
@@ -126,13 +128,13 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         const double inverse = c + b * v;
         const float x = (static_cast<float>(u) - camera.cx) / camera.fx;
         const double ray = std::sqrt(1.0 + x * x + y * y);
-        if (!(inverse > 0.0) || std::abs(b) * camera.fy * fit.anchor_depth * ray > config.facade_max_normal_y) {
+        if (!(inverse > 0.0) || std::abs(b) * camera.fy * ray > config.facade_max_normal_y * fit.last_inverse) {
           fit.stop();
           continue;
         }
         const float line_depth = static_cast<float>(1.0 / inverse);
         const float height = static_cast<float>(fit.anchor_row - v) * line_depth / camera.fy;
-        const float sigma = fit.anchor_sigma + config.facade_sigma_per_m * height;
+        const float sigma = 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
           if (std::abs(z[u] - line_depth) <= 3.f * std::max(sigma, own_sigma))
