@@ -196,6 +196,7 @@ TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {
                           "at the completeness of each other mesh", "| bar | vertices | accuracy m | completeness |"})
     EXPECT_NE(report.find(row), std::string::npos) << row << " not in report.md:\n" << report;
   EXPECT_NE(r.out.find("mesh_paper"), std::string::npos) << r.out; // the console's table
+  EXPECT_NE(r.out.find("mesh as complete as mesh_paper"), std::string::npos) << r.out;
 }
 
 TEST(ReconstructEvaluation, BadInputIsAClearErrorAndLeavesNoOutput) {
