@@ -38,6 +38,7 @@ ADDITIONS = [
     ("uncertainty fusion", ["fusion.method"], "depth"),
     ("eq. 6 weights relative to stereo's", ["fusion.paper_weights"], "depth"),
     ("edge support", ["fusion.edge_support"], "depth"),
+    ("facade extension", ["fusion.facade_extension"], "depth"),
     ("the integrator's settings (all below)", ["tsdf_integrator.*", "marching_cubes.min_weight"], "map"),
     ("per-pixel weights", ["tsdf_integrator.weighting"], "map"),
     ("plane distance", ["tsdf_integrator.signed_distance"], "map"),

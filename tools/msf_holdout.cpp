@@ -9,6 +9,7 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
 #include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/facade_extension.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
@@ -96,7 +97,8 @@ msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
 
 /// Paper steps 1-4 with the stages' configurations: compound interpolation of the input
 /// rings, SGBM (narrowed by it with stereo.prior_search_range, guided by the projected input
-/// rings with stereo.guidance lidar), and the per-pixel fusion of the two.
+/// rings with stereo.guidance lidar), and the per-pixel fusion of the two, with the facade
+/// extension after it (fusion.facade_extension) as in the pipeline.
 msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf::InterpolationConfig& interpolation,
                              const msf::SgbmConfig& stereo_config, const msf::DepthFusionConfig& fusion) {
   std::shared_ptr<msf::LidarCompletion> completion;
@@ -117,7 +119,14 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
     sgbm->setGuidance(sparse);
     sgbm->computeDisparity();
     fuser->setCalibration(*in.calibration);
-    fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
+    cv::Mat weight, no_free_space;
+    fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth, &weight);
+    if (fusion.facade_extension) {
+      msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(*in.calibration);
+      camera.width = depth.cols;
+      camera.height = depth.rows;
+      msf::extendFacades(in.left, camera, fusion, depth, weight, no_free_space);
+    }
     return depth;
   };
 }
