@@ -215,13 +215,13 @@ TEST(StereoConfidence, HandMadeDisparity) {
   cv::Mat d(1, 41, CV_32FC1, cv::Scalar(20.f));
   d.at<float>(0, 0) = 0.f;
   d.colRange(30, 41).setTo(26.f);
-  msf::StereoConfidenceConfig config; // hole 15 px, window 5, free 2 px, scale 2 px
+  msf::StereoConfidenceConfig config; // hole 15 px, window 5, free 1 px, scale 1 px
   const cv::Mat c = msf::stereoConfidence(d, config);
   EXPECT_EQ(c.at<float>(0, 0), 0.f);
   EXPECT_NEAR(c.at<float>(0, 1), 1.f - std::exp(-1.f / 15.f), 1e-5f);
   EXPECT_NEAR(c.at<float>(0, 20), 1.f - std::exp(-20.f / 15.f), 1e-5f);
-  // Within 2 columns of the step, the local range is 6 px: 4 px over the free 2 px.
-  EXPECT_NEAR(c.at<float>(0, 29), (1.f - std::exp(-29.f / 15.f)) * std::exp(-2.f), 1e-5f);
+  // Within 2 columns of the step, the local range is 6 px: 5 px over the free 1 px.
+  EXPECT_NEAR(c.at<float>(0, 29), (1.f - std::exp(-29.f / 15.f)) * std::exp(-5.f), 1e-5f);
   EXPECT_NEAR(c.at<float>(0, 27), 1.f - std::exp(-27.f / 15.f), 1e-5f);
   // Hole distances beyond the hole term's table (1024 px).
   cv::Mat wide(1, 2100, CV_32FC1, cv::Scalar(20.f));

@@ -13,8 +13,8 @@ namespace msf {
 struct StereoConfidenceConfig {
   float hole_distance_px = 15.f; ///< confidence 1 - exp(-distance to the nearest hole / this)
   int range_window_px = 5;       ///< odd window of the local disparity range
-  float range_free_px = 2.f;     ///< a local range up to this costs nothing
-  float range_scale_px = 2.f;    ///< beyond it, confidence falls as exp(-excess / this)
+  float range_free_px = 1.f;     ///< a local range up to this costs nothing
+  float range_scale_px = 1.f;    ///< beyond it, confidence falls as exp(-excess / this)
 
   /// Throws ConfigError naming the key of a value out of range.
   void validate() const;
