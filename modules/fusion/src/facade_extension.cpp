@@ -23,7 +23,7 @@ struct ColumnFit {
   float last_inverse = 0;    ///< 1 / depth of the run's last anchor
   float anchor_weight = 0;
   int anchor_row = -1;       ///< row of the run's last anchor, -1: no run to go on from
-  bool anchor_below = false; ///< the row below was an anchor (the run goes on)
+  bool run_below = false;    ///< the row below was the run's: an anchor, or a pixel its line reached
 
   static constexpr double kDecay = 0.8;
 
@@ -38,9 +38,9 @@ struct ColumnFit {
   }
   void add(int v, float z, float weight, float g) {
     const float inverse = 1.f / z;
-    // A new run where the column's last was not just below, or where the depth jumps by more
-    // than 5 % from the row below (an edge between two LiDAR-backed surfaces).
-    if (!anchor_below || std::abs(inverse - last_inverse) > 0.05f * inverse) {
+    // A new run where the row below was not the run's, or where the depth jumps by more than
+    // 5 % from the run's last anchor (an edge between two surfaces known that well).
+    if (!run_below || std::abs(inverse - last_inverse) > 0.05f * inverse) {
       *this = ColumnFit();
       grey = g;
     } else {
@@ -54,7 +54,7 @@ struct ColumnFit {
     last_inverse = inverse;
     anchor_weight = weight;
     anchor_row = v;
-    anchor_below = true;
+    run_below = true;
   }
 };
 
@@ -113,7 +113,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
           fit.add(v, z[u], w[u], grey_here);
           continue;
         }
-        fit.anchor_below = false;
+        fit.run_below = false;
         if (fit.anchor_row < 0)
           continue;
         const bool same_surface = std::abs(grey_here - fit.grey) <= tolerance &&
@@ -137,13 +137,16 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         const float sigma = 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
-          if (std::abs(z[u] - line_depth) <= 3.f * std::max(sigma, own_sigma))
+          if (std::abs(z[u] - line_depth) <= 3.f * std::max(sigma, own_sigma)) {
+            fit.run_below = true;
             continue; // it agrees: kept as it is
+          }
         }
         z[u] = line_depth;
         w[u] = 1.f / (sigma * sigma);
         if (f)
           f[u] = w[u];
+        fit.run_below = true;
         ++count;
       }
     }

@@ -14,9 +14,9 @@ namespace msf {
 /// continues each column's LiDAR-backed surface upward instead.
 ///
 /// Each column is walked from the bottom up. Its anchors are fused pixels known to within
-/// facade_anchor_sigma_m (LiDAR-backed); the last run of them is fitted with a line in inverse
-/// depth against the row (exact on any plane), its nearest rows weighing most. Above the run the
-/// line goes on, while
+/// facade_anchor_sigma_m (LiDAR-backed, or stereo near the cameras); the last run of them is
+/// fitted with a line in inverse depth against the row (exact on any plane), its nearest rows
+/// weighing most. Above the run the line goes on (an anchor it reaches joins the run), while
 /// - the surface is near vertical: the normal's component along the image's y axis is at most
 ///   facade_max_normal_y (a wall, not the road or a car's roof, whose line leads into the sky);
 /// - the image looks the same and blank: the grey's mean over 5x5 pixels stays within

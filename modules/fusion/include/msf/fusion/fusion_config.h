@@ -71,7 +71,7 @@ struct DepthFusionConfig {
 
   // --- after both: a LiDAR-backed wall goes on upward where the image stays blank (facade_extension.h)
   bool facade_extension = true;
-  float facade_anchor_sigma_m = 0.1f;         ///< anchors: fused pixels known to within this (LiDAR-backed)
+  float facade_anchor_sigma_m = 0.2f;         ///< anchors: fused pixels known to within this (LiDAR, near stereo)
   float facade_grey_tolerance = 8.f;          ///< grey levels from the anchors' run (5x5 box-filtered image)
   float facade_max_texture = 4.f;             ///< blank: grey levels of standard deviation over 5x5 pixels
   float facade_sigma_per_m = 0.1f;            ///< sigma's growth per metre above the last anchor
