@@ -9,7 +9,6 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
 #include <msf/fusion/depth_image_fusion.h>
-#include <msf/fusion/facade_extension.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
@@ -119,14 +118,8 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
     sgbm->setGuidance(sparse);
     sgbm->computeDisparity();
     fuser->setCalibration(*in.calibration);
-    cv::Mat weight, no_free_space;
-    fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth, &weight);
-    if (fusion.facade_extension) {
-      msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(*in.calibration);
-      camera.width = depth.cols;
-      camera.height = depth.rows;
-      msf::extendFacades(in.left, camera, fusion, depth, weight, no_free_space);
-    }
+    fuser->setInputImage(in.left);
+    fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
     return depth;
   };
 }

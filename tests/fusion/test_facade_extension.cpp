@@ -1,8 +1,10 @@
 // extendFacades: a LiDAR-backed wall goes on upward over the blank pixels above it, and nothing
 // else does: not the road, not a textured surface, not the sky.
 #include <msf/common/exceptions.h>
+#include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/facade_extension.h>
 
+#include "../stereo/stereo_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -140,6 +142,24 @@ TEST(FacadeExtension, NotTheRoadNorATexturedSurface) {
       textured.grey.at<std::uint8_t>(v, u) = ((u / 4 + v / 4) % 2) ? 160 : 80;
   textured.run();
   EXPECT_LT(cv::countNonZero(textured.depth.rowRange(0, kLidarTop - 3)), kWidth / 10);
+}
+
+TEST(FacadeExtension, TheImageFusionRunsItWhenGivenTheGreyImage) {
+  // DepthImageFusion (the pipeline's and msf_holdout's fusion): the LiDAR's wall alone, no
+  // stereo. Without the grey image nothing lies above the LiDAR; with it the wall goes on.
+  Wall wall;
+  msf::DepthImageFusion fusion;
+  fusion.setCalibration(msf::test::syntheticCalibration(cv::Size(kWidth, kHeight))); // camera()'s intrinsics
+  const cv::Mat no_returns_away(kHeight, kWidth, CV_32FC1, cv::Scalar(0)), no_stereo = no_returns_away;
+  cv::Mat fused;
+  fusion.fuse(wall.depth, no_returns_away, no_stereo, cv::Mat(), fused);
+  EXPECT_EQ(cv::countNonZero(fused.rowRange(0, kLidarTop)), 0);
+  fusion.setInputImage(wall.grey);
+  fusion.fuse(wall.depth, no_returns_away, no_stereo, cv::Mat(), fused);
+  for (int v = kWallTop + 3; v < kLidarTop; v += 5)
+    EXPECT_NEAR(fused.at<float>(v, 100), kWall, 1e-3f) << v;
+  fusion.setInputImage(wall.grey.rowRange(0, 100));
+  EXPECT_THROW(fusion.fuse(wall.depth, no_returns_away, no_stereo, cv::Mat(), fused), msf::InvalidInputError);
 }
 
 TEST(FacadeExtension, BadInputIsAClearError) {

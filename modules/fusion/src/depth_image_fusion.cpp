@@ -1,5 +1,6 @@
 #include <msf/common/exceptions.h>
 #include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/facade_extension.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -81,6 +82,8 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   });
   if (config_.edge_support)
     supportAtDepthEdges(lidar, distance, fB, config_, fused_depth, edge_buffers_);
+  if (config_.facade_extension && !left_.empty())
+    extendFacades(left_, calibration_, config_, fused_depth, weight, free_weight);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

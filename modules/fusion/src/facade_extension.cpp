@@ -155,4 +155,12 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
   return extended;
 }
 
+std::size_t extendFacades(const cv::Mat& left, const Calibration& calibration, const DepthFusionConfig& config,
+                          cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight) {
+  Calibration at_depth_size = calibration;
+  at_depth_size.image_size = depth.size();
+  return extendFacades(left, PinholeCamera::fromCalibration(at_depth_size, 0), config, depth, weight,
+                       free_space_weight);
+}
+
 } // namespace msf

@@ -1,6 +1,5 @@
 #include <msf/common/exceptions.h>
 #include <msf/fusion/depth_image_fusion.h>
-#include <msf/fusion/facade_extension.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline.h>
@@ -115,10 +114,9 @@ void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
 void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   DepthFrame& fused = result.fused;
+  stages_->fusion.setInputImage(frame.left); // for the facade extension
   stages_->fusion.fuse(result.lidar_depth, result.lidar_distance, result.stereo_depth, result.stereo_confidence,
                        fused.depth, &fused.weight, &fused.free_space_weight);
-  if (config_.fusion.facade_extension)
-    extendFacades(frame.left, camera_, config_.fusion, fused.depth, fused.weight, fused.free_space_weight);
   // Colour from the colour camera at the fused point, also where only the LiDAR has depth.
   fused.camera = camera_;
   const ColorSampler sampler = frame.color.empty()

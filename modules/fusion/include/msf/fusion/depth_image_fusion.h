@@ -30,13 +30,17 @@ public:
   const DepthFusionConfig& getConfig() const { return config_; }
   /// f B and the LiDAR's mounting over the camera. Throws CalibrationError without a baseline.
   void setCalibration(const Calibration& calibration);
+  /// Optional grey image of camera 0 (CV_8UC1, the depth images' size), for the next fuse():
+  /// with it and fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank
+  /// pixels above it (extendFacades). Empty: nothing after the fusion but edge support.
+  void setInputImage(const cv::Mat& left) { left_ = left; }
 
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]
   /// (empty: all 1); all of one size. Writes fused_depth (CV_32FC1, 0 = none) and, when
   /// given, fused_weight and free_space_weight (CV_32FC1, FusionResult). Throws
-  /// InvalidInputError naming the image whose type or size is wrong, CalibrationError when no
-  /// calibration was set.
+  /// InvalidInputError naming the image whose type or size is wrong (setInputImage's too),
+  /// CalibrationError when no calibration was set.
   void fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
             const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr,
             cv::Mat* free_space_weight = nullptr);
@@ -46,6 +50,7 @@ private:
   double focal_baseline_{0.0};
   Calibration calibration_;
   LidarParallax parallax_;
+  cv::Mat left_;                        ///< setInputImage's
   cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames
   cv::Mat weight_, free_weight_;        ///< weights when the caller wants none
   cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none

@@ -1,5 +1,6 @@
 #pragma once
 #include <msf/fusion/fusion_config.h>
+#include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
 
 #include <opencv2/core/mat.hpp>
@@ -34,6 +35,11 @@ namespace msf {
 /// parallel. Returns the number of pixels given a depth. Throws InvalidInputError for images of
 /// another type or size, or an invalid camera.
 std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, const DepthFusionConfig& config,
+                          cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight);
+
+/// The same through camera 0 of `calibration`, at the depth image's size (the fusion's form:
+/// DepthImageFusion and DepthFusion run it when given the grey image, setInputImage).
+std::size_t extendFacades(const cv::Mat& left, const Calibration& calibration, const DepthFusionConfig& config,
                           cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight);
 
 } // namespace msf

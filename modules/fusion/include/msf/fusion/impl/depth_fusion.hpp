@@ -119,18 +119,13 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   });
   if (config.edge_support)
     supportAtDepthEdges(lidar_depth_, lidar_distance_, fB, config, fused_depth_, edge_buffers_);
-  // Where neither input has a point (a wall the extension continued), the pixel's own ray.
-  PinholeCamera camera;
-  camera.fx = static_cast<float>(calibration_.fx());
-  camera.fy = static_cast<float>(calibration_.fy());
-  camera.cx = static_cast<float>(calibration_.cx());
-  camera.cy = static_cast<float>(calibration_.cy());
-  camera.width = cols;
-  camera.height = rows;
   if (config.facade_extension && !left_.empty()) {
     cv::Mat no_free_space;
-    extendFacades(left_, camera, config, fused_depth_, fused_weight_, no_free_space);
+    extendFacades(left_, calibration_, config, fused_depth_, fused_weight_, no_free_space);
   }
+  // Where neither input has a point (a wall the extension continued), the pixel's own ray.
+  const float fx = static_cast<float>(calibration_.fx()), fy = static_cast<float>(calibration_.fy());
+  const float cx = static_cast<float>(calibration_.cx()), cy = static_cast<float>(calibration_.cy());
 
   // 2. The points, on the rays of the input points.
   std::atomic<bool> dense{true};
@@ -154,8 +149,8 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
             p.x = (from_stereo ? s.x : l.x) * scale;
             p.y = (from_stereo ? s.y : l.y) * scale;
           } else {
-            p.x = (static_cast<float>(u) - camera.cx) * z / camera.fx;
-            p.y = (static_cast<float>(v) - camera.cy) * z / camera.fy;
+            p.x = (static_cast<float>(u) - cx) * z / fx;
+            p.y = (static_cast<float>(v) - cy) * z / fy;
           }
           p.z = z;
         } else {
