@@ -401,15 +401,14 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
     print_info("\n");
   }
   // The fused mesh's surest surface as complete as each other mesh (its weight curve).
-  for (const auto& fused : e.rows)
-    if (fused.score.source == "mesh" && fused.has_accuracy && !fused.accuracy.by_weight.empty())
-      for (const auto& other : e.rows)
-        if (&other != &fused && other.has_accuracy) {
-          const msf::WeightLevel l = fused.accuracy.by_weight.atCompleteness(other.accuracy.completeness);
-          print_info("  mesh as complete as %s (%.1f %%, %.3f m): its vertices of weight >= %.0f, %.1f %%, %.3f m\n",
-                     other.score.source.c_str(), 100 * other.accuracy.completeness, other.accuracy.accuracy_mean_m,
-                     l.min_weight, 100 * l.completeness, l.accuracy_mean_m);
-        }
+  if (const auto* fused = e.fusedCurveRow())
+    for (const auto& other : e.rows)
+      if (&other != fused && other.has_accuracy) {
+        const msf::WeightLevel l = fused->accuracy.by_weight.atCompleteness(other.accuracy.completeness);
+        print_info("  mesh as complete as %s (%.1f %%, %.3f m): its vertices of weight >= %.0f, %.1f %%, %.3f m\n",
+                   other.score.source.c_str(), 100 * other.accuracy.completeness, other.accuracy.accuracy_mean_m,
+                   l.min_weight, 100 * l.completeness, l.accuracy_mean_m);
+      }
   if (!e.no_ghosts.empty())
     print_info("  no ghost figure: %s\n", e.no_ghosts.c_str());
 }

@@ -113,14 +113,6 @@ std::string levelJson(const WeightLevel& l) {
          ", \"accuracy_mean_m\": " + num(l.accuracy_mean_m) + ", \"completeness\": " + num(l.completeness) + "}";
 }
 
-/// The fused mesh's row with a weight curve, if any.
-const RunReport::MapEvaluation::Row* fusedCurveRow(const RunReport::MapEvaluation& e) {
-  for (const auto& r : e.rows)
-    if (r.score.source == "mesh" && r.has_accuracy && !r.accuracy.by_weight.empty())
-      return &r;
-  return nullptr;
-}
-
 std::string accuracyJson(const MeshAccuracy& m) {
   std::string curve;
   if (!m.by_weight.empty())
@@ -201,6 +193,13 @@ double residentMemoryMb() {
   if (!(statm >> pages_total >> pages_resident))
     return 0.0;
   return pages_resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+const RunReport::MapEvaluation::Row* RunReport::MapEvaluation::fusedCurveRow() const {
+  for (const auto& r : rows)
+    if (r.score.source == "mesh" && r.has_accuracy && !r.accuracy.by_weight.empty())
+      return &r;
+  return nullptr;
 }
 
 double RunReport::framesPerSecond() const {
@@ -303,7 +302,7 @@ void RunReport::writeSummaryJson(const std::string& path) const {
           << in << "\"moving_all\": " << metricsJson(r.score.moving_all, in);
       if (r.has_accuracy)
         s << ",\n" << in << "\"accuracy\": " << accuracyJson(r.accuracy);
-      if (&r == fusedCurveRow(e)) {
+      if (&r == e.fusedCurveRow()) {
         // The fused mesh's surest surface that is as complete as each other mesh.
         std::string matched;
         for (const auto& other : e.rows)
@@ -494,7 +493,7 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
   if (accuracy)
     s << "Accuracy: mean distance of the mesh's vertices to the true surface; completeness: share of the seen true "
          "surface within the threshold of the mesh (as above).\n";
-  if (const MapEvaluation::Row* fused = fusedCurveRow(e)) {
+  if (const MapEvaluation::Row* fused = e.fusedCurveRow()) {
     std::string rows;
     for (const auto& other : e.rows)
       if (&other != fused && other.has_accuracy) {

@@ -50,6 +50,8 @@ public:
     bool moving_split = false;     ///< the dataset marks moving objects (gt/moving_0)
     std::string no_ghosts;         ///< why there is no ghost figure, when there is none
     std::vector<Row> rows;         ///< empty without ground truth
+    /// The fused mesh's row ("mesh") when it has a weight curve (MeshAccuracy::by_weight), else null.
+    const Row* fusedCurveRow() const;
   };
 
   std::string dataset;            ///< folder reconstructed
