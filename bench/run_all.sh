@@ -16,3 +16,5 @@ echo "== bench_pipeline.sh"
 "$(dirname "$0")/bench_pipeline.sh" "$bin" "$kitti" 5
 echo "== bench_reconstruction.sh"
 "$(dirname "$0")/bench_reconstruction.sh" "$bin" "$kitti"
+echo "== bench_stereo_sigma.sh"
+"$(dirname "$0")/bench_stereo_sigma.sh" "$bin" "$kitti"

@@ -2,11 +2,16 @@
 // background, foreground and all pixels, the paper's eq. 8 mean absolute error, density.
 // Given two folders, every frame of the estimate folder against its ground truth, summed
 // over the pixels of all frames (a synthetic sequence's gt/disp_0, split by gt/obj_map_0).
+// With -confidence, also the error by the matcher's confidence beside the fusion's sigma model.
 #include <msf/common/atomic_file.h>
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
+#include <msf/evaluation/confidence_calibration.h>
 #include <msf/evaluation/disparity_metrics.h>
+#include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
+#include <msf/io/point_types.h>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -23,9 +28,27 @@ void printRow(const char* name, const msf::DisparityRegionErrors& r) {
               100.0 * r.density(), r.meanAbsError(), r.bad, r.gt_pixels);
 }
 
-/// One frame: the disparities and, when `obj_map_path` is not empty, the object map.
+/// The confidence field of an organized cloud (msf_stereo's output) as an image of `size`.
+cv::Mat readConfidence(const std::string& path, const cv::Size& size) {
+  pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
+  msf::loadCloud(path, cloud);
+  if (static_cast<int>(cloud.width) != size.width || static_cast<int>(cloud.height) != size.height)
+    throw msf::InvalidInputError("confidence cloud '" + path + "' is " + std::to_string(cloud.width) + "x" +
+                                 std::to_string(cloud.height) + " but the ground truth is " +
+                                 std::to_string(size.width) + "x" + std::to_string(size.height) +
+                                 " (it must be the organized cloud of the estimate, as msf_stereo writes)");
+  cv::Mat confidence(size, CV_32FC1);
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u)
+      confidence.at<float>(v, u) = cloud(u, v).confidence;
+  return confidence;
+}
+
+/// One frame: the disparities and, when `obj_map_path` is not empty, the object map; with a
+/// `confidence_path`, its pixels also go into `calibration`.
 msf::DisparityEvaluation evaluateFiles(const std::string& gt_path, const std::string& est_path,
-                                       const std::string& obj_map_path, const msf::DisparityEvalOptions& options) {
+                                       const std::string& obj_map_path, const msf::DisparityEvalOptions& options,
+                                       const std::string& confidence_path, msf::ConfidenceCalibration& calibration) {
   const cv::Mat gt = msf::readKittiDisparityPng(gt_path);
   const cv::Mat est = msf::readKittiDisparityPng(est_path);
   if (est.size() != gt.size())
@@ -43,10 +66,36 @@ msf::DisparityEvaluation evaluateFiles(const std::string& gt_path, const std::st
                                    std::to_string(gt.cols) + "x" + std::to_string(gt.rows));
   }
   const msf::DisparityEvaluation e = msf::evaluateDisparity(gt, est, obj_map, options);
+  if (!confidence_path.empty())
+    calibration.add(gt, est, readConfidence(confidence_path, gt.size()));
   // A ground truth without a valid pixel scores nothing: D1 0.00 % would read as perfect.
   if (e.all.gt_pixels == 0)
     throw msf::InvalidInputError("ground truth '" + gt_path + "' has no valid pixel (every disparity is 0)");
   return e;
+}
+
+/// The error by confidence: measured (robust sigma, the outliers beyond the D1 threshold
+/// apart) against the fusion's sigma for that confidence.
+void printCalibration(const msf::ConfidenceCalibration& calibration, const msf::DepthFusionConfig& model,
+                      float outlier_px) {
+  if (calibration.pixels() == 0)
+    throw msf::InvalidInputError("-confidence: no pixel has a ground truth, an estimate and a confidence");
+  std::printf("\nerror by stereo confidence (the fusion's sigma: %g px at confidence 1, %g px at 0)\n",
+              model.stereo_sigma_min_px, model.stereo_sigma_max_px);
+  const std::string beyond = "> " + msf::configValue(outlier_px) + " px";
+  std::printf("%-11s %9s  %9s  %9s  %12s  %8s  %12s  %9s\n", "confidence", "pixels", "mean conf", "median px",
+              "robust sd px", beyond.c_str(), "model sd px", "sd/model");
+  for (const auto& r : calibration.rows(model, outlier_px)) {
+    if (r.pixels == 0) {
+      std::printf("%4.2f-%4.2f  %9zu\n", r.lo, r.hi, r.pixels);
+      continue;
+    }
+    std::printf("%4.2f-%4.2f  %9zu  %9.3f  %+9.3f  %12.3f  %6.2f %%  %12.3f  %9.2f\n", r.lo, r.hi, r.pixels,
+                r.mean_confidence, r.median_px, r.robust_sigma_px, 100.0 * r.outlier_share, r.model_sigma_px,
+                r.robust_sigma_px / r.model_sigma_px);
+  }
+  std::printf("(robust sd: 1.4826 x the median absolute deviation of estimate - truth; %s: the share of errors "
+              "beyond -abs_px)\n", beyond.c_str());
 }
 
 bool isDirectory(const std::string& path) {
@@ -66,9 +115,11 @@ std::string siblingObjectMapDir(const std::string& gt_dir) {
   return "";
 }
 
-/// Folder mode: every *.png of est_dir against gt_dir (and obj_map_dir when not empty).
+/// Folder mode: every *.png of est_dir against gt_dir (and obj_map_dir, confidence_dir when
+/// not empty: NNNNNN.png and NNNNNN.pcd).
 msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::string& est_dir,
                                          const std::string& obj_map_dir, const msf::DisparityEvalOptions& options,
+                                         const std::string& confidence_dir, msf::ConfidenceCalibration& calibration,
                                          std::size_t& frames) {
   namespace fs = std::filesystem;
   std::vector<std::string> names;
@@ -87,8 +138,14 @@ msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::s
         throw msf::InvalidInputError("object map '" + obj_map_path + "' for estimate '" + est_path +
                                      "' does not exist");
     }
-    const msf::DisparityEvaluation e = evaluateFiles(gt_path, est_path, obj_map_path, options);
-    sum += e;
+    std::string confidence_path;
+    if (!confidence_dir.empty()) {
+      confidence_path = (fs::path(confidence_dir) / fs::path(name).replace_extension(".pcd")).string();
+      if (!fs::is_regular_file(confidence_path))
+        throw msf::InvalidInputError("confidence cloud '" + confidence_path + "' for estimate '" + est_path +
+                                     "' does not exist");
+    }
+    sum += evaluateFiles(gt_path, est_path, obj_map_path, options, confidence_path, calibration);
   }
   frames = names.size();
   return sum;
@@ -98,7 +155,8 @@ msf::DisparityEvaluation evaluateFolders(const std::string& gt_dir, const std::s
 
 int main(int argc, char** argv) {
   msf::DisparityEvalOptions options;
-  std::string obj_map_path, obj_map_dir;
+  std::string obj_map_path, obj_map_dir, confidence;
+  msf::DepthFusionConfig model;
   msf::tool::CommandLine cli(
       "msf_eval_disparity", "<gt.png> <est.png> [options]\n<gt_dir> <est_dir> [options]",
       "KITTI 16-bit disparity PNGs (pixels x 256, 0 = none): D1 outliers (error > 3 px and > 5 %), mean absolute "
@@ -112,7 +170,12 @@ int main(int argc, char** argv) {
             "fill missing estimates as the devkit does (background interpolation); without it a missing estimate "
             "counts as bad in D1")
       .value("-abs_px", "X", options.abs_threshold_px, "absolute threshold in pixels (default {default})")
-      .value("-rel", "X", options.rel_threshold, "relative threshold (default {default})");
+      .value("-rel", "X", options.rel_threshold, "relative threshold (default {default})")
+      .value("-confidence", "PATH", confidence,
+             "the estimate's confidence: msf_stereo's output cloud (field confidence), or with folders a folder of "
+             "NNNNNN.pcd; adds the error by confidence beside the sigma the fusion assumes for it")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "fusion", model); },
+             "YAML config, section fusion: the sigma model of -confidence (stereo_sigma_min_px, stereo_sigma_max_px)");
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <gt.png> <est.png> or <gt_dir> <est_dir> (see -h)");
@@ -123,7 +186,12 @@ int main(int argc, char** argv) {
     if (folders != isDirectory(files[1]))
       throw msf::InvalidInputError("'" + files[0] + "' and '" + files[1] +
                                    "' must both be PNG files or both be folders");
+    if (!confidence.empty() && folders != isDirectory(confidence))
+      throw msf::InvalidInputError("-confidence '" + confidence + "' must be " +
+                                   (folders ? "a folder of NNNNNN.pcd, as the estimates are folders"
+                                            : "a .pcd file, as the estimate is one frame"));
     std::size_t frames = 1;
+    msf::ConfidenceCalibration calibration;
     msf::DisparityEvaluation e;
     if (folders) {
       if (!obj_map_path.empty())
@@ -132,11 +200,11 @@ int main(int argc, char** argv) {
         obj_map_dir = siblingObjectMapDir(files[0]);
       else if (!isDirectory(obj_map_dir))
         throw msf::InvalidInputError("-obj_map_dir '" + obj_map_dir + "' is not a folder");
-      e = evaluateFolders(files[0], files[1], obj_map_dir, options, frames);
+      e = evaluateFolders(files[0], files[1], obj_map_dir, options, confidence, calibration, frames);
     } else {
       if (!obj_map_dir.empty())
         throw msf::InvalidInputError("-obj_map_dir is for folders; with one frame use -obj_map");
-      e = evaluateFiles(files[0], files[1], obj_map_path, options);
+      e = evaluateFiles(files[0], files[1], obj_map_path, options, confidence, calibration);
     }
 
     if (folders)
@@ -153,6 +221,8 @@ int main(int argc, char** argv) {
                 100.0 * options.rel_threshold,
                 options.interpolate_background ? "missing estimates interpolated as the devkit"
                                                : "missing estimates count as bad");
+    if (!confidence.empty())
+      printCalibration(calibration, model, options.abs_threshold_px);
     return 0;
   });
 }
