@@ -39,7 +39,7 @@ ADDITIONS = [
     ("eq. 6 weights relative to stereo's", ["fusion.paper_weights"], "depth"),
     ("edge support", ["fusion.edge_support"], "depth"),
     ("facade extension", ["fusion.facade_extension"], "depth"),
-    ("the integrator's settings (all below)", ["tsdf_integrator.*", "marching_cubes.min_weight"], "map"),
+    ("the integrator's settings (all below)", ["tsdf_integrator.*", "marching_cubes.min_weight", "marching_cubes.max_unseen_corners"], "map"),
     ("per-pixel weights", ["tsdf_integrator.weighting"], "map"),
     ("plane distance", ["tsdf_integrator.signed_distance"], "map"),
     ("bands of 2 sigma", ["tsdf_integrator.truncation_sigmas"], "map"),
@@ -49,6 +49,7 @@ ADDITIONS = [
     ("bilinear depth", ["tsdf_integrator.interpolate_depth"], "map"),
     ("lambda 0 (eq. 7 off)", ["tsdf_integrator.lambda", "tsdf_integrator.solve"], "map"),
     ("marching cubes min_weight", ["marching_cubes.min_weight"], "map"),
+    ("a cube's corner no frame reached", ["marching_cubes.max_unseen_corners"], "map"),
 ]
 
 

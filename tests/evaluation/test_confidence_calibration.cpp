@@ -122,7 +122,7 @@ TEST(EvalDisparityTool, ErrorByConfidenceBesideTheFusionSigma) {
   auto r = msf::test::runTool("msf_eval_disparity",
                               tmp.file("gt.png") + " " + tmp.file("est.png") + " -confidence " + tmp.file("est.pcd"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("error by stereo confidence (the fusion's sigma: 0.5 px at confidence 1, 2.5 px at 0)"),
+  EXPECT_NE(r.out.find("error by stereo confidence (the fusion's sigma: 0.35 px at confidence 1, 1.75 px at 0)"),
             std::string::npos)
       << r.out;
   // The bins of 0.1 and 0.95 (the PNGs keep 1/256 px).

@@ -7,6 +7,7 @@
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -158,6 +159,79 @@ TEST(MarchingCubes, MinimumWeightDropsWeakVoxels) {
   MarchingCubes::Config bad;
   bad.min_weight = -1.f;
   EXPECT_THROW(MarchingCubes{bad}, ConfigError);
+}
+
+namespace {
+
+/// The plane sdf = 0.25 - z over one block (0.1 m voxels, weight 100), with `unseen` voxels
+/// (x, y, z) at weight 0, as a frame's band leaves them behind a grazing surface.
+TsdfVolume planeWithUnseenVoxels(const std::vector<std::array<int, 3>>& unseen) {
+  TsdfVolume volume(0.1, 0.5);
+  TsdfBlock& block = volume.allocateBlock(GridIndex(0, 0, 0));
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        TsdfVoxel& v = block.at(x, y, z);
+        v.sdf = 0.25f - 0.1f * static_cast<float>(z);
+        v.weight = 100.f;
+      }
+  for (const auto& u : unseen) {
+    TsdfVoxel& v = block.at(u[0], u[1], u[2]);
+    v.sdf = 0.f;
+    v.weight = 0.f;
+  }
+  block.stamp = volume.beginGeneration();
+  block.updateSigns();
+  return volume;
+}
+
+TriangleMesh meshOf(const TsdfVolume& volume, int max_unseen_corners) {
+  MarchingCubes::Config c;
+  c.min_component_triangles = 0;
+  c.smoothing_lambda = 0.f;
+  c.max_unseen_corners = max_unseen_corners;
+  TriangleMesh mesh;
+  MarchingCubes(c).extract(volume, mesh);
+  return mesh;
+}
+
+} // namespace
+
+TEST(MarchingCubes, ACornerNoFrameReachedBehindTheSurfaceLeavesNoHole) {
+  // 8 x 8 voxel columns -> 7 x 7 cubes -> 98 triangles at z = 0.25 (between voxel layers 2 and 3).
+  EXPECT_EQ(meshOf(planeWithUnseenVoxels({}), 1).triangles.size(), 98u);
+  // Voxel (3, 3, 3), just behind the plane, unseen: the 4 cubes around it lose it as a corner.
+  const TsdfVolume one = planeWithUnseenVoxels({{3, 3, 3}});
+  EXPECT_EQ(meshOf(one, 0).triangles.size(), 98u - 8u); // a hole of 4 cubes
+  const TriangleMesh filled = meshOf(one, 1);
+  ASSERT_EQ(filled.triangles.size(), 98u);
+  // The unseen corner is taken a voxel behind the surface: the edges to it from the seen voxel
+  // above (sdf 0.05) are crossed at 0.05 / (0.05 + 0.1) of the edge, z = 0.2 + 0.033; the others exact.
+  ASSERT_EQ(filled.weights.size(), filled.vertices.size());
+  std::size_t guessed = 0;
+  for (std::size_t k = 0; k < filled.vertices.size(); ++k) {
+    const float z = filled.vertices[k].z();
+    if (filled.weights[k] > 0.f) {
+      EXPECT_NEAR(z, 0.25f, 1e-5f);
+    } else { // next to the unseen voxel: no evidence of its own
+      ++guessed;
+      EXPECT_NEAR(z, 0.2f + 0.1f / 3.f, 1e-5f);
+      EXPECT_NEAR(filled.vertices[k].x(), 0.3f, 1e-5f);
+      EXPECT_NEAR(filled.vertices[k].y(), 0.3f, 1e-5f);
+    }
+  }
+  EXPECT_EQ(guessed, 1u);
+  // Two unseen corners in one cube: filled only with max_unseen_corners 2.
+  const TsdfVolume two = planeWithUnseenVoxels({{3, 3, 3}, {4, 3, 3}});
+  EXPECT_LT(meshOf(two, 1).triangles.size(), 98u);
+  EXPECT_EQ(meshOf(two, 2).triangles.size(), 98u);
+  // A cube whose seen corners are all on one side (here all free space) is not a surface.
+  const TsdfVolume free_corner = planeWithUnseenVoxels({{3, 3, 0}});
+  EXPECT_EQ(meshOf(free_corner, 4).triangles.size(), 98u);
+  MarchingCubes::Config bad;
+  bad.max_unseen_corners = 5;
+  EXPECT_NE(test::errorOf([&] { MarchingCubes{bad}; }).find("marching_cubes.max_unseen_corners must be in 0..4"),
+            std::string::npos);
 }
 
 TEST(MarchingCubes, SmoothingMovesWhatIsUncertainAndKeepsWhatIsKnown) {

@@ -86,6 +86,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.lambda = 5.0;
   c.integrator.solve = TsdfIntegrator::Solve::Argmin;
   c.mesher.min_weight = 0.f;
+  c.mesher.max_unseen_corners = 0;
   c.mesher.smoothing_lambda = 0.f;
   c.mesher.min_component_triangles = 0;
   c.validate();

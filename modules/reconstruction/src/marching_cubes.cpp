@@ -29,6 +29,8 @@ constexpr int kHalo = kSide + 3; // smoothed, those grid points read one voxel m
 
 // Bourke's corner numbering and edges, those of PCL's tables (see marching_cubes_tables.cpp).
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+/// A crossing this near an edge's end (a share of the edge) is at the end's voxel.
+constexpr float kOnVoxel = 1e-5f;
 constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
 
@@ -58,7 +60,8 @@ struct Scratch {
   // of a row's mask is voxel x, and each row's voxels are found through two pointers (x < 8
   // in one block, x = 8 in its +x neighbour), so no voxel is copied.
   std::array<std::uint16_t, kPad * kPad> valid; // weight > min_weight
-  std::array<std::uint16_t, kPad * kPad> negative; // sdf < 0
+  std::array<std::uint16_t, kPad * kPad> negative; // sdf < 0 and valid
+  std::array<std::uint16_t, kPad * kPad> unseen;   // weight 0 (no frame reached it)
   std::array<std::array<const TsdfVoxel*, 2>, kPad * kPad> row;
   std::array<float, kPad * kPad * kPad> sdf; // of the 9^3 grid points (x + 9 (y + 9 z)), smoothed or not
   std::array<float, kHalo * kHalo * kHalo> halo_sdf, halo_weight; // -1..9 on each axis, for smoothing
@@ -112,6 +115,7 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
                    MarchingCubes::BlockMesh& out, Scratch& s) {
   const float vs = static_cast<float>(volume.voxelSize());
   const float min_weight = config.min_weight;
+  const int max_unseen = config.max_unseen_corners;
   const bool smooth = config.smoothing_lambda > 0.f;
 
   if (block.signs == 0)
@@ -141,7 +145,7 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
     for (int y = 0; y < kPad; ++y) {
       const int r = y + kPad * z;
       const int sel = ((y >> 3) << 1) | ((z >> 3) << 2);
-      std::uint16_t valid = 0, negative = 0;
+      std::uint16_t valid = 0, negative = 0, unseen = 0;
       for (int part = 0; part < 2; ++part) {
         const TsdfBlock* b = nb[sel | part];
         s.row[r][part] = b ? &b->at(0, y & 7, z & 7) : nullptr;
@@ -153,12 +157,14 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
           if (!smooth)
             sdf[x] = src[k].sdf;
           valid |= static_cast<std::uint16_t>((src[k].weight > min_weight) << x);
+          unseen |= static_cast<std::uint16_t>((src[k].weight <= 0.f) << x);
           negative |= static_cast<std::uint16_t>((sdf[x] < 0.f) << x);
         }
       }
       negative &= valid;
       s.valid[r] = valid;
       s.negative[r] = negative;
+      s.unseen[r] = unseen;
       any_negative |= negative;
       any_positive |= valid & ~negative;
     }
@@ -177,12 +183,15 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
     if (code < 3)
       p[code] += t;
     out.vertices.push_back(p * vs);
-    const std::uint8_t ca[3] = {a.r, a.g, a.b}, cb[3] = {b.r, b.g, b.b};
+    // An unseen voxel (a filled cube's corner) has no colour: its edge takes the other end's.
+    const TsdfVoxel& colour_a = a.weight > 0.f ? a : b;
+    const TsdfVoxel& colour_b = b.weight > 0.f ? b : a;
+    const std::uint8_t ca[3] = {colour_a.r, colour_a.g, colour_a.b}, cb[3] = {colour_b.r, colour_b.g, colour_b.b};
     std::array<std::uint8_t, 3> c;
     for (int k = 0; k < 3; ++k)
       c[k] = static_cast<std::uint8_t>(ca[k] + t * (static_cast<float>(cb[k]) - ca[k]) + 0.5f);
     out.colors.push_back(c);
-    out.weights.push_back(std::min(a.weight, b.weight));
+    out.weights.push_back(std::min(a.weight, b.weight)); // 0 next to an unseen corner: no evidence
     // Interior: every cube around this edge (or voxel) belongs to this block, so no other
     // block makes this vertex.
     const int q[3] = {px, py, pz};
@@ -204,20 +213,40 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
       const unsigned all_negative = n00 & n10 & n01 & n11, any_neg = n00 | n10 | n01 | n11;
       // Cubes whose 8 corners are observed and not all of one sign.
       unsigned active = valid4 & (valid4 >> 1) & (any_neg | (any_neg >> 1)) & ~(all_negative & (all_negative >> 1)) & 0xffu;
-      for (; active; active &= active - 1) {
+      // Cubes whose unseen corners lie behind the surface (Config::max_unseen_corners): every
+      // corner valid or unseen, a valid one on each side, and at most max_unseen_corners unseen.
+      const unsigned u00 = s.unseen[r00], u10 = s.unseen[r10], u01 = s.unseen[r01], u11 = s.unseen[r11];
+      unsigned filled = 0;
+      if (max_unseen > 0) {
+        const unsigned known4 = (s.valid[r00] | u00) & (s.valid[r10] | u10) & (s.valid[r01] | u01) & (s.valid[r11] | u11);
+        const unsigned any_pos = (s.valid[r00] & ~n00) | (s.valid[r10] & ~n10) | (s.valid[r01] & ~n01) | (s.valid[r11] & ~n11);
+        for (unsigned c = known4 & (known4 >> 1) & (any_pos | (any_pos >> 1)) & (any_neg | (any_neg >> 1)) & ~active & 0xffu;
+             c; c &= c - 1) {
+          const int x = __builtin_ctz(c);
+          const unsigned corners = ((u00 >> x) & 3) | ((u10 >> x) & 3) << 2 | ((u01 >> x) & 3) << 4 | ((u11 >> x) & 3) << 6;
+          filled |= (__builtin_popcount(corners) <= max_unseen ? 1u : 0u) << x;
+        }
+      }
+      for (active |= filled; active; active &= active - 1) {
         const int x = __builtin_ctz(active);
+        // An unseen corner of a filled cube is a voxel behind the surface: an edge from a seen
+        // corner at distance p to it is crossed p / (p + voxel) along, which is p for a small p.
+        const bool fill = (filled >> x) & 1;
+        const unsigned m00 = fill ? n00 | u00 : n00, m10 = fill ? n10 | u10 : n10;
+        const unsigned m01 = fill ? n01 | u01 : n01, m11 = fill ? n11 | u11 : n11;
         // Bourke's corners 0..7: (0,0,0) (1,0,0) (1,1,0) (0,1,0) (0,0,1) (1,0,1) (1,1,1) (0,1,1).
-        const int cube = static_cast<int>(((n00 >> x) & 1) | ((n00 >> x) & 2) | ((n10 >> x) & 2) << 1 | ((n10 >> x) & 1) << 3 |
-                                          ((n01 >> x) & 1) << 4 | ((n01 >> x) & 2) << 4 | ((n11 >> x) & 2) << 5 |
-                                          ((n11 >> x) & 1) << 7);
+        const int cube = static_cast<int>(((m00 >> x) & 1) | ((m00 >> x) & 2) | ((m10 >> x) & 2) << 1 | ((m10 >> x) & 1) << 3 |
+                                          ((m01 >> x) & 1) << 4 | ((m01 >> x) & 2) << 4 | ((m11 >> x) & 2) << 5 |
+                                          ((m11 >> x) & 1) << 7);
         const unsigned int edges = detail::kEdgeTable[cube];
         const TsdfVoxel* c[8];
         float d[8];
         for (int i = 0; i < 8; ++i) {
           const int px = x + kCorner[i][0], py = y + kCorner[i][1], pz = z + kCorner[i][2];
           c[i] = &s.voxel(px, py, pz);
-          d[i] = s.sdf[px + kPad * (py + kPad * pz)];
+          d[i] = fill && c[i]->weight <= 0.f ? -vs : s.sdf[px + kPad * (py + kPad * pz)];
         }
+
         std::uint32_t vert[12];
         for (int e = 0; e < 12; ++e) {
           if (!(edges & (1u << e)))
@@ -232,13 +261,15 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
           const TsdfVoxel& b = *c[ib];
           const float da = d[ia], db = d[ib];
           const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
-          // A voxel with sdf exactly 0 is the vertex of all its edges (no duplicate positions).
-          if (da == 0.f)
+          // A voxel at the crossing (sdf 0, or so near it that the vertex would round to the voxel's
+          // position) is the vertex of all its edges (no duplicate positions).
+          const float t = da / (da - db);
+          if (!(t > kOnVoxel))
             vert[e] = vertexOf(px, py, pz, 3, 0.f, a, a);
-          else if (db == 0.f)
+          else if (!(t < 1.f - kOnVoxel))
             vert[e] = vertexOf(px + (axis == 0), py + (axis == 1), pz + (axis == 2), 3, 0.f, b, b);
           else
-            vert[e] = vertexOf(px, py, pz, axis, da / (da - db), a, b);
+            vert[e] = vertexOf(px, py, pz, axis, t, a, b);
         }
         const int* tri = detail::kTriTable[cube];
         for (int t = 0; tri[t] != -1; t += 3) {
@@ -389,6 +420,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
 
 void MarchingCubes::Config::read(const cv::FileNode& node) {
   readKey(node, "min_weight", min_weight);
+  readKey(node, "max_unseen_corners", max_unseen_corners);
   readKey(node, "smoothing_lambda", smoothing_lambda);
   readKey(node, "min_component_triangles", min_component_triangles);
   readKey(node, "component_keep_weight", component_keep_weight);
@@ -398,6 +430,9 @@ void MarchingCubes::Config::read(const cv::FileNode& node) {
 void MarchingCubes::Config::validate() const {
   if (!(min_weight >= 0.f))
     throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(min_weight));
+  if (max_unseen_corners < 0 || max_unseen_corners > 4)
+    throw ConfigError("marching_cubes.max_unseen_corners must be in 0..4 (0: off), got " +
+                      std::to_string(max_unseen_corners));
   if (!(smoothing_lambda >= 0.f) || !std::isfinite(smoothing_lambda))
     throw ConfigError("marching_cubes.smoothing_lambda must be >= 0 (m^-2; 0: off), got " +
                       std::to_string(smoothing_lambda));
@@ -411,6 +446,7 @@ void MarchingCubes::Config::validate() const {
 
 void MarchingCubes::Config::print(std::ostream& out) const {
   out << "marching_cubes:\n  min_weight: " << configValue(min_weight)
+      << "\n  max_unseen_corners: " << configValue(max_unseen_corners)
       << "\n  smoothing_lambda: " << configValue(smoothing_lambda)
       << "\n  min_component_triangles: " << configValue(min_component_triangles)
       << "\n  component_keep_weight: " << configValue(component_keep_weight) << "\n";
@@ -420,7 +456,8 @@ MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
 
 void MarchingCubes::setConfig(const Config& config) {
   config.validate();
-  if (config.min_weight != config_.min_weight || config.smoothing_lambda != config_.smoothing_lambda)
+  if (config.min_weight != config_.min_weight || config.smoothing_lambda != config_.smoothing_lambda ||
+      config.max_unseen_corners != config_.max_unseen_corners)
     reset();
   config_ = config;
 }

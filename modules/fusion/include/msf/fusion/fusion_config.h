@@ -47,8 +47,8 @@ struct DepthFusionConfig {
   float paper_min_stereo_confidence = 0.05f;  ///< floor of the confidence in w_S
 
   // --- uncertainty: sigmas of the disparity d = f B / z, in pixels
-  float stereo_sigma_min_px = 0.5f;           ///< sigma of a stereo disparity of confidence 1
-  float stereo_sigma_max_px = 2.5f;           ///< ... of confidence 0 (quadratic in 1 - confidence between)
+  float stereo_sigma_min_px = 0.35f;          ///< sigma of a stereo disparity of confidence 1
+  float stereo_sigma_max_px = 1.75f;          ///< ... of confidence 0 (quadratic in 1 - confidence between)
   float lidar_sigma_px = 0.1f;                ///< sigma of the LiDAR on a smooth surface at a real return
   float lidar_sigma_per_distance = 0.02f;     ///< growth per pixel of distance to the nearest real return
   float lidar_sigma_per_range = 0.3f;         ///< growth per pixel of the edge cue (lidar_edge_cue)

@@ -41,12 +41,17 @@ public:
 
   struct Config {
     /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
-    /// TsdfIntegrator::Weighting): 2 meshes what is known to sigma 0.7 m on its own, a LiDAR-backed
+    /// TsdfIntegrator::Weighting): 4 meshes what is known to sigma 0.5 m on its own, a LiDAR-backed
     /// surface after one frame, a stereo-only one at 20 m after one or two; smoothing_lambda pools
     /// the neighbours' evidence in, and the floating pieces such a bar lets through (matches in
-    /// the sky) are removed below (docs/reconstruction.md: 4 without the piece filter, 7 without
-    /// the smoothing).
-    float min_weight = 2.f;
+    /// the sky) are removed below (docs/reconstruction.md).
+    float min_weight = 4.f;
+    /// A cube with up to this many corners that no frame reached (weight 0), its other corners
+    /// above min_weight and on both sides of the surface, is meshed with those corners a voxel
+    /// behind the surface: the band a frame writes behind a surface seen at a grazing
+    /// angle, or at the end of its smooth run, stops short of the far corners of the cubes the
+    /// surface crosses, which left holes there (KITTI's cars and roads). 0: off.
+    int max_unseen_corners = 1;
     /// Eq. 7 at meshing (m^-2; 0: off): each grid point within half a truncation of its surface
     /// is meshed at (W y + lambda sum_j y_j) / (W + lambda n) over its observed 6-neighbours j,
     /// one Jacobi step on the volume's weighted means y with weights W. A LiDAR-backed voxel
@@ -63,8 +68,8 @@ public:
     /// near stereo) is kept whatever its size. 0: no piece is kept for its weight.
     float component_keep_weight = 300.f;
 
-    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight, smoothing_lambda,
-    /// min_component_triangles, component_keep_weight.
+    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight,
+    /// max_unseen_corners, smoothing_lambda, min_component_triangles, component_keep_weight.
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
