@@ -155,6 +155,9 @@ int main(int argc, char** argv) {
             "YAML with a section marching_cubes; the options below override it")
       .value("-min_weight", "W", config.min_weight,
              "voxels with weight <= W (m^-2, an inverse variance) make no triangles (default {default})")
+      .value("-max_unseen_corners", "N", config.max_unseen_corners,
+             "mesh a cube with up to N corners no frame reached, the others on both sides of the surface, with them "
+             "behind it (0..4; default {default}, 0 = off)")
       .value("-smoothing_lambda", "L", config.smoothing_lambda,
              "eq. 7 at meshing, each voxel's data term weighed by its weight (m^-2; default {default}, 0 = off)")
       .value("-min_component_triangles", "N", config.min_component_triangles,
