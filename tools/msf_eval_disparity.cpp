@@ -157,6 +157,7 @@ int main(int argc, char** argv) {
   msf::DisparityEvalOptions options;
   std::string obj_map_path, obj_map_dir, confidence;
   msf::DepthFusionConfig model;
+  bool config_given = false;
   msf::tool::CommandLine cli(
       "msf_eval_disparity", "<gt.png> <est.png> [options]\n<gt_dir> <est_dir> [options]",
       "KITTI 16-bit disparity PNGs (pixels x 256, 0 = none): D1 outliers (error > 3 px and > 5 %), mean absolute "
@@ -174,7 +175,11 @@ int main(int argc, char** argv) {
       .value("-confidence", "PATH", confidence,
              "the estimate's confidence: msf_stereo's output cloud (field confidence), or with folders a folder of "
              "NNNNNN.pcd; adds the error by confidence beside the sigma the fusion assumes for it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "fusion", model); },
+      .value("-config", "FILE",
+             [&](const std::string& path) {
+               msf::readConfigSection(path, "fusion", model);
+               config_given = true;
+             },
              "YAML config, section fusion: the sigma model of -confidence (stereo_sigma_min_px, stereo_sigma_max_px)");
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
@@ -186,6 +191,8 @@ int main(int argc, char** argv) {
     if (folders != isDirectory(files[1]))
       throw msf::InvalidInputError("'" + files[0] + "' and '" + files[1] +
                                    "' must both be PNG files or both be folders");
+    if (config_given && confidence.empty())
+      throw msf::InvalidInputError("-config gives the sigma model of -confidence, which is not given");
     if (!confidence.empty() && folders != isDirectory(confidence))
       throw msf::InvalidInputError("-confidence '" + confidence + "' must be " +
                                    (folders ? "a folder of NNNNNN.pcd, as the estimates are folders"

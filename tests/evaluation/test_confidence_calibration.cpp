@@ -115,6 +115,14 @@ void writeFrame(const Frame& f, const std::string& gt_png, const std::string& es
   msf::saveCloud(cloud_pcd, cloud);
 }
 
+/// Folder mode: gt/000000.png, est/000000.png and conf/<cloud_name>; the tool's arguments.
+std::string writeFolders(const Frame& f, const msf::test::TempDir& tmp, const std::string& cloud_name) {
+  for (const char* d : {"gt", "est", "conf"})
+    std::filesystem::create_directories(tmp.file(d));
+  writeFrame(f, tmp.file("gt/000000.png"), tmp.file("est/000000.png"), tmp.file("conf/" + cloud_name));
+  return tmp.file("gt") + " " + tmp.file("est") + " -confidence " + tmp.file("conf");
+}
+
 TEST(EvalDisparityTool, ErrorByConfidenceBesideTheFusionSigma) {
   const Frame f;
   msf::test::TempDir tmp;
@@ -135,14 +143,11 @@ TEST(EvalDisparityTool, ErrorByConfidenceBesideTheFusionSigma) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("0.25 px at confidence 1, 1.25 px at 0"), std::string::npos) << r.out;
 
-  // Folders: the clouds as NNNNNN.pcd.
-  for (const char* d : {"gt", "est", "conf"})
-    std::filesystem::create_directories(tmp.file(d));
-  writeFrame(f, tmp.file("gt/000000.png"), tmp.file("est/000000.png"), tmp.file("conf/000000.pcd"));
-  r = msf::test::runTool("msf_eval_disparity",
-                         tmp.file("gt") + " " + tmp.file("est") + " -confidence " + tmp.file("conf"));
+  // Folders: the clouds as NNNNNN.pcd, the same figures.
+  r = msf::test::runTool("msf_eval_disparity", writeFolders(f, tmp, "000000.pcd"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("error by stereo confidence"), std::string::npos) << r.out;
+  EXPECT_NEAR(robustSigmaOfRow(r.out, "0.00-0.20"), 1.374, 0.03) << r.out;
+  EXPECT_NEAR(robustSigmaOfRow(r.out, "0.90-0.97"), 0.3, 0.01) << r.out;
 }
 
 TEST(EvalDisparityTool, ConfidenceBadInput) {
@@ -164,13 +169,14 @@ TEST(EvalDisparityTool, ConfidenceBadInput) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("must be a .pcd file, as the estimate is one frame"), std::string::npos) << r.err;
   // Folders without the frame's cloud.
-  for (const char* d : {"gt", "est", "conf"})
-    std::filesystem::create_directories(tmp.file(d));
-  writeFrame(f, tmp.file("gt/000000.png"), tmp.file("est/000000.png"), tmp.file("conf/000001.pcd"));
-  r = msf::test::runTool("msf_eval_disparity",
-                         tmp.file("gt") + " " + tmp.file("est") + " -confidence " + tmp.file("conf"));
+  r = msf::test::runTool("msf_eval_disparity", writeFolders(f, tmp, "000001.pcd"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("000000.pcd' for estimate"), std::string::npos) << r.err;
+  // A sigma model without -confidence to use it.
+  writeTextFile(tmp.file("c.yaml"), "%YAML:1.0\nfusion:\n  stereo_sigma_min_px: 0.25\n");
+  r = msf::test::runTool("msf_eval_disparity", pair + " -config " + tmp.file("c.yaml"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("-config gives the sigma model of -confidence"), std::string::npos) << r.err;
   // No pixel with a confidence in [0, 1].
   Frame none;
   none.confidence.setTo(std::nanf(""));

@@ -230,7 +230,8 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
       for (active |= filled; active; active &= active - 1) {
         const int x = __builtin_ctz(active);
         // An unseen corner of a filled cube is a voxel behind the surface: an edge from a seen
-        // corner at distance p to it is crossed p / (p + voxel) along, which is p for a small p.
+        // corner at distance p to it is crossed p * voxel / (p + voxel) from that corner, about p
+        // for a small p.
         const bool fill = (filled >> x) & 1;
         const unsigned m00 = fill ? n00 | u00 : n00, m10 = fill ? n10 | u10 : n10;
         const unsigned m01 = fill ? n01 | u01 : n01, m11 = fill ? n11 | u11 : n11;
@@ -246,7 +247,6 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
           c[i] = &s.voxel(px, py, pz);
           d[i] = fill && c[i]->weight <= 0.f ? -vs : s.sdf[px + kPad * (py + kPad * pz)];
         }
-
         std::uint32_t vert[12];
         for (int e = 0; e < 12; ++e) {
           if (!(edges & (1u << e)))

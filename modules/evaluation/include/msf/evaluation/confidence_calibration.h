@@ -12,7 +12,8 @@ namespace msf {
 /// A stereo matcher's disparity error by its confidence (stereoConfidence), measured against
 /// ground truth, beside the sigma the fusion assumes for that confidence (stereoSigmaPx:
 /// fusion.stereo_sigma_min_px and stereo_sigma_max_px). The check of the fusion's uncertainty
-/// model on a user's data (docs/evaluation.md, "Is the stereo sigma right?").
+/// model on a user's data (msf_eval_disparity -confidence, bench/bench_stereo_sigma.sh; the
+/// figures in docs/results.md, session 15).
 ///
 /// Errors are kept in a histogram per confidence bin (1/64 px over +-32 px; larger errors in
 /// the end cells), so that a sequence of any length costs the same memory, and the robust
