@@ -46,10 +46,11 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   EXPECT_EQ(c.integrator.solve, msf::TsdfIntegrator::Solve::Argmin);
   EXPECT_EQ(c.integrator.signed_distance, msf::TsdfIntegrator::SignedDistance::Projective);
   EXPECT_FALSE(c.integrator.space_carving);
+  EXPECT_FALSE(c.integrator.silhouette_band);
   // The project's own defaults keep every addition.
   const msf::PipelineConfig ours;
   EXPECT_TRUE(ours.interpolation.slice.inverse_depth && ours.interpolation.slice.edge_test &&
-              ours.fusion.edge_support && ours.stereo.lidarGuidance());
+              ours.fusion.edge_support && ours.stereo.lidarGuidance() && ours.integrator.silhouette_band);
   EXPECT_EQ(ours.fusion.paper_weights, msf::PaperWeights::Relative);
   EXPECT_EQ(ours.integrator.solve, msf::TsdfIntegrator::Solve::Sweeps);
 }
@@ -60,6 +61,7 @@ TEST(PaperConfig, ABadValueOfANewKeyIsNamed) {
       {"interpolation:\n  edge_test: sometimes\n", "interpolation.edge_test"},
       {"fusion:\n  paper_weights: literal\n", "fusion.paper_weights"},
       {"tsdf_integrator:\n  solve: exact\n", "tsdf_integrator.solve"},
+      {"tsdf_integrator:\n  silhouette_band: sometimes\n", "tsdf_integrator.silhouette_band"},
       {"tsdf_integrator:\n  argmin_tolerance_m: -1\n", "tsdf_integrator.argmin_tolerance_m"},
       {"tsdf_integrator:\n  argmin_max_sweeps: 0\n", "tsdf_integrator.argmin_max_sweeps"}};
   for (const auto& [yaml, key] : cases) {

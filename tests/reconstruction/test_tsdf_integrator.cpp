@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 using namespace msf;
 using test::SceneKind;
@@ -672,6 +673,52 @@ TEST(TsdfIntegrator, ARoofSeenAtAGrazingAngleIsMeshedWithoutASkirt) {
   std::printf("  roof vertices %zu, skirt vertices %zu\n", roof, skirt);
   EXPECT_GT(roof, 100u);
   EXPECT_EQ(skirt, 0u);
+}
+
+TEST(TsdfIntegrator, APoleSeenByFarStereoLeavesNoSheetInItsShadow) {
+  // A pole 0.2 m wide 12 m ahead of a wall at 30 m, seen while driving towards it, every pixel
+  // with far stereo's sigma of 1 m: the band behind a pixel is 2 m. Every frame sees the 2 m
+  // behind the pole through the pole, and the wall past its sides: that band meets free space
+  // along the rays past its silhouette, and marching cubes meshed the meeting as two sheets
+  // reaching 2 m behind a pole 0.2 m thick. With silhouette_band the band behind the pole's
+  // pixels is its width, at least two truncations.
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, 0, -1), -30.0);
+  scene.addBox(Eigen::Vector3d(1.0, 0, 12), Eigen::Vector3d(0.1, 20, 0.1));
+  const PinholeCamera camera = test::smallCamera();
+  const auto sheet_and_pole = [&](bool silhouette_band) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator::Config config;
+    config.silhouette_band = silhouette_band;
+    TsdfIntegrator integrator(volume, config);
+    for (int i = 0; i < 8; ++i) {
+      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      pose.translation() = Eigen::Vector3d(0, 0, 0.5 * i);
+      DepthFrame frame;
+      frame.camera = camera;
+      frame.depth = scene.renderDepth(camera, pose, 40.0);
+      frame.weight = cv::Mat(camera.height, camera.width, CV_32FC1, cv::Scalar(1.f)); // sigma 1 m
+      integrator.integrate(frame, pose);
+    }
+    TriangleMesh mesh;
+    MarchingCubes::Config every_piece; // the pole is a small piece of low weight
+    every_piece.min_component_triangles = 0;
+    MarchingCubes(every_piece).extract(volume, mesh);
+    std::size_t sheet = 0, front = 0;
+    for (const auto& v : mesh.vertices) {
+      const bool beside = std::abs(v.x() - 1.f) < 0.5f && std::abs(v.y()) < 1.f;
+      front += beside && std::abs(v.z() - 11.9f) < 0.1f && std::abs(v.x() - 1.f) < 0.1f;
+      sheet += beside && v.z() > 12.1f + 0.6f + 0.2f && v.z() < 28.f; // past the floor of two truncations
+    }
+    std::printf("  silhouette_band %d: pole front vertices %zu, sheet vertices %zu\n", silhouette_band, front, sheet);
+    return std::make_pair(sheet, front);
+  };
+  const auto [sheet_before, front_before] = sheet_and_pole(false);
+  const auto [sheet, front] = sheet_and_pole(true);
+  EXPECT_GT(sheet_before, 20u); // the sheets the option removes
+  EXPECT_EQ(sheet, 0u);
+  EXPECT_GT(front, 10u); // and the pole stays
+  EXPECT_GE(front + 5, front_before);
 }
 
 TEST(TsdfIntegrator, FarStereoNeitherOverwritesNearLidarGeometryNorLeavesSpecks) {

@@ -82,6 +82,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.min_pixel_weight = 0.f;
   c.integrator.space_carving = false;
   c.integrator.weight_dropoff = false;
+  c.integrator.silhouette_band = false;
   c.integrator.interpolate_depth = false;
   c.integrator.lambda = 5.0;
   c.integrator.solve = TsdfIntegrator::Solve::Argmin;

@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/reconstruction/plane_distance.h>
+#include <msf/reconstruction/silhouette_thickness.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include "voxel_update.h"
@@ -20,6 +21,15 @@
 namespace msf {
 
 namespace {
+
+/// silhouette_band: neighbours lie on one object unless their depths differ by more than a tenth
+/// of the nearer, or by more than the larger of their sigmas (far stereo's noise does not cut a
+/// wall into slivers); the band behind stays at least two truncations deep, which keeps the
+/// weights of the drop-off around a surface as they were (one truncation took 0.01-0.15 points
+/// of the streets' completeness; two took 0.00-0.06).
+constexpr float kSilhouetteRelativeJump = 0.1f;
+constexpr float kSilhouetteSigmas = 1.f;
+constexpr float kSilhouetteFloor = 2.f;
 
 /// How far from a surface's plane its band reaches along a grazing ray, either side: a voxel
 /// and a half (see integrate's step 0), never more than the truncation.
@@ -167,6 +177,7 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "carving_weight", carving_weight);
   readKey(node, "scan_carving_m", scan_carving_m);
   readKey(node, "weight_dropoff", weight_dropoff);
+  readKey(node, "silhouette_band", silhouette_band);
   std::string distance = toString(signed_distance);
   readKey(node, "signed_distance", distance);
   signed_distance = parseSignedDistance(distance);
@@ -249,6 +260,7 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  carving_weight: " << configValue(carving_weight) << "\n"
       << "  scan_carving_m: " << configValue(scan_carving_m) << "\n"
       << "  weight_dropoff: " << configValue(weight_dropoff) << "\n"
+      << "  silhouette_band: " << configValue(silhouette_band) << "\n"
       << "  signed_distance: " << toString(signed_distance) << "\n"
       << "  plane_step_px: " << configValue(plane.step_px) << "\n"
       << "  plane_max_curvature: " << configValue(plane.max_curvature) << "\n"
@@ -402,18 +414,28 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
   const cv::Mat& free_weight = own_weights ? frame.free_space_weight : cv::Mat();
   const float carving_weight = static_cast<float>(config_.carving_weight);
+  // The band behind a thin object's pixels reaches no deeper than the object is wide, and at
+  // least kSilhouetteFloor truncations (see Config::silhouette_band).
+  const bool silhouette = config_.silhouette_band && sigmas > 0.f;
+  if (silhouette)
+    silhouetteThickness(depth_image, weight_, cam, kSilhouetteRelativeJump, kSilhouetteSigmas, thickness_);
+  const float silhouette_floor = kSilhouetteFloor * trunc;
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
       const float* e = extent_.ptr<float>(v);
       const float* f = free_weight.empty() ? w : free_weight.ptr<float>(v);
+      const float* thick = silhouette ? thickness_.ptr<float>(v) : nullptr;
       PixelBand* out = &pixels_[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
         const float noise = w[u] > 0.f ? sigmas / std::sqrt(w[u]) : 0.f;
         const float front = std::max({trunc, plane_band / s[u], noise});
         const float below = std::min(plane_band / s[u], e[u]); // not past where the surface is seen
-        out[u] = {s[u], front, std::min(front, std::max({trunc, below, noise})), w[u], carving_weight * f[u]};
+        float behind = std::min(front, std::max({trunc, below, noise}));
+        if (thick)
+          behind = std::min(behind, std::max(silhouette_floor, thick[u]));
+        out[u] = {s[u], front, behind, w[u], carving_weight * f[u]};
       }
     }
   });

@@ -103,6 +103,12 @@ public:
     /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
     /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
     bool weight_dropoff = true;
+    /// The band behind a pixel reaches no deeper than its object is seen to be wide
+    /// (silhouetteThickness), and at least two truncations. A pole that far stereo sees with a
+    /// sigma of a metre otherwise leaves a band metres long in its shadow, which no later frame
+    /// clears (driving on, they all see it through the pole) and which marching cubes meshes as
+    /// a sheet along the rays. Only bands wider than the truncation are cut (truncation_sigmas).
+    bool silhouette_band = true;
     SignedDistance signed_distance = SignedDistance::Plane;
     PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
     double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
@@ -148,7 +154,7 @@ public:
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
     /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
     /// space_carving, carving_weight, scan_carving_m,
-    /// weight_dropoff, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
+    /// weight_dropoff, silhouette_band, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
     /// plane_min_scale, lambda, lambda_data (uniform | inverse_variance), sweeps, solve (sweeps |
     /// argmin), argmin_tolerance_m,
     /// argmin_max_sweeps, min_depth_m, max_depth_m, precise_max_depth_m, interpolate_depth,
@@ -264,6 +270,7 @@ private:
   std::vector<float> data_term_;  // y of eq. 7 for the changed voxels, reused across frames
   std::vector<std::uint16_t> changed_index_; // local indices of the changed voxels, per block
   std::vector<float> tile_min_, tile_max_, tile_band_; // depth range and widest band of 8x8-pixel tiles, reused
+  cv::Mat thickness_;
   cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused

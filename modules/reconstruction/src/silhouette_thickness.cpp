@@ -1,0 +1,80 @@
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/silhouette_thickness.h>
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace msf {
+
+namespace {
+
+/// Thickness along each row of `depth` (sigma beside it), min'ed into `thickness`.
+void rowThickness(const cv::Mat& depth, const cv::Mat& sigma, float focal, float relative_jump, float sigmas,
+                  cv::Mat& thickness) {
+  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      const float* z = depth.ptr<float>(v);
+      const float* s = sigma.ptr<float>(v);
+      float* out = thickness.ptr<float>(v);
+      const int n = depth.cols;
+      const auto same = [&](int a, int b) {
+        return std::fabs(z[a] - z[b]) <= std::max(relative_jump * std::min(z[a], z[b]), sigmas * std::max(s[a], s[b]));
+      };
+      // Past an end, across a hole of at most kMaxHole pixels (stereo leaves the background an
+      // object hides from the other camera without a match), the next depth sees farther.
+      const auto bounded = [&](int end, int step) {
+        for (int i = end + step, hole = 0; i >= 0 && i < n && hole <= kSilhouetteMaxHole; i += step, ++hole)
+          if (z[i] > 0.f)
+            return z[i] > z[end] && !same(i, end);
+        return false;
+      };
+      for (int a = 0; a < n;) {
+        if (!(z[a] > 0.f)) {
+          ++a;
+          continue;
+        }
+        int b = a;
+        while (b + 1 < n && z[b + 1] > 0.f && same(b, b + 1))
+          ++b;
+        if (bounded(a, -1) && bounded(b, 1)) {
+          const float width = static_cast<float>(b - a + 1) / focal; // metres per metre of depth
+          for (int i = a; i <= b; ++i)
+            out[i] = std::min(out[i], width * z[i]);
+        }
+        a = b + 1;
+      }
+    }
+  });
+}
+
+} // namespace
+
+void silhouetteThickness(const cv::Mat& depth, const cv::Mat& weight, const PinholeCamera& camera,
+                         float relative_jump, float sigmas, cv::Mat& thickness) {
+  if (depth.type() != CV_32FC1 || weight.type() != CV_32FC1 || depth.size() != weight.size())
+    throw InvalidInputError("silhouetteThickness: depth and weight must be CV_32FC1 of one size");
+  if (!(camera.fx > 0.0) || !(camera.fy > 0.0))
+    throw InvalidInputError("silhouetteThickness: the camera's focal lengths must be > 0");
+  if (!(relative_jump >= 0.f) || !(sigmas >= 0.f))
+    throw InvalidInputError("silhouetteThickness: relative_jump and sigmas must be >= 0");
+  cv::Mat sigma;
+  cv::sqrt(weight, sigma);
+  cv::divide(1.f, sigma, sigma); // 1 / sqrt(w): infinite where w = 0, which has no depth anyway
+  thickness.create(depth.size(), CV_32FC1);
+  thickness.setTo(std::numeric_limits<float>::infinity());
+  rowThickness(depth, sigma, static_cast<float>(camera.fx), relative_jump, sigmas, thickness);
+  // Columns as the rows of the transposed images: contiguous, and the same code.
+  cv::Mat depth_t, sigma_t, thickness_t(depth.cols, depth.rows, CV_32FC1,
+                                        cv::Scalar(std::numeric_limits<float>::infinity()));
+  cv::transpose(depth, depth_t);
+  cv::transpose(sigma, sigma_t);
+  rowThickness(depth_t, sigma_t, static_cast<float>(camera.fy), relative_jump, sigmas, thickness_t);
+  cv::Mat columns;
+  cv::transpose(thickness_t, columns);
+  cv::min(thickness, columns, thickness);
+}
+
+} // namespace msf
