@@ -18,6 +18,7 @@
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/distance_transform.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/reconstruction/silhouette_thickness.h>
 #include <msf/stereo/sgbm_stereo.h>
 
 #include <benchmark/benchmark.h>
@@ -136,6 +137,31 @@ void BM_FacadeExtension(benchmark::State& state) {
   state.counters["pixels_extended"] = static_cast<double>(extended) / static_cast<double>(state.iterations());
 }
 
+/// The integrator's silhouette_band step on the fused frames: the thickness each pixel's object
+/// is seen to have (msf::silhouetteThickness), which bounds the band behind it.
+void BM_SilhouetteThickness(benchmark::State& state) {
+  const Data& d = data();
+  const msf::DepthFusionConfig config;
+  msf::DepthImageFusion fusion(config);
+  fusion.setCalibration(d.calibration);
+  std::vector<cv::Mat> depth(d.lidar.size()), weight(d.lidar.size()), free(d.lidar.size());
+  for (std::size_t f = 0; f < d.lidar.size(); ++f)
+    fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], depth[f], &weight[f],
+                &free[f]);
+  const msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(d.calibration);
+  cv::Mat thickness;
+  std::size_t i = 0;
+  double bounded = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    msf::silhouetteThickness(depth[f], weight[f], camera, 0.1f, 1.f, thickness);
+    state.PauseTiming();
+    bounded += cv::countNonZero(thickness < 1e30f);
+    state.ResumeTiming();
+  }
+  state.counters["pixels_bounded"] = bounded / static_cast<double>(state.iterations());
+}
+
 void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Paper); }
 void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
 void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
@@ -153,5 +179,6 @@ BENCHMARK(BM_FusionImagePaper)->Unit(benchmark::kMillisecond)->UseRealTime()->It
 BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImageUncertaintyNoEdgeSupport)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FacadeExtension)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
+BENCHMARK(BM_SilhouetteThickness)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
 
 BENCHMARK_MAIN();

@@ -11,19 +11,23 @@ namespace msf {
 
 namespace {
 
-/// Thickness along each row of `depth` (sigma beside it), min'ed into `thickness`.
-void rowThickness(const cv::Mat& depth, const cv::Mat& sigma, float focal, float relative_jump, float sigmas,
+/// Thickness along each row of `depth` (its weight beside it), min'ed into `thickness`.
+void rowThickness(const cv::Mat& depth, const cv::Mat& weight, float focal, float relative_jump, float sigmas,
                   cv::Mat& thickness) {
+  const float sigmas2 = sigmas * sigmas;
   cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* z = depth.ptr<float>(v);
-      const float* s = sigma.ptr<float>(v);
+      const float* w = weight.ptr<float>(v);
       float* out = thickness.ptr<float>(v);
       const int n = depth.cols;
+      // Within relative_jump of the nearer depth, or within `sigmas` of the larger sigma
+      // (1 / sqrt of the lesser weight): |dz| <= sigmas / sqrt(w) as dz^2 w <= sigmas^2.
       const auto same = [&](int a, int b) {
-        return std::fabs(z[a] - z[b]) <= std::max(relative_jump * std::min(z[a], z[b]), sigmas * std::max(s[a], s[b]));
+        const float dz = z[a] - z[b];
+        return std::fabs(dz) <= relative_jump * std::min(z[a], z[b]) || dz * dz * std::min(w[a], w[b]) <= sigmas2;
       };
-      // Past an end, across a hole of at most kMaxHole pixels (stereo leaves the background an
+      // Past an end, across a hole of at most kSilhouetteMaxHole pixels (stereo leaves the background an
       // object hides from the other camera without a match), the next depth sees farther.
       const auto bounded = [&](int end, int step) {
         for (int i = end + step, hole = 0; i >= 0 && i < n && hole <= kSilhouetteMaxHole; i += step, ++hole)
@@ -60,18 +64,15 @@ void silhouetteThickness(const cv::Mat& depth, const cv::Mat& weight, const Pinh
     throw InvalidInputError("silhouetteThickness: the camera's focal lengths must be > 0");
   if (!(relative_jump >= 0.f) || !(sigmas >= 0.f))
     throw InvalidInputError("silhouetteThickness: relative_jump and sigmas must be >= 0");
-  cv::Mat sigma;
-  cv::sqrt(weight, sigma);
-  cv::divide(1.f, sigma, sigma); // 1 / sqrt(w): infinite where w = 0, which has no depth anyway
   thickness.create(depth.size(), CV_32FC1);
   thickness.setTo(std::numeric_limits<float>::infinity());
-  rowThickness(depth, sigma, static_cast<float>(camera.fx), relative_jump, sigmas, thickness);
+  rowThickness(depth, weight, static_cast<float>(camera.fx), relative_jump, sigmas, thickness);
   // Columns as the rows of the transposed images: contiguous, and the same code.
-  cv::Mat depth_t, sigma_t, thickness_t(depth.cols, depth.rows, CV_32FC1,
+  cv::Mat depth_t, weight_t, thickness_t(depth.cols, depth.rows, CV_32FC1,
                                         cv::Scalar(std::numeric_limits<float>::infinity()));
   cv::transpose(depth, depth_t);
-  cv::transpose(sigma, sigma_t);
-  rowThickness(depth_t, sigma_t, static_cast<float>(camera.fy), relative_jump, sigmas, thickness_t);
+  cv::transpose(weight, weight_t);
+  rowThickness(depth_t, weight_t, static_cast<float>(camera.fy), relative_jump, sigmas, thickness_t);
   cv::Mat columns;
   cv::transpose(thickness_t, columns);
   cv::min(thickness, columns, thickness);
