@@ -113,15 +113,23 @@ void imageFusion(benchmark::State& state, msf::FusionMethod method, bool edge_su
       1000.0 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(state.iterations());
 }
 
+/// The fused frames (depth, weight, free-space weight) of the sample, with the default fusion.
+struct FusedFrames {
+  std::vector<cv::Mat> depth, weight, free;
+  explicit FusedFrames(const Data& d) : depth(d.lidar.size()), weight(d.lidar.size()), free(d.lidar.size()) {
+    msf::DepthImageFusion fusion{msf::DepthFusionConfig()};
+    fusion.setCalibration(d.calibration);
+    for (std::size_t f = 0; f < d.lidar.size(); ++f)
+      fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], depth[f],
+                  &weight[f], &free[f]);
+  }
+};
+
 void BM_FacadeExtension(benchmark::State& state) {
   const Data& d = data();
   const msf::DepthFusionConfig config;
-  msf::DepthImageFusion fusion(config);
-  fusion.setCalibration(d.calibration);
-  std::vector<cv::Mat> depth(d.lidar.size()), weight(d.lidar.size()), free(d.lidar.size());
-  for (std::size_t f = 0; f < d.lidar.size(); ++f)
-    fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], depth[f], &weight[f],
-                &free[f]);
+  const FusedFrames fused(d);
+  const auto& [depth, weight, free] = fused;
   const msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(d.calibration);
   cv::Mat z, w, fw;
   std::size_t i = 0, extended = 0;
@@ -141,20 +149,14 @@ void BM_FacadeExtension(benchmark::State& state) {
 /// is seen to have (msf::silhouetteThickness), which bounds the band behind it.
 void BM_SilhouetteThickness(benchmark::State& state) {
   const Data& d = data();
-  const msf::DepthFusionConfig config;
-  msf::DepthImageFusion fusion(config);
-  fusion.setCalibration(d.calibration);
-  std::vector<cv::Mat> depth(d.lidar.size()), weight(d.lidar.size()), free(d.lidar.size());
-  for (std::size_t f = 0; f < d.lidar.size(); ++f)
-    fusion.fuse(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f], d.stereo_confidence[f], depth[f], &weight[f],
-                &free[f]);
+  const FusedFrames fused(d);
   const msf::PinholeCamera camera = msf::PinholeCamera::fromCalibration(d.calibration);
   cv::Mat thickness;
   std::size_t i = 0;
   double bounded = 0;
   for (auto _ : state) {
     const std::size_t f = i++ % d.lidar.size();
-    msf::silhouetteThickness(depth[f], weight[f], camera, 0.1f, 1.f, thickness);
+    msf::silhouetteThickness(fused.depth[f], fused.weight[f], camera, 0.1f, 1.f, thickness);
     state.PauseTiming();
     bounded += cv::countNonZero(thickness < 1e30f);
     state.ResumeTiming();

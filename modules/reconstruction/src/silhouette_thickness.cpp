@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <vector>
 
 namespace msf {
 
@@ -16,19 +19,25 @@ void rowThickness(const cv::Mat& depth, const cv::Mat& weight, float focal, floa
                   cv::Mat& thickness) {
   const float sigmas2 = sigmas * sigmas;
   cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+    const int n = depth.cols;
+    std::vector<std::uint8_t> joined(static_cast<std::size_t>(n)); // pixel u and u + 1 on one object
     for (int v = rows.start; v < rows.end; ++v) {
       const float* z = depth.ptr<float>(v);
       const float* w = weight.ptr<float>(v);
       float* out = thickness.ptr<float>(v);
-      const int n = depth.cols;
       // Within relative_jump of the nearer depth, or within `sigmas` of the larger sigma
       // (1 / sqrt of the lesser weight): |dz| <= sigmas / sqrt(w) as dz^2 w <= sigmas^2.
       const auto same = [&](int a, int b) {
         const float dz = z[a] - z[b];
-        return std::fabs(dz) <= relative_jump * std::min(z[a], z[b]) || dz * dz * std::min(w[a], w[b]) <= sigmas2;
+        return (std::fabs(dz) <= relative_jump * std::min(z[a], z[b])) | (dz * dz * std::min(w[a], w[b]) <= sigmas2);
       };
-      // Past an end, across a hole of at most kSilhouetteMaxHole pixels (stereo leaves the background an
-      // object hides from the other camera without a match), the next depth sees farther.
+      // Branch-free, so that it runs in vectors; the runs are then found with memchr.
+      for (int u = 0; u + 1 < n; ++u)
+        joined[static_cast<std::size_t>(u)] = static_cast<std::uint8_t>((z[u] > 0.f) & (z[u + 1] > 0.f) & same(u, u + 1));
+      joined[static_cast<std::size_t>(n - 1)] = 0;
+      // Past an end, across a hole of at most kSilhouetteMaxHole pixels (stereo leaves the
+      // background an object hides from the other camera without a match), the next depth
+      // sees farther.
       const auto bounded = [&](int end, int step) {
         for (int i = end + step, hole = 0; i >= 0 && i < n && hole <= kSilhouetteMaxHole; i += step, ++hole)
           if (z[i] > 0.f)
@@ -40,9 +49,8 @@ void rowThickness(const cv::Mat& depth, const cv::Mat& weight, float focal, floa
           ++a;
           continue;
         }
-        int b = a;
-        while (b + 1 < n && z[b + 1] > 0.f && same(b, b + 1))
-          ++b;
+        const void* stop = std::memchr(joined.data() + a, 0, static_cast<std::size_t>(n - a));
+        const int b = static_cast<int>(static_cast<const std::uint8_t*>(stop) - joined.data()); // joined[n - 1] is 0
         if (bounded(a, -1) && bounded(b, 1)) {
           const float width = static_cast<float>(b - a + 1) / focal; // metres per metre of depth
           for (int i = a; i <= b; ++i)
