@@ -75,13 +75,14 @@ void silhouetteThickness(const cv::Mat& depth, const cv::Mat& weight, const Pinh
   thickness.create(depth.size(), CV_32FC1);
   thickness.setTo(std::numeric_limits<float>::infinity());
   rowThickness(depth, weight, static_cast<float>(camera.fx), relative_jump, sigmas, thickness);
-  // Columns as the rows of the transposed images: contiguous, and the same code.
-  cv::Mat depth_t, weight_t, thickness_t(depth.cols, depth.rows, CV_32FC1,
-                                        cv::Scalar(std::numeric_limits<float>::infinity()));
+  // Columns as the rows of the transposed images: contiguous, and the same code. The buffers
+  // stay allocated from frame to frame (one set per calling thread).
+  thread_local cv::Mat depth_t, weight_t, thickness_t, columns;
   cv::transpose(depth, depth_t);
   cv::transpose(weight, weight_t);
+  thickness_t.create(depth.cols, depth.rows, CV_32FC1);
+  thickness_t.setTo(std::numeric_limits<float>::infinity());
   rowThickness(depth_t, weight_t, static_cast<float>(camera.fy), relative_jump, sigmas, thickness_t);
-  cv::Mat columns;
   cv::transpose(thickness_t, columns);
   cv::min(thickness, columns, thickness);
 }
