@@ -92,6 +92,19 @@ TEST(SilhouetteThickness, FarStereosNoiseDoesNotCutAWallIntoSlivers) {
   EXPECT_GT(cv::countNonZero(precise.thickness(camera) < 1e30f), 0);
 }
 
+TEST(SilhouetteThickness, OneColumnAndEmptyImages) {
+  const PinholeCamera camera = test::smallCamera();
+  cv::Mat t;
+  // A column 9 pixels high in front of a farther one: bounded along the column only.
+  cv::Mat depth(20, 1, CV_32FC1, cv::Scalar(20.f)), weight(20, 1, CV_32FC1, cv::Scalar(1.f));
+  depth.rowRange(5, 14).setTo(12.f);
+  silhouetteThickness(depth, weight, camera, kJump, kSigmas, t);
+  EXPECT_NEAR(t.at<float>(9, 0), 9.f * 12.f / 300.f, 1e-5f);
+  EXPECT_TRUE(std::isinf(t.at<float>(0, 0)));
+  silhouetteThickness(cv::Mat(0, 0, CV_32FC1), cv::Mat(0, 0, CV_32FC1), camera, kJump, kSigmas, t);
+  EXPECT_TRUE(t.empty());
+}
+
 TEST(SilhouetteThickness, BadInputIsNamed) {
   const PinholeCamera camera = test::smallCamera();
   const Frame frame(camera, 20.f, 1.f);

@@ -18,6 +18,8 @@ namespace {
 void rowThickness(const cv::Mat& depth, const cv::Mat& weight, float focal, float relative_jump, float sigmas,
                   cv::Mat& thickness) {
   const float sigmas2 = sigmas * sigmas;
+  if (depth.cols == 0)
+    return;
   cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     const int n = depth.cols;
     std::vector<std::uint8_t> joined(static_cast<std::size_t>(n)); // pixel u and u + 1 on one object
