@@ -107,7 +107,8 @@ public:
     /// (silhouetteThickness), and at least two truncations. A pole that far stereo sees with a
     /// sigma of a metre otherwise leaves a band metres long in its shadow, which no later frame
     /// clears (driving on, they all see it through the pole) and which marching cubes meshes as
-    /// a sheet along the rays. Only bands wider than the truncation are cut (truncation_sigmas).
+    /// a sheet along the rays. Only bands deeper than two truncations are cut: those that
+    /// truncation_sigmas widens for noisy depth.
     bool silhouette_band = true;
     SignedDistance signed_distance = SignedDistance::Plane;
     PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
@@ -270,7 +271,7 @@ private:
   std::vector<float> data_term_;  // y of eq. 7 for the changed voxels, reused across frames
   std::vector<std::uint16_t> changed_index_; // local indices of the changed voxels, per block
   std::vector<float> tile_min_, tile_max_, tile_band_; // depth range and widest band of 8x8-pixel tiles, reused
-  cv::Mat thickness_;
+  cv::Mat thickness_; // silhouetteThickness of the frame, reused
   cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
