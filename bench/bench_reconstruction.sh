@@ -18,19 +18,12 @@ kitti=${2:?usage: bench_reconstruction.sh BIN_DIR KITTI_DIR [OUT [options...]]}
 out=${3:-}
 shift $(($# < 3 ? $# : 3))
 options=("$@")
-for tool in msf_reconstruct msf_synth; do
-  [ -x "$bin/$tool" ] || { echo "bench_reconstruction: no $bin/$tool (build first)" >&2; exit 1; }
-done
+source "$(dirname "$0")/bench_args.sh"
+need_tools bench_reconstruction "$bin" msf_reconstruct msf_synth
 odometry="$kitti/odometry/sequences/04"
 raw="$kitti/raw/2011_09_26/2011_09_26_drive_0009_sync"
-for dir in "$odometry" "$raw"; do
-  [ -d "$dir" ] || { echo "bench_reconstruction: no KITTI sequence at $dir" >&2; exit 1; }
-done
-if [ -z "$out" ]; then
-  out=$(mktemp -d)
-  trap 'rm -rf "$out"' EXIT
-fi
-mkdir -p "$out"
+need_sequences bench_reconstruction "$odometry" "$raw"
+output_folder
 
 run() { # name dataset options...
   local name=$1 dataset=$2

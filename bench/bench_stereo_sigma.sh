@@ -17,20 +17,13 @@ bin=${1:?usage: bench_stereo_sigma.sh BIN_DIR KITTI_DIR [OUT]}
 kitti=${2:?usage: bench_stereo_sigma.sh BIN_DIR KITTI_DIR [OUT]}
 out=${3:-}
 here=$(cd "$(dirname "$0")/.." && pwd)
-for tool in msf_stereo msf_project msf_pcd2png msf_eval_disparity msf_synth; do
-  [ -x "$bin/$tool" ] || { echo "bench_stereo_sigma: no $bin/$tool (build first)" >&2; exit 1; }
-done
+source "$here/bench/bench_args.sh"
+need_tools bench_stereo_sigma "$bin" msf_stereo msf_project msf_pcd2png msf_eval_disparity msf_synth
 odometry="$kitti/odometry/sequences/04"
 raw_date="$kitti/raw/2011_09_26"
 raw="$raw_date/2011_09_26_drive_0009_sync"
-for dir in "$odometry" "$raw"; do
-  [ -d "$dir" ] || { echo "bench_stereo_sigma: no KITTI sequence at $dir" >&2; exit 1; }
-done
-if [ -z "$out" ]; then
-  out=$(mktemp -d)
-  trap 'rm -rf "$out"' EXIT
-fi
-mkdir -p "$out"
+need_sequences bench_stereo_sigma "$odometry" "$raw"
+output_folder
 
 quiet() { # log command...: runs it, shows its log when it fails
   local log=$1

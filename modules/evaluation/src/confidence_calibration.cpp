@@ -2,24 +2,13 @@
 #include <msf/evaluation/confidence_calibration.h>
 #include <msf/fusion/fusion_model.h>
 
+#include "image_checks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 namespace msf {
-
-namespace {
-
-void requireImage(const cv::Mat& image, const char* name, const cv::Size& size) {
-  if (image.type() != CV_32FC1)
-    throw InvalidInputError(std::string("confidence calibration: the ") + name + " must be CV_32FC1");
-  if (image.size() != size)
-    throw InvalidInputError(std::string("confidence calibration: the ") + name + " is " +
-                            std::to_string(image.cols) + "x" + std::to_string(image.rows) + " but the ground truth is " +
-                            std::to_string(size.width) + "x" + std::to_string(size.height));
-}
-
-} // namespace
 
 ConfidenceCalibration::ConfidenceCalibration(std::vector<float> edges) : edges_(std::move(edges)) {
   if (edges_.size() < 2)
@@ -36,8 +25,8 @@ ConfidenceCalibration::ConfidenceCalibration(std::vector<float> edges) : edges_(
 void ConfidenceCalibration::add(const cv::Mat& ground_truth, const cv::Mat& estimate, const cv::Mat& confidence) {
   if (ground_truth.type() != CV_32FC1)
     throw InvalidInputError("confidence calibration: the ground truth must be CV_32FC1");
-  requireImage(estimate, "estimate", ground_truth.size());
-  requireImage(confidence, "confidence", ground_truth.size());
+  detail::requireLikeGroundTruth(estimate, "confidence calibration", "the estimate", ground_truth.size());
+  detail::requireLikeGroundTruth(confidence, "confidence calibration", "the confidence", ground_truth.size());
   const float lo = edges_.front(), hi = edges_.back();
   for (int v = 0; v < ground_truth.rows; ++v) {
     const float* g = ground_truth.ptr<float>(v);

@@ -2,6 +2,8 @@
 #include <msf/evaluation/holdout_breakdown.h>
 #include <msf/io/organized_conversion.h>
 
+#include "image_checks.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <cstdint>
@@ -11,14 +13,6 @@
 namespace msf {
 
 namespace {
-void checkDepth(const cv::Mat& image, const char* name, const cv::Size& size) {
-  if (image.type() != CV_32FC1)
-    throw InvalidInputError(std::string("hold-out breakdown: ") + name + " must be CV_32FC1");
-  if (image.size() != size)
-    throw InvalidInputError(std::string("hold-out breakdown: ") + name + " is " + std::to_string(image.cols) + "x" +
-                            std::to_string(image.rows) + " but the ground truth is " + std::to_string(size.width) +
-                            "x" + std::to_string(size.height));
-}
 inline bool has(float z) { return z > 0.f && z < std::numeric_limits<float>::infinity(); }
 } // namespace
 
@@ -26,8 +20,8 @@ cv::Mat hiddenGroundTruthMask(const cv::Mat& gt_depth, const cv::Mat& input_dept
                               int radius_px, const D1Threshold& d1) {
   if (gt_depth.empty())
     throw InvalidInputError("hold-out breakdown: the ground-truth depth is empty");
-  checkDepth(gt_depth, "the ground-truth depth", gt_depth.size());
-  checkDepth(input_depth, "the input depth", gt_depth.size());
+  detail::requireLikeGroundTruth(gt_depth, "hold-out breakdown", "the ground-truth depth", gt_depth.size());
+  detail::requireLikeGroundTruth(input_depth, "hold-out breakdown", "the input depth", gt_depth.size());
   if (!(focal_baseline > 0.0))
     throw InvalidInputError("hold-out breakdown: focal length x baseline must be > 0, not " +
                             std::to_string(focal_baseline));
