@@ -1,8 +1,9 @@
 #pragma once
 // The vectorised core of SemiGlobalMatcher (private to the stereo module): one horizontal
-// strip of rows of OpenCV's 3-way semi-global block matching. Kept free of OpenCV and of
-// the standard library's templates so that its kernels can be compiled for AVX2 and
-// AVX-512 without lending such copies of inline functions to the rest of the program.
+// strip of rows of OpenCV's 3-way semi-global block matching (5-way with the diagonal paths
+// from above, as its MODE_SGBM). Kept free of OpenCV and of the standard library's templates
+// so that its kernels can be compiled for AVX2 and AVX-512 without lending such copies of
+// inline functions to the rest of the program.
 #include <cstddef>
 #include <cstdint>
 
@@ -28,6 +29,8 @@ struct SgmStrip {
   int prefilter_cap{63};              ///< OpenCV's ftzero: max(pre_filter_cap, 15) | 1
   int uniqueness_ratio{10};           ///< percent; 0 = off
   int disp12_max_diff{1};             ///< pseudo left-right check, >= 0
+  /// Also the paths from the top-left and the top-right (OpenCV's MODE_SGBM: five in all).
+  bool diagonal_paths{false};
   int row_begin{0}, row_output_begin{0}, row_end{0};
   /// Optional guidance (Poggi et al., CVPR 2019, as an additive cost): disparity x 16 of the
   /// left view per pixel, <= 0 = no hint; where there is one, every disparity d's block cost
@@ -45,7 +48,8 @@ struct SgmStrip {
 };
 
 /// Bytes of workspace one strip needs for images `width` wide.
-std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius);
+std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius,
+                              bool diagonal_paths);
 
 /// Runs one strip with AVX2 instructions; call only where the CPU has them.
 void sgmStripAvx2(const SgmStrip& strip);

@@ -12,8 +12,9 @@
 //     buffers of a strip stay within a core's L2 cache), then a sliding sum over 2r+1 columns;
 //  3. guidance (optional): at pixels with a disparity hint, a penalty growing with the
 //     distance from the hint is added to the block costs, so that the paths carry the hint on;
-//  4. paths: left-to-right and top-to-bottom in one pass, right-to-left in a second pass that
-//     also picks the disparity (uniqueness, parabolic sub-pixel, pseudo left-right check).
+//  4. paths: left-to-right and top-to-bottom in one pass (with diagonal_paths, top-left and
+//     top-right too), right-to-left in a second pass that also picks the disparity
+//     (uniqueness, parabolic sub-pixel, pseudo left-right check).
 
 using Reg = typename V::Reg;
 constexpr int kLanes = V::kLanes; // 16-bit lanes per vector
@@ -69,7 +70,7 @@ struct Strip {
   MSF_SIMD_INLINE explicit Strip(const SgmStrip& strip)
       : s(strip),
         layout(strip.width, strip.min_disparity, strip.num_disparities,
-               (strip.num_disparities + kLanes - 1) / kLanes * kLanes, strip.block_radius),
+               (strip.num_disparities + kLanes - 1) / kLanes * kLanes, strip.block_radius, strip.diagonal_paths),
         base(reinterpret_cast<std::uint8_t*>((reinterpret_cast<std::uintptr_t>(strip.workspace) + kAlign - 1) &
                                              ~static_cast<std::uintptr_t>(kAlign - 1))) {
     alignas(64) std::int16_t lanes[kLanes];
@@ -299,14 +300,55 @@ MSF_SIMD_INLINE Reg nextCost(const Strip& strip, std::int16_t* box, const std::i
   return k == K - 1 ? V::max16(cost, strip.padding) : cost;
 }
 
-/// Left-to-right and top-to-bottom paths of one row; their sum goes to `sums` (output rows).
+/// The diagonal paths of one pixel, from the top-left and the top-right pixel of the row
+/// above, as OpenCV's MODE_SGBM: their sum is added to the pixel's `sums_x` (output rows).
+/// A pixel's predecessor on the top-left path is at column xi - 1 of the row above, so the
+/// paths are kept by diagonal, at (xi - row) and (xi + row) modulo the row's width: each
+/// pixel's costs overwrite its predecessor's, in place, and the pixels of one row use
+/// distinct slots. A path entering at the first (top-left) or last column (top-right) starts
+/// with L = C, whatever its slot held.
+template <bool kOutput>
+MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int row, std::int16_t* sums_x, const int K) {
+  const Layout& layout = strip.layout;
+  const int D = kLanes * K, width1 = layout.width1, shift = row % width1;
+  const int left_slot = xi - shift < 0 ? xi - shift + width1 : xi - shift;
+  const int right_slot = xi + shift >= width1 ? xi + shift - width1 : xi + shift;
+  std::int16_t* top_left = strip.at<std::int16_t>(layout.top_left) + static_cast<std::size_t>(left_slot) * D;
+  std::int16_t* top_right = strip.at<std::int16_t>(layout.top_right) + static_cast<std::size_t>(right_slot) * D;
+  std::uint16_t* left_minima = strip.at<std::uint16_t>(layout.top_left_minima);
+  std::uint16_t* right_minima = strip.at<std::uint16_t>(layout.top_right_minima);
+  if (xi == 0) {
+    std::memset(top_left, 0, sizeof(std::int16_t) * static_cast<std::size_t>(D));
+    left_minima[left_slot] = 0;
+  }
+  if (xi == width1 - 1) {
+    std::memset(top_right, 0, sizeof(std::int16_t) * static_cast<std::size_t>(D));
+    right_minima[right_slot] = 0;
+  }
+  const std::int16_t* costs = strip.at<std::int16_t>(layout.costs);
+  const Reg p1 = V::set16(strip.s.p1);
+  PathSweep from_left(top_left, K, left_minima[left_slot], strip.s.p2);
+  PathSweep from_right(top_right, K, right_minima[right_slot], strip.s.p2);
+#pragma GCC unroll 8
+  for (int k = 0; k < K; ++k) {
+    const Reg cost = V::load(costs + kLanes * k);
+    const Reg both = V::adds16(from_left.step(k, cost, p1), from_right.step(k, cost, p1));
+    if constexpr (kOutput)
+      V::store(sums_x + kLanes * k, V::adds16(V::load(sums_x + kLanes * k), both));
+  }
+  left_minima[left_slot] = static_cast<std::uint16_t>(V::horizontalMin(from_left.minimum));
+  right_minima[right_slot] = static_cast<std::uint16_t>(V::horizontalMin(from_right.minimum));
+}
+
+/// Left-to-right and top-to-bottom paths of one row (and the diagonal ones with
+/// kDiagonal); their sum goes to `sums` (output rows). `row`: the row's index in the strip.
 /// K (vectors of disparities) is a compile-time constant where forwardPassK is
 /// instantiated for it, so that the sweep over disparities unrolls.
 /// With `add` (and `sub`), each column's sums first move down one row: the block row
 /// entering is `add`, the one leaving `sub` (fused here so the sums are read once).
-template <bool kOutput>
+template <bool kOutput, bool kDiagonal>
 MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub,
-                                    const Guide& guide, const int K) {
+                                    const Guide& guide, int row, const int K) {
   const Layout& layout = strip.layout;
   const int D = kLanes * K, r = strip.s.block_radius, last = layout.width1 - 1;
   const std::int16_t* column_sums = strip.at<std::int16_t>(layout.column_sums);
@@ -315,6 +357,7 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
   std::int16_t* top = strip.at<std::int16_t>(layout.top);
   std::int16_t* sums = strip.at<std::int16_t>(layout.sums);
   std::uint16_t* top_minima = strip.at<std::uint16_t>(layout.top_minima);
+  std::int16_t* costs = strip.at<std::int16_t>(layout.costs);
   const Reg p1 = V::set16(strip.s.p1);
   const int p2 = strip.s.p2;
   if (add)
@@ -340,6 +383,8 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
 #pragma GCC unroll 8
     for (int k = 0; k < K; ++k) {
       const Reg cost = guide.guided(nextCost(strip, box, entering, leaving, step, k, K), pixel, k);
+      if constexpr (kDiagonal)
+        V::store(costs + kLanes * k, cost);
       const Reg t = top_path.step(k, cost, p1);
       if constexpr (kOutput)
         V::store(sums_x + kLanes * k, V::adds16(left_path.step(k, cost, p1), t));
@@ -347,10 +392,13 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     if constexpr (kOutput)
       left_min = V::horizontalMin(left_path.minimum);
     top_minima[xi] = static_cast<std::uint16_t>(V::horizontalMin(top_path.minimum));
+    // In a loop of their own: with the two above, the paths' state outgrows the registers.
+    if constexpr (kDiagonal)
+      diagonalPaths<kOutput>(strip, xi, row, sums_x, K);
   }
 }
 
-/// Right-to-left path, the total over the three paths, and the disparity of each pixel.
+/// Right-to-left path, the total over the paths, and the disparity of each pixel.
 MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, const Guide& guide, const int K) {
   const SgmStrip& s = strip.s;
   const Layout& layout = strip.layout;
@@ -437,9 +485,10 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
   }
 }
 
-template <bool kOutput, int KC>
-MSF_SIMD void forwardPassK(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide) {
-  forwardPassFor<kOutput>(strip, add, sub, guide, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
+template <bool kOutput, bool kDiagonal, int KC>
+MSF_SIMD void forwardPassK(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide,
+                           int row) {
+  forwardPassFor<kOutput, kDiagonal>(strip, add, sub, guide, row, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
 }
 
 template <int KC>
@@ -448,32 +497,34 @@ MSF_SIMD void backwardPassK(const Strip& strip, std::int16_t* out, const Guide& 
 }
 
 /// `add`, `sub`: the block rows entering and leaving (none at the strip's first row);
-/// `out`: the disparity row, none on warm-up rows; `guide`: the row's hints.
-template <int KC>
+/// `out`: the disparity row, none on warm-up rows; `guide`: the row's hints; `row`: the
+/// row's index in the strip.
+template <bool kDiagonal, int KC>
 MSF_SIMD void matchRow(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide,
-                       std::int16_t* out) {
+                       int row, std::int16_t* out) {
   if (!out) {
-    forwardPassK<false, KC>(strip, add, sub, guide);
+    forwardPassK<false, kDiagonal, KC>(strip, add, sub, guide, row);
     return;
   }
-  forwardPassK<true, KC>(strip, add, sub, guide);
+  forwardPassK<true, kDiagonal, KC>(strip, add, sub, guide, row);
   backwardPassK<KC>(strip, out, guide);
 }
 
-using RowMatcher = void (*)(const Strip&, const std::uint8_t*, const std::uint8_t*, const Guide&, std::int16_t*);
+using RowMatcher = void (*)(const Strip&, const std::uint8_t*, const std::uint8_t*, const Guide&, int, std::int16_t*);
 
 /// The passes of one row, unrolled for up to 128 disparities.
+template <bool kDiagonal>
 MSF_SIMD RowMatcher rowMatcherFor(int vectors) {
   switch (vectors) {
-  case 1: return matchRow<1>;
-  case 2: return matchRow<2>;
-  case 3: return matchRow<3>;
-  case 4: return matchRow<4>;
-  case 5: return matchRow<5>;
-  case 6: return matchRow<6>;
-  case 7: return matchRow<7>;
-  case 8: return matchRow<8>;
-  default: return matchRow<0>;
+  case 1: return matchRow<kDiagonal, 1>;
+  case 2: return matchRow<kDiagonal, 2>;
+  case 3: return matchRow<kDiagonal, 3>;
+  case 4: return matchRow<kDiagonal, 4>;
+  case 5: return matchRow<kDiagonal, 5>;
+  case 6: return matchRow<kDiagonal, 6>;
+  case 7: return matchRow<kDiagonal, 7>;
+  case 8: return matchRow<kDiagonal, 8>;
+  default: return matchRow<kDiagonal, 0>;
   }
 }
 
@@ -510,17 +561,25 @@ MSF_SIMD void runStrip(const SgmStrip& s) {
   std::memset(strip.at<std::int16_t>(layout.top), 0, sizeof(std::int16_t) * volume_row);
   std::memset(strip.at<std::uint16_t>(layout.top_minima), 0,
               sizeof(std::uint16_t) * static_cast<std::size_t>(layout.width1));
+  if (s.diagonal_paths) { // so do the diagonal ones
+    std::memset(strip.at<std::int16_t>(layout.top_left), 0, sizeof(std::int16_t) * volume_row);
+    std::memset(strip.at<std::int16_t>(layout.top_right), 0, sizeof(std::int16_t) * volume_row);
+    std::memset(strip.at<std::uint16_t>(layout.top_left_minima), 0,
+                sizeof(std::uint16_t) * static_cast<std::size_t>(layout.width1));
+    std::memset(strip.at<std::uint16_t>(layout.top_right_minima), 0,
+                sizeof(std::uint16_t) * static_cast<std::size_t>(layout.width1));
+  }
   std::int16_t* disp2 = strip.at<std::int16_t>(layout.disp2);
   std::int16_t* disp2_cost = strip.at<std::int16_t>(layout.disp2_cost);
 
-  const RowMatcher match_row = rowMatcherFor(D / kLanes);
+  const RowMatcher match_row = s.diagonal_paths ? rowMatcherFor<true>(D / kLanes) : rowMatcherFor<false>(D / kLanes);
   const bool guided = s.guidance && s.guidance_gain > 0 && s.guidance_max_penalty > 0;
   for (int y = s.row_begin; y < s.row_end; ++y) {
     const std::uint8_t* add = y > s.row_begin ? strip.preparedRow(y + r) : nullptr;
     const std::uint8_t* sub = y > s.row_begin ? strip.preparedRow(y - r - 1) : nullptr;
     const Guide guide(s, guided ? rowHints(s, y, layout) : nullptr);
     if (y < s.row_output_begin) {
-      match_row(strip, add, sub, guide, nullptr);
+      match_row(strip, add, sub, guide, y - s.row_begin, nullptr);
       continue;
     }
     std::int16_t* out = s.disparity + static_cast<std::size_t>(y) * s.disparity_step;
@@ -529,7 +588,7 @@ MSF_SIMD void runStrip(const SgmStrip& s) {
       disp2[x] = static_cast<std::int16_t>(s.min_disparity - 1);
       disp2_cost[x] = 0x7FFF;
     }
-    match_row(strip, add, sub, guide, out);
+    match_row(strip, add, sub, guide, y - s.row_begin, out);
     // OpenCV's pseudo left-right check: the right view's winners, gathered above from the
     // left view's, must agree with the disparity rounded down or up.
     const int max_diff = s.disp12_max_diff;

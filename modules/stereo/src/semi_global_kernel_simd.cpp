@@ -1,5 +1,5 @@
-// The vector kernels of SemiGlobalMatcher: OpenCV's StereoSGBM (MODE_SGBM_3WAY) cost,
-// aggregation and winner selection (semi_global_kernel_body.h), compiled twice, for AVX2
+// The vector kernels of SemiGlobalMatcher: OpenCV's StereoSGBM (MODE_SGBM_3WAY, or with the
+// two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection (semi_global_kernel_body.h), compiled twice, for AVX2
 // (16 disparities per instruction) and AVX-512BW (32). Only the code between the target
 // pragmas uses those instruction sets, so this file builds for any x86-64 and the caller
 // picks a kernel at run time.
@@ -26,9 +26,14 @@ struct Layout {
   int num_disparities{0}; ///< searched, padded to whole vectors: the stride of the buffers
   int ring{0};         ///< prepared rows kept (2r + 2: the row entering and the one leaving)
   std::size_t column_sums{0}, top{0}, sums{0}, top_minima{0}, box{0}, left{0}, right{0}, total{0};
-  std::size_t prep{0}, prep_rows{0}, disp2{0}, disp2_cost{0}, bytes{0};
+  std::size_t prep{0}, prep_rows{0}, disp2{0}, disp2_cost{0};
+  /// The diagonal paths' rows and minima, and the pixel's block costs they read (empty
+  /// without diagonal paths).
+  std::size_t top_left{0}, top_right{0}, top_left_minima{0}, top_right_minima{0}, costs{0};
+  std::size_t bytes{0};
 
-  Layout(int width, int min_disparity, int searched_disparities, int padded_disparities, int block_radius)
+  Layout(int width, int min_disparity, int searched_disparities, int padded_disparities, int block_radius,
+         bool diagonal_paths)
       : num_disparities(padded_disparities) {
     const int max_disparity = min_disparity + searched_disparities;
     min_x = max_disparity > 0 ? max_disparity : 0;
@@ -55,6 +60,12 @@ struct Layout {
     prep_rows = take(sizeof(int) * static_cast<std::size_t>(ring));
     disp2 = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
     disp2_cost = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
+    const std::size_t diagonal = diagonal_paths ? 1 : 0;
+    top_left = take(diagonal * volume_row);
+    top_right = take(diagonal * volume_row);
+    top_left_minima = take(diagonal * sizeof(std::uint16_t) * static_cast<std::size_t>(width1));
+    top_right_minima = take(diagonal * sizeof(std::uint16_t) * static_cast<std::size_t>(width1));
+    costs = take(diagonal * line);
     bytes = at + kAlign; // the caller's pointer is aligned here
   }
 
@@ -65,9 +76,11 @@ struct Layout {
 
 } // namespace
 
-std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius) {
+std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius,
+                              bool diagonal_paths) {
   // Disparities padded to whole vectors of the widest kernel (32 lanes).
-  return Layout(width, min_disparity, num_disparities, (num_disparities + 31) / 32 * 32, block_radius).bytes;
+  return Layout(width, min_disparity, num_disparities, (num_disparities + 31) / 32 * 32, block_radius, diagonal_paths)
+      .bytes;
 }
 
 #ifdef MSF_SGM_X86

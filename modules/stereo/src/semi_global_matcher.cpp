@@ -110,7 +110,7 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   const int strip_rows = (height + strips - 1) / strips;
   // OpenCV's warm-up: the block's half height plus a tenth of a strip.
   const int overlap = radius + 1 + static_cast<int>(std::ceil(0.1 * strip_rows));
-  const std::size_t workspace_bytes = detail::sgmWorkspaceBytes(left.cols, p.min_disparity, p.num_disparities, radius);
+  const std::size_t workspace_bytes = detail::sgmWorkspaceBytes(left.cols, p.min_disparity, p.num_disparities, radius, p.diagonal_paths);
   workspaces_.resize(static_cast<std::size_t>(strips));
   for (auto& workspace : workspaces_)
     if (workspace.size() < workspace_bytes)
@@ -131,6 +131,7 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   job.prefilter_cap = std::max(p.pre_filter_cap, 15) | 1;
   job.uniqueness_ratio = p.uniqueness_ratio;
   job.disp12_max_diff = p.disp12_max_diff > 0 ? p.disp12_max_diff : 1; // as OpenCV 4.6: never off
+  job.diagonal_paths = p.diagonal_paths;
   if (!guidance.empty()) {
     job.guidance = guidance.ptr<std::int16_t>();
     job.guidance_step = guidance.step[0] / sizeof(std::int16_t);

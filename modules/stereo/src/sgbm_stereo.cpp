@@ -96,10 +96,10 @@ bool SgbmStereo::nativeRuns(int width) const {
     });
     return false;
   }
-  if (config_.mode != "sgbm_3way") {
+  if (config_.mode != "sgbm_3way" && config_.mode != "sgbm") {
     static std::once_flag noted;
     std::call_once(noted, [&] {
-      std::cerr << "msf: note: stereo.engine native implements mode sgbm_3way; mode " << config_.mode
+      std::cerr << "msf: note: stereo.engine native implements modes sgbm_3way and sgbm; mode " << config_.mode
                 << " runs on OpenCV's StereoSGBM\n";
     });
     return false;
@@ -128,6 +128,7 @@ void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_d
     params.speckle_window_size = config_.speckle_window_size_px;
     params.speckle_range = config_.speckle_range_px;
     params.disp12_max_diff = config_.disp12_max_diff_px;
+    params.diagonal_paths = config_.mode == "sgbm";
     params.guidance_gain = config_.guidance_gain;
     params.guidance_max_penalty = config_.guidance_max_penalty;
     native_.setParams(params);

@@ -13,8 +13,9 @@ namespace msf {
 /// baseline docs/results.md quotes), narrowed by a LiDAR depth prior when one is given.
 struct SgbmConfig {
   /// native: our AVX2 / AVX-512 matcher (SemiGlobalMatcher), the same algorithm and
-  /// parameters as OpenCV's 3-way SGBM, 2-3x faster per core; on a CPU without AVX2, or for
-  /// the other modes, it falls back to OpenCV with a one-time note. opencv: cv::StereoSGBM.
+  /// parameters as OpenCV's 3-way SGBM (and its 5-path sgbm), 2-3x faster per core; on a CPU
+  /// without AVX2, or for hh and hh4, it falls back to OpenCV with a one-time note.
+  /// opencv: cv::StereoSGBM.
   std::string engine = "native";
   std::string mode = "sgbm_3way";  ///< sgbm_3way | sgbm (5 paths) | hh (8 paths) | hh4
   int min_disparity_px = 0;

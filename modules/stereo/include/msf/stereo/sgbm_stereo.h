@@ -82,7 +82,7 @@ public:
   /// Number of disparities searched by the last computeDisparity() (narrowed by the prior).
   int getSearchedDisparities() const { return searched_disparities_; }
   /// The engine that ran the last computeDisparity(): "native" or "opencv" (the fallback
-  /// where native was asked for but the CPU has no AVX2, the mode is not sgbm_3way or the
+  /// where native was asked for but the CPU has no AVX2, the mode is hh or hh4 or the
   /// images are wider than SemiGlobalMatcher::maxWidth()).
   const std::string& getEngineUsed() const { return engine_used_; }
 
