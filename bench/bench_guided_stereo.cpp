@@ -1,9 +1,9 @@
 // Guided SGBM (stereo.guidance lidar) beside unguided, per KITTI frame (odometry 04, frames
 // 0-9 in turn, 1226 x 370), both narrowed by the interpolated LiDAR as the pipeline does.
-// BM_SgbmStereo: SgbmStereo::computeDisparity (hints from the sparse depth included), both
-// threads; cpu_ms_all_threads is the process CPU time per frame, steadier than wall time on
-// a shared machine. BM_MatcherOneCore: SemiGlobalMatcher alone on one thread at 128
-// disparities, without and with the hints of the projected scan (bridged): the kernel's cost
+// BM_SgbmStereo: SgbmStereo::computeDisparity (the default five paths, hints from the sparse
+// depth included), both threads; cpu_ms_all_threads is the process CPU time per frame,
+// steadier than wall time on a shared machine. BM_MatcherOneCore: SemiGlobalMatcher alone
+// (3-way) on one thread at 128 disparities, without and with the hints of the projected scan (bridged): the kernel's cost
 // of the guidance. Unguided and guided rows alternate, so that both see the same load.
 //
 //   bench_guided_stereo [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]

@@ -5,8 +5,9 @@
 // explicit left-right check. Times are of SgbmStereo::computeDisparity (matching,
 // conversion, confidence); cpu_ms_all_threads is the process CPU time per frame (all threads).
 // BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
-// SemiGlobalMatcher with its AVX2 and its AVX-512 kernel): per-core cost, steadier than wall
-// time on a machine shared with other work.
+// SemiGlobalMatcher with its AVX2 and its AVX-512 kernel), 3-way and with five paths
+// (MODE_SGBM, stereo.mode sgbm): per-core cost, steadier than wall time on a machine shared
+// with other work. BM_Sgbm5WayLidarRange: the LiDAR-narrowed rows with five paths.
 // Post-processing, side by side: the native rows again with OpenCV's serial speckle filter
 // and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)), and
 // BM_PostFilter, that tail alone (OpenCV's median, speckle filter, conversion to float,
@@ -133,19 +134,29 @@ void BM_PostFilter(benchmark::State& state, bool parallel) {
   msf::setParallelPostFilterEnabled(true);
 }
 
-void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, msf::SgbmConfig{}, false, engine); }
+/// The defaults with `mode`.
+msf::SgbmConfig inMode(const char* mode) {
+  msf::SgbmConfig config;
+  config.mode = mode;
+  return config;
+}
+
+void BM_Sgbm3Way128(benchmark::State& state, const char* engine) { run(state, inMode("sgbm_3way"), false, engine); }
 
 void BM_Sgbm3WayLidarRange(benchmark::State& state, const char* engine) {
-  run(state, msf::SgbmConfig{}, true, engine);
+  run(state, inMode("sgbm_3way"), true, engine);
 }
 
 void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state, const char* engine) {
-  msf::SgbmConfig config;
+  msf::SgbmConfig config = inMode("sgbm_3way");
   config.left_right_check = true;
   run(state, config, true, engine);
 }
 
-void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
+void BM_Sgbm5WayLidarRange(benchmark::State& state, const char* engine) { run(state, inMode("sgbm"), true, engine); }
+
+/// `five_paths`: the diagonal paths too (OpenCV's MODE_SGBM).
+void BM_MatcherOneCore(benchmark::State& state, const char* kernel, bool five_paths) {
   const Data& d = data();
   const std::string name = kernel;
   const msf::SgbmConfig config;
@@ -153,11 +164,12 @@ void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
   params.num_disparities = config.num_disparities_px;
   params.p1 = config.resolvedP1();
   params.p2 = config.resolvedP2();
+  params.diagonal_paths = five_paths;
   msf::SemiGlobalMatcher native(params);
-  const cv::Ptr<cv::StereoSGBM> opencv =
-      cv::StereoSGBM::create(0, params.num_disparities, params.block_size, params.p1, params.p2, params.disp12_max_diff,
-                             params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size,
-                             params.speckle_range, cv::StereoSGBM::MODE_SGBM_3WAY);
+  const cv::Ptr<cv::StereoSGBM> opencv = cv::StereoSGBM::create(
+      0, params.num_disparities, params.block_size, params.p1, params.p2, params.disp12_max_diff,
+      params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size, params.speckle_range,
+      five_paths ? cv::StereoSGBM::MODE_SGBM : cv::StereoSGBM::MODE_SGBM_3WAY);
   if (name != "opencv" && !msf::SemiGlobalMatcher::isAvailable()) {
     state.SkipWithError("this CPU has no AVX2");
     return;
@@ -183,9 +195,18 @@ void BM_MatcherOneCore(benchmark::State& state, const char* kernel) {
 
 } // namespace
 
-BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2, "avx2")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512, "avx512")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv, "opencv", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2, "avx2", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512, "avx512", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv_5paths, "opencv", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2_5paths, "avx2", true)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512_5paths, "avx512", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(10);
 
 // Each case's engines one after the other, so that both see the same machine load.
 BENCHMARK_CAPTURE(BM_Sgbm3Way128, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
@@ -200,6 +221,8 @@ BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRange, native_opencv_tail, "native_opencv_tail
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm5WayLidarRange, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
+BENCHMARK_CAPTURE(BM_Sgbm5WayLidarRange, native, "native")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
 BENCHMARK_CAPTURE(BM_Sgbm3WayLidarRangeLrCheck, opencv, "opencv")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

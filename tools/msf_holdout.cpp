@@ -153,7 +153,7 @@ const std::vector<MethodEntry>& methodTable() {
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicFast); }},
       {"ipbasic_multiscale", "IP-Basic multiscale, same projection",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::IpBasicMultiscale); }},
-      {"sgbm", "3-way SGBM on the grey pair (section stereo, stereo.engine), no LiDAR",
+      {"sgbm", "SGBM on the grey pair (section stereo: stereo.mode, stereo.engine), no LiDAR",
        [](const msf::ConfigFile& f) { return stereo(f, StereoInput::None); }},
       {"sgbm_prior", "the same, its search narrowed by the interpolated input rings, unguided",
        [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Prior); }},

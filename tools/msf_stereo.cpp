@@ -1,4 +1,4 @@
-// Paper step 3: 3-way SGBM on a rectified grey pair to an organized cloud in camera 0
+// Paper step 3: SGBM (5-path or 3-way) on a rectified grey pair to an organized cloud in camera 0
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
 #include <msf/common/atomic_file.h>
@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
   msf::SgbmConfig config;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
-      "Matches a rectified pair (KITTI image_0, image_1) with 3-way SGBM (stereo.engine: the native AVX2 kernel or "
+      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.mode; stereo.engine: the native AVX2 kernel or "
       "OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
       "is no match).");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
       .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
-      .value("-mode", "NAME", config.mode, "sgbm_3way (default) | sgbm | hh | hh4")
+      .value("-mode", "NAME", config.mode, "sgbm (5 paths, default) | sgbm_3way | hh | hh4")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
       .flag("-print_config", print_config, "print the stereo settings in use");
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {

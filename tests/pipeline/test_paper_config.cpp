@@ -36,6 +36,7 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   EXPECT_EQ(c.interpolation.column_seed_gap_px, 0); // rows and columns independent
   EXPECT_TRUE(c.interpolation.gaussian);
   EXPECT_EQ(c.stereo.engine, "opencv");
+  EXPECT_EQ(c.stereo.mode, "sgbm_3way");
   EXPECT_FALSE(c.stereo.lidarGuidance());
   EXPECT_FALSE(c.stereo.prior_search_range);
   EXPECT_FALSE(c.scheduling.stereo_prior);
@@ -51,6 +52,7 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   const msf::PipelineConfig ours;
   EXPECT_TRUE(ours.interpolation.slice.inverse_depth && ours.interpolation.slice.edge_test &&
               ours.fusion.edge_support && ours.stereo.lidarGuidance() && ours.integrator.silhouette_band);
+  EXPECT_EQ(ours.stereo.mode, "sgbm");
   EXPECT_EQ(ours.fusion.paper_weights, msf::PaperWeights::Relative);
   EXPECT_EQ(ours.integrator.solve, msf::TsdfIntegrator::Solve::Sweeps);
 }
