@@ -47,7 +47,7 @@ public:
     int disp12_max_diff = -1;  ///< pseudo left-right check in pixels; <= 0 means 1, as OpenCV 4.6
     /// Also the two diagonal paths from above (OpenCV's MODE_SGBM, five paths in all): a
     /// blank wall between periodic windows, which the rows alone match at a window's pitch,
-    /// takes the disparity of the textured pixels above and beside it. ~1.4x the time.
+    /// takes the disparity of the textured pixels above and beside it. ~1.25x the time.
     bool diagonal_paths = false;
     /// Guidance (compute() with a hint image): at a pixel with a hint, each disparity d's
     /// block cost grows by min(guidance_gain * |d - hint|, guidance_max_penalty) before the
