@@ -187,6 +187,31 @@ TEST(SemiGlobalMatcher, DiagonalPathsMatchWhereRowsAndColumnsSeeNoTexture) {
   EXPECT_GT(shareWithin(five, truth, textured, 0.25f), 0.99);
 }
 
+TEST(SemiGlobalMatcher, DiagonalPathsOnImagesBarelyWiderThanTheRange) {
+  MSF_REQUIRE_AVX2();
+  // One to three matchable columns, fewer rows than strips: the diagonal slots wrap on every
+  // row, and every column is a path's first or last.
+  for (const int extra : {1, 2, 3})
+    for (const int rows : {1, 3, 7}) {
+      const cv::Size size(48 + extra, rows);
+      cv::Mat left(size, CV_8UC1), right;
+      cv::randu(left, 0, 256);
+      right = left.clone();
+      msf::SemiGlobalMatcher::Params params = smallParams();
+      params.diagonal_paths = true;
+      cv::Mat fixed;
+      msf::SemiGlobalMatcher(params).compute(left, right, fixed);
+      ASSERT_EQ(fixed.size(), size);
+      const short none = -16;
+      EXPECT_EQ(cv::countNonZero(fixed.colRange(0, 48) != none), 0) << extra << "x" << rows;
+      for (int v = 0; v < rows; ++v)
+        for (int u = 48; u < size.width; ++u) {
+          const short d = fixed.at<short>(v, u);
+          EXPECT_TRUE(d == none || (d >= 0 && d <= 47 * 16)) << d;
+        }
+    }
+}
+
 TEST(SemiGlobalMatcher, UniquenessRatioRemovesAmbiguousMatches) {
   MSF_REQUIRE_AVX2();
   // A noisy pair: the stricter the ratio, the fewer pixels keep a disparity.
