@@ -365,22 +365,37 @@ TEST(SemiGlobalMatcher, SgbmStereoMatchesTheLeftBorderWithTheNativeEngine) {
   EXPECT_GT(cv::countNonZero(cv::abs(band - 12.f) < 0.25f), band.total() * 9 / 10);
 }
 
+/// The grey pair of KITTI odometry 04, frame 0.
+struct GreyPair {
+  cv::Mat left, right;
+};
+
+GreyPair odometryFrame0() {
+  const std::string seq = msf::test::kittiDir() + "/odometry/sequences/04/";
+  return {msf::readImage(seq + "image_0/000000.png", cv::IMREAD_GRAYSCALE),
+          msf::readImage(seq + "image_1/000000.png", cv::IMREAD_GRAYSCALE)};
+}
+
+/// OpenCV's StereoSGBM in `mode` with the native matcher's `params` (block 5).
+cv::Mat openCvDisparity(const GreyPair& pair, const msf::SemiGlobalMatcher::Params& params, int mode) {
+  cv::Mat disparity;
+  cv::StereoSGBM::create(0, params.num_disparities, 5, params.p1, params.p2, params.disp12_max_diff,
+                         params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size,
+                         params.speckle_range, mode)
+      ->compute(pair.left, pair.right, disparity);
+  return disparity;
+}
+
 TEST(SemiGlobalMatcherKitti, AgreesWithOpenCvOnAnOdometryFrame) {
   MSF_REQUIRE_KITTI();
   MSF_REQUIRE_AVX2();
-  const std::string seq = msf::test::kittiDir() + "/odometry/sequences/04/";
-  const cv::Mat left = msf::readImage(seq + "image_0/000000.png", cv::IMREAD_GRAYSCALE);
-  const cv::Mat right = msf::readImage(seq + "image_1/000000.png", cv::IMREAD_GRAYSCALE);
+  const GreyPair pair = odometryFrame0();
   for (const int disparities : {128, 80}) {
     msf::SemiGlobalMatcher::Params params;
     params.num_disparities = disparities;
-    cv::Mat native, opencv;
-    msf::SemiGlobalMatcher(params).compute(left, right, native);
-    cv::StereoSGBM::create(0, disparities, 5, params.p1, params.p2, params.disp12_max_diff, params.pre_filter_cap,
-                           params.uniqueness_ratio, params.speckle_window_size, params.speckle_range,
-                           cv::StereoSGBM::MODE_SGBM_3WAY)
-        ->compute(left, right, opencv);
-    const Agreement agreement = compare(native, opencv);
+    cv::Mat native;
+    msf::SemiGlobalMatcher(params).compute(pair.left, pair.right, native);
+    const Agreement agreement = compare(native, openCvDisparity(pair, params, cv::StereoSGBM::MODE_SGBM_3WAY));
     // Measured on frames 0, 5, 9: <= 0.03 % of the common pixels more than 1 px apart,
     // ~0.1 % matched by one only (ties, and OpenCV's strip warm-up from the strip's first row).
     ASSERT_GT(agreement.both, 350000);
@@ -392,18 +407,13 @@ TEST(SemiGlobalMatcherKitti, AgreesWithOpenCvOnAnOdometryFrame) {
 TEST(SemiGlobalMatcherKitti, DiagonalPathsAgreeWithOpenCvsFivePathMode) {
   MSF_REQUIRE_KITTI();
   MSF_REQUIRE_AVX2();
-  const std::string seq = msf::test::kittiDir() + "/odometry/sequences/04/";
-  const cv::Mat left = msf::readImage(seq + "image_0/000000.png", cv::IMREAD_GRAYSCALE);
-  const cv::Mat right = msf::readImage(seq + "image_1/000000.png", cv::IMREAD_GRAYSCALE);
+  const GreyPair pair = odometryFrame0();
   msf::SemiGlobalMatcher::Params params;
-  cv::Mat opencv, five, three;
-  cv::StereoSGBM::create(0, params.num_disparities, 5, params.p1, params.p2, params.disp12_max_diff,
-                         params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size,
-                         params.speckle_range, cv::StereoSGBM::MODE_SGBM)
-      ->compute(left, right, opencv);
-  msf::SemiGlobalMatcher(params).compute(left, right, three);
+  const cv::Mat opencv = openCvDisparity(pair, params, cv::StereoSGBM::MODE_SGBM);
+  cv::Mat five, three;
+  msf::SemiGlobalMatcher(params).compute(pair.left, pair.right, three);
   params.diagonal_paths = true;
-  msf::SemiGlobalMatcher(params).compute(left, right, five);
+  msf::SemiGlobalMatcher(params).compute(pair.left, pair.right, five);
   // Measured on frames 0, 5, 9: <= 0.16 % of the common pixels more than 1 px apart and
   // <= 1.3 % matched by one only (OpenCV runs MODE_SGBM's paths over the whole image, we over
   // strips warmed up as in 3-way); three paths differ from it on 2.1-2.4 % and 5.2-6.7 %.

@@ -306,11 +306,11 @@ MSF_SIMD_INLINE Reg nextCost(const Strip& strip, std::int16_t* box, const std::i
 /// paths are kept by diagonal, at (xi - row) and (xi + row) modulo the row's width: each
 /// pixel's costs overwrite its predecessor's, in place, and the pixels of one row use
 /// distinct slots. A path entering at the first (top-left) or last column (top-right) starts
-/// with L = C, whatever its slot held.
+/// with L = C, whatever its slot held. `shift`: the row's index in the strip modulo width1.
 template <bool kOutput>
-MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int row, std::int16_t* sums_x, const int K) {
+MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int shift, std::int16_t* sums_x, const int K) {
   const Layout& layout = strip.layout;
-  const int D = kLanes * K, width1 = layout.width1, shift = row % width1;
+  const int D = kLanes * K, width1 = layout.width1;
   const int left_slot = xi - shift < 0 ? xi - shift + width1 : xi - shift;
   const int right_slot = xi + shift >= width1 ? xi + shift - width1 : xi + shift;
   std::int16_t* top_left = strip.at<std::int16_t>(layout.top_left) + static_cast<std::size_t>(left_slot) * D;
@@ -358,6 +358,7 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
   std::int16_t* sums = strip.at<std::int16_t>(layout.sums);
   std::uint16_t* top_minima = strip.at<std::uint16_t>(layout.top_minima);
   std::int16_t* costs = strip.at<std::int16_t>(layout.costs);
+  const int diagonal_shift = row % layout.width1;
   const Reg p1 = V::set16(strip.s.p1);
   const int p2 = strip.s.p2;
   if (add)
@@ -394,7 +395,7 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     top_minima[xi] = static_cast<std::uint16_t>(V::horizontalMin(top_path.minimum));
     // In a loop of their own: with the two above, the paths' state outgrows the registers.
     if constexpr (kDiagonal)
-      diagonalPaths<kOutput>(strip, xi, row, sums_x, K);
+      diagonalPaths<kOutput>(strip, xi, diagonal_shift, sums_x, K);
   }
 }
 

@@ -1,8 +1,8 @@
 // The vector kernels of SemiGlobalMatcher: OpenCV's StereoSGBM (MODE_SGBM_3WAY, or with the
-// two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection (semi_global_kernel_body.h), compiled twice, for AVX2
-// (16 disparities per instruction) and AVX-512BW (32). Only the code between the target
-// pragmas uses those instruction sets, so this file builds for any x86-64 and the caller
-// picks a kernel at run time.
+// two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection
+// (semi_global_kernel_body.h), compiled twice, for AVX2 (16 disparities per instruction) and
+// AVX-512BW (32). Only the code between the target pragmas uses those instruction sets, so
+// this file builds for any x86-64 and the caller picks a kernel at run time.
 #include "semi_global_kernel.h"
 
 #if defined(__x86_64__) || defined(__i386__)

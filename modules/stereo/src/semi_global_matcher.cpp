@@ -110,7 +110,8 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   const int strip_rows = (height + strips - 1) / strips;
   // OpenCV's warm-up: the block's half height plus a tenth of a strip.
   const int overlap = radius + 1 + static_cast<int>(std::ceil(0.1 * strip_rows));
-  const std::size_t workspace_bytes = detail::sgmWorkspaceBytes(left.cols, p.min_disparity, p.num_disparities, radius, p.diagonal_paths);
+  const std::size_t workspace_bytes =
+      detail::sgmWorkspaceBytes(left.cols, p.min_disparity, p.num_disparities, radius, p.diagonal_paths);
   workspaces_.resize(static_cast<std::size_t>(strips));
   for (auto& workspace : workspaces_)
     if (workspace.size() < workspace_bytes)
