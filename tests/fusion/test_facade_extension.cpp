@@ -122,6 +122,46 @@ TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
   EXPECT_NEAR(wall.depth.at<float>(kWallTop + 3, 30), kWall, 0.2f);
 }
 
+TEST(FacadeExtension, AColumnStopsWhereStereoSeesABuildingBehindTheWall) {
+  // A building 16 m away behind the wall's top, of the wall's grey (no edge in the image):
+  // stereo sees it (sigma 0.5 m: no anchor) in rows 20-45 of columns 40-79, nothing sees rows
+  // 46-69.
+  Wall wall;
+  wall.grey.setTo(120);
+  const cv::Rect behind(40, 20, 40, 26);
+  wall.depth(behind).setTo(16.f);
+  wall.weight(behind).setTo(4.f);
+  wall.run();
+  for (int u = behind.x; u < behind.x + behind.width; ++u) {
+    // The wall goes on up to the building, takes its first two rows as SGBM's guesses and
+    // stops at the third: the building keeps the rest.
+    for (int v = 46; v < kLidarTop; ++v)
+      ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
+    for (int v = behind.y; v <= 43; ++v) {
+      ASSERT_EQ(wall.depth.at<float>(v, u), 16.f) << v << "," << u;
+      ASSERT_EQ(wall.weight.at<float>(v, u), 4.f) << v << "," << u;
+    }
+  }
+  // Where stereo sees nothing behind it, the wall goes on to the top of the image.
+  EXPECT_NEAR(wall.depth.at<float>(5, 20), kWall, 1e-3f);
+  EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
+}
+
+TEST(FacadeExtension, TheWallGoesOnVerticalWhateverItsAnchorsSlope) {
+  // Anchors whose inverse depth falls 4e-5 per row upward (n_y 0.2, within the bar): carried
+  // on, their line would put row 25 at 10.18 m. The wall goes on at the run's own inverse
+  // depth, that of its top ~5 rows (weights 0.8^k): 1 / (0.1 + 4e-5 * 4) m.
+  Wall wall;
+  for (int v = kLidarTop; v < kHeight; ++v)
+    wall.depth.row(v).setTo(1.f / (0.1f + 4e-5f * static_cast<float>(v - kLidarTop)));
+  wall.run();
+  const float run_depth = 1.f / (0.1f + 4e-5f * 4.f);
+  for (int u = 10; u < kWidth; u += 30) {
+    EXPECT_NEAR(wall.depth.at<float>(25, u), run_depth, 0.01f) << u;
+    EXPECT_EQ(wall.depth.at<float>(25, u), wall.depth.at<float>(kLidarTop - 1, u)) << u;
+  }
+}
+
 TEST(FacadeExtension, NotTheRoadNorATexturedSurface) {
   // The road 1.65 m below the camera, LiDAR-backed from row 80 down, blank above it up to the
   // horizon: its line leads into the sky, and it stays where it is.

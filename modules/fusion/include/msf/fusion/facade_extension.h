@@ -16,19 +16,24 @@ namespace msf {
 ///
 /// Each column is walked from the bottom up. Its anchors are fused pixels known to within
 /// facade_anchor_sigma_m (LiDAR-backed, or stereo near the cameras); the last run of them is
-/// fitted with a line in inverse depth against the row (exact on any plane), its nearest rows
-/// weighing most. Above the run the line goes on (an anchor it reaches joins the run), while
-/// - the surface is near vertical: the normal's component along the image's y axis is at most
-///   facade_max_normal_y (a wall, not the road or a car's roof, whose line leads into the sky);
+/// fitted with a line in inverse depth against the row, its nearest rows weighing most. Above
+/// the run the wall goes on vertical, at the run's inverse depth (on a vertical plane a level
+/// camera sees 1/z constant up a column; an anchor it reaches joins the run), while
+/// - the surface is near vertical: the line's slope gives the normal's component along the
+///   image's y axis at most facade_max_normal_y (a wall, not the road or a car's roof, whose
+///   line leads into the sky);
 /// - the image looks the same and blank: the grey's mean over 5x5 pixels stays within
 ///   facade_grey_tolerance of the run's, and its standard deviation there within
 ///   facade_max_texture (about twice the image noise: a window, the wall's top edge against the
 ///   sky, another object or a texture stereo can match stops it), and not overexposed (a mean of
-///   250 or more: a bright sky is blank too).
-/// A pixel on the way takes the line's depth with the sigma of the run's last anchor plus
+///   250 or more: a bright sky is blank too);
+/// - stereo does not see the surface behind it: three pixels with a depth more than 3 of their
+///   own sigmas behind the wall, none agreeing between them, stop the column (the wall's top
+///   edge against a building behind it of the same grey) and keep their depth.
+/// A pixel on the way takes the wall's depth with the sigma of the run's last anchor plus
 /// facade_sigma_per_m per metre above it (a wall leaning by ~6 degrees), as its weight and free
-/// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the line's):
-/// then it is kept. Stereo that disagrees on a blank surface is a guess, and is replaced.
+/// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the
+/// wall's): then it is kept. Other stereo on a blank surface is a guess, and is replaced.
 ///
 /// left: CV_8UC1, the grey image of camera 0 (the fused depth's pixels); depth, weight (and
 /// free_space_weight, if not empty): CV_32FC1 of its size, changed in place. Columns run in
