@@ -24,13 +24,14 @@ struct ColumnFit {
   float anchor_weight = 0;
   int anchor_row = -1;       ///< row of the run's last anchor, -1: no run to go on from
   bool run_below = false;    ///< the row below was the run's: an anchor, or a pixel it reached
-  int behind = 0;            ///< pixels since the last that agreed whose depth lies behind the wall
+  int behind = 0;            ///< the last pixels with a depth, in a row, that lie behind the wall
 
-  /// That many stereo pixels of a column, each more than kBehindSigmas of its sigmas behind the
-  /// wall and none agreeing between them, see the surface above the wall's top edge (a building
-  /// behind a lower one of the same grey, street 20: 12 sigmas): the column stops. SGBM's
-  /// guesses on a blank wall come in runs too (its paths carry them), but nearer: at 3 sigmas
-  /// they stopped columns on streets 4, 5 and 12 (fused D1 +0.3 points a frame), at 6 not.
+  /// That many stereo pixels of a column in a row (no other depth between them), each more
+  /// than kBehindSigmas of its sigmas behind the wall, see the surface above the wall's top
+  /// edge (a building behind a lower one of the same grey, street 20: 12 sigmas): the column
+  /// stops. SGBM's guesses on a blank wall come in runs too (its paths carry them), but
+  /// nearer: at 3 sigmas they stopped columns on streets 4, 5 and 12 (fused D1 +0.3 points a
+  /// frame), at 6 not.
   static constexpr int kBehindToStop = 3;
   static constexpr float kBehindSigmas = 6.f;
 

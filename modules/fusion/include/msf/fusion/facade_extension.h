@@ -27,9 +27,10 @@ namespace msf {
 ///   facade_max_texture (about twice the image noise: a window, the wall's top edge against the
 ///   sky, another object or a texture stereo can match stops it), and not overexposed (a mean of
 ///   250 or more: a bright sky is blank too);
-/// - stereo does not see the surface behind it: three pixels with a depth more than 6 of their
-///   own sigmas behind the wall, none agreeing between them, stop the column (the wall's top
-///   edge against a building behind it of the same grey) and keep their depth.
+/// - stereo does not see the surface behind it: three of the column's pixels with a depth in a
+///   row, each more than 6 of its own sigmas behind the wall, stop the column (the wall's top
+///   edge against a building behind it of the same grey); the third and those above keep their
+///   depth.
 /// A pixel on the way takes the wall's depth with the sigma of the run's last anchor plus
 /// facade_sigma_per_m per metre above it (a wall leaning by ~6 degrees), as its weight and free
 /// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the
