@@ -115,8 +115,8 @@ TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
   EXPECT_EQ(wall.weight.at<float>(50, 30), 25.f);
   EXPECT_NEAR(wall.depth.at<float>(50, 60), kWall, 1e-3f);
   EXPECT_GT(wall.weight.at<float>(50, 60), 25.f);
-  // The column goes on above both. The first, known to 0.2 m, is an anchor the line reached: it
-  // joins the run, and its 5 cm tilt the line a little.
+  // The column goes on above both. The first, known to 0.2 m, is an anchor the wall reached: it
+  // joins the run, and its 5 cm move the run's depth a little.
   EXPECT_NEAR(wall.depth.at<float>(40, 30), kWall, 0.1f);
   EXPECT_NEAR(wall.depth.at<float>(40, 60), kWall, 1e-3f);
   EXPECT_NEAR(wall.depth.at<float>(kWallTop + 3, 30), kWall, 0.2f);
