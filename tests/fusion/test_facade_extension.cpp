@@ -81,17 +81,64 @@ TEST(FacadeExtension, ABlankWallGoesOnUpToItsTopEdge) {
   EXPECT_EQ(cv::countNonZero(wall.depth.rowRange(kLidarTop, kHeight) != kWall), 0);
 }
 
-TEST(FacadeExtension, AWindowStopsItsColumns) {
-  // A dark window (grey 40) over rows 40-49 of columns 50-79: those columns go up to the
-  // window, not past it; the others go on to the top.
+// A dark window (grey 40) over rows 40-49 of columns 50-79 of the wall.
+const cv::Rect kWindow(50, 40, 30, 10);
+
+TEST(FacadeExtension, AWindowWithoutStereoStopsItsColumns) {
+  // Nothing says the wall goes on above it: those columns go up to the window, not past it;
+  // the others go on to the top.
   Wall wall;
-  wall.grey(cv::Rect(50, 40, 30, 10)).setTo(40);
+  wall.grey(kWindow).setTo(40);
   wall.run();
   for (int u = 55; u < 75; ++u) {
     EXPECT_NEAR(wall.depth.at<float>(55, u), kWall, 1e-3f) << u;
     EXPECT_EQ(cv::countNonZero(wall.depth(cv::Rect(u, 0, 1, 45))), 0) << u;
   }
   EXPECT_NEAR(wall.depth.at<float>(30, 20), kWall, 1e-3f);
+  EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
+}
+
+/// The window, with stereo (sigma 0.5 m) at `depth` on its top and bottom frames, rows 41 and 48.
+Wall wallWithWindowSeenAt(float depth) {
+  Wall wall;
+  wall.grey(kWindow).setTo(40);
+  for (int v : {kWindow.y + 1, kWindow.y + kWindow.height - 2}) {
+    wall.depth(cv::Rect(kWindow.x, v, kWindow.width, 1)).setTo(depth);
+    wall.weight(cv::Rect(kWindow.x, v, kWindow.width, 1)).setTo(4.f);
+  }
+  return wall;
+}
+
+TEST(FacadeExtension, AWindowIsCrossedWhereStereoSeesTheWall) {
+  Wall wall = wallWithWindowSeenAt(kWall + 0.3f);
+  wall.run();
+  for (int u = 55; u < 75; ++u) {
+    // Above the window the wall goes on, at its depth; the window keeps what it had.
+    for (int v = kWallTop + 3; v < kWindow.y - 3; ++v)
+      ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
+    for (int v = kWindow.y + 2; v < kWindow.y + kWindow.height - 2; ++v)
+      ASSERT_EQ(wall.depth.at<float>(v, u), 0.f) << v << "," << u;
+    ASSERT_EQ(wall.depth.at<float>(kWindow.y + 1, u), kWall + 0.3f) << u;
+  }
+  // With facade_max_gap_m under the window's 0.2 m (10 rows at 10 m), or 0, it stops them.
+  for (float max_gap : {0.1f, 0.f}) {
+    msf::DepthFusionConfig config;
+    config.facade_max_gap_m = max_gap;
+    Wall short_gap = wallWithWindowSeenAt(kWall + 0.3f);
+    short_gap.run(config);
+    for (int u = 55; u < 75; ++u)
+      EXPECT_EQ(cv::countNonZero(short_gap.depth(cv::Rect(u, 0, 1, kWindow.y))), 0) << max_gap << ", " << u;
+  }
+}
+
+TEST(FacadeExtension, WhatStereoSeesInFrontOfTheWallIsNotCrossed) {
+  // A tree's crown, a pole, 3 m in front of the wall where the window is: 6 of its sigmas.
+  Wall wall = wallWithWindowSeenAt(kWall - 3.f);
+  wall.run();
+  for (int u = 55; u < 75; ++u) {
+    EXPECT_EQ(cv::countNonZero(wall.depth(cv::Rect(u, 0, 1, kWindow.y))), 0) << u;
+    EXPECT_EQ(wall.depth.at<float>(kWindow.y + 1, u), kWall - 3.f) << u;
+  }
   EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
 }
 
@@ -230,6 +277,9 @@ TEST(FacadeExtension, BadInputIsAClearError) {
   EXPECT_THROW(config.validate(), msf::ConfigError);
   config = {};
   config.facade_max_texture = std::nanf("");
+  EXPECT_THROW(config.validate(), msf::ConfigError);
+  config = {};
+  config.facade_max_gap_m = -1.f;
   EXPECT_THROW(config.validate(), msf::ConfigError);
 }
 

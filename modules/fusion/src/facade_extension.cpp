@@ -25,6 +25,8 @@ struct ColumnFit {
   int anchor_row = -1;       ///< row of the run's last anchor, -1: no run to go on from
   bool run_below = false;    ///< the row below was the run's: an anchor, or a pixel it reached
   int behind = 0;            ///< the last pixels with a depth, in a row, that lie behind the wall
+  int gap = 0;               ///< rows of other image (a window) crossed since the wall's grey
+  bool gap_seen = false;     ///< stereo in that gap saw the wall
 
   /// That many stereo pixels of a column in a row (no other depth between them), each more
   /// than kBehindSigmas of its sigmas behind the wall, see the surface above the wall's top
@@ -63,6 +65,8 @@ struct ColumnFit {
     svi = kDecay * svi + v * static_cast<double>(inverse);
     last_inverse = inverse;
     behind = 0;
+    gap = 0;
+    gap_seen = false;
     anchor_weight = weight;
     anchor_row = v;
     run_below = true;
@@ -130,7 +134,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         const bool same_surface = std::abs(grey_here - fit.grey) <= tolerance &&
                                   g2[u] - grey_here * grey_here <= max_variance && grey_here < kOverexposed;
         double b, c;
-        if (!same_surface || !fit.solve(b, c)) {
+        if ((!same_surface && config.facade_max_gap_m <= 0.f) || !fit.solve(b, c)) {
           fit.stop();
           continue;
         }
@@ -149,6 +153,33 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         const float wall_depth = static_cast<float>(1.0 / inverse);
         const float height = static_cast<float>(fit.anchor_row - v) * wall_depth / camera.fy;
         const float sigma = 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
+        if (!same_surface) {
+          // Another image on the wall (a window) is crossed, not written, up to
+          // facade_max_gap_m, while the stereo there sees the wall and nothing else (a pole, a
+          // crown, the building behind a roof's edge).
+          if (++fit.gap * wall_depth > config.facade_max_gap_m * camera.fy) {
+            fit.stop();
+            continue;
+          }
+          if (has_depth) {
+            const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
+            if (std::abs(z[u] - wall_depth) > 3.f * std::max(sigma, own_sigma)) {
+              fit.stop();
+              continue;
+            }
+            fit.gap_seen = true;
+          }
+          fit.run_below = true;
+          continue;
+        }
+        if (fit.gap > 0) {
+          if (!fit.gap_seen) {
+            fit.stop(); // nothing says the wall goes on behind what was crossed (the sky)
+            continue;
+          }
+          fit.gap = 0;
+          fit.gap_seen = false;
+        }
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
           if (std::abs(z[u] - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {

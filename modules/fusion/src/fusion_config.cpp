@@ -80,6 +80,7 @@ void DepthFusionConfig::read(const cv::FileNode& node) {
   readKey(node, "facade_max_texture", facade_max_texture);
   readKey(node, "facade_sigma_per_m", facade_sigma_per_m);
   readKey(node, "facade_max_normal_y", facade_max_normal_y);
+  readKey(node, "facade_max_gap_m", facade_max_gap_m);
   validate();
 }
 
@@ -113,6 +114,7 @@ void DepthFusionConfig::validate() const {
   nonNegative(facade_sigma_per_m, "facade_sigma_per_m");
   if (!(facade_max_normal_y >= 0.f && facade_max_normal_y <= 1.f))
     throw ConfigError("config key 'fusion.facade_max_normal_y' must be within [0, 1]");
+  nonNegative(facade_max_gap_m, "facade_max_gap_m");
 }
 
 void DepthFusionConfig::print(std::ostream& out) const {
@@ -144,7 +146,8 @@ void DepthFusionConfig::print(std::ostream& out) const {
       << "  facade_grey_tolerance: " << configValue(facade_grey_tolerance) << "\n"
       << "  facade_max_texture: " << configValue(facade_max_texture) << "\n"
       << "  facade_sigma_per_m: " << configValue(facade_sigma_per_m) << "\n"
-      << "  facade_max_normal_y: " << configValue(facade_max_normal_y) << "\n";
+      << "  facade_max_normal_y: " << configValue(facade_max_normal_y) << "\n"
+      << "  facade_max_gap_m: " << configValue(facade_max_gap_m) << "\n";
 }
 
 } // namespace msf

@@ -24,9 +24,12 @@ namespace msf {
 ///   line leads into the sky);
 /// - the image looks the same and blank: the grey's mean over 5x5 pixels stays within
 ///   facade_grey_tolerance of the run's, and its standard deviation there within
-///   facade_max_texture (about twice the image noise: a window, the wall's top edge against the
-///   sky, another object or a texture stereo can match stops it), and not overexposed (a mean of
-///   250 or more: a bright sky is blank too);
+///   facade_max_texture (about twice the image noise: the wall's top edge against the sky,
+///   another object or a texture stereo can match stops it), and not overexposed (a mean of 250
+///   or more: a bright sky is blank too). Other image up to facade_max_gap_m high (a window) is
+///   crossed, its pixels left as they are, if the wall's grey comes back above it and stereo
+///   there sees the wall: some of its pixels agree with the wall within 3 sigmas, none
+///   disagrees (a pole, a tree's crown, a building behind a roof's edge stop the column);
 /// - stereo does not see the surface behind it: three of the column's pixels with a depth in a
 ///   row, each more than 6 of its own sigmas behind the wall, stop the column (the wall's top
 ///   edge against a building behind it of the same grey); the third and those above keep their

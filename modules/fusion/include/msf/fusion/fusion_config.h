@@ -76,6 +76,7 @@ struct DepthFusionConfig {
   float facade_max_texture = 4.f;             ///< blank: grey levels of standard deviation over 5x5 pixels
   float facade_sigma_per_m = 0.1f;            ///< sigma's growth per metre above the last anchor
   float facade_max_normal_y = 0.3f;           ///< near vertical surfaces only (|n_y| of the unit normal)
+  float facade_max_gap_m = 2.5f;              ///< a window's height crossed where stereo sees the wall; 0: none
 
   /// Overrides the keys present in `node` (the `fusion` section), then validates.
   void read(const cv::FileNode& node);
