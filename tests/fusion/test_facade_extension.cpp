@@ -151,8 +151,13 @@ TEST(FacadeExtension, AnOverexposedSkyIsNoWall) {
   EXPECT_EQ(cv::countNonZero(wall.depth.rowRange(0, kLidarTop)), 0);
 }
 
-TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
+TEST(FacadeExtension, StereoThatAgreesIsAveragedWithTheWallAndAGuessIsReplaced) {
   Wall wall;
+  // Far stereo (sigma 2 m) 1 m behind the wall: within its 3 sigmas, so one more estimate of
+  // the wall's depth, averaged with it by inverse variance.
+  wall.depth.at<float>(45, 100) = kWall + 1.f;
+  wall.weight.at<float>(45, 100) = 0.25f;
+  wall.free_weight.at<float>(45, 100) = 0.25f;
   wall.depth.at<float>(50, 30) = 10.05f; // within 3 sigmas of the wall
   wall.weight.at<float>(50, 30) = 25.f;
   wall.depth.at<float>(50, 60) = 14.f; // SGBM's guess on a blank wall
@@ -167,6 +172,12 @@ TEST(FacadeExtension, StereoThatAgreesIsKeptAndAGuessIsReplaced) {
   EXPECT_NEAR(wall.depth.at<float>(40, 30), kWall, 0.1f);
   EXPECT_NEAR(wall.depth.at<float>(40, 60), kWall, 1e-3f);
   EXPECT_NEAR(wall.depth.at<float>(kWallTop + 3, 30), kWall, 0.2f);
+  const float sigma = 1.f / std::sqrt(kLidarWeight) + 0.1f * (kLidarTop - 45) * kWall / 500.f;
+  const float wall_weight = 1.f / (sigma * sigma);
+  EXPECT_NEAR(wall.weight.at<float>(45, 100), wall_weight + 0.25f, 1e-2f);
+  EXPECT_NEAR(wall.depth.at<float>(45, 100), (kWall * wall_weight + (kWall + 1.f) * 0.25f) / (wall_weight + 0.25f), 1e-4f);
+  EXPECT_GT(wall.depth.at<float>(45, 100), kWall + 1e-3f);
+  EXPECT_EQ(wall.free_weight.at<float>(45, 100), wall.weight.at<float>(45, 100));
 }
 
 TEST(FacadeExtension, AColumnStopsWhereStereoSeesABuildingBehindTheWall) {

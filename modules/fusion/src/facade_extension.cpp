@@ -183,9 +183,16 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
           if (std::abs(z[u] - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {
+            // It agrees: two estimates of one depth, averaged by inverse variance. Far stereo
+            // (sigma 1-3 m at 20-30 m) kept alone weighed too little to be meshed.
+            const float wall_weight = 1.f / (sigma * sigma);
+            z[u] = (z[u] * w[u] + wall_depth * wall_weight) / (w[u] + wall_weight);
+            w[u] += wall_weight;
+            if (f)
+              f[u] = w[u];
             fit.run_below = true;
             fit.behind = 0;
-            continue; // it agrees: kept as it is
+            continue;
           }
           if (z[u] - wall_depth > ColumnFit::kBehindSigmas * own_sigma) {
             if (++fit.behind >= ColumnFit::kBehindToStop) {

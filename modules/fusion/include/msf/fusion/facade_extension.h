@@ -36,8 +36,9 @@ namespace msf {
 ///   depth.
 /// A pixel on the way takes the wall's depth with the sigma of the run's last anchor plus
 /// facade_sigma_per_m per metre above it (a wall leaning by ~6 degrees), as its weight and free
-/// space weight (1 / sigma^2) — unless its own depth agrees within 3 sigmas (theirs or the
-/// wall's): then it is kept. Other stereo on a blank surface is a guess, and is replaced.
+/// space weight (1 / sigma^2). A depth of its own that agrees within 3 sigmas (its own or the
+/// wall's) is averaged with the wall's by inverse variance, the weights added; other stereo on a
+/// blank surface is a guess, and is replaced.
 ///
 /// left: CV_8UC1, the grey image of camera 0 (the fused depth's pixels); depth, weight (and
 /// free_space_weight, if not empty): CV_32FC1 of its size, changed in place. Columns run in
