@@ -74,7 +74,7 @@ struct DepthFusionConfig {
   float facade_anchor_sigma_m = 0.2f;         ///< anchors: fused pixels known to within this (LiDAR, near stereo)
   float facade_grey_tolerance = 8.f;          ///< grey levels from the anchors' run (5x5 box-filtered image)
   float facade_max_texture = 4.f;             ///< blank: grey levels of standard deviation over 5x5 pixels
-  float facade_sigma_per_m = 0.1f;            ///< sigma's growth per metre above the last anchor
+  float facade_sigma_per_m = 0.05f;           ///< sigma's growth per metre above the last anchor
   float facade_max_normal_y = 0.3f;           ///< near vertical surfaces only (|n_y| of the unit normal)
   float facade_max_gap_m = 2.5f;              ///< a window's height crossed where stereo sees the wall; 0: none
 
