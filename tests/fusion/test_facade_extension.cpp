@@ -112,13 +112,22 @@ Wall wallWithWindowSeenAt(float depth) {
 TEST(FacadeExtension, AWindowIsCrossedWhereStereoSeesTheWall) {
   Wall wall = wallWithWindowSeenAt(kWall + 0.3f);
   wall.run();
+  const float per_m = msf::DepthFusionConfig().facade_sigma_per_m;
   for (int u = 55; u < 75; ++u) {
-    // Above the window the wall goes on, at its depth; the window keeps what it had.
+    // Above the window the wall goes on, at its depth.
     for (int v = kWallTop + 3; v < kWindow.y - 3; ++v)
       ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
-    for (int v = kWindow.y + 2; v < kWindow.y + kWindow.height - 2; ++v)
-      ASSERT_EQ(wall.depth.at<float>(v, u), 0.f) << v << "," << u;
-    ASSERT_EQ(wall.depth.at<float>(kWindow.y + 1, u), kWall + 0.3f) << u;
+    // The window is on the wall: where it had no depth it takes the wall's, its sigma with
+    // 0.1 m added for a recess; its stereo (sigma 0.5 m, 0.3 m behind) is averaged with it.
+    for (int v = kWindow.y + 2; v < kWindow.y + kWindow.height - 2; ++v) {
+      const float sigma = 1.f / std::sqrt(kLidarWeight) + per_m * (kLidarTop - v) * kWall / 500.f;
+      ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
+      ASSERT_NEAR(wall.weight.at<float>(v, u), 1.f / (sigma * sigma + 0.01f), 1e-2f) << v << "," << u;
+    }
+    const float seen = wall.depth.at<float>(kWindow.y + 1, u);
+    ASSERT_GT(seen, kWall) << u;
+    ASSERT_LT(seen, kWall + 0.05f) << u;
+    ASSERT_GT(wall.weight.at<float>(kWindow.y + 1, u), 4.f) << u;
   }
   // With facade_max_gap_m under the window's 0.2 m (10 rows at 10 m), or 0, it stops them.
   for (float max_gap : {0.1f, 0.f}) {

@@ -77,6 +77,28 @@ struct ColumnFit {
 /// however blank: a white wall's column stops there.
 constexpr float kOverexposed = 250.f;
 
+/// A window's glass lies up to ~0.2 m behind its façade: the wall's sigma there has this added
+/// in quadrature.
+constexpr float kWindowRecessSigma = 0.1f;
+
+/// The wall's estimate of a pixel's depth, of weight wall_weight: where the pixel has a depth of
+/// its own that agrees with it, two estimates of one depth, averaged by inverse variance (far
+/// stereo, sigma 1-3 m at 20-30 m, kept alone weighed too little to be meshed); where it has
+/// none, the wall's. The free space weight follows. Returns whether the pixel had no depth.
+bool takeWall(float& z, float& w, float* f, float wall_depth, float wall_weight) {
+  const bool had_none = !(z > 0.f && std::isfinite(z));
+  if (had_none) {
+    z = wall_depth;
+    w = wall_weight;
+  } else {
+    z = (z * w + wall_depth * wall_weight) / (w + wall_weight);
+    w += wall_weight;
+  }
+  if (f)
+    *f = w;
+  return had_none;
+}
+
 void checkImage(const cv::Mat& image, int type, const cv::Size& size, const std::string& what) {
   if (image.type() != type || image.size() != size)
     throw InvalidInputError("facade extension: " + what + " is a " + std::to_string(image.cols) + "x" +
@@ -151,12 +173,15 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
           continue;
         }
         const float wall_depth = static_cast<float>(1.0 / inverse);
-        const float height = static_cast<float>(fit.anchor_row - v) * wall_depth / camera.fy;
-        const float sigma = 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
+        auto sigmaAt = [&](int row) {
+          const float height = static_cast<float>(fit.anchor_row - row) * wall_depth / camera.fy;
+          return 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
+        };
+        const float sigma = sigmaAt(v);
         if (!same_surface) {
-          // Another image on the wall (a window) is crossed, not written, up to
-          // facade_max_gap_m, while the stereo there sees the wall and nothing else (a pole, a
-          // crown, the building behind a roof's edge).
+          // Another image on the wall (a window) is crossed up to facade_max_gap_m, while the
+          // stereo there sees the wall and nothing else (a pole, a crown, the building behind a
+          // roof's edge): written once the wall's grey comes back above it.
           if (++fit.gap * wall_depth > config.facade_max_gap_m * camera.fy) {
             fit.stop();
             continue;
@@ -177,19 +202,20 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
             fit.stop(); // nothing says the wall goes on behind what was crossed (the sky)
             continue;
           }
+          // The window is on the wall: its rows below take the wall, its stereo agreed with it.
+          for (int r = v + 1; r <= v + fit.gap; ++r) {
+            const float s = sigmaAt(r);
+            float* fr = f ? free_space_weight.ptr<float>(r) + u : nullptr;
+            count += takeWall(depth.ptr<float>(r)[u], weight.ptr<float>(r)[u], fr, wall_depth,
+                              1.f / (s * s + kWindowRecessSigma * kWindowRecessSigma));
+          }
           fit.gap = 0;
           fit.gap_seen = false;
         }
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
           if (std::abs(z[u] - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {
-            // It agrees: two estimates of one depth, averaged by inverse variance. Far stereo
-            // (sigma 1-3 m at 20-30 m) kept alone weighed too little to be meshed.
-            const float wall_weight = 1.f / (sigma * sigma);
-            z[u] = (z[u] * w[u] + wall_depth * wall_weight) / (w[u] + wall_weight);
-            w[u] += wall_weight;
-            if (f)
-              f[u] = w[u];
+            takeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma)); // it agrees
             fit.run_below = true;
             fit.behind = 0;
             continue;
@@ -203,10 +229,8 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
             fit.behind = 0;
           }
         }
-        z[u] = wall_depth;
-        w[u] = 1.f / (sigma * sigma);
-        if (f)
-          f[u] = w[u];
+        z[u] = 0.f; // no depth, or SGBM's guess on a blank surface: replaced
+        takeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
         fit.run_below = true;
         ++count;
       }

@@ -27,9 +27,10 @@ namespace msf {
 ///   facade_max_texture (about twice the image noise: the wall's top edge against the sky,
 ///   another object or a texture stereo can match stops it), and not overexposed (a mean of 250
 ///   or more: a bright sky is blank too). Other image up to facade_max_gap_m high (a window) is
-///   crossed, its pixels left as they are, if the wall's grey comes back above it and stereo
-///   there sees the wall: some of its pixels agree with the wall within 3 sigmas, none
-///   disagrees (a pole, a tree's crown, a building behind a roof's edge stop the column);
+///   crossed if the wall's grey comes back above it and stereo there sees the wall: some of its
+///   pixels agree with the wall within 3 sigmas, none disagrees (a pole, a tree's crown, a
+///   building behind a roof's edge stop the column). Its pixels then take the wall too, their
+///   sigma with 0.1 m added for a window's recess;
 /// - stereo does not see the surface behind it: three of the column's pixels with a depth in a
 ///   row, each more than 6 of its own sigmas behind the wall, stop the column (the wall's top
 ///   edge against a building behind it of the same grey); the third and those above keep their
