@@ -40,12 +40,12 @@ struct ColumnFit {
   static constexpr double kDecay = 0.8;
 
   void stop() { *this = ColumnFit(); }
-  bool solve(double& b, double& c) const {
+  /// The line's slope b (only it is needed: the wall goes on at the run's mean inverse depth).
+  bool slope(double& b) const {
     const double det = sw * svv - sv * sv;
     if (sw < 3.0 || !(std::abs(det) > 1e-9)) // fewer than 5 anchors in the run, or one row
       return false;
     b = (sw * svi - sv * si) / det;
-    c = (si - b * sv) / sw;
     return true;
   }
   void add(int v, float z, float weight, float g) {
@@ -81,22 +81,23 @@ constexpr float kOverexposed = 250.f;
 /// in quadrature.
 constexpr float kWindowRecessSigma = 0.1f;
 
-/// The wall's estimate of a pixel's depth, of weight wall_weight: where the pixel has a depth of
-/// its own that agrees with it, two estimates of one depth, averaged by inverse variance (far
-/// stereo, sigma 1-3 m at 20-30 m, kept alone weighed too little to be meshed); where it has
-/// none, the wall's. The free space weight follows. Returns whether the pixel had no depth.
-bool takeWall(float& z, float& w, float* f, float wall_depth, float wall_weight) {
-  const bool had_none = !(z > 0.f && std::isfinite(z));
-  if (had_none) {
-    z = wall_depth;
-    w = wall_weight;
-  } else {
-    z = (z * w + wall_depth * wall_weight) / (w + wall_weight);
-    w += wall_weight;
-  }
+/// A pixel takes the wall's depth and weight (and free space weight): it had none, or SGBM's
+/// guess on a blank surface.
+void writeWall(float& z, float& w, float* f, float wall_depth, float wall_weight) {
+  z = wall_depth;
+  w = wall_weight;
   if (f)
     *f = w;
-  return had_none;
+}
+
+/// A pixel's own depth that agrees with the wall: two estimates of one depth, averaged by
+/// inverse variance, the weights added (far stereo, sigma 1-3 m at 20-30 m, kept alone weighed
+/// too little to be meshed).
+void averageWithWall(float& z, float& w, float* f, float wall_depth, float wall_weight) {
+  z = (z * w + wall_depth * wall_weight) / (w + wall_weight);
+  w += wall_weight;
+  if (f)
+    *f = w;
 }
 
 void checkImage(const cv::Mat& image, int type, const cv::Size& size, const std::string& what) {
@@ -155,8 +156,8 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
           continue;
         const bool same_surface = std::abs(grey_here - fit.grey) <= tolerance &&
                                   g2[u] - grey_here * grey_here <= max_variance && grey_here < kOverexposed;
-        double b, c;
-        if ((!same_surface && config.facade_max_gap_m <= 0.f) || !fit.solve(b, c)) {
+        double b;
+        if ((!same_surface && config.facade_max_gap_m <= 0.f) || !fit.slope(b)) {
           fit.stop();
           continue;
         }
@@ -204,10 +205,15 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
           }
           // The window is on the wall: its rows below take the wall, its stereo agreed with it.
           for (int r = v + 1; r <= v + fit.gap; ++r) {
-            const float s = sigmaAt(r);
+            const float s = sigmaAt(r), window_weight = 1.f / (s * s + kWindowRecessSigma * kWindowRecessSigma);
+            float& zr = depth.ptr<float>(r)[u];
             float* fr = f ? free_space_weight.ptr<float>(r) + u : nullptr;
-            count += takeWall(depth.ptr<float>(r)[u], weight.ptr<float>(r)[u], fr, wall_depth,
-                              1.f / (s * s + kWindowRecessSigma * kWindowRecessSigma));
+            if (zr > 0.f && std::isfinite(zr)) {
+              averageWithWall(zr, weight.ptr<float>(r)[u], fr, wall_depth, window_weight);
+            } else {
+              writeWall(zr, weight.ptr<float>(r)[u], fr, wall_depth, window_weight);
+              ++count;
+            }
           }
           fit.gap = 0;
           fit.gap_seen = false;
@@ -215,7 +221,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
         if (has_depth) {
           const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
           if (std::abs(z[u] - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {
-            takeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma)); // it agrees
+            averageWithWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
             fit.run_below = true;
             fit.behind = 0;
             continue;
@@ -229,8 +235,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
             fit.behind = 0;
           }
         }
-        z[u] = 0.f; // no depth, or SGBM's guess on a blank surface: replaced
-        takeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
+        writeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
         fit.run_below = true;
         ++count;
       }

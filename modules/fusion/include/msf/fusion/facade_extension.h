@@ -36,10 +36,10 @@ namespace msf {
 ///   edge against a building behind it of the same grey); the third and those above keep their
 ///   depth.
 /// A pixel on the way takes the wall's depth with the sigma of the run's last anchor plus
-/// facade_sigma_per_m per metre above it (a wall leaning by ~3 degrees, or a camera pitched so), as its weight and free
-/// space weight (1 / sigma^2). A depth of its own that agrees within 3 sigmas (its own or the
-/// wall's) is averaged with the wall's by inverse variance, the weights added; other stereo on a
-/// blank surface is a guess, and is replaced.
+/// facade_sigma_per_m per metre above it (a wall leaning by ~3 degrees, or a camera pitched so),
+/// as its weight and free space weight (1 / sigma^2). A depth of its own that agrees within 3
+/// sigmas (its own or the wall's) is averaged with the wall's by inverse variance, the weights
+/// added; other stereo on a blank surface is a guess, and is replaced.
 ///
 /// left: CV_8UC1, the grey image of camera 0 (the fused depth's pixels); depth, weight (and
 /// free_space_weight, if not empty): CV_32FC1 of its size, changed in place. Columns run in
