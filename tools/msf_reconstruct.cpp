@@ -817,6 +817,11 @@ int main(int argc, char** argv) {
       print_value("%s ", scene.c_str());
       pcl::PolygonMesh truth;
       msf::loadMesh(scene, truth);
+      // What each true vertex is (ground, building, tree...): the scores split by it. Datasets
+      // written before gt/scene_classes.txt have none.
+      std::optional<msf::SurfaceClasses> classes;
+      if (scores.truth->hasSceneClasses())
+        classes = scores.truth->sceneClasses(static_cast<std::size_t>(truth.cloud.width) * truth.cloud.height);
       // Where moving objects were: inside a box of gt/moving_objects.txt at any frame, grown by
       // a voxel (a car's surface is meshed up to a voxel off its box).
       msf::MovingSpace was_moving;
@@ -844,7 +849,8 @@ int main(int argc, char** argv) {
         const std::vector<float>& weights = m.first->weights;
         accuracy[name] =
             msf::evaluateMesh(*m.second, truth, scores.seen_surface, 2.0 * config.volume.voxel_size_m, 1.0, 200000,
-                              &view_distance, weights.size() == m.first->vertices.size() ? &weights : nullptr);
+                              &view_distance, weights.size() == m.first->vertices.size() ? &weights : nullptr,
+                              classes ? &*classes : nullptr);
         if (was_moving)
           ghosts[name] = msf::measureGhosts(m.first->vertices, *static_surface, was_moving, kGhostDistanceM);
       }

@@ -179,6 +179,81 @@ TEST(MeshAccuracy, TheWeightCurveKeepsTheSurestSurface) {
   EXPECT_THROW(msf::WeightCurve({1.f}, {1.f, 2.f}, {0.0}), msf::InvalidInputError);
 }
 
+/// Two meshes as one: b's vertices and triangles after a's.
+pcl::PolygonMesh joined(const pcl::PolygonMesh& a, const pcl::PolygonMesh& b) {
+  pcl::PointCloud<pcl::PointXYZ> ca, cb;
+  pcl::fromPCLPointCloud2(a.cloud, ca);
+  pcl::fromPCLPointCloud2(b.cloud, cb);
+  pcl::PolygonMesh out;
+  out.polygons = a.polygons;
+  for (pcl::Vertices t : b.polygons) {
+    for (auto& i : t.vertices)
+      i += static_cast<std::uint32_t>(ca.size());
+    out.polygons.push_back(t);
+  }
+  ca += cb;
+  pcl::toPCLPointCloud2(ca, out.cloud);
+  return out;
+}
+
+TEST(SurfaceDistance, NamesTheNearestTriangle) {
+  const msf::SurfaceDistance surface(gridSquare(2.f, 1, 0.f), 0.5f); // triangles 0 (x > y) and 1 (x < y)
+  std::uint32_t nearest = 7;
+  EXPECT_NEAR(surface.distance({1.5f, 0.5f, 0.2f}, 5.f, &nearest), 0.2f, 1e-6);
+  EXPECT_EQ(nearest, 0u);
+  surface.distance({0.5f, 1.5f, -0.1f}, 5.f, &nearest);
+  EXPECT_EQ(nearest, 1u);
+  surface.distance({10.f, 10.f, 10.f}, 0.5f, &nearest);
+  EXPECT_EQ(nearest, msf::SurfaceDistance::kNoTriangle);
+}
+
+TEST(MeshAccuracy, ByClassSplitsTheMeanIntoPartsThatAddUpToIt) {
+  // The truth: a ground square (class 0) at z = 0 and a wall square (class 1) at z = 5.
+  const pcl::PolygonMesh ground = gridSquare(4.f, 4, 0.f), wall = gridSquare(4.f, 4, 5.f);
+  const pcl::PolygonMesh truth = joined(ground, wall);
+  msf::SurfaceClasses classes;
+  classes.names = {"ground", "wall"};
+  classes.vertex_class.assign(25, 0);
+  classes.vertex_class.resize(50, 1);
+  // The mesh: the ground 3 cm above it (121 vertices) and a speck of 4 vertices 2.5 m from both.
+  const pcl::PolygonMesh mesh = joined(gridSquare(4.f, 10, 0.03f), gridSquare(0.1f, 1, 2.5f));
+  std::vector<Eigen::Vector3f> seen;
+  for (int i = 0; i < 10; ++i) {
+    seen.emplace_back(0.4f * i + 0.2f, 1.f, 0.f); // on the ground: covered
+    seen.emplace_back(0.4f * i + 0.2f, 1.f, 5.f); // on the wall: not
+  }
+  const msf::MeshAccuracy a = msf::evaluateMesh(mesh, truth, seen, 0.1, 1.0, 200000, nullptr, nullptr, &classes);
+  ASSERT_EQ(a.by_class.size(), 3u);
+  const msf::ClassAccuracy &g = a.by_class[0], &w = a.by_class[1], &off = a.by_class[2];
+  EXPECT_EQ(g.name, "ground");
+  EXPECT_EQ(g.vertices, 121u);
+  EXPECT_NEAR(g.accuracy_mean_m, 0.03, 1e-6);
+  EXPECT_EQ(g.truth_samples, 10u);
+  EXPECT_DOUBLE_EQ(g.completeness, 1.0);
+  EXPECT_EQ(w.name, "wall");
+  EXPECT_EQ(w.vertices, 0u);
+  EXPECT_EQ(w.truth_samples, 10u);
+  EXPECT_DOUBLE_EQ(w.completeness, 0.0);
+  EXPECT_EQ(off.name, msf::ClassAccuracy::kOffSurface);
+  EXPECT_EQ(off.vertices, 4u);
+  EXPECT_DOUBLE_EQ(off.accuracy_mean_m, 1.0); // at the cap
+  EXPECT_EQ(off.truth_samples, 0u);
+  EXPECT_NEAR(g.contribution_m + w.contribution_m + off.contribution_m, a.accuracy_mean_m, 1e-9);
+  EXPECT_NEAR(off.contribution_m, 4.0 / 125.0, 1e-9);
+}
+
+TEST(MeshAccuracy, ClassesThatDoNotFitTheTruthAreAnError) {
+  const pcl::PolygonMesh truth = gridSquare(1.f, 1, 0.f); // 4 vertices
+  msf::SurfaceClasses classes;
+  classes.names = {"ground"};
+  classes.vertex_class = {0, 0, 0};
+  EXPECT_THROW(msf::evaluateMesh(truth, truth, {}, 0.1, 1.0, 200000, nullptr, nullptr, &classes),
+               msf::InvalidInputError);
+  classes.vertex_class = {0, 0, 0, 1}; // class 1 of 1 name
+  EXPECT_THROW(msf::evaluateMesh(truth, truth, {}, 0.1, 1.0, 200000, nullptr, nullptr, &classes),
+               msf::InvalidInputError);
+}
+
 TEST(MeshAccuracy, EmptyMeshIsAnError) {
   EXPECT_THROW(msf::evaluateMesh(pcl::PolygonMesh(), gridSquare(1.f, 1, 0.f), {}, 0.1), msf::InvalidInputError);
   EXPECT_THROW(msf::SurfaceDistance(pcl::PolygonMesh()), msf::InvalidInputError);

@@ -28,7 +28,9 @@ protected:
     const int lock = ::open((root / "street.lock").c_str(), O_CREAT | O_RDWR, 0644);
     ASSERT_GE(lock, 0);
     ::flock(lock, LOCK_EX);
-    if (!fs::exists(fs::path(dataset_) / "gt" / "scene.ply")) {
+    // Written again when an older build's lacks a file that ground truth has since gained.
+    if (!fs::exists(fs::path(dataset_) / "gt" / "scene.ply") ||
+        !fs::exists(fs::path(dataset_) / "gt" / "scene_classes.txt")) {
       msf::synthetic::SyntheticConfig config;
       config.frames = 4;
       config.seed = 7;

@@ -140,6 +140,21 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_LT(ghosts, 0.5);
   EXPECT_GT(jsonNumber(mesh, "vertices", "ghosts"), 1000.0);
   EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
+  // Split by the class of the nearest true surface (gt/scene_classes.txt): the parts add up
+  // to the mean (each rounded to 4 digits), and the road is there, meshed nearly whole.
+  const std::size_t classes = mesh.find("\"by_class\": [");
+  ASSERT_NE(classes, std::string::npos) << mesh;
+  const std::string split = mesh.substr(classes, mesh.find(']', classes) - classes);
+  double parts = 0;
+  for (std::size_t at = split.find("\"contribution_m\""); at != std::string::npos;
+       at = split.find("\"contribution_m\"", at + 1))
+    parts += jsonNumber(split.substr(at), "contribution_m");
+  EXPECT_NEAR(parts, jsonNumber(mesh, "accuracy_mean_m", "accuracy"), 5e-4);
+  const std::string ground = split.substr(split.find("\"class\": \"ground\""));
+  EXPECT_GT(jsonNumber(ground, "vertices"), 1000.0);
+  EXPECT_GT(jsonNumber(ground, "completeness"), 0.9);
+  EXPECT_NE(split.find("\"class\": \"off_surface\""), std::string::npos) << split; // the cars' ghosts
+  EXPECT_NE(readFile(out.file("report.md")).find("By the class of the nearest true surface"), std::string::npos);
 }
 
 TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {

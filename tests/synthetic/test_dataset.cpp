@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 
 namespace fs = std::filesystem;
 
@@ -73,7 +74,7 @@ TEST_F(SyntheticDataset, WritesTheKittiOdometryLayoutThatSequenceOpensUnchanged)
   for (const char* f :
        {"sequences/00/calib.txt", "sequences/00/times.txt", "poses/00.txt", "gt/scene.ply", "gt/README.txt",
         "gt/synthetic.yaml", "sequences/00/velodyne/000000.bin", "gt/depth_0/000000.png", "gt/disp_0/000000.png",
-        "gt/obj_map_0/000000.png", "gt/moving_0/000000.png", "gt/moving_objects.txt"})
+        "gt/obj_map_0/000000.png", "gt/moving_0/000000.png", "gt/moving_objects.txt", "gt/scene_classes.txt"})
     EXPECT_TRUE(fs::is_regular_file(r / f)) << f;
   for (int c = 0; c < 4; ++c)
     EXPECT_TRUE(fs::is_regular_file(r / "sequences/00" / ("image_" + std::to_string(c)) / "000000.png")) << c;
@@ -248,6 +249,34 @@ TEST_F(SyntheticDataset, SceneMeshIsTheSurfaceTheCamerasSee) {
               mesh.polygons.size(), distances.size(), median, p95);
   EXPECT_LT(median, 0.005);
   EXPECT_LT(p95, 0.03);
+}
+
+TEST_F(SyntheticDataset, SceneClassesNameWhatEachVertexOfTheSceneMeshIs) {
+  const GroundTruth gt(root());
+  ASSERT_TRUE(gt.hasSceneClasses());
+  pcl::PolygonMesh mesh;
+  msf::loadMesh(gt.sceneMeshPath(), mesh);
+  pcl::PointCloud<pcl::PointXYZ> vertices;
+  pcl::fromPCLPointCloud2(mesh.cloud, vertices);
+  const msf::SurfaceClasses classes = gt.sceneClasses(vertices.size());
+  ASSERT_EQ(classes.vertex_class.size(), vertices.size());
+  // Heights above the road (y points down; the road is the lowest surface), per class.
+  float road_y = -1e9f;
+  for (const auto& p : vertices)
+    road_y = std::max(road_y, p.y);
+  std::map<std::string, std::pair<float, float>> height; // least and greatest
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    auto [it, fresh] = height.try_emplace(classes.names[classes.vertex_class[i]], 1e9f, -1e9f);
+    const float h = road_y - vertices[i].y;
+    it->second = {std::min(it->second.first, h), std::max(it->second.second, h)};
+  }
+  for (const char* name : {"ground", "building", "car", "pole", "tree"})
+    EXPECT_TRUE(height.count(name)) << name;
+  EXPECT_LT(height["ground"].second, 0.3f); // the road and the kerbs' sidewalk
+  EXPECT_LT(height["car"].second, 2.5f);    // parked cars
+  EXPECT_GT(height["tree"].second, 4.f);    // crowns
+  EXPECT_GT(height["building"].second, 8.f);
+  EXPECT_THROW(gt.sceneClasses(vertices.size() + 1), msf::IOError); // another mesh's
 }
 
 TEST_F(SyntheticDataset, SameSeedGivesByteIdenticalFilesAndAnotherSeedDoesNot) {

@@ -108,16 +108,20 @@ void SurfaceDistance::buildGrid() {
   }
 }
 
-float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) const {
+float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m, std::uint32_t* nearest) const {
   float best2 = max_distance_m * max_distance_m;
+  std::uint32_t best = kNoTriangle;
   auto scan = [&](const Cell& cell) {
     const auto it = grid_.find(cell);
     if (it == grid_.end())
       return;
     for (std::uint32_t t : it->second) {
       const auto& tri = triangles_[t];
-      best2 = std::min(best2, (closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p)
-                                  .squaredNorm());
+      const float d2 = (closestOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]) - p).squaredNorm();
+      if (d2 < best2) {
+        best2 = d2;
+        best = t;
+      }
     }
   };
   // The point's own cell first: near the surface it bounds the search, and the other cells
@@ -137,6 +141,8 @@ float SurfaceDistance::distance(const Eigen::Vector3f& p, float max_distance_m) 
         if (box2 < best2)
           scan(cell);
       }
+  if (nearest)
+    *nearest = best;
   return std::sqrt(best2);
 }
 
@@ -214,7 +220,7 @@ WeightLevel WeightCurve::atCompleteness(double completeness) const {
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m,
                           std::size_t max_samples, const std::vector<float>* view_distance_m,
-                          const std::vector<float>* vertex_weights) {
+                          const std::vector<float>* vertex_weights, const SurfaceClasses* truth_classes) {
   if (view_distance_m && view_distance_m->size() != seen_truth.size())
     throw InvalidInputError("mesh evaluation: " + std::to_string(view_distance_m->size()) + " view distances for " +
                             std::to_string(seen_truth.size()) + " samples of the seen surface");
@@ -247,12 +253,35 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
     }
   }
   const SurfaceDistance to_truth(truth, std::max(cap, 0.25f));
+  // Each true triangle's class, kOff for none: vertices and samples take their nearest's.
+  constexpr std::uint8_t kOff = 255;
+  std::vector<std::uint8_t> triangle_class;
+  if (truth_classes) {
+    const std::size_t truth_vertices = truth.cloud.width * truth.cloud.height;
+    if (truth_classes->vertex_class.size() != truth_vertices)
+      throw InvalidInputError("mesh evaluation: " + std::to_string(truth_classes->vertex_class.size()) +
+                              " classes for the true surface's " + std::to_string(truth_vertices) + " vertices");
+    for (std::uint8_t c : truth_classes->vertex_class)
+      if (c >= truth_classes->names.size())
+        throw InvalidInputError("mesh evaluation: class " + std::to_string(c) + " of " +
+                                std::to_string(truth_classes->names.size()) + " names");
+    triangle_class.resize(to_truth.numTriangles());
+    for (std::uint32_t t = 0; t < triangle_class.size(); ++t)
+      triangle_class[t] = truth_classes->vertex_class[to_truth.triangle(t)[0]];
+  }
+  const auto classOf = [&](std::uint32_t t) { return t == SurfaceDistance::kNoTriangle ? kOff : triangle_class[t]; };
   // A regular stride over large inputs: deterministic, and the statistics barely move.
   const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
   std::vector<double> distances((vertices.size() + vertex_step - 1) / vertex_step);
+  std::vector<std::uint8_t> vertex_class(truth_classes ? distances.size() : 0);
   cv::parallel_for_(cv::Range(0, static_cast<int>(distances.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i)
-      distances[i] = to_truth.distance(vertices[static_cast<std::size_t>(i) * vertex_step], cap);
+    for (int i = range.start; i < range.end; ++i) {
+      std::uint32_t nearest = SurfaceDistance::kNoTriangle;
+      distances[i] = to_truth.distance(vertices[static_cast<std::size_t>(i) * vertex_step], cap,
+                                       truth_classes ? &nearest : nullptr);
+      if (truth_classes)
+        vertex_class[i] = classOf(nearest);
+    }
   });
   result.vertices = distances.size();
   double sum = 0;
@@ -288,6 +317,42 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
     result.by_weight = WeightCurve(std::move(sample_levels), sampled_levels, distances);
   }
   const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
+  if (truth_classes) {
+    // A sample lies on the truth: its class is the triangle it lies on (within a few mm).
+    constexpr float kOnSurface = 0.05f;
+    std::vector<std::uint8_t> sample_class(samples);
+    cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
+      for (int i = range.start; i < range.end; ++i) {
+        std::uint32_t nearest = SurfaceDistance::kNoTriangle;
+        to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], kOnSurface, &nearest);
+        sample_class[i] = classOf(nearest);
+      }
+    });
+    const std::size_t n = truth_classes->names.size();
+    std::vector<ClassAccuracy> split(n + 1);
+    std::vector<double> sums(n + 1, 0.0);
+    std::vector<std::size_t> hits(n + 1, 0);
+    for (std::size_t c = 0; c < n; ++c)
+      split[c].name = truth_classes->names[c];
+    split[n].name = ClassAccuracy::kOffSurface;
+    const auto slot = [n](std::uint8_t c) { return c == kOff ? n : static_cast<std::size_t>(c); };
+    for (std::size_t i = 0; i < distances.size(); ++i) {
+      ++split[slot(vertex_class[i])].vertices;
+      sums[slot(vertex_class[i])] += distances[i];
+    }
+    for (std::size_t i = 0; i < samples; ++i) {
+      ++split[slot(sample_class[i])].truth_samples;
+      hits[slot(sample_class[i])] += is_covered[i];
+    }
+    for (std::size_t c = 0; c <= n; ++c) {
+      ClassAccuracy& a = split[c];
+      a.accuracy_mean_m = a.vertices ? sums[c] / static_cast<double>(a.vertices) : 0.0;
+      a.contribution_m = distances.empty() ? 0.0 : sums[c] / static_cast<double>(distances.size());
+      a.completeness = a.truth_samples ? static_cast<double>(hits[c]) / static_cast<double>(a.truth_samples) : 0.0;
+      if (a.vertices > 0 || a.truth_samples > 0 || c < n)
+        result.by_class.push_back(a);
+    }
+  }
   result.truth_samples = samples;
   result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);
   if (view_distance_m && samples > 0) {

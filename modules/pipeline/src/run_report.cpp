@@ -123,12 +123,19 @@ std::string accuracyJson(const MeshAccuracy& m) {
     bands += std::string(bands.empty() ? "" : ", ") + "{\"lower_m\": " + num(b.lower_m) + ", \"upper_m\": " +
              num(b.upper_m) + ", \"samples\": " + std::to_string(b.samples) + ", \"completeness\": " +
              num(b.completeness) + "}";
+  std::string classes;
+  for (const auto& c : m.by_class)
+    classes += std::string(classes.empty() ? "" : ", ") + "{\"class\": \"" + c.name + "\", \"vertices\": " +
+               std::to_string(c.vertices) + ", \"accuracy_mean_m\": " + num(c.accuracy_mean_m) +
+               ", \"contribution_m\": " + num(c.contribution_m) + ", \"truth_samples\": " +
+               std::to_string(c.truth_samples) + ", \"completeness\": " + num(c.completeness) + "}";
   return "{\"accuracy_mean_m\": " + num(m.accuracy_mean_m) + ", \"accuracy_median_m\": " + num(m.accuracy_median_m) +
          ", \"precision\": " + num(m.precision) + ", \"completeness\": " + num(m.completeness) +
          ", \"threshold_m\": " + num(m.threshold_m) + ", \"cap_m\": " + num(m.cap_m) +
          ", \"mesh_vertices\": " + std::to_string(m.vertices) + ", \"truth_samples\": " +
          std::to_string(m.truth_samples) + ", \"completeness_by_nearest_view\": [" + bands + "]" +
-         (curve.empty() ? "" : ", \"by_min_weight\": [" + curve + "]") + "}";
+         (curve.empty() ? "" : ", \"by_min_weight\": [" + curve + "]") +
+         (classes.empty() ? "" : ", \"by_class\": [" + classes + "]") + "}";
 }
 
 /// What a second stop signal left out, as a sentence of report.md ("" when nothing was).
@@ -445,6 +452,44 @@ void RunReport::writeMarkdown(const std::string& path) const {
   writeText(path, s.str());
 }
 
+void RunReport::writeClassTable(std::ostream& s) const {
+  std::vector<const MapEvaluation::Row*> rows;
+  for (const auto& r : map_evaluation.rows)
+    if (r.has_accuracy && !r.accuracy.by_class.empty())
+      rows.push_back(&r);
+  if (rows.empty())
+    return;
+  s << "\nBy the class of the nearest true surface: each mesh's vertices there, their mean distance, their part of "
+       "the mesh's accuracy (the parts add up to it) and the class's completeness ("
+    << ClassAccuracy::kOffSurface << ": vertices no true surface is within the cap of):\n\n| class |";
+  for (const auto* r : rows)
+    s << " " << r->score.source << " vertices | accuracy m | part m | completeness |";
+  s << "\n|---|";
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    s << "---|---|---|---|";
+  s << "\n";
+  std::vector<std::string> names; // every row's classes, in order of first appearance
+  for (const auto* r : rows)
+    for (const auto& a : r->accuracy.by_class)
+      if (std::find(names.begin(), names.end(), a.name) == names.end())
+        names.push_back(a.name);
+  for (const std::string& name : names) {
+    s << "| " << name << " |";
+    for (const auto* r : rows) {
+      const auto& split = r->accuracy.by_class;
+      const auto it = std::find_if(split.begin(), split.end(), [&](const ClassAccuracy& a) { return a.name == name; });
+      if (it == split.end()) {
+        s << " | | | |";
+        continue;
+      }
+      s << " " << it->vertices << " | " << num(it->accuracy_mean_m, 3) << " | " << num(it->contribution_m, 4) << " | "
+        << (it->truth_samples ? num(100 * it->completeness, 1) + " %" : std::string("")) << " |";
+    }
+    s << "\n";
+  }
+  s << "\n";
+}
+
 void RunReport::writeMapEvaluation(std::ostream& s) const {
   const MapEvaluation& e = map_evaluation;
   s << "## The map against ground truth it never saw (evaluation protocol 4)\n\n"
@@ -508,6 +553,7 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
            "accuracy m |\n|---|---|---|---|---|---|\n"
         << rows << "\n";
   }
+  writeClassTable(s);
   if (!e.no_ghosts.empty())
     s << "No ghost figure: " << e.no_ghosts << ".\n";
   else if (ghosts)

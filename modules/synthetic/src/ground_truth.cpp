@@ -81,6 +81,17 @@ std::string GroundTruth::sceneMeshPath() const {
   return path;
 }
 
+std::string GroundTruth::sceneClassesPath() const { return (fs::path(dir_) / "scene_classes.txt").string(); }
+
+bool GroundTruth::hasSceneClasses() const {
+  std::error_code ec;
+  return fs::is_regular_file(sceneClassesPath(), ec);
+}
+
+SurfaceClasses GroundTruth::sceneClasses(std::size_t vertices) const {
+  return readSurfaceClasses(sceneClassesPath(), vertices);
+}
+
 bool GroundTruth::hasMovingMasks() const {
   std::error_code ec;
   return fs::is_directory(fs::path(dir_) / "moving_0", ec);

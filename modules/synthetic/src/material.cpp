@@ -287,6 +287,38 @@ SurfaceResponse foliage(const Material& m, const Primitive& p, const Hit& hit, c
 
 } // namespace
 
+SurfaceClass surfaceClass(MaterialType type) {
+  switch (type) {
+  case MaterialType::Road:
+  case MaterialType::Sidewalk:
+    return SurfaceClass::Ground;
+  case MaterialType::Plaster:
+  case MaterialType::Brick:
+  case MaterialType::BlankWall:
+    return SurfaceClass::Building;
+  case MaterialType::CarPaint:
+  case MaterialType::CarCabin:
+  case MaterialType::Tyre:
+    return SurfaceClass::Car;
+  case MaterialType::Metal:
+  case MaterialType::SignPlate:
+    return SurfaceClass::Pole;
+  case MaterialType::Cloth:
+  case MaterialType::Skin:
+    return SurfaceClass::Person;
+  case MaterialType::Bark:
+  case MaterialType::Foliage:
+    return SurfaceClass::Tree;
+  }
+  return SurfaceClass::Building; // not reached: every type is listed above
+}
+
+const char* surfaceClassName(SurfaceClass c) {
+  static const char* const kNames[] = {"ground", "building", "car", "pole", "person", "tree"};
+  static_assert(sizeof kNames / sizeof kNames[0] == static_cast<std::size_t>(SurfaceClass::Count));
+  return kNames[static_cast<std::size_t>(c)];
+}
+
 SurfaceResponse shadeSurface(const Material& material, const Primitive* primitive, const Hit& hit, V3 world,
                              const Footprint& footprint, const StreetLayout& layout) {
   if (primitive == nullptr || material.type == MaterialType::Road)

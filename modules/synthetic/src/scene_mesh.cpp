@@ -22,7 +22,8 @@ public:
   /// The primitive being tessellated (-1: the road plane).
   void setCurrent(std::int32_t index) { current_ = index; }
 
-  void setColor(const Material& m) {
+  void setMaterial(const Material& m) {
+    class_ = static_cast<std::uint8_t>(surfaceClass(m.type));
     auto to8 = [](float linear) {
       return static_cast<std::uint8_t>(std::lround(255.f * std::pow(std::clamp(linear, 0.f, 1.f), 1.f / 2.2f)));
     };
@@ -145,6 +146,8 @@ public:
     grid({L.road_center_x - half, L.ground_y, z0}, {2.f * half, 0.f, 0.f}, {0.f, 0.f, z1 - z0});
   }
 
+  std::vector<std::uint8_t>& vertexClasses() { return vertex_class_; }
+
   pcl::PolygonMesh finish() {
     pcl::PolygonMesh mesh;
     pcl::toPCLPointCloud2(cloud_, mesh.cloud);
@@ -164,6 +167,7 @@ private:
     q.g = color_[1];
     q.b = color_[2];
     cloud_.push_back(q);
+    vertex_class_.push_back(class_);
     return static_cast<std::uint32_t>(cloud_.size() - 1);
   }
 
@@ -171,20 +175,22 @@ private:
   float max_edge_;
   std::int32_t current_ = -1;
   std::array<std::uint8_t, 3> color_{{128, 128, 128}};
+  std::uint8_t class_ = 0;
+  std::vector<std::uint8_t> vertex_class_; ///< SurfaceClass of each vertex
   pcl::PointCloud<pcl::PointXYZRGB> cloud_;
   std::vector<std::array<std::uint32_t, 3>> triangles_;
 };
 
 } // namespace
 
-pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m) {
+pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m, SurfaceClasses* classes) {
   MeshBuilder builder(scene, static_cast<float>(max_edge_m));
-  builder.setColor(scene.materials[scene.ground_material]);
+  builder.setMaterial(scene.materials[scene.ground_material]);
   builder.road();
   for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
     const Primitive& p = scene.primitives[i];
     builder.setCurrent(static_cast<std::int32_t>(i));
-    builder.setColor(scene.materials[p.material]);
+    builder.setMaterial(scene.materials[p.material]);
     switch (p.shape) {
     case Shape::Box:
       builder.box(p);
@@ -196,6 +202,12 @@ pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m) {
       builder.ellipsoid(p);
       break;
     }
+  }
+  if (classes) {
+    classes->names.clear();
+    for (std::size_t c = 0; c < static_cast<std::size_t>(SurfaceClass::Count); ++c)
+      classes->names.emplace_back(surfaceClassName(static_cast<SurfaceClass>(c)));
+    classes->vertex_class = std::move(builder.vertexClasses());
   }
   return builder.finish();
 }

@@ -71,6 +71,8 @@ const char* kGroundTruthReadme =
     "                      (one line per frame and object; its header names the columns)\n"
     "scene.ply             the true static surface (no moving objects), in the world of poses/00.txt\n"
     "                      (camera 0 at frame 0)\n"
+    "scene_classes.txt     what each vertex of scene.ply is (ground, building, car, pole, person, tree), in runs\n"
+    "                      of vertices: first_vertex vertex_count class\n"
     "synthetic.yaml        the generator's configuration\n"
     "Every pixel is exact: the value of the ray through the pixel centre.\n";
 
@@ -161,7 +163,9 @@ SyntheticFrame SyntheticGenerator::renderFrame(std::size_t i, bool with_color) c
   return f;
 }
 
-pcl::PolygonMesh SyntheticGenerator::mesh() const { return sceneMesh(scene_, config_.mesh_max_edge_m); }
+pcl::PolygonMesh SyntheticGenerator::mesh(SurfaceClasses* classes) const {
+  return sceneMesh(scene_, config_.mesh_max_edge_m, classes);
+}
 
 void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progress& progress) const {
   if (root_arg.empty())
@@ -195,7 +199,9 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     config_.print(yaml);
     writeText(gt / "synthetic.yaml", yaml.str());
     writeText(gt / "README.txt", kGroundTruthReadme);
-    saveMesh((gt / "scene.ply").string(), mesh());
+    SurfaceClasses classes;
+    saveMesh((gt / "scene.ply").string(), mesh(&classes));
+    writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));
     writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
 
     // Frame i's files are written (PNG compression, a tenth of a frame's time) on a thread of

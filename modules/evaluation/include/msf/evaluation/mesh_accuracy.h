@@ -1,9 +1,12 @@
 #pragma once
+#include <msf/io/surface_classes.h>
+
 #include <Eigen/Core>
 #include <pcl/PolygonMesh.h>
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -20,13 +23,16 @@ public:
   /// From a pcl::PolygonMesh (fields x y z; polygons with 3 or more vertices are fanned).
   explicit SurfaceDistance(const pcl::PolygonMesh& mesh, float cell_size_m = 0.5f);
 
-  /// Distance from p to the nearest triangle, or `max_distance_m` when none is nearer.
-  float distance(const Eigen::Vector3f& p, float max_distance_m) const;
+  /// Distance from p to the nearest triangle, or `max_distance_m` when none is nearer; with
+  /// `nearest`, that triangle's index (kNoTriangle when none is nearer).
+  float distance(const Eigen::Vector3f& p, float max_distance_m, std::uint32_t* nearest = nullptr) const;
+  static constexpr std::uint32_t kNoTriangle = 0xffffffffu;
   /// The largest of `values` (one per triangle) over the triangles nearer to p than
   /// `radius_m`, or `none` when no triangle is that near.
   float highestWithin(const Eigen::Vector3f& p, float radius_m, const std::vector<float>& values, float none) const;
 
   std::size_t numTriangles() const { return triangles_.size(); }
+  const std::array<std::uint32_t, 3>& triangle(std::uint32_t t) const { return triangles_[t]; }
 
 private:
   using Cell = Eigen::Vector3i;
@@ -90,6 +96,20 @@ private:
   std::vector<double> distance_sums_; ///< of the vertices' distances in that order, from 0
 };
 
+/// The part of a mesh nearest one class of the true surface, and that class's completeness:
+/// where the error of a mean comes from (trees, poles, buildings...).
+struct ClassAccuracy {
+  /// The class (SurfaceClasses::names); kOffSurface: vertices no true surface is within the
+  /// cap of (ghosts, specks), each counted at the cap.
+  std::string name;
+  std::size_t vertices = 0;      ///< evaluated vertices whose nearest true surface is of the class
+  double accuracy_mean_m = 0;    ///< their mean distance (capped); 0 without vertices
+  double contribution_m = 0;     ///< their part of the mesh's accuracy_mean_m: the classes' sum is it
+  std::size_t truth_samples = 0; ///< samples of the seen true surface on the class
+  double completeness = 0;       ///< share of them within the threshold of the mesh; 0 without
+  static constexpr const char* kOffSurface = "off_surface";
+};
+
 /// Mesh quality against the true surface (protocol 3, docs/design.md).
 struct MeshAccuracy {
   std::size_t vertices = 0;            ///< vertices of the reconstructed mesh evaluated (sampled)
@@ -104,6 +124,9 @@ struct MeshAccuracy {
   std::vector<CompletenessBand> by_view_distance;
   /// Accuracy and completeness as the bar on the vertices' weights rises (when given).
   WeightCurve by_weight;
+  /// Split by the class of the nearest true surface (when the truth's classes are given), in
+  /// the order of their names, then kOffSurface.
+  std::vector<ClassAccuracy> by_class;
 };
 
 /// For each of `points` (the seen true surface, from every frame), the least of `depths` (the
@@ -119,12 +142,15 @@ std::vector<float> nearestViewDistance(const std::vector<Eigen::Vector3f>& point
 /// capped at `cap_m`. Inputs larger than `max_samples` are taken at a regular stride.
 /// With `view_distance_m` (one per seen_truth point, nearestViewDistance), completeness is also
 /// given in bands of that distance, 10 m wide up to the farthest. With `vertex_weights` (one
-/// per mesh vertex, TriangleMesh::weights), also by_weight. Throws InvalidInputError when
-/// `mesh` or `truth` has no triangle, or view_distance_m's size is not seen_truth's or
-/// vertex_weights' not the mesh's vertices'.
+/// per mesh vertex, TriangleMesh::weights), also by_weight. With `truth_classes` (one per
+/// vertex of `truth`; a triangle is its first vertex's class), also by_class. Throws
+/// InvalidInputError when `mesh` or `truth` has no triangle, or view_distance_m's size is not
+/// seen_truth's, vertex_weights' not the mesh's vertices', truth_classes' not the truth's
+/// vertices' or a class index is not below its names' count.
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m = 1.0,
                           std::size_t max_samples = 200000, const std::vector<float>* view_distance_m = nullptr,
-                          const std::vector<float>* vertex_weights = nullptr);
+                          const std::vector<float>* vertex_weights = nullptr,
+                          const SurfaceClasses* truth_classes = nullptr);
 
 } // namespace msf

@@ -106,6 +106,8 @@ public:
 
 private:
   void writeMapEvaluation(std::ostream& out) const;
+  /// The meshes' accuracy and completeness by the class of the true surface (when known).
+  void writeClassTable(std::ostream& out) const;
 };
 
 /// Peak resident memory of this process so far, in MiB (getrusage).

@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/io/surface_classes.h>
 #include <msf/synthetic/moving_box.h>
 
 #include <opencv2/core/mat.hpp>
@@ -19,6 +20,7 @@ namespace msf::synthetic {
 ///   gt/moving_objects.txt    the moving objects' oriented boxes at every frame (MovingBox)
 ///   gt/scene.ply             the true static surface (no moving objects), world = camera 0
 ///                            at frame 0 (poses/00.txt)
+///   gt/scene_classes.txt     what each of scene.ply's vertices is (SurfaceClasses)
 /// Frames are in file-name order, the same order as msf::Sequence's frames.
 class GroundTruth {
 public:
@@ -42,6 +44,12 @@ public:
   std::string movingMaskPath(std::size_t i) const;
   std::string movingBoxesPath() const;
   std::string sceneMeshPath() const;
+  std::string sceneClassesPath() const;
+  /// True when gt/scene_classes.txt exists (datasets written before it have none).
+  bool hasSceneClasses() const;
+  /// gt/scene_classes.txt for a scene.ply of `vertices` vertices. Throws IOError naming the
+  /// file when it is missing, garbled or covers another number of vertices.
+  SurfaceClasses sceneClasses(std::size_t vertices) const;
   /// True when the dataset marks moving objects (gt/moving_0/ exists).
   bool hasMovingMasks() const;
 

@@ -40,6 +40,13 @@ struct Material {
   float sill_height_m = 0.9f;
 };
 
+/// The kinds of surface the mesh evaluation reports apart (MeshAccuracy::by_class), by material:
+/// ground (road, sidewalk), building, car, pole (poles, lamp heads, signs), person, tree.
+enum class SurfaceClass : std::uint8_t { Ground, Building, Car, Pole, Person, Tree, Count };
+SurfaceClass surfaceClass(MaterialType type);
+/// "ground", "building", ...: gt/scene_classes.txt's names.
+const char* surfaceClassName(SurfaceClass c);
+
 /// What a surface point looks like to the sensors.
 struct SurfaceResponse {
   float r = 0.f, g = 0.f, b = 0.f; ///< albedo (linear)

@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/io/surface_classes.h>
 #include <msf/synthetic/scene.h>
 
 #include <pcl/PolygonMesh.h>
@@ -10,7 +11,8 @@ namespace msf::synthetic {
 /// cells of at most `max_edge_m`, cylinders and ellipsoids tessellated finely enough to
 /// stay within a few centimetres of the solid. Faces hidden inside another solid (a
 /// building's foot on the sidewalk, the road under the sidewalk) are left out, so the mesh
-/// is the visible boundary of the union, up to one cell at the seams.
-pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m);
+/// is the visible boundary of the union, up to one cell at the seams. With `classes`, also
+/// each vertex's SurfaceClass (by its material; names: surfaceClassName).
+pcl::PolygonMesh sceneMesh(const Scene& scene, double max_edge_m, SurfaceClasses* classes = nullptr);
 
 } // namespace msf::synthetic

@@ -1,6 +1,7 @@
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/io/poses.h>
+#include <msf/io/surface_classes.h>
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/lidar_simulator.h>
 #include <msf/synthetic/moving_box.h>
@@ -58,7 +59,7 @@ public:
   SyntheticFrame renderFrame(std::size_t i, bool with_color = true) const;
 
   /// The true static surface (see sceneMesh in scene_mesh.h), without the moving objects.
-  pcl::PolygonMesh mesh() const;
+  pcl::PolygonMesh mesh(SurfaceClasses* classes = nullptr) const;
 
   /// Called after each written frame with its index, the seconds it took (from its start to
   /// the next frame's, and any wait for its files: they are written while the next frame
