@@ -318,13 +318,14 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   }
   const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
   if (truth_classes) {
-    // A sample lies on the truth: its class is the triangle it lies on (within a few mm).
-    constexpr float kOnSurface = 0.05f;
+    // A sample lies on the truth, or within the tessellation's few centimetres of a curved
+    // solid's: its class is the nearest triangle's within the threshold.
+    const float on_surface = std::max(threshold, 0.05f);
     std::vector<std::uint8_t> sample_class(samples);
     cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
       for (int i = range.start; i < range.end; ++i) {
         std::uint32_t nearest = SurfaceDistance::kNoTriangle;
-        to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], kOnSurface, &nearest);
+        to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], on_surface, &nearest);
         sample_class[i] = classOf(nearest);
       }
     });

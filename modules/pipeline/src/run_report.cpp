@@ -459,8 +459,8 @@ void RunReport::writeClassTable(std::ostream& s) const {
       rows.push_back(&r);
   if (rows.empty())
     return;
-  s << "\nBy the class of the nearest true surface: each mesh's vertices there, their mean distance, their part of "
-       "the mesh's accuracy (the parts add up to it) and the class's completeness ("
+  s << "\nBy the class of the nearest true surface: the share of each mesh's vertices there, their mean distance, "
+       "their part of the mesh's accuracy (the parts add up to it) and the class's completeness ("
     << ClassAccuracy::kOffSurface << ": vertices no true surface is within the cap of):\n\n| class |";
   for (const auto* r : rows)
     s << " " << r->score.source << " vertices | accuracy m | part m | completeness |";
@@ -482,8 +482,9 @@ void RunReport::writeClassTable(std::ostream& s) const {
         s << " | | | |";
         continue;
       }
-      s << " " << it->vertices << " | " << num(it->accuracy_mean_m, 3) << " | " << num(it->contribution_m, 4) << " | "
-        << (it->truth_samples ? num(100 * it->completeness, 1) + " %" : std::string("")) << " |";
+      const double share = static_cast<double>(it->vertices) / static_cast<double>(std::max<std::size_t>(1, r->accuracy.vertices));
+      s << " " << num(100 * share, 1) << " % | " << num(it->accuracy_mean_m, 3) << " | " << num(it->contribution_m, 4)
+        << " | " << (it->truth_samples ? num(100 * it->completeness, 1) + " %" : std::string("")) << " |";
     }
     s << "\n";
   }
