@@ -107,6 +107,8 @@ struct GroundTruthScores {
   std::map<std::string, msf::DepthErrorAccumulator> all, background, foreground;
   std::vector<Eigen::Vector3f> seen_surface;  // ground-truth depth back-projected to the world
   std::vector<float> seen_depth;              // the depth each was seen at
+  pcl::PolygonMesh scene;                     // gt/scene.ply, read before the run
+  std::optional<msf::SurfaceClasses> classes; // gt/scene_classes.txt, when the dataset has it
   /// For the mesh's completeness; not for a streamed map (no mesh scores): it grows by ~0.4 MB
   /// a frame, what a drive in bounded memory cannot keep.
   bool keep_surface = true;
@@ -578,9 +580,19 @@ int main(int argc, char** argv) {
     report.trajectory = poses.description();
 
     GroundTruthScores scores;
-    if (!sequence.groundTruthDir().empty())
-      scores.truth = std::make_unique<msf::synthetic::GroundTruth>(sequence.groundTruthDir());
     scores.keep_surface = !streaming;
+    if (!sequence.groundTruthDir().empty()) {
+      scores.truth = std::make_unique<msf::synthetic::GroundTruth>(sequence.groundTruthDir());
+      // The true surface and what each of its vertices is (ground, building, tree...: the mesh
+      // scores split by it; datasets written before gt/scene_classes.txt have none), read
+      // before the run: a garbled file stops it now, not after its last frame.
+      if (scores.keep_surface) {
+        msf::loadMesh(scores.truth->sceneMeshPath(), scores.scene);
+        if (scores.truth->hasSceneClasses())
+          scores.classes =
+              scores.truth->sceneClasses(static_cast<std::size_t>(scores.scene.cloud.width) * scores.scene.cloud.height);
+      }
+    }
 
     // Protocol 4: the held-out rings with -holdout, else a synthetic sequence's exact depth.
     std::unique_ptr<msf::ReconstructionEvaluation> evaluation;
@@ -815,13 +827,10 @@ int main(int argc, char** argv) {
       tt.tic();
       print_highlight("Scoring the mesh%s against ", meshes.size() > 1 ? "es" : "");
       print_value("%s ", scene.c_str());
-      pcl::PolygonMesh truth;
-      msf::loadMesh(scene, truth);
-      // What each true vertex is (ground, building, tree...): the scores split by it. Datasets
-      // written before gt/scene_classes.txt have none.
-      std::optional<msf::SurfaceClasses> classes;
-      if (scores.truth->hasSceneClasses())
-        classes = scores.truth->sceneClasses(static_cast<std::size_t>(truth.cloud.width) * truth.cloud.height);
+      if (scores.scene.polygons.empty())
+        msf::loadMesh(scene, scores.scene);
+      const pcl::PolygonMesh& truth = scores.scene;
+      const std::optional<msf::SurfaceClasses>& classes = scores.classes;
       // Where moving objects were: inside a box of gt/moving_objects.txt at any frame, grown by
       // a voxel (a car's surface is meshed up to a voxel off its box).
       msf::MovingSpace was_moving;

@@ -52,6 +52,11 @@ TEST(SurfaceClasses, BadFilesNameTheFileAndWhatIsWrong) {
   expectIOError(writeFile(dir, "0 0 ground\n"), 0, "line 1: expected");
   expectIOError(writeFile(dir, "0 3 ground\n4 2 tree\n"), 0, "line 2: the run begins at vertex 4, the last ended at 3");
   expectIOError(writeFile(dir, "0 3 ground\n3 2 tree\n"), 6, "cover 5 vertices, the mesh has 6");
+  expectIOError(writeFile(dir, "0 3 ground\n3 4 tree\n"), 6, "line 2: the run of 4 vertices from 3 goes past the mesh's 6");
+  // A count that would take all memory (or wrap) is refused before anything is allocated.
+  expectIOError(writeFile(dir, "0 18446744073709551615 ground\n"), 0, "goes past 2^32 vertices");
+  expectIOError(writeFile(dir, "0 1 ground\n1 18446744073709551615 tree\n"), 5, "goes past the mesh's 5");
+  expectIOError(writeFile(dir, "0 99999999999999999999999 ground\n"), 0, "line 1: expected");
 }
 
 } // namespace

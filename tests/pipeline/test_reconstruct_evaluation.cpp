@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 namespace fs = std::filesystem;
 
@@ -212,6 +213,27 @@ TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {
     EXPECT_NE(report.find(row), std::string::npos) << row << " not in report.md:\n" << report;
   EXPECT_NE(r.out.find("mesh_paper"), std::string::npos) << r.out; // the console's table
   EXPECT_NE(r.out.find("mesh as complete as mesh_paper"), std::string::npos) << r.out;
+}
+
+TEST_F(PipelineTest, GarbledSceneClassesAreAClearErrorAndLeaveNoOutput) {
+  // The street with its gt/scene_classes.txt replaced: one run past the mesh's vertices.
+  msf::test::TempDir dir;
+  const fs::path copy = dir.file("street"), source = dataset();
+  fs::create_directories(copy / "gt");
+  for (const char* entry : {"sequences", "poses"})
+    fs::create_symlink(source / entry, copy / entry);
+  for (const auto& e : fs::directory_iterator(source / "gt"))
+    if (e.path().filename() != "scene_classes.txt")
+      fs::create_symlink(e.path(), copy / "gt" / e.path().filename());
+  std::ofstream(copy / "gt" / "scene_classes.txt") << "# garbled\n0 3 ground\n3 999999999 tree\n";
+  const std::string out = dir.file("out");
+  const auto r = msf::test::runTool("msf_reconstruct", copy.string() + " -frames 0:0 -panels 0 -o " + out);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("msf_reconstruct: error: surface classes '" + (copy / "gt" / "scene_classes.txt").string() +
+                       "' line 3: the run of 999999999 vertices from 3 goes past the mesh's"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "a failed run left " << out;
 }
 
 TEST(ReconstructEvaluation, BadInputIsAClearErrorAndLeavesNoOutput) {

@@ -9,6 +9,8 @@ namespace msf {
 
 namespace {
 
+constexpr std::size_t kMaxVertices = std::size_t{1} << 32;
+
 bool parseCount(const std::string& token, std::size_t& value) {
   const char* end = token.data() + token.size();
   const auto [ptr, ec] = std::from_chars(token.data(), end, value);
@@ -57,6 +59,13 @@ SurfaceClasses readSurfaceClasses(const std::string& path, std::size_t expected_
     if (first != classes.vertex_class.size())
       throw IOError("surface classes '" + path + "' line " + std::to_string(number) + ": the run begins at vertex " +
                     std::to_string(first) + ", the last ended at " + std::to_string(classes.vertex_class.size()));
+    // A mesh indexes its vertices with 32 bits: a longer run is a garbled file, not memory to take.
+    const std::size_t limit = expected_vertices > 0 ? expected_vertices : kMaxVertices;
+    if (count > limit - first)
+      throw IOError("surface classes '" + path + "' line " + std::to_string(number) + ": the run of " +
+                    std::to_string(count) + " vertices from " + std::to_string(first) + " goes past " +
+                    (expected_vertices > 0 ? "the mesh's " + std::to_string(expected_vertices) + " vertices"
+                                           : std::string("2^32 vertices")));
     std::size_t index = 0;
     while (index < classes.names.size() && classes.names[index] != name)
       ++index;
