@@ -1,21 +1,12 @@
 #include <msf/common/exceptions.h>
+#include <msf/common/text_records.h>
 #include <msf/io/surface_classes.h>
-
-#include <charconv>
-#include <fstream>
-#include <sstream>
 
 namespace msf {
 
 namespace {
 
 constexpr std::size_t kMaxVertices = std::size_t{1} << 32;
-
-bool parseCount(const std::string& token, std::size_t& value) {
-  const char* end = token.data() + token.size();
-  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  return ec == std::errc() && ptr == end;
-}
 
 } // namespace
 
@@ -39,43 +30,35 @@ std::string formatSurfaceClasses(const SurfaceClasses& classes) {
 }
 
 SurfaceClasses readSurfaceClasses(const std::string& path, std::size_t expected_vertices) {
-  std::ifstream in(path);
-  if (!in)
-    throw IOError("cannot open surface classes '" + path + "'");
   SurfaceClasses classes;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    const auto start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos || line[start] == '#')
-      continue;
-    std::istringstream tokens(line);
-    std::string first_token, count_token, name, extra;
+  forEachTextRecord(path, "surface classes", [&](int number, const std::vector<std::string>& fields,
+                                                 const std::string& line) {
+    const std::string at = "surface classes '" + path + "' line " + std::to_string(number);
     std::size_t first = 0, count = 0;
-    if (!(tokens >> first_token >> count_token >> name) || (tokens >> extra) || !parseCount(first_token, first) ||
-        !parseCount(count_token, count) || count == 0)
-      throw IOError("surface classes '" + path + "' line " + std::to_string(number) +
-                    ": expected 'first_vertex vertex_count class' (two whole numbers, the count > 0), got '" + line +
-                    "'");
+    if (fields.size() != 3 || !parseNumber(fields[0], first) || !parseNumber(fields[1], count) || count == 0)
+      throw IOError(at + ": expected 'first_vertex vertex_count class' (two whole numbers, the count > 0), got '" +
+                    line + "'");
     if (first != classes.vertex_class.size())
-      throw IOError("surface classes '" + path + "' line " + std::to_string(number) + ": the run begins at vertex " +
-                    std::to_string(first) + ", the last ended at " + std::to_string(classes.vertex_class.size()));
+      throw IOError(at + ": the run begins at vertex " + std::to_string(first) + ", the last ended at " +
+                    std::to_string(classes.vertex_class.size()));
     // A mesh indexes its vertices with 32 bits: a longer run is a garbled file, not memory to take.
     const std::size_t limit = expected_vertices > 0 ? expected_vertices : kMaxVertices;
     if (count > limit - first)
-      throw IOError("surface classes '" + path + "' line " + std::to_string(number) + ": the run of " +
-                    std::to_string(count) + " vertices from " + std::to_string(first) + " goes past " +
+      throw IOError(at + ": the run of " + std::to_string(count) + " vertices from " + std::to_string(first) +
+                    " goes past " +
                     (expected_vertices > 0 ? "the mesh's " + std::to_string(expected_vertices) + " vertices"
                                            : std::string("2^32 vertices")));
+    const std::string& name = fields[2];
     std::size_t index = 0;
     while (index < classes.names.size() && classes.names[index] != name)
       ++index;
     if (index == classes.names.size()) {
       if (index == 256)
-        throw IOError("surface classes '" + path + "' line " + std::to_string(number) + ": more than 256 classes");
+        throw IOError(at + ": more than 256 classes");
       classes.names.push_back(name);
     }
     classes.vertex_class.insert(classes.vertex_class.end(), count, static_cast<std::uint8_t>(index));
-  }
+  });
   if (expected_vertices > 0 && classes.vertex_class.size() != expected_vertices)
     throw IOError("surface classes '" + path + "' cover " + std::to_string(classes.vertex_class.size()) +
                   " vertices, the mesh has " + std::to_string(expected_vertices));

@@ -1,11 +1,9 @@
 #include <msf/common/exceptions.h>
+#include <msf/common/text_records.h>
 #include <msf/synthetic/moving_box.h>
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
 namespace msf::synthetic {
 
@@ -29,12 +27,6 @@ const char* kHeader =
     "# yaw: radians about world y, the front points along world (sin yaw, 0, cos yaw). A world point p\n"
     "# is inside when R_y(yaw)^T (p - center) lies within +-half in every axis.\n";
 
-template <typename T> bool parseNumber(const std::string& token, T& value) {
-  const char* end = token.data() + token.size();
-  const auto result = std::from_chars(token.data(), end, value);
-  return result.ec == std::errc() && result.ptr == end;
-}
-
 } // namespace
 
 std::string formatMovingBoxes(const std::vector<MovingBox>& boxes) {
@@ -50,19 +42,9 @@ std::string formatMovingBoxes(const std::vector<MovingBox>& boxes) {
 }
 
 std::vector<MovingBox> readMovingBoxes(const std::string& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw IOError("cannot open moving objects '" + path + "'");
   std::vector<MovingBox> boxes;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#')
-      continue;
-    std::istringstream tokens(line);
-    std::vector<std::string> fields;
-    for (std::string token; tokens >> token;)
-      fields.push_back(token);
+  forEachTextRecord(path, "moving objects", [&](int number, const std::vector<std::string>& fields,
+                                                const std::string& line) {
     MovingBox b;
     double v[7];
     bool ok = fields.size() == 9 && parseNumber(fields[0], b.frame) && parseNumber(fields[1], b.object);
@@ -77,7 +59,7 @@ std::vector<MovingBox> readMovingBoxes(const std::string& path) {
     b.half_extents = {v[3], v[4], v[5]};
     b.yaw = v[6];
     boxes.push_back(b);
-  }
+  });
   return boxes;
 }
 

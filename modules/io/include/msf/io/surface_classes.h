@@ -17,9 +17,10 @@ struct SurfaceClasses {
 /// order from 0: `first_vertex vertex_count class_name`. Throws InvalidInputError when a
 /// vertex's class is not < names.size() or there are more than 256 names.
 std::string formatSurfaceClasses(const SurfaceClasses& classes);
-/// Throws IOError naming the file and the line when it cannot be read, a line is not
-/// `first count name`, a run does not begin where the last ended, or (expected_vertices > 0)
-/// the runs do not cover exactly that many vertices.
+/// Throws IOError naming the file (and the line) when it cannot be read, a line is not
+/// `first count name`, a run does not begin where the last ended, a run goes past
+/// expected_vertices (past 2^32 when it is 0, before anything is allocated), there are more
+/// than 256 names, or (expected_vertices > 0) the runs do not cover exactly that many vertices.
 SurfaceClasses readSurfaceClasses(const std::string& path, std::size_t expected_vertices = 0);
 
 } // namespace msf
