@@ -1,6 +1,7 @@
 // Converts KITTI Velodyne .bin scans to PointXYZI .pcd clouds, in file order.
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/output_folder.h>
 #include <msf/common/tool.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/velodyne_io.h>
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
       "Reads KITTI Velodyne scans (float32 x, y, z, reflectance) into pcl::PointXYZI clouds, in file order (which "
       "carries the ring structure). Records with NaN or Inf are dropped.");
   cli.value("-input_dir", "DIR", input_dir, "convert every *.bin of DIR ...")
-      .value("-output_dir", "DIR", output_dir, "... into DIR/<name>.pcd (the folder must exist)")
+      .value("-output_dir", "DIR", output_dir, "... into DIR/<name>.pcd (DIR: absent, empty, or written by an earlier batch, which it replaces)")
       .flag("-ascii", ascii, "write ASCII .pcd instead of binary compressed");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (!input_dir.empty() || !output_dir.empty()) {
@@ -66,29 +67,17 @@ int main(int argc, char** argv) {
       std::vector<fs::path> scans;
       for (const std::string& scan : msf::filesIn(input_dir, {".bin"}, "input folder"))
         scans.emplace_back(scan);
-      msf::requireDirectory(output_dir, "output folder");
-      // The batch is a unit: a truncated scan is found before anything is written, and a
-      // failure later removes the clouds this run wrote.
+      // The batch is a unit: a truncated scan is found before anything is written, and the
+      // clouds go into OUT as a whole (an OutputFolder) or not at all.
       for (const auto& scan : scans)
         if (fs::file_size(scan) % 16 != 0)
           throw msf::IOError("scan '" + scan.string() + "' has " + std::to_string(fs::file_size(scan)) +
                              " bytes, not a multiple of 16 (float32 x, y, z, reflectance): truncated or not a "
                              "KITTI .bin; nothing was converted");
-      std::vector<fs::path> written;
-      try {
-        for (const auto& scan : scans) {
-          const fs::path out = fs::path(output_dir) / (scan.stem().string() + ".pcd");
-          const bool existed = fs::exists(out);
-          convert(scan.string(), out.string(), ascii);
-          if (!existed)
-            written.push_back(out);
-        }
-      } catch (...) {
-        std::error_code ec;
-        for (const auto& f : written)
-          fs::remove(f, ec);
-        throw;
-      }
+      msf::OutputFolder output(output_dir, "msf_kitti2pcd", {input_dir});
+      for (const auto& scan : scans)
+        convert(scan.string(), (fs::path(output.dir()) / (scan.stem().string() + ".pcd")).string(), ascii);
+      output.commit();
       print_info("converted %zu scans\n", scans.size());
       return 0;
     }

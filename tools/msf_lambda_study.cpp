@@ -3,6 +3,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/output_folder.h>
 #include <msf/common/tool.h>
 #include <msf/io/image_io.h>
 #include <msf/reconstruction/lambda_study.h>
@@ -23,7 +24,7 @@ namespace {
 /// The study of `config` into `out_dir`: the table on the console, the CSV and the figure.
 int run(const msf::LambdaStudy::Config& config, const std::string& out_dir) {
   const msf::LambdaStudy study(config); // validates: a bad value leaves no output folder
-  msf::ensureOutputDirectory(out_dir);
+  msf::OutputFolder output(out_dir, "msf_lambda_study");
   config.print(std::cout);
 
   std::vector<msf::LambdaStudy::Cell> cells;
@@ -49,8 +50,9 @@ int run(const msf::LambdaStudy::Config& config, const std::string& out_dir) {
   }
   const std::string csv = out_dir + "/lambda_study.csv", png = out_dir + "/lambda_study.png";
   const cv::Mat figure = msf::LambdaStudy::plot(cells);
-  msf::LambdaStudy::writeCsv(csv, cells);
-  msf::writeImage(png, figure);
+  msf::LambdaStudy::writeCsv(output.dir() + "/lambda_study.csv", cells);
+  msf::writeImage(output.dir() + "/lambda_study.png", figure);
+  output.commit();
   print_info("Wrote ");
   print_value("%s", csv.c_str());
   print_info(" and ");
@@ -68,7 +70,7 @@ int main(int argc, char** argv) {
       "msf_lambda_study", "-o DIR [options]",
       "Fuses noisy depth of a synthetic scene (smooth parts, edges, sharp boundaries) with each lambda of eq. 7 and "
       "writes DIR/lambda_study.csv and DIR/lambda_study.png (paper Fig. 5).");
-  cli.value("-o", "DIR", out_dir, "output folder")
+  cli.value("-o", "DIR", out_dir, "output folder: absent, empty, or one an earlier study wrote (replaced)")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "lambda_study", config); },
              "YAML with a section lambda_study (noise_mm, lambdas, frames, ...)")
       .value("-frames", "N", config.frames, "frames fused per cell (default {default})")

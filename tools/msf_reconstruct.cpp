@@ -2,6 +2,8 @@
 // with a report of speed and, where ground truth exists, accuracy.
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/output_folder.h>
+#include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
@@ -56,50 +58,23 @@ namespace {
 
 constexpr int kMaxPanels = 100;
 
-// Stop signals (SIGINT, SIGTERM). None ends the process before the mesh and the summary are
-// written: the first stops the run after the frames under way (the pipeline's stop flag); the
-// second also skips the optional work after the mesh (its scores, the renderings, the
-// single-source maps of -compare_sources), what can take minutes on a long drive; later ones
-// are only acknowledged. Ending at once is SIGKILL's job, and it leaves OUT as it was (the
-// staging folder is removed by the next run). A second Ctrl-C that killed the run, as it
-// did, lost the whole run's work and left no mesh and no summary.
-std::atomic<bool> g_stop{false};
-std::atomic<int> g_stop_signals{0};
-static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
-              "the signal handler needs lock-free atomics");
-
-void onSignal(int) {
-  const int saved_errno = errno;
-  const int n = ++g_stop_signals;
-  g_stop = true;
-  // write(2) only: the one output that is safe in a signal handler.
-  static const char first[] = "\nmsf_reconstruct: stopping after the frames under way; the mesh and the summary are "
-                              "still written (again: also skip the mesh's scores and renderings)\n";
-  static const char second[] = "\nmsf_reconstruct: skipping the mesh's scores and renderings; writing the mesh and the "
-                               "summary (kill -9 ends at once and leaves the output folder as it was)\n";
-  static const char later[] = "\nmsf_reconstruct: still writing the mesh and the summary (kill -9 ends at once and "
-                              "leaves the output folder as it was)\n";
-  const char* text = n == 1 ? first : n == 2 ? second : later;
-  const std::size_t size = n == 1 ? sizeof first : n == 2 ? sizeof second : sizeof later;
-  if (::write(STDERR_FILENO, text, size - 1) < 0) {
-    // Nothing to do: the stop itself does not depend on the message.
-  }
-  errno = saved_errno;
+// Stop signals (SIGINT, SIGTERM, SIGHUP, SIGPIPE). None ends the process before the mesh and
+// the summary are written: the first stops the run after the frames under way; the second
+// also skips the optional work after the mesh (its scores, the renderings, the single-source
+// maps), what can take minutes on a long drive; later ones are only acknowledged. Ending at
+// once is SIGKILL's job, and it leaves OUT as it was.
+void installStopHandler() {
+  msf::tool::installStopSignals(
+      {"msf_reconstruct: stopping after the frames under way; the mesh and the summary are still written (again: "
+       "also skip the mesh's scores and renderings)",
+       "msf_reconstruct: skipping the mesh's scores and renderings; writing the mesh and the summary (kill -9 ends "
+       "at once and leaves the output folder as it was)",
+       "msf_reconstruct: still writing the mesh and the summary (kill -9 ends at once and leaves the output folder "
+       "as it was)"});
 }
 
 /// After a second stop signal: the optional work after the mesh is skipped.
-bool hurried() { return g_stop_signals.load() >= 2; }
-
-void installStopHandler() {
-  struct sigaction action {};
-  action.sa_handler = onSignal;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESTART; // a write under way when a signal comes goes on
-  for (int signal_number : {SIGINT, SIGTERM})
-    if (::sigaction(signal_number, &action, nullptr) != 0)
-      throw msf::IOError(std::string("cannot install the handler of ") + ::strsignal(signal_number) + ": " +
-                         std::strerror(errno));
-}
+bool hurried() { return msf::tool::stopRequests() >= 2; }
 
 /// Ground truth of a synthetic sequence, accumulated over the run.
 struct GroundTruthScores {
@@ -288,102 +263,13 @@ std::string generateDefaultStreet(const std::string& dir) {
   const msf::synthetic::SyntheticGenerator generator(config);
   TicToc tt;
   tt.tic();
-  generator.writeDataset(dir);
+  generator.writeDataset(dir, [](std::size_t, double, std::size_t) {
+    if (msf::tool::stopFlag())
+      throw msf::InvalidInputError("interrupted while generating the default street: nothing was written");
+  });
   print_info("  generated in %.1f s\n", tt.toc() / 1000.0);
   return dir;
 }
-
-/// The run's outputs as a unit: everything is written into a hidden folder beside OUT
-/// (.NAME.partial.PID) that replaces OUT by one rename at the end (an atomic exchange when
-/// OUT exists), so a failed or killed run leaves OUT as it was, never a mix of two runs'
-/// files. A failed run removes its folder; a killed one's is removed by the next run.
-class StagedOutput {
-public:
-  explicit StagedOutput(const std::string& path) : final_(fs::absolute(path).lexically_normal()) {
-    if (final_.filename().empty())
-      final_ = final_.parent_path();
-    const fs::path parent = final_.parent_path();
-    msf::requireDirectory(parent.string(), "parent folder of the output folder '" + path + "'");
-    std::error_code ec;
-    if (fs::exists(final_, ec)) {
-      if (!fs::is_directory(final_, ec))
-        throw msf::IOError("output '" + path + "' exists and is not a folder");
-      // The folder is replaced as a whole: only a previous run's files may be in it.
-      for (const auto& e : fs::directory_iterator(final_)) {
-        const std::string name = e.path().filename().string();
-        if (!isRunOutput(name, e.is_directory()))
-          throw msf::IOError("output folder '" + path + "' holds '" + name +
-                             "', which no msf_reconstruct run writes: the run replaces the folder as a whole; "
-                             "choose a new or empty folder");
-      }
-    }
-    removeStale(parent);
-    staging_ = parent / (prefix() + std::to_string(::getpid()));
-    fs::remove_all(staging_, ec);
-    if (!fs::create_directory(staging_, ec))
-      throw msf::IOError("cannot create '" + staging_.string() + "': " + ec.message());
-  }
-  ~StagedOutput() {
-    std::error_code e;
-    fs::remove_all(staging_, e);
-  }
-  StagedOutput(const StagedOutput&) = delete;
-  StagedOutput& operator=(const StagedOutput&) = delete;
-
-  /// Where the run writes.
-  const fs::path& dir() const { return staging_; }
-
-  /// Puts the outputs in place: OUT becomes the staging folder in one rename.
-  void commit() {
-    std::error_code ec;
-    if (fs::exists(final_, ec)) {
-      if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, final_.c_str(), RENAME_EXCHANGE) != 0)
-        throw msf::IOError("cannot replace '" + final_.string() + "' by '" + staging_.string() +
-                           "': " + std::strerror(errno));
-      // staging_ now holds the previous run's files; the destructor removes them.
-    } else {
-      fs::rename(staging_, final_, ec);
-      if (ec)
-        throw msf::IOError("cannot rename '" + staging_.string() + "' to '" + final_.string() + "': " + ec.message());
-    }
-  }
-
-private:
-  std::string prefix() const { return "." + final_.filename().string() + ".partial."; }
-
-  /// Names a run writes (and the hidden temporaries of its atomic writes).
-  static bool isRunOutput(const std::string& name, bool directory) {
-    if (directory)
-      return name == "depth" || name == "tiles" || name == "tsdf"; // -save_depth, -stream
-    if (!name.empty() && name[0] == '.')
-      return name.find(".tmp") != std::string::npos;
-    const std::string ext = msf::fileExtension(name);
-    return ext == ".ply" || ext == ".pcd" || ext == ".json" || ext == ".md" || ext == ".csv" || ext == ".png" ||
-           ext == ".yaml" || ext == ".txt"; // poses.txt
-  }
-
-  /// Staging folders of this OUT left by killed runs (their process is gone).
-  void removeStale(const fs::path& parent) const {
-    std::error_code ec;
-    const std::string p = prefix();
-    for (const auto& e : fs::directory_iterator(parent, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.rfind(p, 0) != 0)
-        continue;
-      const std::string pid_text = name.substr(p.size());
-      char* end = nullptr;
-      const long pid = std::strtol(pid_text.c_str(), &end, 10);
-      if (end == pid_text.c_str() || *end != '\0' || pid <= 0)
-        continue;
-      if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
-        std::error_code rm;
-        fs::remove_all(e.path(), rm);
-      }
-    }
-  }
-
-  fs::path final_, staging_;
-};
 
 /// The console's protocol 4 table: per source, coverage, D1 (missing = bad) and MAE within
 /// the map's range and over all ground-truth pixels (static ones, when the dataset says which).
@@ -453,7 +339,7 @@ void checkMemoryBudget(const msf::Pipeline& pipeline, const msf::PoseList& poses
 }
 
 int main(int argc, char** argv) {
-  std::string out = "msf_out", frames_text = "0:", poses_option;
+  std::string out = "msf_out", frames_text = "0:", poses_option, config_path;
   int panels = 3;
   bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
   msf::PipelineConfig config;
@@ -466,7 +352,10 @@ int main(int argc, char** argv) {
   cli.value("-o", "DIR", out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
             "depth_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt")
-      .value("-config", "FILE", [&](const std::string& path) { config = msf::PipelineConfig::load(path); },
+      .value("-config", "FILE", [&](const std::string& path) {
+               config = msf::PipelineConfig::load(path);
+               config_path = path;
+             },
              "YAML configuration (config/kitti.yaml); the options below override it")
       .value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)")
       .value("-poses", "P", poses_option,
@@ -529,26 +418,21 @@ int main(int argc, char** argv) {
                                    "streaming.active_radius_m)");
     const msf::FrameRange range = msf::FrameRange::parse(frames_text);
 
-    StagedOutput output(out);
-    const std::string stage = output.dir().string(); // where this run writes; `out` at the end
+    // Inputs inside OUT are refused: OUT is replaced as a whole.
+    const std::string poses_file = poses_option == "dataset" || poses_option == "estimate" ? "" : poses_option;
+    installStopHandler();
+    msf::OutputFolder output(out, "msf_reconstruct",
+                             {positional.empty() ? "" : positional.front(), config_path, poses_file});
+    const std::string stage = output.dir(); // where this run writes; `out` at the end
 
-    // The dataset, or the default synthetic street in a temporary folder removed at the end.
+    // The dataset, or the default synthetic street generated inside the staging folder (a
+    // killed run's is removed with it by the next run) and removed before the commit.
     std::string dataset;
-    std::unique_ptr<fs::path, void (*)(fs::path*)> temporary(nullptr, [](fs::path* p) {
-      std::error_code e;
-      fs::remove_all(*p, e);
-      delete p;
-    });
-    if (positional.empty()) {
-      char pattern[] = "/tmp/msf_street_XXXXXX";
-      if (!::mkdtemp(pattern))
-        throw msf::IOError("cannot create a temporary folder in /tmp");
-      temporary.reset(new fs::path(pattern));
-      dataset = generateDefaultStreet((*temporary / "street").string());
-    } else {
+    const fs::path street = fs::path(stage) / ".street";
+    if (positional.empty())
+      dataset = generateDefaultStreet(street.string());
+    else
       dataset = positional.front();
-    }
-
     const msf::Sequence sequence(dataset);
     const std::vector<std::size_t> frames = sequence.indices(range);
     msf::PoseSource poses(poses_option, sequence, frames, config.odometry);
@@ -638,7 +522,6 @@ int main(int argc, char** argv) {
     if (poses.kind() == msf::PoseSource::Kind::Estimated) // after the hold-out: the scan the pipeline sees
       pipeline.setPoseEstimator([&](const msf::Frame& frame) { return poses.estimate(frame); });
     msf::PoseList used_poses;
-    installStopHandler();
     Progress progress(frames.size());
 
     const auto stats = pipeline.run(
@@ -701,7 +584,7 @@ int main(int argc, char** argv) {
           }
           progress.frame(r, report.frames.size());
         },
-        &g_stop);
+        &msf::tool::stopFlag());
     progress.end();
     report.wall_s = stats.wall_s;
     report.first_frame_s = stats.first_frame_s;
@@ -933,6 +816,11 @@ int main(int argc, char** argv) {
       report.writeRuntimePlot((fs::path(stage) / "runtime.png").string());
     report.writeSummaryJson((fs::path(stage) / "summary.json").string());
     report.writeMarkdown((fs::path(stage) / "report.md").string());
+    if (report.triangles == 0 && !stats.interrupted)
+      throw msf::InvalidInputError("no surface was reconstructed from " + std::to_string(report.frames.size()) +
+                                   " frames: nothing is written to '" + out + "'");
+    std::error_code ec;
+    fs::remove_all(street, ec);
     output.commit();
 
     print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
@@ -950,9 +838,6 @@ int main(int argc, char** argv) {
       printMapEvaluation(report.map_evaluation);
     print_info("Report: ");
     print_value("%s/report.md\n", out.c_str());
-    if (report.triangles == 0 && !stats.interrupted)
-      throw msf::InvalidInputError("no surface was reconstructed from " + std::to_string(report.frames.size()) +
-                                   " frames (no mesh.ply): see " + out + "/report.md");
     return stats.interrupted ? 130 : 0;
   });
 }

@@ -2,6 +2,7 @@
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
+#include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
 #include <msf/synthetic/synthetic_generator.h>
 
@@ -40,7 +41,7 @@ int main(int argc, char** argv) {
       "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
       "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
       "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.");
-  cli.value("-o", "DIR", output, "output folder (absent, empty, or an earlier synthetic dataset, replaced)")
+  cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
              "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
       .value("-frames", "N", config.frames, "number of frames (default {default})")
@@ -83,7 +84,12 @@ int main(int argc, char** argv) {
     print_value("%d frames", config.frames);
     print_info(" to ");
     print_value("%s\n", output.c_str());
+    // A stop signal ends the run at the next frame, leaving no staging folder and OUT as it was.
+    msf::tool::installStopSignals({"msf_synth: stopping after the frame under way; nothing is written"});
     generator.writeDataset(output, [&](std::size_t frame, double s, std::size_t points) {
+      if (msf::tool::stopFlag())
+        throw msf::InvalidInputError("interrupted at frame " + std::to_string(frame) + ": nothing was written to '" +
+                                     output + "'");
       seconds.push_back(s);
       print_info("  frame %06zu ", frame);
       msf::tool::printDone(1000.0 * s, points);

@@ -34,6 +34,7 @@ protected:
       msf::synthetic::SyntheticConfig config;
       config.frames = 4;
       config.seed = 7;
+      fs::remove_all(dataset_); // the tests' own street, as an older build wrote it
       msf::synthetic::SyntheticGenerator(config).writeDataset(dataset_);
     }
     ::flock(lock, LOCK_UN);

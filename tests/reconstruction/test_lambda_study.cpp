@@ -54,9 +54,10 @@ TEST(LambdaStudy, ToolWritesTheTableAndThePlot) {
   test::TempDir dir;
   std::ofstream(dir.file("study.yaml")) << "%YAML:1.0\nlambda_study:\n  noise_mm: [0, 40]\n  lambdas: [0, 5]\n"
                                            "  frames: 2\n  width: 160\n  height: 120\n  focal_px: 150\n";
-  auto r = test::runTool("msf_lambda_study", "-o " + dir.path() + " -config " + dir.file("study.yaml"));
+  const std::string out = dir.file("out");
+  auto r = test::runTool("msf_lambda_study", "-o " + out + " -config " + dir.file("study.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream csv(dir.file("lambda_study.csv"));
+  std::ifstream csv(out + "/lambda_study.csv");
   std::string line;
   std::getline(csv, line);
   EXPECT_EQ(line, "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame,sweeps_per_frame");
@@ -67,18 +68,18 @@ TEST(LambdaStudy, ToolWritesTheTableAndThePlot) {
     EXPECT_EQ(sweeps, line.find(",5.00,") != std::string::npos ? 1.0 : 0.0) << line; // one per frame, none at 0
   }
   EXPECT_EQ(rows, 4);
-  EXPECT_TRUE(test::fileExists(dir.file("lambda_study.png")));
+  EXPECT_TRUE(test::fileExists(out + "/lambda_study.png"));
   // The paper's solve: eq. 7 to its minimizer, many sweeps a frame.
-  r = test::runTool("msf_lambda_study", "-o " + dir.path() + " -config " + dir.file("study.yaml") + " -solve argmin");
+  r = test::runTool("msf_lambda_study", "-o " + out + " -config " + dir.file("study.yaml") + " -solve argmin");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream argmin(dir.file("lambda_study.csv"));
+  std::ifstream argmin(out + "/lambda_study.csv");
   std::getline(argmin, line);
   while (std::getline(argmin, line)) {
     if (line.find(",5.00,") != std::string::npos) {
       EXPECT_GT(std::stod(line.substr(line.rfind(',') + 1)), 5.0) << line;
     }
   }
-  r = test::runTool("msf_lambda_study", "-o " + dir.path() + " -solve exact");
+  r = test::runTool("msf_lambda_study", "-o " + out + " -solve exact");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("-solve"), std::string::npos) << r.err;
   r = test::runTool("msf_lambda_study", "-o " + dir.file("missing/out"));

@@ -344,23 +344,64 @@ if [ $have_kitti = 1 ]; then
     echo "FAIL  kitti2pcd -input_dir left $(ls "$K/pcds")"
   fi
   # reconstruct: a run killed in OUT leaves OUT as it was; the next run removes its staging.
+  # An earlier output is a folder whose manifest lists its files (msf::OutputFolder).
   mkdir -p "$T/killed/out"
   echo '{"previous": true}' >"$T/killed/out/summary.json"
-  mkdir "$T/killed/.out.partial.999999999" && touch "$T/killed/.out.partial.999999999/.mesh.tmp1.ply"
+  printf '# msfusion output of msf_reconstruct\nsummary.json\n' >"$T/killed/out/.msf_manifest"
+  mkdir "$T/killed/.out.partial.999999999.0" && touch "$T/killed/.out.partial.999999999.0/.msf_staging" \
+    "$T/killed/.out.partial.999999999.0/.mesh.tmp1.ply"
   mkdir -p "$T/foreign" && touch "$T/foreign/notes.odt"
-  check "reconstruct: existing OUT with a foreign file" 1 "holds 'notes.odt', which no msf_reconstruct run writes" -- \
+  check "reconstruct: existing OUT with a foreign file" 1 "holds 'notes.odt' and is not an output of msfusion" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -o "$T/foreign"
   check "reconstruct: failed run in an existing OUT" 1 "frame range 0:100000" -- \
     msf_reconstruct "$SEQ" -frames 0:100000 -o "$T/killed/out"
-  if ! grep -q previous "$T/killed/out/summary.json" || [ -e "$T/killed/.out.partial.999999999" ]; then
+  if ! grep -q previous "$T/killed/out/summary.json" || [ -e "$T/killed/.out.partial.999999999.0" ] ||
+     [ ! -e "$T/foreign/notes.odt" ]; then
     failures=$((failures + 1))
-    echo "FAIL  reconstruct: the previous OUT changed or a killed run's staging folder remains"
-    ls -la "$T/killed" "$T/killed/out"
+    echo "FAIL  reconstruct: the previous OUT changed, a killed run's staging folder remains or a user's file went"
+    ls -la "$T/killed" "$T/killed/out" "$T/foreign"
+  fi
+  # Nothing of the user's is lost: each folder below must be byte for byte as it was.
+  D=$T/dataloss
+  mkdir -p "$D/seq/velodyne" "$D/seq/image_0" "$D/seq/image_1" "$D/seq/image_2" "$D/poses" "$D/home"
+  cp "$SEQ/calib.txt" "$SEQ/times.txt" "$D/seq/"
+  for c in velodyne image_0 image_1 image_2; do
+    for f in "$SEQ/$c"/000000.*; do cp "$f" "$D/seq/$c/"; done
+  done
+  head -n 1 "$KITTI/odometry/poses/04.txt" >"$D/poses/04.txt"
+  echo "my notes" >"$D/home/notes.txt" && echo "a,b" >"$D/home/data.csv" &&
+    printf '%%YAML:1.0\npipeline:\n  queue_capacity: 2\n' >"$D/home/my.yaml" && cp "$D/seq/image_2/000000.png" "$D/home/photo.png"
+  before=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
+  check "reconstruct -o HOME/. over a user's files" 1 "holds 'data.csv' and is not an output of msfusion" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/home/."
+  check "reconstruct -o SEQ/image_2" 1 "holds '000000.png' and is not an output of msfusion" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/seq/image_2"
+  check "reconstruct -o ../poses" 1 "holds '04.txt' and is not an output of msfusion" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/poses"
+  check "reconstruct -poses inside OUT" 1 "input '.*/home/data.csv' lies inside the output folder" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -poses "$D/home/data.csv" -o "$D/home"
+  check "reconstruct -config inside OUT" 1 "input '.*/home/my.yaml' lies inside the output folder" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -config "$D/home/my.yaml" -o "$D/home"
+  check "reconstruct -o the dataset itself" 1 "input '.*/seq' lies inside the output folder" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/seq"
+  check "synth -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
+    msf_synth -frames 1 -o "$D/home"
+  check "kitti2pcd -output_dir over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
+    msf_kitti2pcd -input_dir "$D/seq/velodyne" -output_dir "$D/home"
+  check "lambda_study -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
+    msf_lambda_study -frames 1 -o "$D/home"
+  after=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
+  if [ "$before" != "$after" ] || [ -n "$(ls -A "$D" | grep -v -x -e seq -e poses -e home)" ]; then
+    failures=$((failures + 1))
+    echo "FAIL  data loss: a user's folder changed"
+    diff <(echo "$before") <(echo "$after") | head
   fi
 else
   for c in project-huge-calib interpolate-scaled-tr stereo-num-disparities stereo-prior stereo-color p1x \
            reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
-           reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out; do
+           reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out \
+           dataloss-dot dataloss-image2 dataloss-poses dataloss-poses-input dataloss-config-input dataloss-dataset \
+           dataloss-synth dataloss-kitti2pcd dataloss-lambda; do
     skip "$c"
   done
 fi

@@ -325,18 +325,30 @@ TEST(SyntheticRendering, ColourImagesWithTiedSolidsArePixelForPixelAsBefore) {
   }
 }
 
-TEST(SyntheticDatasetOutput, ReplacesAnEarlierDatasetAndRefusesAForeignFolder) {
+TEST(SyntheticDatasetOutput, ReplacesAnEarlierDatasetAndRefusesAnyOtherFolder) {
   msf::test::TempDir dir;
-  // An earlier dataset (gt/scene.ply and sequences/) is replaced as a whole, not merged.
+  // A dataset msf_synth wrote is replaced as a whole, not merged.
   const std::string root = dir.file("ds");
-  fs::create_directories(root + "/gt");
-  fs::create_directories(root + "/sequences/00/image_0");
-  std::ofstream(root + "/gt/scene.ply") << "old";
-  std::ofstream(root + "/sequences/00/image_0/000005.png") << "old";
+  SyntheticGenerator(smallConfig(2, 1)).writeDataset(root);
+  ASSERT_TRUE(fs::exists(root + "/sequences/00/image_0/000001.png"));
   SyntheticGenerator(smallConfig(1, 1)).writeDataset(root);
   EXPECT_EQ(msf::Sequence(root).size(), 1u);
-  EXPECT_FALSE(fs::exists(root + "/sequences/00/image_0/000005.png"));
+  EXPECT_FALSE(fs::exists(root + "/sequences/00/image_0/000001.png"));
   EXPECT_EQ(msf::test::countEntries(dir.path()), 1u);
+
+  // A file the user put into it since is theirs: the folder is refused and the file kept.
+  std::ofstream(root + "/gt/my_notes.txt") << "mine";
+  const std::string error = msf::test::errorOf([&] { SyntheticGenerator(smallConfig(1, 1)).writeDataset(root); });
+  EXPECT_NE(error.find("gt/my_notes.txt"), std::string::npos) << error;
+  EXPECT_TRUE(fs::exists(root + "/gt/my_notes.txt"));
+
+  // So is a folder that looks like a dataset but that msf_synth did not write (no manifest).
+  const std::string lookalike = dir.file("lookalike");
+  fs::create_directories(lookalike + "/gt");
+  fs::create_directories(lookalike + "/sequences/00/image_0");
+  std::ofstream(lookalike + "/gt/scene.ply") << "mine";
+  EXPECT_THROW(SyntheticGenerator(smallConfig(1, 1)).writeDataset(lookalike), msf::IOError);
+  EXPECT_TRUE(fs::exists(lookalike + "/gt/scene.ply"));
 
   const std::string foreign = dir.file("photos");
   fs::create_directory(foreign);
@@ -348,12 +360,12 @@ TEST(SyntheticDatasetOutput, ReplacesAnEarlierDatasetAndRefusesAForeignFolder) {
     EXPECT_NE(std::string(e.what()).find(foreign), std::string::npos) << e.what();
   }
   EXPECT_EQ(msf::test::countEntries(foreign), 1u);
-  EXPECT_EQ(msf::test::countEntries(dir.path()), 2u);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 3u);
 
   std::ofstream(dir.file("plain_file")) << "x";
   EXPECT_THROW(SyntheticGenerator(smallConfig(1, 1)).writeDataset(dir.file("plain_file") + "/ds"), msf::IOError);
   EXPECT_THROW(SyntheticGenerator(smallConfig(1, 1)).writeDataset(dir.file("missing/ds")), msf::IOError);
-  EXPECT_EQ(msf::test::countEntries(dir.path()), 3u);
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 4u);
 }
 
 TEST(SyntheticDatasetOutput, AFailureMidwayLeavesNothing) {

@@ -1,6 +1,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/output_folder.h>
 #include <msf/reconstruction/streaming_map.h>
 
 #include <algorithm>
@@ -456,7 +457,9 @@ StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const March
   for (const char* sub : {"tsdf", "tiles"}) {
     const fs::path p = fs::path(directory_) / sub;
     std::error_code e;
-    fs::remove_all(p, e); // an earlier run's tiles would join this one's union
+    // An earlier run's tiles would join this one's union, and a folder of the user's is not ours to empty.
+    if (fs::exists(p, e) && !fs::is_empty(p, e))
+      throw IOError("folder '" + p.string() + "' is not empty: a streamed map starts in empty folders");
     fs::create_directories(p, e);
     if (e)
       throw IOError("cannot create folder '" + p.string() + "': " + e.message());
@@ -691,12 +694,9 @@ std::size_t StreamingMap::remesh(const std::string& directory, const MarchingCub
                                  const std::string& mesh_path, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   const StoreIndex index = readIndex(directory);
   const MarchingCubes mesher(mesher_config);
-  const std::string tiles = mesh_path + ".tiles";
-  std::error_code e;
-  fs::remove_all(tiles, e);
-  fs::create_directories(tiles, e);
-  if (e)
-    throw IOError("cannot create folder '" + tiles + "': " + e.message());
+  // The tiles' folder is an output folder of its own: replaced only when an earlier remesh wrote it.
+  OutputFolder tiles_folder(mesh_path + ".tiles", "msf_mesh", {directory});
+  const std::string tiles = tiles_folder.dir();
   TileCache cache(directory, index.voxel_size, index.truncation);
   std::map<std::tuple<int, int, int>, bool> stored;
   for (const GridIndex& t : index.tiles)
@@ -715,7 +715,9 @@ std::size_t StreamingMap::remesh(const std::string& directory, const MarchingCub
     meshTile(t, mine, nullptr, on_disk, cache, mesher, index.tile_blocks, index.voxel_size, index.truncation, tiles);
     meshes.push_back(meshPath(tiles, t));
   }
-  return writeUnion(meshes, mesh_path, index.voxel_size, index.tile_blocks * kSide);
+  const std::size_t triangles = writeUnion(meshes, mesh_path, index.voxel_size, index.tile_blocks * kSide);
+  tiles_folder.commit();
+  return triangles;
 }
 
 void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) {

@@ -1,5 +1,6 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/output_folder.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
@@ -76,32 +77,6 @@ const char* kGroundTruthReadme =
     "synthetic.yaml        the generator's configuration\n"
     "Every pixel is exact: the value of the ray through the pixel centre.\n";
 
-bool looksLikeDataset(const fs::path& root) {
-  std::error_code ec;
-  return fs::is_regular_file(root / "gt" / "scene.ply", ec) && fs::is_directory(root / "sequences", ec);
-}
-
-/// Checks `root` before any work, so a bad output folder fails fast.
-void checkOutput(const fs::path& root) {
-  std::error_code ec;
-  const fs::path parent = root.parent_path();
-  if (!fs::is_directory(parent, ec))
-    throw IOError("output folder '" + root.string() + "': its parent folder '" + parent.string() +
-                  "' does not exist");
-  if (::access(parent.c_str(), W_OK) != 0)
-    throw IOError("output folder '" + root.string() + "': its parent folder '" + parent.string() +
-                  "' is not writable");
-  if (fs::exists(root, ec)) {
-    if (!fs::is_directory(root, ec))
-      throw IOError("output folder '" + root.string() + "' exists and is not a folder");
-    if (!fs::is_empty(root, ec) && !looksLikeDataset(root))
-      throw IOError("output folder '" + root.string() +
-                    "' is not empty and holds no synthetic dataset; refusing to overwrite it");
-    if (::access(root.c_str(), W_OK) != 0)
-      throw IOError("output folder '" + root.string() + "' is not writable");
-  }
-}
-
 } // namespace
 
 SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
@@ -170,104 +145,77 @@ pcl::PolygonMesh SyntheticGenerator::mesh(SurfaceClasses* classes) const {
 void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progress& progress) const {
   if (root_arg.empty())
     throw InvalidInputError("no output folder given");
-  const fs::path root = fs::absolute(root_arg).lexically_normal();
-  const fs::path target = root.filename().empty() ? root.parent_path() : root;
-  checkOutput(target);
-
-  const fs::path staging =
-      target.parent_path() / ("." + target.filename().string() + ".msf_synth." + std::to_string(::getpid()));
+  OutputFolder output(root_arg, "msf_synth");
+  const fs::path staging = output.dir();
   const fs::path seq = staging / "sequences" / "00", gt = staging / "gt";
   std::error_code ec;
-  fs::remove_all(staging, ec);
-  try {
-    for (const fs::path& dir : {seq / "image_0", seq / "image_1", seq / "image_2", seq / "image_3", seq / "velodyne",
-                                staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0", gt / "moving_0"})
-      if (!fs::create_directories(dir, ec) || ec)
-        throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
+  for (const fs::path& dir : {seq / "image_0", seq / "image_1", seq / "image_2", seq / "image_3", seq / "velodyne",
+                              staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0", gt / "moving_0"})
+    if (!fs::create_directories(dir, ec) || ec)
+      throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
 
-    saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
-    std::ostringstream times;
-    for (int i = 0; i < config_.frames; ++i) {
-      char line[32];
-      std::snprintf(line, sizeof line, "%e\n", i / config_.frame_rate_hz);
-      times << line;
-    }
-    writeText(seq / "times.txt", times.str());
-    saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
-    std::ostringstream yaml;
-    yaml << "%YAML:1.0\n";
-    config_.print(yaml);
-    writeText(gt / "synthetic.yaml", yaml.str());
-    writeText(gt / "README.txt", kGroundTruthReadme);
-    SurfaceClasses classes;
-    saveMesh((gt / "scene.ply").string(), mesh(&classes));
-    writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));
-    writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
-
-    // Frame i's files are written (PNG compression, a tenth of a frame's time) on a thread of
-    // their own while frame i + 1 renders: they fill the renderer's idle moments instead of
-    // following them. A frame's writes end before the next frame's begin.
-    struct Pending {
-      std::future<void> written;
-      std::size_t frame, points;
-      std::chrono::steady_clock::time_point start;
-    };
-    std::optional<Pending> pending; // its future waits for the writes when an error unwinds
-    using Clock = std::chrono::steady_clock;
-    const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
-    // A frame's time: from its start to the next frame's, plus any wait for its writes.
-    const auto finishPending = [&](Clock::time_point next_start) {
-      const auto wait_start = Clock::now();
-      pending->written.get();
-      if (progress)
-        progress(pending->frame, seconds(next_start - pending->start) + seconds(Clock::now() - wait_start),
-                 pending->points);
-      pending.reset();
-    };
-    for (std::size_t i = 0; i < poses_.size(); ++i) {
-      const auto start = Clock::now();
-      auto f = std::make_shared<const SyntheticFrame>(renderFrame(i));
-      if (pending)
-        finishPending(start);
-      const std::string png = frameName(i) + ".png", bin = frameName(i) + ".bin";
-      // One after another: a parallel loop here would run serially while the renderer holds
-      // OpenCV's pool (or make the renderer's run serially).
-      auto write = [&seq, &gt, f, png, bin] {
-        for (int c = 0; c < 4; ++c)
-          writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f->images[c]);
-        saveVelodyneBin((seq / "velodyne" / bin).string(), f->scan);
-        writeKittiDepthPng((gt / "depth_0" / png).string(), f->depth);
-        writeKittiDisparityPng((gt / "disp_0" / png).string(), f->disparity);
-        writeImage((gt / "obj_map_0" / png).string(), f->objects);
-        writeImage((gt / "moving_0" / png).string(), f->moving);
-      };
-      pending = Pending{std::async(std::launch::async, write), i, f->scan.size(), start};
-    }
-    if (pending)
-      finishPending(Clock::now());
-
-    // Move into place: the old dataset (if any) aside, the new one in, the old one away.
-    const fs::path old = target.parent_path() / ("." + target.filename().string() + ".msf_synth_old." +
-                                                 std::to_string(::getpid()));
-    const bool replace = fs::exists(target, ec);
-    if (replace) {
-      fs::rename(target, old, ec);
-      if (ec)
-        throw IOError("cannot replace output folder '" + target.string() + "': " + ec.message());
-    }
-    fs::rename(staging, target, ec);
-    if (ec) {
-      const std::string why = ec.message();
-      if (replace)
-        fs::rename(old, target, ec);
-      throw IOError("cannot move the dataset into '" + target.string() + "': " + why);
-    }
-    if (replace)
-      fs::remove_all(old, ec);
-  } catch (...) {
-    fs::remove_all(staging, ec);
-    throw;
+  saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
+  std::ostringstream times;
+  for (int i = 0; i < config_.frames; ++i) {
+    char line[32];
+    std::snprintf(line, sizeof line, "%e\n", i / config_.frame_rate_hz);
+    times << line;
   }
+  writeText(seq / "times.txt", times.str());
+  saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+  std::ostringstream yaml;
+  yaml << "%YAML:1.0\n";
+  config_.print(yaml);
+  writeText(gt / "synthetic.yaml", yaml.str());
+  writeText(gt / "README.txt", kGroundTruthReadme);
+  SurfaceClasses classes;
+  saveMesh((gt / "scene.ply").string(), mesh(&classes));
+  writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));
+  writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
+
+  // Frame i's files are written (PNG compression, a tenth of a frame's time) on a thread of
+  // their own while frame i + 1 renders: they fill the renderer's idle moments instead of
+  // following them. A frame's writes end before the next frame's begin.
+  struct Pending {
+    std::future<void> written;
+    std::size_t frame, points;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::optional<Pending> pending; // its future waits for the writes when an error unwinds
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  // A frame's time: from its start to the next frame's, plus any wait for its writes.
+  const auto finishPending = [&](Clock::time_point next_start) {
+    const auto wait_start = Clock::now();
+    pending->written.get();
+    if (progress)
+      progress(pending->frame, seconds(next_start - pending->start) + seconds(Clock::now() - wait_start),
+               pending->points);
+    pending.reset();
+  };
+  for (std::size_t i = 0; i < poses_.size(); ++i) {
+    const auto start = Clock::now();
+    auto f = std::make_shared<const SyntheticFrame>(renderFrame(i));
+    if (pending)
+      finishPending(start);
+    const std::string png = frameName(i) + ".png", bin = frameName(i) + ".bin";
+    // One after another: a parallel loop here would run serially while the renderer holds
+    // OpenCV's pool (or make the renderer's run serially).
+    auto write = [&seq, &gt, f, png, bin] {
+      for (int c = 0; c < 4; ++c)
+        writeImage((seq / ("image_" + std::to_string(c)) / png).string(), f->images[c]);
+      saveVelodyneBin((seq / "velodyne" / bin).string(), f->scan);
+      writeKittiDepthPng((gt / "depth_0" / png).string(), f->depth);
+      writeKittiDisparityPng((gt / "disp_0" / png).string(), f->disparity);
+      writeImage((gt / "obj_map_0" / png).string(), f->objects);
+      writeImage((gt / "moving_0" / png).string(), f->moving);
+    };
+    pending = Pending{std::async(std::launch::async, write), i, f->scan.size(), start};
+  }
+  if (pending)
+    finishPending(Clock::now());
+
+  output.commit();
 }
 
 } // namespace msf::synthetic

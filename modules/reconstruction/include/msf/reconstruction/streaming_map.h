@@ -84,7 +84,8 @@ public:
   double minimumRadius() const;
 
   /// Meshes a block store written by a StreamingMap (DIR/tsdf) tile by tile, in bounded
-  /// memory, into the folder `mesh_path`.tiles (replaced) and their union `mesh_path`; with
+  /// memory, into the folder `mesh_path`.tiles (an OutputFolder: absent, empty or written by
+  /// an earlier remesh, which it replaces) and their union `mesh_path`; with
   /// `lo` <= `hi` (metres) only the tiles that overlap that box. Returns the triangles
   /// written. Throws IOError naming a missing or garbled file.
   static std::size_t remesh(const std::string& directory, const MarchingCubes::Config& mesher,

@@ -1,0 +1,20 @@
+#pragma once
+#include <atomic>
+#include <string>
+#include <vector>
+
+namespace msf::tool {
+
+/// Makes SIGINT, SIGTERM, SIGHUP (a closed terminal) and SIGPIPE (`| head`) requests to stop
+/// instead of deaths, so that a tool ends its work cleanly: no partial output, no temporary
+/// left. The k-th signal prints messages[k-1] on stderr (the last one for later signals);
+/// the tool polls stopRequests() at the points where it can stop. Throws IOError when a
+/// handler cannot be installed.
+void installStopSignals(const std::vector<std::string>& messages);
+
+/// How many stop signals have come since installStopSignals.
+int stopRequests();
+/// True once a stop signal has come: what a loop that takes a stop flag polls.
+const std::atomic<bool>& stopFlag();
+
+} // namespace msf::tool
