@@ -14,7 +14,7 @@
 
 #include <msf/io/pinhole_camera.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/reconstruction/mesh_rasterizer.h>
 
 #include <benchmark/benchmark.h>
@@ -90,14 +90,14 @@ struct KittiMap {
   std::vector<Eigen::Isometry3d> poses;
   KittiMap() {
     const Sequence sequence = msf::bench::kittiSequence();
-    Pipeline pipeline(sequence.calibration(), PipelineConfig());
+    Reconstructor pipeline(sequence.calibration(), PipelineConfig());
     for (std::size_t i = 0; i < msf::bench::kFrames; ++i) {
       const Frame frame = sequence.load(i);
       FrameResult result = pipeline.computeDepth(frame);
       pipeline.integrate(result);
       poses.push_back(frame.T_world_cam0);
     }
-    mesh = pipeline.updateMesh();
+    mesh = pipeline.mesh();
     camera = PinholeCamera::fromCalibration(sequence.calibration());
   }
 };

@@ -1,5 +1,5 @@
 // The stages of msf_reconstruct on KITTI odometry 04 frames 0-9 with config/kitti.yaml, each
-// alone on the pipeline's own input (the fused depth and the scans of Pipeline::computeDepth,
+// alone on the pipeline's own input (the fused depth and the scans of Reconstructor::computeDepth,
 // the dataset's poses), in process CPU time per frame: the figure that tells whether a change
 // makes the whole pipeline cheaper, with less noise than msf_reconstruct's frame rate on a
 // shared machine (bench/bench_pipeline.sh).
@@ -8,11 +8,11 @@
 //                                                        path, MSF_CONFIG the configuration)
 //
 // BM_StageIntegrate: the 10 fused frames and each scan's free space into a fresh volume
-// (Pipeline::integrate's work: TsdfIntegrator::integrate, then carveWithScan), per frame.
-// BM_StageDepth: steps 1-4 of one frame (Pipeline::computeDepth), per frame.
+// (Reconstructor::integrate's work: TsdfIntegrator::integrate, then carveWithScan), per frame.
+// BM_StageDepth: steps 1-4 of one frame (Reconstructor::computeDepth), per frame.
 #include "kitti_sample.h"
 
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/pipeline/source_depth_frame.h>
 
@@ -35,11 +35,11 @@ std::string configPath() {
 struct Data {
   Sequence sequence = msf::bench::kittiSequence();
   PipelineConfig config = PipelineConfig::load(configPath());
-  std::unique_ptr<Pipeline> pipeline;
+  std::unique_ptr<Reconstructor> pipeline;
   std::vector<FrameResult> results;
   std::vector<DepthFrame> frames;
   Data() {
-    pipeline = std::make_unique<Pipeline>(sequence.calibration(), config);
+    pipeline = std::make_unique<Reconstructor>(sequence.calibration(), config);
     for (std::size_t i = 0; i < msf::bench::kFrames; ++i) {
       FrameResult r = pipeline->computeDepth(sequence.load(i));
       frames.push_back(fusedDepthFrame(r, config.fusion, sequence.calibration().focalBaseline()));

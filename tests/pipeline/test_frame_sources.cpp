@@ -2,7 +2,7 @@
 // them (the ring hold-out), and each source's depth as a frame to integrate alone.
 #include <msf/common/exceptions.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/ring_split.h>
@@ -24,8 +24,9 @@ void checkTheFilterComesFirst(const std::string& dataset) {
   const msf::Sequence sequence(dataset);
   const auto frames = sequence.indices(msf::FrameRange::parse("0:1"));
   const msf::PipelineConfig config;
-  msf::Pipeline pipeline(sequence.calibration(), config);
-  pipeline.setKeepSparse(true); // the projected scan step 1 worked on
+  msf::Reconstructor::Options options;
+  options.keep_sparse = true; // the projected scan step 1 worked on
+  msf::Reconstructor pipeline(sequence.calibration(), config, options);
   // The filter keeps the input rings and remembers, per frame, what it removed and kept.
   std::mutex mutex;
   std::map<std::size_t, pcl::PointCloud<pcl::PointXYZI>> kept, removed;

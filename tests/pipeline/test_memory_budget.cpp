@@ -1,8 +1,8 @@
 // The memory budget of msf_reconstruct (issue 19, item 1g): with the poses known before the run,
-// its peak is predicted (Pipeline::predictMemory) and a run predicted over an explicit budget is
+// its peak is predicted (Reconstructor::predictMemory) and a run predicted over an explicit budget is
 // refused before it starts; the prediction bounds the measured peak within a stated factor.
 #include <msf/io/sequence.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include "pipeline_fixture.h"
 #include "test_support.h"
@@ -91,17 +91,17 @@ TEST_F(PipelineTest, AStreamedMapIsPredictedWithinItsWindow) {
   for (std::size_t i : frames)
     poses.push_back(sequence.poses()[i]);
   msf::PipelineConfig config;
-  const msf::MemoryPrediction whole = msf::Pipeline(sequence.calibration(), config).predictMemory(poses);
+  const msf::MemoryPrediction whole = msf::Reconstructor(sequence.calibration(), config).predictMemory(poses);
   config.streaming.active_radius_m = 1000.0;
-  const msf::MemoryPrediction wide = msf::Pipeline(sequence.calibration(), config).predictMemory(poses);
+  const msf::MemoryPrediction wide = msf::Reconstructor(sequence.calibration(), config).predictMemory(poses);
   EXPECT_EQ(wide.blocks_in_memory, whole.footprint_blocks) << "a window wider than the drive holds all of it";
   config.streaming.active_radius_m = 30.0;
-  const msf::MemoryPrediction narrow = msf::Pipeline(sequence.calibration(), config).predictMemory(poses);
+  const msf::MemoryPrediction narrow = msf::Reconstructor(sequence.calibration(), config).predictMemory(poses);
   EXPECT_EQ(narrow.footprint_blocks, whole.footprint_blocks);
   EXPECT_LT(narrow.blocks_in_memory, whole.blocks_in_memory);
   EXPECT_LT(narrow.volume_mb, whole.volume_mb);
   EXPECT_NE(narrow.describe().find("in memory at once"), std::string::npos) << narrow.describe();
-  EXPECT_EQ(msf::Pipeline(sequence.calibration(), msf::PipelineConfig{}).predictMemory(poses, 3).volume_mb,
+  EXPECT_EQ(msf::Reconstructor(sequence.calibration(), msf::PipelineConfig{}).predictMemory(poses, 3).volume_mb,
             3 * whole.volume_mb);
 }
 

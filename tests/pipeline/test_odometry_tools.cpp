@@ -4,7 +4,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include "pipeline_fixture.h"
 #include "test_support.h"
@@ -162,44 +162,40 @@ TEST_F(PipelineTest, DegenerateScansStopTheTrackingWithTheScansName) {
   }
 }
 
-TEST_F(PipelineTest, APoseEstimatorGivesEachFrameItsPoseOnAThreadOfItsOwn) {
+TEST_F(PipelineTest, FramesWithoutAPoseAreTrackedByTheEngineAlikeInBothWaysOfFeedingIt) {
+  // Frames stripped of their poses: the engine's own LiDAR odometry places them (PoseMode
+  // Auto), anchored at the identity; fed frame by frame or run overlapped, the same poses.
   const msf::Sequence sequence(dataset());
   const auto frames = sequence.indices(msf::FrameRange::parse("0:"));
-  msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
-  const auto caller = std::this_thread::get_id();
-  std::vector<std::thread::id> estimator_threads;
-  std::vector<std::size_t> estimated;
-  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
-  shift.translation() << 0.0, 0.0, 0.5;
-  pipeline.setFrameFilter([](msf::Frame& frame) { frame.has_pose = false; }); // the estimator's alone
-  pipeline.setPoseEstimator([&](const msf::Frame& frame) {
-    estimator_threads.push_back(std::this_thread::get_id());
-    estimated.push_back(frame.index);
-    EXPECT_TRUE(frame.scan && !frame.scan->empty());
-    return sequence.poses()[frame.index] * shift;
-  });
-  std::vector<std::size_t> integrated;
-  pipeline.run(sequence, frames, [&](msf::FrameResult& r) {
-    integrated.push_back(r.index);
+  msf::Reconstructor overlapped(sequence.calibration(), msf::PipelineConfig{});
+  overlapped.setFrameFilter([](msf::Frame& frame) { frame.has_pose = false; });
+  msf::PoseList run_poses;
+  overlapped.run(sequence, frames, [&](msf::FrameResult& r) {
     EXPECT_TRUE(r.has_pose);
-    EXPECT_TRUE(r.T_world_cam0.isApprox(sequence.poses()[r.index] * shift, 1e-12)) << r.index;
+    run_poses.push_back(r.T_world_cam0);
   });
-  EXPECT_EQ(estimated, frames);
-  EXPECT_EQ(integrated, frames);
-  for (const auto& id : estimator_threads)
-    EXPECT_NE(id, caller);
-
-  // An estimator that fails stops the run with its error.
-  msf::Pipeline failing(sequence.calibration(), msf::PipelineConfig{});
-  failing.setPoseEstimator([](const msf::Frame& frame) -> Eigen::Isometry3d {
-    if (frame.index == 2)
-      throw msf::InvalidInputError("scan 2 is degenerate");
-    return Eigen::Isometry3d::Identity();
-  });
-  try {
-    failing.run(sequence, frames, nullptr);
-    FAIL() << "expected the estimator's error";
-  } catch (const msf::InvalidInputError& e) {
-    EXPECT_STREQ(e.what(), "scan 2 is degenerate");
+  ASSERT_EQ(run_poses.size(), frames.size());
+  EXPECT_EQ(overlapped.odometryMs().size(), frames.size());
+  msf::Reconstructor::Options options;
+  options.sweeping_scans = sequence.sweepingScans(); // what run() takes from its source
+  msf::Reconstructor one_by_one(sequence.calibration(), msf::PipelineConfig{}, options);
+  for (std::size_t i : frames) {
+    msf::Frame frame = sequence.load(i);
+    frame.has_pose = false;
+    const msf::FrameResult r = one_by_one.addFrame(frame);
+    EXPECT_TRUE(r.T_world_cam0.isApprox(run_poses[i], 1e-9)) << "frame " << i;
   }
+  // Against the exact poses, the first frame's taken as the odometry's origin: centimetres (as msf_odometry).
+  const Eigen::Isometry3d T_world_first = sequence.poses()[frames.front()];
+  for (std::size_t i : frames)
+    EXPECT_LT((run_poses[i].translation() - (T_world_first.inverse() * sequence.poses()[i]).translation()).norm(), 0.08)
+        << "frame " << i;
+
+  // Given poses are required where the mode says so: a frame without one is named.
+  msf::Reconstructor::Options given;
+  given.poses = msf::Reconstructor::PoseMode::Given;
+  msf::Reconstructor strict(sequence.calibration(), msf::PipelineConfig{}, given);
+  msf::Frame frame = sequence.load(0);
+  frame.has_pose = false;
+  EXPECT_NE(msf::test::errorOf([&] { strict.addFrame(frame); }).find("has no pose"), std::string::npos);
 }

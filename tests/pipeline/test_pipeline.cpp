@@ -8,7 +8,7 @@
 #include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/bounded_queue.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/synthetic/synthetic_generator.h>
 
 #include "pipeline_fixture.h"
@@ -37,7 +37,7 @@ namespace {
 TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   const msf::Sequence sequence(dataset());
   const msf::Frame frame = sequence.load(1);
-  msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor pipeline(sequence.calibration(), msf::PipelineConfig{});
   const msf::FrameResult result = pipeline.computeDepth(frame);
 
   msf::test::TempDir out;
@@ -63,7 +63,7 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   // guidance the depth differs.
   msf::PipelineConfig unguided;
   unguided.stereo.guidance = "none";
-  msf::Pipeline plain(sequence.calibration(), unguided);
+  msf::Reconstructor plain(sequence.calibration(), unguided);
   EXPECT_GT(cv::norm(a, plain.computeDepth(frame).fused.depth, cv::NORM_INF), 0.0);
 }
 
@@ -71,7 +71,7 @@ TEST_F(PipelineTest, RunIntegratesEveryFrameInOrderAndStopsCleanly) {
   const msf::Sequence sequence(dataset());
   const auto frames = sequence.indices(msf::FrameRange::parse("0:"));
   {
-    msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+    msf::Reconstructor pipeline(sequence.calibration(), msf::PipelineConfig{});
     std::vector<std::size_t> seen;
     const auto stats = pipeline.run(sequence, frames, [&](msf::FrameResult& r) {
       seen.push_back(r.index);
@@ -81,22 +81,22 @@ TEST_F(PipelineTest, RunIntegratesEveryFrameInOrderAndStopsCleanly) {
     EXPECT_EQ(seen, frames);
     EXPECT_EQ(stats.frames_done, frames.size());
     EXPECT_FALSE(stats.interrupted);
-    EXPECT_GT(pipeline.updateMesh().triangles.size(), 1000u);
+    EXPECT_GT(pipeline.mesh().triangles.size(), 1000u);
   }
   {
     // A stop during the first frame: it is finished, the frames behind it are dropped.
-    msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+    msf::Reconstructor pipeline(sequence.calibration(), msf::PipelineConfig{});
     std::atomic<bool> stop{false};
     const auto stats = pipeline.run(sequence, frames, [&](msf::FrameResult&) { stop = true; }, &stop);
     EXPECT_TRUE(stats.interrupted);
     EXPECT_EQ(stats.frames_done, 1u);
-    EXPECT_GT(pipeline.updateMesh().triangles.size(), 100u);
+    EXPECT_GT(pipeline.mesh().triangles.size(), 100u);
   }
 }
 
 TEST_F(PipelineTest, AFailingStageStopsTheRunWithItsError) {
   const msf::Sequence sequence(dataset());
-  msf::Pipeline pipeline(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor pipeline(sequence.calibration(), msf::PipelineConfig{});
   EXPECT_THROW(pipeline.run(sequence, {0, 1, 99}, nullptr), msf::InvalidInputError); // frame 99 does not exist
 }
 

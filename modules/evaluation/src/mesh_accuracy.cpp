@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/evaluation/mesh_accuracy.h>
@@ -274,7 +275,7 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
   std::vector<double> distances((vertices.size() + vertex_step - 1) / vertex_step);
   std::vector<std::uint8_t> vertex_class(truth_classes ? distances.size() : 0);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(distances.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(distances.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       std::uint32_t nearest = SurfaceDistance::kNoTriangle;
       distances[i] = to_truth.distance(vertices[static_cast<std::size_t>(i) * vertex_step], cap,
@@ -299,7 +300,7 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   const std::size_t samples = (seen_truth.size() + truth_step - 1) / truth_step;
   std::vector<std::uint8_t> is_covered(samples);
   std::vector<float> sample_levels(vertex_weights ? samples : 0);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const Eigen::Vector3f& p = seen_truth[static_cast<std::size_t>(i) * truth_step];
       if (vertex_weights) {
@@ -322,7 +323,7 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
     // solid's: its class is the nearest triangle's within the threshold.
     const float on_surface = std::max(threshold, 0.05f);
     std::vector<std::uint8_t> sample_class(samples);
-    cv::parallel_for_(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
+    parallelFor(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
       for (int i = range.start; i < range.end; ++i) {
         std::uint32_t nearest = SurfaceDistance::kNoTriangle;
         to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], on_surface, &nearest);

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/facade_extension.h>
@@ -74,7 +75,7 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   cv::Mat& free_weight = free_space_weight ? *free_space_weight : free_weight_;
   free_weight.create(size, CV_32FC1);
   const float fB = static_cast<float>(focal_baseline_);
-  cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& r) {
+  parallelFor(cv::Range(0, size.height), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v)
       fuseRow(config_, fB, parallax_, lidar, v, distance.ptr<float>(v), edge_.ptr<float>(v), stereo.ptr<float>(v),
               confidence.ptr<float>(v), fused_depth.ptr<float>(v), weight.ptr<float>(v),

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/vector_clones.h>
 #include <msf/fusion/edge_support.h>
 
@@ -69,14 +70,14 @@ void supportAtDepthEdges(const cv::Mat& lidar_depth, const cv::Mat& lidar_distan
   // 1. The real returns' disparities, and their extremes over the window around each pixel.
   buffers.returns.create(rows, cols, CV_16UC1);
   buffers.smallest.create(rows, cols, CV_16UC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v)
       returnSteps(lidar_depth.ptr<float>(v),
                   lidar_distance.empty() ? buffers.zeros.ptr<float>(0) : lidar_distance.ptr<float>(v), cols, fB,
                   buffers.returns.ptr<std::uint16_t>(v), buffers.smallest.ptr<std::uint16_t>(v));
   });
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {config.edge_window_cols, config.edge_window_rows});
-  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) { // the two at once
+  parallelFor(cv::Range(0, 2), [&](const cv::Range& range) { // the two at once
     for (int k = range.start; k < range.end; ++k)
       if (k == 0)
         cv::dilate(buffers.returns, buffers.largest, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
@@ -87,7 +88,7 @@ void supportAtDepthEdges(const cv::Mat& lidar_depth, const cv::Mat& lidar_distan
   //    the return in the window nearest their disparity, unless one is within the tolerance.
   const int half_rows = config.edge_window_rows / 2, half_cols = config.edge_window_cols / 2;
   const float jump = config.edge_jump_px * kSteps, tolerance = config.edge_tolerance_px * kSteps;
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     std::vector<std::int32_t> candidate(static_cast<std::size_t>(cols));
     for (int v = range.start; v < range.end; ++v) {
       float* z = fused_depth.ptr<float>(v);

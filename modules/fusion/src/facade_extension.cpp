@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/fusion/facade_extension.h>
 
@@ -132,7 +133,7 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
   const float max_variance = config.facade_max_texture * config.facade_max_texture;
   std::atomic<std::size_t> extended{0};
   constexpr int kStrip = 128; // columns of one task, walked bottom-up together: rows stay contiguous
-  cv::parallel_for_(cv::Range(0, (size.width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
+  parallelFor(cv::Range(0, (size.width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
     const int u0 = strips.start * kStrip, u1 = std::min(size.width, strips.end * kStrip);
     std::vector<ColumnFit> fits(static_cast<std::size_t>(u1 - u0));
     std::size_t count = 0;

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/vector_clones.h>
 #include <msf/fusion/fusion_model.h>
@@ -33,7 +34,7 @@ void localDisparityExtremes(const cv::Mat& depth, double focal_baseline, int win
   // Missing pixels are 0 for the maximum and +inf for the minimum, so both see only values.
   largest.create(rows, cols, CV_32FC1);
   smallest.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v)
       disparityBounds(depth.ptr<float>(v), cols, fB, largest.ptr<float>(v), smallest.ptr<float>(v));
   });
@@ -79,12 +80,12 @@ void localDisparityBend(const cv::Mat& depth, double focal_baseline, int step, c
   // The disparities first (0 = none), then the second differences of whole rows.
   cv::Mat d(rows, cols, CV_32FC1);
   bend.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& r) {
     std::vector<float> unused(static_cast<std::size_t>(cols));
     for (int v = r.start; v < r.end; ++v)
       disparityBounds(depth.ptr<float>(v), cols, fB, d.ptr<float>(v), unused.data());
   });
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& r) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& r) {
     for (int v = r.start; v < r.end; ++v) {
       const float* __restrict__ c = d.ptr<float>(v);
       float* __restrict__ out = bend.ptr<float>(v);

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
@@ -263,13 +264,13 @@ void DepthInterpolator::interpolate(const cv::Mat& depth, cv::Mat& out) {
 
   // Slices are independent, so every pass splits them over OpenCV's pool and the result
   // does not depend on the number of threads.
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, H), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r)
       row_has_[r] = rowPass(depth.ptr<float>(r), W, slice, out.ptr<float>(r), row_gap_.ptr<std::uint8_t>(r));
   }, stripes);
   // One band of columns per thread, of whole cache lines (16 floats).
   const int bands = config_.threads > 0 ? config_.threads : cv::getNumThreads();
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, bands), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b) {
       const int c0 = std::min(W, (W * b / bands + 15) / 16 * 16);
       const int c1 = b + 1 == bands ? W : std::min(W, (W * (b + 1) / bands + 15) / 16 * 16);
@@ -314,7 +315,7 @@ void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out, double str
   const float* g = kernel_.data();
   const float min_weight = config_.gaussian_min_weight;
   const bool smooth = config_.gaussian_smooth_valid;
-  cv::parallel_for_(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r) {
       // The targets of this row (holes; with smooth_valid, every pixel but the samples), as
       // a byte mask made by a vectorized loop, then gathered into spans of targets +- k:
@@ -346,7 +347,7 @@ void DepthInterpolator::fillHoles(const cv::Mat& depth, cv::Mat& out, double str
     }
   }, stripes);
   // Every vertical sum is made (the call above has returned) before any hole is written.
-  cv::parallel_for_(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(r0, r1 + 1), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r) {
       // The horizontal pass at the targets only.
       const std::uint8_t* mask = targets_.ptr<std::uint8_t>(r);

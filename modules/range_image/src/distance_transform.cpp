@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/vector_clones.h>
 #include <msf/range_image/distance_transform.h>
@@ -105,7 +106,7 @@ void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest
     nearest->create(H, W, CV_32SC1);
 
   // Pass 1, rows: the distance along each row (LiDAR samples lie on rows).
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, H), [&](const cv::Range& rows) {
     for (int r = rows.start; r < rows.end; ++r) {
       rowDistances(depth.ptr<float>(r), W, h2.ptr<std::int32_t>(r), column.ptr<std::int32_t>(r));
       row_has_sample[static_cast<std::size_t>(r)] = column.ptr<std::int32_t>(r)[0] >= 0;
@@ -117,7 +118,7 @@ void distanceToSamples(const cv::Mat& depth, cv::Mat& distance, cv::Mat* nearest
   // span's largest distance so far: between the rings of a scan that is a few rows, where
   // the lower envelope of parabolas (exact in any case) branches on every column.
   constexpr int kSpan = 64;
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, H), [&](const cv::Range& rows) {
     std::vector<std::int32_t> best(static_cast<std::size_t>(W));
     for (int r = rows.start; r < rows.end; ++r) {
       std::int32_t* b = best.data();

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/range_image/lidar_projector.h>
@@ -100,7 +101,7 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
 
   // Transform and project in parallel; the z-buffer below is serial over the points kept
   // (the quarter of the scan in front of the camera).
-  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, n), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
       pixel_[i] = -1;
@@ -155,7 +156,7 @@ void LidarProjector::projectDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   const int* w = winner_.ptr<int>();
   float* out = intensity->ptr<float>();
   const int total = static_cast<int>(depth.total());
-  cv::parallel_for_(cv::Range(0, total), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, total), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k)
       out[k] = w[k] >= 0 ? scan[static_cast<std::size_t>(w[k])].intensity : 0.f;
   });
@@ -199,7 +200,7 @@ void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
   const int* w = winner_.ptr<int>();
   std::atomic<bool> dense{true};
-  cv::parallel_for_(cv::Range(0, W * H), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, W * H), [&](const cv::Range& range) {
     bool all = true;
     for (int k = range.start; k < range.end; ++k) {
       PointT& out = cloud[static_cast<std::size_t>(k)];

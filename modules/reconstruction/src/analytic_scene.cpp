@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/reconstruction/analytic_scene.h>
 
 #include <opencv2/core/utility.hpp>
@@ -84,7 +85,7 @@ cv::Mat AnalyticScene::renderDepth(const PinholeCamera& camera, const Eigen::Iso
   cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0));
   const Eigen::Vector3d o = T_world_cam.translation();
   const Eigen::Matrix3d R = T_world_cam.linear();
-  cv::parallel_for_(cv::Range(0, camera.height), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, camera.height), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       float* row = depth.ptr<float>(v);
       for (int u = 0; u < camera.width; ++u) {

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -388,7 +389,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
   mesh.colors.resize(n_vertices);
   mesh.weights.resize(n_vertices);
   mesh.triangles.resize(triangle_offset[parts]);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(parts)), [&](const cv::Range& range) {
   for (int i = range.start; i < range.end; ++i) {
     const MarchingCubes::BlockMesh& part = *order[i].second;
     std::uint32_t* map = &remap[remap_offset[i]];
@@ -406,7 +407,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
       out[t] = {map[part.triangles[t][0]], map[part.triangles[t][1]], map[part.triangles[t][2]]};
   }
   }, std::max(1.0, static_cast<double>(parts) / 16));
-  cv::parallel_for_(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(n_shared)), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const MarchingCubes::BlockMesh& part = *order[shared_source[k].first].second;
       mesh.vertices[k] = part.vertices[shared_source[k].second];
@@ -521,7 +522,7 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
       targets.push_back(&cache_[block->index]);
     }
   // cv::parallel_for_ (TBB) as the integrator: one pool shared with the other stages.
-  cv::parallel_for_(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(dirty.size())), [&](const cv::Range& range) {
     Scratch scratch;
     for (int i = range.start; i < range.end; ++i)
       meshBlock(volume, *dirty[i], config_, *targets[i], scratch);
@@ -558,7 +559,7 @@ void MarchingCubes::extractBlocks(const TsdfVolume& volume, const std::vector<Gr
     if (const TsdfBlock* block = volume.findBlock(index))
       present.push_back(block);
   std::vector<BlockMesh> parts(present.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(present.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(present.size())), [&](const cv::Range& range) {
     Scratch scratch;
     for (int i = range.start; i < range.end; ++i)
       meshBlock(volume, *present[i], config_, parts[i], scratch);
@@ -596,7 +597,7 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
   cloud.row_step = cloud.point_step * cloud.width;
   cloud.is_dense = true;
   cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
-  cv::parallel_for_(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       std::uint8_t* p = cloud.data.data() + 16 * static_cast<std::size_t>(i);
       std::memcpy(p, vertices[i].data(), 12);
@@ -606,7 +607,7 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
     }
   }, 8);
   mesh.polygons.resize(triangles.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(triangles.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(triangles.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i)
       mesh.polygons[i].vertices.assign(triangles[i].begin(), triangles[i].end());
   }, 8);

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/mesh_rasterizer.h>
 
@@ -180,7 +181,7 @@ bool MeshRasterizer::binTriangles(const TriangleMesh& mesh, const PinholeCamera&
   offsets_.assign(chunks * bands, 0);
   std::atomic<bool> bad_index{false};
   // 1. The rows each triangle may cover; per chunk, how many triangles each band gets.
-  cv::parallel_for_(cv::Range(0, static_cast<int>(chunks)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(chunks)), [&](const cv::Range& range) {
     Polygon polygon;
     for (int c = range.start; c < range.end; ++c) {
       std::uint32_t* count = &offsets_[static_cast<std::size_t>(c) * bands];
@@ -234,7 +235,7 @@ bool MeshRasterizer::binTriangles(const TriangleMesh& mesh, const PinholeCamera&
   bin_start_[bands] = total;
   binned_.resize(total);
   // 3. The lists.
-  cv::parallel_for_(cv::Range(0, static_cast<int>(chunks)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(chunks)), [&](const cv::Range& range) {
     for (int c = range.start; c < range.end; ++c) {
       std::uint32_t* next = &offsets_[static_cast<std::size_t>(c) * bands];
       const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunkTriangles);
@@ -293,7 +294,7 @@ void MeshRasterizer::render(const TriangleMesh& mesh, const PinholeCamera& camer
   cam_.resize(vertices);
   pixel_.resize(vertices);
   const int vertex_chunks = static_cast<int>((vertices + kChunkVertices - 1) / kChunkVertices);
-  cv::parallel_for_(cv::Range(0, vertex_chunks), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, vertex_chunks), [&](const cv::Range& range) {
     const std::size_t end = std::min(vertices, static_cast<std::size_t>(range.end) * kChunkVertices);
     for (std::size_t i = static_cast<std::size_t>(range.start) * kChunkVertices; i < end; ++i) {
       cam_[i] = T_cam_world * mesh.vertices[i];
@@ -305,7 +306,7 @@ void MeshRasterizer::render(const TriangleMesh& mesh, const PinholeCamera& camer
   if (!binTriangles(mesh, camera))
     throw InvalidInputError("mesh rasterizer: a triangle has a vertex index out of range (the mesh has " +
                             std::to_string(vertices) + " vertices)");
-  cv::parallel_for_(
+  parallelFor(
       cv::Range(0, bands_),
       [&](const cv::Range& range) {
         for (int band = range.start; band < range.end; ++band)

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/plane_distance.h>
 
@@ -51,7 +52,7 @@ void store(float* p, T x) {
 /// each depth is inverted once rather than by every neighbour that reads it.
 cv::Mat paddedInverse(const cv::Mat& depth, int pad) {
   cv::Mat inverse(depth.rows + 2 * pad, depth.cols + 2 * pad, CV_32FC1, cv::Scalar(0.f));
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* d = depth.ptr<float>(v);
       float* out = inverse.ptr<float>(v + pad) + pad;
@@ -78,7 +79,7 @@ void planeDistanceScale(const cv::Mat& depth, const PinholeCamera& camera, const
   const int pad = 2 * k;
   const cv::Mat inverse = paddedInverse(depth, pad);
   const std::ptrdiff_t down = static_cast<std::ptrdiff_t>(inverse.step1()) * k; // k rows
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* i = inverse.ptr<float>(v + pad) + pad; // 1/z at (u, v) is i[u]
       float* s = scale.ptr<float>(v);
@@ -132,7 +133,7 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
     return join ? -run : run;
   };
   // Along rows, into `extent`.
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, height), [&](const cv::Range& rows) {
     std::vector<float> kinks(static_cast<std::size_t>(width));
     for (int v = rows.start; v < rows.end; ++v) {
       const float* d = depth.ptr<float>(v);
@@ -160,7 +161,7 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
   cv::Mat down(depth.size(), CV_32FC1);
   constexpr int kStrip = 64;
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(inverse.step1());
-  cv::parallel_for_(cv::Range(0, (width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
+  parallelFor(cv::Range(0, (width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
     const int u0 = strips.start * kStrip, n = std::min(width, strips.end * kStrip) - u0;
     // Per column of the strip: the run's largest so far, whether the pixel above is a kink.
     std::vector<float> run(static_cast<std::size_t>(n)), kink_above(run.size(), 0.f), none(run.size(), 0.f);

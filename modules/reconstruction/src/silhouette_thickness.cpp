@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/silhouette_thickness.h>
 
@@ -20,7 +21,7 @@ void rowThickness(const cv::Mat& depth, const cv::Mat& weight, float focal, floa
   const float sigmas2 = sigmas * sigmas;
   if (depth.cols == 0)
     return;
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     const int n = depth.cols;
     std::vector<std::uint8_t> joined(static_cast<std::size_t>(n)); // pixel u and u + 1 on one object
     for (int v = rows.start; v < rows.end; ++v) {

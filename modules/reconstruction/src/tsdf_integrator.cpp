@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
@@ -420,7 +421,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   if (silhouette)
     silhouetteThickness(depth_image, weight_, cam, kSilhouetteRelativeJump, kSilhouetteSigmas, thickness_);
   const float silhouette_floor = kSilhouetteFloor * trunc;
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
@@ -466,7 +467,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   // core each. An OpenMP team of its own was measured too: no faster on KITTI, and 0.85x on
   // the synthetic street, where both stages' threads time-share the cores and SGBM's strips
   // lose their cache.
-  cv::parallel_for_(cv::Range(0, tiles_y), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, tiles_y), [&](const cv::Range& range) {
     std::vector<std::uint64_t> local;
     std::array<std::uint64_t, 256> recent;
     recent.fill(~0ull);
@@ -621,7 +622,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     order[i] = tile << 32 | i;
   }
   std::sort(order.begin(), order.end());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
   // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
   // so that their voxels and colours are prefetched while the rest of the block is tested
   // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
@@ -753,7 +754,7 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
   }
   const std::uint64_t stamp = volume_.beginGeneration();
   const float max_weight = config_.max_weight;
-  cv::parallel_for_(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
     for (int n = range.start; n < range.end; ++n) {
       TsdfBlock& block = *blocks[static_cast<std::size_t>(n)];
       const Eigen::Vector3f origin = T_lidar_world * (block.origin().cast<float>() * vs);
@@ -909,7 +910,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
   // Face neighbours of each touched block (-x, +x, -y, +y, -z, +z), looked up once: the
   // map is only read here, so the lookups may run in parallel.
   std::vector<std::array<TsdfBlock*, 6>> neighbours(n);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
     const GridIndex steps[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
     for (int i = range.start; i < range.end; ++i)
       for (int k = 0; k < 6; ++k)
@@ -937,7 +938,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     std::atomic<float> largest_change{0.f};
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
-      cv::parallel_for_(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
+      parallelFor(cv::Range(0, static_cast<int>(m)), [&](const cv::Range& range) {
       for (std::ptrdiff_t g = range.start; g < range.end; ++g) {
         const std::size_t i = group[static_cast<std::size_t>(g)];
         if (g + 1 < m) {

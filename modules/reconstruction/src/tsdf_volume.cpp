@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
@@ -224,7 +225,7 @@ void TsdfVolume::allocateBlocks(const std::vector<GridIndex>& indices, std::vect
     }
     position[i] = slot.block;
   }
-  cv::parallel_for_(cv::Range(0, static_cast<int>(fresh.size())), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(fresh.size())), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const std::size_t b = before + static_cast<std::size_t>(k);
       auto* block = new (storage(b)) TsdfBlock();

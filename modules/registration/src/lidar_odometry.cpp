@@ -174,9 +174,9 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
   return pose;
 }
 
-LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const Sequence& sequence) {
+LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const FrameSource& source) {
   if (config.deskew == "auto")
-    config.deskew = sequence.groundTruthDir().empty() ? "sweep" : "none";
+    config.deskew = source.sweepingScans() ? "sweep" : "none";
   return config;
 }
 

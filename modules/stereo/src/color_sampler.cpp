@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/color_sampler.h>
 
@@ -78,7 +79,7 @@ void colorizeDepth(const cv::Mat& depth, const PinholeCamera& camera, const Colo
     fallback.copyTo(bgr);
   if (sampler.empty())
     return;
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v)
       sampler.sampleRow(depth.ptr<float>(v), depth.cols, v, camera, bgr.ptr<std::uint8_t>(v));
   });

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/l1_distance_transform.h>
 
@@ -79,7 +80,7 @@ void columnPass(cv::Mat& row_distance, cv::Mat& distance, int type) {
   else if (type == CV_32F)
     distance.create(row_distance.size(), CV_32FC1);
   const int chunks = (row_distance.cols + kColumnChunk - 1) / kColumnChunk;
-  cv::parallel_for_(cv::Range(0, chunks), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, chunks), [&](const cv::Range& range) {
     const int begin = range.start * kColumnChunk, end = std::min(range.end * kColumnChunk, row_distance.cols);
     if (type == CV_32F)
       columnScans<float>(row_distance, distance, begin, end);
@@ -97,7 +98,7 @@ void l1DistanceTransform(const cv::Mat& mask, cv::Mat& distance, int type) {
     throw InvalidInputError("l1DistanceTransform: the output type must be CV_32F or CV_16U, not " +
                             std::to_string(type));
   cv::Mat rows(mask.size(), CV_16UC1);
-  cv::parallel_for_(cv::Range(0, mask.rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, mask.rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v)
       l1_distance::rowPass(mask.ptr<std::uint8_t>(v), mask.cols, rows.ptr<std::uint16_t>(v));
   });

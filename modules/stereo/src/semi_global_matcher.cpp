@@ -1,5 +1,6 @@
 #include "semi_global_kernel.h"
 
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/parallel_post_filter.h>
 #include <msf/stereo/semi_global_matcher.h>
@@ -144,7 +145,7 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   // AVX-512 where the disparities fill whole 32-lane vectors; with 16 left over its padding
   // lanes cost as much as it saves (80 disparities: 55 ms either way, one core).
   const auto kernel = usesAvx512() && p.num_disparities % 32 == 0 ? detail::sgmStripAvx512 : detail::sgmStripAvx2;
-  cv::parallel_for_(
+  parallelFor(
       cv::Range(0, strips),
       [&](const cv::Range& range) {
         for (int i = range.start; i < range.end; ++i) {

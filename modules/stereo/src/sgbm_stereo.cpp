@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/stereo/disparity_search_range.h>
@@ -208,7 +209,7 @@ void SgbmStereo::computeDisparity() {
                                   : 0.f;
   const float lr_max = config_.left_right_max_diff_px;
   disparity_.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const short* in = fixed.ptr<short>(v);
       const short* in_right = fixed_right.empty() ? nullptr : fixed_right.ptr<short>(v);

@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/speckle_filter.h>
 
@@ -180,7 +181,7 @@ void filterSpecklesParallel(cv::Mat& disparity, int new_value, int max_speckle_s
                   base + 5 * pixels + rows};
 
   const int bands = (rows + kRowsPerBand - 1) / kRowsPerBand;
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, bands), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b) {
       const int begin = b * kRowsPerBand, end = std::min(begin + kRowsPerBand, rows);
       labelBand(disparity, r, begin, end, new_value, max_diff);
@@ -190,7 +191,7 @@ void filterSpecklesParallel(cv::Mat& disparity, int new_value, int max_speckle_s
   for (int b = 1; b < bands; ++b)
     joinAcross(disparity, r, b * kRowsPerBand, max_diff);
 
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, bands), [&](const cv::Range& range) {
     const int end = std::min(range.end * kRowsPerBand, rows);
     for (int v = range.start * kRowsPerBand; v < end; ++v) {
       std::int16_t* d = disparity.ptr<std::int16_t>(v);

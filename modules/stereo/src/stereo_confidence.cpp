@@ -1,3 +1,4 @@
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/l1_distance_transform.h>
 #include <msf/stereo/parallel_post_filter.h>
@@ -104,7 +105,7 @@ cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig&
   // One parallel pass gives the inputs of the local max and min and the holes: each row's
   // distance to its nearest hole at once (our transform's row pass), or the mask OpenCV's
   // transform needs.
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     std::vector<std::uint8_t> valid_row(ours ? static_cast<std::size_t>(cols) : 0);
     for (int v = range.start; v < range.end; ++v) {
       std::uint8_t* m = ours ? valid_row.data() : s.mask.ptr<std::uint8_t>(v);
@@ -131,7 +132,7 @@ cv::Mat stereoConfidence(const cv::Mat& disparity, const StereoConfidenceConfig&
   const float free = config.range_free_px, inv_scale = 1.f / config.range_scale_px;
   const float* const hole_term = s.hole_term.data();
   const float* const range_term = s.range_term.data();
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const std::uint16_t* dist = s.hole_distance.ptr<std::uint16_t>(v);
       const float* hi = s.local_max.ptr<float>(v);

@@ -4,7 +4,7 @@
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include <iosfwd>
 #include <map>

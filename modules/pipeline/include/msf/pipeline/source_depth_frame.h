@@ -1,6 +1,6 @@
 #pragma once
 #include <msf/fusion/fusion_config.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/reconstruction/depth_frame.h>
 
 namespace msf {

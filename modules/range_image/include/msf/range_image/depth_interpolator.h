@@ -1,5 +1,6 @@
 #pragma once
 #include <iosfwd>
+#include <msf/common/parallel.h>
 #include <msf/range_image/slice_interpolation.h>
 
 #include <opencv2/core/mat.hpp>

@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/scan_free_space.h>

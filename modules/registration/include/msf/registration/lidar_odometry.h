@@ -1,6 +1,6 @@
 #pragma once
 #include <msf/io/poses.h>
-#include <msf/io/sequence.h>
+#include <msf/io/frame_source.h>
 #include <msf/registration/adaptive_threshold.h>
 #include <msf/registration/local_map.h>
 #include <msf/registration/nearest_cache.h>
@@ -126,7 +126,7 @@ private:
 
 /// `config` with deskew auto resolved for `sequence`: none for a synthetic sequence (msf_synth's
 /// LiDAR takes a snapshot at the frame's pose), sweep for KITTI's.
-LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const Sequence& sequence);
+LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const FrameSource& source);
 
 /// Camera 0's pose from the odometry's T_velo0_velo (its world is the first scan's sensor
 /// frame), with the first frame's camera 0 at T_world_cam0_first (the identity in KITTI's

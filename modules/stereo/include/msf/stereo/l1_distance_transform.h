@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <opencv2/core/mat.hpp>
 
 #include <cstdint>

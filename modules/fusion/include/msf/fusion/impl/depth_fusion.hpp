@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/fusion/depth_fusion.h>
@@ -64,7 +65,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
     lidar_distance_.release(); // every LiDAR depth counts as a real return
   // cv::parallel_for_ rather than OpenMP: its work stealing keeps both cores busy when the
   // machine is shared, where a static OpenMP split waits for the slower thread.
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
       float* z = lidar_depth_.ptr<float>(v);
@@ -100,7 +101,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   // 1. The fused depth and weight images, a row at a time in contiguous arrays for fuseRow.
   fused_depth_.create(rows, cols, CV_32FC1);
   fused_weight_.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     std::vector<float> zeros(static_cast<std::size_t>(cols), 0.f), z_stereo(zeros), confidence(zeros), free(zeros);
     for (int v = range.start; v < range.end; ++v) {
       const std::size_t row = static_cast<std::size_t>(v) * cols;
@@ -129,7 +130,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
 
   // 2. The points, on the rays of the input points.
   std::atomic<bool> dense{true};
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     bool range_dense = true;
     for (int v = range.start; v < range.end; ++v) {
       const std::size_t row = static_cast<std::size_t>(v) * cols;

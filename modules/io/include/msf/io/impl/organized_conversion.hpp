@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
 
@@ -29,7 +30,7 @@ void depthImageToCloud(const cv::Mat& depth, const Calibration& calibration, int
   cloud.height = static_cast<std::uint32_t>(depth.rows);
   cloud.header.frame_id = cameraFrameId(camera);
   std::atomic<bool> dense{true};
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& range) {
     bool all = true;
     for (int v = range.start; v < range.end; ++v) {
       const float* row = depth.ptr<float>(v);
@@ -59,7 +60,7 @@ cv::Mat cloudToDepthImage(const pcl::PointCloud<PointT>& cloud) {
     throw InvalidInputError("expected an organized cloud (height > 1), got " + std::to_string(cloud.width) + "x" +
                             std::to_string(cloud.height));
   cv::Mat depth(static_cast<int>(cloud.height), static_cast<int>(cloud.width), CV_32FC1);
-  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       float* row = depth.ptr<float>(v);
       const PointT* in = &cloud[static_cast<std::size_t>(v) * cloud.width];

@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/range_image/depth_completion_filter.h>
 #include <msf/range_image/distance_transform.h>
@@ -37,7 +38,7 @@ void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
   const double stripes = threads() > 0 ? threads() : -1; // at most that many threads at once
 
   sparse_.create(H, W, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, H), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       float* d = sparse_.ptr<float>(v);
       const PointT* p = &in[static_cast<std::size_t>(v) * W];
@@ -56,7 +57,7 @@ void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inv_fx = 1.f / camera.fx, inv_fy = 1.f / camera.fy;
   std::atomic<bool> dense{true};
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, H), [&](const cv::Range& range) {
     bool all = true;
     for (int v = range.start; v < range.end; ++v) {
       const float* s = sparse_.ptr<float>(v);

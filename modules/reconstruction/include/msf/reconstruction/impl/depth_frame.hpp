@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/pinhole_camera.hpp>
 #include <msf/reconstruction/depth_frame.h>
@@ -33,7 +34,7 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
     frame.color.create(rows, cols, CV_8UC3);
   if constexpr (kHasWeight)
     frame.weight.create(rows, cols, CV_32FC1);
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const PointT* in = &cloud[static_cast<std::size_t>(v) * cols];
       float* depth = frame.depth.ptr<float>(v);

@@ -1,4 +1,5 @@
 #pragma once
+#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
@@ -31,7 +32,7 @@ void SgbmStereo::compute(pcl::PointCloud<PointT>& output) {
   output.height = static_cast<std::uint32_t>(rows);
   // cv::parallel_for_ (work stealing) keeps both cores busy on a shared machine.
   std::atomic<bool> dense{true};
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     bool range_dense = true;
     for (int v = range.start; v < range.end; ++v) {
       const float* d = disparity_.ptr<float>(v);

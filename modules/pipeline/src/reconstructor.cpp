@@ -1,8 +1,9 @@
 #include <msf/common/exceptions.h>
+#include <msf/common/parallel.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/run_report.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
@@ -47,7 +48,7 @@ double msSince(Clock::time_point start) {
 } // namespace
 
 /// The stage objects of steps 1-4, configured once; they keep their work buffers.
-struct Pipeline::Stages {
+struct Reconstructor::Stages {
   explicit Stages(const Calibration& calibration, const PipelineConfig& config)
       : lidar(calibration, CompletionMethod::Compound, config.projection, config.interpolation) {}
   LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
@@ -55,10 +56,16 @@ struct Pipeline::Stages {
   DepthImageFusion fusion;
 };
 
-Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
-    : calibration_(calibration), config_(config), mesher_(config.mesher) {
+Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config)
+    : Reconstructor(rig, config, Options()) {}
+
+Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options)
+    : calibration_(rig), config_(config), options_(options), mesher_(config.mesher) {
   config_.validate();
   calibration_.requireImageSize();
+  if (options_.threads < 0)
+    throw ConfigError("Reconstructor: threads must be >= 0 (0: all cores), got " + std::to_string(options_.threads));
+  const ThreadBudget budget(options_.threads);
   stages_ = std::make_unique<Stages>(calibration_, config_);
   volume_ = std::make_unique<TsdfVolume>(config_.volume.voxel_size_m, config_.volume.truncation_m);
   volume_->setMaxMemoryMb(config_.volume.max_memory_mb);
@@ -69,11 +76,12 @@ Pipeline::Pipeline(const Calibration& calibration, const PipelineConfig& config)
   stages_->fusion.setConfig(config_.fusion);
   stages_->fusion.setCalibration(calibration_);
   camera_ = PinholeCamera::fromCalibration(calibration_, config_.projection.camera);
+  startStreaming();
 }
 
-Pipeline::~Pipeline() = default;
+Reconstructor::~Reconstructor() = default;
 
-FrameResult Pipeline::startFrame(const Frame& frame) const {
+FrameResult Reconstructor::startFrame(const Frame& frame) const {
   FrameResult result;
   result.index = frame.index;
   result.has_pose = frame.has_pose;
@@ -82,7 +90,7 @@ FrameResult Pipeline::startFrame(const Frame& frame) const {
   return result;
 }
 
-void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
+void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   stages_->lidar.computeDepth(*frame.scan, result.lidar_depth, &result.lidar_distance);
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
@@ -91,11 +99,11 @@ void Pipeline::computeLidar(const Frame& frame, FrameResult& result) {
   if (config_.integrator.scan_carving_m > 0.0 && config_.integrator.space_carving)
     result.scan_free_space = ScanFreeSpace(*frame.scan);
   result.times.lidar_ms = msSince(start);
-  if (keep_sparse_)
+  if (options_.keep_sparse)
     stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);
 }
 
-void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
+void Reconstructor::computeStereo(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   stages_->stereo.setInputImages(frame.left, frame.right);
   // With the prior, SGBM searches only the disparities the interpolated LiDAR allows; guided,
@@ -111,7 +119,7 @@ void Pipeline::computeStereo(const Frame& frame, FrameResult& result) {
 
 
 
-void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
+void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   DepthFrame& fused = result.fused;
   stages_->fusion.setInputImage(frame.left); // for the facade extension
@@ -126,11 +134,12 @@ void Pipeline::computeFusion(const Frame& frame, FrameResult& result) {
   result.times.fusion_ms = msSince(start);
 }
 
-bool Pipeline::lidarBeforeStereo() const {
+bool Reconstructor::lidarBeforeStereo() const {
   return config_.scheduling.stereo_prior || config_.stereo.lidarGuidance();
 }
 
-FrameResult Pipeline::computeDepth(const Frame& frame) {
+FrameResult Reconstructor::computeDepth(const Frame& frame) {
+  const ThreadBudget budget(options_.threads);
   FrameResult result = startFrame(frame);
   const auto depth_start = Clock::now();
   if (lidarBeforeStereo()) {
@@ -161,10 +170,13 @@ void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const 
                            static_cast<float>(1.0 / (sigma * sigma)), camera, result.T_world_cam0);
 }
 
-void Pipeline::integrate(FrameResult& result) {
+void Reconstructor::integrate(FrameResult& result) {
   if (!result.has_pose)
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
-                            " has no pose: integration needs the sequence's poses");
+                            " has no pose: integration needs one (the frame's, or PoseMode Odometry)");
+  if (config_.streaming.enabled() && !streaming_)
+    throw ConfigError("streaming.active_radius_m > 0 needs a folder for the tiles (Options::stream_directory)");
+  const ThreadBudget budget(options_.threads);
   const auto start = Clock::now();
   if (streaming_)
     streaming_->beforeIntegration(result.T_world_cam0.translation());
@@ -180,27 +192,81 @@ void Pipeline::integrate(FrameResult& result) {
   result.times.integrate_ms = msSince(start);
 }
 
-void Pipeline::setStreamingDirectory(const std::string& directory) {
-  if (!config_.streaming.enabled())
-    throw ConfigError("streaming.active_radius_m is 0: the map is not streamed, no folder is needed");
+bool Reconstructor::tracks(const Frame& first) const {
+  switch (options_.poses) {
+  case PoseMode::Given:
+    return false;
+  case PoseMode::Odometry:
+    return true;
+  case PoseMode::Auto:
+    break;
+  }
+  return !first.has_pose;
+}
+
+Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& scan_name) {
+  if (!odometry_) {
+    LidarOdometry::Config odometry = config_.odometry;
+    if (odometry.deskew == "auto")
+      odometry.deskew = options_.sweeping_scans ? "sweep" : "none";
+    odometry_ = std::make_unique<LidarOdometry>(odometry);
+    T_world_cam0_first_ = frame.has_pose ? frame.T_world_cam0 : Eigen::Isometry3d::Identity();
+  }
+  if (!frame.scan)
+    throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan to track");
+  const auto start = Clock::now();
+  const Eigen::Isometry3d T_velo0_velo = odometry_->registerScan(*frame.scan, scan_name);
+  odometry_ms_.push_back(msSince(start));
+  return cameraPose(T_velo0_velo, calibration_.T_cam0_velo, T_world_cam0_first_);
+}
+
+FrameResult Reconstructor::addFrame(const Frame& frame) {
+  const ThreadBudget budget(options_.threads);
+  if (frames_added_ == 0)
+    add_tracks_ = tracks(frame);
+  FrameResult result = computeDepth(frame);
+  if (add_tracks_) {
+    result.T_world_cam0 = track(frame, "the scan of frame " + std::to_string(frame.index));
+    result.has_pose = true;
+  }
+  integrate(result);
+  ++frames_added_;
+  if (config_.scheduling.mesh_every_n_frames > 0 &&
+      frames_added_ % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
+    mesh();
+  return result;
+}
+
+void Reconstructor::startStreaming() {
+  if (!config_.streaming.enabled()) {
+    if (!options_.stream_directory.empty())
+      throw ConfigError("a folder for the streamed map was given, but streaming.active_radius_m is 0: the map "
+                        "stays in memory");
+    return;
+  }
+  if (options_.stream_directory.empty())
+    return; // integrate() refuses to run without it; predictMemory() needs none
   // How far from the camera integration changes blocks that exist, over the LiDAR's canvas
   // (the image and its margin: the frames integrated are at most that).
   const double reach = integrator_->reach(stages_->lidar.projector().canvasCamera());
   if (!std::isfinite(reach))
     throw ConfigError("a streamed map needs a bound on the band behind a surface: tsdf_integrator.min_pixel_weight > 0 "
                       "or truncation_sigmas 0 (with per-pixel weights the band grows as a pixel's weight falls)");
-  streaming_ = std::make_unique<StreamingMap>(*volume_, config_.streaming, config_.mesher, reach, directory);
+  streaming_ = std::make_unique<StreamingMap>(*volume_, config_.streaming, config_.mesher, reach,
+                                              options_.stream_directory);
 }
 
-std::size_t Pipeline::finishStreaming(const std::string& mesh_path) {
+std::size_t Reconstructor::finishStreaming(const std::string& mesh_path) {
   if (!streaming_)
-    throw ConfigError("finishStreaming: the map is not streamed (setStreamingDirectory)");
+    throw ConfigError("finishStreaming: the map is not streamed (Options::stream_directory)");
+  const ThreadBudget budget(options_.threads);
   mesher_.reset();
   return streaming_->finish(mesh_path);
 }
 
-Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std::size_t>& frames,
-                                 const FrameCallback& on_frame, const std::atomic<bool>* stop) {
+Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                           const FrameCallback& on_frame, const std::atomic<bool>* stop) {
+  options_.sweeping_scans = source.sweepingScans();
   struct Loaded {
     Frame frame;
     FrameResult result;  // with the stereo prior or guidance, steps 1-2 are already done
@@ -209,8 +275,10 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
   BoundedQueue<Loaded> loaded(capacity);
   BoundedQueue<FrameResult> depths(capacity);
-  BoundedQueue<Frame> to_track(capacity);            // scans for the pose estimator
+  BoundedQueue<Frame> to_track(capacity);            // scans for the odometry
   BoundedQueue<Eigen::Isometry3d> tracked(capacity);  // its poses, in frame order
+  // Set by the loader from the first frame before any frame moves on: read after a queue's pop.
+  std::atomic<bool> tracking{false};
   std::exception_ptr failure;
   std::mutex failure_mutex;
   auto fail = [&](std::exception_ptr e) {
@@ -228,6 +296,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
 
   const auto run_start = Clock::now();
   std::thread loader([&] {
+    const ThreadBudget budget(options_.threads);
     try {
       for (std::size_t i : frames) {
         if (stop && stop->load()) {
@@ -235,15 +304,19 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
           break;
         }
         const auto start = Clock::now();
-        Loaded item{sequence.load(i), FrameResult(), 0.0};
+        Loaded item{source.load(i), FrameResult(), 0.0};
         if (frame_filter_)
           frame_filter_(item.frame);
         item.load_ms = msSince(start);
-        if (pose_estimator_) {
+        if (i == frames.front())
+          tracking = tracks(item.frame);
+        if (tracking) {
           Frame scan_only;
           scan_only.index = item.frame.index;
           scan_only.timestamp = item.frame.timestamp;
           scan_only.scan = item.frame.scan; // shared, read only: no stage changes a scan after the filter
+          scan_only.has_pose = item.frame.has_pose; // the first frame's anchors the odometry's world
+          scan_only.T_world_cam0 = item.frame.T_world_cam0;
           if (!to_track.push(std::move(scan_only)))
             break;
         }
@@ -260,19 +333,19 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
     loaded.close();
     to_track.close();
   });
-  std::thread tracker;
-  if (pose_estimator_)
-    tracker = std::thread([&] {
-      try {
-        while (auto frame = to_track.pop())
-          if (!tracked.push(pose_estimator_(*frame)))
-            break;
-      } catch (...) {
-        fail(std::current_exception());
-      }
-      tracked.close();
-    });
+  std::thread tracker([&] {
+    const ThreadBudget budget(options_.threads);
+    try {
+      while (auto frame = to_track.pop())
+        if (!tracked.push(track(*frame, source.scanName(frame->index))))
+          break;
+    } catch (...) {
+      fail(std::current_exception());
+    }
+    tracked.close();
+  });
   std::thread depth([&] {
+    const ThreadBudget budget(options_.threads);
     try {
       while (auto item = loaded.pop()) {
         if (stop && stop->load())
@@ -287,7 +360,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
         } else {
           result = computeDepth(item->frame);
         }
-        result.name = sequence.frameName(item->frame.index);
+        result.name = source.frameName(item->frame.index);
         result.times.load_ms = item->load_ms;
         if (!depths.push(std::move(result)))
           break;
@@ -298,12 +371,11 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
     depths.close();
   });
 
-  if (config_.streaming.enabled() && !streaming_)
-    throw ConfigError("streaming.active_radius_m > 0 needs a folder for the tiles: Pipeline::setStreamingDirectory");
   RunStats stats;
+  const ThreadBudget budget(options_.threads);
   try {
     while (auto result = depths.pop()) {
-      if (pose_estimator_) {
+      if (tracking) {
         auto pose = tracked.pop();
         if (!pose)
           break; // the estimator failed (its error is rethrown below) or the run stopped
@@ -313,7 +385,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
       integrate(*result);
       if (config_.scheduling.mesh_every_n_frames > 0 &&
           (stats.frames_done + 1) % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
-        updateMesh();
+        mesh();
       ++stats.frames_done;
       if (on_frame)
         on_frame(*result);
@@ -333,8 +405,7 @@ Pipeline::RunStats Pipeline::run(const Sequence& sequence, const std::vector<std
   tracked.close();
   loader.join();
   depth.join();
-  if (tracker.joinable())
-    tracker.join();
+  tracker.join();
   if (failure)
     std::rethrow_exception(failure);
   stats.wall_s = msSince(run_start) / 1000.0;
@@ -352,7 +423,7 @@ std::string MemoryPrediction::describe() const {
   return text;
 }
 
-MemoryPrediction Pipeline::predictMemory(const PoseList& T_world_cam0, int maps, bool scores_every_frame) const {
+MemoryPrediction Reconstructor::predictMemory(const PoseList& T_world_cam0, int maps, bool scores_every_frame) const {
   const auto start = Clock::now();
   MemoryPrediction p;
   p.frames = T_world_cam0.size();
@@ -406,7 +477,8 @@ MemoryPrediction Pipeline::predictMemory(const PoseList& T_world_cam0, int maps,
   return p;
 }
 
-const TriangleMesh& Pipeline::updateMesh() {
+const TriangleMesh& Reconstructor::mesh() {
+  const ThreadBudget budget(options_.threads);
   mesher_.extract(*volume_, mesh_);
   return mesh_;
 }

@@ -1,11 +1,12 @@
 #pragma once
-#include <msf/io/sequence.h>
+#include <msf/io/frame_source.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
+#include <msf/registration/lidar_odometry.h>
 
 #include <atomic>
 #include <functional>
@@ -15,7 +16,7 @@
 
 namespace msf {
 
-/// What a run is predicted to hold at its peak, before it starts (Pipeline::predictMemory), in
+/// What a run is predicted to hold at its peak, before it starts (Reconstructor::predictMemory), in
 /// MiB: an upper bound on the TSDF volume from the poses alone (the blocks of every frame's
 /// view up to the integrator's allocation depth, BlockFootprint), plus a model of the rest
 /// (per pixel of the frames in flight, and a fraction of the volume for the mesh and files
@@ -75,39 +76,72 @@ struct FrameResult {
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration);
 
-/// The whole method (the README's data flow) for a sequence: per frame, LiDAR projection and
-/// compound interpolation (LidarCompletion: the scan is projected onto the image grown by
-/// a margin, so gaps across the image's border are bridged) run at the same time as SGBM, then the two depth images are
-/// fused and integrated into the regularized TSDF volume; marching cubes gives the mesh.
-/// The stages are the library's classes with the settings of one PipelineConfig, the same
-/// as the msf_project, msf_interpolate, msf_stereo, msf_fuse and msf_integrate tools use,
-/// so the chain of tools and the pipeline give the same fused depth. The tools exchange
-/// organized clouds; the pipeline runs the same per-pixel code on depth images
-/// (LidarCompletion::computeDepth, SgbmStereo::getDepth, DepthImageFusion), which is faster.
+/// The reconstruction engine: the whole method (the README's data flow) as one object that
+/// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
+/// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected
+/// onto the image grown by a margin, so gaps across the image's border are bridged) and SGBM
+/// stereo give two depth images, fused per pixel; the frame's pose (its own, or LiDAR
+/// odometry's) places the fused depth in the regularized TSDF volume; marching cubes gives the
+/// mesh, incrementally. The stages are the library's classes with the settings of one
+/// PipelineConfig, the same as the msf_project, msf_interpolate, msf_stereo, msf_fuse and
+/// msf_integrate tools use, so the chain of tools and the engine give the same fused depth.
+///
+/// Two ways to feed it:
+///  - addFrame(frame), one call per frame on the caller's thread (a ROS callback, a notebook);
+///  - run(source, frames, ...), which overlaps frames: loading (with steps 1-2 when they feed
+///    SGBM), stereo + fusion, integration, and the odometry each have a thread, joined by
+///    bounded queues, so memory is bounded by the map, not by the number of frames.
+/// Both give the same map for the same frames.
 ///
 /// With `pipeline.stereo_prior` (the default) SGBM searches only the disparities that the
-/// interpolated LiDAR allows, and with `stereo.guidance: lidar` (the default) the LiDAR's
-/// real returns guide it, so steps 1-2 run first; otherwise they run beside SGBM.
-/// run() overlaps frames: loading (with steps 1-2 when they feed SGBM), stereo +
-/// fusion, and integration each have a thread, joined by bounded queues, so the LiDAR of
-/// frame t+2 and the stereo of frame t+1 run while frame t integrates, and memory is
-/// bounded by the map, not by the number of frames.
-class Pipeline {
+/// interpolated LiDAR allows, and with `stereo.guidance: lidar` (the default) the LiDAR's real
+/// returns guide it, so steps 1-2 run first; otherwise they run beside SGBM.
+class Reconstructor {
 public:
-  using Ptr = std::shared_ptr<Pipeline>;
-  using ConstPtr = std::shared_ptr<const Pipeline>;
+  using Ptr = std::shared_ptr<Reconstructor>;
 
-  /// Throws ConfigError for an invalid config, CalibrationError when the calibration has no
-  /// image size.
-  Pipeline(const Calibration& calibration, const PipelineConfig& config);
-  ~Pipeline();
-  Pipeline(const Pipeline&) = delete;
-  Pipeline& operator=(const Pipeline&) = delete;
+  /// Where each frame's pose comes from.
+  enum class PoseMode {
+    Auto,     ///< the frame's own pose; LiDAR odometry for a run whose first frame has none
+    Given,    ///< the frame's own pose; a frame without one is an error
+    Odometry, ///< LiDAR odometry, in the world of the first frame's pose when it has one
+  };
 
-  /// Depth of one frame, synchronously: steps 1-4. Throws InvalidInputError for images or a
-  /// scan that do not fit the calibration.
+  struct Options {
+    PoseMode poses = PoseMode::Auto;
+    /// Threads of this object's parallel loops: 0 = all cores, 1 = only the thread that calls
+    /// (run() still overlaps its stages), n = at most n at a time. For a process that shares
+    /// the machine (a ROS node, a Python program).
+    int threads = 0;
+    /// Scans swept over their period (a spinning LiDAR): the odometry deskews them
+    /// (odometry.deskew auto); false for scans taken at one instant. run() takes it from its
+    /// FrameSource (FrameSource::sweepingScans); set it for addFrame.
+    bool sweeping_scans = true;
+    /// With `streaming.active_radius_m` > 0 (docs/streaming.md): the folder where the map
+    /// streams the tiles that leave the active radius (tiles/*.ply, tsdf/*.blk); integration
+    /// needs it then.
+    std::string stream_directory;
+    /// Also keep each frame's projected scan (step 1) in FrameResult::lidar_sparse, for
+    /// pictures; off by default, since step 2 projects the scan itself, with a margin.
+    bool keep_sparse = false;
+  };
+
+  /// Throws ConfigError for an invalid config or streaming options, CalibrationError when the
+  /// rig has no image size.
+  Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options);
+  Reconstructor(const Calibration& rig, const PipelineConfig& config);
+  ~Reconstructor();
+  Reconstructor(const Reconstructor&) = delete;
+  Reconstructor& operator=(const Reconstructor&) = delete;
+
+  /// One frame, synchronously: its depth (steps 1-4), its pose (the frame's or the odometry's,
+  /// as Options::poses says) and its integration into the map (step 5). Returns the frame's
+  /// depth images, weight and the pose used. Throws InvalidInputError for images or a scan
+  /// that do not fit the rig, or a frame without a pose where one is needed.
+  FrameResult addFrame(const Frame& frame);
+
+  /// Depth of one frame, synchronously: steps 1-4, nothing added to the map.
   FrameResult computeDepth(const Frame& frame);
-
   /// Integrates the fused depth of `result` at its pose (step 5), grown by the interpolated
   /// LiDAR of the canvas's margin (fusedDepthFrame). Throws InvalidInputError when the frame
   /// has no pose.
@@ -124,45 +158,28 @@ public:
   /// Called on the integration thread after each frame is integrated, in frame order.
   using FrameCallback = std::function<void(FrameResult&)>;
 
-  /// Runs `frames` of `sequence` through the stages, overlapped. When `stop` becomes true,
-  /// the frame being integrated is finished and the frames behind it are dropped, so the
-  /// stop is prompt and the volume holds whole frames only. An exception in any stage
-  /// stops the run and is rethrown.
-  RunStats run(const Sequence& sequence, const std::vector<std::size_t>& frames, const FrameCallback& on_frame,
+  /// Runs `frames` of `source` through the stages, overlapped. When `stop` becomes true, the
+  /// frame being integrated is finished and the frames behind it are dropped, so the stop is
+  /// prompt and the volume holds whole frames only. An exception in any stage stops the run
+  /// and is rethrown.
+  RunStats run(const FrameSource& source, const std::vector<std::size_t>& frames, const FrameCallback& on_frame,
                const std::atomic<bool>* stop = nullptr);
 
-  /// Also keep each frame's projected scan (step 1) in FrameResult::lidar_sparse, for
-  /// pictures; off by default, since step 2 projects the scan itself, with a margin.
-  void setKeepSparse(bool keep) { keep_sparse_ = keep; }
-
   /// Changes each frame before any stage sees it: run() calls it on its loading thread right
-  /// after Sequence::load, once per frame in frame order (its time counts as loading). E.g.
+  /// after FrameSource::load, once per frame in frame order (its time counts as loading). E.g.
   /// the ring hold-out of evaluation protocol 4 removes the held-out rings from the scan
   /// there. It runs beside run()'s callback (the integration thread): what the two share
-  /// needs a lock. Set it before run(); computeDepth's caller holds its frame and filters it.
+  /// needs a lock. Set it before run(); addFrame's caller holds its frame and changes it.
   using FrameFilter = std::function<void(Frame&)>;
   void setFrameFilter(FrameFilter filter) { frame_filter_ = std::move(filter); }
 
-  /// Gives each frame its pose T_world_cam0 on a thread of its own (LiDAR odometry: the
-  /// tracking module), beside steps 1-4, which do not need it; integration waits for it.
-  /// run() calls it once per frame in frame order, after the frame filter, with the frame's
-  /// index, timestamp and scan (no images). It runs beside the filter and the callback: what
-  /// they share needs a lock. An exception stops the run like a failing stage. Set it before run().
-  using PoseEstimator = std::function<Eigen::Isometry3d(const Frame&)>;
-  void setPoseEstimator(PoseEstimator estimator) { pose_estimator_ = std::move(estimator); }
-
-  /// The mesh of the volume, re-meshing only the blocks changed since the last call.
-  const TriangleMesh& updateMesh();
-  /// What the last updateMesh did (blocks meshed, small pieces removed).
+  /// The mesh of the map, re-meshing only the blocks changed since the last call.
+  const TriangleMesh& mesh();
+  /// What the last mesh() did (blocks meshed, small pieces removed).
   const MarchingCubes::Stats& meshStats() const { return mesher_.lastStats(); }
 
-  /// With `streaming.active_radius_m` > 0 (docs/streaming.md): the map keeps in memory only
-  /// the tiles around the camera and streams the others into `directory` (tiles/*.ply,
-  /// tsdf/*.blk); required before run() then. Its time counts as integration. Throws
-  /// ConfigError when streaming is off or the radius is below the integrator's reach.
-  void setStreamingDirectory(const std::string& directory);
-  /// Writes the tiles still in memory and the union of all as `mesh_path`; the volume is
-  /// empty afterwards. Returns the triangles written.
+  /// A streamed map (Options::stream_directory): writes the tiles still in memory and the
+  /// union of all as `mesh_path`; the volume is empty afterwards. Returns the triangles written.
   std::size_t finishStreaming(const std::string& mesh_path);
   /// The peak memory of run() over frames seen from `T_world_cam0` (their poses, known before
   /// the run: a dataset's or a file's; not estimated ones), predicted without reading the
@@ -176,9 +193,12 @@ public:
 
   /// The streaming map, or nullptr when the map stays in memory.
   const StreamingMap* streaming() const { return streaming_.get(); }
+  /// Milliseconds the odometry took for each frame it tracked (empty when it did not run).
+  const std::vector<double>& odometryMs() const { return odometry_ms_; }
 
   const PipelineConfig& config() const { return config_; }
   const Calibration& calibration() const { return calibration_; }
+  const Options& options() const { return options_; }
   TsdfVolume& volume() { return *volume_; }
   const TsdfVolume& volume() const { return *volume_; }
   const TsdfIntegrator& integrator() const { return *integrator_; }
@@ -193,9 +213,15 @@ private:
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
+  /// Whether frames from `first` on are tracked by the odometry (PoseMode).
+  bool tracks(const Frame& first) const;
+  /// The odometry's pose of the frame's scan; frames in order.
+  Eigen::Isometry3d track(const Frame& frame, const std::string& scan_name);
+  void startStreaming();
 
   Calibration calibration_;
   PipelineConfig config_;
+  Options options_;
   PinholeCamera camera_;  // of the depth images
   std::unique_ptr<TsdfVolume> volume_;
   std::unique_ptr<TsdfIntegrator> integrator_;
@@ -203,9 +229,13 @@ private:
   MarchingCubes mesher_;
   TriangleMesh mesh_;
   std::unique_ptr<StreamingMap> streaming_;
-  bool keep_sparse_ = false;
   FrameFilter frame_filter_;
-  PoseEstimator pose_estimator_;
+  // The odometry (PoseMode): made at the first frame it tracks, anchored at that frame's pose.
+  std::unique_ptr<LidarOdometry> odometry_;
+  Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
+  std::vector<double> odometry_ms_;
+  std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
+  bool add_tracks_ = false;
 };
 
 } // namespace msf

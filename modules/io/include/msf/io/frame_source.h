@@ -1,0 +1,78 @@
+#pragma once
+#include <msf/io/calibration.h>
+#include <msf/io/poses.h>
+
+#include <opencv2/core/mat.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+/// Inclusive frame range "a:b" ("3:" to the end, "5" a single frame).
+struct FrameRange {
+  int first = 0;
+  int last = -1; ///< -1: to the end
+  /// Parses "a:b", "a:", ":b" or "a"; throws InvalidInputError naming the text.
+  static FrameRange parse(const std::string& text);
+};
+
+/// One frame of a rig, everything in memory: what the reconstruction engine is fed.
+struct Frame {
+  std::size_t index = 0;         ///< position in its source (0-based)
+  double timestamp = 0.0;        ///< seconds from the source's first frame
+  pcl::PointCloud<pcl::PointXYZI>::Ptr scan; ///< the LiDAR's points in its own frame, in the order it sent them
+  /// Optional per point of `scan`: its ring (beam) id; empty = derived from the order (azimuth wraps).
+  std::vector<std::uint16_t> point_ring;
+  /// Optional per point of `scan`: seconds from the sweep's start; empty = derived from the azimuth.
+  std::vector<float> point_time_s;
+  cv::Mat left;                  ///< camera 0, grey CV_8UC1, rectified
+  cv::Mat right;                 ///< camera 1, grey CV_8UC1, rectified
+  cv::Mat color;                 ///< camera 2, BGR CV_8UC3, rectified; empty if absent
+  bool has_pose = false;
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
+};
+
+/// Where frames come from: a dataset folder, a bag, a program. Readers of every layout (KITTI
+/// odometry and raw, synthetic, a generic folder with a rig file, a ROS bag) give the engine
+/// the same Frame, so a new reader touches no stage.
+class FrameSource {
+public:
+  virtual ~FrameSource() = default;
+
+  /// The rig: cameras, LiDAR extrinsic, image size.
+  virtual const Calibration& calibration() const = 0;
+  virtual std::size_t size() const = 0;
+  /// The frame's name in outputs and messages ("000042").
+  virtual std::string frameName(std::size_t i) const = 0;
+  /// Loads frame i (scan, images and, when the source has them, its pose); `with_color` false
+  /// skips the colour camera. Safe to call from another thread than the one that made the
+  /// source. Throws IOError naming a missing or malformed file.
+  virtual Frame load(std::size_t i, bool with_color = true) const = 0;
+
+  /// The source's own poses T_world_cam0, one per frame, or none.
+  virtual const PoseList& poses() const;
+  bool hasPoses() const { return !poses().empty(); }
+  /// Where poses() come from, in words ("the odometry ground truth").
+  virtual std::string posesName() const { return "the dataset's poses"; }
+  /// The source in words for messages and reports: its folder or file.
+  virtual std::string description() const = 0;
+  /// Frame i's scan in words for messages ("scan '.../000042.bin'").
+  virtual std::string scanName(std::size_t i) const { return "the scan of frame " + frameName(i); }
+  /// Whether frames carry a colour image (camera 2).
+  virtual bool hasColor() const { return false; }
+  /// Whether a scan is swept over its period (a spinning LiDAR: deskewed by the odometry) rather
+  /// than taken at one instant.
+  virtual bool sweepingScans() const { return true; }
+  /// Folder of synthetic ground truth, "" when there is none.
+  virtual std::string groundTruthDir() const { return {}; }
+
+  /// Indices of a range; throws InvalidInputError when it selects no frame or goes beyond the last.
+  std::vector<std::size_t> indices(const FrameRange& range) const;
+};
+
+} // namespace msf

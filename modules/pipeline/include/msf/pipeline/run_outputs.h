@@ -1,0 +1,31 @@
+#pragma once
+#include <msf/evaluation/reconstruction_evaluation.h>
+#include <msf/io/frame_source.h>
+#include <msf/pipeline/run_report.h>
+#include <msf/pipeline/synthetic_scoring.h>
+
+#include <map>
+#include <string>
+
+namespace msf {
+
+// The parts of a run's report that come after its last frame, each written into the run's
+// output folder `dir` and named in the report.
+
+/// The mesh from above and from the first frame's camera, one picture (mesh_preview.png).
+void writeMeshPreview(const std::string& dir, const TriangleMesh& mesh, const Calibration& calibration,
+                      const Eigen::Isometry3d& T_world_cam0_first, RunReport& report);
+
+/// The poses used (poses.txt, KITTI's format) and the trajectory from above (trajectory.png),
+/// with the source's own poses beside them when the used ones came from elsewhere (then also
+/// scored against them: protocol 5). `used_name`: "dataset", "poses file" or "estimated".
+void writeTrajectory(const std::string& dir, const PoseList& used, const std::vector<std::size_t>& frames,
+                     const std::string& used_name, const FrameSource& source, RunReport& report);
+
+/// Protocol 4's rows for the report: each source the evaluation scored, in a fixed order, with
+/// its mesh's accuracy and ghosts where the ground truth gave them.
+void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
+                            const std::map<std::string, SyntheticScoring::MeshScores>& mesh_scores,
+                            RunReport::MapEvaluation& out);
+
+} // namespace msf

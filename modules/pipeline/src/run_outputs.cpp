@@ -1,0 +1,71 @@
+#include <msf/evaluation/odometry_metrics.h>
+#include <msf/evaluation/trajectory_plot.h>
+#include <msf/io/image_io.h>
+#include <msf/pipeline/mesh_renderer.h>
+#include <msf/pipeline/run_outputs.h>
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace msf {
+
+void writeMeshPreview(const std::string& dir, const TriangleMesh& mesh, const Calibration& calibration,
+                      const Eigen::Isometry3d& T_world_cam0_first, RunReport& report) {
+  const cv::Size size = calibration.requireImageSize();
+  const cv::Mat above = MeshRenderer::renderFromAbove(mesh, -(T_world_cam0_first.linear().col(1)),
+                                                      cv::Size(size.width, size.width / 2));
+  const cv::Mat camera = MeshRenderer::render(mesh, T_world_cam0_first, calibration.fx(), calibration.fy(),
+                                              calibration.cx(), calibration.cy(), size);
+  cv::Mat preview;
+  cv::vconcat(above, camera, preview);
+  report.preview_file = "mesh_preview.png";
+  writeImage((fs::path(dir) / report.preview_file).string(), preview);
+}
+
+void writeTrajectory(const std::string& dir, const PoseList& used, const std::vector<std::size_t>& frames,
+                     const std::string& used_name, const FrameSource& source, RunReport& report) {
+  if (used.empty())
+    return;
+  saveOdometryPoses((fs::path(dir) / report.poses_file).string(), used);
+  std::vector<std::pair<std::string, PoseList>> trajectories{{used_name, used}};
+  if (source.hasPoses() && used_name != "dataset") {
+    PoseList reference;
+    for (std::size_t k = 0; k < used.size() && k < frames.size(); ++k)
+      reference.push_back(source.poses()[frames[k]]);
+    trajectories.emplace_back("dataset", reference);
+    if (used.size() > 1) {
+      report.trajectory_metrics = evaluateOdometry(used, reference);
+      report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
+      report.trajectory_reference = source.posesName();
+    }
+  }
+  report.trajectory_plot_file = "trajectory.png";
+  writeImage((fs::path(dir) / report.trajectory_plot_file).string(), plotTrajectoriesFromAbove(trajectories));
+}
+
+void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
+                            const std::map<std::string, SyntheticScoring::MeshScores>& mesh_scores,
+                            RunReport::MapEvaluation& out) {
+  out.frames = evaluation.frames();
+  out.gt_pixels = evaluation.groundTruthPixels();
+  const auto rows = evaluation.scores();
+  for (const char* source : {"mesh", "fused", "mesh_lidar", "mesh_stereo", "mesh_paper", "paper"})
+    for (const auto& score : rows)
+      if (score.source == source) {
+        RunReport::MapEvaluation::Row row;
+        row.score = score;
+        const auto it = mesh_scores.find(source);
+        if (it != mesh_scores.end()) {
+          row.has_accuracy = true;
+          row.accuracy = it->second.accuracy;
+          row.has_ghosts = it->second.has_ghosts;
+          row.ghosts = it->second.ghosts;
+        }
+        out.rows.push_back(row);
+      }
+}
+
+} // namespace msf

@@ -1,0 +1,113 @@
+#include <msf/io/cloud_io.h>
+#include <msf/pipeline/synthetic_scoring.h>
+
+#include <filesystem>
+
+namespace msf {
+
+namespace {
+constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
+} // namespace
+
+SyntheticScoring::SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes)
+    : truth_(std::make_unique<synthetic::GroundTruth>(ground_truth_dir)), score_meshes_(score_meshes) {
+  if (!score_meshes_)
+    return;
+  loadMesh(truth_->sceneMeshPath(), scene_);
+  if (truth_->hasSceneClasses())
+    classes_ = truth_->sceneClasses(static_cast<std::size_t>(scene_.cloud.width) * scene_.cloud.height);
+}
+
+cv::Mat SyntheticScoring::depth(const std::string& frame_name) const {
+  return truth_->depth(truth_->indexOf(frame_name));
+}
+
+void SyntheticScoring::addDepth(const std::string& method, const std::string& frame_name, const cv::Mat& true_depth,
+                                const cv::Mat& estimate, double focal_baseline) {
+  const std::size_t gt_index = truth_->indexOf(frame_name);
+  all_[method].add(true_depth, estimate, focal_baseline);
+  background_[method].add(true_depth, estimate, focal_baseline, truth_->backgroundMask(gt_index));
+  foreground_[method].add(true_depth, estimate, focal_baseline, truth_->foregroundMask(gt_index));
+}
+
+void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth, const Calibration& calibration,
+                                double max_depth_m) {
+  const double fb = calibration.focalBaseline();
+  const std::pair<const char*, cv::Mat> methods[] = {
+      {"sgbm", r.stereo_depth}, {"interpolated", r.lidar_depth}, {"fused", r.fused.depth}};
+  for (const auto& [name, estimate] : methods)
+    addDepth(name, r.name, true_depth, estimate, fb);
+  if (!score_meshes_)
+    return;
+  // Every 4th pixel of the true static surface in range, for the mesh's completeness against
+  // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
+  const cv::Mat moving = truth_->movingMask(truth_->indexOf(r.name));
+  const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
+  const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
+  const Eigen::Isometry3f T = r.T_world_cam0.cast<float>();
+  for (int v = 0; v < true_depth.rows; v += 4)
+    for (int u = 0; u < true_depth.cols; u += 4) {
+      const float z = true_depth.at<float>(v, u);
+      if (z > 0.f && z <= max_depth_m && moving.at<std::uint8_t>(v, u) == 0) {
+        seen_surface_.push_back(T * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
+        seen_depth_.push_back(z);
+      }
+    }
+}
+
+std::map<std::string, SyntheticScoring::MeshScores>
+SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, double voxel_size_m) const {
+  std::map<std::string, MeshScores> scores;
+  if (!score_meshes_ || meshes.empty())
+    return scores;
+  // Where moving objects were: inside a box of gt/moving_objects.txt at any frame, grown by a
+  // voxel (a car's surface is meshed up to a voxel off its box).
+  MovingSpace was_moving;
+  if (std::filesystem::exists(truth_->movingBoxesPath()))
+    was_moving = [boxes = truth_->movingBoxes(), margin = voxel_size_m](const Eigen::Vector3f& p) {
+      const Eigen::Vector3d q = p.cast<double>();
+      for (const auto& box : boxes)
+        if (box.contains(q, margin))
+          return true;
+      return false;
+    };
+  std::unique_ptr<SurfaceDistance> static_surface;
+  if (was_moving)
+    static_surface = std::make_unique<SurfaceDistance>(scene_);
+  // The nearest distance each piece of the seen surface was seen from (cells of a voxel):
+  // what a frame far away cannot place within the completeness threshold.
+  const std::vector<float> view_distance =
+      nearestViewDistance(seen_surface_, seen_depth_, static_cast<float>(voxel_size_m));
+  for (const auto& [name, m] : meshes) {
+    if (!m.polygons)
+      continue;
+    // Marching cubes' meshes weigh their vertices: also scored as the bar on them rises.
+    const std::vector<float>& weights = m.mesh->weights;
+    MeshScores& s = scores[name];
+    s.accuracy = evaluateMesh(*m.polygons, scene_, seen_surface_, 2.0 * voxel_size_m, 1.0, 200000, &view_distance,
+                              weights.size() == m.mesh->vertices.size() ? &weights : nullptr,
+                              classes_ ? &*classes_ : nullptr);
+    if (was_moving) {
+      s.ghosts = measureGhosts(m.mesh->vertices, *static_surface, was_moving, kGhostDistanceM);
+      s.has_ghosts = true;
+    }
+  }
+  return scores;
+}
+
+void SyntheticScoring::writeDepthScores(RunReport& report) const {
+  for (const auto& [name, acc] : all_) {
+    auto& d = report.depth[name];
+    d.all = acc.metrics();
+    d.background = background_.at(name).metrics();
+    d.foreground = foreground_.at(name).metrics();
+    d.has_split = true;
+  }
+}
+
+std::string SyntheticScoring::noGhostsReason() const {
+  return std::filesystem::exists(truth_->movingBoxesPath()) ? ""
+                                                              : "the dataset has no moving-object boxes (gt/moving_objects.txt)";
+}
+
+} // namespace msf

@@ -1,0 +1,84 @@
+// The engine as a library object: fed frame by frame it gives msf_reconstruct's map, byte for
+// byte; its thread budget changes nothing but the time.
+#include <msf/io/cloud_io.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/reconstructor.h>
+
+#include "pipeline_fixture.h"
+#include "test_support.h"
+
+#include <filesystem>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The mesh and volume files of `engine`'s map, written as msf_reconstruct writes them.
+std::pair<std::string, std::string> savedMap(msf::Reconstructor& engine, const msf::test::TempDir& dir) {
+  pcl::PolygonMesh polygons;
+  engine.mesh().toPolygonMesh(polygons);
+  msf::saveMesh(dir.file("mesh.ply"), polygons);
+  engine.volume().save(dir.file("volume.pcd"));
+  return {readFile(dir.file("mesh.ply")), readFile(dir.file("volume.pcd"))};
+}
+
+/// Frames 0-2 of the test street fed one call each into an engine of `options`.
+void feed(msf::Reconstructor& engine, const msf::Sequence& sequence) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    const msf::FrameResult r = engine.addFrame(sequence.load(i));
+    EXPECT_TRUE(r.has_pose);
+    EXPECT_EQ(r.fused.depth.size(), sequence.calibration().image_size);
+    EXPECT_EQ(r.fused.weight.size(), sequence.calibration().image_size);
+  }
+}
+
+} // namespace
+
+TEST_F(PipelineTest, TheEngineFedFrameByFrameGivesTheToolsMapByteForByte) {
+  msf::test::TempDir dir;
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:2 -panels 0 -o " + dir.file("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  feed(engine, sequence);
+  msf::test::TempDir mine;
+  const auto [mesh, volume] = savedMap(engine, mine);
+  EXPECT_TRUE(mesh == readFile(dir.file("out/mesh.ply"))) << "the mesh differs from msf_reconstruct's";
+  EXPECT_TRUE(volume == readFile(dir.file("out/volume.pcd"))) << "the volume differs from msf_reconstruct's";
+}
+
+TEST_F(PipelineTest, OneThreadGivesTheSameMapAsAllCores) {
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor all(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor::Options single;
+  single.threads = 1;
+  msf::Reconstructor one(sequence.calibration(), msf::PipelineConfig{}, single);
+  feed(all, sequence);
+  feed(one, sequence);
+  msf::test::TempDir a, b;
+  const auto map_all = savedMap(all, a), map_one = savedMap(one, b);
+  EXPECT_GT(all.mesh().triangles.size(), 1000u);
+  EXPECT_TRUE(map_all.first == map_one.first) << "the mesh depends on the thread budget";
+  EXPECT_TRUE(map_all.second == map_one.second) << "the volume depends on the thread budget";
+}
+
+TEST_F(PipelineTest, AStreamedEngineWritesItsTilesWhereItIsTold) {
+  const msf::Sequence sequence(dataset());
+  msf::PipelineConfig config;
+  config.streaming.active_radius_m = 101;
+  msf::test::TempDir dir;
+  msf::Reconstructor::Options options;
+  options.stream_directory = dir.path();
+  msf::Reconstructor engine(sequence.calibration(), config, options);
+  feed(engine, sequence);
+  EXPECT_GT(engine.finishStreaming(dir.file("mesh.ply")), 1000u);
+  EXPECT_TRUE(fs::is_regular_file(dir.file("tsdf/index.txt")));
+  EXPECT_FALSE(fs::is_empty(dir.file("tiles")));
+  // Without a folder a streamed map is refused at its first frame, and a folder without streaming at once.
+  msf::Reconstructor folderless(sequence.calibration(), config);
+  EXPECT_NE(msf::test::errorOf([&] { folderless.addFrame(sequence.load(0)); }).find("stream_directory"),
+            std::string::npos);
+  EXPECT_NE(msf::test::errorOf([&] { msf::Reconstructor(sequence.calibration(), msf::PipelineConfig{}, options); })
+                .find("streaming.active_radius_m is 0"),
+            std::string::npos);
+}
