@@ -11,6 +11,7 @@
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/frame_panel.h>
+#include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/fused_cloud.h>
 #include <msf/pipeline/pose_source.h>
 #include <msf/pipeline/reconstructor.h>
@@ -638,11 +639,12 @@ int main(int argc, char** argv) {
     // The default street is generated inside the staging folder (a killed run's goes with it
     // at the next run) and removed before the commit.
     const fs::path street = fs::path(output.dir()) / ".street";
-    const msf::Sequence source(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset);
+    const std::unique_ptr<msf::FrameSource> source =
+        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset);
     if (request.save_depth)
       fs::create_directories(fs::path(output.dir()) / "depth");
 
-    Run run(request, config, source, output.dir());
+    Run run(request, config, *source, output.dir());
     const bool interrupted = run.reconstruct();
     run.finish(interrupted);
     std::error_code ec;

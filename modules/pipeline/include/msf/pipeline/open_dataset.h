@@ -1,0 +1,22 @@
+#pragma once
+#include <msf/io/frame_source.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+/// What a dataset is read with, beyond its path.
+struct DatasetOptions {
+  /// A calibration or rig file (-calib / -rig): required by layouts that carry none, and
+  /// overriding the dataset's own otherwise. "" = the dataset's.
+  std::string rig;
+};
+
+/// Opens a dataset by what the path holds: a KITTI odometry sequence (or a root with one
+/// sequence, as msf_synth writes), a KITTI raw drive. Throws IOError naming the path and the
+/// layouts it knows when it is none of them.
+std::unique_ptr<FrameSource> openDataset(const std::string& path, const DatasetOptions& options = {});
+
+} // namespace msf
