@@ -10,7 +10,8 @@ DEMO_OUT ?= out/demo
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
 # time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
-                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time
+                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
+                libyaml-cpp-dev python3-yaml
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
       .value("-calib", "PATH", calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
+      .value("-rig", "FILE", calib, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
       .value("-config", "FILE",
              [&](const std::string& path) {
                const msf::ConfigFile file(path);
@@ -134,13 +135,13 @@ int main(int argc, char** argv) {
 
     msf::PinholeCamera camera;
     msf::Calibration calibration;
-    if (cli.given("-calib")) {
+    if (cli.given("-calib") || cli.given("-rig")) {
       calibration = msf::loadCalibration(calib);
       camera = msf::PinholeCamera::fromCalibration(calibration);
     }
     std::vector<std::string> scans;
     if (cli.given("-scans")) {
-      if (!cli.given("-calib"))
+      if (!(cli.given("-calib") || cli.given("-rig")))
         throw msf::InvalidInputError("-scans needs -calib: the LiDAR's pose is the camera's times its extrinsics");
       calibration.requireVelodyne();
       if (!config.space_carving || !(config.scan_carving_m > 0.0))

@@ -10,6 +10,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
+#include <msf/io/world_frame.h>
 #include <msf/pipeline/frame_panel.h>
 #include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/fused_cloud.h>
@@ -45,7 +46,7 @@ constexpr int kMaxPanels = 100;
 
 /// What the command line asks for beyond the configuration.
 struct Request {
-  std::string out = "msf_out", frames = "0:", poses, config_path, dataset;
+  std::string out = "msf_out", frames = "0:", poses, config_path, dataset, rig, world = "camera";
   int panels = 3;
   bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
 };
@@ -208,7 +209,8 @@ public:
         frames_(source.indices(msf::FrameRange::parse(request.frames))),
         poses_(request.poses, source, frames_),
         holdout_(source, msf::HoldoutConfig{config.rings, config.projection, {}}),
-        panel_frames_(spread(frames_, request.panels)) {
+        panel_frames_(spread(frames_, request.panels)),
+        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world))) {
     if (!source.hasColor())
       print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
                  source.description().c_str());
@@ -272,7 +274,7 @@ public:
     const char* used_name = poses_.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
                             : poses_.kind() == msf::PoseSource::Kind::File    ? "poses file"
                                                                               : "dataset";
-    msf::writeTrajectory(stage_, used_poses_, frames_, used_name, source_, report_);
+    msf::writeTrajectory(stage_, used_poses_, frames_, used_name, source_, T_out_world_, report_);
     report_.peak_memory_mb = msf::peakMemoryMb();
     report_.writeFramesCsv(path("frames.csv"));
     if (!report_.frames.empty())
@@ -442,8 +444,10 @@ private:
     if (streaming()) {
       if (report_.triangles == 0)
         print_warn("\nno surface was reconstructed: mesh.ply is not written\n");
+      else if (!T_out_world_.matrix().isIdentity())
+        msf::StreamingMap::transformMeshFile(path(report_.mesh_file), T_out_world_);
     } else if (!mesh_->triangles.empty()) {
-      msf::saveMesh(path(report_.mesh_file), polygons_["mesh"]);
+      saveInOutputWorld(report_.mesh_file, polygons_["mesh"]);
       engine_->volume().save(path(report_.volume_file));
     } else {
       print_warn("\nno surface was reconstructed: mesh.ply and volume.pcd are not written\n");
@@ -470,7 +474,16 @@ private:
     if (mesh.triangles.empty())
       return;
     mesh.toPolygonMesh(polygons_[name]);
-    msf::saveMesh(path(name + ".ply"), polygons_[name]);
+    saveInOutputWorld(name + ".ply", polygons_[name]);
+  }
+
+  /// A mesh file in the output's world (-world); `mesh` stays in the map's, for the scores.
+  void saveInOutputWorld(const std::string& name, const pcl::PolygonMesh& mesh) const {
+    if (T_out_world_.matrix().isIdentity())
+      return msf::saveMesh(path(name), mesh);
+    pcl::PolygonMesh moved = mesh;
+    msf::transformMesh(moved, T_out_world_);
+    msf::saveMesh(path(name), moved);
   }
 
   /// The meshes against the true surface (synthetic) and protocol 4 (rendered at every pose).
@@ -533,6 +546,7 @@ private:
   msf::PoseSource poses_;
   msf::RingHoldout holdout_;
   std::set<std::size_t> panel_frames_;
+  Eigen::Isometry3d T_out_world_; // -world: from the map's world to the outputs'
   msf::RunReport report_;
   std::unique_ptr<msf::SyntheticScoring> truth_;
   std::unique_ptr<msf::ReconstructionEvaluation> evaluation_;
@@ -553,8 +567,8 @@ int main(int argc, char** argv) {
   msf::PipelineConfig config;
   msf::tool::CommandLine cli(
       "msf_reconstruct", "[DATASET_DIR] [options]",
-      "Reconstructs a KITTI odometry sequence, a KITTI raw drive or a synthetic sequence (msf_synth) into a coloured "
-      "mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "Reconstructs a dataset (a folder of the generic layout with a rig file, a KITTI odometry sequence or raw drive, "
+      "a synthetic sequence of msf_synth) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
       "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
@@ -567,7 +581,14 @@ int main(int argc, char** argv) {
                request.config_path = path;
              },
              "YAML configuration (config/kitti.yaml); the options below override it")
+      .value("-rig", "FILE", request.rig,
+             "a rig file (README, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
+             "without rig.yaml, and used instead of a dataset's own")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
+      .value("-world", "W", request.world,
+             "camera: the outputs in camera 0 of the first frame (x right, y down, z forward; the default) | z_up: "
+             "x forward, y left, z up (ROS): mesh*.ply, poses.txt, poses_tum.txt (volume.pcd and a streamed map's "
+             "tiles/ and tsdf/ stay the map's own store, in camera 0)")
       .value("-poses", "P", request.poses,
              "dataset: the dataset's poses (the default when it has them) | estimate: LiDAR odometry as each frame is "
              "loaded (the default without them; section odometry) | a KITTI poses file, line i for frame i. "
@@ -635,12 +656,12 @@ int main(int argc, char** argv) {
     const bool poses_file = request.poses != "dataset" && request.poses != "estimate";
     installStopHandler();
     msf::OutputFolder output(request.out, "msf_reconstruct",
-                             {request.dataset, request.config_path, poses_file ? request.poses : ""});
+                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.rig});
     // The default street is generated inside the staging folder (a killed run's goes with it
     // at the next run) and removed before the commit.
     const fs::path street = fs::path(output.dir()) / ".street";
     const std::unique_ptr<msf::FrameSource> source =
-        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset);
+        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, {request.rig});
     if (request.save_depth)
       fs::create_directories(fs::path(output.dir()) / "depth");
 

@@ -4,6 +4,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/io/calibration.h>
+#include <msf/io/rig_file.h>
 #include <msf/io/image_io.h>
 
 #include <opencv2/core/persistence.hpp>
@@ -308,6 +309,8 @@ Calibration readCalibration(const std::string& path) {
                   "' has neither calib_cam_to_cam.txt (KITTI raw) nor calib.txt (KITTI odometry)");
   }
   const std::string ext = fileExtension(path);
+  if ((ext == ".yaml" || ext == ".yml") && isRigFile(path))
+    return loadRigFile(path);
   if (ext == ".yaml" || ext == ".yml" || ext == ".xml")
     return fromYaml(path);
   if (p.filename() == "calib_cam_to_cam.txt")

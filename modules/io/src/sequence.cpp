@@ -62,7 +62,7 @@ bool isOdometrySequence(const fs::path& p) {
 
 } // namespace
 
-Sequence::Sequence(const std::string& dir) {
+Sequence::Sequence(const std::string& dir, const std::string& calibration) {
   requireDirectory(dir, "sequence");
   fs::path p = fs::absolute(dir).lexically_normal();
   if (p.filename().empty())
@@ -104,9 +104,12 @@ Sequence::Sequence(const std::string& dir) {
       poses_ = oxtsToCameraPoses(loadOxts((p / "oxts" / "data").string()), calibration_);
   } else {
     throw IOError("'" + dir +
-                  "' is neither a KITTI odometry sequence (calib.txt, image_0/) nor a KITTI raw drive "
-                  "(image_00/data/ with calib_cam_to_cam.txt in the folder above)");
+                  "' is neither a KITTI odometry sequence (calib.txt, image_0/), a KITTI raw drive "
+                  "(image_00/data/ with calib_cam_to_cam.txt in the folder above) nor a folder of the generic "
+                  "layout (left/, right/, lidar/, rig.yaml)");
   }
+  if (!calibration.empty())
+    calibration_ = loadCalibration(calibration);
   if (frame_names_.empty())
     throw IOError("sequence '" + dir_ + "' has no frames (no images in camera 0's folder)");
   // More right images or scans than frames is a damaged or mixed copy whose extra frames
@@ -153,7 +156,7 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
                             std::to_string(size()) + " frames");
   Frame f;
   f.index = i;
-  f.timestamp = i < timestamps_.size() ? timestamps_[i] : 0.1 * static_cast<double>(i);
+  f.timestamp = timestamp(i);
   // The three PNG decodes (zlib: ~18 ms per KITTI frame) run beside the scan's loading: the
   // first frame of a pipeline waits for them with the other stages idle. A failure's
   // exception reaches the caller through its future.
@@ -192,6 +195,10 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
     f.T_world_cam0 = poses_[i];
   }
   return f;
+}
+
+double Sequence::timestamp(std::size_t i) const {
+  return i < timestamps_.size() ? timestamps_[i] : 0.1 * static_cast<double>(i);
 }
 
 bool Sequence::hasColor() const {

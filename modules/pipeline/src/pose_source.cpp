@@ -1,5 +1,9 @@
 #include <msf/common/exceptions.h>
+#include <msf/io/tum_poses.h>
 #include <msf/pipeline/pose_source.h>
+
+#include <algorithm>
+#include <cmath>
 
 namespace msf {
 
@@ -20,11 +24,35 @@ PoseSource::PoseSource(const std::string& option, const FrameSource& source, con
     kind_ = Kind::File;
     file_ = choice;
     description_ = "file '" + choice + "'";
-    file_poses_ = loadOdometryPoses(choice);
-    for (std::size_t i : frames)
-      if (i >= file_poses_.size())
-        throw InvalidInputError("-poses '" + choice + "' has " + std::to_string(file_poses_.size()) +
-                                " poses (line i is frame i) and no pose for frame " + std::to_string(i));
+    if (isTumPoses(choice))
+      readTum(frames);
+    else
+      readKitti(frames);
+  }
+}
+
+void PoseSource::readKitti(const std::vector<std::size_t>& frames) {
+  file_poses_ = loadOdometryPoses(file_);
+  for (std::size_t i : frames)
+    if (i >= file_poses_.size())
+      throw InvalidInputError("-poses '" + file_ + "' has " + std::to_string(file_poses_.size()) +
+                              " poses (line i is frame i) and no pose for frame " + std::to_string(i));
+}
+
+void PoseSource::readTum(const std::vector<std::size_t>& frames) {
+  // TUM's lines carry their time: each frame takes the pose at its own time (the dataset's,
+  // from its first frame), within 5 ms: a 100 Hz INS's nearest record.
+  constexpr double kToleranceS = 0.005;
+  const StampedPoses tum = loadTumPoses(file_);
+  file_poses_.assign(source_.size(), Eigen::Isometry3d::Identity());
+  for (std::size_t i : frames) {
+    const double t = source_.timestamp(i);
+    const auto it = std::lower_bound(tum.timestamps.begin(), tum.timestamps.end(), t - kToleranceS);
+    if (it == tum.timestamps.end() || std::abs(*it - t) > kToleranceS)
+      throw InvalidInputError("-poses '" + file_ + "' (TUM: timestamp tx ty tz qx qy qz qw) has no pose within 5 ms "
+                              "of frame " + source_.frameName(i) + "'s time " + std::to_string(t) +
+                              " s (times from the dataset's first frame)");
+    file_poses_[i] = tum.poses[static_cast<std::size_t>(it - tum.timestamps.begin())];
   }
 }
 

@@ -1,6 +1,8 @@
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>
+#include <msf/io/tum_poses.h>
+#include <msf/io/world_frame.h>
 #include <msf/pipeline/mesh_renderer.h>
 #include <msf/pipeline/run_outputs.h>
 
@@ -26,10 +28,15 @@ void writeMeshPreview(const std::string& dir, const TriangleMesh& mesh, const Ca
 }
 
 void writeTrajectory(const std::string& dir, const PoseList& used, const std::vector<std::size_t>& frames,
-                     const std::string& used_name, const FrameSource& source, RunReport& report) {
+                     const std::string& used_name, const FrameSource& source, const Eigen::Isometry3d& T_out_world,
+                     RunReport& report) {
   if (used.empty())
     return;
-  saveOdometryPoses((fs::path(dir) / report.poses_file).string(), used);
+  StampedPoses out{{}, transformPoses(used, T_out_world)};
+  for (std::size_t k = 0; k < used.size(); ++k)
+    out.timestamps.push_back(source.timestamp(frames[k]));
+  saveOdometryPoses((fs::path(dir) / report.poses_file).string(), out.poses);
+  saveTumPoses((fs::path(dir) / "poses_tum.txt").string(), out);
   std::vector<std::pair<std::string, PoseList>> trajectories{{used_name, used}};
   if (source.hasPoses() && used_name != "dataset") {
     PoseList reference;

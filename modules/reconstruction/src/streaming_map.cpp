@@ -742,6 +742,16 @@ void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) 
   });
 }
 
+void StreamingMap::transformMeshFile(const std::string& path, const Eigen::Isometry3d& T) {
+  TriangleMesh mesh;
+  readMesh(path, mesh);
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  for (auto& v : mesh.vertices)
+    v = R * v + t;
+  writeMesh(path, mesh);
+}
+
 void StreamingMap::readMesh(const std::string& path, TriangleMesh& mesh) {
   requireFile(path, "mesh");
   std::ifstream in(path, std::ios::binary);

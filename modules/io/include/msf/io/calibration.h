@@ -4,6 +4,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -23,6 +24,13 @@ struct Calibration {
   /// is then the identity and means nothing
   bool has_velodyne = true;
   std::string source;                       ///< where it was read from, for messages
+  /// What the rig says of its LiDAR beyond the extrinsic (a rig file's `lidar:`); KITTI's
+  /// calibrations leave it unknown, and the stages take the rings from the scan's order.
+  struct Lidar {
+    int rings = 0;                          ///< beams, 0 = unknown
+    std::vector<double> beam_elevations_deg; ///< one per ring, lowest first; empty = unknown
+    bool sweeping = true;                   ///< a spinning LiDAR: each scan swept over its period
+  } lidar;
 
   double fx(int camera = 0) const { return P[camera](0, 0); }
   double fy(int camera = 0) const { return P[camera](1, 1); }

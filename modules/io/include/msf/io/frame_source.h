@@ -54,6 +54,8 @@ public:
   /// source. Throws IOError naming a missing or malformed file.
   virtual Frame load(std::size_t i, bool with_color = true) const = 0;
 
+  /// Frame i's time, seconds from the source's first frame (Frame::timestamp), without loading it.
+  virtual double timestamp(std::size_t i) const = 0;
   /// The source's own poses T_world_cam0, one per frame, or none.
   virtual const PoseList& poses() const;
   bool hasPoses() const { return !poses().empty(); }

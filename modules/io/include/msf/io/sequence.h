@@ -18,7 +18,8 @@ public:
   enum class Layout { Odometry, Raw };
 
   /// Throws IOError naming the folder when it is neither layout.
-  explicit Sequence(const std::string& dir);
+  /// `calibration`: a calibration or rig file to use instead of the dataset's own ("" = its own).
+  explicit Sequence(const std::string& dir, const std::string& calibration = "");
 
   Layout layout() const { return layout_; }
   const std::string& directory() const { return dir_; }
@@ -33,6 +34,7 @@ public:
   /// File stem of a frame ("000042" or "0000000042").
   std::string frameName(std::size_t i) const override { return frame_names_.at(i); }
   std::string description() const override { return dir_; }
+  double timestamp(std::size_t i) const override;
   std::string scanName(std::size_t i) const override { return "scan '" + scanPath(i) + "'"; }
   bool hasColor() const override;
   /// A synthetic sequence's scans are taken at one instant; KITTI's are swept.

@@ -14,7 +14,8 @@ struct DatasetOptions {
   std::string rig;
 };
 
-/// Opens a dataset by what the path holds: a KITTI odometry sequence (or a root with one
+/// Opens a dataset by what the path holds: a folder of the generic layout (FolderSource:
+/// left/, right/, lidar/ and a rig file), a KITTI odometry sequence (or a root with one
 /// sequence, as msf_synth writes), a KITTI raw drive. Throws IOError naming the path and the
 /// layouts it knows when it is none of them.
 std::unique_ptr<FrameSource> openDataset(const std::string& path, const DatasetOptions& options = {});

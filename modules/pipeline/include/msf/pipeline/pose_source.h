@@ -16,7 +16,8 @@ class PoseSource {
 public:
   enum class Kind { Dataset, File, Estimated };
 
-  /// `option`: "dataset", "estimate" or the path of a poses file whose line i is frame i;
+  /// `option`: "dataset", "estimate" or the path of a poses file: KITTI's (line i is frame
+  /// i) or TUM's (each frame takes the pose at its time, within 5 ms);
   /// "" is "dataset" when the source has poses, else "estimate". Throws InvalidInputError
   /// naming the option when "dataset" has no poses or the file has no line for one of
   /// `frames`, and IOError for a malformed file.
@@ -39,6 +40,9 @@ public:
   const std::string& file() const { return file_; }
 
 private:
+  void readKitti(const std::vector<std::size_t>& frames);
+  void readTum(const std::vector<std::size_t>& frames);
+
   Kind kind_ = Kind::Dataset;
   std::string description_, file_;
   const FrameSource& source_;

@@ -98,6 +98,9 @@ public:
   /// Reads a PLY that writeMesh or finish wrote (binary, x y z float, red green blue uchar,
   /// triangles). Throws IOError naming the file when it is not one.
   static void readMesh(const std::string& path, TriangleMesh& mesh);
+  /// Moves the vertices of a PLY that writeMesh or finish wrote by T, in place (atomically):
+  /// the union of a streamed map in another world (msf_reconstruct -world z_up).
+  static void transformMeshFile(const std::string& path, const Eigen::Isometry3d& T);
   /// Writes `mesh` as such a PLY, atomically.
   static void writeMesh(const std::string& path, const TriangleMesh& mesh);
   /// Merges vertices at the same position (bit for bit), e.g. of tiles/*.ply put together
