@@ -1,19 +1,11 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
+#include <msf/common/message_text.h>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace msf::limits {
-
-namespace {
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-} // namespace
 
 void checkThreads(int threads, const std::string& name) {
   if (threads < 0 || threads > kMaxThreads)
@@ -39,16 +31,16 @@ void checkRigid(const Eigen::Isometry3d& T, const std::string& what) {
   const double det = R.determinant();
   if (orthonormality > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance)
     throw InvalidInputError(what + " is not a rigid transform: its rotation is not orthonormal (|R^T R - I| = " +
-                            str(orthonormality) + ", det R = " + str(det) + ", tolerance " +
-                            str(kRotationTolerance) + ")");
+                            number(orthonormality) + ", det R = " + number(det) + ", tolerance " +
+                            number(kRotationTolerance) + ")");
   const double t = M.topRightCorner<3, 1>().cwiseAbs().maxCoeff();
   if (t > kMaxTranslationM)
-    throw InvalidInputError(what + " has a translation of " + str(t) + " m, beyond " + str(kMaxTranslationM) + " m");
+    throw InvalidInputError(what + " has a translation of " + number(t) + " m, beyond " + number(kMaxTranslationM) + " m");
 }
 
 std::int64_t checkedRound(double value, std::int64_t lo, std::int64_t hi, const std::string& what) {
   if (!std::isfinite(value) || value < static_cast<double>(lo) - 0.5 || value > static_cast<double>(hi) + 0.5)
-    throw InvalidInputError(what + " " + str(value) + " is outside " + std::to_string(lo) + " .. " +
+    throw InvalidInputError(what + " " + number(value) + " is outside " + std::to_string(lo) + " .. " +
                             std::to_string(hi));
   return std::clamp<std::int64_t>(std::llround(value), lo, hi);
 }

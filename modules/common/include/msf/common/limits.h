@@ -15,12 +15,24 @@ inline constexpr int kMaxThreads = 256;
 /// Side of an image, canvas or calibration in pixels: KITTI's is 1242, 8192 leaves room for
 /// any camera of the field and keeps every pixel index, area and offset within an int.
 inline constexpr int kMaxImageSide = 8192;
+/// Points one LiDAR scan file may hold: the densest sensors give about half a million a sweep;
+/// 2^24 (256 MB of KITTI records) leaves room for any, and a larger file is not one scan (a
+/// 2 GB file was read whole before anything looked at it).
+inline constexpr std::uint64_t kMaxScanPoints = std::uint64_t{1} << 24;
 /// Largest magnitude of a translation in metres (a pose, a calibration's extrinsics):
 /// 1000 km, beyond any drive; divided by the smallest voxel (1 mm) it still fits an int.
 inline constexpr double kMaxTranslationM = 1e6;
 /// Largest depth in metres an input depth image or cloud may hold: KITTI's LiDAR reaches
 /// 120 m; a depth of 1e30 m is a broken input, not a far surface.
 inline constexpr double kMaxDepthM = 1000.0;
+/// Plausible length of a stereo pair's baseline in metres: below a millimetre a pair sees no
+/// depth beyond arm's length, and no rig is 10 m wide (its cameras would share little view);
+/// KITTI's 0.54 m written in millimetres or kilometres lands outside, as does a zero.
+inline constexpr double kMinBaselineM = 1e-3;
+inline constexpr double kMaxBaselineM = 10.0;
+/// How far the intrinsics (fx, fy, cx, cy) of the two cameras of a rectified pair may differ
+/// in pixels: rectification gives both the same, up to the digits a file keeps.
+inline constexpr double kRectifiedIntrinsicsTolerancePx = 0.01;
 /// Tolerance of |R^T R - I| (largest element) and of |det R - 1| for a rotation that was
 /// written with 9 to 12 digits (KITTI's poses and calibrations).
 inline constexpr double kRotationTolerance = 1e-3;
