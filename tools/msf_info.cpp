@@ -46,7 +46,7 @@ void describe(const std::string& path) {
   if (!has_xyz)
     return;
   pcl::PointCloud<pcl::PointXYZ> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(blob, cloud, path);
   std::size_t valid = 0;
   float zmin = std::numeric_limits<float>::max(), zmax = -zmin, rmin = zmin, rmax = -zmin;
   for (const auto& p : cloud) {

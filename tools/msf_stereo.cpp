@@ -45,12 +45,12 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
     if (guided)
       print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
     pcl::PointCloud<pcl::PointXYZ> cloud;
-    pcl::fromPCLPointCloud2(blob, cloud);
+    msf::fromCloudBlob(std::move(blob), cloud, path);
     prior = msf::cloudToDepthImage(cloud);
     return;
   }
   pcl::PointCloud<msf::PointXYZID> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(std::move(blob), cloud, path);
   prior = msf::cloudToDepthImage(cloud);
   cv::Mat distance(prior.size(), CV_32FC1);
   for (int v = 0; v < distance.rows; ++v)

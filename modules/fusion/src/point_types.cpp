@@ -7,6 +7,7 @@
 namespace msf {
 
 template void loadCloud<PointXYZRGBWeight>(const std::string&, pcl::PointCloud<PointXYZRGBWeight>&);
+template void fromCloudBlob<PointXYZRGBWeight>(pcl::PCLPointCloud2, pcl::PointCloud<PointXYZRGBWeight>&, const std::string&);
 template void saveCloud<PointXYZRGBWeight>(const std::string&, const pcl::PointCloud<PointXYZRGBWeight>&);
 template void depthImageToCloud<PointXYZRGBWeight>(const cv::Mat&, const Calibration&, int,
                                                    pcl::PointCloud<PointXYZRGBWeight>&);

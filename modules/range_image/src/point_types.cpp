@@ -7,6 +7,7 @@
 namespace msf {
 
 template void loadCloud<PointXYZID>(const std::string&, pcl::PointCloud<PointXYZID>&);
+template void fromCloudBlob<PointXYZID>(pcl::PCLPointCloud2, pcl::PointCloud<PointXYZID>&, const std::string&);
 template void saveCloud<PointXYZID>(const std::string&, const pcl::PointCloud<PointXYZID>&);
 template void depthImageToCloud<PointXYZID>(const cv::Mat&, const Calibration&, int, pcl::PointCloud<PointXYZID>&);
 template cv::Mat cloudToDepthImage<PointXYZID>(const pcl::PointCloud<PointXYZID>&);

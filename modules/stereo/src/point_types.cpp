@@ -7,6 +7,8 @@
 namespace msf {
 
 template void loadCloud<PointXYZRGBConfidence>(const std::string&, pcl::PointCloud<PointXYZRGBConfidence>&);
+template void fromCloudBlob<PointXYZRGBConfidence>(pcl::PCLPointCloud2, pcl::PointCloud<PointXYZRGBConfidence>&,
+                                                   const std::string&);
 template void saveCloud<PointXYZRGBConfidence>(const std::string&, const pcl::PointCloud<PointXYZRGBConfidence>&);
 template void depthImageToCloud<PointXYZRGBConfidence>(const cv::Mat&, const Calibration&, int,
                                                        pcl::PointCloud<PointXYZRGBConfidence>&);
