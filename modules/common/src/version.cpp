@@ -1,0 +1,3 @@
+#include <msf/common/version.h>
+
+const char* msf::versionString() { return MSF_VERSION_STRING; }
