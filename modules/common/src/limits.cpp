@@ -18,6 +18,11 @@ void checkImageSize(long long width, long long height, const std::string& what) 
     throw InvalidInputError(what + ": image size " + std::to_string(width) + "x" + std::to_string(height) +
                             " is outside 1x1 .. " + std::to_string(kMaxImageSide) + "x" +
                             std::to_string(kMaxImageSide));
+  if (width * height > kMaxImagePixels)
+    throw InvalidInputError(what + ": image size " + std::to_string(width) + "x" + std::to_string(height) + " has " +
+                            std::to_string(width * height) + " pixels, more than the " +
+                            std::to_string(kMaxImagePixels) + " (4096x4096) a frame may have: each of its stages "
+                            "would take gigabytes and minutes");
 }
 
 void checkRigid(const Eigen::Isometry3d& T, const std::string& what) {

@@ -15,6 +15,11 @@ inline constexpr int kMaxThreads = 256;
 /// Side of an image, canvas or calibration in pixels: KITTI's is 1242, 8192 leaves room for
 /// any camera of the field and keeps every pixel index, area and offset within an int.
 inline constexpr int kMaxImageSide = 8192;
+/// Pixels of an image: 2^24 (4096x4096, twice the largest automotive camera's). A pixel takes
+/// tens of bytes in each stage of a frame (an organized cloud alone 32, the matcher's costs,
+/// the writer's buffers): a larger frame needs gigabytes and minutes, not the fraction of a
+/// second a frame is meant to take.
+inline constexpr long long kMaxImagePixels = 1LL << 24;
 /// Points one LiDAR scan file may hold: the densest sensors give about half a million a sweep;
 /// 2^24 (256 MB of KITTI records) leaves room for any, and a larger file is not one scan (a
 /// 2 GB file was read whole before anything looked at it).
@@ -40,7 +45,8 @@ inline constexpr double kRotationTolerance = 1e-3;
 /// Throws ConfigError naming `name` unless 0 <= threads <= kMaxThreads.
 void checkThreads(int threads, const std::string& name);
 
-/// Throws InvalidInputError naming `what` unless 1 <= width, height <= kMaxImageSide.
+/// Throws InvalidInputError naming `what` unless 1 <= width, height <= kMaxImageSide and
+/// width x height <= kMaxImagePixels.
 void checkImageSize(long long width, long long height, const std::string& what);
 
 /// Throws InvalidInputError naming `what` unless T's linear part is a rotation (orthonormal
