@@ -377,6 +377,14 @@ TEST(FuzzRegressions, APlyOfNoVertexLoadsAsAnEmptyCloud) {
   EXPECT_EQ(cloud.width * cloud.height, 0u);
 }
 
+TEST(FuzzRegressions, APlyHeaderLineStartingWithABlankIsRefusedBeforePclAssertsOnIt) {
+  // fuzz_cloud: ' obj_info x' passed the header check (which split the line at blanks) and PCL's
+  // PLYReader, which asserts that the line's first word is obj_info, aborted the program.
+  EXPECT_NE(cloudFindingError("crash-7c247a34df5eacb31f4f9a6e61a64e328c9a51a2").find("c.ply' is not a valid .ply file (bad header): line 3 ' obj_info x': a line "
+                                         "that starts with a blank"),
+            std::string::npos);
+}
+
 TEST(FuzzRegressions, APlyElementCountThatIsNotAWholeNumberIsRefusedBeforePclSizesTheCloud) {
   // fuzz_cloud (the fourth 600 s run): a binary .ply with `element vertex -7`, which PCL's
   // parser reads into a std::size_t as 2^64 - 7 and sized the cloud from (~52 GB). Its second
