@@ -195,6 +195,10 @@ def chunk(kind, data):
 with open(f + "/huge.png", "wb") as o:
     o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 30000, 20000, 8, 0, 0, 0, 0)) +
             chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b""))
+# ... and 8192 x 2472: within 8192 a side, but a pair of them ran for minutes in gigabytes.
+with open(f + "/wide.png", "wb") as o:
+    o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 8192, 2472, 8, 0, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b""))
 # Calibrations (the project's YAML): good, and each fault on its own.
 def yaml(path, fx=60.0, tx1=-30.0, w=8, h=6, nan=False):
     P = lambda tx: "[ %s, 0., 3.5, %s, 0., %s, 2.5, 0., 0., 0., 1., 0. ]" % (fx, tx, fx)
@@ -330,6 +334,10 @@ check "pcd2png: a depth of 1e30 m saturates, said" 0 "1 pixel of the depth beyon
   msf_pcd2png "$F/far.pcd" d.png
 check "stereo: 30000x20000 PNG header" 1 "huge.png': image size 30000x20000 is outside 1x1 .. 8192x8192" -- \
   msf_stereo "$F/huge.png" "$F/huge.png" o.pcd -calib "$F/camera.yaml"
+check "stereo: an 8192x2472 pair" 1 "wide.png': image size 8192x2472 has 20250624 pixels, more than the 16777216 \(4096x4096\)" -- \
+  msf_stereo "$F/wide.png" "$F/wide.png" o.pcd -calib "$F/camera.yaml"
+check "project -image_size 8192x8192" 1 "the image size given: image size 8192x8192 has 67108864 pixels, more than the 16777216" -- \
+  msf_project "$F/scan.bin" o.pcd -calib "$F/camera.yaml" -image_size 8192x8192
 check "interpolate: empty (all-NaN) cloud" 1 "allnan.pcd' lands in the image: the cloud has no finite point" -- \
   msf_interpolate "$F/allnan.pcd" o.pcd -calib "$F/camera.yaml"
 check "interpolate: empty cloud, no calibration" 1 "too few valid points \(0\)" -- msf_interpolate "$F/allnan.pcd" o.pcd
