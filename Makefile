@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The cost of writing checked to the end (msf/common/checked_write.h) beside PCL's own writers,
 // in the same run, into /dev/shm (the CPU's cost, not a disk's): an organized KITTI-sized
 // cloud as a binary compressed .pcd (PCL's file writer maps the file; saveCloud goes through

@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # cmake -DSOURCE_DIR=... -DOUTPUT=... -P GitCommit.cmake
 # Writes OUTPUT, the definition of msf::gitCommit(), from the git checkout at SOURCE_DIR; the
 # file is rewritten only when the commit changes, so a build recompiles it only then.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The PLY readers: msf::loadCloud and msf::loadMesh on .ply files, with inputs up to 256 KB
 // (make fuzz) so that headers reach the 64 KB the header check reads. The first byte picks
 // the reader (even: cloud, odd: mesh), the rest is the file.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Seed corpora of the fuzz targets, from the KITTI sample (../shared/data/kitti).
 
     make_corpus.py KITTI_DIR OUT_DIR

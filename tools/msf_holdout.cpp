@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Evaluation protocol 2 (docs/design.md): ring hold-out on real KITTI scans. One row per
 // method: the table a user compares depth methods with. On a synthetic sequence (gt/ beside
 // it, protocol 3) the whole scan is the input and every pixel of gt/depth_0 is ground truth,

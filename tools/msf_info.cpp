@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Prints what a .pcd holds: size, organization, fields, valid points, depth range.
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>

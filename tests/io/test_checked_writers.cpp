@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The writers of the io module on a full disk: an error naming the file and the reason, and no
 // file left, where PCL's and OpenCV's writers returned success with a truncated file.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The pipeline on a small synthetic sequence: same depth as the chain of tools, a sane
 // summary, a clean stop, and clear errors.
 #include <msf/common/output_folder.h>

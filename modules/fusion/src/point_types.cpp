@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The io templates (cloud files, organized conversion) for the fused point type, so tools
 // and tests load and save it without including the implementations.
 #include <msf/fusion/point_types.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The io templates (cloud files, organized conversion) for the interpolated-LiDAR point
 // type, so tools and tests load and save it without including the implementations.
 #include <msf/io/impl/cloud_io.hpp>
