@@ -26,9 +26,9 @@ TEST(Version, IsTheProjectsAndTheCommitBuiltFrom) {
 TEST(Version, EveryToolPrintsItOnVersionAndAtTheEndOfItsHelp) {
   const std::string line = std::string("(msfusion) ") + msf::versionString() + ", commit " + msf::gitCommit();
   std::size_t tools = 0;
-  for (const auto& e : fs::directory_iterator(msf::test::binDir())) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind("msf_", 0) != 0)
+  for (const auto& e : fs::directory_iterator(fs::path(msf::test::sourceDir()) / "tools")) {
+    const std::string name = e.path().stem().string();
+    if (name.rfind("msf_", 0) != 0 || e.path().extension() != ".cpp")
       continue;
     ++tools;
     const auto version = msf::test::runTool(name, "--version");
