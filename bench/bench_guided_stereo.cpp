@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Guided SGBM (stereo.guidance lidar) beside unguided, per KITTI frame (odometry 04, frames
 // 0-9 in turn, 1226 x 370), both narrowed by the interpolated LiDAR as the pipeline does.
 // BM_SgbmStereo: SgbmStereo::computeDisparity (the default five paths, hints from the sparse

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads),
 // each with both engines side by side (stereo.engine: native = our AVX2 SemiGlobalMatcher,
 // opencv = cv::StereoSGBM): the baseline docs/results.md quotes (3-way, 128 disparities, block 5), the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # make bench: every benchmark of bench/, on the KITTI sample.
 # Usage: bench/run_all.sh BIN_DIR KITTI_DIR
 set -euo pipefail

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_convert: any dataset the project reads into the generic layout (a rig file, lidar/,
 // left/, right/, color/, timestamps.txt, poses.txt): what a user's own recording looks like.
 #include <msf/common/atomic_file.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The main job: a dataset (or the built-in synthetic street) to a coloured mesh, with a report
 // of speed and, where ground truth exists, accuracy. A door over the library's engine
 // (msf::Reconstructor): a reader feeds it, writers and evaluations take what it gives.

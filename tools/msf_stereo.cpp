@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 3: SGBM (5-path or 3-way) on a rectified grey pair to an organized cloud in camera 0
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
@@ -45,12 +46,12 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
     if (guided)
       print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
     pcl::PointCloud<pcl::PointXYZ> cloud;
-    pcl::fromPCLPointCloud2(blob, cloud);
+    msf::fromCloudBlob(std::move(blob), cloud, path);
     prior = msf::cloudToDepthImage(cloud);
     return;
   }
   pcl::PointCloud<msf::PointXYZID> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(std::move(blob), cloud, path);
   prior = msf::cloudToDepthImage(cloud);
   cv::Mat distance(prior.size(), CV_32FC1);
   for (int v = 0; v < distance.rows; ++v)

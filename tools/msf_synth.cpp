@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Writes a synthetic street in KITTI's odometry layout, with exact ground truth.
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A user's own recording: the generic folder layout (FolderSource) read as the KITTI reader
 // reads the same frames, in every scan and image format, with frames matched to their lines
 // by number.

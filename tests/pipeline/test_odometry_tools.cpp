@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The tracking module end to end: a dataset without poses is tracked (msf_odometry) and
 // reconstructed (msf_reconstruct's default -poses estimate, on the pipeline's pose thread);
 // bad pose files and degenerate scans are errors that name what is wrong.

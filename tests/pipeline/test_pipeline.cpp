@@ -1,8 +1,10 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The pipeline on a small synthetic sequence: same depth as the chain of tools, a sane
 // summary, a clean stop, and clear errors.
 #include <msf/common/output_folder.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/version.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/organized_conversion.h>
@@ -108,6 +110,11 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
                            "report.md", "depth_000000.png", "depth_000003.png"})
     EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
   const std::string json = readFile(out.file("summary.json"));
+  // The run names the build that made it.
+  EXPECT_NE(json.find("\"msfusion\": {\"version\": \"" + msf::versionString() + "\", \"commit\": \"" +
+                      msf::gitCommit() + "\"}"),
+            std::string::npos)
+      << json;
   EXPECT_EQ(jsonNumber(json, "frames"), 4);
   EXPECT_GT(jsonNumber(json, "frames_per_second"), 0.0);
   // The first frame is done before the run ends, and the three after it take the rest.

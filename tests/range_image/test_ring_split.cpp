@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Ring ids by azimuth wraps (protocol 2) on hand-made sweeps and a real KITTI scan.
 #include <msf/common/exceptions.h>
 #include <msf/io/sequence.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Analytic scenes and cameras shared by the reconstruction tests.
 #include <msf/reconstruction/analytic_scene.h>

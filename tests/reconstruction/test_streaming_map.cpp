@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "scenes.h"
 #include "test_support.h"
 
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 using namespace msf;
@@ -271,6 +273,37 @@ TEST(StreamingMap, StoreReloadsAndMeshesAgainToTheSameMesh) {
                                                 Eigen::Vector3d(10, 10, 6));
   EXPECT_GT(part, 0u);
   EXPECT_LT(part, memory.mesh.triangles.size());
+}
+
+TEST(StreamingMap, AStoreIndexListingATileTwiceIsRefused) {
+  // Meshed twice, every triangle of the tile was doubled.
+  const double length = 10.0;
+  test::TempDir dir;
+  integrateDrive(drive(length, 0.5), length, dir.path(), minimumRadius() + 0.2);
+  const std::string index = dir.path() + "/tsdf/index.txt";
+  std::ifstream in(index);
+  std::string text, line, first_tile;
+  std::size_t tiles = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("tiles ", 0) == 0) {
+      tiles = std::stoul(line.substr(6));
+      line = "tiles " + std::to_string(tiles + 1);
+    } else if (tiles > 0 && first_tile.empty()) {
+      first_tile = line;
+    }
+    text += line + "\n";
+  }
+  in.close();
+  ASSERT_GT(tiles, 1u);
+  std::ofstream(index) << text << first_tile << "\n";
+  std::istringstream xyz(first_tile);
+  int x = 0, y = 0, z = 0;
+  xyz >> x >> y >> z;
+  const std::string e = test::errorOf([&] { StreamingMap::loadStore(dir.path()); });
+  EXPECT_EQ(e, "TSDF store index '" + index + "' lists tile " + std::to_string(x) + "_" + std::to_string(y) + "_" +
+                   std::to_string(z) + " twice (tiles 1 and " + std::to_string(tiles + 1) + ")");
+  EXPECT_THROW(StreamingMap::remesh(dir.path(), MarchingCubes::Config(), dir.file("m.ply")), IOError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
 }
 
 TEST(StreamingMap, ALoopBackIntoStreamedSpaceReadsItBackAndDoublesNoSurface) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Hand-made rectified pairs with known disparity, shared by the stereo tests.
 #include <msf/io/calibration.h>

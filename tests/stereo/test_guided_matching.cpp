@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Guided semi-global matching: sparse disparity hints (projected LiDAR returns) in the
 // native matcher's costs, the hints made from a sparse depth, and SgbmStereo's plumbing.
 #include <msf/common/exceptions.h>

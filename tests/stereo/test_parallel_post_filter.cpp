@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The stereo post-processing with our parallel routines gives exactly what OpenCV's serial
 // functions give (setParallelPostFilterEnabled(false)): the matcher's disparity and the
 // stereo confidence, on a synthetic pair and on KITTI.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/image_io.h>
 #include <msf/stereo/semi_global_matcher.h>

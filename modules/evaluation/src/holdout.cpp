@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/evaluation/holdout.h>
@@ -174,8 +176,7 @@ std::string formatHoldoutBreakdown(const std::vector<HoldoutResult>& results) {
 }
 
 void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& results) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out << "method,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
            "imae_per_km,irmse_per_km,median_ms,gross_share,gross_mae_part_m\n";
     out.precision(6);
@@ -186,9 +187,6 @@ void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& 
           << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << r.median_ms << ',' << m.gross_share << ','
           << m.gross_mae_part_m << '\n';
     }
-    out.flush();
-    if (!out)
-      throw IOError("cannot write '" + path + "'");
   });
 }
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/folder_source.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/open_dataset.h>

@@ -1,7 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/line_plot.h>
+#include <msf/common/version.h>
 #include <msf/common/statistics.h>
 #include <msf/io/image_io.h>
 #include <msf/pipeline/run_report.h>
@@ -236,6 +238,8 @@ void RunReport::writeFramesCsv(const std::string& path) const {
 void RunReport::writeSummaryJson(const std::string& path) const {
   std::ostringstream s;
   s << "{\n"
+    << "  \"msfusion\": {\"version\": " << jsonString(versionString()) << ", \"commit\": " << jsonString(gitCommit())
+    << "},\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
     << "  \"layout\": " << jsonString(layout) << ",\n"
     << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);

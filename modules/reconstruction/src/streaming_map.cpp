@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
@@ -64,11 +66,16 @@ StoreIndex readIndex(const std::string& directory) {
       k1 != "voxel_size_m" || k2 != "truncation_m" || k3 != "block_side" || k4 != "tile_blocks" || k5 != "tiles" ||
       side != kSide || !(index.voxel_size > 0) || !(index.truncation > 0) || index.tile_blocks < 1)
     throw IOError("TSDF store index '" + path + "' is not one a StreamingMap wrote (first line '" + kIndexTag + "')");
+  std::map<std::tuple<int, int, int>, std::size_t> listed; // a tile twice would be meshed twice
   for (std::size_t i = 0; i < count; ++i) {
     GridIndex t;
     if (!(in >> t.x() >> t.y() >> t.z()))
       throw IOError("TSDF store index '" + path + "' lists " + std::to_string(count) + " tiles but ends after " +
                     std::to_string(i));
+    const auto [first, fresh] = listed.emplace(std::make_tuple(t.x(), t.y(), t.z()), i + 1);
+    if (!fresh)
+      throw IOError("TSDF store index '" + path + "' lists tile " + tileName(t) + " twice (tiles " +
+                    std::to_string(first->second) + " and " + std::to_string(i + 1) + ")");
     index.tiles.push_back(t);
   }
   return index;
@@ -86,8 +93,7 @@ std::string meshPath(const std::string& tiles, const GridIndex& tile) {
 /// and its 512 voxels as in memory (12 bytes each, the integrator's flags zeroed; they are
 /// zero between frames anyway), little-endian as the host.
 void writeBlocks(const std::string& path, double voxel_size, double truncation, const std::vector<const TsdfBlock*>& blocks) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out.write(kBlockMagic, sizeof(kBlockMagic));
     const std::int32_t header[2] = {kSide, static_cast<std::int32_t>(blocks.size())};
     out.write(reinterpret_cast<const char*>(&voxel_size), sizeof(double));
@@ -106,8 +112,6 @@ void writeBlocks(const std::string& path, double voxel_size, double truncation, 
         v.flags = 0;
       out.write(reinterpret_cast<const char*>(voxels.data()), sizeof(voxels));
     }
-    if (!out.flush())
-      throw IOError("cannot write TSDF blocks '" + path + "': disk full?");
   });
 }
 
@@ -301,8 +305,7 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
       throw IOError("mesh '" + path + "': more than 2^32 vertices");
     welder.number(buffer.data(), counts[i].vertices, first[i], index, fresh);
   }
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     const std::string header = plyHeader(welder.next(), faces);
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
     for (std::size_t i = 0; i < present.size(); ++i) {
@@ -335,8 +338,6 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
       }
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     }
-    if (!out.flush())
-      throw IOError("cannot write mesh '" + path + "': disk full?");
   });
   return faces;
 }
@@ -640,12 +641,8 @@ void StreamingMap::writeIndex() const {
     ss << t.x() << " " << t.y() << " " << t.z() << "\n";
   }
   const std::string text = ss.str();
-  writeAtomically((fs::path(directory_) / "tsdf" / "index.txt").string(), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw IOError("cannot write the TSDF store index in '" + directory_ + "': disk full?");
-  });
+  writeStreamAtomically((fs::path(directory_) / "tsdf" / "index.txt").string(),
+                        [&](std::ostream& out) { out << text; });
 }
 
 std::size_t StreamingMap::finish(const std::string& mesh_path) {
@@ -734,12 +731,7 @@ void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) 
     std::memcpy(p + 1, t.data(), 12);
     p += kFaceBytes;
   }
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    if (!out.flush())
-      throw IOError("cannot write mesh '" + path + "': disk full?");
-  });
+  writeBytesAtomically(path, data.data(), data.size());
 }
 
 void StreamingMap::transformMeshFile(const std::string& path, const Eigen::Isometry3d& T) {

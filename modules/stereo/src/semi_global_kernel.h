@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The vectorised core of SemiGlobalMatcher (private to the stereo module): one horizontal
 // strip of rows of OpenCV's 3-way semi-global block matching (5-way with the diagonal paths

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The kernel of SemiGlobalMatcher, written once over a vector type V (semi_global_kernel_simd.cpp
 // includes it twice: V = 16 x int16 AVX2 lanes and V = 32 x int16 AVX-512BW lanes, each under
 // its own target pragma and namespace). No include guard, on purpose; no includes, so that

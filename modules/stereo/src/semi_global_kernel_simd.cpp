@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The vector kernels of SemiGlobalMatcher: OpenCV's StereoSGBM (MODE_SGBM_3WAY, or with the
 // two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection
 // (semi_global_kernel_body.h), compiled twice, for AVX2 (16 disparities per instruction) and

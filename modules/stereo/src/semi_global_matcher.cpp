@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "semi_global_kernel.h"
 
 #include <msf/common/parallel.h>

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/io/cloud_io.h>
@@ -54,12 +56,7 @@ double farthestZ(const PoseList& poses) {
 }
 
 void writeText(const fs::path& path, const std::string& text) {
-  writeAtomically(path.string(), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw IOError("cannot write '" + path.string() + "'");
-  });
+  writeStreamAtomically(path.string(), [&](std::ostream& out) { out << text; });
 }
 
 const char* kGroundTruthReadme =
