@@ -1,0 +1,119 @@
+"""The Python module gives what the C++ tools give on the shared KITTI frames, bit for bit: each
+stage against msf_interpolate, msf_stereo and msf_fuse, the pipeline's depth and mesh against
+msf_reconstruct's, and the TSDF volume against msf_integrate and msf_mesh."""
+import os
+
+import numpy as np
+import pytest
+
+import msfusion
+
+FRAMES = 10  # odometry 04 frames 0-9
+
+
+@pytest.fixture(scope="module")
+def sequence(odometry04):
+    return msfusion.Sequence(odometry04)
+
+
+@pytest.fixture(scope="module")
+def tool_chain(odometry04, run_tool, tmp_path_factory):
+    """Frames 0-2 through msf_interpolate, msf_stereo, msf_fuse, then msf_integrate and msf_mesh."""
+    out = tmp_path_factory.mktemp("tools")
+    calib = os.path.join(odometry04, "calib.txt")
+    fused = []
+    for i in range(3):
+        name = f"{i:06d}"
+        lidar, stereo = out / f"lidar_{name}.pcd", out / f"stereo_{name}.pcd"
+        fused.append(out / f"fused_{name}.pcd")
+        image = lambda camera: os.path.join(odometry04, f"image_{camera}", name + ".png")  # noqa: E731
+        run_tool("msf_interpolate", os.path.join(odometry04, "velodyne", name + ".bin"), lidar, "-calib", calib)
+        run_tool("msf_stereo", image(0), image(1), stereo, "-calib", calib, "-color", image(2), "-prior", lidar)
+        run_tool("msf_fuse", lidar, stereo, fused[-1], "-calib", calib, "-color", image(2), "-left", image(0))
+    poses = os.path.join(odometry04, "..", "..", "poses", "04.txt")
+    run_tool("msf_integrate", *fused, "-poses", poses, "-frames", "0:2", "-calib", calib, "-o", out / "volume.pcd")
+    run_tool("msf_mesh", out / "volume.pcd", out / "mesh.ply")
+    return out
+
+
+@pytest.fixture(scope="module")
+def reconstructed(odometry04, run_tool, tmp_path_factory):
+    """msf_reconstruct on frames 0-9, with each frame's fused depth saved."""
+    out = tmp_path_factory.mktemp("reconstruct") / "out"
+    run_tool("msf_reconstruct", odometry04, "-o", out, "-frames", f"0:{FRAMES - 1}", "-save_depth", "-panels", "0")
+    return out
+
+
+def per_stage_depth(sequence, i):
+    """Steps 1-4 of frame i through the per-stage calls, as the pipeline chains them."""
+    calibration = sequence.calibration
+    frame = sequence[i]
+    lidar_depth, distance = msfusion.LidarCompletion(calibration).compute_depth(frame.scan)
+    stereo_depth, confidence = msfusion.SgbmStereo(calibration).compute_depth(
+        frame.left, frame.right, prior=lidar_depth, guidance=msfusion.real_returns(lidar_depth, distance))
+    depth, weight = msfusion.DepthFusion(calibration).fuse(lidar_depth, distance, stereo_depth, confidence,
+                                                            left=frame.left)
+    color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
+    return dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color)
+
+
+def assert_same_image(a, b, what):
+    assert a.shape == b.shape and a.dtype == b.dtype, what
+    differ = np.count_nonzero(a != b)
+    assert differ == 0, f"{what}: {differ} pixels differ, largest by {np.max(np.abs(a.astype(float) - b))}"
+
+
+def test_each_stage_gives_the_tools_output(sequence, tool_chain):
+    camera = sequence.calibration.camera(0)
+    for i in range(3):
+        ours = per_stage_depth(sequence, i)
+        lidar, _, _ = msfusion.read_depth_cloud(str(tool_chain / f"lidar_{i:06d}.pcd"), camera)
+        stereo, _, _ = msfusion.read_depth_cloud(str(tool_chain / f"stereo_{i:06d}.pcd"), camera)
+        fused, weight, color = msfusion.read_depth_cloud(str(tool_chain / f"fused_{i:06d}.pcd"), camera)
+        assert np.count_nonzero(fused) > fused.size / 2
+        assert_same_image(ours["lidar"], lidar, f"frame {i}: LiDAR depth against msf_interpolate")
+        assert_same_image(ours["stereo"], stereo, f"frame {i}: stereo depth against msf_stereo")
+        assert_same_image(ours["depth"], fused, f"frame {i}: fused depth against msf_fuse")
+        has_depth = fused > 0
+        assert_same_image(ours["weight"][has_depth], weight[has_depth], f"frame {i}: weight against msf_fuse")
+        assert_same_image(ours["color"][has_depth], color[has_depth], f"frame {i}: colour against msf_fuse")
+
+
+def test_the_volume_meshes_as_msf_integrate_and_msf_mesh(sequence, tool_chain):
+    volume = msfusion.TsdfVolume()
+    for i in range(3):
+        ours = per_stage_depth(sequence, i)
+        volume.integrate(ours["depth"], sequence.poses[i], sequence.calibration, weight=ours["weight"],
+                         color=ours["color"])
+    mesh, theirs = volume.extract_mesh(), msfusion.read_mesh(str(tool_chain / "mesh.ply"))
+    assert len(mesh.triangles) > 10000
+    np.testing.assert_array_equal(mesh.vertices, theirs.vertices)
+    np.testing.assert_array_equal(mesh.triangles, theirs.triangles)
+    np.testing.assert_array_equal(mesh.colors, theirs.colors)
+
+
+def test_the_pipeline_gives_msf_reconstructs_depth_and_mesh(sequence, reconstructed):
+    pipeline = msfusion.Pipeline(sequence.calibration)
+    camera = sequence.calibration.camera(0)
+    for i in range(FRAMES):
+        result = pipeline.add_frame(sequence[i])
+        theirs, weight, _ = msfusion.read_depth_cloud(str(reconstructed / "depth" / f"{i:06d}.pcd"), camera)
+        assert_same_image(result.depth, theirs, f"frame {i}: fused depth against msf_reconstruct -save_depth")
+        if i == 0:  # the per-stage calls chain into the pipeline's depth
+            assert_same_image(per_stage_depth(sequence, 0)["depth"], result.depth, "per-stage against the pipeline")
+    mesh, theirs = pipeline.update_mesh(), msfusion.read_mesh(str(reconstructed / "mesh.ply"))
+    assert len(mesh.triangles) > 50000
+    np.testing.assert_array_equal(mesh.vertices, theirs.vertices)
+    np.testing.assert_array_equal(mesh.triangles, theirs.triangles)
+    np.testing.assert_array_equal(mesh.colors, theirs.colors)
+
+
+def test_a_frame_made_of_arrays_gives_the_loaded_frames_depth(sequence):
+    loaded = sequence[3]
+    made = msfusion.Frame(loaded.left.copy(), loaded.right.copy(), loaded.scan, color=loaded.color,
+                          pose=loaded.pose, index=3)
+    a = msfusion.Pipeline(sequence.calibration).compute_depth(loaded)
+    b = msfusion.Pipeline(sequence.calibration).compute_depth(made)
+    assert_same_image(a.depth, b.depth, "fused depth of a frame made of arrays")
+    assert_same_image(a.weight, b.weight, "weight of a frame made of arrays")
+    np.testing.assert_array_equal(a.color, b.color)
