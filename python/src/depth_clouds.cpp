@@ -8,6 +8,7 @@
 #include <msf/reconstruction/depth_frame.h>
 
 #include <opencv2/imgproc.hpp>
+#include <pybind11/stl.h>
 
 #include <optional>
 #include <string>
