@@ -1,0 +1,13 @@
+"""A KITTI drive to a coloured mesh: python3 kitti_to_mesh.py SEQUENCE_DIR MESH.ply"""
+import sys
+
+import msfusion
+
+sequence = msfusion.Sequence(sys.argv[1])           # KITTI odometry sequence, raw drive or msf_synth's street
+pipeline = msfusion.Pipeline(sequence.calibration)  # every stage with config/kitti.yaml's settings
+for frame in sequence:
+    result = pipeline.add_frame(frame)              # fused depth and weight, integrated at the frame's pose
+    print(f"frame {frame.name}: {(result.depth > 0).mean():.0%} of the pixels have depth")
+mesh = pipeline.update_mesh()
+mesh.save(sys.argv[2])
+print(f"{len(mesh.vertices)} vertices, {len(mesh.triangles)} triangles -> {sys.argv[2]}")
