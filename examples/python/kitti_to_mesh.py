@@ -1,11 +1,12 @@
-"""A KITTI drive to a coloured mesh: python3 kitti_to_mesh.py SEQUENCE_DIR MESH.ply"""
+"""A KITTI drive to a coloured mesh: python3 kitti_to_mesh.py SEQUENCE_DIR MESH.ply [FRAMES]"""
+import itertools
 import sys
 
 import msfusion
 
 sequence = msfusion.Sequence(sys.argv[1])           # KITTI odometry sequence, raw drive or msf_synth's street
 pipeline = msfusion.Pipeline(sequence.calibration)  # every stage with config/kitti.yaml's settings
-for frame in sequence:
+for frame in itertools.islice(sequence, int(sys.argv[3]) if len(sys.argv) > 3 else None):
     result = pipeline.add_frame(frame)              # fused depth and weight, integrated at the frame's pose
     print(f"frame {frame.name}: {(result.depth > 0).mean():.0%} of the pixels have depth")
 mesh = pipeline.update_mesh()

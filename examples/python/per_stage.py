@@ -1,9 +1,10 @@
 """A KITTI drive to a mesh stage by stage, each stage a call on numpy arrays:
-python3 per_stage.py SEQUENCE_DIR MESH.ply
+python3 per_stage.py SEQUENCE_DIR MESH.ply [FRAMES]
 
 The pipeline (kitti_to_mesh.py) chains the same stages; it also integrates the interpolated
 LiDAR beyond the image's border and clears free space with the whole scan, so its mesh is a
 little larger."""
+import itertools
 import sys
 
 import msfusion
@@ -15,7 +16,7 @@ stereo = msfusion.SgbmStereo(calibration)       # step 3: semi-global matching
 fusion = msfusion.DepthFusion(calibration)      # step 4: per-pixel fusion
 volume = msfusion.TsdfVolume()                  # step 5: TSDF volume and marching cubes
 
-for frame in sequence:
+for frame in itertools.islice(sequence, int(sys.argv[3]) if len(sys.argv) > 3 else None):
     lidar_depth, distance = lidar.compute_depth(frame.scan)            # (N, 4) float32 -> (H, W) float32
     stereo_depth, confidence = stereo.compute_depth(
         frame.left, frame.right,                                       # (H, W) uint8

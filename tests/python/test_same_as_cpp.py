@@ -49,17 +49,34 @@ def reconstructed(odometry04, run_tool, tmp_path_factory):
     return out
 
 
-def per_stage_depth(sequence, i):
-    """Steps 1-4 of frame i through the per-stage calls, as the pipeline chains them."""
+@pytest.fixture(scope="module")
+def per_stage(sequence):
+    """Steps 1-4 of frames 0-2 through the per-stage calls, as the pipeline chains them (one
+    object per stage for all frames, as a notebook keeps them)."""
     calibration = sequence.calibration
-    frame = sequence[i]
-    lidar_depth, distance = msfusion.LidarCompletion(calibration).compute_depth(frame.scan)
-    stereo_depth, confidence = msfusion.SgbmStereo(calibration).compute_depth(
-        frame.left, frame.right, prior=lidar_depth, guidance=msfusion.real_returns(lidar_depth, distance))
-    depth, weight = msfusion.DepthFusion(calibration).fuse(lidar_depth, distance, stereo_depth, confidence,
-                                                            left=frame.left)
-    color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
-    return dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color)
+    lidar, stereo = msfusion.LidarCompletion(calibration), msfusion.SgbmStereo(calibration)
+    fusion = msfusion.DepthFusion(calibration)
+    results = []
+    for i in range(3):
+        frame = sequence[i]
+        lidar_depth, distance = lidar.compute_depth(frame.scan)
+        stereo_depth, confidence = stereo.compute_depth(frame.left, frame.right, prior=lidar_depth,
+                                                        guidance=msfusion.real_returns(lidar_depth, distance))
+        depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left)
+        color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
+        results.append(dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color))
+    return results
+
+
+@pytest.fixture(scope="module")
+def pipeline_run(sequence):
+    """Frames 0-9 through Pipeline.add_frame: each frame's fused depth, weight and colour, and the mesh."""
+    pipeline = msfusion.Pipeline(sequence.calibration)
+    frames = []
+    for i in range(FRAMES):
+        result = pipeline.add_frame(sequence[i])
+        frames.append(dict(depth=result.depth, weight=result.weight, color=result.color))
+    return frames, pipeline.update_mesh()
 
 
 def assert_same_image(a, b, what):
@@ -68,10 +85,15 @@ def assert_same_image(a, b, what):
     assert differ == 0, f"{what}: {differ} pixels differ, largest by {np.max(np.abs(a.astype(float) - b))}"
 
 
-def test_each_stage_gives_the_tools_output(sequence, tool_chain):
+def assert_same_mesh(a, b):
+    np.testing.assert_array_equal(a.vertices, b.vertices)
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    np.testing.assert_array_equal(a.colors, b.colors)
+
+
+def test_each_stage_gives_the_tools_output(sequence, tool_chain, per_stage, pipeline_run):
     camera = sequence.calibration.camera(0)
-    for i in range(3):
-        ours = per_stage_depth(sequence, i)
+    for i, ours in enumerate(per_stage):
         lidar, _, _ = msfusion.read_depth_cloud(str(tool_chain / f"lidar_{i:06d}.pcd"), camera)
         stereo, _, _ = msfusion.read_depth_cloud(str(tool_chain / f"stereo_{i:06d}.pcd"), camera)
         fused, weight, _ = msfusion.read_depth_cloud(str(tool_chain / f"fused_{i:06d}.pcd"), camera)
@@ -81,8 +103,9 @@ def test_each_stage_gives_the_tools_output(sequence, tool_chain):
         assert_same_image(ours["depth"], fused, f"frame {i}: fused depth against msf_fuse")
         has_depth = fused > 0
         assert_same_image(ours["weight"][has_depth], weight[has_depth], f"frame {i}: weight against msf_fuse")
-        pipeline = msfusion.Pipeline(sequence.calibration).compute_depth(sequence[i])
-        assert_same_image(ours["color"], pipeline.color, f"frame {i}: colour against the pipeline's")
+        pipeline = pipeline_run[0][i]
+        assert_same_image(ours["depth"], pipeline["depth"], f"frame {i}: fused depth against the pipeline's")
+        assert_same_image(ours["color"], pipeline["color"], f"frame {i}: colour against the pipeline's")
 
 
 def test_the_volume_meshes_as_msf_integrate_and_msf_mesh(sequence, tool_chain):
@@ -92,27 +115,21 @@ def test_the_volume_meshes_as_msf_integrate_and_msf_mesh(sequence, tool_chain):
     for i in range(3):
         depth, weight, color = msfusion.read_depth_cloud(str(tool_chain / f"fused_{i:06d}.pcd"), camera)
         volume.integrate(depth, sequence.poses[i], camera, weight=weight, color=color)
-    mesh, theirs = volume.extract_mesh(), msfusion.read_mesh(str(tool_chain / "mesh.ply"))
+    mesh = volume.extract_mesh()
     assert len(mesh.triangles) > 10000
-    np.testing.assert_array_equal(mesh.vertices, theirs.vertices)
-    np.testing.assert_array_equal(mesh.triangles, theirs.triangles)
-    np.testing.assert_array_equal(mesh.colors, theirs.colors)
+    assert_same_mesh(mesh, msfusion.read_mesh(str(tool_chain / "mesh.ply")))
 
 
-def test_the_pipeline_gives_msf_reconstructs_depth_and_mesh(sequence, reconstructed):
-    pipeline = msfusion.Pipeline(sequence.calibration)
+def test_the_pipeline_gives_msf_reconstructs_depth_and_mesh(sequence, reconstructed, pipeline_run):
+    frames, mesh = pipeline_run
     camera = sequence.calibration.camera(0)
-    for i in range(FRAMES):
-        result = pipeline.add_frame(sequence[i])
+    for i, ours in enumerate(frames):
         theirs, weight, _ = msfusion.read_depth_cloud(str(reconstructed / "depth" / f"{i:06d}.pcd"), camera)
-        assert_same_image(result.depth, theirs, f"frame {i}: fused depth against msf_reconstruct -save_depth")
-        if i == 0:  # the per-stage calls chain into the pipeline's depth
-            assert_same_image(per_stage_depth(sequence, 0)["depth"], result.depth, "per-stage against the pipeline")
-    mesh, theirs = pipeline.update_mesh(), msfusion.read_mesh(str(reconstructed / "mesh.ply"))
+        assert_same_image(ours["depth"], theirs, f"frame {i}: fused depth against msf_reconstruct -save_depth")
+        has_depth = theirs > 0
+        assert_same_image(ours["weight"][has_depth], weight[has_depth], f"frame {i}: weight against msf_reconstruct")
     assert len(mesh.triangles) > 50000
-    np.testing.assert_array_equal(mesh.vertices, theirs.vertices)
-    np.testing.assert_array_equal(mesh.triangles, theirs.triangles)
-    np.testing.assert_array_equal(mesh.colors, theirs.colors)
+    assert_same_mesh(mesh, msfusion.read_mesh(str(reconstructed / "mesh.ply")))
 
 
 def test_a_frame_made_of_arrays_gives_the_loaded_frames_depth(sequence):
