@@ -64,6 +64,7 @@ def main():
     loaded = [sequence[i] for i in range(FRAMES)]
     arrays = [dict(left=f.left.copy(), right=f.right.copy(), scan=f.scan, color=f.color, pose=f.pose, index=i)
               for i, f in enumerate(loaded)]
+    python_round(sequence, loaded, arrays)  # warm-up, as bench_frame_loop does
     cpp, python = [], []
     for k in range(rounds):
         cpp.append(cpp_round(bin_dir, kitti_dir))
