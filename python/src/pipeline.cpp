@@ -20,10 +20,17 @@ struct PipelineObject {
   std::mutex mutex;
 };
 
-FrameResult computeDepth(PipelineObject& p, const FrameObject& frame) {
-  FrameResult result = withoutGil(p.mutex, [&] { return p.pipeline.computeDepth(frame.frame); });
+/// The result a Python object keeps: its own copy of the left image when that is a view of the
+/// caller's array, which may be gone before the result is.
+FrameResult keepable(FrameResult result, const FrameObject& frame) {
+  if (!frame.arrays.is_none())
+    result.left = result.left.clone();
   result.name = frame.name;
   return result;
+}
+
+FrameResult computeDepth(PipelineObject& p, const FrameObject& frame) {
+  return keepable(withoutGil(p.mutex, [&] { return p.pipeline.computeDepth(frame.frame); }), frame);
 }
 
 void integrate(PipelineObject& p, FrameResult& result) {
@@ -31,13 +38,11 @@ void integrate(PipelineObject& p, FrameResult& result) {
 }
 
 FrameResult addFrame(PipelineObject& p, const FrameObject& frame) {
-  FrameResult result = withoutGil(p.mutex, [&] {
-    FrameResult r = p.pipeline.computeDepth(frame.frame);
-    p.pipeline.integrate(r);
-    return r;
-  });
-  result.name = frame.name;
-  return result;
+  return keepable(withoutGil(p.mutex, [&] {
+    FrameResult result = p.pipeline.computeDepth(frame.frame);
+    p.pipeline.integrate(result);
+    return result;
+  }), frame);
 }
 
 TriangleMesh updateMesh(PipelineObject& p) {

@@ -1,4 +1,5 @@
 """Shapes, dtypes and errors: what the binding takes and gives, and how it refuses."""
+import gc
 import os
 import threading
 import time
@@ -80,6 +81,16 @@ def test_inputs_are_viewed_and_results_are_views(frame):
     assert np.shares_memory(made.left, left) and np.shares_memory(made.right, right)
     assert np.shares_memory(frame.left, frame.left)  # a loaded frame's image is a view of the frame
     assert made.pose is None and made.color is None and made.scan.shape == frame.scan.shape
+
+
+def test_a_result_outlives_the_arrays_of_its_frame(calibration, frame):
+    left = frame.left.copy()
+    expected = left.copy()
+    made = msfusion.Frame(left, frame.right.copy(), frame.scan, pose=frame.pose)
+    result = msfusion.Pipeline(calibration).add_frame(made)
+    del made, left  # numpy unmaps a buffer this large: a view of it would now fault
+    gc.collect()
+    np.testing.assert_array_equal(result.left, expected)
 
 
 def test_wrong_arrays_are_errors_naming_the_argument(calibration, frame):
