@@ -60,6 +60,25 @@ def test_a_raw_date_folder_is_a_calibration(kitti_dir):
     assert calibration.image_size == (1242, 375) and calibration.has_velodyne
 
 
+def test_a_sequence_is_an_iterable_of_frames(kitti_dir, odometry04):
+    drive = msfusion.Sequence(os.path.join(kitti_dir, "raw", "2011_09_26", "2011_09_26_drive_0009_sync"))
+    assert (len(drive), drive.layout, drive.poses.shape) == (5, "raw", (5, 4, 4))
+    frames = list(drive)
+    assert [f.name for f in frames] == [f"{i:010d}" for i in range(5)]
+    last = frames[-1]
+    assert last.left.shape == (375, 1242) and last.left.dtype == np.uint8
+    assert last.color.shape == (375, 1242, 3) and last.color.dtype == np.uint8
+    assert last.scan.ndim == 2 and last.scan.shape[1] == 4 and last.scan.dtype == np.float32
+    np.testing.assert_array_equal(last.pose, drive.poses[4])
+    np.testing.assert_array_equal(drive[-1].left, last.left)
+    odometry = msfusion.Sequence(odometry04)
+    scan = np.fromfile(os.path.join(odometry04, "velodyne", "000007.bin"), np.float32).reshape(-1, 4)
+    np.testing.assert_array_equal(odometry[7].scan, scan)  # the .bin as it is on disk
+    np.testing.assert_allclose(odometry.poses[0], np.eye(4), atol=1e-9)  # poses/04.txt starts at the identity
+    with pytest.raises(IndexError):
+        odometry[10]
+
+
 def test_stage_outputs_are_owned_contiguous_arrays(calibration, frame):
     lidar = msfusion.LidarCompletion(calibration)
     depth, distance = lidar.compute_depth(frame.scan)
