@@ -24,10 +24,8 @@ namespace {
 /// and completed (compound interpolation by default).
 struct LidarStage {
   LidarStage(const Calibration& calibration, const PipelineConfig& config, const std::string& method)
-      : completion(calibration, parseCompletionMethod(method), config.projection, config.interpolation),
-        size(calibration.requireImageSize()) {}
+      : completion(calibration, parseCompletionMethod(method), config.projection, config.interpolation) {}
   LidarCompletion completion;
-  cv::Size size;
   std::mutex mutex;
 };
 
