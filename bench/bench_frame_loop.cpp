@@ -1,18 +1,20 @@
-// The frame loop a door drives on its caller's thread (the Python module's Pipeline.add_frame):
-// KITTI odometry 04 frames 0-9, one frame after the other, each through Pipeline::computeDepth
-// and Pipeline::integrate, into a fresh Pipeline per iteration, with the default configuration.
-// bench/bench_python.py runs it beside the same loop through the Python module.
+// The frame loop a door drives on its caller's thread (the Python module's
+// Reconstructor.add_frame): KITTI odometry 04 frames 0-9, one frame after the other through
+// Reconstructor::addFrame (depth, the frame's pose, integration), into a fresh engine per
+// iteration, with the default configuration. bench/bench_python.py runs it beside the same loop
+// through the Python module.
 //
 //   bench_frame_loop [--benchmark_format=json]   (MSF_KITTI_DIR overrides the sample's path)
 //
 // BM_LoadAndAddFrame: each frame read by Sequence::load, then added. BM_AddFrame: the frames
 // read before the timing, then added. Each runs the 10 frames once untimed first, so that the
-// process's first allocations and thread pool are not counted (the Python side runs warm too). Times per iteration are for the 10 frames: wall time, and
-// the process's CPU time (all its threads), which a machine shared with other work disturbs less.
+// process's first allocations and thread pool are not counted (the Python side runs warm too).
+// Times per iteration are for the 10 frames: wall time, and the process's CPU time (all its
+// threads), which a machine shared with other work disturbs less.
 #include "kitti_sample.h"
 
-#include <msf/pipeline/pipeline.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include <benchmark/benchmark.h>
 
@@ -22,22 +24,21 @@ using namespace msf;
 
 namespace {
 
-void addFrame(Pipeline& pipeline, const Frame& frame) {
-  FrameResult result = pipeline.computeDepth(frame);
-  pipeline.integrate(result);
+void addFrame(Reconstructor& engine, const Frame& frame) {
+  const FrameResult result = engine.addFrame(frame);
   benchmark::DoNotOptimize(result.fused.depth.data);
 }
 
 void loadAndAddFrames(const Sequence& sequence) {
-  Pipeline pipeline(sequence.calibration(), PipelineConfig());
+  Reconstructor engine(sequence.calibration(), PipelineConfig());
   for (std::size_t i = 0; i < msf::bench::kFrames; ++i)
-    addFrame(pipeline, sequence.load(i));
+    addFrame(engine, sequence.load(i));
 }
 
 void addFrames(const Sequence& sequence, const std::vector<Frame>& frames) {
-  Pipeline pipeline(sequence.calibration(), PipelineConfig());
+  Reconstructor engine(sequence.calibration(), PipelineConfig());
   for (const Frame& frame : frames)
-    addFrame(pipeline, frame);
+    addFrame(engine, frame);
 }
 
 void BM_LoadAndAddFrame(benchmark::State& state) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""The Python module's per-frame cost against the C++ pipeline's, in one run: KITTI odometry 04
-frames 0-9, one frame after the other through Pipeline.add_frame (compute_depth, then integrate)
-into a fresh Pipeline, as bench_frame_loop (C++) does; rounds alternate between the two, and the
+"""The Python module's per-frame cost against the C++ engine's, in one run: KITTI odometry 04
+frames 0-9, one frame after the other through Reconstructor.add_frame (depth, pose, integration)
+into a fresh engine, as bench_frame_loop (C++) does; rounds alternate between the two, and the
 medians are compared: wall time, and the process's CPU time (all threads), which other work on
 a shared machine disturbs less.
 
@@ -36,11 +36,11 @@ def cpp_round(bin_dir, kitti_dir):
 
 def timed(calibration, frames):
     """(wall, CPU) ms per frame of adding `frames` (a callable per index giving a Frame) to a fresh
-    Pipeline."""
+    engine."""
     wall, cpu = time.perf_counter(), time.process_time()
-    pipeline = msfusion.Pipeline(calibration)
+    engine = msfusion.Reconstructor(calibration)
     for i in range(FRAMES):
-        pipeline.add_frame(frames(i))
+        engine.add_frame(frames(i))
     return (time.perf_counter() - wall) * 1000 / FRAMES, (time.process_time() - cpu) * 1000 / FRAMES
 
 

@@ -12,7 +12,7 @@ import msfusion  # noqa: E402
 
 sequence = msfusion.Sequence(sys.argv[1])
 frame = sequence[int(sys.argv[2])]
-result = msfusion.Pipeline(sequence.calibration).compute_depth(frame)
+result = msfusion.Reconstructor(sequence.calibration).compute_depth(frame)  # steps 1-4, each stage's depth
 
 panels = [("left image (camera 0)", frame.left, "gray"),
           ("interpolated LiDAR", result.lidar_depth, "turbo"),

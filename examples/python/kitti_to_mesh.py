@@ -4,11 +4,11 @@ import sys
 
 import msfusion
 
-sequence = msfusion.Sequence(sys.argv[1])           # KITTI odometry sequence, raw drive or msf_synth's street
-pipeline = msfusion.Pipeline(sequence.calibration)  # every stage with config/kitti.yaml's settings
+sequence = msfusion.Sequence(sys.argv[1])              # KITTI odometry sequence, raw drive or msf_synth's street
+engine = msfusion.Reconstructor(sequence.calibration)  # every stage with config/kitti.yaml's settings
 for frame in itertools.islice(sequence, int(sys.argv[3]) if len(sys.argv) > 3 else None):
-    result = pipeline.add_frame(frame)              # fused depth and weight, integrated at the frame's pose
+    result = engine.add_frame(frame)                   # fused depth and weight, integrated at the frame's pose
     print(f"frame {frame.name}: {(result.depth > 0).mean():.0%} of the pixels have depth")
-mesh = pipeline.update_mesh()
+mesh = engine.mesh()
 mesh.save(sys.argv[2])
 print(f"{len(mesh.vertices)} vertices, {len(mesh.triangles)} triangles -> {sys.argv[2]}")

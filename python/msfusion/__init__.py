@@ -9,10 +9,10 @@ names the argument), outputs own their memory, and heavy calls release the GIL.
 
     import msfusion
     sequence = msfusion.Sequence("kitti/odometry/sequences/04")
-    pipeline = msfusion.Pipeline(sequence.calibration)
+    engine = msfusion.Reconstructor(sequence.calibration)
     for frame in sequence:
-        result = pipeline.add_frame(frame)   # result.depth, result.weight, result.pose
-    pipeline.update_mesh().save("mesh.ply")
+        result = engine.add_frame(frame)     # result.depth, result.weight, result.pose
+    engine.mesh().save("mesh.ply")
 
 Stage by stage: LidarCompletion, SgbmStereo, DepthFusion, colorize_depth, TsdfVolume; the
 configuration of every stage: Config and load_config; Open3D objects: msfusion.o3d.
@@ -26,18 +26,20 @@ from ._core import (  # noqa: F401  (the package's API)
     Error,
     Frame,
     FrameResult,
+    FrameSource,
     InvalidInputError,
     IOError,
     LidarCompletion,
     Mesh,
     PinholeCamera,
-    Pipeline,
+    Reconstructor,
     SgbmStereo,
     Sequence,
     TsdfVolume,
     colorize_depth,
     get_num_threads,
     load_calibration,
+    open_dataset,
     read_depth_cloud,
     read_mesh,
     real_returns,

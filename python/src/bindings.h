@@ -12,7 +12,7 @@ void bindStages(py::module_& m);       // stages.cpp: steps 1-4 on arrays
 void bindMesh(py::module_& m);         // mesh.cpp: TriangleMesh as Mesh, read_mesh
 void bindTsdf(py::module_& m);         // tsdf.cpp: TsdfVolume with its integrator and mesher
 void bindDepthClouds(py::module_& m);  // depth_clouds.cpp: the organized clouds the msf_* tools write
-void bindFrames(py::module_& m);       // frames.cpp: Frame, Sequence
-void bindPipeline(py::module_& m);     // pipeline.cpp: Pipeline, FrameResult
+void bindFrames(py::module_& m);       // frames.cpp: Frame, FrameSource, Sequence, open_dataset
+void bindReconstructor(py::module_& m);  // reconstructor.cpp: the engine, FrameResult
 
 } // namespace msf::python

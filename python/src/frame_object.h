@@ -1,7 +1,7 @@
 #pragma once
 #include "arrays.h"
 
-#include <msf/io/sequence.h>
+#include <msf/io/frame_source.h>
 
 #include <string>
 

@@ -1,10 +1,12 @@
-// Frames in: msf::Frame as msfusion.Frame (loaded by a Sequence, or made from arrays: grey pair,
-// scan, colour image, pose) and msf::Sequence (a KITTI odometry sequence or raw drive, or the
-// synthetic street) as an iterable of frames.
+// Frames in: msf::Frame as msfusion.Frame (loaded from a source, or made from arrays: grey pair,
+// scan, colour image, pose), and msf::FrameSource (msf::Sequence: a KITTI odometry sequence or
+// raw drive, or the synthetic street; open_dataset) as an iterable of frames.
 #include "bindings.h"
 #include "frame_object.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/open_dataset.h>
 
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
@@ -42,31 +44,31 @@ FrameObject fromArrays(const py::handle& left, const py::handle& right, const py
   return object;
 }
 
-FrameObject load(const Sequence& sequence, long long i, bool with_color) {
-  const auto size = static_cast<long long>(sequence.size());
+FrameObject load(const FrameSource& source, long long i, bool with_color) {
+  const auto size = static_cast<long long>(source.size());
   if (i < -size || i >= size)
-    throw py::index_error("frame " + std::to_string(i) + " of a sequence of " + std::to_string(size));
+    throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(size));
   const auto index = static_cast<std::size_t>(i < 0 ? i + size : i);
   FrameObject object;
   {
     py::gil_scoped_release release;
-    object.frame = sequence.load(index, with_color);
+    object.frame = source.load(index, with_color);
   }
-  object.name = sequence.frameName(index);
+  object.name = source.frameName(index);
   object.arrays = py::none();
   return object;
 }
 
-/// for frame in sequence: loads frame after frame.
+/// for frame in source: loads frame after frame.
 struct FrameIterator {
-  py::object sequence;  // keeps the Sequence alive
+  py::object source;  // keeps the FrameSource alive
   std::size_t next = 0;
 };
 
-py::object posesOf(const Sequence& sequence) {
-  if (!sequence.hasPoses())
+py::object posesOf(const FrameSource& source) {
+  if (!source.hasPoses())
     return py::none();
-  const PoseList& poses = sequence.poses();
+  const PoseList& poses = source.poses();
   py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(poses.size()), 4, 4});
   auto o = out.mutable_unchecked<3>();
   for (std::size_t i = 0; i < poses.size(); ++i)
@@ -119,44 +121,56 @@ void bindFrame(py::module_& m) {
       });
 }
 
-void bindSequence(py::module_& m) {
+void bindSources(py::module_& m) {
   py::class_<FrameIterator>(m, "_FrameIterator")
       .def("__iter__", [](const py::handle& self) { return self; })
       .def("__next__", [](FrameIterator& it) {
-        const Sequence& sequence = it.sequence.cast<const Sequence&>();
-        if (it.next >= sequence.size())
+        const FrameSource& source = it.source.cast<const FrameSource&>();
+        if (it.next >= source.size())
           throw py::stop_iteration();
-        return load(sequence, static_cast<long long>(it.next++), true);
+        return load(source, static_cast<long long>(it.next++), true);
       });
-  py::class_<Sequence>(m, "Sequence",
-                       "A dataset on disk, its layout detected: a KITTI odometry sequence (sequences/XX with "
-                       "poses/XX.txt), a KITTI raw drive (YYYY_MM_DD_drive_NNNN_sync, calibration in the date folder, "
-                       "poses from OXTS) or msf_synth's synthetic street. Indexing loads a Frame; iterating loads "
-                       "one after the other.")
-      .def(py::init<const std::string&>(), py::arg("path"), py::call_guard<py::gil_scoped_release>(),
-           "Raises IOError naming the folder when it is no known layout.")
-      .def("__len__", &Sequence::size)
-      .def("__getitem__", [](const Sequence& s, long long i) { return load(s, i, true); }, py::arg("index"))
+  py::class_<FrameSource>(m, "FrameSource",
+                          "Where frames come from (a dataset folder): its rig, its frames by index or one after "
+                          "the other, and its poses, if any.")
+      .def("__len__", &FrameSource::size)
+      .def("__getitem__", [](const FrameSource& s, long long i) { return load(s, i, true); }, py::arg("index"))
       .def("load", &load, py::arg("index"), py::arg("with_color") = true,
            "Frame `index`; with_color=False skips reading the colour camera.")
       .def("__iter__", [](const py::object& self) { return FrameIterator{self, 0}; })
-      .def_property_readonly("calibration", &Sequence::calibration)
+      .def_property_readonly("calibration", &FrameSource::calibration)
       .def_property_readonly("poses", &posesOf, "(N, 4, 4) float64 T_world_cam0 per frame, or None.")
+      .def("frame_name", &FrameSource::frameName, py::arg("index"))
+      .def("__repr__", [](const FrameSource& s) {
+        return "FrameSource('" + s.description() + "', " + std::to_string(s.size()) + " frames)";
+      });
+  py::class_<Sequence, FrameSource>(m, "Sequence",
+                                    "A dataset on disk, its layout detected: a KITTI odometry sequence (sequences/XX "
+                                    "with poses/XX.txt), a KITTI raw drive (YYYY_MM_DD_drive_NNNN_sync, calibration "
+                                    "in the date folder, poses from OXTS) or msf_synth's synthetic street. "
+                                    "Indexing loads a Frame; iterating loads one after the other.")
+      .def(py::init<const std::string&>(), py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+           "Raises IOError naming the folder when it is no known layout.")
       .def_property_readonly("directory", &Sequence::directory)
       .def_property_readonly("layout", [](const Sequence& s) {
         return s.layout() == Sequence::Layout::Raw ? "raw" : "odometry";
       })
-      .def("frame_name", &Sequence::frameName, py::arg("index"))
       .def("__repr__", [](const Sequence& s) {
         return "Sequence('" + s.directory() + "', " + std::to_string(s.size()) + " frames)";
       });
+  m.def("open_dataset", [](const std::string& path, const std::string& rig) {
+    py::gil_scoped_release release;
+    return openDataset(path, DatasetOptions{rig});
+  }, py::arg("path"), py::arg("rig") = "",
+        "The FrameSource of a dataset folder, its layout detected (as msf_reconstruct reads it); rig: a "
+        "calibration or rig file for layouts without one, or to override the dataset's.");
 }
 
 } // namespace
 
 void bindFrames(py::module_& m) {
   bindFrame(m);
-  bindSequence(m);
+  bindSources(m);
 }
 
 } // namespace msf::python

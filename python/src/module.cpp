@@ -13,7 +13,7 @@ PYBIND11_MODULE(_core, m) {
   bindTsdf(m);
   bindDepthClouds(m);
   bindFrames(m);
-  bindPipeline(m);
+  bindReconstructor(m);
   m.def("set_num_threads", &cv::setNumThreads, py::arg("threads"),
         "Threads of the library's parallel loops (OpenCV's pool, shared by every object): n, 1 or 0 = "
         "the calling thread only, negative = all the cores (the default).");

@@ -16,8 +16,13 @@ def calibration(odometry04):
 
 
 @pytest.fixture(scope="module")
-def frame(odometry04):
-    return msfusion.Sequence(odometry04)[0]
+def sequence(odometry04):
+    return msfusion.Sequence(odometry04)
+
+
+@pytest.fixture(scope="module")
+def frame(sequence):
+    return sequence[0]
 
 
 def test_errors_are_library_kinds_and_python_builtins():
@@ -106,7 +111,7 @@ def test_a_result_outlives_the_arrays_of_its_frame(calibration, frame):
     left = frame.left.copy()
     expected = left.copy()
     made = msfusion.Frame(left, frame.right.copy(), frame.scan, pose=frame.pose)
-    result = msfusion.Pipeline(calibration).add_frame(made)
+    result = msfusion.Reconstructor(calibration).add_frame(made)
     del made, left  # numpy unmaps a buffer this large: a view of it would now fault
     gc.collect()
     np.testing.assert_array_equal(result.left, expected)
@@ -146,15 +151,26 @@ def test_poses_must_be_rigid():
         volume.integrate(depth, np.eye(4), "camera 0")
 
 
-def test_a_frame_without_pose_is_not_integrated(calibration, frame):
-    pipeline = msfusion.Pipeline(calibration)
-    result = pipeline.compute_depth(msfusion.Frame(frame.left, frame.right, frame.scan))
-    assert result.pose is None and result.depth.shape == (370, 1226)
+def test_a_frame_without_pose_takes_the_odometrys_or_is_refused(calibration, sequence):
+    def bare(i):  # the frame as a driver without poses gives it
+        f = sequence[i]
+        return msfusion.Frame(f.left, f.right, f.scan, index=i)
+
+    given = msfusion.Reconstructor(calibration, poses="given")
     with pytest.raises(msfusion.InvalidInputError, match="has no pose"):
-        pipeline.integrate(result)
-    result.pose = np.eye(4)  # given one, it is
-    pipeline.integrate(result)
-    assert pipeline.num_blocks > 0
+        given.add_frame(bare(0))
+    result = given.compute_depth(bare(0))
+    assert result.pose is None and result.depth.shape == (370, 1226)
+    result.pose = np.eye(4)  # given one, it is integrated
+    given.integrate(result)
+    assert given.num_blocks > 0
+    auto = msfusion.Reconstructor(calibration)  # poses="auto": the LiDAR odometry's, from the first frame's
+    poses = [auto.add_frame(bare(i)).pose for i in range(3)]
+    np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-6)
+    assert np.linalg.norm(poses[2][:3, 3] - sequence.poses[2][:3, 3]) < 0.1  # the vehicle drove ~2 m
+    assert len(auto.odometry_ms) == 3
+    with pytest.raises(msfusion.InvalidInputError, match="poses must be auto, given or odometry, not 'gps'"):
+        msfusion.Reconstructor(calibration, poses="gps")
 
 
 def test_config_overrides_are_read_as_a_file_reads():

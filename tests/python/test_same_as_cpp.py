@@ -7,6 +7,7 @@ the pipeline and colorize_depth a depth image row by row (colorizeDepth), and th
 a few pixels (0.1 %: the colour camera's pixel borders, and pixels it does not see, which keep
 the stereo cloud's colour in one and camera 0's grey in the other)."""
 import os
+import signal
 
 import numpy as np
 import pytest
@@ -70,13 +71,14 @@ def per_stage(sequence):
 
 @pytest.fixture(scope="module")
 def pipeline_run(sequence):
-    """Frames 0-9 through Pipeline.add_frame: each frame's fused depth, weight and colour, and the mesh."""
-    pipeline = msfusion.Pipeline(sequence.calibration)
+    """Frames 0-9 through Reconstructor.add_frame: each frame's fused depth, weight and colour, and the
+    mesh."""
+    engine = msfusion.Reconstructor(sequence.calibration)
     frames = []
     for i in range(FRAMES):
-        result = pipeline.add_frame(sequence[i])
+        result = engine.add_frame(sequence[i])
         frames.append(dict(depth=result.depth, weight=result.weight, color=result.color))
-    return frames, pipeline.update_mesh()
+    return frames, engine.mesh()
 
 
 def assert_same_image(a, b, what):
@@ -132,12 +134,59 @@ def test_the_pipeline_gives_msf_reconstructs_depth_and_mesh(sequence, reconstruc
     assert_same_mesh(mesh, msfusion.read_mesh(str(reconstructed / "mesh.ply")))
 
 
+def test_run_gives_what_add_frame_gives(sequence, pipeline_run):
+    """The engine's overlapped run, on its threads, gives the frames and the map add_frame gives."""
+    frames, mesh = pipeline_run
+    engine = msfusion.Reconstructor(sequence.calibration)
+    seen = []
+
+    def on_frame(result):
+        ours = frames[result.index]
+        assert_same_image(result.depth, ours["depth"], f"frame {result.index}: run's depth against add_frame's")
+        seen.append(result.name)
+
+    stats = engine.run(sequence, on_frame=on_frame)
+    assert seen == [f"{i:06d}" for i in range(FRAMES)]
+    assert stats["frames_done"] == FRAMES and not stats["interrupted"]
+    assert_same_mesh(engine.mesh(), mesh)
+
+
+def test_a_failing_callback_stops_the_run_with_its_error(sequence):
+    def on_frame(result):
+        raise ValueError(f"stop at {result.name}")
+
+    with pytest.raises(ValueError, match="stop at 000001"):
+        msfusion.Reconstructor(sequence.calibration).run(sequence, frames=[1, 2, 3], on_frame=on_frame)
+    with pytest.raises(IndexError, match="frame 10 of a source of 10"):
+        msfusion.Reconstructor(sequence.calibration).run(sequence, frames=[10])
+
+
+def test_ctrl_c_stops_a_run_after_the_frame_under_way(sequence):
+    class Stop(Exception):
+        pass
+
+    def on_sigint(signum, frame):
+        raise Stop()
+
+    engine = msfusion.Reconstructor(sequence.calibration)
+    done = []
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        with pytest.raises(Stop):
+            engine.run(sequence, on_frame=lambda r: (done.append(r.index),
+                                                     len(done) == 2 and os.kill(os.getpid(), signal.SIGINT)))
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert 2 <= len(done) < FRAMES and done == list(range(len(done)))
+    assert len(engine.mesh().triangles) > 0  # the frames integrated before the stop are in the map
+
+
 def test_a_frame_made_of_arrays_gives_the_loaded_frames_depth(sequence):
     loaded = sequence[3]
     made = msfusion.Frame(loaded.left.copy(), loaded.right.copy(), loaded.scan, color=loaded.color,
                           pose=loaded.pose, index=3)
-    a = msfusion.Pipeline(sequence.calibration).compute_depth(loaded)
-    b = msfusion.Pipeline(sequence.calibration).compute_depth(made)
+    a = msfusion.Reconstructor(sequence.calibration).compute_depth(loaded)
+    b = msfusion.Reconstructor(sequence.calibration).compute_depth(made)
     assert_same_image(a.depth, b.depth, "fused depth of a frame made of arrays")
     assert_same_image(a.weight, b.weight, "weight of a frame made of arrays")
     np.testing.assert_array_equal(a.color, b.color)
