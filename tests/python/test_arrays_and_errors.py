@@ -82,6 +82,10 @@ def test_a_sequence_is_an_iterable_of_frames(kitti_dir, odometry04):
     np.testing.assert_allclose(odometry.poses[0], np.eye(4), atol=1e-9)  # poses/04.txt starts at the identity
     with pytest.raises(IndexError):
         odometry[10]
+    opened = msfusion.open_dataset(odometry04)  # as msf_reconstruct opens it: the Sequence under FrameSource
+    assert isinstance(opened, msfusion.Sequence) and isinstance(opened, msfusion.FrameSource) and len(opened) == 10
+    with pytest.raises(msfusion.IOError, match="/nonexistent/drive"):
+        msfusion.open_dataset("/nonexistent/drive")
 
 
 def test_stage_outputs_are_owned_contiguous_arrays(calibration, frame):
