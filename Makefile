@@ -8,11 +8,14 @@ PREFIX ?= /usr/local
 KITTI_DIR ?= $(abspath ../shared/data/kitti)
 DEMO_OUT ?= out/demo
 
+# The Python module msfusion (python/) and its tests and examples (matplotlib). Open3D
+# (python3-open3d) is optional: msfusion.o3d and its test use it when it is installed.
+PYTHON_PACKAGES := pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
 # time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
-                libyaml-cpp-dev python3-yaml
+                libyaml-cpp-dev $(PYTHON_PACKAGES)
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev
@@ -73,7 +76,7 @@ test: deps
 # -Wno-maybe-uninitialized: GCC 12 warns inside libstdc++'s std::regex under -fsanitize (a
 # false positive that -Werror would make fatal).
 SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
-  -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
+  -DMSF_BUILD_BENCH=OFF -DMSF_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
   -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
 # A report goes to stderr (no log_path), where the tests look for it in every tool they run
 # (runCommand in tests/support, bad_inputs.sh) and fail quoting it; abort_on_error=1 for ASan and
@@ -99,7 +102,7 @@ test-sanitize-fast: deps
 fuzz: deps-fuzz
 	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_CXX_COMPILER=clang++ -DMSF_BUILD_TESTS=OFF -DMSF_BUILD_TOOLS=OFF -DMSF_BUILD_BENCH=OFF \
-	  -DMSF_BUILD_FUZZ=ON -DMSF_WARNINGS_AS_ERRORS=OFF \
+	  -DMSF_BUILD_PYTHON=OFF -DMSF_BUILD_FUZZ=ON -DMSF_WARNINGS_AS_ERRORS=OFF \
 	  -DCMAKE_CXX_FLAGS="-g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_all
 	python3 fuzz/make_corpus.py $(KITTI_DIR) $(FUZZ_BUILD_DIR)/seeds

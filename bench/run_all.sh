@@ -13,6 +13,11 @@ for b in "$bin"/bench_*; do
   "$b" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 done
 [ "$found" = 1 ] || echo "bench: no benchmark built yet"
+if [ -d "$bin/../python/msfusion" ]; then
+  # The interpreter the module was built for (python/CMakeLists.txt: Debian's by default).
+  echo "== bench_python.py"
+  PYTHONPATH="$bin/../python" "${PYTHON:-/usr/bin/python3}" "$(dirname "$0")/bench_python.py" "$bin" "$kitti" 5
+fi
 echo "== bench_pipeline.sh"
 "$(dirname "$0")/bench_pipeline.sh" "$bin" "$kitti" 5
 echo "== bench_reconstruction.sh"
