@@ -68,8 +68,8 @@ int main(int argc, char** argv) {
   msf::SgbmConfig config;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
-      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.mode; stereo.engine: the native AVX2 kernel or "
-      "OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
+      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.unguided_mode, or stereo.mode where -prior "
+      "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
       "is no match).");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
       .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
@@ -86,7 +86,9 @@ int main(int argc, char** argv) {
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
       .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
-      .value("-mode", "NAME", config.mode, "sgbm (5 paths, default) | sgbm_3way | hh | hh4")
+      .value("-mode", "NAME", [&](const std::string& mode) { config.mode = config.unguided_mode = mode; },
+             "the paths, guided or not: ground_3way | sgbm (5 paths) | sgbm_3way | hh | hh4 (default: sgbm guided by "
+             "-prior, ground_3way without)")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
       .flag("-print_config", print_config, "print the stereo settings in use");
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {

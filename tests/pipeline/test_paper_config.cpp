@@ -38,6 +38,7 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   EXPECT_TRUE(c.interpolation.gaussian);
   EXPECT_EQ(c.stereo.engine, "opencv");
   EXPECT_EQ(c.stereo.mode, "sgbm_3way");
+  EXPECT_EQ(c.stereo.unguided_mode, "sgbm_3way");
   EXPECT_FALSE(c.stereo.lidarGuidance());
   EXPECT_FALSE(c.stereo.prior_search_range);
   EXPECT_FALSE(c.scheduling.stereo_prior);

@@ -68,6 +68,7 @@ PipelineConfig PipelineConfig::paper() {
   // Step 3: OpenCV's SGBM on the grey pair alone, over the full disparity range.
   c.stereo.engine = "opencv";
   c.stereo.mode = "sgbm_3way";
+  c.stereo.unguided_mode = "sgbm_3way";
   c.stereo.guidance = "none";
   c.stereo.prior_search_range = false;
   c.scheduling.stereo_prior = false;
