@@ -115,3 +115,4 @@ MSF_WRITER_BENCH(BM_CloudPclFileWriter);
 MSF_WRITER_BENCH(BM_CloudSaveCloudChecked);
 MSF_WRITER_BENCH(BM_MeshPclPlyWriter);
 MSF_WRITER_BENCH(BM_MeshSaveMeshChecked);
+BENCHMARK_MAIN();

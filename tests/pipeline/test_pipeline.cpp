@@ -111,7 +111,7 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
     EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
   const std::string json = readFile(out.file("summary.json"));
   // The run names the build that made it.
-  EXPECT_NE(json.find("\"msfusion\": {\"version\": \"" + msf::versionString() + "\", \"commit\": \"" +
+  EXPECT_NE(json.find(std::string("\"msfusion\": {\"version\": \"") + msf::versionString() + "\", \"commit\": \"" +
                       msf::gitCommit() + "\"}"),
             std::string::npos)
       << json;

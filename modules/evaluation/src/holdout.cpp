@@ -12,6 +12,20 @@
 
 namespace msf {
 
+namespace {
+
+/// Each point's ring: from the data when the scan carries it, else from the rig's beam
+/// elevations, else from the sensor's order (KITTI's files: ring after ring).
+std::vector<int> scanRingIds(const Frame& frame, const Calibration& calibration) {
+  if (!frame.point_ring.empty())
+    return std::vector<int>(frame.point_ring.begin(), frame.point_ring.end());
+  if (!calibration.lidar.beam_elevations_deg.empty())
+    return ringIdsFromElevations(*frame.scan, calibration.lidar.beam_elevations_deg);
+  return ringIds(*frame.scan);
+}
+
+} // namespace
+
 HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration, const HoldoutConfig& config) {
   if (config.projection.camera != 0)
     throw ConfigError("protocol 2 evaluates in camera 0; projection.camera is " +
@@ -21,7 +35,7 @@ HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration
   HoldoutFrame out;
   auto input = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
   pcl::PointCloud<pcl::PointXYZI> heldout;
-  out.ring_count = splitRings(*frame.scan, config.rings, *input, heldout);
+  out.ring_count = splitRings(*frame.scan, scanRingIds(frame, calibration), config.rings, *input, heldout);
   out.heldout_points = heldout.size();
   const LidarProjector projector(calibration, config.projection);
   projector.projectToImage(heldout, out.gt_depth);
