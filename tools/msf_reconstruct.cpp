@@ -46,6 +46,7 @@ constexpr int kMaxPanels = 100;
 /// What the command line asks for beyond the configuration.
 struct Request {
   std::string out = "msf_out", frames = "0:", poses, config_path, dataset;
+  msf::DatasetOptions reader;
   int panels = 3;
   bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
 };
@@ -296,6 +297,7 @@ private:
     report_.layout = !source_.groundTruthDir().empty()                                   ? "synthetic"
                      : sequence && sequence->layout() == msf::Sequence::Layout::Raw ? "raw"
                      : sequence                                                     ? "odometry"
+                     : msf::isRosBag(source_.description())                         ? "ros bag"
                                                                                     : "generic";
     report_.frames_requested = frames_.size();
     report_.voxel_size_m = config_.volume.voxel_size_m;
@@ -553,8 +555,8 @@ int main(int argc, char** argv) {
   msf::PipelineConfig config;
   msf::tool::CommandLine cli(
       "msf_reconstruct", "[DATASET_DIR] [options]",
-      "Reconstructs a KITTI odometry sequence, a KITTI raw drive or a synthetic sequence (msf_synth) into a coloured "
-      "mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "Reconstructs a KITTI odometry sequence, a KITTI raw drive, a synthetic sequence (msf_synth) or a ROS 1 bag "
+      "(kitti2bag's layout, or the topics named below: docs/ros.md) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
       "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
@@ -586,6 +588,21 @@ int main(int argc, char** argv) {
              "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
              "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "
              "the TSDF volume also stops the run at the first frame whose blocks would not fit")
+      .value("-rig", "FILE", request.reader.rig,
+             "the rig's calibration (a KITTI calib.txt or a rig YAML) for a ROS bag, replacing its CameraInfo and "
+             "LiDAR extrinsic")
+      .value("-lidar_topic", "T", request.reader.bag.lidar_topic, "a bag's LiDAR scans, PointCloud2 (default {default})")
+      .value("-left_topic", "T", request.reader.bag.left_topic,
+             "a bag's left rectified image (default {default}); each image's CameraInfo is its sibling camera_info")
+      .value("-right_topic", "T", request.reader.bag.right_topic, "a bag's right rectified image (default {default})")
+      .value("-color_topic", "T", request.reader.bag.color_topic,
+             "a bag's colour image (default {default}, when the bag has it; '' for none)")
+      .value("-world_frame", "F", request.reader.bag.world_frame,
+             "a bag's tf frame of the poses (default: camera_init, kitti2bag's, when the bag has it, else the root "
+             "of the left camera's tf tree)")
+      .value("-max_offset", "S", request.reader.bag.max_offset_s,
+             "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
+             "{default})")
       .flag("-save_depth", request.save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
       .flag("-holdout", request.holdout,
             "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
@@ -635,12 +652,14 @@ int main(int argc, char** argv) {
     const bool poses_file = request.poses != "dataset" && request.poses != "estimate";
     installStopHandler();
     msf::OutputFolder output(request.out, "msf_reconstruct",
-                             {request.dataset, request.config_path, poses_file ? request.poses : ""});
+                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});
     // The default street is generated inside the staging folder (a killed run's goes with it
     // at the next run) and removed before the commit.
     const fs::path street = fs::path(output.dir()) / ".street";
-    const std::unique_ptr<msf::FrameSource> source =
-        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset);
+    const std::unique_ptr<msf::FrameSource> source = msf::openDataset(
+        request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, request.reader);
+    for (const std::string& note : source->notes())
+      print_warn("%s: %s\n", source->description().c_str(), note.c_str());
     if (request.save_depth)
       fs::create_directories(fs::path(output.dir()) / "depth");
 
