@@ -240,32 +240,23 @@ void BagSource::readCalibration(const std::string& rig) {
     if (!message)
       throw CalibrationError("ROS bag '" + path_ + "' has no " + kCameraInfo + " on '" + sibling(topic, "camera_info") +
                              "': give the rig's calibration with -rig FILE (a KITTI calib.txt or a rig YAML)");
-  Calibration c;
-  c.source = path_;
-  c.image_size = size;
-  c.P[0] = projectionFromCameraInfo(*left, "'" + sibling(options_.left_topic, "camera_info") + "'");
-  c.P[1] = projectionFromCameraInfo(*right, "'" + sibling(options_.right_topic, "camera_info") + "'");
-  c.P[2] = color ? projectionFromCameraInfo(*color, "'" + sibling(options_.color_topic, "camera_info") + "'") : c.P[0];
-  // Camera 3 (the colour pair's right camera) is not read: the stages do not use it.
-  c.P[3] = c.P[2];
-  c.P[3].col(3) += (c.P[1].col(3) - c.P[0].col(3)) * (c.fx(2) / c.fx(0));
   if (has_color_ && !color)
     throw CalibrationError("ROS bag '" + path_ + "' has no " + kCameraInfo + " on '" +
                            sibling(options_.color_topic, "camera_info") + "' for its colour camera: give -color_topic " +
                            "'' to leave colour out, or the rig's calibration with -rig FILE");
   const std::string& lidar_frame = bag_->scans.frame_id;
   const std::string& camera_frame = bag_->left.frame_id;
+  Eigen::Isometry3d T_cam0_velo = Eigen::Isometry3d::Identity();
   if (lidar_frame != camera_frame) {
     try {
-      c.T_cam0_velo = isometryFromTransform(bag_->tf->lookupTransform(camera_frame, lidar_frame, ros::Time(0)).transform);
+      T_cam0_velo = isometryFromTransform(bag_->tf->lookupTransform(camera_frame, lidar_frame, ros::Time(0)).transform);
     } catch (const tf2::TransformException& e) {
       throw CalibrationError("ROS bag '" + path_ + "' has no transform from the LiDAR's frame '" + lidar_frame +
                              "' to the left camera's frame '" + camera_frame + "' in /tf_static or /tf (" + e.what() +
                              "): give the LiDAR-camera extrinsic with -rig FILE (a KITTI calib.txt or a rig YAML)");
     }
   }
-  c.validate();
-  calibration_ = c;
+  calibration_ = rigFromCameraInfo(*left, *right, color.get(), T_cam0_velo, size, path_);
 }
 
 void BagSource::matchAndPose() {
@@ -363,16 +354,11 @@ Frame BagSource::load(std::size_t i, bool with_color) const {
                          : nullptr;
 
   Frame f;
-  f.index = i;
-  // Exact in nanoseconds, then one correctly rounded division: the seconds a times.txt holds.
-  f.timestamp = static_cast<double>(scanStampNs(i) - scanStampNs(0)) / 1e9;
   const std::string what = "frame " + frameName(i) + " of '" + path_ + "'";
   scanFromMessage(*scan, f, what + ", topic '" + options_.lidar_topic + "'");
   if (f.scan->empty())
     throw InvalidInputError(what + ": " + scanName(i) + " has no finite point");
-  f.scan->header.frame_id = scan->header.frame_id;
-  f.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, f.timestamp) * 1e6));
-  f.scan->header.seq = static_cast<std::uint32_t>(i);
+  stampFrame(f, i, scanStampNs(i), scanStampNs(0), scan->header.frame_id);
   f.left = greyFromMessage(*left, what + ", topic '" + options_.left_topic + "'");
   f.right = greyFromMessage(*right, what + ", topic '" + options_.right_topic + "'");
   if (color)

@@ -217,6 +217,31 @@ sensor_msgs::CameraInfo cameraInfoFromCalibration(const Calibration& calibration
   return info;
 }
 
+Calibration rigFromCameraInfo(const sensor_msgs::CameraInfo& left, const sensor_msgs::CameraInfo& right,
+                              const sensor_msgs::CameraInfo* color, const Eigen::Isometry3d& T_cam0_velo,
+                              cv::Size image_size, const std::string& source) {
+  Calibration c;
+  c.source = source;
+  c.image_size = image_size;
+  c.P[0] = projectionFromCameraInfo(left, source + ", the left camera");
+  c.P[1] = projectionFromCameraInfo(right, source + ", the right camera");
+  c.P[2] = color ? projectionFromCameraInfo(*color, source + ", the colour camera") : c.P[0];
+  c.P[3] = c.P[2];
+  c.P[3].col(3) += (c.P[1].col(3) - c.P[0].col(3)) * (c.fx(2) / c.fx(0));
+  c.T_cam0_velo = T_cam0_velo;
+  c.validate();
+  return c;
+}
+
+void stampFrame(Frame& frame, std::size_t index, std::int64_t scan_ns, std::int64_t first_scan_ns,
+                const std::string& lidar_frame) {
+  frame.index = index;
+  frame.timestamp = static_cast<double>(scan_ns - first_scan_ns) / 1e9;
+  frame.scan->header.frame_id = lidar_frame;
+  frame.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, frame.timestamp) * 1e6));
+  frame.scan->header.seq = static_cast<std::uint32_t>(index);
+}
+
 Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& transform) {
   const auto& q = transform.rotation;
   const auto& t = transform.translation;

@@ -51,6 +51,22 @@ Calibration::Projection projectionFromCameraInfo(const sensor_msgs::CameraInfo& 
 sensor_msgs::CameraInfo cameraInfoFromCalibration(const Calibration& calibration, int camera,
                                                   const std_msgs::Header& header);
 
+/// The rig of a rectified stereo pair from its CameraInfo (and a colour camera's, or none: then
+/// camera 2 is the left one) and the LiDAR-to-left-camera extrinsic, validated; `source` names
+/// it in messages. Camera 3 (the colour pair's right camera, which the stages do not use) is
+/// camera 2 moved by the grey pair's baseline. Throws CalibrationError for a P that is not a
+/// rectified camera's, InvalidInputError for an uncalibrated one.
+Calibration rigFromCameraInfo(const sensor_msgs::CameraInfo& left, const sensor_msgs::CameraInfo& right,
+                              const sensor_msgs::CameraInfo* color, const Eigen::Isometry3d& T_cam0_velo,
+                              cv::Size image_size, const std::string& source);
+
+/// Frame `index`'s time from the scan stamps, as every reader gives it: frame.timestamp in
+/// seconds from `first_scan_ns` (exact nanoseconds, then one correctly rounded division: the
+/// seconds a KITTI times.txt holds), and the scan's header (its sensor frame, microseconds
+/// from the first frame, seq = index).
+void stampFrame(Frame& frame, std::size_t index, std::int64_t scan_ns, std::int64_t first_scan_ns,
+                const std::string& lidar_frame);
+
 Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& transform);
 geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& T);
 
