@@ -79,6 +79,25 @@ for ((k = 0; ; ++k)); do
   sleep 0.1
 done
 
+# Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
+refuse() { # NAME EXPECTED _param:=value...
+  local name=$1 expected=$2 out status=0
+  shift 2
+  out=$(timeout 30 "$build/bin/msf_ros_node" __name:="$name" "$@" 2>&1) || status=$?
+  [ "$status" = 1 ] && [[ "$out" == *"msf_ros_node: error: $expected"* ]] ||
+    fail "msf_ros_node $*: exit $status, '$out' (expected exit 1 and '$expected')"
+  echo "ok: msf_ros_node $* refused: $expected"
+}
+touch "$work/mine.ply"
+refuse bad_path "parameter /bad_path/mesh_path: '$work/mine.ply' exists, and a mesh is never written over a file" \
+  _mesh_path:="$work/mine.ply"
+[ ! -s "$work/mine.ply" ] || fail "the node wrote over '$work/mine.ply'"
+refuse bad_name "unknown parameter /bad_name/queue_sise" _queue_sise:=2
+refuse bad_type "parameter /bad_type/queue_size must be an integer" _queue_size:=two
+refuse bad_range "parameter /bad_range/queue_size must be 1..8 frames, not 20" _queue_size:=20
+refuse bad_poses "parameter /bad_poses/poses must be auto, tf or odometry, not 'gps'" _poses:=gps
+refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
+
 # The recorder first, so that it hears the first frame; then the node, and the player, which
 # waits for the node's subscriptions. queue_size: every frame, however slow the machine.
 rosbag record -q -O "$work/published.bag" /msf_ros_node/depth /msf_ros_node/weight /msf_ros_node/points \
@@ -104,6 +123,7 @@ stop_group "$recorder" 10
 grep -a "msf_ros_node" "$work/launch.log" | grep -a -v "^ \*" | sed 's/\x1b\[[0-9;]*m//g'
 
 account=$(grep -a -A3 "scans received" "$work/launch.log" | sed 's/\x1b\[[0-9;]*m//g')
+echo "the node's account: $account"
 [[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||
   fail "the node's account at shutdown is not every frame reconstructed: '$account'"
 [ -f "$work/node_mesh.ply" ] || fail "the node saved no mesh"

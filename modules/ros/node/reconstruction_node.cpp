@@ -12,7 +12,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <set>
+#include <sstream>
 
 namespace msf {
 
@@ -23,15 +25,9 @@ std::string cameraInfoTopic(const std::string& image_topic) {
   return (slash == std::string::npos ? std::string() : image_topic.substr(0, slash + 1)) + "camera_info";
 }
 
-Reconstructor::PoseMode poseMode(const std::string& name) {
-  if (name == "auto")
-    return Reconstructor::PoseMode::Auto;
-  if (name == "tf")
-    return Reconstructor::PoseMode::Given;
-  if (name == "odometry")
-    return Reconstructor::PoseMode::Odometry;
-  throw ConfigError("parameter ~poses must be auto, tf or odometry, not '" + name + "'");
-}
+const std::map<std::string, Reconstructor::PoseMode> kPoseModes{
+    {"auto", Reconstructor::PoseMode::Auto}, {"tf", Reconstructor::PoseMode::Given},
+    {"odometry", Reconstructor::PoseMode::Odometry}};
 
 /// Reads one parameter when it is set; a value of another type is an error, not the default.
 template <typename T>
@@ -83,11 +79,13 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
   for (auto [name, value] : {std::pair{"sync_slop_s", &p.sync_slop_s}, {"tf_timeout_s", &p.tf_timeout_s},
                              {"mesh_rate_hz", &p.mesh_rate_hz}})
     readParam(nh, name, *value, "a number");
-  poseMode(p.poses);
-  const auto check = [&](bool ok, const std::string& name, const std::string& range, double value) {
+  const auto check = [&](bool ok, const std::string& name, const std::string& range, auto value) {
+    std::ostringstream text;
+    text << value;
     if (!ok)
-      throw ConfigError("parameter " + nh.resolveName(name) + " must be " + range + ", not " + std::to_string(value));
+      throw ConfigError("parameter " + nh.resolveName(name) + " must be " + range + ", not " + text.str());
   };
+  check(kPoseModes.count(p.poses) > 0, "poses", "auto, tf or odometry", "'" + p.poses + "'");
   check(p.threads >= 0, "threads", ">= 0", p.threads);
   check(p.queue_size >= 1 && p.queue_size <= 8, "queue_size", "1..8 frames", p.queue_size);
   check(p.sync_slop_s > 0, "sync_slop_s", "> 0", p.sync_slop_s);
@@ -108,9 +106,12 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
 ReconstructionNode::ReconstructionNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
     : params_(NodeParameters::read(private_nh)), tf_listener_(tf_buffer_),
       queue_(static_cast<std::size_t>(params_.queue_size)) {
-  if (!params_.config.empty())
-    config_ = PipelineConfig::load(params_.config);
-  config_.validate();
+  try {
+    config_ = PipelineConfig::load(params_.config); // "" = the defaults
+    config_.validate();
+  } catch (const Error& e) {
+    throw ConfigError("parameter " + private_nh.resolveName("config") + ": " + e.what());
+  }
   depth_pub_ = private_nh.advertise<Image>("depth", 2);
   weight_pub_ = private_nh.advertise<Image>("weight", 2);
   points_pub_ = private_nh.advertise<Cloud>("points", 2);
@@ -227,7 +228,7 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
                             "the CameraInfo on " + cameraInfoTopic(params_.left_topic));
   }
   Reconstructor::Options options;
-  options.poses = poseMode(params_.poses);
+  options.poses = kPoseModes.at(params_.poses);
   options.threads = params_.threads;
   options.sweeping_scans = params_.sweeping_scans;
   engine_ = std::make_unique<Reconstructor>(rig, config_, options);
