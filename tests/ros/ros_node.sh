@@ -2,12 +2,13 @@
 # msf_ros_node against a real ROS master: a roscore of its own on a free port, a bag of KITTI
 # odometry 04 frames 0..LAST written by msf_kitti2bag, the node and the player started by
 # launch/kitti_bag.launch, what the node publishes recorded by `rosbag record`; then
+#  - its refusals of bad parameters,
 #  - each frame's depth and weight image, fused points and the mesh marker checked against the
 #    engine on the same frames (check_node_output),
 #  - the mesh the node saves on shutdown equal, byte for byte, to msf_reconstruct's of the bag
 #    (both read the poses and the extrinsic through tf's quaternions, so no rounding differs),
-#  - the node's account at shutdown: every frame reconstructed, none dropped.
-# Everything it starts runs in process groups of its own, stopped on any exit (trap).
+#  - the node's account at shutdown: every frame reconstructed, none dropped,
+#  - nothing it started left running (ros_session.sh).
 #   ros_node.sh BUILD_DIR KITTI_DIR [LAST_FRAME]
 set -euo pipefail
 build=$1
@@ -23,61 +24,10 @@ if [ ! -d "$sequence" ]; then
   echo "SKIPPED: KITTI odometry 04 not found in '$kitti' (set MSF_KITTI_DIR)"
   exit 77
 fi
-
-work=$(mktemp -d "${TMPDIR:-/tmp}/msf_ros_node.XXXXXX")
-groups=() # process groups started (set -m: each background job leads its own)
-set -m
-
-stop_group() { # SIGINT (a ROS process's orderly stop), then SIGKILL after $2 s
-  local pgid=$1 wait_s=$2
-  kill -INT -- "-$pgid" 2>/dev/null || return 0
-  for ((k = 0; k < wait_s * 10; ++k)); do
-    kill -0 -- "-$pgid" 2>/dev/null || return 0
-    sleep 0.1
-  done
-  kill -KILL -- "-$pgid" 2>/dev/null || true
-}
-
-# roslaunch starts each node in a session of its own (setsid): what is left of them after
-# their launcher stopped is found by the unique folder in their command line or log path.
-leftovers() { pgrep -f -- "$work" || true; }
-
-cleanup() {
-  local status=$?
-  for ((g = ${#groups[@]} - 1; g >= 0; --g)); do
-    stop_group "${groups[g]}" 5
-  done
-  local left
-  left=$(leftovers)
-  if [ -n "$left" ]; then
-    echo "processes left running, killed: $(ps -o pid=,args= -p "${left//$'\n'/,}" | cut -c1-120)"
-    kill -KILL $left 2>/dev/null || true
-    status=1
-  fi
-  rm -rf "$work"
-  exit "$status"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-
-fail() {
-  echo "FAILED: $*"
-  exit 1
-}
-
-# A free port for the master (the kernel's pick), and ROS's files in the scratch folder.
-port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI=http://localhost:$port ROS_HOME=$work/ros_home ROS_LOG_DIR=$work/ros_home/log
-export ROS_PACKAGE_PATH=$build/ros${ROS_PACKAGE_PATH:+:$ROS_PACKAGE_PATH}
-roscore -p "$port" >"$work/roscore.log" 2>&1 &
-groups+=($!)
-
+source "$(dirname "$0")/ros_session.sh"
+ros_session_start "$build"
 "$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -o "$work/04.bag" >/dev/null
-for ((k = 0; ; ++k)); do
-  rosparam get /run_id >/dev/null 2>&1 && break
-  ((k < 300)) || fail "roscore did not answer on port $port in 30 s: $(tail -5 "$work/roscore.log")"
-  sleep 0.1
-done
+ros_session_wait_master
 
 # Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
 refuse() { # NAME EXPECTED _param:=value...
@@ -100,30 +50,26 @@ refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does n
 
 # The recorder first, so that it hears the first frame; then the node, and the player, which
 # waits for the node's subscriptions. queue_size: every frame, however slow the machine.
-rosbag record -q -O "$work/published.bag" /msf_ros_node/depth /msf_ros_node/weight /msf_ros_node/points \
-  /msf_ros_node/mesh >"$work/record.log" 2>&1 &
-groups+=($!)
-recorder=$!
-rostopic echo -n "$frames" /msf_ros_node/depth/header/seq >"$work/depth_seen.txt" 2>&1 &
-groups+=($!)
-counter=$!
-roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames \
-  mesh_path:="$work/node_mesh.ply" >"$work/launch.log" 2>&1 &
-groups+=($!)
-launcher=$!
+background record rosbag record -q -O "$work/published.bag" /msf_ros_node/depth /msf_ros_node/weight \
+  /msf_ros_node/points /msf_ros_node/mesh
+recorder=$started
+background depth_seen rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
+counter=$started
+background launch roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames \
+  mesh_path:="$work/node_mesh.ply"
+launcher=$started
 
 # The node is done when it has published a depth image per frame: rostopic echo -n exits then.
 for ((k = 0; ; ++k)); do
   kill -0 "$counter" 2>/dev/null || break
-  ((k < 600)) || fail "the node published $(grep -c '^---' "$work/depth_seen.txt") depth images of $frames in 60 s"
+  ((k < 600)) || fail "the node published $(grep -c '^---' "$work/depth_seen.log") depth images of $frames in 60 s"
   sleep 0.1
 done
 stop_group "$launcher" 30 # the node publishes the last mesh marker, saves the mesh, gives its account
 stop_group "$recorder" 10
-grep -a "msf_ros_node" "$work/launch.log" | grep -a -v "^ \*" | sed 's/\x1b\[[0-9;]*m//g'
+node_lines "$work/launch.log"
 
-account=$(grep -a -A3 "scans received" "$work/launch.log" | sed 's/\x1b\[[0-9;]*m//g')
-echo "the node's account: $account"
+account=$(node_lines "$work/launch.log" | grep -a "scans received")
 [[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||
   fail "the node's account at shutdown is not every frame reconstructed: '$account'"
 [ -f "$work/node_mesh.ply" ] || fail "the node saved no mesh"
@@ -137,11 +83,5 @@ cmp "$work/node_mesh.ply" "$work/reconstruct/mesh.ply" ||
   fail "the node's mesh differs from msf_reconstruct's of the same bag"
 echo "ok: the node's mesh is msf_reconstruct's, byte for byte ($(stat -c %s "$work/node_mesh.ply") bytes)"
 
-# All stopped in order: nothing of the run is left.
-for ((g = ${#groups[@]} - 1; g >= 0; --g)); do
-  stop_group "${groups[g]}" 10
-done
-groups=()
-left=$(leftovers)
-[ -z "$left" ] || fail "processes left after the stop: $(ps -o pid=,args= -p "${left//$'\n'/,}" | cut -c1-120)"
+ros_session_stop
 echo "ok: roscore, the node, the player and the recorder stopped; no process left"

@@ -167,8 +167,8 @@ void ReconstructionNode::onColor(const Cloud::ConstPtr& cloud, const Image::Cons
 
 void ReconstructionNode::enqueue(Pending pending) {
   if (frames_++ == 0)
-    first_stamp_ = pending.cloud->header.stamp;
-  last_stamp_ = pending.cloud->header.stamp;
+    first_arrival_ = Clock::now();
+  last_arrival_ = Clock::now();
   if (queue_.pushNewest(std::move(pending)))
     drop("the engine was busy: the oldest of " + std::to_string(params_.queue_size) +
          " waiting frames made room for the newest");
@@ -348,7 +348,8 @@ std::string ReconstructionNode::summary() const {
   if (reconstructed_ > 1 && frames_ > 1)
     std::snprintf(times, sizeof times, "\n  the engine: %.0f ms a frame (the first %.0f ms); the frames came every %.0f ms",
                   later_frames_ms_ / static_cast<double>(reconstructed_ - 1), first_frame_ms_,
-                  (last_stamp_ - first_stamp_).toSec() * 1e3 / static_cast<double>(frames_ - 1));
+                  std::chrono::duration<double, std::milli>(last_arrival_ - first_arrival_).count() /
+                      static_cast<double>(frames_ - 1));
   return std::to_string(scans_) + " scans received, " + std::to_string(frames_) + " frames, " +
          std::to_string(reconstructed_) + " reconstructed, " + std::to_string(dropped) + " dropped" + reasons + times;
 }

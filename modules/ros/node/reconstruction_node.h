@@ -109,7 +109,7 @@ private:
 
   BoundedQueue<Pending> queue_;
   std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
-  ros::Time first_stamp_, last_stamp_; // of the frames' scans (the spin thread's)
+  Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;
   std::map<std::string, std::size_t> dropped_; // reason -> frames
 
