@@ -11,11 +11,16 @@ DEMO_OUT ?= out/demo
 # The Python module msfusion (python/) and its tests and examples (matplotlib). Open3D
 # (python3-open3d) is optional: msfusion.o3d and its test use it when it is installed.
 PYTHON_PACKAGES := pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
+# The ros module (bag reader, msf_kitti2bag, msf_ros_node) and its tests: Debian's ROS 1
+# (roscore, rosbag, roslaunch, rostopic in ros-core; the C++ libraries and messages), and
+# procps (pgrep, ps) with which the node's test makes sure nothing it started is left.
+ROS_PACKAGES := ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-msgs-dev libmessage-filters-dev \
+                libsensor-msgs-dev libvisualization-msgs-dev libcv-bridge-dev libpcl-conversions-dev procps
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
 # time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
-                libyaml-cpp-dev $(PYTHON_PACKAGES)
+                libyaml-cpp-dev $(PYTHON_PACKAGES) $(ROS_PACKAGES)
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev

@@ -477,4 +477,24 @@ TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {
   EXPECT_FALSE(queue.pop().has_value());
 }
 
+TEST(BoundedQueue, PushNewestDropsTheOldestAndNeverBlocks) {
+  msf::BoundedQueue<int> queue(2);
+  EXPECT_FALSE(queue.pushNewest(1));
+  EXPECT_FALSE(queue.pushNewest(2));
+  EXPECT_TRUE(queue.pushNewest(3)); // full: 1 makes room
+  EXPECT_TRUE(queue.pushNewest(4)); // and 2
+  EXPECT_EQ(queue.pop().value(), 3);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(queue.popFor(std::chrono::seconds(5)).value(), 4);
+  EXPECT_FALSE(queue.popFor(std::chrono::milliseconds(20)).has_value()); // empty: runs out
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_FALSE(queue.drained());
+  EXPECT_FALSE(queue.pushNewest(5));
+  queue.close();
+  EXPECT_FALSE(queue.pushNewest(6)); // closed: refused
+  EXPECT_EQ(queue.popFor(std::chrono::seconds(5)).value(), 5);
+  EXPECT_TRUE(queue.drained());
+  EXPECT_FALSE(queue.popFor(std::chrono::seconds(5)).has_value()); // at once
+}
+
 } // namespace

@@ -73,6 +73,9 @@ public:
   virtual bool sweepingScans() const { return true; }
   /// Folder of synthetic ground truth, "" when there is none.
   virtual std::string groundTruthDir() const { return {}; }
+  /// What the reader skipped or assumed, one line each, for the tool to print (a bag's frames
+  /// left out for want of an image, say).
+  virtual std::vector<std::string> notes() const { return {}; }
 
   /// Indices of the frames whose numbers (frameNumber of their names, else their index) lie in
   /// the range; throws InvalidInputError when it selects no frame or goes beyond the last.
