@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# A single-node Slurm cluster on this host, everything in a state folder this script owns:
+#   scripts/slurm_local.sh start [DIR]   munge key and daemon, slurm.conf for this host's name,
+#                                        CPUs and memory, slurmctld and slurmd; waits until the
+#                                        node takes jobs and prints `export SLURM_CONF=DIR/slurm.conf`
+#   scripts/slurm_local.sh stop [DIR]    stops the daemons it started (by their pid files) and
+#                                        removes DIR
+#   scripts/slurm_local.sh status [DIR]  exit 0 when the cluster in DIR takes jobs
+# DIR defaults to $MSF_SLURM_DIR or /tmp/msf_slurm. Ports: $MSF_SLURM_PORT (slurmctld) and the
+# next one (slurmd), 6817 by default. Needs root (slurmd runs jobs as their user) and Debian's
+# slurm-wlm and munge (make deps). Client commands find the cluster through SLURM_CONF.
+set -euo pipefail
+
+command=${1:-}
+dir=${2:-${MSF_SLURM_DIR:-/tmp/msf_slurm}}
+port=${MSF_SLURM_PORT:-6817}
+die() { echo "slurm_local.sh: error: $*" >&2; exit 1; }
+
+# The script only ever removes a folder it made: it carries this marker.
+marker="$dir/.msf_slurm_local"
+
+stop_daemon() { # pid file, name
+  local pid_file=$1 pid
+  [ -f "$pid_file" ] || return 0
+  pid=$(cat "$pid_file" 2>/dev/null || true)
+  [ -n "$pid" ] && kill -0 "$pid" 2>/dev/null || return 0
+  kill "$pid" 2>/dev/null || true
+  for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || return 0; sleep 0.1; done
+  kill -9 "$pid" 2>/dev/null || true
+}
+
+stop() {
+  [ -e "$dir" ] || return 0
+  [ -f "$marker" ] || die "'$dir' was not made by slurm_local.sh (no $marker): not touching it"
+  stop_daemon "$dir/slurmd.pid"
+  stop_daemon "$dir/slurmctld.pid"
+  stop_daemon "$dir/munged.pid"
+  rm -rf "$dir"
+}
+
+node_ready() {
+  SLURM_CONF="$dir/slurm.conf" timeout 10 sinfo -h -N -o '%t' 2>/dev/null | grep -Eq '^(idle|mix|alloc)'
+}
+
+write_conf() {
+  local host cpus mem_mb
+  host=$(hostname -s)
+  cpus=$(nproc)
+  # What jobs may ask for: the host's memory less 512 MiB for the system and the daemons.
+  mem_mb=$(( $(awk '/MemTotal/ {print int($2 / 1024)}' /proc/meminfo) - 512 ))
+  cat > "$dir/slurm.conf" <<EOF
+# Written by scripts/slurm_local.sh: a single-node cluster on $host.
+ClusterName=msflocal
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+# cred_expire: how long a requeued job waits before it starts again (120 s by default).
+AuthInfo=socket=$dir/munge/munge.socket,cred_expire=10
+CredType=cred/munge
+StateSaveLocation=$dir/state
+SlurmdSpoolDir=$dir/spool
+SlurmctldPidFile=$dir/slurmctld.pid
+SlurmdPidFile=$dir/slurmd.pid
+SlurmctldLogFile=$dir/slurmctld.log
+SlurmdLogFile=$dir/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+MpiDefault=none
+SwitchType=switch/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SchedulerType=sched/backfill
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core_Memory
+ReturnToService=2
+# Finished jobs stay visible to scontrol for 10 minutes (tests read their restart counts).
+MinJobAge=600
+DefMemPerCPU=1024
+SchedulerParameters=bf_interval=1,sched_interval=1
+InactiveLimit=0
+KillWait=5
+Waittime=0
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem_mb State=UNKNOWN
+PartitionName=local Nodes=$host Default=YES MaxTime=INFINITE State=UP OverSubscribe=NO
+EOF
+}
+
+start() {
+  [ "$(id -u)" -eq 0 ] || die "needs root: slurmd runs each job as its user"
+  for tool in munged slurmctld slurmd sinfo sbatch; do
+    command -v "$tool" >/dev/null || die "'$tool' not found: install Debian's slurm-wlm and munge (make deps)"
+  done
+  if [ -e "$dir" ]; then
+    if [ -f "$marker" ] && node_ready; then
+      echo "export SLURM_CONF=$dir/slurm.conf"
+      return 0
+    fi
+    stop
+  fi
+  mkdir -p "$dir"
+  touch "$marker"
+  chmod 755 "$dir"
+  mkdir -p "$dir/munge" "$dir/state" "$dir/spool"
+  chmod 700 "$dir/munge"
+  dd if=/dev/urandom of="$dir/munge/munge.key" bs=1024 count=1 status=none
+  chmod 400 "$dir/munge/munge.key"
+  munged --force --key-file="$dir/munge/munge.key" --socket="$dir/munge/munge.socket" \
+         --pid-file="$dir/munged.pid" --log-file="$dir/munged.log" --seed-file="$dir/munge/munged.seed" \
+    || die "munged did not start (see $dir/munged.log)"
+  write_conf
+  export SLURM_CONF="$dir/slurm.conf"
+  # -i: a fresh state (no jobs of an earlier cluster).
+  slurmctld -i -f "$SLURM_CONF" || die "slurmctld did not start (see $dir/slurmctld.log)"
+  slurmd -f "$SLURM_CONF" || die "slurmd did not start (see $dir/slurmd.log)"
+  for _ in $(seq 60); do
+    if node_ready; then
+      echo "export SLURM_CONF=$SLURM_CONF"
+      return 0
+    fi
+    sleep 0.5
+  done
+  die "the node did not come up in 30 s (see $dir/slurmctld.log and $dir/slurmd.log)"
+}
+
+case "$command" in
+  start) start ;;
+  stop) stop ;;
+  status) node_ready ;;
+  *) die "usage: slurm_local.sh start|stop|status [DIR]" ;;
+esac
