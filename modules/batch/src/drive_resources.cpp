@@ -1,0 +1,27 @@
+#include <msf/batch/drive_resources.h>
+#include <msf/common/exceptions.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/pose_source.h>
+
+#include <cmath>
+
+namespace msf {
+
+DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames) {
+  const Sequence sequence(drive.dataset);
+  const std::vector<std::size_t> indices = sequence.indices(FrameRange::parse(frames));
+  if (drive.poses.empty() && !sequence.hasPoses())
+    throw InvalidInputError("drive '" + drive.name + "' ('" + drive.dataset +
+                            "') has no poses: a batch merges drives whose poses share a world; give its poses file "
+                            "in the drive list (DATASET POSES)");
+  const PoseSource poses(drive.poses.empty() ? "dataset" : drive.poses, sequence, indices, config.odometry);
+  const Pipeline pipeline(sequence.calibration(), config);
+  DriveResources r;
+  r.frames = indices.size();
+  r.predicted_mb = pipeline.predictMemory(poses.knownPoses(indices)).total_mb;
+  const double step = static_cast<double>(DriveResources::kRequestStepMb);
+  r.request_mb = static_cast<std::size_t>(std::ceil(r.predicted_mb * DriveResources::kMargin / step) * step);
+  return r;
+}
+
+} // namespace msf
