@@ -1,4 +1,4 @@
-# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
+# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -11,6 +11,9 @@ DEMO_OUT ?= out/demo
 # time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time
+# A single-node Slurm cluster on localhost (scripts/slurm_local.sh), which the batch's tests
+# submit to (tests/batch/test_slurm.cpp; .ci/run starts it before `make test`).
+SLURM_PACKAGES := slurm-wlm munge
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev
@@ -19,7 +22,7 @@ BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-slurm deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -46,6 +49,9 @@ endef
 deps:
 	$(call apt_install,$(APT_PACKAGES))
 
+deps-slurm: deps
+	$(call apt_install,$(SLURM_PACKAGES))
+
 deps-bench: deps
 	$(call apt_install,$(BENCH_PACKAGES))
 
@@ -58,7 +64,7 @@ $(BUILD_DIR)/CMakeCache.txt:
 build: $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j$(JOBS)
 
-test: deps
+test: deps deps-slurm
 	$(MAKE) build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
 

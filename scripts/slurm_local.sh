@@ -107,14 +107,15 @@ start() {
   chmod 700 "$dir/munge"
   dd if=/dev/urandom of="$dir/munge/munge.key" bs=1024 count=1 status=none
   chmod 400 "$dir/munge/munge.key"
+  # Daemons say nothing on stdout, which callers read with eval.
   munged --force --key-file="$dir/munge/munge.key" --socket="$dir/munge/munge.socket" \
-         --pid-file="$dir/munged.pid" --log-file="$dir/munged.log" --seed-file="$dir/munge/munged.seed" \
+         --pid-file="$dir/munged.pid" --log-file="$dir/munged.log" --seed-file="$dir/munge/munged.seed" >&2 \
     || die "munged did not start (see $dir/munged.log)"
   write_conf
   export SLURM_CONF="$dir/slurm.conf"
   # -i: a fresh state (no jobs of an earlier cluster).
-  slurmctld -i -f "$SLURM_CONF" || die "slurmctld did not start (see $dir/slurmctld.log)"
-  slurmd -f "$SLURM_CONF" || die "slurmd did not start (see $dir/slurmd.log)"
+  slurmctld -i -f "$SLURM_CONF" >&2 || die "slurmctld did not start (see $dir/slurmctld.log)"
+  slurmd -f "$SLURM_CONF" >&2 || die "slurmd did not start (see $dir/slurmd.log)"
   for _ in $(seq 60); do
     if node_ready; then
       echo "export SLURM_CONF=$SLURM_CONF"

@@ -69,8 +69,8 @@ std::vector<Drive> findDrives(const std::string& path) {
       if (isOdometrySequence(p))
         found.push_back(p);
     for (const fs::path& level1 : subfolders(root)) {
-      if (const fs::path one = sequenceOf(level1); !one.empty())
-        found.push_back(one);
+      if (const fs::path inside = sequenceOf(level1); !inside.empty())
+        found.push_back(inside);
       else
         for (const fs::path& level2 : subfolders(level1))
           if (isRawDrive(level2))
@@ -104,9 +104,11 @@ std::vector<Drive> readDriveList(const std::string& path) {
     std::vector<std::string> fields;
     if (line.find('\t') != std::string::npos) {
       std::stringstream ss(line);
-      for (std::string f; std::getline(ss, f, '\t');)
-        if (!f.empty())
-          fields.push_back(f);
+      for (std::string f; std::getline(ss, f, '\t');) {
+        const auto first = f.find_first_not_of(' '), last = f.find_last_not_of(' ');
+        if (first != std::string::npos)
+          fields.push_back(f.substr(first, last - first + 1));
+      }
     } else {
       std::stringstream ss(line);
       for (std::string f; ss >> f;)

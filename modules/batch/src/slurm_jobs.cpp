@@ -141,8 +141,7 @@ SlurmSubmission submitToSlurm(const BatchPlan& plan, const SlurmOptions& options
 }
 
 bool waitForSlurm(const SlurmSubmission& jobs, double timeout_s, double poll_s) {
-  const std::set<std::string> ours(jobs.drive_jobs.begin(), jobs.drive_jobs.end());
-  std::set<std::string> waiting = ours;
+  std::set<std::string> waiting(jobs.drive_jobs.begin(), jobs.drive_jobs.end());
   for (const std::string& id : {jobs.merge_job, jobs.mesh_job, jobs.finish_job})
     if (!id.empty())
       waiting.insert(id);

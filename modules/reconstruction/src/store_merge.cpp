@@ -66,12 +66,12 @@ struct MergedBlock {
       TsdfVoxel& v = block.voxels[i];
       if (!(s.w > 0))
         continue;
-      if (s.observers > 1)
-        ++stats.voxels_shared;
-      if (s.w > max_weight)
-        ++stats.voxels_capped;
+      // A voxel one store observed keeps its values (its integrator capped its weight).
+      const bool shared = s.observers > 1;
+      stats.voxels_shared += shared ? 1 : 0;
+      stats.voxels_capped += shared && s.w > max_weight ? 1 : 0;
       v.sdf = std::clamp(static_cast<float>(s.sdf_w / s.w), -truncation, truncation);
-      v.weight = static_cast<float>(std::min(s.w, static_cast<double>(max_weight)));
+      v.weight = static_cast<float>(shared ? std::min(s.w, static_cast<double>(max_weight)) : s.w);
       v.r = static_cast<std::uint8_t>(s.r_w / s.w + 0.5);
       v.g = static_cast<std::uint8_t>(s.g_w / s.w + 0.5);
       v.b = static_cast<std::uint8_t>(s.b_w / s.w + 0.5);
@@ -120,6 +120,8 @@ StoreMerge::StoreMerge(const std::vector<std::string>& stores, const Config& con
   for (const auto& [tile, holders] : holders_)
     tiles_.push_back(tile);
 }
+
+StoreMerge::StoreMerge(const std::vector<std::string>& stores) : StoreMerge(stores, Config()) {}
 
 const std::vector<int>& StoreMerge::storesOf(const GridIndex& tile) const {
   static const std::vector<int> none;

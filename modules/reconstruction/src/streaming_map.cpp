@@ -27,6 +27,8 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr int kSide = TsdfBlock::kSide;
+constexpr std::int64_t kTileBias = 1 << 20;
+
 std::string number(double v) {
   std::ostringstream ss;
   ss.precision(9);

@@ -41,7 +41,9 @@ public:
   /// Opens the stores in `stores` (folders with tsdf/index.txt). Throws IOError naming a
   /// store whose index is missing or garbled, InvalidInputError naming two stores on different
   /// grids (voxel size, truncation, tile size) or when `stores` is empty.
-  explicit StoreMerge(const std::vector<std::string>& stores, const Config& config = Config());
+  StoreMerge(const std::vector<std::string>& stores, const Config& config);
+  /// With the default Config (the integrator's default cap).
+  explicit StoreMerge(const std::vector<std::string>& stores);
 
   const Config& config() const { return config_; }
   const std::vector<TsdfStore>& stores() const { return stores_; }

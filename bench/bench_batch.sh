@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# What docs/scale.md sizes the batch from (figures in docs/results.md, "Many drives, one map"):
+#  1. a real KITTI drive streamed (04_10_50, 0.1 m voxels): frames per second, peak memory, the
+#     store's bytes and tiles per frame and per metre;
+#  2. three overlapping synthetic drives of one street (msf_synth -street_m, 60 frames each,
+#     0.1 m voxels, moving cars on): the batch on this machine (-local 1) against the drives' own
+#     run time (the machinery's overhead), the merge's and the mesh's time per tile, and the maps
+#     scored against the street's truth beside the one-process map;
+#  3. the merge's time against its fan-in: one drive's store merged with k copies of itself.
+# usage: bench/bench_batch.sh BIN_DIR KITTI_DIR [WORK_DIR]   (WORK_DIR is kept; ~15 min on 2 cores)
+set -euo pipefail
+bin=$(cd "$1" && pwd)
+kitti=$2
+work=${3:-/tmp/msf_bench_batch}
+mkdir -p "$work"
+cd "$work"
+json() { grep -o "\"$2\": [0-9.e+-]*" "$1" | head -1 | awk '{print $2}'; }
+
+echo "== 1. KITTI odometry 04_10_50 streamed at 0.1 m voxels"
+rm -rf kitti_drive
+/usr/bin/time -f "%e s wall, %M KiB peak" "$bin/msf_reconstruct" "$kitti/odometry/sequences/04_10_50" \
+  -o kitti_drive -stream 101 -panels 0 > kitti_drive.log 2> kitti_drive.time
+frames=$(json kitti_drive/summary.json frames_done || true)
+echo "frames per second $(json kitti_drive/summary.json frames_per_second), $(cat kitti_drive.time)"
+echo "store: tsdf/ $(du -sb kitti_drive/tsdf | cut -f1) bytes, tiles/ $(du -sb kitti_drive/tiles | cut -f1) bytes," \
+     "$(($(ls kitti_drive/tsdf | wc -l) - 1)) tiles"
+awk 'NR == 1 {x0 = $4; z0 = $12} {x = $4; z = $12} END {printf "path %.1f m (first to last pose)\n", sqrt((x - x0)^2 + (z - z0)^2)}' \
+  kitti_drive/poses.txt
+
+echo "== 2. Three drives of one street"
+if [ ! -e a/gt/scene.ply ]; then
+  "$bin/msf_synth" -o a -frames 60 -seed 3 -street_m 130 > /dev/null
+  "$bin/msf_synth" -o b -frames 60 -seed 3 -street_m 130 -start_m 30 > /dev/null
+  "$bin/msf_synth" -o c -frames 60 -seed 3 -street_m 130 -start_m 125 -reverse > /dev/null
+fi
+rm -rf batch one
+start=$(date +%s.%N)
+"$bin/msf_batch" -o batch -local 1 -merge_tasks 2 -stream 101 a b c > batch.log 2>&1
+end=$(date +%s.%N)
+echo "batch -local 1: $(echo "$end - $start" | bc) s wall"
+grep -o '"reconstruct_s": [0-9.]*' batch/map/summary.json
+for key in tiles tiles_shared blocks voxels_shared voxels_capped merge_s mesh_s finish_s triangles; do
+  echo "$key $(json batch/map/summary.json $key)"
+done
+"$bin/msf_batch" -o one -one_process -stream 101 a b c > one.log 2>&1
+echo "one process: $(json one/summary.json wall_s) s"
+for mesh in batch/drives/a/mesh.ply batch/drives/b/mesh.ply batch/drives/c/mesh.ply batch/map/mesh.ply one/mesh.ply; do
+  echo "$mesh: $("$bin/msf_eval_mesh" "$mesh" a b c | tail -1)"
+done
+
+echo "== 3. The merge against its fan-in (one drive's store, k copies)"
+for k in 1 2 4 8; do
+  rm -rf fanin_$k merged_$k
+  mkdir -p fanin_$k
+  stores=()
+  for i in $(seq "$k"); do
+    cp -al batch/drives/a "fanin_$k/s$i"
+    stores+=("fanin_$k/s$i")
+  done
+  "$bin/msf_merge" -o "merged_$k" "${stores[@]}" > "merged_$k.log" 2>&1
+  echo "fan-in $k: merge $(json merged_$k/summary.json merge_s) s, mesh $(json merged_$k/summary.json mesh_s) s," \
+       "$(json merged_$k/summary.json tiles) tiles, $(json merged_$k/summary.json blocks) blocks"
+done
