@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
     if (!s.run_task.empty()) {
       if (!paths.empty() || s.slurm || s.local > 0 || s.one_process || !s.list.empty())
         throw msf::InvalidInputError("-run TASK takes only -o OUT: the plan in OUT says the rest");
-      return msf::runBatchTask(msf::BatchPlan::load(s.out), msf::BatchTask::parse(s.run_task));
+      const msf::BatchTask task = msf::BatchTask::parse(s.run_task);
+      return msf::runBatchTask(msf::BatchPlan::load(s.out), task);
     }
     return plan_and_run(s, paths, options);
   });

@@ -89,6 +89,7 @@ BatchPlan::BatchPlan(std::string out, std::vector<Drive> drives, BatchOptions op
     out_.pop_back();
   if (drives_.empty())
     throw InvalidInputError("a batch needs at least one drive");
+  requireBatchRoot(out_); // before anything is read or predicted: a folder of someone else's is refused at once
   if (options_.cpus < 1 || options_.merge_tasks < 1 || options_.max_attempts < 1)
     throw InvalidInputError("-cpus, -merge_tasks and -max_attempts must be at least 1");
   config_ = PipelineConfig::load(options_.config);
