@@ -18,7 +18,7 @@ json() { grep -o "\"$2\": [0-9.e+-]*" "$1" | head -1 | awk '{print $2}'; }
 
 echo "== 1. KITTI odometry 04_10_50 streamed at 0.1 m voxels"
 rm -rf kitti_drive
-/usr/bin/time -f "%e s wall, %M KiB peak" "$bin/msf_reconstruct" "$kitti/odometry/sequences/04_10_50" \
+/usr/bin/time -f "%e s wall, %U s user, %S s system, %M KiB peak" "$bin/msf_reconstruct" "$kitti/odometry/sequences/04_10_50" \
   -o kitti_drive -stream 101 -panels 0 > kitti_drive.log 2> kitti_drive.time
 frames=$(json kitti_drive/summary.json frames_done || true)
 echo "frames per second $(json kitti_drive/summary.json frames_per_second), $(cat kitti_drive.time)"
@@ -28,16 +28,14 @@ awk 'NR == 1 {x0 = $4; z0 = $12} {x = $4; z = $12} END {printf "path %.1f m (fir
   kitti_drive/poses.txt
 
 echo "== 2. Three drives of one street"
-if [ ! -e a/gt/scene.ply ]; then
-  "$bin/msf_synth" -o a -frames 60 -seed 3 -street_m 130 > /dev/null
-  "$bin/msf_synth" -o b -frames 60 -seed 3 -street_m 130 -start_m 30 > /dev/null
-  "$bin/msf_synth" -o c -frames 60 -seed 3 -street_m 130 -start_m 125 -reverse > /dev/null
-fi
+synth() { [ -e "$1/gt/scene.ply" ] || "$bin/msf_synth" -o "$@" -frames 60 -seed 3 -street_m 130 > /dev/null; }
+synth a
+synth b -start_m 30
+synth c -start_m 125 -reverse
 rm -rf batch one
-start=$(date +%s.%N)
-"$bin/msf_batch" -o batch -local 1 -merge_tasks 2 -stream 101 a b c > batch.log 2>&1
-end=$(date +%s.%N)
-echo "batch -local 1: $(echo "$end - $start" | bc) s wall"
+/usr/bin/time -f "%e s wall, %U s user, %S s system (the batch and its children)" -o batch.time \
+  "$bin/msf_batch" -o batch -local 1 -merge_tasks 2 -stream 101 a b c > batch.log 2>&1
+echo "batch -local 1: $(cat batch.time)"
 grep -o '"reconstruct_s": [0-9.]*' batch/map/summary.json
 for key in tiles tiles_shared blocks voxels_shared voxels_capped merge_s mesh_s finish_s triangles; do
   echo "$key $(json batch/map/summary.json $key)"
@@ -61,3 +59,16 @@ for k in 1 2 4 8; do
   echo "fan-in $k: merge $(json merged_$k/summary.json merge_s) s, mesh $(json merged_$k/summary.json mesh_s) s," \
        "$(json merged_$k/summary.json tiles) tiles, $(json merged_$k/summary.json blocks) blocks"
 done
+
+echo "== 4. The same batch on Slurm (when SLURM_CONF names a cluster that takes jobs)"
+if sinfo -h >/dev/null 2>&1; then
+  rm -rf slurm
+  start=$(date +%s.%N)
+  "$bin/msf_batch" -o slurm -slurm -wait -cpus 2 -merge_tasks 2 -stream 101 a b c > slurm.log 2>&1
+  end=$(date +%s.%N)
+  echo "batch -slurm (submit to map): $(echo "$end - $start" | bc) s wall"
+  grep -o '"reconstruct_s": [0-9.]*' slurm/map/summary.json
+  for key in merge_s mesh_s finish_s; do echo "$key $(json slurm/map/summary.json $key)"; done
+else
+  echo "no Slurm cluster: skipped (scripts/slurm_local.sh start; export SLURM_CONF=...)"
+fi

@@ -97,7 +97,7 @@ int report(const msf::BatchPlan& plan) {
   return 1;
 }
 
-int plan_and_run(const Settings& s, const msf::tool::Arguments& paths, msf::BatchOptions options) {
+int planAndRun(const Settings& s, const msf::tool::Arguments& paths, msf::BatchOptions options) {
   const int modes = (s.slurm ? 1 : 0) + (s.local > 0 ? 1 : 0) + (s.one_process ? 1 : 0);
   if (modes != 1)
     throw msf::InvalidInputError("say where the tasks run, once: -slurm (jobs on a Slurm cluster), -local N (N at a "
@@ -118,6 +118,7 @@ int plan_and_run(const Settings& s, const msf::tool::Arguments& paths, msf::Batc
     msf::tool::printDone(tt.toc(), triangles);
     return 0;
   }
+  plan.requireRoot(); // a folder of someone else's is refused before the drives are read
   predictResources(plan);
   plan.save();
   if (!plan.mapDone()) { // the merge starts from nothing
@@ -202,6 +203,6 @@ int main(int argc, char** argv) {
       const msf::BatchTask task = msf::BatchTask::parse(s.run_task);
       return msf::runBatchTask(msf::BatchPlan::load(s.out), task);
     }
-    return plan_and_run(s, paths, options);
+    return planAndRun(s, paths, options);
   });
 }

@@ -1,6 +1,5 @@
 #include <msf/batch/batch_plan.h>
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 
@@ -89,7 +88,6 @@ BatchPlan::BatchPlan(std::string out, std::vector<Drive> drives, BatchOptions op
     out_.pop_back();
   if (drives_.empty())
     throw InvalidInputError("a batch needs at least one drive");
-  requireBatchRoot(out_); // before anything is read or predicted: a folder of someone else's is refused at once
   if (options_.cpus < 1 || options_.merge_tasks < 1 || options_.max_attempts < 1)
     throw InvalidInputError("-cpus, -merge_tasks and -max_attempts must be at least 1");
   config_ = PipelineConfig::load(options_.config);
@@ -110,6 +108,8 @@ void BatchPlan::setResources(std::size_t drive, double predicted_mb, std::size_t
   predicted_mb_.at(drive) = predicted_mb;
   request_mb_.at(drive) = request_mb;
 }
+
+void BatchPlan::requireRoot() const { requireBatchRoot(out_); }
 
 void BatchPlan::save() const {
   requireBatchRoot(out_);
@@ -159,7 +159,12 @@ BatchPlan BatchPlan::load(const std::string& out) {
   } catch (const std::exception&) {
     throw fail("has a number that is not one");
   }
-  const std::size_t count = std::stoul(values["drives"]);
+  std::size_t count = 0;
+  try {
+    count = std::stoul(values["drives"]);
+  } catch (const std::exception&) {
+    throw fail("has a drive count that is not a number");
+  }
   std::vector<Drive> drives;
   std::vector<std::pair<double, std::size_t>> resources;
   for (std::size_t i = 0; i < count; ++i) {
@@ -172,7 +177,11 @@ BatchPlan BatchPlan::load(const std::string& out) {
     if (f.size() != 5)
       throw fail("has a drive line that is not 'NAME DATASET POSES PREDICTED_MB REQUEST_MB': '" + line + "'");
     drives.push_back({f[0], f[1], f[2] == "-" ? "" : f[2]});
-    resources.emplace_back(std::stod(f[3]), std::stoul(f[4]));
+    try {
+      resources.emplace_back(std::stod(f[3]), std::stoul(f[4]));
+    } catch (const std::exception&) {
+      throw fail("has a drive line whose memory is not a number: '" + line + "'");
+    }
   }
   BatchPlan plan(out, drives, o);
   for (std::size_t i = 0; i < count; ++i)

@@ -138,8 +138,10 @@ int runDrive(const BatchPlan& plan, std::size_t i) {
 }
 
 int runMerge(const BatchPlan& plan, std::size_t share) {
-  if (plan.mapDone())
-    return std::printf("merge share %zu: the map is done: nothing to do\n", share), 0;
+  if (plan.mapDone()) {
+    std::printf("merge share %zu: the map is done: nothing to do\n", share);
+    return 0;
+  }
   const StoreMerge merge = openMerge(plan);
   const std::vector<GridIndex> tiles = merge.tilesOfTask(static_cast<int>(share), plan.options().merge_tasks);
   const StoreMerge::Stats s = merge.merge(tiles, merge.outputStore(plan.mergeDir()));
@@ -153,8 +155,10 @@ int runMerge(const BatchPlan& plan, std::size_t share) {
 }
 
 int runMesh(const BatchPlan& plan, std::size_t share) {
-  if (plan.mapDone())
-    return std::printf("mesh share %zu: the map is done: nothing to do\n", share), 0;
+  if (plan.mapDone()) {
+    std::printf("mesh share %zu: the map is done: nothing to do\n", share);
+    return 0;
+  }
   const auto start = Clock::now();
   const StoreMerge merge = openMerge(plan);
   for (int k = 0; k < plan.options().merge_tasks; ++k)
@@ -202,8 +206,10 @@ void linkInto(const fs::path& from, const fs::path& to) {
 }
 
 int runFinish(const BatchPlan& plan) {
-  if (plan.mapDone())
-    return std::printf("finish: %s is the map of these drives: nothing to do\n", plan.mapDir().c_str()), 0;
+  if (plan.mapDone()) {
+    std::printf("finish: %s is the map of these drives: nothing to do\n", plan.mapDir().c_str());
+    return 0;
+  }
   const auto start = Clock::now();
   Figures merged_figures, mesh_figures;
   for (int k = 0; k < plan.options().merge_tasks; ++k) {

@@ -25,9 +25,10 @@ struct BatchOptions {
 /// every task, so that the tasks of one submission agree on what they do:
 ///   OUT/plan.txt             the options and the drives (name, dataset, poses, predicted memory)
 ///   OUT/drives/NAME/         msf_reconstruct's output for the drive (an OutputFolder: committed whole)
-///   OUT/state/NAME.done      the request it was made for (dataset, frames, poses, options and the
-///                            digests of the config and poses files): a drive is done when its
-///                            folder is committed and this matches the plan's request
+///   OUT/state/drive_NAME.done  the request it was made for (dataset, frames, poses, options and
+///                            the digests of the config and poses files): a drive is done when
+///                            its folder is committed and this matches the plan's request;
+///                            OUT/state/map.done likewise for the map
 ///   OUT/logs/                each drive's log (its attempts, appended) and the tasks' logs
 ///   OUT/merge/               the merge's work: merged tiles (tsdf/) and their meshes (tiles/)
 ///   OUT/map/                 the merged map (an OutputFolder): tsdf/, tiles/, mesh.ply, summary.json
@@ -38,9 +39,10 @@ public:
   BatchPlan(std::string out, std::vector<Drive> drives, BatchOptions options);
   /// The plan in OUT/plan.txt. Throws IOError naming the file when it is missing or garbled.
   static BatchPlan load(const std::string& out);
-  /// Makes OUT (absent, empty or an earlier batch's: its plan.txt and only the entries a
-  /// batch writes) and writes OUT/plan.txt atomically. Throws IOError naming an entry of OUT
-  /// that is not a batch's.
+  /// Throws IOError naming an entry of OUT that is not a batch's: OUT must be absent, empty or
+  /// an earlier batch's (its plan.txt and only the entries a batch writes).
+  void requireRoot() const;
+  /// Makes OUT (requireRoot first) and writes OUT/plan.txt atomically.
   void save() const;
 
   const std::string& out() const { return out_; }
