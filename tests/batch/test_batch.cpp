@@ -142,8 +142,9 @@ TEST_F(BatchPlanTest, LocalBatchMergesToTheOneProcessMapAndNeverRedoesADrive) {
   EXPECT_LT(d.weight_relative, 1e-4);
 
   // More complete than any one drive's map, as accurate, and as good as one process.
-  const MeshAccuracy merged = expectBetterThanEachDrive(dir.file("batch"));
-  const MeshAccuracy together = test::scoreMesh(dir.file("one/mesh.ply"), drives());
+  const test::StreetTruth truth(drives());
+  const MeshAccuracy merged = expectBetterThanEachDrive(dir.file("batch"), truth);
+  const MeshAccuracy together = truth.score(dir.file("one/mesh.ply"));
   EXPECT_NEAR(merged.accuracy_mean_m, together.accuracy_mean_m, 0.001);
   EXPECT_NEAR(merged.completeness, together.completeness, 0.002);
 

@@ -133,18 +133,23 @@ TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndAKilledTaskRequeued) {
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   const std::string map = dir.file("s1/map");
   ASSERT_TRUE(test::fileExists(map + "/mesh.ply"));
-  expectBetterThanEachDrive(dir.file("s1"));
+  expectBetterThanEachDrive(dir.file("s1"), test::StreetTruth(drives()));
 
-  // Again, and a drive's run killed once it is under way.
+  // The same batch with one drive to make again, and its run killed once it is under way. The
+  // others are done: they are not run again.
+  fs::copy(dir.file("s1"), dir.file("s2"), fs::copy_options::recursive);
+  fs::remove(dir.file("s2/state/drive_b_from_12m.done"));
+  fs::remove(dir.file("s2/state/map.done"));
+  const std::string log = dir.file("s2/logs/b_from_12m.log");
+  const std::size_t logged = test::readText(log).size(); // the first run's attempt
   const test::CommandResult submitted = test::runCommand(batchTool() + " -o " + dir.file("s2") + common);
   ASSERT_EQ(submitted.exit_code, 0) << submitted.out << submitted.err;
   const std::vector<std::string> jobs = submittedJobs(submitted.out);
-  ASSERT_EQ(jobs.size(), 4u) << submitted.out; // the drives (one memory request), merge, mesh, finish
+  ASSERT_EQ(jobs.size(), 4u) << submitted.out; // the drive (an array of one), merge, mesh, finish
   const std::string victim = dir.file("s2/drives/b_from_12m");
-  const std::string log = dir.file("s2/logs/b_from_12m.log");
   pid_t pid = -1;
   for (int k = 0; k < 1200 && pid < 0; ++k) {
-    if (test::readText(log).find("frame 000001") != std::string::npos)
+    if (test::readText(log).find("frame 000001", logged) != std::string::npos)
       pid = processWith(victim);
     if (pid < 0)
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -153,10 +158,12 @@ TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndAKilledTaskRequeued) {
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   ASSERT_TRUE(waitForJobs(jobs, 900)) << "the jobs did not end within 15 minutes";
   ASSERT_TRUE(test::fileExists(dir.file("s2/map/mesh.ply"))) << test::readText(log);
-  // Two attempts: the killed one (128 + 9) and the one after the requeue.
+  // Two more attempts: the killed one (128 + 9) and the one after the requeue; none of the others.
   const std::string times = test::readText(dir.file("s2/logs/b_from_12m.times"));
-  EXPECT_EQ(test::lineCount(dir.file("s2/logs/b_from_12m.times")), 2u) << times;
+  EXPECT_EQ(test::lineCount(dir.file("s2/logs/b_from_12m.times")), 3u) << times;
   EXPECT_NE(times.find(" 137\n"), std::string::npos) << times;
+  EXPECT_EQ(test::lineCount(dir.file("s2/logs/a_from_start.times")), 1u);
+  EXPECT_EQ(test::lineCount(dir.file("s2/logs/c_back_from_44m.times")), 1u);
   EXPECT_NE(test::readText(dir.file("s2/logs/slurm_drive_1.out")).find("requeued"), std::string::npos);
   EXPECT_TRUE(sameMap(map, dir.file("s2/map")));
 }

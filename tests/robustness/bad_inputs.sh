@@ -407,6 +407,8 @@ if [ $have_kitti = 1 ]; then
     msf_batch -o "$D/home" -local 1 "$SEQ"
   check "batch: a drive whose poses are not known" 1 "drive 'seq' .* has no poses: a batch merges drives whose poses share a world" -- \
     msf_batch -o out -local 1 "$D/seq"
+  check "batch -stream below the integrator's reach" 1 "streaming.active_radius_m 30 is below .* the integrator's reach" -- \
+    msf_batch -o out -local 1 -stream 30 "$SEQ"
   check "eval_mesh: a sequence without synthetic truth" 1 "is not a synthetic sequence \(no gt/\)" -- \
     msf_eval_mesh "$F/bomb.ply" "$SEQ"
   check "kitti2pcd -output_dir over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
@@ -424,7 +426,7 @@ else
            reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out \
            dataloss-dot dataloss-image2 dataloss-poses dataloss-poses-input dataloss-config-input dataloss-dataset \
-           dataloss-synth dataloss-kitti2pcd dataloss-lambda dataloss-batch batch-no-poses eval-mesh-no-truth; do
+           dataloss-synth dataloss-kitti2pcd dataloss-lambda dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth; do
     skip "$c"
   done
 fi

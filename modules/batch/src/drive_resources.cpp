@@ -2,6 +2,8 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pose_source.h>
+#include <msf/range_image/lidar_projector.h>
+#include <msf/reconstruction/tsdf_integrator.h>
 
 #include <cmath>
 
@@ -15,6 +17,11 @@ DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& c
                             "') has no poses: a batch merges drives whose poses share a world; give its poses file "
                             "in the drive list (DATASET POSES)");
   const PoseSource poses(drive.poses.empty() ? "dataset" : drive.poses, sequence, indices, config.odometry);
+  // The radius a streamed run checks at its start, checked before any task is submitted.
+  TsdfVolume volume(config.volume.voxel_size_m, config.volume.truncation_m);
+  const double reach = TsdfIntegrator(volume, config.integrator)
+                           .reach(LidarProjector(sequence.calibration(), config.projection).canvasCamera());
+  config.streaming.requireRadius(reach, config.volume.voxel_size_m);
   const Pipeline pipeline(sequence.calibration(), config);
   DriveResources r;
   r.frames = indices.size();

@@ -322,6 +322,15 @@ void StreamingMap::Config::validate() const {
     throw ConfigError("streaming.tile_blocks must be in 1..64, got " + std::to_string(tile_blocks));
 }
 
+void StreamingMap::Config::requireRadius(double reach_m, double voxel_size_m) const {
+  const double tile_m = tile_blocks * kSide * voxel_size_m;
+  if (active_radius_m < reach_m + tile_m)
+    throw ConfigError("streaming.active_radius_m " + number(active_radius_m) + " is below " +
+                      number(reach_m + tile_m) + " m, the integrator's reach (" + number(reach_m) +
+                      " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
+                      number(tile_m) + " m)");
+}
+
 void StreamingMap::Config::print(std::ostream& out) const {
   out << "streaming:\n  active_radius_m: " << configValue(active_radius_m)
       << "\n  tile_blocks: " << configValue(tile_blocks) << "\n";
@@ -334,11 +343,7 @@ StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const March
   config_.validate();
   if (!config_.enabled())
     throw ConfigError("StreamingMap: streaming.active_radius_m is 0 (off)");
-  if (config_.active_radius_m < minimumRadius())
-    throw ConfigError("streaming.active_radius_m " + number(config_.active_radius_m) + " is below " +
-                      number(minimumRadius()) + " m, the integrator's reach (" + number(reach_m_) +
-                      " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
-                      number(config_.tile_blocks * kSide * volume_.voxelSize()) + " m)");
+  config_.requireRadius(reach_m_, volume_.voxelSize());
   ensureOutputDirectory(directory_);
   for (const char* sub : {"tsdf", "tiles"}) {
     const fs::path p = fs::path(directory_) / sub;

@@ -24,7 +24,8 @@ struct DriveResources {
 /// The resources of `drive` reconstructed with `config` (its streaming settings included) over
 /// the frames of `frames` ("a:b"). Throws InvalidInputError naming the drive when its poses are
 /// not known before the run (a batch merges drives whose poses share a world: give a poses
-/// file), IOError / ConfigError as Sequence and Pipeline do.
+/// file), ConfigError when the streaming radius is below what the run needs (as the run would
+/// at its start), IOError / ConfigError as Sequence and Pipeline do.
 DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames);
 
 } // namespace msf

@@ -46,6 +46,9 @@ public:
     void read(const cv::FileNode& node);
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
+    /// Throws ConfigError when the active radius is below `reach_m` (TsdfIntegrator::reach)
+    /// plus a tile of `voxel_size_m` voxels: a tile would be freed and read back at once.
+    void requireRadius(double reach_m, double voxel_size_m) const;
     void print(std::ostream& out) const;
   };
 
