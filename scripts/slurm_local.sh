@@ -29,9 +29,31 @@ stop_daemon() { # pid file, name
   kill -9 "$pid" 2>/dev/null || true
 }
 
+# Jobs still queued or running are cancelled first: slurmd stopped under a running job would
+# leave its processes (slurmstepd and the job's own) behind.
+cancel_jobs() {
+  local conf=$dir/slurm.conf
+  [ -f "$conf" ] && [ -f "$dir/slurmctld.pid" ] && kill -0 "$(cat "$dir/slurmctld.pid")" 2>/dev/null || return 0
+  SLURM_CONF=$conf timeout 10 scancel --full --quiet --partition=local >/dev/null 2>&1 || true
+  for _ in $(seq 100); do
+    [ -z "$(SLURM_CONF=$conf timeout 10 squeue -h -o %A 2>/dev/null)" ] && return 0
+    sleep 0.2
+  done
+  echo "slurm_local.sh: jobs still queued after 20 s; stopping the daemons anyway" >&2
+}
+
+failed_start() {
+  local log
+  for log in "$dir"/*.log; do
+    [ -f "$log" ] && { echo "--- $log (last lines)" >&2; tail -n 20 "$log" >&2; }
+  done
+  stop
+}
+
 stop() {
   [ -e "$dir" ] || return 0
   [ -f "$marker" ] || die "'$dir' was not made by slurm_local.sh (no $marker): not touching it"
+  cancel_jobs
   stop_daemon "$dir/slurmd.pid"
   stop_daemon "$dir/slurmctld.pid"
   stop_daemon "$dir/munged.pid"
@@ -102,6 +124,8 @@ start() {
   fi
   mkdir -p "$dir"
   touch "$marker"
+  # A start that fails shows the daemons' logs, stops what it started and removes its folder.
+  trap 'failed_start' EXIT
   chmod 755 "$dir"
   mkdir -p "$dir/munge" "$dir/state" "$dir/spool"
   chmod 700 "$dir/munge"
@@ -110,20 +134,21 @@ start() {
   # Daemons say nothing on stdout, which callers read with eval.
   munged --force --key-file="$dir/munge/munge.key" --socket="$dir/munge/munge.socket" \
          --pid-file="$dir/munged.pid" --log-file="$dir/munged.log" --seed-file="$dir/munge/munged.seed" >&2 \
-    || die "munged did not start (see $dir/munged.log)"
+    || die "munged did not start (the daemons' logs follow)"
   write_conf
   export SLURM_CONF="$dir/slurm.conf"
   # -i: a fresh state (no jobs of an earlier cluster).
-  slurmctld -i -f "$SLURM_CONF" >&2 || die "slurmctld did not start (see $dir/slurmctld.log)"
-  slurmd -f "$SLURM_CONF" >&2 || die "slurmd did not start (see $dir/slurmd.log)"
+  slurmctld -i -f "$SLURM_CONF" >&2 || die "slurmctld did not start (the daemons' logs follow)"
+  slurmd -f "$SLURM_CONF" >&2 || die "slurmd did not start (the daemons' logs follow)"
   for _ in $(seq 60); do
     if node_ready; then
+      trap - EXIT
       echo "export SLURM_CONF=$SLURM_CONF"
       return 0
     fi
     sleep 0.5
   done
-  die "the node did not come up in 30 s (see $dir/slurmctld.log and $dir/slurmd.log)"
+  die "the node did not come up in 30 s (the daemons' logs follow)"
 }
 
 case "$command" in
