@@ -15,6 +15,14 @@ work=${3:-/tmp/msf_bench_batch}
 mkdir -p "$work"
 cd "$work"
 json() { grep -o "\"$2\": [0-9.e+-]*" "$1" | head -1 | awk '{print $2}'; }
+# The batch machinery's own time: submit-to-map wall less the drives' msf_reconstruct runs and
+# the merge, mesh and finish tasks' time, against the drives' time. Exact when the tasks run one
+# after another (-local 1; -slurm with -merge_tasks 1 and drives of -cpus all the CPUs).
+overhead() { # summary.json, wall seconds
+  awk -v wall="$2" '/"reconstruct_s":/ {match($0, /"reconstruct_s": [0-9.e+-]+/); split(substr($0, RSTART, RLENGTH), a, ": "); drives += a[2]}
+    /"(merge|mesh|finish)_s":/ {gsub(/[",]/, ""); tasks += $2}
+    END {printf "drives %.1f s, merge+mesh+finish %.1f s, machinery %.1f s = %.2f %% of the drives\n", drives, tasks, wall - drives - tasks, 100 * (wall - drives - tasks) / drives}' "$1"
+}
 
 echo "== 1. KITTI odometry 04_10_50 streamed at 0.1 m voxels"
 rm -rf kitti_drive
@@ -36,6 +44,7 @@ rm -rf batch one
 /usr/bin/time -f "%e s wall, %U s user, %S s system (the batch and its children)" -o batch.time \
   "$bin/msf_batch" -o batch -local 1 -merge_tasks 2 -stream 101 a b c > batch.log 2>&1
 echo "batch -local 1: $(cat batch.time)"
+overhead batch/map/summary.json "$(awk '{print $1}' batch.time)"
 grep -o '"reconstruct_s": [0-9.]*' batch/map/summary.json
 for key in tiles tiles_shared blocks voxels_shared voxels_capped merge_s mesh_s finish_s triangles; do
   echo "$key $(json batch/map/summary.json $key)"
@@ -64,9 +73,10 @@ echo "== 4. The same batch on Slurm (when SLURM_CONF names a cluster that takes 
 if sinfo -h >/dev/null 2>&1; then
   rm -rf slurm
   start=$(date +%s.%N)
-  "$bin/msf_batch" -o slurm -slurm -wait -cpus 2 -merge_tasks 2 -stream 101 a b c > slurm.log 2>&1
+  "$bin/msf_batch" -o slurm -slurm -wait -cpus "$(nproc)" -merge_tasks 1 -stream 101 a b c > slurm.log 2>&1
   end=$(date +%s.%N)
   echo "batch -slurm (submit to map): $(echo "$end - $start" | bc) s wall"
+  overhead slurm/map/summary.json "$(echo "$end - $start" | bc)"
   grep -o '"reconstruct_s": [0-9.]*' slurm/map/summary.json
   for key in merge_s mesh_s finish_s; do echo "$key $(json slurm/map/summary.json $key)"; done
 else

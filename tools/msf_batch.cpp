@@ -14,6 +14,8 @@
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -97,6 +99,52 @@ int report(const msf::BatchPlan& plan) {
   return 1;
 }
 
+/// The merge starts from nothing unless the map is done: a cancelled round's shares are not reused.
+void restartMerge(const msf::BatchPlan& plan) {
+  if (plan.mapDone())
+    return;
+  plan.clearMapDone();
+  std::error_code e;
+  fs::remove_all(plan.mergeDir(), e);
+}
+
+/// Submits what is not done and prints the job ids ("Submitted ..."); none when the map is done.
+msf::SlurmSubmission submitRound(const msf::BatchPlan& plan, const Settings& s) {
+  restartMerge(plan);
+  const msf::SlurmSubmission jobs = msf::submitToSlurm(plan, s.slurm_options);
+  if (jobs.all().empty()) {
+    print_info("Nothing to submit: the map is done for these drives\n");
+    return jobs;
+  }
+  std::string ids;
+  for (const std::string& id : jobs.all())
+    ids += (ids.empty() ? "" : " ") + id;
+  print_highlight("Submitted ");
+  print_value("%s", ids.c_str());
+  print_info(" (drives, merge, mesh, finish; scripts in %s)\n", plan.jobDir().c_str());
+  std::fflush(stdout); // the ids, for whoever reads a log of -wait while it waits
+  return jobs;
+}
+
+/// -wait: submits, waits for the jobs to end, and submits again what is not done, up to
+/// -max_attempts rounds: a task whose job ends without its script (scancel, or the script
+/// killed with it) is not requeued by Slurm nor by the script, and its dependents are cancelled.
+int submitAndWait(const msf::BatchPlan& plan, const Settings& s) {
+  const auto start = std::chrono::steady_clock::now();
+  for (int round = 1; round <= plan.options().max_attempts && !plan.mapDone(); ++round) {
+    if (round > 1)
+      print_warn("The jobs ended and the map is not done: submitting what is not done again (round %d of %d)\n",
+                 round, plan.options().max_attempts);
+    const msf::SlurmSubmission jobs = submitRound(plan, s);
+    const double spent = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double left = s.timeout_s > 0 ? std::max(s.timeout_s - spent, 1.0) : 0.0; // 0: no bound
+    if (!msf::waitForSlurm(jobs, left))
+      throw msf::InvalidInputError("-timeout: the jobs are still queued or running after " +
+                                   std::to_string(s.timeout_s) + " s (ids in " + plan.jobDir() + "/submitted.txt)");
+  }
+  return report(plan);
+}
+
 int planAndRun(const Settings& s, const msf::tool::Arguments& paths, msf::BatchOptions options) {
   const int modes = (s.slurm ? 1 : 0) + (s.local > 0 ? 1 : 0) + (s.one_process ? 1 : 0);
   if (modes != 1)
@@ -121,33 +169,13 @@ int planAndRun(const Settings& s, const msf::tool::Arguments& paths, msf::BatchO
   plan.requireRoot(); // a folder of someone else's is refused before the drives are read
   predictResources(plan);
   plan.save();
-  if (!plan.mapDone()) { // the merge starts from nothing
-    plan.clearMapDone();
-    std::error_code e;
-    fs::remove_all(plan.mergeDir(), e);
-  }
   if (s.local > 0) {
+    restartMerge(plan);
     print_highlight("Running the batch here, %d task%s at a time\n", s.local, s.local > 1 ? "s" : "");
     msf::LocalRunner(plan, s.local, localMemoryMb()).run();
     return report(plan);
   }
-  const msf::SlurmSubmission jobs = msf::submitToSlurm(plan, s.slurm_options);
-  if (jobs.all().empty()) {
-    print_info("Nothing to submit: the map is done for these drives\n");
-    return report(plan);
-  }
-  std::string ids;
-  for (const std::string& id : jobs.all())
-    ids += (ids.empty() ? "" : " ") + id;
-  print_highlight("Submitted ");
-  print_value("%s", ids.c_str());
-  print_info(" (drives, merge, mesh, finish; scripts in %s)\n", plan.jobDir().c_str());
-  if (!s.wait)
-    return 0;
-  if (!msf::waitForSlurm(jobs, s.timeout_s))
-    throw msf::InvalidInputError("-timeout: the jobs (" + ids + ") are still queued or running after " +
-                                 std::to_string(s.timeout_s) + " s");
-  return report(plan);
+  return s.wait ? submitAndWait(plan, s) : (submitRound(plan, s), 0);
 }
 
 } // namespace
@@ -173,7 +201,9 @@ int main(int argc, char** argv) {
       .flag("-one_process", s.one_process,
             "integrate every drive's frames into one volume in this process into OUT (the map the merge equals for "
             "a plain weighted mean; for a few small drives)")
-      .flag("-wait", s.wait, "with -slurm: wait until the jobs end, then say whether the map is done")
+      .flag("-wait", s.wait,
+            "with -slurm: wait until the jobs end, submit again what a cancelled or killed job left undone "
+            "(up to -max_attempts rounds), then say whether the map is done")
       .value("-timeout", "S", s.timeout_s, "with -wait: give up after S seconds (default {default}: no bound)")
       .value("-config", "FILE", options.config, "YAML configuration of every drive's msf_reconstruct")
       .value("-frames", "a:b", options.frames, "each drive's frame range (default {default})")

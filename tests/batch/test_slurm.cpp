@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <regex>
 #include <set>
 #include <signal.h>
@@ -68,21 +69,6 @@ std::vector<std::string> submittedJobs(const std::string& out) {
   return ids;
 }
 
-/// Waits until none of `ids` is queued, at most `seconds`. False when the bound ran out.
-bool waitForJobs(const std::vector<std::string>& ids, double seconds) {
-  const auto start = std::chrono::steady_clock::now();
-  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds) {
-    const CommandOutput r = captureCommand({"squeue", "-h", "-o", "%A"});
-    bool queued = false;
-    for (const std::string& id : ids)
-      queued = queued || (r.status == 0 && std::regex_search(r.out, std::regex("(^|\n)" + id + "(\n|$)")));
-    if (r.status == 0 && !queued)
-      return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  }
-  return false;
-}
-
 /// The process whose command line holds `needle` (this test's own msf_reconstruct), or -1.
 pid_t processWith(const std::string& needle) {
   for (const auto& e : fs::directory_iterator("/proc")) {
@@ -98,6 +84,39 @@ pid_t processWith(const std::string& needle) {
   }
   return -1;
 }
+
+/// When the test ends, however it ends: stops the msf_batch it started if it still runs, and
+/// cancels the jobs its batches submitted (a failed assertion would leave them queued, to fail
+/// again and again once the test's folder is gone).
+class JobsOfTheTest {
+public:
+  explicit JobsOfTheTest(std::vector<std::string> outs) : outs_(std::move(outs)) {}
+  JobsOfTheTest(const JobsOfTheTest&) = delete;
+  JobsOfTheTest& operator=(const JobsOfTheTest&) = delete;
+  /// Starts msf_batch with `argv`, its output appended to `log`.
+  Subprocess& start(const std::vector<std::string>& argv, const std::string& log) {
+    batch_ = std::make_unique<Subprocess>(argv, log);
+    return *batch_;
+  }
+  ~JobsOfTheTest() {
+    int status = 0;
+    if (batch_ && !batch_->finished(status))
+      ::kill(batch_->pid(), SIGTERM);
+    batch_.reset();
+    std::vector<std::string> cancel = {"scancel"};
+    for (const std::string& out : outs_) {
+      std::stringstream ids(test::readText(out + "/jobs/submitted.txt"));
+      for (std::string id; ids >> id;)
+        cancel.push_back(id);
+    }
+    if (cancel.size() > 1)
+      captureCommand(cancel); // finished jobs are refused, and that is all
+  }
+
+private:
+  std::vector<std::string> outs_;
+  std::unique_ptr<Subprocess> batch_;
+};
 
 /// Every file of the map's store and its mesh, byte for byte.
 bool sameMap(const std::string& a, const std::string& b) {
@@ -115,10 +134,10 @@ bool sameMap(const std::string& a, const std::string& b) {
 
 class SlurmBatch : public test::BatchDrives {};
 
-/// Three drives as a job array on the cluster and merged; then again with a drive's
-/// msf_reconstruct killed (kill -9) in the middle: the task is requeued, starts the drive
-/// again from nothing, and the map is the undisturbed run's, byte for byte.
-TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndAKilledTaskRequeued) {
+/// Three drives as a job array on the cluster and merged; then two of them again, one drive's
+/// msf_reconstruct killed (kill -9) and the other's task cancelled (scancel) in the middle: each
+/// is made again from nothing, and the map is the undisturbed run's, byte for byte.
+TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndKilledOrCancelledTasksMadeAgain) {
   const SlurmCluster cluster;
   if (!cluster.whyNot().empty()) {
     if (test::underCi())
@@ -126,45 +145,62 @@ TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndAKilledTaskRequeued) {
     GTEST_SKIP() << cluster.whyNot();
   }
   test::TempDir dir;
-  const std::string common = " -slurm -cpus 1 -merge_tasks 2 -config '" + config() + "' -stream " + kStream +
-                             driveArguments();
-  const test::CommandResult run =
-      test::runCommand(batchTool() + " -o " + dir.file("s1") + common + " -wait -timeout 900");
+  JobsOfTheTest jobs_of_the_test({dir.file("s1"), dir.file("s2")});
+  // The batch into `out` on the cluster, waiting for its map.
+  const auto batchArguments = [](const std::string& out) {
+    std::vector<std::string> argv = {batchTool(), "-o", out, "-slurm", "-cpus", "1", "-merge_tasks", "2", "-config",
+                                     config(), "-stream", kStream, "-wait", "-timeout", "900"};
+    argv.insert(argv.end(), drives().begin(), drives().end());
+    return argv;
+  };
+  const test::CommandResult run = test::runCommand(shellQuote(batchArguments(dir.file("s1"))));
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   const std::string map = dir.file("s1/map");
   ASSERT_TRUE(test::fileExists(map + "/mesh.ply"));
   expectBetterThanEachDrive(dir.file("s1"), test::StreetTruth(drives()));
 
-  // The same batch with one drive to make again, and its run killed once it is under way. The
-  // others are done: they are not run again.
+  // The same batch with two drives to make again, run with -wait: one drive's msf_reconstruct
+  // killed (kill -9) under way, whose task the job script requeues; the other's task cancelled
+  // (scancel), which ends its job and cancels the merge: msf_batch submits it again. The first
+  // drive is done: it is not run again.
   fs::copy(dir.file("s1"), dir.file("s2"), fs::copy_options::recursive);
-  fs::remove(dir.file("s2/state/drive_b_from_12m.done"));
-  fs::remove(dir.file("s2/state/map.done"));
-  const std::string log = dir.file("s2/logs/b_from_12m.log");
-  const std::size_t logged = test::readText(log).size(); // the first run's attempt
-  const test::CommandResult submitted = test::runCommand(batchTool() + " -o " + dir.file("s2") + common);
-  ASSERT_EQ(submitted.exit_code, 0) << submitted.out << submitted.err;
-  const std::vector<std::string> jobs = submittedJobs(submitted.out);
-  ASSERT_EQ(jobs.size(), 4u) << submitted.out; // the drive (an array of one), merge, mesh, finish
-  const std::string victim = dir.file("s2/drives/b_from_12m");
-  pid_t pid = -1;
-  for (int k = 0; k < 1200 && pid < 0; ++k) {
-    if (test::readText(log).find("frame 000001", logged) != std::string::npos)
-      pid = processWith(victim);
-    if (pid < 0)
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (const char* stamp : {"drive_b_from_12m.done", "drive_c_back_from_44m.done", "map.done"})
+    fs::remove(dir.file("s2/state/") + stamp);
+  const std::string killed_log = dir.file("s2/logs/b_from_12m.log"), cancelled_log = dir.file("s2/logs/c_back_from_44m.log");
+  const std::size_t killed_from = test::readText(killed_log).size(), cancelled_from = test::readText(cancelled_log).size();
+  const std::string batch_log = dir.file("batch.log");
+  Subprocess& batch = jobs_of_the_test.start(batchArguments(dir.file("s2")), batch_log);
+  pid_t victim = -1;
+  bool cancelled = false;
+  for (int k = 0; k < 1200 && (victim < 0 || !cancelled); ++k) {
+    if (victim < 0 && test::readText(killed_log).find("frame 000000", killed_from) != std::string::npos &&
+        (victim = processWith(dir.file("s2/drives/b_from_12m"))) > 0) {
+      ASSERT_EQ(::kill(victim, SIGKILL), 0);
+    }
+    if (!cancelled && test::readText(cancelled_log).find("frame 000000", cancelled_from) != std::string::npos) {
+      const std::vector<std::string> jobs = submittedJobs(test::readText(batch_log));
+      ASSERT_EQ(jobs.size(), 4u) << test::readText(batch_log); // the two drives (one array), merge, mesh, finish
+      const CommandOutput r = captureCommand({"scancel", jobs[0] + "_2"});
+      ASSERT_EQ(r.status, 0) << r.err;
+      cancelled = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  ASSERT_GT(pid, 0) << "the drive's run was never seen under way: " << test::readText(log);
-  ASSERT_EQ(::kill(pid, SIGKILL), 0);
-  ASSERT_TRUE(waitForJobs(jobs, 900)) << "the jobs did not end within 15 minutes";
-  ASSERT_TRUE(test::fileExists(dir.file("s2/map/mesh.ply"))) << test::readText(log);
-  // Two more attempts: the killed one (128 + 9) and the one after the requeue; none of the others.
+  ASSERT_GT(victim, 0) << "the drive's run was never seen under way: " << test::readText(killed_log);
+  ASSERT_TRUE(cancelled) << "the drive's run was never seen under way: " << test::readText(cancelled_log);
+  ASSERT_EQ(batch.wait(), 0) << test::readText(batch_log);
+  EXPECT_NE(test::readText(batch_log).find("submitting what is not done again (round 2"), std::string::npos)
+      << test::readText(batch_log);
+  // The killed drive: two more attempts, the killed one (128 + 9) and the one after the requeue.
   const std::string times = test::readText(dir.file("s2/logs/b_from_12m.times"));
   EXPECT_EQ(test::lineCount(dir.file("s2/logs/b_from_12m.times")), 3u) << times;
   EXPECT_NE(times.find(" 137\n"), std::string::npos) << times;
-  EXPECT_EQ(test::lineCount(dir.file("s2/logs/a_from_start.times")), 1u);
-  EXPECT_EQ(test::lineCount(dir.file("s2/logs/c_back_from_44m.times")), 1u);
   EXPECT_NE(test::readText(dir.file("s2/logs/slurm_drive_1.out")).find("requeued"), std::string::npos);
+  // The cancelled drive made again to its end; the done one never run again.
+  const std::string cancelled_times = test::readText(dir.file("s2/logs/c_back_from_44m.times"));
+  EXPECT_GE(test::lineCount(dir.file("s2/logs/c_back_from_44m.times")), 2u) << cancelled_times;
+  EXPECT_EQ(cancelled_times.substr(cancelled_times.rfind(' ')), " 0\n") << cancelled_times;
+  EXPECT_EQ(test::lineCount(dir.file("s2/logs/a_from_start.times")), 1u);
   EXPECT_TRUE(sameMap(map, dir.file("s2/map")));
 }
 
