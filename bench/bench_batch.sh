@@ -6,7 +6,9 @@
 #     0.1 m voxels, moving cars on): the batch on this machine (-local 1) against the drives' own
 #     run time (the machinery's overhead), the merge's and the mesh's time per tile, and the maps
 #     scored against the street's truth beside the one-process map;
-#  3. the merge's time against its fan-in: one drive's store merged with k copies of itself.
+#  3. the merge's time against its fan-in: one drive's store merged with k copies of itself;
+#  4. the same batch on Slurm (SLURM_CONF), each task alone on the node (-cpus: all its CPUs;
+#     -merge_tasks 1), so that the machinery's overhead is the wall less the tasks' own time.
 # usage: bench/bench_batch.sh BIN_DIR KITTI_DIR [WORK_DIR]   (WORK_DIR is kept; ~15 min on 2 cores)
 set -euo pipefail
 bin=$(cd "$1" && pwd)
