@@ -19,13 +19,16 @@ die() { echo "slurm_local.sh: error: $*" >&2; exit 1; }
 # The script only ever removes a folder it made: it carries this marker.
 marker="$dir/.msf_slurm_local"
 
-stop_daemon() { # pid file, name
+# Alive and not a zombie (where nothing reaps the detached daemons, a stopped one stays a zombie).
+running() { kill -0 "$1" 2>/dev/null && ! grep -qE '^[0-9]+ \(.*\) Z' "/proc/$1/stat" 2>/dev/null; }
+
+stop_daemon() { # pid file
   local pid_file=$1 pid
   [ -f "$pid_file" ] || return 0
   pid=$(cat "$pid_file" 2>/dev/null || true)
-  [ -n "$pid" ] && kill -0 "$pid" 2>/dev/null || return 0
+  [ -n "$pid" ] && running "$pid" || return 0
   kill "$pid" 2>/dev/null || true
-  for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || return 0; sleep 0.1; done
+  for _ in $(seq 50); do running "$pid" || return 0; sleep 0.1; done
   kill -9 "$pid" 2>/dev/null || true
 }
 
