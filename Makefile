@@ -1,5 +1,5 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
+# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -21,6 +21,9 @@ ROS_PACKAGES := ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-msgs-
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
                 libyaml-cpp-dev $(PYTHON_PACKAGES) $(ROS_PACKAGES)
+# A single-node Slurm cluster on localhost (scripts/slurm_local.sh), which the batch's tests
+# submit to (tests/batch/test_slurm.cpp; .ci/run starts it before `make test`).
+SLURM_PACKAGES := slurm-wlm munge
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev
@@ -29,7 +32,7 @@ BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-slurm deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -59,6 +62,9 @@ endef
 deps:
 	$(call apt_install,$(APT_PACKAGES))
 
+deps-slurm: deps
+	$(call apt_install,$(SLURM_PACKAGES))
+
 deps-bench: deps
 	$(call apt_install,$(BENCH_PACKAGES))
 
@@ -71,7 +77,7 @@ $(BUILD_DIR)/CMakeCache.txt:
 build: $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j$(JOBS)
 
-test: deps
+test: deps deps-slurm
 	$(MAKE) build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
 

@@ -72,6 +72,22 @@ inline AnalyticScene makeScene(SceneKind kind) {
   return scene;
 }
 
+/// A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
+/// either side every few metres, each a little different, so that no two tiles look alike.
+inline AnalyticScene corridor(double length, double wall = 4.0) {
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5);  // floor: y >= 1.5
+  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -wall); // x >= wall
+  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -wall);  // x <= -wall
+  for (int i = 0; i * 3.0 < length; ++i) {
+    const double side = i % 2 ? 1.0 : -1.0;
+    scene.addBox(Eigen::Vector3d(side * (wall - 1.2 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
+                 Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
+                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
+  }
+  return scene;
+}
+
 /// Depth frame of `scene` from `pose`, with Gaussian depth noise of `sigma` metres.
 inline DepthFrame renderFrame(const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose,
                               double sigma = 0.0, unsigned seed = 1) {

@@ -22,22 +22,6 @@ using namespace msf;
 
 namespace {
 
-// A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
-// either side every few metres, each a little different, so that no two tiles look alike.
-AnalyticScene corridor(double length, double wall = 4.0) {
-  AnalyticScene scene;
-  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5);  // floor: y >= 1.5
-  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -wall); // x >= wall
-  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -wall);  // x <= -wall
-  for (int i = 0; i * 3.0 < length; ++i) {
-    const double side = i % 2 ? 1.0 : -1.0;
-    scene.addBox(Eigen::Vector3d(side * (wall - 1.2 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
-                 Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
-                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
-  }
-  return scene;
-}
-
 constexpr double kVoxel = 0.2, kTruncation = 0.5, kMaxDepth = 8.0;
 constexpr double kTile = 2 * TsdfBlock::kSide * kVoxel; // tile_blocks 2
 
@@ -90,7 +74,7 @@ double minimumRadius(const Corridor& setup = Corridor()) {
 /// back from the union the map writes (as written: welded by the map), else meshed in memory.
 DriveResult integrateDrive(const std::vector<Eigen::Isometry3d>& poses, double length, const std::string& directory = "",
                    double radius = 0.0, const Corridor& setup = Corridor()) {
-  const AnalyticScene scene = corridor(length + 10, setup.wall);
+  const AnalyticScene scene = test::corridor(length + 10, setup.wall);
   TsdfVolume volume(kVoxel, kTruncation);
   TsdfIntegrator integrator(volume, integratorConfig());
   MarchingCubes::Config mesher;

@@ -426,6 +426,23 @@ else
   done
 fi
 
+# ---- many drives, one map (msf_batch, msf_merge, msf_eval_mesh; msf_synth's shared street) --
+check "batch: no place to run the tasks" 1 "say where the tasks run, once: -slurm .* -local N" -- \
+  msf_batch -o out "$F"
+check "batch -run before a plan" 1 "batch plan '.*out/plan.txt' does not exist" -- msf_batch -o out -run drive:0
+check "batch -run a task of no kind" 1 "task 'drives:1' is not drive:N, merge:N, mesh:N or finish" -- \
+  msf_batch -o "$F" -run drives:1
+check "batch: a folder that holds no drive" 1 "dataset '.*' holds no sequence" -- msf_batch -o out -local 1 "$F"
+printf '%s\n' "$F/dense.pcd" >"$F/drives.txt"
+check "batch -list with a line that is no drive" 1 "drive list '.*drives.txt' line 1: '.*dense.pcd' is not a sequence" -- \
+  msf_batch -o out -local 1 -list "$F/drives.txt"
+check "merge: a folder without a store" 1 "TSDF store index '.*/tsdf/index.txt' does not exist" -- \
+  msf_merge -o map "$F" "$F"
+check "synth -reverse off the street's start" 1 "synthetic.start_m' = 3.* leaves the street's start" -- \
+  msf_synth -o out -frames 10 -start_m 3 -reverse
+check "synth -street_m shorter than the drive" 1 "synthetic.street_length_m' = 5.* is shorter than the drive" -- \
+  msf_synth -o out -frames 20 -street_m 5
+
 if [ $have_kitti = 1 ]; then
   SCAN=$SEQ/velodyne/000000.bin
   L=$SEQ/image_0/000000.png R=$SEQ/image_1/000000.png
@@ -525,6 +542,14 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/seq"
   check "synth -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_synth -frames 1 -o "$D/home"
+  check "batch -o over a user's folder" 1 "holds '(data.csv|notes.txt|my.yaml|photo.png)', which is not a batch's" -- \
+    msf_batch -o "$D/home" -local 1 "$SEQ"
+  check "batch: a drive whose poses are not known" 1 "drive 'seq' .* has no poses: a batch merges drives whose poses share a world" -- \
+    msf_batch -o out -local 1 "$D/seq"
+  check "batch -stream below the integrator's reach" 1 "streaming.active_radius_m 30 is below .* the integrator's reach" -- \
+    msf_batch -o out -local 1 -stream 30 "$SEQ"
+  check "eval_mesh: a sequence without synthetic truth" 1 "is not a synthetic sequence \(no gt/\)" -- \
+    msf_eval_mesh "$F/bomb.ply" "$SEQ"
   check "kitti2pcd -output_dir over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_kitti2pcd -input_dir "$D/seq/velodyne" -output_dir "$D/home"
   check "lambda_study -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
@@ -540,7 +565,8 @@ else
            reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out \
            dataloss-dot dataloss-image2 dataloss-poses dataloss-poses-input dataloss-config-input dataloss-dataset \
-           dataloss-synth dataloss-kitti2pcd dataloss-lambda odometry-stray-files odometry-beyond-poses; do
+           dataloss-synth dataloss-kitti2pcd dataloss-lambda odometry-stray-files odometry-beyond-poses \
+           dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth; do
     skip "$c"
   done
 fi

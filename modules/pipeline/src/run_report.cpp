@@ -2,6 +2,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/json_text.h>
 #include <msf/common/line_plot.h>
 #include <msf/common/version.h>
 #include <msf/common/statistics.h>
@@ -52,21 +53,6 @@ std::vector<double> column(const std::vector<RunReport::FrameRow>& rows, const S
   for (const auto& r : rows)
     values.push_back(c.get(r));
   return values;
-}
-
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\')
-      out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else
-      out += c;
-  }
-  return out + "\"";
 }
 
 std::string num(double v, int precision = 4) {

@@ -17,7 +17,8 @@ namespace msf::synthetic {
 ///    oncoming_group_period_s, the next ones every 9..10.5 m of lane, so that in a short
 ///    sequence they pass early and the road they covered is seen empty afterwards.
 /// Deterministic in config.seed, from counter-based streams of their own: the static
-/// street does not change with these settings.
+/// street does not change with these settings. For a placed drive (start_m, reverse) the cars
+/// are laid out so along its own path and carried with it (driveTransform).
 void addTraffic(const SyntheticConfig& config, Scene& scene);
 
 } // namespace msf::synthetic
