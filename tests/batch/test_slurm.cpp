@@ -179,9 +179,11 @@ TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndKilledOrCancelledTasksMadeAgain) {
       ASSERT_EQ(::kill(victim, SIGKILL), 0);
     }
     if (!cancelled && test::readText(cancelled_log).find("frame 000000", cancelled_from) != std::string::npos) {
-      const std::vector<std::string> jobs = submittedJobs(test::readText(batch_log));
-      ASSERT_EQ(jobs.size(), 4u) << test::readText(batch_log); // the two drives (one array), merge, mesh, finish
-      const CommandOutput r = captureCommand({"scancel", jobs[0] + "_2"});
+      // The task's id from its attempt's header: msf_batch may still be submitting the stages after it.
+      std::smatch task;
+      const std::string attempt = test::readText(cancelled_log).substr(cancelled_from);
+      ASSERT_TRUE(std::regex_search(attempt, task, std::regex("Slurm job ([0-9]+_[0-9]+)"))) << attempt;
+      const CommandOutput r = captureCommand({"scancel", task[1].str()});
       ASSERT_EQ(r.status, 0) << r.err;
       cancelled = true;
     }
@@ -190,6 +192,8 @@ TEST_F(SlurmBatch, ThreeDrivesOnTheClusterAndKilledOrCancelledTasksMadeAgain) {
   ASSERT_GT(victim, 0) << "the drive's run was never seen under way: " << test::readText(killed_log);
   ASSERT_TRUE(cancelled) << "the drive's run was never seen under way: " << test::readText(cancelled_log);
   ASSERT_EQ(batch.wait(), 0) << test::readText(batch_log);
+  EXPECT_EQ(submittedJobs(test::readText(batch_log)).size(), 4u) // the two drives (one array), merge, mesh, finish
+      << test::readText(batch_log);
   EXPECT_NE(test::readText(batch_log).find("submitting what is not done again (round 2"), std::string::npos)
       << test::readText(batch_log);
   // The killed drive: two more attempts, the killed one (128 + 9) and the one after the requeue.
