@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
       .value("-run", "TASK", s.run_task,
              "run one task of the batch in OUT (drive:N, merge:N, mesh:N, finish): what the jobs and the local "
              "runner call")
-      .note("Memory: each drive asks for its predicted peak (msf_reconstruct's own model, Pipeline::predictMemory) "
+      .note("Memory: each drive asks for its predicted peak (msf_reconstruct's own model, Reconstructor::predictMemory) "
             "with a margin of 20 %, rounded up to 256 MiB; -local runs no more drives at once than fit in 3/4 of "
             "this machine's memory. See docs/batch.md and docs/scale.md.");
   return cli.run(argc, argv, 0, [&](const msf::tool::Arguments& paths) {

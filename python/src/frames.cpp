@@ -161,7 +161,9 @@ void bindSources(py::module_& m) {
       });
   m.def("open_dataset", [](const std::string& path, const std::string& rig) {
     py::gil_scoped_release release;
-    return openDataset(path, DatasetOptions{rig});
+    DatasetOptions options;
+    options.rig = rig;
+    return openDataset(path, options);
   }, py::arg("path"), py::arg("rig") = "",
         "The FrameSource of a dataset folder, its layout detected (as msf_reconstruct reads it); rig: a "
         "calibration or rig file for layouts without one, or to override the dataset's.");

@@ -1,6 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper steps 1-4 on numpy arrays, the stage objects the pipeline runs (modules/pipeline's
-// Pipeline::computeDepth): LiDAR projection and completion, SGBM stereo, per-pixel fusion, and
+// Reconstructor::computeDepth): LiDAR projection and completion, SGBM stereo, per-pixel fusion, and
 // the fused depth's colour. Each object keeps its work buffers from one call to the next.
 #include "bindings.h"
 

@@ -17,16 +17,16 @@ DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& c
     throw InvalidInputError("drive '" + drive.name + "' ('" + drive.dataset +
                             "') has no poses: a batch merges drives whose poses share a world; give its poses file "
                             "in the drive list (DATASET POSES)");
-  const PoseSource poses(drive.poses.empty() ? "dataset" : drive.poses, sequence, indices, config.odometry);
+  const PoseSource poses(drive.poses.empty() ? "dataset" : drive.poses, sequence, indices);
   // The radius a streamed run checks at its start, checked before any task is submitted.
   TsdfVolume volume(config.volume.voxel_size_m, config.volume.truncation_m);
   const double reach = TsdfIntegrator(volume, config.integrator)
                            .reach(LidarProjector(sequence.calibration(), config.projection).canvasCamera());
   config.streaming.requireRadius(reach, config.volume.voxel_size_m);
-  const Pipeline pipeline(sequence.calibration(), config);
+  const Reconstructor engine(sequence.calibration(), config);
   DriveResources r;
   r.frames = indices.size();
-  r.predicted_mb = pipeline.predictMemory(poses.knownPoses(indices)).total_mb;
+  r.predicted_mb = engine.predictMemory(poses.knownPoses(indices)).total_mb;
   const double step = static_cast<double>(DriveResources::kRequestStepMb);
   r.request_mb = static_cast<std::size_t>(std::ceil(r.predicted_mb * DriveResources::kMargin / step) * step);
   return r;

@@ -4,7 +4,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/pose_source.h>
 
 #include <chrono>
@@ -16,7 +16,7 @@ namespace msf {
 
 namespace {
 
-/// One pipeline runs every drive: their rigs must be one.
+/// One engine runs every drive: their rigs must be one.
 void requireSameRig(const Calibration& a, const Calibration& b, const std::string& drive) {
   bool same = a.image_size == b.image_size && a.T_cam0_velo.isApprox(b.T_cam0_velo, 1e-9);
   for (int c = 0; c < 4 && same; ++c)
@@ -36,21 +36,23 @@ std::size_t reconstructInOneProcess(const BatchPlan& plan, const std::string& ou
   OutputFolder folder(out, "msf_batch", inputs);
   const PipelineConfig& config = plan.pipelineConfig();
   const Sequence first(plan.drives().front().dataset);
-  Pipeline pipeline(first.calibration(), config);
-  pipeline.setStreamingDirectory(folder.dir());
+  Reconstructor::Options options;
+  options.poses = Reconstructor::PoseMode::Given;
+  options.stream_directory = folder.dir();
+  Reconstructor engine(first.calibration(), config, options);
   const auto start = std::chrono::steady_clock::now();
   std::size_t frames = 0;
   for (const Drive& d : plan.drives()) {
     const Sequence sequence(d.dataset);
     requireSameRig(first.calibration(), sequence.calibration(), d.name);
     const std::vector<std::size_t> indices = sequence.indices(FrameRange::parse(plan.options().frames));
-    const PoseSource poses(d.poses.empty() ? "dataset" : d.poses, sequence, indices, config.odometry);
+    const PoseSource poses(d.poses.empty() ? "dataset" : d.poses, sequence, indices);
     if (poses.kind() == PoseSource::Kind::Estimated)
       throw InvalidInputError("drive '" + d.name + "' has no poses: one map needs poses in one world");
-    pipeline.setFrameFilter([&poses](Frame& frame) { poses.apply(frame); });
-    frames += pipeline.run(sequence, indices, nullptr).frames_done;
+    engine.setFrameFilter([&poses](Frame& frame) { poses.apply(frame); });
+    frames += engine.run(sequence, indices, nullptr).frames_done;
   }
-  const std::size_t triangles = pipeline.finishStreaming(folder.dir() + "/mesh.ply");
+  const std::size_t triangles = engine.finishStreaming(folder.dir() + "/mesh.ply");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (triangles == 0)
     throw InvalidInputError("no surface was reconstructed from the " + std::to_string(frames) + " frames of " +

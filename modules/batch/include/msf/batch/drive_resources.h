@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/batch/drive_list.h>
-#include <msf/pipeline/pipeline.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include <cstddef>
 #include <string>
@@ -9,7 +9,7 @@
 namespace msf {
 
 /// What a drive's task needs, known before it runs: its frames and the peak memory that
-/// msf_reconstruct predicts for it (Pipeline::predictMemory, the same model and poses the run
+/// msf_reconstruct predicts for it (Reconstructor::predictMemory, the same model and poses the run
 /// prints as "Memory: predicted peak N MiB"), and what the task asks the scheduler for.
 struct DriveResources {
   std::size_t frames = 0;
@@ -26,7 +26,7 @@ struct DriveResources {
 /// the frames of `frames` ("a:b"). Throws InvalidInputError naming the drive when its poses are
 /// not known before the run (a batch merges drives whose poses share a world: give a poses
 /// file), ConfigError when the streaming radius is below what the run needs (as the run would
-/// at its start), IOError / ConfigError as Sequence and Pipeline do.
+/// at its start), IOError / ConfigError as Sequence and Reconstructor do.
 DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames);
 
 } // namespace msf

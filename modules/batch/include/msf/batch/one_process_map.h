@@ -13,7 +13,7 @@ namespace msf {
 /// drives. Written to `out` (an OutputFolder): tsdf/, tiles/, mesh.ply and summary.json (frames,
 /// seconds, triangles). Returns the triangles. Throws InvalidInputError when the drives'
 /// calibrations differ (one pipeline runs them all) or a drive has no known poses, and what
-/// Pipeline throws.
+/// Reconstructor throws.
 std::size_t reconstructInOneProcess(const BatchPlan& plan, const std::string& out);
 
 } // namespace msf

@@ -38,6 +38,8 @@ public:
   std::size_t size() const override { return frames_.size(); }
   /// "000042": the frame's position among the bag's frames.
   std::string frameName(std::size_t i) const override;
+  /// Seconds from the first frame's scan to frame i's, as load() stamps the frame.
+  double timestamp(std::size_t i) const override { return static_cast<double>(scanStampNs(i) - scanStampNs(0)) / 1e9; }
   /// Thread-safe (the bag's reads are serialized). Throws InvalidInputError for an image whose
   /// size is not the calibration's or a message that cannot be converted.
   Frame load(std::size_t i, bool with_color = true) const override;
