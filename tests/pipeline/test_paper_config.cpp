@@ -1,5 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-// The paper as published, as a configuration (issue 18, part 1): config/paper.yaml is
+// The paper as published, as a configuration: config/paper.yaml is
 // PipelineConfig::paper(), and its rows on the shared KITTI frames are the ones docs/paper.md
 // shows (the table between its test:paper_rows markers is this test's oracle).
 #include <msf/common/exceptions.h>

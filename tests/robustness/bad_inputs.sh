@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-# The bad-input matrix of issue 19: hostile or mistaken inputs against the msf_* tools.
+# The bad-input matrix: hostile or mistaken inputs against the msf_* tools.
 # Every case must end in under 5 s and under 500 MB, with the exit code it expects (1: a
 # clear error; 0: a result, e.g. with a warning) and a message matching a pattern that names
 # the option, key or file at fault; a failed run must leave no output file behind.

@@ -28,7 +28,7 @@ void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
   readKey(node, "stereo_prior", stereo_prior);
-  // Removed with OpenMP (issue 18): said so rather than "not a key", for configs printed before.
+  // Removed with OpenMP: said so rather than "not a key", for configs printed before.
   if (node.isMap() && !node["lidar_threads"].empty())
     throw ConfigError("pipeline.lidar_threads was removed: the LiDAR steps run on OpenCV's pool like the other "
                       "stages (serially on the loader while another stage's loop holds it); delete the key");

@@ -8,7 +8,7 @@
 /// Limits a hostile or mistaken input is checked against before anything is allocated or
 /// converted: a run that cannot be done in reasonable memory or time, or whose numbers are
 /// not physical, stops with an error naming the option, key or file instead of crashing,
-/// running away or writing a silently wrong result (issue 19).
+/// running away or writing a silently wrong result.
 namespace msf::limits {
 
 /// Threads a `threads` option may ask for (0 = all the cores).
