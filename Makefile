@@ -1,5 +1,5 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | install | clean
+# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | docs | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -29,10 +29,12 @@ SLURM_PACKAGES := slurm-wlm munge
 FUZZ_PACKAGES := clang libomp-dev
 # Only the Open3D baseline of `make bench` needs these.
 BENCH_PACKAGES := python3-open3d python3-numpy
+# Only `make docs` needs this: the API reference from the headers' comments (docs/Doxyfile).
+DOCS_PACKAGES := doxygen
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-slurm deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-slurm deps-bench deps-fuzz deps-docs docs build test test-sanitize test-sanitize-fast fuzz demo bench install clean
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -70,6 +72,9 @@ deps-bench: deps
 
 deps-fuzz: deps
 	$(call apt_install,$(FUZZ_PACKAGES))
+
+deps-docs:
+	$(call apt_install,$(DOCS_PACKAGES))
 
 $(BUILD_DIR)/CMakeCache.txt:
 	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DMSF_KITTI_DIR=$(KITTI_DIR)
@@ -136,6 +141,12 @@ demo: deps
 bench: deps-bench
 	$(MAKE) build
 	bash bench/run_all.sh $(BUILD_DIR)/bin $(KITTI_DIR)
+
+# The API reference in $(BUILD_DIR)/docs/html (warnings in $(BUILD_DIR)/docs/warnings.log).
+docs: deps-docs
+	mkdir -p $(BUILD_DIR)/docs
+	MSF_DOCS_DIR=$(abspath $(BUILD_DIR))/docs doxygen docs/Doxyfile
+	@echo "docs: $(BUILD_DIR)/docs/html/index.html ($$(grep -c 'warning:' $(BUILD_DIR)/docs/warnings.log || true) warnings)"
 
 install: build
 	cmake --install $(BUILD_DIR) --prefix $(PREFIX)

@@ -9,7 +9,7 @@
 #     counts against stereo there, which the robust sigma ignores and the outlier share does not);
 #   - the synthetic street (msf_synth, 40 frames) frames 5, 20 and 35 against their exact
 #     disparity (config/synthetic.yaml).
-# Prints msf_eval_disparity -confidence's table for each (docs/results.md, session 15).
+# Prints msf_eval_disparity -confidence's table for each (docs/results.md, "The stereo sigma against SGBM's measured error").
 #
 # Usage: bench/bench_stereo_sigma.sh BIN_DIR KITTI_DIR [OUT]
 #   OUT keeps the disparities, clouds and truths (and the street, which later runs reuse).

@@ -1,5 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-// Issue 19: the limits hostile inputs are checked against.
+// The limits hostile inputs are checked against.
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 

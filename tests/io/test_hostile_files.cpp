@@ -1,5 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-// Issue 19: files whose headers, values or shapes are hostile end in an error naming the
+// Files whose headers, values or shapes are hostile end in an error naming the
 // file and what is wrong, before anything large is allocated.
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>

@@ -1,5 +1,5 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-"""The README's Python example runs as written (the KITTI sample's path made the test's)."""
+"""The Python example of docs/python.md runs as written (the KITTI sample's path made the test's)."""
 import os
 import re
 import subprocess
@@ -8,9 +8,9 @@ import sys
 
 def readme_block(name):
     root = os.environ.get("MSF_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
-    text = open(os.path.join(root, "README.md")).read()
+    text = open(os.path.join(root, "docs", "python.md")).read()
     block = re.search(rf"<!-- example:{name}:begin -->\s*```python\n(.*?)```\s*<!-- example:{name}:end -->", text, re.S)
-    assert block, f"README.md has no python block example:{name}"
+    assert block, f"docs/python.md has no python block example:{name}"
     return block.group(1)
 
 

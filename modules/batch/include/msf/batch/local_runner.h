@@ -11,7 +11,7 @@ namespace msf {
 /// (batchTaskCommand), `parallel` at a time, the drives first (no more at once than their
 /// predicted memory fits in `memory_mb`), then the merge shares, the mesh shares and the
 /// finish. A task that fails runs again from nothing, up to the plan's max_attempts, as a
-/// requeued job would. Each task's own output goes to OUT/logs/task_<kind>_<n>.log.
+/// requeued job would. Each task's own output goes to `OUT/logs/task_<kind>_<n>.log`.
 class LocalRunner {
 public:
   /// Throws InvalidInputError when `parallel` < 1.

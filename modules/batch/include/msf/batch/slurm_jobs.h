@@ -31,7 +31,7 @@ constexpr int kFinishTaskMemoryMb = 1024;
 /// job for the finish) that runs `msf_batch -o OUT -run KIND:$SLURM_ARRAY_TASK_ID`, asks for
 /// `memory_mb` and `cpus`, is requeued when preempted or its node fails (--requeue), and
 /// requeues itself when the task fails, until the plan's max_attempts (each attempt starts the
-/// task from nothing); its output is appended to OUT/logs/slurm_<kind>_<index>.out.
+/// task from nothing); its output is appended to `OUT/logs/slurm_<kind>_<index>.out`.
 std::string slurmStageScript(const BatchPlan& plan, BatchTask::Kind kind, const std::vector<std::size_t>& indices,
                              std::size_t memory_mb, int cpus, const SlurmOptions& options);
 
