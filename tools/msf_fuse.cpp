@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
       "'distance' (pixels to the nearest real return; without it every point counts as a real return). stereo.pcd: "
       "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
-      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "fusion", config); },
              "YAML config, section fusion")

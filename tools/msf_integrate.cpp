@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
       .value("-calib", "PATH", calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
-      .value("-rig", "FILE", calib, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
+      .value("-rig", "FILE", calib, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-config", "FILE",
              [&](const std::string& path) {
                const msf::ConfigFile file(path);

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
              "YAML config, sections interpolation, projection, ip_basic")
       .value("-calib", "PATH", calib_path,
              "calibration: camera of the cloud (else recovered from its points); needed for a scan")
-      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-camera", "N", projection.camera, "rectified camera 0..3 of -calib (default {default})")
       .value("-short_gap", "N", interpolation.slice.short_gap_px,

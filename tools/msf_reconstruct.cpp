@@ -586,7 +586,7 @@ int main(int argc, char** argv) {
              },
              "YAML configuration (config/kitti.yaml); the options below override it")
       .value("-rig", "FILE", request.reader.rig,
-             "a rig file (README, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
+             "a rig file (docs/usage.md, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
              "without rig.yaml, and used instead of a dataset's own (a bag's CameraInfo and LiDAR extrinsic too)")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
       .value("-world", "W", request.world,

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
       "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
       "is no match).");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
-      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-color", "PATH", color_path,
              "colour camera image (image_2), projected for each point's colour; without it the colour is the left "

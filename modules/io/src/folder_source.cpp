@@ -113,7 +113,7 @@ FolderSource::FolderSource(const std::string& dir, const std::string& rig) {
     throw IOError("folder '" + dir_ + "' is not a dataset of the generic layout: it needs left/, right/ and lidar/");
   const std::string rig_file = rig.empty() ? (p / "rig.yaml").string() : rig;
   if (rig.empty() && !fs::exists(rig_file))
-    throw IOError("dataset '" + dir_ + "' has no rig.yaml: write one (README, \"Your own rig\") or give -rig FILE");
+    throw IOError("dataset '" + dir_ + "' has no rig.yaml: write one (docs/usage.md, \"Your own rig\") or give -rig FILE");
   calibration_ = loadCalibration(rig_file);
   calibration_.requireVelodyne();
   findFrames();

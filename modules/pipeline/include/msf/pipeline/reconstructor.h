@@ -77,7 +77,7 @@ struct FrameResult {
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration);
 
-/// The reconstruction engine: the whole method (the README's data flow) as one object that
+/// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
 /// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected
 /// onto the image grown by a margin, so gaps across the image's border are bridged) and SGBM

@@ -67,7 +67,7 @@ public:
   /// renders) and its number of LiDAR points.
   using Progress = std::function<void(std::size_t frame, double seconds, std::size_t points)>;
 
-  /// Writes the dataset under `root` (see README: KITTI odometry layout plus gt/) as an
+  /// Writes the dataset under `root` (see docs/usage.md, "Data layouts": KITTI odometry layout plus gt/) as an
   /// OutputFolder: the tree is written into a hidden folder beside `root` and moved into
   /// place at the end, so a failure (or an exception from `progress`) leaves `root` as it
   /// was. `root` may be absent, empty, or a dataset written before (replaced); anything else
