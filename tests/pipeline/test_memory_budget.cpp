@@ -19,7 +19,7 @@ namespace {
 /// street (measured 3.3 for 1 frame, 2.9 for 2 while every depth stopped at 40 m; 7.6 for 1 frame
 /// since depth known to within the truncation goes on to 60 m (tsdf_integrator.precise_max_depth_m):
 /// the footprint holds every view's frustum to 66 m, though only LiDAR-backed pixels reach past
-/// 40 m; docs/robustness.md, "Memory budget", has the figures on KITTI and 40 frames of the street).
+/// 40 m; docs/results.md, "Robustness", has the figures on KITTI and 40 frames of the street).
 constexpr double kMaxOverPrediction = 10.0;
 
 /// The figure N of "predicted to need up to N MiB" in a refusal, or -1.
