@@ -606,7 +606,7 @@ int main(int argc, char** argv) {
              "keep only R metres around the camera in memory (streaming.active_radius_m; at least the integrator's "
              "reach + a tile, 101 m with the shipped configs): the rest is meshed into OUT/tiles/X_Y_Z.ply and its TSDF "
              "written to OUT/tsdf/ as it leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview; "
-             "msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md")
+             "msf_mesh OUT out.ply meshes the TSDF again). See docs/streaming.md")
       .value("-max_memory", "MB", config.volume.max_memory_mb,
              "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
              "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "

@@ -23,7 +23,7 @@ struct SgbmConfig {
   /// The paths where the LiDAR's returns guide the matching (guidance lidar and returns given:
   /// msf_reconstruct, msf_stereo -prior): sgbm (5 paths) | sgbm_3way | ground_3way | hh (8
   /// paths) | hh4. Guided, five paths beat three on KITTI (odometry 04 and raw 0009 fused D1)
-  /// and on the streets' meshes (docs/results.md, "Five paths").
+  /// and on the streets' meshes (docs/results.md, "Depth at held-out LiDAR rings").
   std::string mode = "sgbm";
   /// The paths where nothing guides it (msf_stereo alone, guidance none), the same names.
   /// ground_3way: OpenCV's 3-way paths, the top-to-bottom one with the ground prior (p1_rise;
