@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
       "  DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
       "  DIR/poses/00.txt\n"
       "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
-      "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
+      "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars),\n"
+      "    poses.txt (with -ins_poses: the truth, poses/00.txt then being a GPS/INS's measurement)\n"
       "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.");
   cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
@@ -50,6 +51,10 @@ int main(int argc, char** argv) {
       .flag("-loop", config.loop,
             "drive out, turn round across the road and drive back in the other lane to the start (synthetic.loop): "
             "the way back revisits the street")
+      .flag("-ins_poses", config.ins_poses,
+            "write the poses as a GPS/INS measures them (synthetic.ins_poses): poses/00.txt with a heading that "
+            "drifts by synthetic.ins_heading_drift_deg_per_s and a position that wanders by "
+            "synthetic.ins_position_error_m, gt/poses.txt the truth; msf_reconstruct refines them by default")
       .flag("-print_config", print_config, "print the configuration in effect");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (!positional.empty())

@@ -93,6 +93,8 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
       poses_ = loadOdometryPoses(poses.string());
     if (fs::is_directory(root / "gt", ec))
       gt_dir_ = (root / "gt").string();
+    if (fs::is_regular_file(root / "gt" / "poses.txt", ec))
+      true_poses_ = loadOdometryPoses((root / "gt" / "poses.txt").string());
   } else if (fs::is_directory(p / "image_00" / "data", ec) &&
              fs::is_regular_file(p.parent_path() / "calib_cam_to_cam.txt", ec)) {
     layout_ = Layout::Raw;
@@ -121,17 +123,28 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
       throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " images in camera 0's " +
                     "folder but " + std::to_string(n) + " " + ext + " files in '" + folder.string() + "'");
   }
-  if (!poses_.empty() && poses_.size() < frame_names_.size())
-    throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " frames but only " +
-                  std::to_string(poses_.size()) + " poses");
+  for (const PoseList* poses : {&poses_, &true_poses_})
+    if (!poses->empty() && poses->size() < frame_names_.size())
+      throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " frames but only " +
+                    std::to_string(poses->size()) + (poses == &poses_ ? " poses" : " true poses (gt/poses.txt)"));
   if (calibration_.image_size.width <= 0)
     calibration_.image_size = readImage(imagePath(0, 0), cv::IMREAD_GRAYSCALE).size();
 }
 
 std::string Sequence::posesName() const {
+  if (!true_poses_.empty())
+    return "the synthetic INS";
   if (!gt_dir_.empty())
     return "the synthetic ground truth";
   return layout_ == Layout::Raw ? "OXTS (GPS/IMU)" : "the odometry ground truth";
+}
+
+bool Sequence::posesAreMeasured() const {
+  return !poses_.empty() && (layout_ == Layout::Raw || !true_poses_.empty());
+}
+
+std::string Sequence::referencePosesName() const {
+  return true_poses_.empty() ? posesName() : "the synthetic ground truth (gt/poses.txt)";
 }
 
 std::string Sequence::scanPath(std::size_t i) const {

@@ -31,6 +31,9 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "oncoming_car_speed_mps", oncoming_car_speed_mps);
   readKey(node, "oncoming_group_period_s", oncoming_group_period_s);
   readKey(node, "loop", loop);
+  readKey(node, "ins_poses", ins_poses);
+  readKey(node, "ins_heading_drift_deg_per_s", ins_heading_drift_deg_per_s);
+  readKey(node, "ins_position_error_m", ins_position_error_m);
   validate();
 }
 
@@ -83,6 +86,10 @@ void SyntheticConfig::validate() const {
           oncoming_group_period_s, "must be in 1..3600");
   require(!loop || frames >= kLoopTurnFrames + 2, "frames", frames,
           "must be >= 12 for a loop (out, the turn of 10 frames, back)");
+  require(ins_heading_drift_deg_per_s >= 0.0 && ins_heading_drift_deg_per_s <= 10.0, "ins_heading_drift_deg_per_s",
+          ins_heading_drift_deg_per_s, "must be in 0..10");
+  require(ins_position_error_m >= 0.0 && ins_position_error_m <= 10.0, "ins_position_error_m", ins_position_error_m,
+          "must be in 0..10");
 }
 
 namespace {
@@ -120,7 +127,10 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  moving_cars_oncoming: " << moving_cars_oncoming << "\n"
       << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
       << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n"
-      << "  loop: " << (loop ? "true" : "false") << "\n";
+      << "  loop: " << (loop ? "true" : "false") << "\n"
+      << "  ins_poses: " << (ins_poses ? "true" : "false") << "\n"
+      << "  ins_heading_drift_deg_per_s: " << exact(ins_heading_drift_deg_per_s) << "\n"
+      << "  ins_position_error_m: " << exact(ins_position_error_m) << "\n";
 }
 
 } // namespace msf::synthetic

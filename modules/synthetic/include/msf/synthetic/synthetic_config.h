@@ -35,6 +35,11 @@ struct SyntheticConfig {
   /// other lane to where the drive began: the second half revisits the first's street.
   bool loop = false;
   static constexpr int kLoopTurnFrames = 10;
+  // The dataset's poses as a GPS/INS measures them (see insPoses in ins_error.h): poses/00.txt
+  // then carries the error and gt/poses.txt the truth.
+  bool ins_poses = false;
+  double ins_heading_drift_deg_per_s = 0.3; ///< heading error grows at this rate from frame 0 [0, 10]
+  double ins_position_error_m = 1.0;        ///< RMS of the position's smooth wander [0, 10]
 
   /// Overrides the keys present in `node` (a `synthetic` section), then validates.
   /// Throws ConfigError naming a key with a wrong type or value.
