@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 namespace msf {
 
@@ -25,6 +26,10 @@ PoseSource::PoseSource(const std::string& option, const FrameSource& source, con
     kind_ = Kind::Estimated;
     description_ = "estimated (LiDAR odometry)";
   } else {
+    if (!std::filesystem::is_regular_file(choice))
+      throw InvalidInputError("-poses '" + choice +
+                              "': no such file, and not one of dataset, refine (the dataset's GPS/INS poses refined by "
+                              "the scans) or estimate");
     kind_ = Kind::File;
     file_ = choice;
     description_ = "file '" + choice + "'";
