@@ -101,7 +101,7 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
                             " points is a finite return between odometry.min_range_m " +
                             std::to_string(config_.min_range_m) + " and max_range_m " +
                             std::to_string(config_.max_range_m) + " m");
-  checkConstraints(name, stats, measured_motion != nullptr);
+  const ScanConstraints constraints = checkConstraints(name, stats, measured_motion != nullptr);
 
   if (poses_.empty()) {
     if (sweeps_) // deskewed once the second scan tells the motion
@@ -112,12 +112,14 @@ Eigen::Isometry3d LidarOdometry::registerPoints(const PointList& points_sensor, 
   prior.T_world_sensor = prediction;
   prior.translation_sigma_m = config_.prior_translation_sigma_m;
   prior.rotation_sigma_rad = config_.prior_rotation_sigma_deg * M_PI / 180.0;
-  const Eigen::Isometry3d pose = align(points_sensor, name, prediction, measured_motion ? &prior : nullptr, stats);
+  Eigen::Isometry3d pose = align(points_sensor, name, prediction, measured_motion ? &prior : nullptr, stats);
+  if (measured_motion)
+    pose = keepPriorWhereFree(prediction, pose, constraints, config_.min_constraint);
   threshold_.update(prediction.inverse() * pose);
   return accept(pose, stats);
 }
 
-void LidarOdometry::checkConstraints(const std::string& name, Stats& stats, bool has_prior) const {
+ScanConstraints LidarOdometry::checkConstraints(const std::string& name, Stats& stats, bool has_prior) const {
   const ScanConstraints constraints = analyzeConstraints(frame_, 2.0 * config_.voxel_size_m);
   stats.constraint = constraints.weakest();
   const int free = constraints.unconstrained(config_.min_constraint);
@@ -127,6 +129,7 @@ void LidarOdometry::checkConstraints(const std::string& name, Stats& stats, bool
                             ", " + std::to_string(constraints.weakest()) + " <= odometry.min_constraint " +
                             std::to_string(config_.min_constraint) + ", " + std::to_string(constraints.patches) +
                             " planar patches): a single plane or an empty scene cannot be registered");
+  return constraints;
 }
 
 void LidarOdometry::keepFirstReturns(const PointList& points_sensor) {
@@ -199,6 +202,27 @@ Eigen::Isometry3d LidarOdometry::accept(const Eigen::Isometry3d& pose, Stats& st
   poses_.push_back(pose);
   stats_ = stats;
   return pose;
+}
+
+Eigen::Isometry3d keepPriorWhereFree(const Eigen::Isometry3d& prior, const Eigen::Isometry3d& registered,
+                                     const ScanConstraints& constraints, double min_constraint) {
+  const int free = constraints.unconstrained(min_constraint);
+  if (free == 0)
+    return registered;
+  if (constraints.patches == 0 || !(constraints.lever_m > 0.0))
+    return prior;
+  const Eigen::Isometry3d E = prior.inverse() * registered;
+  const Eigen::AngleAxisd rotation(E.linear());
+  Eigen::Matrix<double, 6, 1> e;
+  e << E.translation(), rotation.angle() * constraints.lever_m * rotation.axis();
+  for (int k = 0; k < free; ++k)
+    e -= constraints.eigenvectors.col(k) * constraints.eigenvectors.col(k).dot(e);
+  const Eigen::Vector3d w = e.tail<3>() / constraints.lever_m;
+  Eigen::Isometry3d kept = Eigen::Isometry3d::Identity();
+  if (w.norm() > 0.0)
+    kept.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+  kept.translation() = e.head<3>();
+  return prior * kept;
 }
 
 LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const FrameSource& source) {

@@ -57,6 +57,14 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
                          const IcpSettings& settings, NearestCache* neighbors) {
   IcpResult result;
   result.T_world_sensor = initial_guess;
+  if (map.empty()) { // no pair: the prior alone, or nothing to align to
+    if (!settings.prior)
+      throw InvalidInputError("scan-to-map ICP: the map is empty; no point of " + std::to_string(points_sensor.size()) +
+                              " has a map point within " + std::to_string(settings.max_correspondence_m) + " m");
+    result.T_world_sensor = settings.prior->T_world_sensor;
+    result.converged = true;
+    return result;
+  }
   const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
   LocalMap::Neighbor neighbor;
   // After the first iteration the points move by millimetres: most keep their neighbour.

@@ -128,8 +128,9 @@ private:
   /// second scan of a sweeping LiDAR, once its motion deskews both).
   Eigen::Isometry3d align(const PointList& points_sensor, const std::string& name, const Eigen::Isometry3d& prediction,
                           const PosePrior* prior, Stats& stats);
-  /// Throws when the scan's planes leave a degree of freedom unconstrained and no prior holds it.
-  void checkConstraints(const std::string& name, Stats& stats, bool has_prior) const;
+  /// The scan's constraints; throws when its planes leave a degree of freedom unconstrained and
+  /// no prior holds it.
+  ScanConstraints checkConstraints(const std::string& name, Stats& stats, bool has_prior) const;
   /// The first scan's returns in range, kept until the second scan's motion deskews them.
   void keepFirstReturns(const PointList& points_sensor);
   /// Adds the scan at `pose` to the map and to the poses.
@@ -149,6 +150,14 @@ private:
   VoxelDownsampler downsampler_;
   NearestCache neighbors_;
 };
+
+/// `registered` with its departure from `prior` (in the prior's frame, rotations as the metres
+/// they move a point at the scan's lever) removed along the directions the scan's planes leave
+/// free (eigenvalues of `constraints` at or below `min_constraint`): there the prior holds, not
+/// what spurious pairs (a ring on a tunnel's floor) pulled the registration to. Solution
+/// remapping (Zhang, Kaess and Singh, ICRA 2016).
+Eigen::Isometry3d keepPriorWhereFree(const Eigen::Isometry3d& prior, const Eigen::Isometry3d& registered,
+                                     const ScanConstraints& constraints, double min_constraint);
 
 /// `config` with deskew auto resolved for `sequence`: none for a synthetic sequence (msf_synth's
 /// LiDAR takes a snapshot at the frame's pose), sweep for KITTI's.
