@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A GPS/INS's poses refined by the LiDAR (msf_reconstruct -poses refine, the default for them):
 // on a synthetic drive whose dataset poses drift as an INS's do while its truth is known, the
 // refined poses come back to the truth and the mesh to the exact poses' quality; the dataset's

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A GPS/INS's poses as a prior of the scan-to-map registration: the scans correct what they
 // pin down (a drifting heading), the prior holds what they cannot (a tunnel's axis, no scan).
 #include "box_scene.h"

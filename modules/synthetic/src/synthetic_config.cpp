@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/synthetic_config.h>
@@ -34,6 +35,9 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "ins_poses", ins_poses);
   readKey(node, "ins_heading_drift_deg_per_s", ins_heading_drift_deg_per_s);
   readKey(node, "ins_position_error_m", ins_position_error_m);
+  readKey(node, "start_m", start_m);
+  readKey(node, "reverse", reverse);
+  readKey(node, "street_length_m", street_length_m);
   validate();
 }
 
@@ -90,6 +94,9 @@ void SyntheticConfig::validate() const {
           ins_heading_drift_deg_per_s, "must be in 0..10");
   require(ins_position_error_m >= 0.0 && ins_position_error_m <= 10.0, "ins_position_error_m", ins_position_error_m,
           "must be in 0..10");
+  require(start_m >= 0.0 && start_m <= 5000.0, "start_m", start_m, "must be in 0..5000");
+  require(street_length_m >= 0.0 && street_length_m <= 5000.0, "street_length_m", street_length_m,
+          "must be in 0..5000 (0: as far as the drive goes)");
 }
 
 namespace {
@@ -127,10 +134,16 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  moving_cars_oncoming: " << moving_cars_oncoming << "\n"
       << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
       << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n"
-      << "  loop: " << (loop ? "true" : "false") << "\n"
-      << "  ins_poses: " << (ins_poses ? "true" : "false") << "\n"
-      << "  ins_heading_drift_deg_per_s: " << exact(ins_heading_drift_deg_per_s) << "\n"
-      << "  ins_position_error_m: " << exact(ins_position_error_m) << "\n";
+      << "  loop: " << (loop ? "true" : "false") << "\n";
+  // Only when set: a dataset of exact poses, of one drive on its own street, is written as before.
+  if (ins_poses)
+    out << "  ins_poses: true\n"
+        << "  ins_heading_drift_deg_per_s: " << exact(ins_heading_drift_deg_per_s) << "\n"
+        << "  ins_position_error_m: " << exact(ins_position_error_m) << "\n";
+  if (placed() || street_length_m != 0.0)
+    out << "  start_m: " << exact(start_m) << "\n"
+        << "  reverse: " << (reverse ? "true" : "false") << "\n"
+        << "  street_length_m: " << exact(street_length_m) << "\n";
 }
 
 } // namespace msf::synthetic
