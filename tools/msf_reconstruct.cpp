@@ -275,6 +275,7 @@ public:
     report_.pose_ms = engine_->odometryMs();
     const char* used_name = poses_.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
                             : poses_.kind() == msf::PoseSource::Kind::File    ? "poses file"
+                            : poses_.kind() == msf::PoseSource::Kind::Refined ? "refined"
                                                                               : "dataset";
     msf::writeTrajectory(stage_, used_poses_, frames_, used_name, source_, T_out_world_, report_);
     report_.peak_memory_mb = msf::peakMemoryMb();
@@ -594,9 +595,11 @@ int main(int argc, char** argv) {
              "x forward, y left, z up (ROS): mesh*.ply, poses.txt, poses_tum.txt (volume.pcd and a streamed map's "
              "tiles/ and tsdf/ stay the map's own store, in camera 0)")
       .value("-poses", "P", request.poses,
-             "dataset: the dataset's poses (the default when it has them) | estimate: LiDAR odometry as each frame is "
-             "loaded (the default without them; section odometry) | a KITTI poses file, line i for frame i. "
-             "OUT/poses.txt holds the poses used")
+             "dataset: the dataset's poses as they are (the default for ground truth: KITTI odometry, synthetic) | "
+             "refine: the dataset's GPS/INS poses refined by LiDAR odometry, their motion the prediction and a soft "
+             "constraint of their accuracy (the default for KITTI raw's OXTS; section odometry, prior_*) | "
+             "estimate: LiDAR odometry as each frame is loaded (the default without poses; section odometry) | "
+             "a KITTI poses file, line i for frame i. OUT/poses.txt holds the poses used")
       .value("-voxel", "V", config.volume.voxel_size_m, "voxel size in metres (tsdf_volume.voxel_size_m)")
       .value("-lambda", "L", config.integrator.lambda, "regularization of eq. 7 (tsdf_integrator.lambda)")
       .value("-panels", "N", request.panels,
@@ -669,7 +672,8 @@ int main(int argc, char** argv) {
     msf::FrameRange::parse(request.frames); // a malformed range before any folder is made
 
     // OUT is replaced as a whole: an input inside it is refused.
-    const bool poses_file = request.poses != "dataset" && request.poses != "estimate";
+    const bool poses_file = !request.poses.empty() && request.poses != "dataset" && request.poses != "estimate" &&
+                            request.poses != "refine";
     installStopHandler();
     msf::OutputFolder output(request.out, "msf_reconstruct",
                              {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});

@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
       "  DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
       "  DIR/poses/00.txt\n"
       "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
-      "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
+      "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars),\n"
+      "    poses.txt (with -ins_poses: the truth, poses/00.txt then being a GPS/INS's measurement)\n"
       "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.\n"
       "Several drives over one street: the same -seed and -street_m, and each its own -start_m, -reverse, -frames "
       "(e.g. msf_synth -o A -street_m 120 -frames 30; msf_synth -o B -street_m 120 -start_m 20 -frames 30; msf_synth "
@@ -54,6 +55,10 @@ int main(int argc, char** argv) {
       .flag("-loop", config.loop,
             "drive out, turn round across the road and drive back in the other lane to the start (synthetic.loop): "
             "the way back revisits the street")
+      .flag("-ins_poses", config.ins_poses,
+            "write the poses as a GPS/INS measures them (synthetic.ins_poses): poses/00.txt with a heading that "
+            "drifts by synthetic.ins_heading_drift_deg_per_s and a position that wanders by "
+            "synthetic.ins_position_error_m, gt/poses.txt the truth; msf_reconstruct refines them by default")
       .value("-start_m", "S", config.start_m,
              "the drive starts S metres along the street (synthetic.start_m, default {default}); its poses are in the "
              "street's world, where drives of the same -seed and -street_m meet")

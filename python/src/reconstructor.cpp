@@ -40,7 +40,9 @@ Reconstructor::PoseMode parsePoseMode(const std::string& text) {
     return Reconstructor::PoseMode::Given;
   if (text == "odometry")
     return Reconstructor::PoseMode::Odometry;
-  throw InvalidInputError("poses must be auto, given or odometry, not '" + text + "'");
+  if (text == "refine")
+    return Reconstructor::PoseMode::Refine;
+  throw InvalidInputError("poses must be auto, given, odometry or refine, not '" + text + "'");
 }
 
 std::unique_ptr<Engine> makeEngine(const Calibration& rig, const PipelineConfig& config, const std::string& poses,
@@ -215,7 +217,8 @@ void bindReconstructor(py::module_& m) {
            py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("sweeping_scans") = true,
            py::arg("stream_directory") = "",
            "poses: auto (the frame's own pose; LiDAR odometry when the first frame has none), given (a frame "
-           "without one is an error) or odometry (always). threads: of this engine's parallel loops, 0 = all "
+           "without one is an error), odometry (always) or refine (the frames' own poses, a GPS/INS's, as the "
+           "prior the LiDAR odometry refines). threads: of this engine's parallel loops, 0 = all "
            "cores. sweeping_scans: the scans are swept over their period (a spinning LiDAR; the odometry "
            "deskews them). stream_directory: where a streamed map (streaming.active_radius_m > 0) writes its "
            "tiles. Raises ConfigError for an invalid config, CalibrationError for a rig without an image size.")

@@ -174,7 +174,7 @@ def test_a_frame_without_pose_takes_the_odometrys_or_is_refused(calibration, seq
     np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-6)
     assert np.linalg.norm(poses[2][:3, 3] - sequence.poses[2][:3, 3]) < 0.1  # the vehicle drove ~2 m
     assert len(auto.odometry_ms) == 3
-    with pytest.raises(msfusion.InvalidInputError, match="poses must be auto, given or odometry, not 'gps'"):
+    with pytest.raises(msfusion.InvalidInputError, match="poses must be auto, given, odometry or refine, not 'gps'"):
         msfusion.Reconstructor(calibration, poses="gps")
 
 

@@ -483,6 +483,12 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$K/odo_empty_scan/sequences/04" -panels 0 -o out
   check "reconstruct: a missing colour image" 1 "frame 000000: colour image '.*image_2/000000.png' is missing" -- \
     msf_reconstruct "$K/odo_missing_color/sequences/04" -panels 0 -o out
+  check "reconstruct -poses refined (a typo)" 1 "-poses 'refined': no such file, and not one of dataset, refine" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -poses refined -o out
+  mkdir -p "$K/no_poses/sequences/04"
+  for f in calib.txt times.txt image_0 image_1 image_2 velodyne; do ln -s "$SEQ/$f" "$K/no_poses/sequences/04/$f"; done
+  check "reconstruct -poses refine without poses" 1 "-poses refine: '.*no_poses/sequences/04' has no poses" -- \
+    msf_reconstruct "$K/no_poses/sequences/04" -frames 0:0 -panels 0 -poses refine -o out
   check "odometry: .DS_Store and a README in image_0" 0 "Saving .*p.txt" -- \
     msf_odometry "$K/odo_stray/sequences/04" -o p.txt
   check "odometry: a frame beyond the poses" 1 "frame 000012 has no entry in poses '.*04.txt', which has 3 \(frames 0..2\)" -- \

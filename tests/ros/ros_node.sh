@@ -46,7 +46,7 @@ refuse bad_path "parameter /bad_path/mesh_path: '$work/mine.ply' exists, and a m
 refuse bad_name "unknown parameter /bad_name/queue_sise" _queue_sise:=2
 refuse bad_type "parameter /bad_type/queue_size must be an integer" _queue_size:=two
 refuse bad_range "parameter /bad_range/queue_size must be 1..8 frames, not 20" _queue_size:=20
-refuse bad_poses "parameter /bad_poses/poses must be auto, tf or odometry, not 'gps'" _poses:=gps
+refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refine, not 'gps'" _poses:=gps
 refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
 
 # The recorder first, so that it hears the first frame; then the node, and the player, which

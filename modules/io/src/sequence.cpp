@@ -155,6 +155,9 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
       poses_ = ofFrames(loadOdometryPoses(poses.string()), frame_names_, "poses '" + poses.string() + "'");
     if (fs::is_directory(root / "gt", ec))
       gt_dir_ = (root / "gt").string();
+    if (fs::is_regular_file(root / "gt" / "poses.txt", ec))
+      true_poses_ = ofFrames(loadOdometryPoses((root / "gt" / "poses.txt").string()), frame_names_,
+                             "the true poses '" + (root / "gt" / "poses.txt").string() + "'");
   } else if (fs::is_directory(p / "image_00" / "data", ec) &&
              fs::is_regular_file(p.parent_path() / "calib_cam_to_cam.txt", ec)) {
     layout_ = Layout::Raw;
@@ -190,9 +193,19 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
 }
 
 std::string Sequence::posesName() const {
+  if (!true_poses_.empty())
+    return "the synthetic INS";
   if (!gt_dir_.empty())
     return "the synthetic ground truth";
   return layout_ == Layout::Raw ? "OXTS (GPS/IMU)" : "the odometry ground truth";
+}
+
+bool Sequence::posesAreMeasured() const {
+  return !poses_.empty() && (layout_ == Layout::Raw || !true_poses_.empty());
+}
+
+std::string Sequence::referencePosesName() const {
+  return true_poses_.empty() ? posesName() : "the synthetic ground truth (gt/poses.txt)";
 }
 
 std::string Sequence::scanPath(std::size_t i) const {

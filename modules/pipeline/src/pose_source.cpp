@@ -5,23 +5,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 namespace msf {
 
 PoseSource::PoseSource(const std::string& option, const FrameSource& source, const std::vector<std::size_t>& frames)
     : source_(source) {
-  const std::string choice = option.empty() ? (source.hasPoses() ? "dataset" : "estimate") : option;
+  const std::string choice = !option.empty()         ? option
+                             : source.posesAreMeasured() ? "refine"
+                             : source.hasPoses()         ? "dataset"
+                                                         : "estimate";
   if (choice == "dataset") {
-    if (!source.hasPoses())
-      throw InvalidInputError("-poses dataset: '" + source.description() +
-                              "' has no poses (odometry poses/XX.txt, raw oxts/ or a poses file of its own); "
-                              "-poses estimate tracks them from the scans");
+    requireDatasetPoses(choice);
     kind_ = Kind::Dataset;
     description_ = "the dataset's: " + source.posesName();
+  } else if (choice == "refine") {
+    requireDatasetPoses(choice);
+    kind_ = Kind::Refined;
+    description_ = "the dataset's: " + source.posesName() + ", refined by LiDAR odometry";
   } else if (choice == "estimate") {
     kind_ = Kind::Estimated;
     description_ = "estimated (LiDAR odometry)";
   } else {
+    if (!std::filesystem::is_regular_file(choice))
+      throw InvalidInputError("-poses '" + choice +
+                              "': no such file, and not one of dataset, refine (the dataset's GPS/INS poses refined by "
+                              "the scans) or estimate");
     kind_ = Kind::File;
     file_ = choice;
     description_ = "file '" + choice + "'";
@@ -30,6 +39,13 @@ PoseSource::PoseSource(const std::string& option, const FrameSource& source, con
     else
       readKitti(frames);
   }
+}
+
+void PoseSource::requireDatasetPoses(const std::string& option) const {
+  if (!source_.hasPoses())
+    throw InvalidInputError("-poses " + option + ": '" + source_.description() +
+                            "' has no poses (odometry poses/XX.txt, raw oxts/ or a poses file of its own); "
+                            "-poses estimate tracks them from the scans");
 }
 
 void PoseSource::readKitti(const std::vector<std::size_t>& frames) {
@@ -65,7 +81,16 @@ void PoseSource::apply(Frame& frame) const {
 }
 
 Reconstructor::PoseMode PoseSource::mode() const {
-  return kind_ == Kind::Estimated ? Reconstructor::PoseMode::Odometry : Reconstructor::PoseMode::Given;
+  switch (kind_) {
+  case Kind::Estimated:
+    return Reconstructor::PoseMode::Odometry;
+  case Kind::Refined:
+    return Reconstructor::PoseMode::Refine;
+  case Kind::Dataset:
+  case Kind::File:
+    break;
+  }
+  return Reconstructor::PoseMode::Given;
 }
 
 PoseList PoseSource::knownPoses(const std::vector<std::size_t>& frames) const {

@@ -198,6 +198,7 @@ bool Reconstructor::tracks(const Frame& first) const {
   case PoseMode::Given:
     return false;
   case PoseMode::Odometry:
+  case PoseMode::Refine:
     return true;
   case PoseMode::Auto:
     break;
@@ -216,9 +217,25 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
   if (!frame.scan)
     throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan to track");
   const auto start = Clock::now();
-  const Eigen::Isometry3d T_velo0_velo = odometry_->registerScan(*frame.scan, scan_name);
+  const std::optional<Eigen::Isometry3d> measured = measuredMotion(frame);
+  const Eigen::Isometry3d T_velo0_velo =
+      odometry_->registerScan(*frame.scan, scan_name, measured ? &*measured : nullptr);
   odometry_ms_.push_back(msSince(start));
   return cameraPose(T_velo0_velo, calibration_.T_cam0_velo, T_world_cam0_first_);
+}
+
+std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& frame) {
+  if (options_.poses != PoseMode::Refine)
+    return std::nullopt;
+  if (!frame.has_pose)
+    throw InvalidInputError("frame " + std::to_string(frame.index) +
+                            " has no pose to refine (PoseMode Refine refines each frame's own pose with its scan)");
+  const Eigen::Isometry3d T_world_velo = frame.T_world_cam0 * calibration_.T_cam0_velo;
+  if (odometry_->poses().empty()) // the first scan is the odometry's origin: any motion marks it as measured
+    T_world_velo_measured_last_ = T_world_velo;
+  const Eigen::Isometry3d motion = T_world_velo_measured_last_.inverse() * T_world_velo;
+  T_world_velo_measured_last_ = T_world_velo;
+  return motion;
 }
 
 FrameResult Reconstructor::addFrame(const Frame& frame) {

@@ -28,7 +28,7 @@ std::string cameraInfoTopic(const std::string& image_topic) {
 
 const std::map<std::string, Reconstructor::PoseMode> kPoseModes{
     {"auto", Reconstructor::PoseMode::Auto}, {"tf", Reconstructor::PoseMode::Given},
-    {"odometry", Reconstructor::PoseMode::Odometry}};
+    {"odometry", Reconstructor::PoseMode::Odometry}, {"refine", Reconstructor::PoseMode::Refine}};
 
 /// Reads one parameter when it is set; a value of another type is an error, not the default.
 template <typename T>
@@ -86,7 +86,7 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
     if (!ok)
       throw ConfigError("parameter " + nh.resolveName(name) + " must be " + range + ", not " + text.str());
   };
-  check(kPoseModes.count(p.poses) > 0, "poses", "auto, tf or odometry", "'" + p.poses + "'");
+  check(kPoseModes.count(p.poses) > 0, "poses", "auto, tf, odometry or refine", "'" + p.poses + "'");
   check(p.threads >= 0, "threads", ">= 0", p.threads);
   check(p.queue_size >= 1 && p.queue_size <= 8, "queue_size", "1..8 frames", p.queue_size);
   check(p.sync_slop_s > 0, "sync_slop_s", "> 0", p.sync_slop_s);

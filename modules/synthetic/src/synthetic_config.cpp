@@ -32,6 +32,9 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "oncoming_car_speed_mps", oncoming_car_speed_mps);
   readKey(node, "oncoming_group_period_s", oncoming_group_period_s);
   readKey(node, "loop", loop);
+  readKey(node, "ins_poses", ins_poses);
+  readKey(node, "ins_heading_drift_deg_per_s", ins_heading_drift_deg_per_s);
+  readKey(node, "ins_position_error_m", ins_position_error_m);
   readKey(node, "start_m", start_m);
   readKey(node, "reverse", reverse);
   readKey(node, "street_length_m", street_length_m);
@@ -87,6 +90,10 @@ void SyntheticConfig::validate() const {
           oncoming_group_period_s, "must be in 1..3600");
   require(!loop || frames >= kLoopTurnFrames + 2, "frames", frames,
           "must be >= 12 for a loop (out, the turn of 10 frames, back)");
+  require(ins_heading_drift_deg_per_s >= 0.0 && ins_heading_drift_deg_per_s <= 10.0, "ins_heading_drift_deg_per_s",
+          ins_heading_drift_deg_per_s, "must be in 0..10");
+  require(ins_position_error_m >= 0.0 && ins_position_error_m <= 10.0, "ins_position_error_m", ins_position_error_m,
+          "must be in 0..10");
   require(start_m >= 0.0 && start_m <= 5000.0, "start_m", start_m, "must be in 0..5000");
   require(street_length_m >= 0.0 && street_length_m <= 5000.0, "street_length_m", street_length_m,
           "must be in 0..5000 (0: as far as the drive goes)");
@@ -128,7 +135,11 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
       << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n"
       << "  loop: " << (loop ? "true" : "false") << "\n";
-  // Only when set: a dataset of one drive on its own street is written as before.
+  // Only when set: a dataset of exact poses, of one drive on its own street, is written as before.
+  if (ins_poses)
+    out << "  ins_poses: true\n"
+        << "  ins_heading_drift_deg_per_s: " << exact(ins_heading_drift_deg_per_s) << "\n"
+        << "  ins_position_error_m: " << exact(ins_position_error_m) << "\n";
   if (placed() || street_length_m != 0.0)
     out << "  start_m: " << exact(start_m) << "\n"
         << "  reverse: " << (reverse ? "true" : "false") << "\n"

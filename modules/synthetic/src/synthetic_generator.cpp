@@ -7,6 +7,7 @@
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/velodyne_io.h>
+#include <msf/synthetic/ins_error.h>
 #include <msf/synthetic/kitti_rig.h>
 #include <msf/synthetic/scene_mesh.h>
 #include <msf/synthetic/street_scene.h>
@@ -87,6 +88,8 @@ const char* kGroundTruthReadme =
     "scene_classes.txt     what each vertex of scene.ply is (ground, building, car, pole, person, tree), in runs\n"
     "                      of vertices: first_vertex vertex_count class\n"
     "synthetic.yaml        the generator's configuration\n"
+    "poses.txt             with ins_poses: the true T_world_cam0 (poses/00.txt then holds them as a GPS/INS\n"
+    "                      measures them, with a drifting heading and a wandering position)\n"
     "Every pixel is exact: the value of the ray through the pixel centre.\n";
 
 } // namespace
@@ -174,7 +177,12 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     times << line;
   }
   writeText(seq / "times.txt", times.str());
-  saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+  if (config_.ins_poses) {
+    saveOdometryPoses((staging / "poses" / "00.txt").string(), insPoses(poses_, config_));
+    saveOdometryPoses((gt / "poses.txt").string(), poses_);
+  } else {
+    saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+  }
   std::ostringstream yaml;
   yaml << "%YAML:1.0\n";
   config_.print(yaml);

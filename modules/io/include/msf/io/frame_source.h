@@ -62,6 +62,14 @@ public:
   bool hasPoses() const { return !poses().empty(); }
   /// Where poses() come from, in words ("the odometry ground truth").
   virtual std::string posesName() const { return "the dataset's poses"; }
+  /// Whether poses() are a GPS/INS's measurement (KITTI raw's OXTS), which the scans can
+  /// correct, rather than a ground truth: msf_reconstruct refines them by default.
+  virtual bool posesAreMeasured() const { return false; }
+  /// The poses a trajectory is scored against (protocol 5): the true ones when the source
+  /// knows them apart from poses() (a synthetic drive with INS-like poses), else poses().
+  virtual const PoseList& referencePoses() const { return poses(); }
+  /// Where referencePoses() come from, in words.
+  virtual std::string referencePosesName() const { return posesName(); }
   /// The source in words for messages and reports: its folder or file.
   virtual std::string description() const = 0;
   /// Frame i's scan in words for messages ("scan '.../000042.bin'").

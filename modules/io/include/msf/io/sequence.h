@@ -11,7 +11,8 @@ namespace msf {
 /// A KITTI sequence on disk, detected from the folder:
 ///  - odometry: `sequences/XX/{image_0,image_1,image_2,velodyne,calib.txt,times.txt}` with
 ///    poses in `../../poses/XX.txt` when present; the folder may also be the dataset root
-///    holding exactly one `sequences/XX` (as msf_synth writes);
+///    holding exactly one `sequences/XX` (as msf_synth writes; its `gt/poses.txt`, when
+///    present, is the truth that INS-like poses in `poses/XX.txt` err from);
 ///  - raw drive: `YYYY_MM_DD_drive_NNNN_sync/{image_00..03/data,velodyne_points/data,oxts}`
 ///    with the calibration in the date folder above it; poses from OXTS.
 class Sequence : public FrameSource {
@@ -27,9 +28,15 @@ public:
   const Calibration& calibration() const override { return calibration_; }
   std::size_t size() const override { return frame_names_.size(); }
   const PoseList& poses() const override { return poses_; }
-  /// Where poses() come from, in words: "the synthetic ground truth", "OXTS (GPS/IMU)" or
-  /// "the odometry ground truth" (whether or not there are any).
+  /// Where poses() come from, in words: "the synthetic ground truth", "the synthetic INS",
+  /// "OXTS (GPS/IMU)" or "the odometry ground truth" (whether or not there are any).
   std::string posesName() const override;
+  /// A raw drive's OXTS, and a synthetic drive's INS-like poses (msf_synth -ins_poses: the
+  /// truth is then gt/poses.txt).
+  bool posesAreMeasured() const override;
+  /// gt/poses.txt of a synthetic drive with INS-like poses, else poses().
+  const PoseList& referencePoses() const override { return true_poses_.empty() ? poses_ : true_poses_; }
+  std::string referencePosesName() const override;
   /// Folder of synthetic ground truth (`<root>/gt`), "" when there is none.
   std::string groundTruthDir() const override { return gt_dir_; }
   /// File stem of a frame ("000042" or "0000000042").
@@ -56,6 +63,7 @@ private:
   std::vector<std::string> frame_names_;
   std::vector<double> timestamps_;
   PoseList poses_;
+  PoseList true_poses_;  // gt/poses.txt, when poses_ are a synthetic INS's
 };
 
 } // namespace msf

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,12 @@ public:
     Auto,     ///< the frame's own pose; LiDAR odometry for a run whose first frame has none
     Given,    ///< the frame's own pose; a frame without one is an error
     Odometry, ///< LiDAR odometry, in the world of the first frame's pose when it has one
+    /// The frame's own pose (a GPS/INS's) as a prior that the LiDAR odometry refines: its motion
+    /// since the previous frame is the scan's prediction and a soft constraint weighed by its
+    /// accuracy (odometry.prior_*_sigma_*), so the scans correct a drifting heading and a scene
+    /// they cannot pin down (a tunnel, an open field) keeps the prior's motion; in the world of
+    /// the first frame's pose. A frame without a pose is an error.
+    Refine,
   };
 
   struct Options {
@@ -218,6 +225,9 @@ private:
   bool tracks(const Frame& first) const;
   /// The odometry's pose of the frame's scan; frames in order.
   Eigen::Isometry3d track(const Frame& frame, const std::string& scan_name);
+  /// PoseMode::Refine: the LiDAR's motion since the previous frame by the frames' own poses
+  /// (the identity for the first); nullopt in the other modes.
+  std::optional<Eigen::Isometry3d> measuredMotion(const Frame& frame);
   void startStreaming();
 
   Calibration calibration_;
@@ -234,6 +244,7 @@ private:
   // The odometry (PoseMode): made at the first frame it tracks, anchored at that frame's pose.
   std::unique_ptr<LidarOdometry> odometry_;
   Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_velo_measured_last_ = Eigen::Isometry3d::Identity();  // PoseMode::Refine's prior
   std::vector<double> odometry_ms_;
   std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
   bool add_tracks_ = false;

@@ -36,6 +36,11 @@ struct SyntheticConfig {
   /// other lane to where the drive began: the second half revisits the first's street.
   bool loop = false;
   static constexpr int kLoopTurnFrames = 10;
+  // The dataset's poses as a GPS/INS measures them (see insPoses in ins_error.h): poses/00.txt
+  // then carries the error and gt/poses.txt the truth.
+  bool ins_poses = false;
+  double ins_heading_drift_deg_per_s = 0.3; ///< heading error grows at this rate from frame 0 [0, 10]
+  double ins_position_error_m = 1.0;        ///< RMS of the position's smooth wander [0, 10]
   // The drive's place in a street shared with other drives (the same seed and street_length_m
   // give the same static world; the poses are in that world's frame).
   double start_m = 0.0;          ///< the drive starts this far along the street (world z)
