@@ -317,7 +317,7 @@ private:
     if (!streaming() && (request_.holdout || truth_))
       evaluation_ = std::make_unique<msf::ReconstructionEvaluation>(
           msf::PinholeCamera::fromCalibration(source_.calibration(), 0), source_.calibration().focalBaseline(),
-          config_.integrator.max_depth_m, holdout_.config().d1);
+          engine_->config().integrator.max_depth_m, holdout_.config().d1);
     moving_split_ = !request_.holdout && truth_ && truth_->truth().hasMovingMasks();
     if (request_.compare_sources)
       source_maps_ = std::make_unique<msf::SourceMaps>(config_, source_.calibration());
@@ -332,7 +332,7 @@ private:
     cv::Mat true_depth;
     if (truth_) {
       true_depth = truth_->depth(r.name);
-      truth_->addFrame(r, true_depth, source_.calibration(), config_.integrator.max_depth_m);
+      truth_->addFrame(r, true_depth, source_.calibration(), engine_->config().integrator.max_depth_m);
     }
     if (evaluation_) {
       if (request_.holdout)
@@ -526,7 +526,7 @@ private:
       e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
                                        std::to_string(config_.rings.heldout_remainder) + ") projected into camera 0"
                                  : "the synthetic sequence's exact depth (gt/depth_0)";
-      e.range_m = config_.integrator.max_depth_m;
+      e.range_m = engine_->config().integrator.max_depth_m;
       e.moving_split = moving_split_;
       bool any_ghosts = false;
       for (const auto& [name, s] : scores)

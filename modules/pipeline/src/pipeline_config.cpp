@@ -111,6 +111,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.scheduling.read(file.section("pipeline"));
   config.streaming.read(file.section("streaming"));
   config.odometry.read(file.section("odometry"));
+  config.rig.read(file.section("rig"));
   file.rejectUnknownKeys();
   config.validate();
   return config;
@@ -134,6 +135,7 @@ void PipelineConfig::validate() const {
   scheduling.validate();
   streaming.validate();
   odometry.validate();
+  rig.validate();
 }
 
 void PipelineConfig::print(std::ostream& out) const {
@@ -149,6 +151,7 @@ void PipelineConfig::print(std::ostream& out) const {
   scheduling.print(out);
   streaming.print(out);
   odometry.print(out);
+  rig.print(out);
 }
 
 } // namespace msf

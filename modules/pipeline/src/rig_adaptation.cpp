@@ -1,0 +1,69 @@
+#include <msf/common/config.h>
+#include <msf/common/exceptions.h>
+#include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/rig_adaptation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+namespace msf {
+
+void RigAdaptationConfig::read(const cv::FileNode& node) {
+  readKey(node, "stereo_min_disparity_px", stereo_min_disparity_px);
+  readKey(node, "scale_ring_rows", scale_ring_rows);
+  validate();
+}
+
+void RigAdaptationConfig::validate() const {
+  if (!(stereo_min_disparity_px >= 0.0 && stereo_min_disparity_px <= 1000.0))
+    throw ConfigError("rig.stereo_min_disparity_px must be in 0..1000 (0: tsdf_integrator.max_depth_m alone), not " +
+                      configValue(stereo_min_disparity_px));
+}
+
+void RigAdaptationConfig::print(std::ostream& out) const {
+  out << "rig:\n"
+      << "  stereo_min_disparity_px: " << configValue(stereo_min_disparity_px) << "\n"
+      << "  scale_ring_rows: " << configValue(scale_ring_rows) << "\n";
+}
+
+namespace {
+
+int scaled(int rows, double scale) { return std::max(1, static_cast<int>(std::lround(rows * scale))); }
+
+/// An odd window stays odd (its centre is a pixel).
+int scaledOdd(int rows, double scale) {
+  const int r = scaled(rows, scale);
+  return r % 2 == 1 ? r : r + 1;
+}
+
+void scaleRingRows(PipelineConfig& c, double s) {
+  c.interpolation.slice.short_gap_px = scaled(c.interpolation.slice.short_gap_px, s);
+  c.interpolation.slice.max_gap_px = scaled(c.interpolation.slice.max_gap_px, s);
+  c.fusion.edge_window_rows = scaledOdd(c.fusion.edge_window_rows, s);
+  c.fusion.parallax_max_rows = scaled(c.fusion.parallax_max_rows, s);
+  c.stereo.guidance_bridge_rows = scaled(c.stereo.guidance_bridge_rows, s);
+}
+
+} // namespace
+
+PipelineConfig adaptToRig(const PipelineConfig& config, const Calibration& rig, RigAdaptation* adaptation) {
+  PipelineConfig c = config;
+  RigAdaptation a;
+  a.geometry = RigGeometry::of(rig);
+  if (config.rig.scale_ring_rows) {
+    a.ring_scale = a.geometry.ringScale();
+    scaleRingRows(c, a.ring_scale);
+  }
+  if (config.rig.stereo_min_disparity_px > 0.0) {
+    a.stereo_trusted_depth_m = a.geometry.depthAtDisparity(config.rig.stereo_min_disparity_px);
+    c.integrator.max_depth_m = std::min(c.integrator.max_depth_m, a.stereo_trusted_depth_m);
+  }
+  a.max_depth_m = c.integrator.max_depth_m;
+  c.validate();
+  if (adaptation)
+    *adaptation = a;
+  return c;
+}
+
+} // namespace msf
