@@ -119,12 +119,14 @@ TEST(AnyRig, TheSimulatedHdl32eSweepsOneRingABeam) {
 }
 
 TEST(AnyRig, TheCompactRigsStreetReconstructsWithinItsTargets) {
-  // A short drive with its moving cars: scored within the range the rig resolves (f·B / 8 px =
-  // 7.5 m), the map is accurate, complete and free of ghosts; scored as KITTI's rig would be
-  // (to 40 m, KITTI's windows), the same street is far from complete.
+  // A short drive behind a moving car (the oncoming ones, which pass in the first second, need a
+  // longer drive to be seen gone): scored within the range the rig resolves (f·B / 8 px = 7.5 m),
+  // the map is accurate, complete and free of ghosts; run with KITTI's sizes (far stereo to 40 m,
+  // KITTI's windows), the same street is far from complete and less accurate.
   msf::test::TempDir dir;
   SyntheticConfig config = compactRig();
-  config.frames = 6;
+  config.frames = 8;
+  config.moving_cars_oncoming = 0;
   msf::synthetic::SyntheticGenerator(config).writeDataset(dir.file("street"));
   const MeshFigures rig = reconstruct(dir.file("street"), "");
   EXPECT_DOUBLE_EQ(rig.range_m, 7.5);
@@ -134,5 +136,6 @@ TEST(AnyRig, TheCompactRigsStreetReconstructsWithinItsTargets) {
   std::ofstream(dir.file("as_kitti.yaml")) << "%YAML:1.0\nrig:\n  stereo_min_disparity_px: 0.0\n  scale_ring_rows: false\n";
   const MeshFigures as_kitti = reconstruct(dir.file("street"), "-config " + dir.file("as_kitti.yaml"));
   EXPECT_DOUBLE_EQ(as_kitti.range_m, 40.0);
-  EXPECT_LT(as_kitti.completeness, 0.95);
+  EXPECT_LT(as_kitti.completeness, 0.9);
+  EXPECT_GT(as_kitti.accuracy_m, 2.0 * rig.accuracy_m);
 }
