@@ -1,4 +1,5 @@
-# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -7,11 +8,22 @@ PREFIX ?= /usr/local
 KITTI_DIR ?= $(abspath ../shared/data/kitti)
 DEMO_OUT ?= out/demo
 
+# The Python module msfusion (python/) and its tests and examples (matplotlib). Open3D
+# (python3-open3d) is optional: msfusion.o3d and its test use it when it is installed.
+PYTHON_PACKAGES := pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
+# The ros module (bag reader, msf_kitti2bag, msf_ros_node) and its tests: Debian's ROS 1
+# (roscore, rosbag, roslaunch, rostopic in ros-core; the C++ libraries and messages), and
+# procps (pgrep, ps) with which the node's test makes sure nothing it started is left.
+ROS_PACKAGES := ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-msgs-dev libmessage-filters-dev \
+                libsensor-msgs-dev libvisualization-msgs-dev libcv-bridge-dev libpcl-conversions-dev procps
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
 # time: GNU time, which the bad-input matrix measures each case's memory with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
-                libyaml-cpp-dev python3-yaml
+                libyaml-cpp-dev $(PYTHON_PACKAGES) $(ROS_PACKAGES)
+# A single-node Slurm cluster on localhost (scripts/slurm_local.sh), which the batch's tests
+# submit to (tests/batch/test_slurm.cpp; .ci/run starts it before `make test`).
+SLURM_PACKAGES := slurm-wlm munge
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev
@@ -20,7 +32,7 @@ BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-slurm deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -28,10 +40,13 @@ SANITIZE_BUILD_DIR ?= build-sanitize
 SANITIZE_FLAGS := -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
                   -fno-omit-frame-pointer
 # `make fuzz`: each libFuzzer target of fuzz/ runs FUZZ_SECONDS from a seed corpus made of
-# the KITTI sample; crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/.
+# the KITTI sample; crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/. Inputs are up to
+# 64 KB, and up to FUZZ_PLY_MAX_LEN for ply, whose header check reads 64 KB: larger inputs
+# reach that limit and what lies beyond it.
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := cloud calibration poses velodyne
+FUZZ_TARGETS := cloud ply calibration poses velodyne
+FUZZ_PLY_MAX_LEN ?= 262144
 
 all: build
 
@@ -47,6 +62,9 @@ endef
 deps:
 	$(call apt_install,$(APT_PACKAGES))
 
+deps-slurm: deps
+	$(call apt_install,$(SLURM_PACKAGES))
+
 deps-bench: deps
 	$(call apt_install,$(BENCH_PACKAGES))
 
@@ -59,7 +77,7 @@ $(BUILD_DIR)/CMakeCache.txt:
 build: $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j$(JOBS)
 
-test: deps
+test: deps deps-slurm
 	$(MAKE) build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j$(JOBS)
 
@@ -69,7 +87,7 @@ test: deps
 # -Wno-maybe-uninitialized: GCC 12 warns inside libstdc++'s std::regex under -fsanitize (a
 # false positive that -Werror would make fatal).
 SANITIZE_CONFIGURE = cmake -S . -B $(SANITIZE_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DMSF_KITTI_DIR=$(KITTI_DIR) \
-  -DMSF_BUILD_BENCH=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
+  -DMSF_BUILD_BENCH=OFF -DMSF_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS) -Wno-maybe-uninitialized" -DCMAKE_C_FLAGS="$(SANITIZE_FLAGS)" \
   -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
 # A report goes to stderr (no log_path), where the tests look for it in every tool they run
 # (runCommand in tests/support, bad_inputs.sh) and fail quoting it; abort_on_error=1 for ASan and
@@ -95,14 +113,15 @@ test-sanitize-fast: deps
 fuzz: deps-fuzz
 	cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang \
 	  -DCMAKE_CXX_COMPILER=clang++ -DMSF_BUILD_TESTS=OFF -DMSF_BUILD_TOOLS=OFF -DMSF_BUILD_BENCH=OFF \
-	  -DMSF_BUILD_FUZZ=ON -DMSF_WARNINGS_AS_ERRORS=OFF \
+	  -DMSF_BUILD_PYTHON=OFF -DMSF_BUILD_FUZZ=ON -DMSF_WARNINGS_AS_ERRORS=OFF \
 	  -DCMAKE_CXX_FLAGS="-g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 	cmake --build $(FUZZ_BUILD_DIR) -j$(JOBS) --target fuzz_all
 	python3 fuzz/make_corpus.py $(KITTI_DIR) $(FUZZ_BUILD_DIR)/seeds
 	@for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/findings/$$t; \
-	  echo "== fuzz_$$t: $(FUZZ_SECONDS) s"; \
-	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=65536 \
+	  max_len=65536; [ $$t = ply ] && max_len=$(FUZZ_PLY_MAX_LEN); \
+	  echo "== fuzz_$$t: $(FUZZ_SECONDS) s, inputs up to $$max_len bytes"; \
+	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=$$max_len \
 	    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
 	    -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$$t/ \
 	    $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/seeds/$$t 2>&1 | \

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Is the fusion's stereo sigma right? SGBM's disparity error by its confidence, against the
 # sigma the fusion assumes for that confidence (fusion.stereo_sigma_min_px / max_px), on the
 # three datasets the pipeline is tuned on:

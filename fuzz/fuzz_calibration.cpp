@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The calibration parsers: KITTI odometry calib.txt, object calib/NNNNNN.txt, raw date folder
 // (calib_cam_to_cam.txt + calib_velo_to_cam.txt [+ calib_imu_to_velo.txt]) and the YAML
 // camera file. The first byte picks the format; for a raw folder the rest is split at the

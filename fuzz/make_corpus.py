@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Seed corpora of the fuzz targets, from the KITTI sample (../shared/data/kitti).
 
     make_corpus.py KITTI_DIR OUT_DIR
 
-Writes OUT_DIR/<target>/<seed> for the targets cloud, calibration, poses and velodyne; the
-first byte of a seed picks the format where a target reads several (see fuzz_*.cpp).
+Writes OUT_DIR/<target>/<seed> for the targets cloud, ply, calibration, poses and velodyne;
+the first byte of a seed picks the format or reader where a target has several (see fuzz_*.cpp).
 """
 import os
 import struct
@@ -62,6 +63,32 @@ def ply(fmt):
     return head.encode() + b"".join(struct.pack("<4f", *p) for p in pts)
 put("cloud", "ascii.ply", b"\1" + ply("ascii"))
 put("cloud", "binary.ply", b"\1" + ply("binary_little_endian"))
+
+# PLY (fuzz_ply, first byte even: cloud, odd: mesh): the clouds above with colour; an
+# organized 8x8 cloud as PCL writes it (obj_info num_cols and num_rows, a range_grid of the
+# points, two of them missing); a mesh of triangles over the first points; and a header of
+# comments near the 64 KB the header check reads, for mutations to cross it.
+def ply_rgb(fmt, header_extra=""):
+    head = ("ply\nformat %s 1.0\n%selement vertex 64\nproperty float x\nproperty float y\nproperty float z\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n" % (fmt, header_extra))
+    if fmt == "ascii":
+        return head.encode() + "".join("%g %g %g 200 100 50\n" % p[:3] for p in pts).encode()
+    return head.encode() + b"".join(struct.pack("<3f3B", *p[:3], 200, 100, 50) for p in pts)
+put("ply", "ascii.ply", b"\0" + ply_rgb("ascii"))
+put("ply", "binary.ply", b"\0" + ply_rgb("binary_little_endian"))
+kept = [i for i in range(64) if i not in (5, 40)]
+organized = ("ply\nformat binary_little_endian 1.0\ncomment PCL generated\nobj_info num_cols 8\nobj_info num_rows 8\n"
+             "element vertex %d\nproperty float x\nproperty float y\nproperty float z\nproperty float intensity\n"
+             "element range_grid 64\nproperty list uchar int vertex_indices\nend_header\n" % len(kept)).encode()
+organized += b"".join(struct.pack("<4f", *pts[i]) for i in kept)
+organized += b"".join(b"\0" if i not in kept else struct.pack("<Bi", 1, kept.index(i)) for i in range(64))
+put("ply", "organized.ply", b"\0" + organized)
+faces = [(i, i + 1, i + 8) for i in range(40)]
+mesh = ("ply\nformat binary_little_endian 1.0\nelement vertex 64\nproperty float x\nproperty float y\n"
+        "property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n" % len(faces)).encode()
+mesh += b"".join(struct.pack("<3f", *p[:3]) for p in pts) + b"".join(struct.pack("<B3i", 3, *f) for f in faces)
+put("ply", "mesh.ply", b"\1" + mesh)
+put("ply", "long_header.ply", b"\0" + ply_rgb("ascii", "comment %s\n" % ("x" * 60) * 900))
 
 # Calibrations: odometry, object (made of the odometry one), raw folder, YAML.
 odo = read(os.path.join(seq, "calib.txt"))

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_convert: any dataset the project reads into the generic layout (a rig file, lidar/,
 // left/, right/, color/, timestamps.txt, poses.txt): what a user's own recording looks like.
 #include <msf/common/atomic_file.h>
@@ -60,7 +61,9 @@ int main(int argc, char** argv) {
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 2)
       throw msf::InvalidInputError("expected DATASET OUT_DIR (see -h)");
-    const auto source = msf::openDataset(positional[0], {rig});
+    msf::DatasetOptions reader;
+    reader.rig = rig;
+    const auto source = msf::openDataset(positional[0], reader);
     const std::vector<std::size_t> frames = source->indices(msf::FrameRange::parse(frames_text));
     msf::tool::installStopSignals({"msf_convert: stopping after the frame under way; nothing is written"});
     msf::OutputFolder output(positional[1], "msf_convert", {positional[0], rig});

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_eval_odometry: evaluation protocol 5 of an estimated trajectory against a reference,
 // with a picture of both from above.
 #include <msf/common/atomic_file.h>

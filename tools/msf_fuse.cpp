@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 4: fuses an interpolated LiDAR cloud and a stereo cloud of one camera (both
 // organized, same size) into one organized cloud, per pixel (eq. 6 or inverse variance).
 #include <msf/common/atomic_file.h>

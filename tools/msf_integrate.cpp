@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_integrate: fuses organized depth clouds (camera frame, NaN = no depth) seen from known
 // poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
 // -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 2: compound interpolation of a projected LiDAR scan (or a baseline).
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_odometry: camera 0's trajectory of a sequence from its LiDAR scans (the tracking module),
 // in KITTI's poses format.
 #include <msf/common/config.h>

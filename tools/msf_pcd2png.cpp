@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Writes the depth of an organized cloud as an image: a KITTI 16-bit depth PNG (default),
 // a KITTI disparity PNG, or a false-colour picture with a legend in metres.
 #include <msf/common/atomic_file.h>

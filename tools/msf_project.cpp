@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 1: a Velodyne scan into an organized cloud of one camera's image.
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The main job: a dataset (or the built-in synthetic street) to a coloured mesh, with a report
 // of speed and, where ground truth exists, accuracy. A door over the library's engine
 // (msf::Reconstructor): a reader feeds it, writers and evaluations take what it gives.
@@ -46,7 +47,8 @@ constexpr int kMaxPanels = 100;
 
 /// What the command line asks for beyond the configuration.
 struct Request {
-  std::string out = "msf_out", frames = "0:", poses, config_path, dataset, rig, world = "camera";
+  std::string out = "msf_out", frames = "0:", poses, config_path, dataset, world = "camera";
+  msf::DatasetOptions reader;
   int panels = 3;
   bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
 };
@@ -299,6 +301,7 @@ private:
     report_.layout = !source_.groundTruthDir().empty()                                   ? "synthetic"
                      : sequence && sequence->layout() == msf::Sequence::Layout::Raw ? "raw"
                      : sequence                                                     ? "odometry"
+                     : msf::isRosBag(source_.description())                         ? "ros bag"
                                                                                     : "generic";
     report_.frames_requested = frames_.size();
     report_.voxel_size_m = config_.volume.voxel_size_m;
@@ -570,7 +573,8 @@ int main(int argc, char** argv) {
   msf::tool::CommandLine cli(
       "msf_reconstruct", "[DATASET_DIR] [options]",
       "Reconstructs a dataset (a folder of the generic layout with a rig file, a KITTI odometry sequence or raw drive, "
-      "a synthetic sequence of msf_synth) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "a synthetic sequence of msf_synth, a ROS 1 bag in kitti2bag's layout or with the topics named below: "
+      "docs/ros.md) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
       "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
@@ -583,9 +587,9 @@ int main(int argc, char** argv) {
                request.config_path = path;
              },
              "YAML configuration (config/kitti.yaml); the options below override it")
-      .value("-rig", "FILE", request.rig,
+      .value("-rig", "FILE", request.reader.rig,
              "a rig file (README, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
-             "without rig.yaml, and used instead of a dataset's own")
+             "without rig.yaml, and used instead of a dataset's own (a bag's CameraInfo and LiDAR extrinsic too)")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
       .value("-world", "W", request.world,
              "camera: the outputs in camera 0 of the first frame (x right, y down, z forward; the default) | z_up: "
@@ -609,6 +613,18 @@ int main(int argc, char** argv) {
              "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
              "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "
              "the TSDF volume also stops the run at the first frame whose blocks would not fit")
+      .value("-lidar_topic", "T", request.reader.bag.lidar_topic, "a bag's LiDAR scans, PointCloud2 (default {default})")
+      .value("-left_topic", "T", request.reader.bag.left_topic,
+             "a bag's left rectified image (default {default}); each image's CameraInfo is its sibling camera_info")
+      .value("-right_topic", "T", request.reader.bag.right_topic, "a bag's right rectified image (default {default})")
+      .value("-color_topic", "T", request.reader.bag.color_topic,
+             "a bag's colour image (default {default}, when the bag has it; '' for none)")
+      .value("-world_frame", "F", request.reader.bag.world_frame,
+             "a bag's tf frame of the poses (default: camera_init, kitti2bag's, when the bag has it, else the root "
+             "of the left camera's tf tree)")
+      .value("-max_offset", "S", request.reader.bag.max_offset_s,
+             "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
+             "{default})")
       .flag("-save_depth", request.save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
       .flag("-holdout", request.holdout,
             "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
@@ -658,12 +674,14 @@ int main(int argc, char** argv) {
     const bool poses_file = request.poses != "dataset" && request.poses != "estimate";
     installStopHandler();
     msf::OutputFolder output(request.out, "msf_reconstruct",
-                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.rig});
+                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});
     // The default street is generated inside the staging folder (a killed run's goes with it
     // at the next run) and removed before the commit.
     const fs::path street = fs::path(output.dir()) / ".street";
-    const std::unique_ptr<msf::FrameSource> source =
-        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, {request.rig});
+    const std::unique_ptr<msf::FrameSource> source = msf::openDataset(
+        request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, request.reader);
+    for (const std::string& note : source->notes())
+      print_warn("%s: %s\n", source->description().c_str(), note.c_str());
     if (request.save_depth)
       fs::create_directories(fs::path(output.dir()) / "depth");
 

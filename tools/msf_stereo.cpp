@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 3: SGBM (5-path or 3-way) on a rectified grey pair to an organized cloud in camera 0
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
@@ -45,12 +46,12 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
     if (guided)
       print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
     pcl::PointCloud<pcl::PointXYZ> cloud;
-    pcl::fromPCLPointCloud2(blob, cloud);
+    msf::fromCloudBlob(std::move(blob), cloud, path);
     prior = msf::cloudToDepthImage(cloud);
     return;
   }
   pcl::PointCloud<msf::PointXYZID> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(std::move(blob), cloud, path);
   prior = msf::cloudToDepthImage(cloud);
   cv::Mat distance(prior.size(), CV_32FC1);
   for (int v = 0; v < distance.rows; ++v)
@@ -67,8 +68,8 @@ int main(int argc, char** argv) {
   msf::SgbmConfig config;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
-      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.mode; stereo.engine: the native AVX2 kernel or "
-      "OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
+      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.unguided_mode, or stereo.mode where -prior "
+      "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
       "is no match).");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
       .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (README, \"Your own rig\") or any calibration above")
@@ -85,7 +86,9 @@ int main(int argc, char** argv) {
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
       .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
-      .value("-mode", "NAME", config.mode, "sgbm (5 paths, default) | sgbm_3way | hh | hh4")
+      .value("-mode", "NAME", [&](const std::string& mode) { config.mode = config.unguided_mode = mode; },
+             "the paths, guided or not: ground_3way | sgbm (5 paths) | sgbm_3way | hh | hh4 (default: sgbm guided by "
+             "-prior, ground_3way without)")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
       .flag("-print_config", print_config, "print the stereo settings in use");
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Writes a synthetic street in KITTI's odometry layout, with exact ground truth.
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
@@ -54,7 +55,10 @@ int main(int argc, char** argv) {
       "  DIR/poses/00.txt\n"
       "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
       "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
-      "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.");
+      "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.\n"
+      "Several drives over one street: the same -seed and -street_m, and each its own -start_m, -reverse, -frames "
+      "(e.g. msf_synth -o A -street_m 120 -frames 30; msf_synth -o B -street_m 120 -start_m 20 -frames 30; msf_synth "
+      "-o C -street_m 120 -start_m 100 -reverse -frames 30).");
   cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
              "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
@@ -82,6 +86,15 @@ int main(int argc, char** argv) {
       .flag("-loop", config.loop,
             "drive out, turn round across the road and drive back in the other lane to the start (synthetic.loop): "
             "the way back revisits the street")
+      .value("-start_m", "S", config.start_m,
+             "the drive starts S metres along the street (synthetic.start_m, default {default}); its poses are in the "
+             "street's world, where drives of the same -seed and -street_m meet")
+      .flag("-reverse", config.reverse,
+            "the drive heads back along the street in the other lane, from -start_m towards the street's start "
+            "(synthetic.reverse)")
+      .value("-street_m", "L", config.street_length_m,
+             "the street's length (synthetic.street_length_m; default {default}: as far as the drive goes): drives "
+             "given the same -seed and -street_m share one static world, gt/scene.ply included")
       .flag("-print_config", print_config, "print the configuration in effect");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (!positional.empty())

@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # ctest script: install the build tree into a scratch prefix, then configure, build and run a
 # consumer project made of the README's library example: its C++ block (example.cpp) and its
 # CMake block (CMakeLists.txt), between <!-- example:consumer:begin --> and ...:end -->.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The rig file: a user's own sensors in plain YAML, read back exactly, each key refused by name
 // when it is missing or cannot be right.
 #include <msf/common/exceptions.h>

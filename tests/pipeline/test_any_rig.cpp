@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A rig unlike KITTI's (640x480 cameras of f 500 px, a 0.12 m baseline, a 32-beam LiDAR):
 // the keys that follow from it, its synthetic street, and the street reconstructed end to end.
 #include <msf/io/rig_file.h>

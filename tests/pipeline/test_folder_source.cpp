@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A user's own recording: the generic folder layout (FolderSource) read as the KITTI reader
 // reads the same frames, in every scan and image format, with frames matched to their lines
 // by number.
@@ -157,5 +158,7 @@ TEST_F(PipelineTest, FramesTakeTheirLinesByNumberAndPosesInEitherFormat) {
   // Without a rig file, the error says what to write or give.
   fs::rename(g / "rig.yaml", g / "my_rig.yaml");
   EXPECT_NE(msf::test::errorOf([&] { msf::openDataset(generic); }).find("has no rig.yaml"), std::string::npos);
-  EXPECT_EQ(msf::openDataset(generic, {(g / "my_rig.yaml").string()})->size(), 3u);
+  msf::DatasetOptions with_rig;
+  with_rig.rig = (g / "my_rig.yaml").string();
+  EXPECT_EQ(msf::openDataset(generic, with_rig)->size(), 3u);
 }

@@ -1,4 +1,5 @@
-// The memory budget of msf_reconstruct (issue 19, item 1g): with the poses known before the run,
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The memory budget of msf_reconstruct: with the poses known before the run,
 // its peak is predicted (Reconstructor::predictMemory) and a run predicted over an explicit budget is
 // refused before it starts; the prediction bounds the measured peak within a stated factor.
 #include <msf/io/sequence.h>

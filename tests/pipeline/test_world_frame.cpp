@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Outputs in a z-up world are the camera-world outputs rotated; poses go out and come back in
 // TUM's format as well as KITTI's.
 #include <msf/io/cloud_io.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The README's integration example, compiled from README.md itself: tests/CMakeLists.txt
 // copies the block between <!-- example:tsdf:begin --> and <!-- example:tsdf:end --> into the
 // build tree as readme_tsdf_example.h (with #line, so compiler messages point into the

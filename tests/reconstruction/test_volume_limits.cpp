@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Issue 19: volume sizes, sweeps, poses and memory that would run away end in an error
 // naming the key or option, before the volume allocates.
 #include "test_support.h"

@@ -1,5 +1,7 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
@@ -7,8 +9,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -20,40 +25,96 @@ namespace msf {
 
 namespace {
 
+/// The stems of the files of `dir` named by a frame number with extension `ext`, sorted;
+/// other files (.DS_Store, a README, a copy) are not frames.
 std::vector<std::string> stemsIn(const fs::path& dir, const std::string& ext) {
   std::vector<std::string> stems;
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     return stems;
   for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file() && e.path().extension() == ext)
+    if (e.is_regular_file(ec) && e.path().extension() == ext && frameNumber(e.path().stem().string()) >= 0)
       stems.push_back(e.path().stem().string());
-  std::sort(stems.begin(), stems.end());
+  const auto before = [](const std::string& a, const std::string& b) { return frameNumber(a) < frameNumber(b); };
+  const auto same = [](const std::string& a, const std::string& b) { return frameNumber(a) == frameNumber(b); };
+  std::sort(stems.begin(), stems.end(), before);
+  const auto twice = std::adjacent_find(stems.begin(), stems.end(), same);
+  if (twice != stems.end())
+    throw IOError("folder '" + dir.string() + "' holds frame " + std::to_string(frameNumber(*twice)) + " twice: '" +
+                  *twice + ext + "' and '" + *(twice + 1) + ext + "'");
   return stems;
 }
 
-/// "2011-09-26 13:08:24.969505176" -> seconds of the day (the date does not change in a drive).
+/// "2011-09-26 13:08:24.969505176" -> seconds of the day (the date does not change in a drive);
+/// NaN when the line is not such a time.
 double parseRawTimestamp(const std::string& line) {
   int h = 0, m = 0;
   double s = 0;
   if (line.size() < 19 || std::sscanf(line.c_str() + 11, "%d:%d:%lf", &h, &m, &s) != 3)
-    return 0.0;
+    return std::nan("");
   return h * 3600.0 + m * 60.0 + s;
 }
 
-std::vector<double> readLines(const fs::path& file, bool raw_format) {
+/// A line of an odometry times.txt (seconds) or of a raw drive's timestamps.txt (a date and
+/// time); NaN when it is neither.
+double parseTime(const std::string& line, bool raw_format) {
+  if (raw_format)
+    return parseRawTimestamp(line);
+  char* end = nullptr;
+  const double t = std::strtod(line.c_str(), &end);
+  const char* rest = end;
+  const bool rest_blank = std::all_of(rest, line.c_str() + line.size(), [](unsigned char c) { return std::isspace(c); });
+  return end != line.c_str() && rest_blank ? t : std::nan("");
+}
+
+/// The times of a timestamps file from its first line's, line n for frame n; empty when the
+/// file is absent. Throws IOError naming the file and line of a value that is not a time.
+std::vector<double> readTimestamps(const fs::path& file, bool raw_format) {
   std::vector<double> t;
   std::ifstream in(file);
   std::string line;
-  while (std::getline(in, line))
-    if (!line.empty())
-      t.push_back(raw_format ? parseRawTimestamp(line) : std::atof(line.c_str()));
-  if (!t.empty()) {
-    const double t0 = t.front();
-    for (double& x : t)
-      x -= t0;
+  for (std::size_t line_no = 1; std::getline(in, line); ++line_no) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos && in.peek() == std::char_traits<char>::eof())
+      break; // a blank last line
+    const double time = parseTime(line, raw_format);
+    if (!std::isfinite(time))
+      throw IOError("timestamps '" + file.string() + "' line " + std::to_string(line_no) + " '" + line +
+                    "' is not a time");
+    t.push_back(time);
   }
+  const double t0 = t.empty() ? 0.0 : t.front();
+  for (double& x : t)
+    x -= t0;
   return t;
+}
+
+/// The entries of `by_number` (frame n's at n) of the frames `names`, in their order. Throws
+/// IOError naming the first frame beyond it, and `what` ("poses 'poses/04.txt'").
+template <typename List>
+List ofFrames(const List& by_number, const std::vector<std::string>& names, const std::string& what) {
+  List out;
+  out.reserve(names.size());
+  for (const std::string& name : names) {
+    const auto n = static_cast<std::size_t>(frameNumber(name));
+    if (n >= by_number.size())
+      throw IOError("frame " + name + " has no entry in " + what + ", which has " + std::to_string(by_number.size()) +
+                    " (frames 0.." + std::to_string(static_cast<long long>(by_number.size()) - 1) + ")");
+    out.push_back(by_number[n]);
+  }
+  return out;
+}
+
+/// OXTS poses of the frames `names` of a raw drive, from each frame's record oxts/data/<name>.txt.
+PoseList oxtsPosesOfFrames(const fs::path& oxts_dir, const std::vector<std::string>& names,
+                           const Calibration& calibration) {
+  std::vector<OxtsRecord> records;
+  for (const std::string& name : names) {
+    const fs::path record = oxts_dir / (name + ".txt");
+    if (!fs::is_regular_file(record))
+      throw IOError("frame " + name + " has no OXTS record: '" + record.string() + "' is missing");
+    records.push_back(loadOxtsRecord(record.string()));
+  }
+  return oxtsToCameraPoses(records, calibration);
 }
 
 bool isOdometrySequence(const fs::path& p) {
@@ -81,17 +142,18 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
     p = found.front();
   }
 
+  std::vector<double> times;
   if (isOdometrySequence(p)) {
     layout_ = Layout::Odometry;
     dir_ = p.string();
     // A rig file beside calib.txt (msf_synth writes both) also says what the LiDAR's beams are.
     calibration_ = loadCalibration((fs::is_regular_file(p / "rig.yaml", ec) ? p / "rig.yaml" : p / "calib.txt").string());
     frame_names_ = stemsIn(p / "image_0", ".png");
-    timestamps_ = readLines(p / "times.txt", false);
+    times = readTimestamps(p / "times.txt", false);
     const fs::path root = p.parent_path().parent_path();
     const fs::path poses = root / "poses" / (p.filename().string() + ".txt");
     if (fs::is_regular_file(poses, ec))
-      poses_ = loadOdometryPoses(poses.string());
+      poses_ = ofFrames(loadOdometryPoses(poses.string()), frame_names_, "poses '" + poses.string() + "'");
     if (fs::is_directory(root / "gt", ec))
       gt_dir_ = (root / "gt").string();
   } else if (fs::is_directory(p / "image_00" / "data", ec) &&
@@ -100,9 +162,9 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
     dir_ = p.string();
     calibration_ = loadCalibration(p.parent_path().string());
     frame_names_ = stemsIn(p / "image_00" / "data", ".png");
-    timestamps_ = readLines(p / "image_00" / "timestamps.txt", true);
+    times = readTimestamps(p / "image_00" / "timestamps.txt", true);
     if (fs::is_directory(p / "oxts" / "data", ec) && calibration_.has_imu)
-      poses_ = oxtsToCameraPoses(loadOxts((p / "oxts" / "data").string()), calibration_);
+      poses_ = oxtsPosesOfFrames(p / "oxts" / "data", frame_names_, calibration_);
   } else {
     throw IOError("'" + dir +
                   "' is neither a KITTI odometry sequence (calib.txt, image_0/), a KITTI raw drive "
@@ -112,7 +174,9 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
   if (!calibration.empty())
     calibration_ = loadCalibration(calibration);
   if (frame_names_.empty())
-    throw IOError("sequence '" + dir_ + "' has no frames (no images in camera 0's folder)");
+    throw IOError("sequence '" + dir_ + "' has no frames (no images named by a frame number in camera 0's folder)");
+  if (!times.empty())
+    timestamps_ = ofFrames(times, frame_names_, "the timestamps of '" + dir_ + "'");
   // More right images or scans than frames is a damaged or mixed copy whose extra frames
   // would be dropped without a word (a frame whose file is missing is named when it loads).
   for (const auto& [folder, ext] : {std::pair<fs::path, const char*>{fs::path(imagePath(1, 0)).parent_path(), ".png"},
@@ -122,9 +186,6 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
       throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " images in camera 0's " +
                     "folder but " + std::to_string(n) + " " + ext + " files in '" + folder.string() + "'");
   }
-  if (!poses_.empty() && poses_.size() < frame_names_.size())
-    throw IOError("sequence '" + dir_ + "' has " + std::to_string(frame_names_.size()) + " frames but only " +
-                  std::to_string(poses_.size()) + " poses");
   if (calibration_.image_size.width <= 0)
     calibration_.image_size = readImage(imagePath(0, 0), cv::IMREAD_GRAYSCALE).size();
 }
@@ -199,7 +260,8 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
 }
 
 double Sequence::timestamp(std::size_t i) const {
-  return i < timestamps_.size() ? timestamps_[i] : 0.1 * static_cast<double>(i);
+  // Without timestamps, KITTI's 10 Hz by the frame's number.
+  return i < timestamps_.size() ? timestamps_[i] : 0.1 * static_cast<double>(frameNumber(frameName(i)));
 }
 
 bool Sequence::hasColor() const {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/pipeline/pipeline_config.h>
@@ -27,7 +28,7 @@ void SchedulingConfig::read(const cv::FileNode& node) {
   readKey(node, "queue_capacity", queue_capacity);
   readKey(node, "mesh_every_n_frames", mesh_every_n_frames);
   readKey(node, "stereo_prior", stereo_prior);
-  // Removed with OpenMP (issue 18): said so rather than "not a key", for configs printed before.
+  // Removed with OpenMP: said so rather than "not a key", for configs printed before.
   if (node.isMap() && !node["lidar_threads"].empty())
     throw ConfigError("pipeline.lidar_threads was removed: the LiDAR steps run on OpenCV's pool like the other "
                       "stages (serially on the loader while another stage's loop holds it); delete the key");
@@ -67,6 +68,7 @@ PipelineConfig PipelineConfig::paper() {
   // Step 3: OpenCV's SGBM on the grey pair alone, over the full disparity range.
   c.stereo.engine = "opencv";
   c.stereo.mode = "sgbm_3way";
+  c.stereo.unguided_mode = "sgbm_3way";
   c.stereo.guidance = "none";
   c.stereo.prior_search_range = false;
   c.scheduling.stereo_prior = false;

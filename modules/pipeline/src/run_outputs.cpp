@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>

@@ -1,7 +1,10 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/json_text.h>
 #include <msf/common/line_plot.h>
+#include <msf/common/version.h>
 #include <msf/common/statistics.h>
 #include <msf/io/image_io.h>
 #include <msf/pipeline/run_report.h>
@@ -50,21 +53,6 @@ std::vector<double> column(const std::vector<RunReport::FrameRow>& rows, const S
   for (const auto& r : rows)
     values.push_back(c.get(r));
   return values;
-}
-
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\')
-      out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else
-      out += c;
-  }
-  return out + "\"";
 }
 
 std::string num(double v, int precision = 4) {
@@ -236,6 +224,8 @@ void RunReport::writeFramesCsv(const std::string& path) const {
 void RunReport::writeSummaryJson(const std::string& path) const {
   std::ostringstream s;
   s << "{\n"
+    << "  \"msfusion\": {\"version\": " << jsonString(versionString()) << ", \"commit\": " << jsonString(gitCommit())
+    << "},\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
     << "  \"layout\": " << jsonString(layout) << ",\n"
     << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);

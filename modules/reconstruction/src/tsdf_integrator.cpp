@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
@@ -206,8 +207,9 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
 void TsdfIntegrator::Config::validate() const {
   if (!(max_weight > 0.f))
     throw ConfigError("tsdf_integrator.max_weight must be > 0, got " + std::to_string(max_weight));
-  if (!(lambda >= 0.0) || !std::isfinite(lambda))
-    throw ConfigError("tsdf_integrator.lambda must be >= 0, got " + std::to_string(lambda));
+  if (!(lambda >= 0.0 && lambda <= kMaxLambda))
+    throw ConfigError("tsdf_integrator.lambda (-lambda) must be 0 .. 1e6 (beyond, eq. 7 flattens the surface "
+                      "instead of smoothing it), got " + configValue(lambda));
   if (allocation_stride < 1)
     throw ConfigError("tsdf_integrator.allocation_stride must be >= 1, got " + std::to_string(allocation_stride));
   if (!(depth_sigma_m > 0.0) || !std::isfinite(depth_sigma_m))

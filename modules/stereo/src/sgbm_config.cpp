@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/stereo/semi_global_matcher.h>
@@ -22,10 +23,10 @@ bool eitherWord(const std::string& key, const std::string& value, const char* ye
     return false;
   bad(key, std::string("must be ") + yes + " or " + no + ", not '" + value + "'");
 }
-} // namespace
 
-int SgbmConfig::opencvMode() const {
-  if (mode == "sgbm_3way")
+/// OpenCV's mode constant of a mode name, else a ConfigError naming `key`.
+int opencvModeOf(const std::string& key, const std::string& mode) {
+  if (mode == "sgbm_3way" || mode == "ground_3way")
     return cv::StereoSGBM::MODE_SGBM_3WAY;
   if (mode == "sgbm")
     return cv::StereoSGBM::MODE_SGBM;
@@ -33,7 +34,12 @@ int SgbmConfig::opencvMode() const {
     return cv::StereoSGBM::MODE_HH;
   if (mode == "hh4")
     return cv::StereoSGBM::MODE_HH4;
-  bad("mode", "must be sgbm_3way, sgbm, hh or hh4, not '" + mode + "'");
+  bad(key, "must be sgbm, sgbm_3way, ground_3way, hh or hh4, not '" + mode + "'");
+}
+} // namespace
+
+int SgbmConfig::opencvMode(bool guided) const {
+  return opencvModeOf(guided ? "mode" : "unguided_mode", modeFor(guided));
 }
 
 bool SgbmConfig::nativeEngine() const { return eitherWord("engine", engine, "native", "opencv"); }
@@ -43,11 +49,13 @@ bool SgbmConfig::lidarGuidance() const { return eitherWord("guidance", guidance,
 void SgbmConfig::read(const cv::FileNode& node) {
   readKey(node, "engine", engine);
   readKey(node, "mode", mode);
+  readKey(node, "unguided_mode", unguided_mode);
   readKey(node, "min_disparity_px", min_disparity_px);
   readKey(node, "num_disparities_px", num_disparities_px);
   readKey(node, "block_size_px", block_size_px);
   readKey(node, "p1", p1);
   readKey(node, "p2", p2);
+  readKey(node, "p1_rise", p1_rise);
   readKey(node, "pre_filter_cap", pre_filter_cap);
   readKey(node, "uniqueness_ratio_pct", uniqueness_ratio_pct);
   readKey(node, "speckle_window_size_px", speckle_window_size_px);
@@ -74,7 +82,8 @@ void SgbmConfig::read(const cv::FileNode& node) {
 
 void SgbmConfig::validate() const {
   nativeEngine();
-  opencvMode();
+  opencvMode(true);
+  opencvMode(false);
   if (num_disparities_px <= 0 || num_disparities_px % 16 != 0)
     bad("num_disparities_px", "must be a positive multiple of 16, not " + std::to_string(num_disparities_px));
   if (block_size_px < 1 || block_size_px > 11 || block_size_px % 2 == 0)
@@ -85,6 +94,11 @@ void SgbmConfig::validate() const {
     bad("p2", "must be >= 0 (0: 32 * block^2), not " + std::to_string(p2));
   if (resolvedP2() <= resolvedP1())
     bad("p2", "must be greater than p1 (" + std::to_string(resolvedP2()) + " <= " + std::to_string(resolvedP1()) + ")");
+  if (p1_rise < 0)
+    bad("p1_rise", "must be >= 0 (0: 3 * block^2), not " + std::to_string(p1_rise));
+  if (resolvedP1Rise() >= resolvedP2())
+    bad("p1_rise", "must be less than p2 (" + std::to_string(resolvedP1Rise()) + " >= " + std::to_string(resolvedP2()) +
+                       ")");
   if (pre_filter_cap < 1 || pre_filter_cap > 63)
     bad("pre_filter_cap", "must be in 1..63, not " + std::to_string(pre_filter_cap));
   if (uniqueness_ratio_pct < 0 || uniqueness_ratio_pct > 100)
@@ -119,12 +133,15 @@ void SgbmConfig::print(std::ostream& out) const {
   out << "stereo:\n"
       << "  engine: " << engine << "\n"
       << "  mode: " << mode << "\n"
+      << "  unguided_mode: " << unguided_mode << "\n"
       << "  min_disparity_px: " << configValue(min_disparity_px) << "\n"
       << "  num_disparities_px: " << configValue(num_disparities_px) << "\n"
       << "  block_size_px: " << configValue(block_size_px) << "\n"
-      << "  # p1 and p2 resolved: " << resolvedP1() << " and " << resolvedP2() << "\n"
+      << "  # p1, p2 and p1_rise resolved: " << resolvedP1() << ", " << resolvedP2() << " and " << resolvedP1Rise()
+      << "\n"
       << "  p1: " << configValue(p1) << "\n"
       << "  p2: " << configValue(p2) << "\n"
+      << "  p1_rise: " << configValue(p1_rise) << "\n"
       << "  pre_filter_cap: " << configValue(pre_filter_cap) << "\n"
       << "  uniqueness_ratio_pct: " << configValue(uniqueness_ratio_pct) << "\n"
       << "  speckle_window_size_px: " << configValue(speckle_window_size_px) << "\n"

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/lidar_simulator.h>
 #include <msf/synthetic/synthetic_rig.h>

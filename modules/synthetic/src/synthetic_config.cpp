@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/synthetic_config.h>
@@ -39,6 +40,9 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "oncoming_car_speed_mps", oncoming_car_speed_mps);
   readKey(node, "oncoming_group_period_s", oncoming_group_period_s);
   readKey(node, "loop", loop);
+  readKey(node, "start_m", start_m);
+  readKey(node, "reverse", reverse);
+  readKey(node, "street_length_m", street_length_m);
   validate();
 }
 
@@ -92,6 +96,9 @@ void SyntheticConfig::validate() const {
           oncoming_group_period_s, "must be in 1..3600");
   require(!loop || frames >= kLoopTurnFrames + 2, "frames", frames,
           "must be >= 12 for a loop (out, the turn of 10 frames, back)");
+  require(start_m >= 0.0 && start_m <= 5000.0, "start_m", start_m, "must be in 0..5000");
+  require(street_length_m >= 0.0 && street_length_m <= 5000.0, "street_length_m", street_length_m,
+          "must be in 0..5000 (0: as far as the drive goes)");
 }
 
 void SyntheticConfig::validateRig() const {
@@ -165,6 +172,11 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  oncoming_car_speed_mps: " << exact(oncoming_car_speed_mps) << "\n"
       << "  oncoming_group_period_s: " << exact(oncoming_group_period_s) << "\n"
       << "  loop: " << (loop ? "true" : "false") << "\n";
+  // Only when set: a dataset of one drive on its own street is written as before.
+  if (placed() || street_length_m != 0.0)
+    out << "  start_m: " << exact(start_m) << "\n"
+        << "  reverse: " << (reverse ? "true" : "false") << "\n"
+        << "  street_length_m: " << exact(street_length_m) << "\n";
 }
 
 } // namespace msf::synthetic

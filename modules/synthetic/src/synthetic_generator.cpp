@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/io/cloud_io.h>
@@ -12,6 +14,7 @@
 #include <msf/synthetic/synthetic_generator.h>
 #include <msf/synthetic/trajectory.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -46,21 +49,30 @@ std::string frameName(std::size_t i) {
   return name;
 }
 
-/// How far along the street the drive goes (a loop comes back).
-double farthestZ(const PoseList& poses) {
-  double z = 0.0;
-  for (const auto& T : poses)
-    z = std::max(z, T.translation().z());
-  return z;
+/// How far the street is built along z: config.street_length_m (shared by the drives of one
+/// world), or as far as this drive goes (a loop comes back). Throws ConfigError naming the keys
+/// when the drive leaves the street (below z = 0, or beyond street_length_m).
+double streetEnd(const SyntheticConfig& config, const PoseList& poses) {
+  double lo = 0.0, hi = 0.0;
+  for (const auto& T : poses) {
+    lo = std::min(lo, T.translation().z());
+    hi = std::max(hi, T.translation().z());
+  }
+  if (lo < 0.0)
+    throw ConfigError("config keys 'synthetic.start_m' = " + std::to_string(config.start_m) +
+                      " and 'reverse' make a drive that leaves the street's start (it reaches z = " +
+                      std::to_string(lo) + " m): start a reversed drive at least as far along as it drives");
+  if (config.street_length_m == 0.0)
+    return hi;
+  if (hi > config.street_length_m + 1e-9)
+    throw ConfigError("config key 'synthetic.street_length_m' = " + std::to_string(config.street_length_m) +
+                      " is shorter than the drive, which reaches z = " + std::to_string(hi) +
+                      " m (start_m, frames, speed_mps): the drive must lie on the street");
+  return config.street_length_m;
 }
 
 void writeText(const fs::path& path, const std::string& text) {
-  writeAtomically(path.string(), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw IOError("cannot write '" + path.string() + "'");
-  });
+  writeStreamAtomically(path.string(), [&](std::ostream& out) { out << text; });
 }
 
 const char* kGroundTruthReadme =
@@ -84,7 +96,7 @@ SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
     : config_(validated(config)),
       calibration_(syntheticRig(config_)),
       poses_(streetTrajectory(config_)),
-      scene_(buildStreetScene(config_, farthestZ(poses_))),
+      scene_(buildStreetScene(config_, streetEnd(config_, poses_))),
       renderer_(calibration_, config_),
       lidar_(config_) {}
 
@@ -169,7 +181,10 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   yaml << "%YAML:1.0\n";
   config_.print(yaml);
   writeText(gt / "synthetic.yaml", yaml.str());
-  writeText(gt / "README.txt", kGroundTruthReadme);
+  std::string readme = kGroundTruthReadme;
+  if (config_.placed()) // the world is the street's, where this drive does not start
+    readme.replace(readme.find("(camera 0 at frame 0)"), 21, "(the street's: camera 0 where a drive from its start begins)");
+  writeText(gt / "README.txt", readme);
   SurfaceClasses classes;
   saveMesh((gt / "scene.ply").string(), mesh(&classes));
   writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <Eigen/Geometry>
 #include <opencv2/core/types.hpp>
@@ -44,10 +45,17 @@ struct Calibration {
   double baseline(int camera_a, int camera_b) const;
   double baselineGrey() const { return baseline(0, 1); }
   double baselineColor() const { return baseline(2, 3); }
-  /// f * B of the grey pair, so that depth = focalBaseline() / disparity.
-  /// Throws CalibrationError naming `source` when it is not > 0 and finite (fx 0, NaN, or
-  /// cameras 0 and 1 at one centre): a disparity made of it would be silently zero.
+  /// f * B of the grey pair, so that depth = focalBaseline() / disparity; what every stereo
+  /// stage asks first. Throws CalibrationError naming `source` when the grey pair cannot be a
+  /// rectified stereo pair: f B not > 0 and finite (fx 0, NaN, cameras 0 and 1 at one centre:
+  /// a disparity made of it would be silently zero), camera 1 left of camera 0 (swapped images
+  /// or sign: the disparities would be of the wrong sign), a baseline outside
+  /// limits::kMinBaselineM .. kMaxBaselineM (a unit slip), or checkRectifiedPair(0, 1).
   double focalBaseline() const;
+  /// Throws CalibrationError naming `source` and the value unless cameras a and b share their
+  /// intrinsics (fx, fy, cx, cy within limits::kRectifiedIntrinsicsTolerancePx) and differ
+  /// along x only, as the cameras of a rectified pair do.
+  void checkRectifiedPair(int a, int b) const;
   /// Throws CalibrationError naming `source` when the image size is unknown.
   cv::Size requireImageSize() const;
   /// Throws CalibrationError naming `source` when it holds the cameras only (no LiDAR

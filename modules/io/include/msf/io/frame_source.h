@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/io/poses.h>
@@ -72,9 +73,17 @@ public:
   virtual bool sweepingScans() const { return true; }
   /// Folder of synthetic ground truth, "" when there is none.
   virtual std::string groundTruthDir() const { return {}; }
+  /// What the reader skipped or assumed, one line each, for the tool to print (a bag's frames
+  /// left out for want of an image, say).
+  virtual std::vector<std::string> notes() const { return {}; }
 
-  /// Indices of a range; throws InvalidInputError when it selects no frame or goes beyond the last.
+  /// Indices of the frames whose numbers (frameNumber of their names, else their index) lie in
+  /// the range; throws InvalidInputError when it selects no frame or goes beyond the last.
   std::vector<std::size_t> indices(const FrameRange& range) const;
 };
+
+/// A frame's number from its name ("000042" -> 42); -1 for a name that is not all digits
+/// (a stray file: "README", "000042 (copy)").
+long long frameNumber(const std::string& name);
 
 } // namespace msf

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
@@ -71,7 +72,7 @@ public:
   double first_frame_s = 0;       ///< when the first frame was done, from the start
   double mesh_ms = 0;
   double peak_memory_mb = 0;
-  /// The peak predicted before the run (Pipeline::predictMemory); < 0 when the poses were not
+  /// The peak predicted before the run (Reconstructor::predictMemory); < 0 when the poses were not
   /// known before it (estimated), written as null.
   double predicted_memory_mb = -1;
   std::size_t observed_voxels = 0, blocks = 0, vertices = 0, triangles = 0;

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/parallel.h>
 #include <msf/reconstruction/depth_frame.h>
@@ -114,6 +115,10 @@ public:
     SignedDistance signed_distance = SignedDistance::Plane;
     PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
     double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
+    /// Beyond it eq. 7 no longer regularizes but erases: a voxel's own mean counts less than a
+    /// millionth against its neighbours' (a hundredth at max_weight with inverse_variance), and
+    /// the surface is flattened to nothing; the float sums near their range long before 1e300.
+    static constexpr double kMaxLambda = 1e6;
     /// Uniform: lambda is a pure number. InverseVariance: x = argmin sum_i W_i (x_i - y_i)^2 +
     /// lambda sum_ij (x_i - x_j)^2, W_i the voxel's weight, lambda in m^-2: a LiDAR-backed voxel
     /// (W ~ 1000) barely moves, a far stereo-only one (W ~ 10) takes its neighbours' mean, so

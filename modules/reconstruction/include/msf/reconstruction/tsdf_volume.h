@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/reconstruction/point_types.h>
 #include <msf/reconstruction/tsdf_block.h>
@@ -34,7 +35,7 @@ public:
     /// The memory budget (MiB); 0 = three quarters of the machine's RAM. The volume's blocks
     /// and map may not exceed it: a growth that would stops with an error before allocating.
     /// msf_reconstruct also refuses, before it starts, a run whose predicted peak (the whole
-    /// process: Pipeline::predictMemory) exceeds a budget given here or with -max_memory.
+    /// process: Reconstructor::predictMemory) exceeds a budget given here or with -max_memory.
     double max_memory_mb = 0.0;
     /// Overrides the keys present (voxel_size_m, truncation_m, max_memory_mb); throws
     /// ConfigError naming a bad one (see validate).

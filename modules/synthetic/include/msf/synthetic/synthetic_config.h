@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <opencv2/core/persistence.hpp>
 
@@ -46,6 +47,14 @@ struct SyntheticConfig {
   /// other lane to where the drive began: the second half revisits the first's street.
   bool loop = false;
   static constexpr int kLoopTurnFrames = 10;
+  // The drive's place in a street shared with other drives (the same seed and street_length_m
+  // give the same static world; the poses are in that world's frame).
+  double start_m = 0.0;          ///< the drive starts this far along the street (world z)
+  bool reverse = false;          ///< the drive heads -z in the other lane, from start_m back
+  /// The street's length in metres (world z from 0); 0: to the farthest point of the drive.
+  double street_length_m = 0.0;
+  /// Whether the drive is placed otherwise than from the street's start, heading +z.
+  bool placed() const { return start_m != 0.0 || reverse; }
 
   /// Overrides the keys present in `node` (a `synthetic` section), then validates.
   /// Throws ConfigError naming a key with a wrong type or value.
