@@ -1,8 +1,13 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A rig unlike KITTI's (640x480 cameras of f 500 px, a 0.12 m baseline, a 32-beam LiDAR):
 // the keys that follow from it, its synthetic street, and the street reconstructed end to end.
+#include <msf/fusion/point_types.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/organized_conversion.h>
 #include <msf/io/rig_file.h>
+#include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/ring_split.h>
 #include <msf/synthetic/synthetic_generator.h>
@@ -43,6 +48,27 @@ MeshFigures reconstruct(const std::string& dataset, const std::string& options) 
   const std::string json = readFile(out.file("summary.json"));
   return {jsonNumber(json, "range_m"), jsonNumber(json, "accuracy_mean_m", "mesh_accuracy"),
           jsonNumber(json, "completeness", "mesh_accuracy"), jsonNumber(json, "share", "ghosts")};
+}
+
+/// Frame `i` of `sequence` through msf_interpolate, msf_stereo -prior and msf_fuse -left with -rig
+/// `rig` (and `options` on each): the fused depth.
+cv::Mat fusedByTheTools(const msf::Sequence& sequence, std::size_t i, const std::string& rig, const std::string& options) {
+  msf::test::TempDir out;
+  const std::string with_rig = " -rig " + rig + options;
+  const std::string steps[][2] = {
+      {"msf_interpolate", sequence.scanPath(i) + " " + out.file("lidar.pcd") + with_rig},
+      {"msf_stereo", sequence.imagePath(0, i) + " " + sequence.imagePath(1, i) + " " + out.file("stereo.pcd") +
+                         with_rig + " -color " + sequence.imagePath(2, i) + " -prior " + out.file("lidar.pcd")},
+      {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + with_rig +
+                       " -left " + sequence.imagePath(0, i)},
+  };
+  for (const auto& step : steps) {
+    const auto r = msf::test::runTool(step[0], step[1]);
+    EXPECT_EQ(r.exit_code, 0) << step[0] << ": " << r.err;
+  }
+  pcl::PointCloud<msf::PointXYZRGBWeight> fused;
+  msf::loadCloud(out.file("fused.pcd"), fused);
+  return msf::cloudToDepthImage(fused);
 }
 
 } // namespace
@@ -139,4 +165,26 @@ TEST(AnyRig, TheCompactRigsStreetReconstructsWithinItsTargets) {
   EXPECT_DOUBLE_EQ(as_kitti.range_m, 40.0);
   EXPECT_LT(as_kitti.completeness, 0.9);
   EXPECT_GT(as_kitti.accuracy_m, 2.0 * rig.accuracy_m);
+}
+
+TEST(AnyRig, TheToolsOfOneStageFollowTheRigAsTheEngineDoes) {
+  // The compact rig's frame through the tools, each given the rig file: the engine's fused depth,
+  // pixel for pixel. With the keys as written (KITTI's rows between rings) it is another depth.
+  msf::test::TempDir dir;
+  SyntheticConfig config = compactRig();
+  config.frames = 2;
+  msf::synthetic::SyntheticGenerator(config).writeDataset(dir.file("street"));
+  const msf::Sequence sequence(dir.file("street"));
+  const std::string rig = sequence.directory() + "/rig.yaml";
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  const cv::Mat expected = engine.computeDepth(sequence.load(1)).fused.depth;
+  EXPECT_GT(cv::countNonZero(expected), expected.total() / 2);
+
+  const cv::Mat chained = fusedByTheTools(sequence, 1, rig, "");
+  ASSERT_EQ(chained.size(), expected.size());
+  EXPECT_EQ(cv::norm(expected, chained, cv::NORM_INF), 0.0) << "the tools' fused depth differs from the engine's";
+
+  std::ofstream(dir.file("as_written.yaml")) << "%YAML:1.0\nrig:\n  scale_ring_rows: false\n";
+  const cv::Mat as_written = fusedByTheTools(sequence, 1, rig, " -config " + dir.file("as_written.yaml"));
+  EXPECT_GT(cv::norm(expected, as_written, cv::NORM_INF), 0.0);
 }

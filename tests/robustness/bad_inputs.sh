@@ -466,6 +466,12 @@ if [ $have_kitti = 1 ]; then
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
+  printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"
+  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig.stereo_min_disparity_px must be in 0..1000.*not -1" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_negative.yaml"
+  printf '%%YAML:1.0\nrig:\n  scale_ring_row: false\n' >"$F/rig_misspelt.yaml"
+  check "interpolate -config: rig.scale_ring_row (misspelt)" 1 "scale_ring_row" -- \
+    msf_interpolate "$SCAN" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_misspelt.yaml"
   check "P1 holds '1.0x'" 1 "key 'P1' has a value that is not a number: '1.0x'" -- \
     msf_project "$SCAN" o.pcd -calib "$K/p1x/calib.txt"
   check "reconstruct -frames 0:100000" 1 "frame range 0:100000 goes beyond the last frame" -- \

@@ -38,28 +38,49 @@ int scaledOdd(int rows, double scale) {
   return r % 2 == 1 ? r : r + 1;
 }
 
-void scaleRingRows(PipelineConfig& c, double s) {
-  c.interpolation.slice.short_gap_px = scaled(c.interpolation.slice.short_gap_px, s);
-  c.interpolation.slice.max_gap_px = scaled(c.interpolation.slice.max_gap_px, s);
-  c.fusion.edge_window_rows = scaledOdd(c.fusion.edge_window_rows, s);
-  c.fusion.parallax_max_rows = scaled(c.fusion.parallax_max_rows, s);
-  c.stereo.guidance_bridge_rows = scaled(c.stereo.guidance_bridge_rows, s);
-}
-
 } // namespace
 
-PipelineConfig adaptToRig(const PipelineConfig& config, const Calibration& rig, RigAdaptation* adaptation) {
-  PipelineConfig c = config;
+RigAdaptation rigAdaptation(const RigAdaptationConfig& config, const Calibration& rig) {
   RigAdaptation a;
   a.geometry = RigGeometry::of(rig);
-  if (config.rig.scale_ring_rows) {
+  if (config.scale_ring_rows)
     a.ring_scale = a.geometry.ringScale();
-    scaleRingRows(c, a.ring_scale);
-  }
-  if (config.rig.stereo_min_disparity_px > 0.0) {
-    a.stereo_trusted_depth_m = a.geometry.depthAtDisparity(config.rig.stereo_min_disparity_px);
-    c.integrator.max_depth_m = std::min(c.integrator.max_depth_m, a.stereo_trusted_depth_m);
-  }
+  if (config.stereo_min_disparity_px > 0.0)
+    a.stereo_trusted_depth_m = a.geometry.depthAtDisparity(config.stereo_min_disparity_px);
+  return a;
+}
+
+void adaptToRig(InterpolationConfig& interpolation, const RigAdaptation& rig) {
+  if (rig.ring_scale == 1.0)
+    return;
+  interpolation.slice.short_gap_px = scaled(interpolation.slice.short_gap_px, rig.ring_scale);
+  interpolation.slice.max_gap_px = scaled(interpolation.slice.max_gap_px, rig.ring_scale);
+}
+
+void adaptToRig(SgbmConfig& stereo, const RigAdaptation& rig) {
+  if (rig.ring_scale != 1.0)
+    stereo.guidance_bridge_rows = scaled(stereo.guidance_bridge_rows, rig.ring_scale);
+}
+
+void adaptToRig(DepthFusionConfig& fusion, const RigAdaptation& rig) {
+  if (rig.ring_scale == 1.0)
+    return;
+  fusion.edge_window_rows = scaledOdd(fusion.edge_window_rows, rig.ring_scale);
+  fusion.parallax_max_rows = scaled(fusion.parallax_max_rows, rig.ring_scale);
+}
+
+void adaptToRig(TsdfIntegrator::Config& integrator, const RigAdaptation& rig) {
+  if (rig.stereo_trusted_depth_m > 0.0)
+    integrator.max_depth_m = std::min(integrator.max_depth_m, rig.stereo_trusted_depth_m);
+}
+
+PipelineConfig adaptToRig(const PipelineConfig& config, const Calibration& rig, RigAdaptation* adaptation) {
+  RigAdaptation a = rigAdaptation(config.rig, rig);
+  PipelineConfig c = config;
+  adaptToRig(c.interpolation, a);
+  adaptToRig(c.stereo, a);
+  adaptToRig(c.fusion, a);
+  adaptToRig(c.integrator, a);
   a.max_depth_m = c.integrator.max_depth_m;
   c.validate();
   if (adaptation)
