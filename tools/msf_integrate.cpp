@@ -12,6 +12,7 @@
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
   msf::TsdfVolume::Config volume_config;
   msf::TsdfIntegrator::Config config;
   msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
+  msf::RigAdaptationConfig rig;
   bool carving = false, no_carving = false, print_config = false;
   msf::tool::CommandLine cli(
       "msf_integrate", "<depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]",
@@ -73,10 +75,12 @@ int main(int argc, char** argv) {
                volume_config.read(file.section("tsdf_volume"));
                config.read(file.section("tsdf_integrator"));
                fusion.read(file.section("fusion"));
+               rig.read(file.section("rig"));
                file.rejectUnknownKeys();
              },
-             "YAML with sections tsdf_volume, tsdf_integrator and fusion (the LiDAR's range noise); the options "
-             "below override it")
+             "YAML with sections tsdf_volume, tsdf_integrator, fusion (the LiDAR's range noise) and rig (with "
+             "-calib, max_depth_m at most stereo's trusted depth, as in msf_reconstruct); the options below override "
+             "it")
       .value("-voxel", "M", volume_config.voxel_size_m, "voxel size in metres (default {default})")
       .value("-trunc", "M", volume_config.truncation_m, "truncation distance in metres (default {default})")
       .value("-lambda", "L", config.lambda, "eq. 7 regularization (default {default}, the paper's KITTI value is 5)")
@@ -112,6 +116,13 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-carving and -no_carving together: choose one");
     if (carving || no_carving)
       config.space_carving = carving;
+    msf::PinholeCamera camera;
+    msf::Calibration calibration;
+    if (cli.given("-calib") || cli.given("-rig")) {
+      calibration = msf::loadCalibration(calib);
+      camera = msf::PinholeCamera::fromCalibration(calibration);
+      msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
+    }
     msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
     msf::TsdfIntegrator integrator(volume, config);
     if (print_config) {
@@ -134,12 +145,6 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " + std::to_string(poses.size()) +
                                    " poses in '" + poses_path + "' (one pose per cloud; -frames a:b selects poses)");
 
-    msf::PinholeCamera camera;
-    msf::Calibration calibration;
-    if (cli.given("-calib") || cli.given("-rig")) {
-      calibration = msf::loadCalibration(calib);
-      camera = msf::PinholeCamera::fromCalibration(calibration);
-    }
     std::vector<std::string> scans;
     if (cli.given("-scans")) {
       if (!(cli.given("-calib") || cli.given("-rig")))

@@ -212,7 +212,8 @@ public:
         poses_(request.poses, source, frames_),
         holdout_(source, msf::HoldoutConfig{config.rings, config.projection, {}}),
         panel_frames_(spread(frames_, request.panels)),
-        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world))) {
+        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world))),
+        on_rig_(msf::adaptToRig(config, source.calibration())) {
     if (!source.hasColor())
       print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
                  source.description().c_str());
@@ -321,10 +322,10 @@ private:
     if (!streaming() && (request_.holdout || truth_))
       evaluation_ = std::make_unique<msf::ReconstructionEvaluation>(
           msf::PinholeCamera::fromCalibration(source_.calibration(), 0), source_.calibration().focalBaseline(),
-          config_.integrator.max_depth_m, holdout_.config().d1);
+          on_rig_.integrator.max_depth_m, holdout_.config().d1);
     moving_split_ = !request_.holdout && truth_ && truth_->truth().hasMovingMasks();
     if (request_.compare_sources)
-      source_maps_ = std::make_unique<msf::SourceMaps>(config_, source_.calibration());
+      source_maps_ = std::make_unique<msf::SourceMaps>(on_rig_, source_.calibration());
   }
 
   /// After each frame is integrated, on the engine's integration thread.
@@ -336,7 +337,7 @@ private:
     cv::Mat true_depth;
     if (truth_) {
       true_depth = truth_->depth(r.name);
-      truth_->addFrame(r, true_depth, source_.calibration(), config_.integrator.max_depth_m);
+      truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m);
     }
     if (evaluation_) {
       if (request_.holdout)
@@ -530,7 +531,7 @@ private:
       e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
                                        std::to_string(config_.rings.heldout_remainder) + ") projected into camera 0"
                                  : "the synthetic sequence's exact depth (gt/depth_0)";
-      e.range_m = config_.integrator.max_depth_m;
+      e.range_m = on_rig_.integrator.max_depth_m;
       e.moving_split = moving_split_;
       bool any_ghosts = false;
       for (const auto& [name, s] : scores)
@@ -551,6 +552,7 @@ private:
   msf::RingHoldout holdout_;
   std::set<std::size_t> panel_frames_;
   Eigen::Isometry3d T_out_world_; // -world: from the map's world to the outputs'
+  msf::PipelineConfig on_rig_; // the engine's configuration on the source's rig (adaptToRig): the map's range, the source maps'
   msf::RunReport report_;
   std::unique_ptr<msf::SyntheticScoring> truth_;
   std::unique_ptr<msf::ReconstructionEvaluation> evaluation_;

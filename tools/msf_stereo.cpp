@@ -10,6 +10,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/point_types.h>
 #include <msf/range_image/real_returns.h>
 #include <msf/stereo/point_types.h>
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   std::string calib_path, image_size_text, color_path, disparity_path, prior_path;
   bool print_config = false;
   msf::SgbmConfig config;
+  msf::RigAdaptationConfig rig;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
       "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.unguided_mode, or stereo.mode where -prior "
@@ -81,8 +83,9 @@ int main(int argc, char** argv) {
       .value("-prior", "PATH", prior_path,
              "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
              "real returns (distance 0) guide it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "stereo", config); },
-             "YAML config, section stereo (every SGBM parameter); the options below override it")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, "stereo", config, rig); },
+             "YAML config, sections stereo (every SGBM parameter; the options below override it) and rig (the keys "
+             "in rows between LiDAR rings follow the rig's beams, as in msf_reconstruct)")
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
       .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
@@ -103,6 +106,8 @@ int main(int argc, char** argv) {
     if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
     config.validate();
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
+    msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
     if (print_config)
       config.print(std::cout);
 
@@ -110,7 +115,6 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Loading ");
     print_value("%s %s ", files[0].c_str(), files[1].c_str());
-    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     const cv::Mat left = msf::readImage(files[0], cv::IMREAD_GRAYSCALE);
     const cv::Mat right = msf::readImage(files[1], cv::IMREAD_GRAYSCALE);
     cv::Mat color;

@@ -5,7 +5,9 @@
 #include <msf/common/statistics.h>
 #include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
+#include <msf/io/rig_file.h>
 #include <msf/synthetic/synthetic_generator.h>
+#include <msf/synthetic/synthetic_rig.h>
 
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
@@ -27,6 +29,18 @@ void checkRange(const msf::tool::CommandLine& cli, const char* option, int value
                                  " is out of range " + std::to_string(lo) + ".." + std::to_string(hi));
 }
 
+/// -image_size, -focal and -baseline describe a pinhole pair: they ask for camera pinhole.
+void requirePinholeFor(const msf::tool::CommandLine& cli, msf::synthetic::SyntheticConfig& config) {
+  for (const char* option : {"-image_size", "-focal", "-baseline"}) {
+    if (!cli.given(option))
+      continue;
+    if (cli.given("-camera") && config.camera != "pinhole")
+      throw msf::InvalidInputError(std::string("option ") + option + " sets a pinhole camera, but -camera is '" +
+                                   config.camera + "'");
+    config.camera = "pinhole";
+  }
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -35,9 +49,9 @@ int main(int argc, char** argv) {
   bool print_config = false;
   msf::tool::CommandLine cli(
       "msf_synth", "-o DIR [options]",
-      "Renders a synthetic street with KITTI's sensor rig and writes it in KITTI's odometry layout with exact ground "
-      "truth:\n"
-      "  DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, times.txt\n"
+      "Renders a synthetic street with KITTI's sensor rig (or another: -rig, -camera, -lidar) and writes it in "
+      "KITTI's odometry layout with exact ground truth:\n"
+      "  DIR/sequences/00/{image_0,image_1,image_2,image_3,velodyne}/, calib.txt, rig.yaml, times.txt\n"
       "  DIR/poses/00.txt\n"
       "  DIR/gt/{depth_0,disp_0,obj_map_0,moving_0}/NNNNNN.png, moving_objects.txt, scene.ply,\n"
       "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars),\n"
@@ -49,6 +63,24 @@ int main(int argc, char** argv) {
   cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
              "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
+      .value("-rig", "FILE",
+             [&](const std::string& path) { msf::synthetic::applyRig(msf::loadRigFile(path), config); },
+             "a rig file (README, \"Your own rig\"): its image size, focal length, principal point, baseline "
+             "and, when it lists them, its LiDAR's beam_elevations_deg (the LiDAR is mounted as KITTI's)")
+      .value("-camera", "NAME", config.camera,
+             "kitti: KITTI's cameras, 1242x375 (default) | pinhole: a grey pair of -image_size, -focal, -baseline")
+      .value("-image_size", "WxH",
+             [&](const std::string& text) {
+               const cv::Size size = msf::parseImageSize(text);
+               config.image_width_px = size.width;
+               config.image_height_px = size.height;
+             },
+             "pinhole image size (default 640x480)")
+      .value("-focal", "PX", config.focal_px, "pinhole focal length in pixels (default {default})")
+      .value("-baseline", "M", config.baseline_m, "pinhole baseline in metres (default {default})")
+      .value("-lidar", "MODEL", config.lidar_model,
+             "hdl64e: KITTI's 64 beams (default) | hdl32e: 32 beams, -30.67..+10.67 deg | beams: "
+             "synthetic.lidar_beam_elevations_deg of -config")
       .value("-frames", "N", config.frames, "number of frames (default {default})")
       .value("-seed", "S", config.seed, "random seed, a whole number >= 0 (default {default})")
       .value("-scene", "NAME", config.scene, "scene to render: street (default)")
@@ -76,6 +108,7 @@ int main(int argc, char** argv) {
     checkRange(cli, "-seed", config.seed, 0, 2147483647);
     if (config.scene != "street")
       throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
+    requirePinholeFor(cli, config);
     config.validate();
     if (output.empty())
       throw msf::InvalidInputError("no output folder: give -o DIR");

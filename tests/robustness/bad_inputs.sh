@@ -323,6 +323,16 @@ check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
 check "lambda_study -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_lambda_study -o out -voxel 1e-6
 check "lambda_study -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100" -- msf_lambda_study -o out -sweeps 1000000
+printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  rings: 32\n' >"$F/rings_only.yaml"
+check "synth -rig: rings without their elevations" 1 "rings_only.yaml': lidar.rings 32 without lidar.beam_elevations_deg" -- \
+  msf_synth -o out -frames 1 -rig "$F/rings_only.yaml"
+check "synth -lidar hdl16" 1 "synthetic.lidar_model' = hdl16 is unknown \(known: hdl64e, hdl32e, beams\)" -- \
+  msf_synth -o out -frames 1 -lidar hdl16
+check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg' = 0 beams must hold 1..1024" -- \
+  msf_synth -o out -frames 1 -lidar beams
+check "synth -camera kitti -focal 500" 1 "option -focal sets a pinhole camera, but -camera is 'kitti'" -- \
+  msf_synth -o out -frames 1 -camera kitti -focal 500
+check "synth -baseline 0" 1 "synthetic.baseline_m' = 0 must be in \(0, 10\]" -- msf_synth -o out -frames 1 -baseline 0
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \
@@ -456,6 +466,12 @@ if [ $have_kitti = 1 ]; then
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
+  printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"
+  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig.stereo_min_disparity_px must be in 0..1000.*not -1" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_negative.yaml"
+  printf '%%YAML:1.0\nrig:\n  scale_ring_row: false\n' >"$F/rig_misspelt.yaml"
+  check "interpolate -config: rig.scale_ring_row (misspelt)" 1 "scale_ring_row" -- \
+    msf_interpolate "$SCAN" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_misspelt.yaml"
   check "P1 holds '1.0x'" 1 "key 'P1' has a value that is not a number: '1.0x'" -- \
     msf_project "$SCAN" o.pcd -calib "$K/p1x/calib.txt"
   check "reconstruct -frames 0:100000" 1 "frame range 0:100000 goes beyond the last frame" -- \

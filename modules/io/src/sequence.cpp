@@ -146,7 +146,8 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
   if (isOdometrySequence(p)) {
     layout_ = Layout::Odometry;
     dir_ = p.string();
-    calibration_ = loadCalibration((p / "calib.txt").string());
+    // A rig file beside calib.txt (msf_synth writes both) also says what the LiDAR's beams are.
+    calibration_ = loadCalibration((fs::is_regular_file(p / "rig.yaml", ec) ? p / "rig.yaml" : p / "calib.txt").string());
     frame_names_ = stemsIn(p / "image_0", ".png");
     times = readTimestamps(p / "times.txt", false);
     const fs::path root = p.parent_path().parent_path();

@@ -113,6 +113,7 @@ PipelineConfig PipelineConfig::load(const std::string& path) {
   config.scheduling.read(file.section("pipeline"));
   config.streaming.read(file.section("streaming"));
   config.odometry.read(file.section("odometry"));
+  config.rig.read(file.section("rig"));
   file.rejectUnknownKeys();
   config.validate();
   return config;
@@ -136,6 +137,7 @@ void PipelineConfig::validate() const {
   scheduling.validate();
   streaming.validate();
   odometry.validate();
+  rig.validate();
 }
 
 void PipelineConfig::print(std::ostream& out) const {
@@ -151,6 +153,7 @@ void PipelineConfig::print(std::ostream& out) const {
   scheduling.print(out);
   streaming.print(out);
   odometry.print(out);
+  rig.print(out);
 }
 
 } // namespace msf

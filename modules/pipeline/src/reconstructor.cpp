@@ -61,7 +61,7 @@ Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& confi
     : Reconstructor(rig, config, Options()) {}
 
 Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options)
-    : calibration_(rig), config_(config), options_(options), mesher_(config.mesher) {
+    : calibration_(rig), config_(adaptToRig(config, rig)), options_(options), mesher_(config.mesher) {
   config_.validate();
   calibration_.requireImageSize();
   if (options_.threads < 0)

@@ -488,7 +488,8 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
     << " frames. Each mesh is rendered into camera 0 at every frame's pose (the first surface along each pixel's ray) "
        "and scored at the ground-truth pixels beside the per-frame fused depth; a missing estimate counts as bad in "
        "D1. Within range: true depth at most "
-    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`), the map holds nothing farther."
+    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`, at most the depth of `rig.stereo_min_disparity_px`), the map holds nothing "
+         "farther."
     << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
     << "\n\n";
   bool accuracy = false, ghosts = false;

@@ -24,6 +24,14 @@ void SyntheticConfig::read(const cv::FileNode& node) {
   readKey(node, "lidar_azimuth_step_deg", lidar_azimuth_step_deg);
   readKey(node, "lidar_upper_elevation_deg", lidar_upper_elevation_deg);
   readKey(node, "lidar_lower_elevation_deg", lidar_lower_elevation_deg);
+  readKey(node, "lidar_model", lidar_model);
+  readKey(node, "lidar_beam_elevations_deg", lidar_beam_elevations_deg);
+  readKey(node, "camera", camera);
+  readKey(node, "image_width_px", image_width_px);
+  readKey(node, "image_height_px", image_height_px);
+  readKey(node, "focal_px", focal_px);
+  readKey(node, "principal_point_px", principal_point_px);
+  readKey(node, "baseline_m", baseline_m);
   readKey(node, "textureless_share", textureless_share);
   readKey(node, "parked_car_share", parked_car_share);
   readKey(node, "mesh_max_edge_m", mesh_max_edge_m);
@@ -74,6 +82,7 @@ void SyntheticConfig::validate() const {
   require(lidar_lower_elevation_deg >= -60.0 && lidar_lower_elevation_deg < lidar_upper_elevation_deg - 11.0,
           "lidar_lower_elevation_deg", lidar_lower_elevation_deg,
           "must be >= -60 and more than 11 below lidar_upper_elevation_deg (the upper block spans 10.33)");
+  validateRig();
   require(textureless_share >= 0.0 && textureless_share <= 1.0, "textureless_share", textureless_share,
           "must be in 0..1");
   require(parked_car_share >= 0.0 && parked_car_share <= 1.0, "parked_car_share", parked_car_share,
@@ -99,6 +108,26 @@ void SyntheticConfig::validate() const {
           "must be in 0..5000 (0: as far as the drive goes)");
 }
 
+void SyntheticConfig::validateRig() const {
+  require(lidar_model == "hdl64e" || lidar_model == "hdl32e" || lidar_model == "beams", "lidar_model", lidar_model,
+          "is unknown (known: hdl64e, hdl32e, beams)");
+  const std::vector<double>& e = lidar_beam_elevations_deg;
+  require(lidar_model != "beams" || (!e.empty() && e.size() <= 1024), "lidar_beam_elevations_deg",
+          std::to_string(e.size()) + " beams", "must hold 1..1024 elevations for lidar_model beams");
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    require(e[i] > -90.0 && e[i] < 90.0, "lidar_beam_elevations_deg", e[i], "must lie in (-90, 90) degrees");
+    require(i == 0 || e[i] > e[i - 1], "lidar_beam_elevations_deg", e[i],
+            "must rise from the lowest beam to the highest");
+  }
+  require(camera == "kitti" || camera == "pinhole", "camera", camera, "is unknown (known: kitti, pinhole)");
+  require(image_width_px >= 16 && image_width_px <= 8192, "image_width_px", image_width_px, "must be in 16..8192");
+  require(image_height_px >= 16 && image_height_px <= 8192, "image_height_px", image_height_px, "must be in 16..8192");
+  require(focal_px >= 1.0 && focal_px <= 100000.0, "focal_px", focal_px, "must be in 1..100000");
+  require(principal_point_px.empty() || principal_point_px.size() == 2, "principal_point_px",
+          std::to_string(principal_point_px.size()) + " numbers", "must be [cx, cy] or empty (the centre)");
+  require(baseline_m > 0.0 && baseline_m <= 10.0, "baseline_m", baseline_m, "must be in (0, 10]");
+}
+
 namespace {
 /// Shortest text that reads back to the same double, so a printed config reproduces a dataset.
 std::string exact(double value) {
@@ -108,6 +137,13 @@ std::string exact(double value) {
   if (text.find_first_of(".en") == std::string::npos)
     text += ".0"; // keep it a real number for YAML
   return text;
+}
+
+std::string exactList(const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i)
+    text += (i ? ", " : "") + exact(values[i]);
+  return text + "]";
 }
 } // namespace
 
@@ -127,6 +163,14 @@ void SyntheticConfig::print(std::ostream& out) const {
       << "  lidar_azimuth_step_deg: " << exact(lidar_azimuth_step_deg) << "\n"
       << "  lidar_upper_elevation_deg: " << exact(lidar_upper_elevation_deg) << "\n"
       << "  lidar_lower_elevation_deg: " << exact(lidar_lower_elevation_deg) << "\n"
+      << "  lidar_model: " << lidar_model << "\n"
+      << "  lidar_beam_elevations_deg: " << exactList(lidar_beam_elevations_deg) << "\n"
+      << "  camera: " << camera << "\n"
+      << "  image_width_px: " << image_width_px << "\n"
+      << "  image_height_px: " << image_height_px << "\n"
+      << "  focal_px: " << exact(focal_px) << "\n"
+      << "  principal_point_px: " << exactList(principal_point_px) << "\n"
+      << "  baseline_m: " << exact(baseline_m) << "\n"
       << "  textureless_share: " << exact(textureless_share) << "\n"
       << "  parked_car_share: " << exact(parked_car_share) << "\n"
       << "  mesh_max_edge_m: " << exact(mesh_max_edge_m) << "\n"

@@ -7,10 +7,11 @@
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/velodyne_io.h>
+#include <msf/io/rig_file.h>
 #include <msf/synthetic/ins_error.h>
-#include <msf/synthetic/kitti_rig.h>
 #include <msf/synthetic/scene_mesh.h>
 #include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/synthetic_rig.h>
 #include <msf/synthetic/synthetic_generator.h>
 #include <msf/synthetic/trajectory.h>
 
@@ -96,7 +97,7 @@ const char* kGroundTruthReadme =
 
 SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
     : config_(validated(config)),
-      calibration_(kittiRig()),
+      calibration_(syntheticRig(config_)),
       poses_(streetTrajectory(config_)),
       scene_(buildStreetScene(config_, streetEnd(config_, poses_))),
       renderer_(calibration_, config_),
@@ -170,6 +171,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
       throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
 
   saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
+  saveRigFile(calibration_, (seq / "rig.yaml").string());
   std::ostringstream times;
   for (int i = 0; i < config_.frames; ++i) {
     char line[32];

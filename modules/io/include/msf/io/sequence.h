@@ -10,7 +10,8 @@ namespace msf {
 
 /// A KITTI sequence on disk, detected from the folder:
 ///  - odometry: `sequences/XX/{image_0,image_1,image_2,velodyne,calib.txt,times.txt}` with
-///    poses in `../../poses/XX.txt` when present; the folder may also be the dataset root
+///    poses in `../../poses/XX.txt` when present, and the calibration from a rig file
+///    `rig.yaml` beside calib.txt when there is one; the folder may also be the dataset root
 ///    holding exactly one `sequences/XX` (as msf_synth writes; its `gt/poses.txt`, when
 ///    present, is the truth that INS-like poses in `poses/XX.txt` err from);
 ///  - raw drive: `YYYY_MM_DD_drive_NNNN_sync/{image_00..03/data,velodyne_points/data,oxts}`

@@ -3,6 +3,7 @@
 #include <msf/fusion/fusion_config.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/ring_split.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -53,6 +54,8 @@ struct PipelineConfig {
   StreamingMap::Config streaming;           ///< `streaming`: the map in bounded memory (off by default)
   /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
   LidarOdometry::Config odometry;
+  /// `rig`: how the keys above follow the rig the stages run on (adaptToRig)
+  RigAdaptationConfig rig;
 
   /// The paper as published (Ali, Rajput et al. 2019), without the project's additions:
   /// config/paper.yaml, and docs/paper.md for what each setting switches off and its effect.

@@ -204,6 +204,7 @@ public:
   /// Milliseconds the odometry took for each frame it tracked (empty when it did not run).
   const std::vector<double>& odometryMs() const { return odometry_ms_; }
 
+  /// The configuration the stages run with: the one given, adapted to the rig (adaptToRig).
   const PipelineConfig& config() const { return config_; }
   const Calibration& calibration() const { return calibration_; }
   const Options& options() const { return options_; }

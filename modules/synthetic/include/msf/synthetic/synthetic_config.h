@@ -4,6 +4,7 @@
 
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace msf::synthetic {
 
@@ -22,8 +23,18 @@ struct SyntheticConfig {
   double lidar_max_range_m = 120.0;
   double lidar_min_range_m = 1.0;
   double lidar_azimuth_step_deg = 0.18; ///< KITTI's files: ~2000 points a ring at 10 Hz
-  double lidar_upper_elevation_deg = 2.0;   ///< highest of the 64 lasers
-  double lidar_lower_elevation_deg = -24.9; ///< lowest
+  double lidar_upper_elevation_deg = 2.0;   ///< hdl64e: highest of the 64 lasers
+  double lidar_lower_elevation_deg = -24.9; ///< hdl64e: lowest
+  /// hdl64e (KITTI's) | hdl32e (32 beams, -30.67..+10.67 deg) | beams (lidar_beam_elevations_deg)
+  std::string lidar_model = "hdl64e";
+  std::vector<double> lidar_beam_elevations_deg; ///< beams: one per ring, lowest first, rising
+  /// kitti: KITTI's cameras (kittiRig) | pinhole: a grey pair of the keys below (colour = grey left)
+  std::string camera = "kitti";
+  int image_width_px = 640;            ///< pinhole
+  int image_height_px = 480;           ///< pinhole
+  double focal_px = 500.0;             ///< pinhole: fx = fy
+  std::vector<double> principal_point_px; ///< pinhole: [cx, cy]; empty = the image's centre
+  double baseline_m = 0.12;            ///< pinhole: the grey pair's
   double textureless_share = 0.2;      ///< share of building lots with blank walls [0, 1]
   double parked_car_share = 0.6;       ///< share of parking slots taken [0, 1]
   double mesh_max_edge_m = 1.0;        ///< triangle size of gt/scene.ply's flat faces
@@ -55,6 +66,8 @@ struct SyntheticConfig {
   void read(const cv::FileNode& node);
   /// Throws ConfigError naming the first key with a value out of range.
   void validate() const;
+  /// The camera and LiDAR keys alone (validate calls it).
+  void validateRig() const;
   void print(std::ostream& out) const;
 };
 

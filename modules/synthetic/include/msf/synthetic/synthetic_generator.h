@@ -32,7 +32,7 @@ struct SyntheticFrame {
   cv::Mat moving;     ///< camera 0, CV_8U: 255 where the pixel sees a moving object, else 0
 };
 
-/// The synthetic KITTI-format generator: KITTI's rig (kittiRig) driving down a street
+/// The synthetic KITTI-format generator: a rig (syntheticRig: KITTI's by default) driving down a street
 /// (buildStreetScene, with its moving cars) along streetTrajectory, rendered by
 /// CameraRenderer and LidarSimulator at each frame's time. Deterministic: one seed, one
 /// byte-identical dataset.
