@@ -536,6 +536,7 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
                             std::to_string(T_world_cam0.size()) + " poses");
   MemoryPrediction p;
   p.frames = frames.size();
+  p.process_mb = residentMemoryMb(); // before the calibration frames, whose buffers the run reuses
   constexpr double kMiB = 1024.0 * 1024.0;
   // The frames integrated are at most the LiDAR's canvas (the image and its margin), and a
   // frame allocates blocks only in its view, from min_depth_m to allocationDepth().
@@ -570,7 +571,6 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
   // The end of the run: an in-memory map is meshed and written whole, a streamed one tile by
   // tile as the camera moves on, within the window's volume.
   p.mesh_mb = (config_.streaming.enabled() ? kStreamedEndShare : kEndOfRunShare) * map_mb;
-  p.process_mb = residentMemoryMb();
   p.total_mb = p.process_mb + p.volume_mb + p.frames_mb + p.mesh_mb;
   p.ms = msSince(start);
   return p;
