@@ -458,34 +458,32 @@ ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::
 }
 
 double Reconstructor::blocksPerBandBlock(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                         const PoseList& T_world_cam0) const {
-  PipelineConfig config = config_;
-  config.streaming.active_radius_m = 0.0;
-  Options options;
-  options.poses = PoseMode::Given;
-  options.threads = options_.threads;
-  options.sweeping_scans = source.sweepingScans();
+                                         const PoseList& T_world_cam0) {
+  const ThreadBudget budget(options_.threads);
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   double most = 0.0;
+  std::size_t last = frames.size();
   for (int c = 0; c < kCalibrationFrames && !frames.empty(); ++c) {
-    const std::size_t k = kCalibrationFrames == 1 ? 0 : (frames.size() - 1) * c / (kCalibrationFrames - 1);
-    if (c > 0 && k == (frames.size() - 1) * (c - 1) / (kCalibrationFrames - 1))
+    const std::size_t k = (frames.size() - 1) * static_cast<std::size_t>(c) / (kCalibrationFrames - 1);
+    if (k == last)
       continue; // fewer frames than calibration frames: each once
+    last = k;
     Frame frame = source.load(frames[k]);
-    frame.T_world_cam0 = T_world_cam0[k];
-    frame.has_pose = true;
     ScanBandBlocks bands = scanBands();
     bands.addScan(*frame.scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
-    Reconstructor scratch(calibration_, config, options);
+    // The depth from this engine's own stages, whose buffers the run then reuses; integrated
+    // into a volume of its own (the scan's carving updates only blocks that exist).
+    FrameResult result = computeDepth(frame);
+    TsdfVolume volume(config_.volume.voxel_size_m, config_.volume.truncation_m);
+    volume.setMaxMemoryMb(config_.volume.max_memory_mb);
+    TsdfIntegrator integrator(volume, config_.integrator);
     try {
-      scratch.addFrame(frame);
+      integrator.integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), T_world_cam0[k]);
     } catch (const InvalidInputError&) {
-      // A frame that does not fit the volume's budget (or not the rig, which the run will say):
-      // no measure, the footprint's bound stays.
-      return 0.0;
+      return 0.0; // a frame whose blocks do not fit the volume's budget: no measure, the bound stays
     }
     if (bands.blocks() > 0)
-      most = std::max(most, static_cast<double>(scratch.volume().numBlocks()) / static_cast<double>(bands.blocks()));
+      most = std::max(most, static_cast<double>(volume.numBlocks()) / static_cast<double>(bands.blocks()));
   }
   return most;
 }
@@ -529,7 +527,7 @@ std::size_t Reconstructor::blocksInWindow(const PoseList& T_world_cam0, const Bl
 }
 
 MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) const {
+                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) {
   const auto start = Clock::now();
   if (frames.size() != T_world_cam0.size())
     throw InvalidInputError("predictMemory: " + std::to_string(frames.size()) + " frames but " +

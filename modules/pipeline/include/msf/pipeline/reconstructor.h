@@ -191,15 +191,15 @@ public:
   std::size_t finishStreaming(const std::string& mesh_path);
   /// The peak memory of run() over `frames` of `source` seen from `T_world_cam0` (one per frame,
   /// known before the run: a dataset's or a file's; not estimated ones), predicted before the run:
-  /// see MemoryPrediction. It reads every frame's scan and integrates a few frames into a volume
-  /// of their own. With streaming, the volume term is the most blocks within the active radius
+  /// see MemoryPrediction. It reads every frame's scan, and computes the depth of a few frames
+  /// (with this object's stages) and integrates it into a volume of their own. With streaming, the volume term is the most blocks within the active radius
   /// (grown by a tile) of any frame's camera. `maps` is the number of volumes the caller fills
   /// from the same frames (msf_reconstruct -compare_sources: 3); `scores_every_frame`: the caller
   /// keeps each frame's ground truth to the end (protocol 4). Throws ConfigError when the
   /// integrator's band has no bound (reach() is infinite), InvalidInputError for views too large
   /// to enumerate or frames and poses of different counts.
   MemoryPrediction predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                 const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false) const;
+                                 const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false);
 
   /// The least streaming.active_radius_m a streamed map of this run accepts: the integrator's
   /// reach over the LiDAR's canvas plus a tile (StreamingMap::minimumRadius).
@@ -239,7 +239,7 @@ private:
   /// The blocks a frame's fused depth allocates per block of its scan's band, the most over a few
   /// frames spread over the run; 0 when none could be measured.
   double blocksPerBandBlock(const FrameSource& source, const std::vector<std::size_t>& frames,
-                            const PoseList& T_world_cam0) const;
+                            const PoseList& T_world_cam0);
   std::size_t predictedBlocks(std::size_t band_blocks, std::size_t footprint_blocks,
                               double blocks_per_band_block) const;
   std::size_t blocksInWindow(const PoseList& T_world_cam0, const BlockFootprint& footprint,
