@@ -30,20 +30,21 @@ using Clock = std::chrono::steady_clock;
 // The memory model of predictMemory beside the TSDF volume, from msf_reconstruct's RSS per frame
 // (frames.csv) and peak (summary.json) on KITTI and the synthetic street (docs/robustness.md,
 // "Memory budget"; the figures in docs/results.md).
-// The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas.
-constexpr double kStageBytesPerPixel = 240;
+// The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas,
+// and the heap the calibration frames' buffers leave behind.
+constexpr double kStageBytesPerPixel = 300;
 // A frame in flight (images, scan, depth images).
 constexpr double kFrameBytesPerPixel = 24;
 // A frame whose ground truth the run keeps to score the mesh at the end (protocol 4).
 constexpr double kScoredFrameBytesPerPixel = 12;
 // What the end of an in-memory run adds (the mesh, its per-block cache, the copy written and
 // the volume.pcd cloud), in units of the volume's bytes.
-constexpr double kEndOfRunShare = 3.5;
+constexpr double kEndOfRunShare = 3.8;
 // A streamed run's tiles meshed as they leave, in units of the window's volume bytes.
-constexpr double kStreamedEndShare = 0.5;
+constexpr double kStreamedEndShare = 1.0;
 // A map of one source alone or of the paper's method (-compare_sources, -compare_paper), its
-// mesh included, in units of the fused map's volume bytes: their blocks are fewer.
-constexpr double kOtherMapShare = 1.3;
+// mesh included, in units of the fused map's volume bytes.
+constexpr double kOtherMapShare = 1.6;
 // The blocks the scans' bands predict, grown against the spread of the measured share between
 // frames (the calibration frames are a few of the run's).
 constexpr double kBlockMargin = 1.15;
