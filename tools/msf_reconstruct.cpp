@@ -311,7 +311,10 @@ private:
     const double radius = std::ceil(engine_->minimumStreamingRadius());
     config_.streaming.active_radius_m = radius;
     engine_ = makeEngine();
-    const msf::MemoryPrediction p = engine_->predictMemory(source_, frames_, poses, maps(), keepsEveryFrame());
+    msf::MemoryPrediction p = engine_->predictMemory(source_, frames_, poses, maps(), keepsEveryFrame());
+    // The process as before the first prediction, whose calibration frames left a heap the run reuses.
+    p.total_mb += in_memory.process_mb - p.process_mb;
+    p.process_mb = in_memory.process_mb;
     report_.predicted_memory_mb = p.total_mb;
     if (explicitBudget() && p.total_mb > budget_mb)
       throw msf::InvalidInputError(
