@@ -32,7 +32,7 @@ using Clock = std::chrono::steady_clock;
 // "Memory budget"; the figures in docs/results.md).
 // The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas,
 // and the heap the calibration frames' buffers leave behind.
-constexpr double kStageBytesPerPixel = 300;
+constexpr double kStageBytesPerPixel = 340;
 // A frame in flight (images, scan, depth images).
 constexpr double kFrameBytesPerPixel = 24;
 // A frame whose ground truth the run keeps to score the mesh at the end (protocol 4).
@@ -559,10 +559,12 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
   const double map_mb = static_cast<double>(TsdfVolume::bytesFor(p.blocks_in_memory)) / kMiB;
   p.volume_mb = map_mb * (1.0 + kOtherMapShare * (maps - 1));
   // The frames in flight: one in each of the three stages (loading, depth, integration) and
-  // queue_capacity in each of the two queues between them, over the stages' own buffers; and
+  // queue_capacity in each of the two queues between them (no more than the run's frames), over
+  // the stages' own buffers; and
   // the frames whose ground truth the caller keeps.
   const double pixels = static_cast<double>(canvas.width) * canvas.height;
-  const double in_flight = 3.0 + 2.0 * config_.scheduling.queue_capacity;
+  const double in_flight =
+      std::min(static_cast<double>(p.frames), 3.0 + 2.0 * config_.scheduling.queue_capacity);
   p.frames_mb = pixels *
                 (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel +
                  (scores_every_frame ? kScoredFrameBytesPerPixel * static_cast<double>(p.frames) : 0.0)) /
