@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // ScanBandBlocks, the surfaces of the memory prediction (Reconstructor::predictMemory): the blocks
 // within the band of the returns a camera sees, their union over scans, and those near a point.
 #include "test_support.h"
