@@ -17,7 +17,7 @@ struct DriveResources {
   std::size_t request_mb = 0; ///< the prediction with a margin, rounded up to kRequestStepMb
   /// Requests are rounded up to steps of this (so that drives of about one size share a job array).
   static constexpr std::size_t kRequestStepMb = 256;
-  /// A margin over the prediction (which held the measured peaks within 1.5 times on the runs of
+  /// A margin over the prediction (which holds the measured peaks of the runs in
   /// docs/results.md, "Memory: predicted and measured peaks"), for drives unlike them.
   static constexpr double kMargin = 1.2;
 };
