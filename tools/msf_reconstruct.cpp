@@ -283,14 +283,15 @@ private:
                  budget_mb);
       return;
     }
-    const msf::MemoryPrediction p = engine_->predictMemory(source_, frames_, poses, maps(), keepsEveryFrame());
+    const msf::MemoryEvidence evidence = engine_->measureMemory(source_, frames_, poses);
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
     report_.predicted_memory_mb = p.total_mb;
     print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
                p.describe().c_str(), budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", p.ms);
     if (p.total_mb <= budget_mb)
       return;
     if (mayStream())
-      return streamOnItsOwn(p, poses, budget_mb);
+      return streamOnItsOwn(p, evidence, budget_mb);
     const std::string whole = streaming() ? "" : ", and the run needs the whole map in memory (" + wholeMapReason() + ")";
     if (explicitBudget())
       throw msf::InvalidInputError("the run is predicted to need up to " + mib(p.total_mb) + " MiB at its peak (" +
@@ -306,15 +307,13 @@ private:
 
   /// A run predicted over the budget streams its map with the least active radius the
   /// integrator allows (its reach plus a tile: every block a frame changes stays in memory,
-  /// and no more); an explicit budget that even the streamed run would exceed refuses it.
-  void streamOnItsOwn(const msf::MemoryPrediction& in_memory, const msf::PoseList& poses, double budget_mb) {
+  /// and no more); an explicit budget that even the streamed run would exceed refuses it. The
+  /// in-memory prediction's evidence serves: the streamed engine differs in its window only.
+  void streamOnItsOwn(const msf::MemoryPrediction& in_memory, const msf::MemoryEvidence& evidence, double budget_mb) {
     const double radius = std::ceil(engine_->minimumStreamingRadius());
     config_.streaming.active_radius_m = radius;
     engine_ = makeEngine();
-    msf::MemoryPrediction p = engine_->predictMemory(source_, frames_, poses, maps(), keepsEveryFrame());
-    // The process as before the first prediction, whose calibration frames left a heap the run reuses.
-    p.total_mb += in_memory.process_mb - p.process_mb;
-    p.process_mb = in_memory.process_mb;
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
     report_.predicted_memory_mb = p.total_mb;
     if (explicitBudget() && p.total_mb > budget_mb)
       throw msf::InvalidInputError(

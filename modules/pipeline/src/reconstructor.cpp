@@ -514,8 +514,7 @@ std::size_t Reconstructor::predictedBlocks(std::size_t band_blocks, std::size_t 
   return std::min(footprint_blocks, static_cast<std::size_t>(blocks));
 }
 
-std::size_t Reconstructor::blocksInWindow(const PoseList& T_world_cam0, const BlockFootprint& footprint,
-                                          const ScanBandBlocks& bands, double blocks_per_band_block) const {
+std::size_t Reconstructor::blocksInWindow(const MemoryEvidence& evidence) const {
   // A tile stays while its box grown by a block is within the active radius of the camera: its
   // blocks are within the radius plus the box's diagonal; the step keeps 1000 frames to a few
   // hundred balls.
@@ -523,21 +522,19 @@ std::size_t Reconstructor::blocksInWindow(const PoseList& T_world_cam0, const Bl
   const double tile_m = config_.streaming.tile_blocks * block_m;
   const double radius = config_.streaming.active_radius_m + std::sqrt(3.0) * (tile_m + block_m);
   const double step = std::max(tile_m, radius / 8.0);
-  return mostWithin(T_world_cam0, radius, step, [&](const Eigen::Vector3d& centre, double r) {
-    return predictedBlocks(bands.blocksWithin(centre, r), footprint.blocksWithin(centre, r), blocks_per_band_block);
+  return mostWithin(evidence.T_world_cam0, radius, step, [&](const Eigen::Vector3d& centre, double r) {
+    return predictedBlocks(evidence.bands.blocksWithin(centre, r), evidence.footprint.blocksWithin(centre, r),
+                           evidence.blocks_per_band_block);
   });
 }
 
-MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) {
+MemoryEvidence Reconstructor::measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                            const PoseList& T_world_cam0) {
   const auto start = Clock::now();
   if (frames.size() != T_world_cam0.size())
     throw InvalidInputError("predictMemory: " + std::to_string(frames.size()) + " frames but " +
                             std::to_string(T_world_cam0.size()) + " poses");
-  MemoryPrediction p;
-  p.frames = frames.size();
-  p.process_mb = residentMemoryMb(); // before the calibration frames, whose buffers the run reuses
-  constexpr double kMiB = 1024.0 * 1024.0;
+  const double process_mb = residentMemoryMb(); // before the calibration frames, whose buffers the run reuses
   // The frames integrated are at most the LiDAR's canvas (the image and its margin), and a
   // frame allocates blocks only in its view, from min_depth_m to allocationDepth().
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
@@ -548,21 +545,33 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
   BlockFootprint footprint(config_.volume.voxel_size_m);
   for (const Eigen::Isometry3d& T : T_world_cam0)
     footprint.addView(canvas, T, config_.integrator.min_depth_m, far_m);
-  p.footprint_blocks = footprint.blocks();
-  const ScanBandBlocks bands = scanBandsOf(source, frames, T_world_cam0);
-  p.band_blocks = bands.blocks();
-  p.blocks_per_band_block = blocksPerBandBlock(source, frames, T_world_cam0);
+  MemoryEvidence evidence{T_world_cam0, std::move(footprint), scanBandsOf(source, frames, T_world_cam0)};
+  evidence.blocks_per_band_block = blocksPerBandBlock(source, frames, T_world_cam0);
+  evidence.process_mb = process_mb;
+  evidence.ms = msSince(start);
+  return evidence;
+}
+
+MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, int maps,
+                                              bool scores_every_frame) const {
+  const auto start = Clock::now();
+  MemoryPrediction p;
+  p.frames = evidence.T_world_cam0.size();
+  p.process_mb = evidence.process_mb;
+  p.footprint_blocks = evidence.footprint.blocks();
+  p.band_blocks = evidence.bands.blocks();
+  p.blocks_per_band_block = evidence.blocks_per_band_block;
   p.blocks = predictedBlocks(p.band_blocks, p.footprint_blocks, p.blocks_per_band_block);
   p.blocks_in_memory = p.blocks;
-  if (config_.streaming.enabled() && !T_world_cam0.empty())
-    p.blocks_in_memory =
-        std::min(p.blocks, blocksInWindow(T_world_cam0, footprint, bands, p.blocks_per_band_block));
+  if (config_.streaming.enabled() && p.frames > 0)
+    p.blocks_in_memory = std::min(p.blocks, blocksInWindow(evidence));
+  constexpr double kMiB = 1024.0 * 1024.0;
   const double map_mb = static_cast<double>(TsdfVolume::bytesFor(p.blocks_in_memory)) / kMiB;
   p.volume_mb = map_mb * (1.0 + kOtherMapShare * (maps - 1));
   // The frames in flight: one in each of the three stages (loading, depth, integration) and
   // queue_capacity in each of the two queues between them (no more than the run's frames), over
-  // the stages' own buffers; and
-  // the frames whose ground truth the caller keeps.
+  // the stages' own buffers; and the frames whose ground truth the caller keeps.
+  const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   const double pixels = static_cast<double>(canvas.width) * canvas.height;
   const double in_flight =
       std::min(static_cast<double>(p.frames), 3.0 + 2.0 * config_.scheduling.queue_capacity);
@@ -574,8 +583,13 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
   // tile as the camera moves on, within the window's volume.
   p.mesh_mb = (config_.streaming.enabled() ? kStreamedEndShare : kEndOfRunShare) * map_mb;
   p.total_mb = p.process_mb + p.volume_mb + p.frames_mb + p.mesh_mb;
-  p.ms = msSince(start);
+  p.ms = evidence.ms + msSince(start);
   return p;
+}
+
+MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) {
+  return predictMemory(measureMemory(source, frames, T_world_cam0), maps, scores_every_frame);
 }
 
 const TriangleMesh& Reconstructor::mesh() {

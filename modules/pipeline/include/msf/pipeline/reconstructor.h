@@ -44,6 +44,19 @@ struct MemoryPrediction {
   std::string describe() const;
 };
 
+/// What the memory prediction measures from a run's data before it starts
+/// (Reconstructor::measureMemory): the blocks of the views, the blocks within the scans' bands,
+/// the share the fused depth adds on the calibration frames, and the process. Measured once, it
+/// serves the predictions of the run in memory and streamed alike.
+struct MemoryEvidence {
+  PoseList T_world_cam0;             ///< the run's poses, one per frame
+  BlockFootprint footprint;          ///< the blocks every frame's view meets: the bound
+  ScanBandBlocks bands;              ///< the blocks within the band of the scans' returns in view
+  double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
+  double process_mb = 0;             ///< the process before the calibration frames
+  double ms = 0;                     ///< time the measure took
+};
+
 /// Milliseconds each stage spent on one frame. lidar = projection + interpolation;
 /// depth_ms = steps 1-3 (lidar + stereo, or their wall time when they run side by side).
 struct StageTimes {
@@ -189,15 +202,22 @@ public:
   /// A streamed map (Options::stream_directory): writes the tiles still in memory and the
   /// union of all as `mesh_path`; the volume is empty afterwards. Returns the triangles written.
   std::size_t finishStreaming(const std::string& mesh_path);
-  /// The peak memory of run() over `frames` of `source` seen from `T_world_cam0` (one per frame,
-  /// known before the run: a dataset's or a file's; not estimated ones), predicted before the run:
-  /// see MemoryPrediction. It reads every frame's scan, and computes the depth of a few frames
-  /// (with this object's stages) and integrates it into a volume of their own. With streaming, the volume term is the most blocks within the active radius
-  /// (grown by a tile) of any frame's camera. `maps` is the number of volumes the caller fills
-  /// from the same frames (msf_reconstruct -compare_sources: 3); `scores_every_frame`: the caller
-  /// keeps each frame's ground truth to the end (protocol 4). Throws ConfigError when the
+  /// What the peak memory of run() over `frames` of `source` seen from `T_world_cam0` (one per
+  /// frame, known before the run: a dataset's or a file's; not estimated ones) is predicted from:
+  /// it reads every frame's scan, and computes the depth of a few frames (with this object's
+  /// stages) and integrates it into a volume of their own. Throws ConfigError when the
   /// integrator's band has no bound (reach() is infinite), InvalidInputError for views too large
   /// to enumerate or frames and poses of different counts.
+  MemoryEvidence measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                               const PoseList& T_world_cam0);
+  /// The peak memory of run() predicted from `evidence` (measured by an engine of the same volume,
+  /// integrator and projection configuration, streamed or not): see MemoryPrediction. With
+  /// streaming, the volume term is the most blocks within the active radius (grown by a tile) of
+  /// any frame's camera. `maps` is the number of volumes the caller fills from the same frames
+  /// (msf_reconstruct -compare_sources: 3); `scores_every_frame`: the caller keeps each frame's
+  /// ground truth to the end (protocol 4).
+  MemoryPrediction predictMemory(const MemoryEvidence& evidence, int maps = 1, bool scores_every_frame = false) const;
+  /// Both: measureMemory, then predictMemory from it.
   MemoryPrediction predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
                                  const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false);
 
@@ -242,8 +262,7 @@ private:
                             const PoseList& T_world_cam0);
   std::size_t predictedBlocks(std::size_t band_blocks, std::size_t footprint_blocks,
                               double blocks_per_band_block) const;
-  std::size_t blocksInWindow(const PoseList& T_world_cam0, const BlockFootprint& footprint,
-                             const ScanBandBlocks& bands, double blocks_per_band_block) const;
+  std::size_t blocksInWindow(const MemoryEvidence& evidence) const;
 
   Calibration calibration_;
   PipelineConfig config_;
