@@ -455,7 +455,7 @@ ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   ScanBandBlocks bands = scanBands();
   for (std::size_t k = 0; k < frames.size(); ++k)
-    bands.addScan(*source.load(frames[k], false).scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+    bands.addScan(*source.loadScan(frames[k]), calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
   return bands;
 }
 
