@@ -120,39 +120,6 @@ std::string generateDefaultStreet(const std::string& dir) {
   return dir;
 }
 
-/// The memory budget against the run's predicted peak, before any frame is read: an explicit
-/// budget (tsdf_volume.max_memory_mb > 0) refuses a run predicted to exceed it; the default
-/// one (three quarters of RAM) warns, since the prediction is an upper bound that grows with
-/// the space the cameras swept, not with the surface they saw. With estimated poses nothing is
-/// known before the run: the volume's own check at each growth stays.
-void checkMemoryBudget(const msf::Reconstructor& engine, const msf::PoseList& poses, int maps, bool scores_every_frame,
-                       msf::RunReport& report) {
-  const double budget_mb = static_cast<double>(engine.volume().maxMemoryBytes()) / (1024.0 * 1024.0);
-  const bool explicit_budget = engine.config().volume.max_memory_mb > 0;
-  if (poses.empty()) {
-    print_info("Memory: the poses are estimated as the run goes, so its peak is not predicted; the TSDF volume "
-               "stops the run at the first frame whose blocks would exceed the budget (%.0f MiB)\n",
-               budget_mb);
-    return;
-  }
-  const msf::MemoryPrediction p = engine.predictMemory(poses, maps, scores_every_frame);
-  report.predicted_memory_mb = p.total_mb;
-  print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
-             p.describe().c_str(), budget_mb, explicit_budget ? "" : " (three quarters of RAM)", p.ms);
-  if (p.total_mb <= budget_mb)
-    return;
-  if (explicit_budget)
-    throw msf::InvalidInputError(
-        "the run is predicted to need up to " + std::to_string(static_cast<long long>(std::ceil(p.total_mb))) +
-        " MiB at its peak (" + p.describe() + "), over the memory budget of " +
-        std::to_string(static_cast<long long>(budget_mb)) +
-        " MiB (tsdf_volume.max_memory_mb, -max_memory): use fewer frames, larger voxels, a streamed map (-stream R) "
-        "or a larger budget");
-  print_warn("the run is predicted to need up to %.0f MiB at its peak, over three quarters of RAM (%.0f MiB): the "
-             "prediction is an upper bound; the run stops at the first frame whose blocks would not fit\n",
-             p.total_mb, budget_mb);
-}
-
 /// The console's protocol 4 table: per source, coverage, D1 (missing = bad) and MAE within
 /// the map's range and over all ground-truth pixels (static ones, when the dataset says which).
 void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
@@ -222,16 +189,10 @@ public:
       holdout_.split(first);
       holdout_.take(first.index);
     }
+    engine_ = makeEngine();
+    planMemory();
     describeReport();
     makeEvaluations();
-    msf::Reconstructor::Options options;
-    options.poses = poses_.mode();
-    options.stream_directory = streaming() ? stage_ : "";
-    options.keep_sparse = !panel_frames_.empty(); // the panels show the projected scan
-    engine_ = std::make_unique<msf::Reconstructor>(source.calibration(), config_, options);
-    checkMemoryBudget(*engine_, poses_.knownPoses(frames_),
-                      1 + (request.compare_sources ? 2 : 0) + (request.compare_paper ? 1 : 0), evaluation_ != nullptr,
-                      report_);
   }
 
   /// The frames through the engine; returns whether the run was interrupted.
@@ -294,6 +255,92 @@ public:
 
 private:
   bool streaming() const { return config_.streaming.enabled(); }
+  /// Whether the run may stream its map: every evaluation it was asked for works on a streamed one.
+  bool mayStream() const {
+    return !streaming() && !request_.holdout && !request_.compare_sources && !request_.compare_paper;
+  }
+  /// Whether the run keeps each frame's ground truth to score the whole mesh at the end (makeEvaluations).
+  bool keepsEveryFrame() const { return !streaming() && (request_.holdout || !source_.groundTruthDir().empty()); }
+  int maps() const { return 1 + (request_.compare_sources ? 2 : 0) + (request_.compare_paper ? 1 : 0); }
+
+  std::unique_ptr<msf::Reconstructor> makeEngine() const {
+    msf::Reconstructor::Options options;
+    options.poses = poses_.mode();
+    options.stream_directory = streaming() ? stage_ : "";
+    options.keep_sparse = !panel_frames_.empty(); // the panels show the projected scan
+    return std::make_unique<msf::Reconstructor>(source_.calibration(), config_, options);
+  }
+
+  /// The memory budget against the run's predicted peak, before the run: a run over it whose
+  /// evaluations allow it streams its map (streamOnItsOwn); otherwise an explicit budget
+  /// (tsdf_volume.max_memory_mb > 0) refuses it, the default one (three quarters of RAM) warns.
+  /// With estimated poses nothing is known before the run: the volume's own check at each
+  /// growth stays.
+  void planMemory() {
+    const double budget_mb = static_cast<double>(engine_->volume().maxMemoryBytes()) / (1024.0 * 1024.0);
+    const msf::PoseList poses = poses_.knownPoses(frames_);
+    if (poses.empty()) {
+      print_info("Memory: the poses are estimated as the run goes, so its peak is not predicted; the TSDF volume "
+                 "stops the run at the first frame whose blocks would exceed the budget (%.0f MiB)\n",
+                 budget_mb);
+      return;
+    }
+    const msf::MemoryEvidence evidence = engine_->measureMemory(source_, frames_, poses);
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    report_.predicted_memory_mb = p.total_mb;
+    print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
+               p.describe().c_str(), budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", p.ms);
+    if (p.total_mb <= budget_mb)
+      return;
+    if (mayStream())
+      return streamOnItsOwn(p, evidence, budget_mb);
+    const std::string whole = streaming() ? "" : ", and the run needs the whole map in memory (" + wholeMapReason() + ")";
+    if (explicitBudget())
+      throw msf::InvalidInputError("the run is predicted to need up to " + mib(p.total_mb) + " MiB at its peak (" +
+                                   p.describe() + "), over the memory budget of " + mib(budget_mb, false) +
+                                   " MiB (tsdf_volume.max_memory_mb, -max_memory)" + whole +
+                                   ": use fewer frames, larger voxels, " +
+                                   (streaming() ? "a smaller active radius" : "a streamed map (-stream R)") +
+                                   " or a larger budget");
+    print_warn("the run is predicted to need up to %.0f MiB at its peak, over three quarters of RAM (%.0f MiB)%s: "
+               "the run stops at the first frame whose blocks would not fit\n",
+               p.total_mb, budget_mb, whole.c_str());
+  }
+
+  /// A run predicted over the budget streams its map with the least active radius the
+  /// integrator allows (its reach plus a tile: every block a frame changes stays in memory,
+  /// and no more); an explicit budget that even the streamed run would exceed refuses it. The
+  /// in-memory prediction's evidence serves: the streamed engine differs in its window only.
+  void streamOnItsOwn(const msf::MemoryPrediction& in_memory, const msf::MemoryEvidence& evidence, double budget_mb) {
+    const double radius = std::ceil(engine_->minimumStreamingRadius());
+    config_.streaming.active_radius_m = radius;
+    engine_ = makeEngine();
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    report_.predicted_memory_mb = p.total_mb;
+    if (explicitBudget() && p.total_mb > budget_mb)
+      throw msf::InvalidInputError(
+          "the run is predicted to need up to " + mib(in_memory.total_mb) + " MiB at its peak in memory and " +
+          mib(p.total_mb) + " MiB streamed with an active radius of " + mib(radius, false) + " m (" + p.describe() +
+          "), over the memory budget of " + mib(budget_mb, false) +
+          " MiB (tsdf_volume.max_memory_mb, -max_memory): use fewer frames, larger voxels or a larger budget");
+    print_info("Memory: predicted %.0f MiB in memory, over the budget of %.0f MiB%s: streaming the map with an "
+               "active radius of %.0f m (tiles in %s/tiles); predicted peak streamed %.0f MiB (%s)\n",
+               in_memory.total_mb, budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", radius,
+               request_.out.c_str(), p.total_mb, p.describe().c_str());
+    if (p.total_mb > budget_mb)
+      print_warn("even streamed, the run is predicted over three quarters of RAM (%.0f MiB): the run stops at the "
+                 "first frame whose blocks would not fit\n",
+                 budget_mb);
+  }
+
+  bool explicitBudget() const { return config_.volume.max_memory_mb > 0; }
+  std::string wholeMapReason() const {
+    return request_.holdout ? "-holdout" : request_.compare_sources ? "-compare_sources" : "-compare_paper";
+  }
+  /// A figure in MiB for a message, rounded up (a prediction) or down (a budget).
+  static std::string mib(double mb, bool up = true) {
+    return std::to_string(static_cast<long long>(up ? std::ceil(mb) : std::floor(mb)));
+  }
   std::string path(const std::string& name) const { return (fs::path(stage_) / name).string(); }
 
   void describeReport() {
@@ -544,7 +591,7 @@ private:
   }
 
   const Request& request_;
-  const msf::PipelineConfig& config_;
+  msf::PipelineConfig config_; // streamOnItsOwn may set its streaming radius
   const msf::FrameSource& source_;
   std::string stage_;
   std::vector<std::size_t> frames_;

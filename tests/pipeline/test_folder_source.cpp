@@ -33,12 +33,16 @@ std::string converted(const std::string& dataset, const std::string& range, cons
   return out;
 }
 
+void expectSameScan(const pcl::PointCloud<pcl::PointXYZI>& a, const pcl::PointCloud<pcl::PointXYZI>& b) {
+  EXPECT_EQ(a.header.frame_id, b.header.frame_id);
+  EXPECT_EQ(a.header.stamp, b.header.stamp);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k)
+    ASSERT_TRUE(a[k].getVector4fMap() == b[k].getVector4fMap() && a[k].intensity == b[k].intensity) << "point " << k;
+}
+
 void expectSameFrame(const msf::Frame& a, const msf::Frame& b) {
-  ASSERT_EQ(a.scan->size(), b.scan->size());
-  for (std::size_t k = 0; k < a.scan->size(); ++k)
-    ASSERT_TRUE((*a.scan)[k].getVector4fMap() == (*b.scan)[k].getVector4fMap() &&
-                (*a.scan)[k].intensity == (*b.scan)[k].intensity)
-        << "point " << k;
+  expectSameScan(*a.scan, *b.scan);
   EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_INF), 0.0);
   EXPECT_EQ(a.color.empty(), b.color.empty());
@@ -63,8 +67,15 @@ TEST(FolderSource, KittiConvertedToTheGenericLayoutGivesTheSameMesh) {
   EXPECT_EQ(folder.calibration().image_size, sequence.calibration().image_size);
   for (int i = 0; i < 4; ++i)
     EXPECT_EQ(folder.calibration().P[i], sequence.calibration().P[i]) << "P" << i;
-  for (std::size_t i = 0; i < 3; ++i)
-    expectSameFrame(folder.load(i), sequence.load(i));
+  for (std::size_t i = 0; i < 3; ++i) {
+    const msf::Frame frame = sequence.load(i);
+    expectSameFrame(folder.load(i), frame);
+    // The scan alone (the memory prediction's read) is the frame's scan.
+    expectSameScan(*folder.loadScan(i), *frame.scan);
+    expectSameScan(*sequence.loadScan(i), *frame.scan);
+  }
+  EXPECT_THROW(folder.loadScan(3), msf::InvalidInputError);
+  EXPECT_THROW(sequence.loadScan(10), msf::InvalidInputError);
   for (const auto& [name, input] : {std::pair<std::string, std::string>{"kitti_run", kitti + " -frames 0:2"},
                                     {"generic_run", generic}}) {
     const auto r = msf::test::runTool("msf_reconstruct", input + " -panels 0 -o " + dir.file(name));

@@ -479,8 +479,11 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
-  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB .* over the memory budget of 1 MiB" -- \
+  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB at its peak in memory and [0-9]+ MiB streamed .* over the memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  # A budget the run would fit only streamed, for a run that needs the whole map in memory.
+  check "reconstruct -compare_sources -max_memory 300" 1 "over the memory budget of 300 MiB .*, and the run needs the whole map in memory \(-compare_sources\)" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -compare_sources -max_memory 300 -o out
   # Estimated poses: nothing to predict from; the volume stops the run at its first growth.
   check "reconstruct -max_memory 1 -poses estimate" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -poses estimate -o out

@@ -23,10 +23,10 @@ DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& c
   const double reach = TsdfIntegrator(volume, config.integrator)
                            .reach(LidarProjector(sequence.calibration(), config.projection).canvasCamera());
   config.streaming.requireRadius(reach, config.volume.voxel_size_m);
-  const Reconstructor engine(sequence.calibration(), config);
+  Reconstructor engine(sequence.calibration(), config);
   DriveResources r;
   r.frames = indices.size();
-  r.predicted_mb = engine.predictMemory(poses.knownPoses(indices)).total_mb;
+  r.predicted_mb = engine.predictMemory(sequence, indices, poses.knownPoses(indices)).total_mb;
   const double step = static_cast<double>(DriveResources::kRequestStepMb);
   r.request_mb = static_cast<std::size_t>(std::ceil(r.predicted_mb * DriveResources::kMargin / step) * step);
   return r;

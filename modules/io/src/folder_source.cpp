@@ -214,10 +214,27 @@ void FolderSource::readPoses() {
   }
 }
 
-Frame FolderSource::load(std::size_t i, bool with_color) const {
+void FolderSource::checkIndex(std::size_t i) const {
   if (i >= size())
     throw InvalidInputError("frame " + std::to_string(i) + " is out of range: dataset '" + dir_ + "' has " +
                             std::to_string(size()) + " frames");
+}
+
+pcl::PointCloud<pcl::PointXYZI>::Ptr FolderSource::frameScan(pcl::PointCloud<pcl::PointXYZI>&& points,
+                                                             std::size_t i) const {
+  auto scan = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>(std::move(points));
+  scan->header.frame_id = kVelodyneFrameId;
+  scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, timestamp(i)) * 1e6));
+  return scan;
+}
+
+pcl::PointCloud<pcl::PointXYZI>::Ptr FolderSource::loadScan(std::size_t i) const {
+  checkIndex(i);
+  return frameScan(std::move(loadScanFile(frames_[i].scan).points), i);
+}
+
+Frame FolderSource::load(std::size_t i, bool with_color) const {
+  checkIndex(i);
   const FrameFiles& files = frames_[i];
   auto read = [](const std::string& path) {
     return std::async(std::launch::async, [path] { return readImage(path, cv::IMREAD_UNCHANGED); });
@@ -230,9 +247,7 @@ Frame FolderSource::load(std::size_t i, bool with_color) const {
   f.index = i;
   f.timestamp = timestamp(i);
   ScanFile scan = loadScanFile(files.scan);
-  f.scan = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>(std::move(scan.points));
-  f.scan->header.frame_id = kVelodyneFrameId;
-  f.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, f.timestamp) * 1e6));
+  f.scan = frameScan(std::move(scan.points), i);
   f.point_ring = std::move(scan.ring);
   f.point_time_s = std::move(scan.time_s);
   const cv::Mat left_image = left.get();

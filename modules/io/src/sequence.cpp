@@ -225,10 +225,26 @@ std::string Sequence::imagePath(int camera, std::size_t i) const {
   return (p / ("image_0" + std::to_string(camera)) / "data" / (frameName(i) + ".png")).string();
 }
 
-Frame Sequence::load(std::size_t i, bool with_color) const {
+void Sequence::checkIndex(std::size_t i) const {
   if (i >= size())
     throw InvalidInputError("frame " + std::to_string(i) + " is out of range: sequence '" + dir_ + "' has " +
                             std::to_string(size()) + " frames");
+}
+
+pcl::PointCloud<pcl::PointXYZI>::Ptr Sequence::loadScan(std::size_t i) const {
+  checkIndex(i);
+  pcl::PointCloud<pcl::PointXYZI>::Ptr scan(new pcl::PointCloud<pcl::PointXYZI>);
+  loadVelodyneBin(scanPath(i), *scan);
+  if (scan->empty())
+    throw IOError("frame " + frameName(i) + ": scan '" + scanPath(i) + "' has no finite point");
+  scan->header.frame_id = kVelodyneFrameId; // the stages carry its stamp into camera 0
+  scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, timestamp(i)) * 1e6));
+  scan->header.seq = static_cast<std::uint32_t>(i);
+  return scan;
+}
+
+Frame Sequence::load(std::size_t i, bool with_color) const {
+  checkIndex(i);
   Frame f;
   f.index = i;
   f.timestamp = timestamp(i);
@@ -246,13 +262,7 @@ Frame Sequence::load(std::size_t i, bool with_color) const {
   else if (with_color && fs::is_directory(fs::path(imagePath(2, i)).parent_path()))
     throw IOError("frame " + frameName(i) + ": colour image '" + imagePath(2, i) +
                   "' is missing (camera 2's folder holds other frames)");
-  f.scan.reset(new pcl::PointCloud<pcl::PointXYZI>);
-  loadVelodyneBin(scanPath(i), *f.scan);
-  if (f.scan->empty())
-    throw IOError("frame " + frameName(i) + ": scan '" + scanPath(i) + "' has no finite point");
-  f.scan->header.frame_id = kVelodyneFrameId; // the stages carry its stamp into camera 0
-  f.scan->header.stamp = static_cast<std::uint64_t>(std::llround(std::max(0.0, f.timestamp) * 1e6));
-  f.scan->header.seq = static_cast<std::uint32_t>(i);
+  f.scan = loadScan(i);
   f.left = left.get();
   f.right = right.get();
   if (color.valid())

@@ -17,8 +17,8 @@ struct DriveResources {
   std::size_t request_mb = 0; ///< the prediction with a margin, rounded up to kRequestStepMb
   /// Requests are rounded up to steps of this (so that drives of about one size share a job array).
   static constexpr std::size_t kRequestStepMb = 256;
-  /// A margin over the prediction (an upper bound on the volume already, but the rest of the
-  /// process is a model: docs/robustness.md, "Memory budget").
+  /// A margin over the prediction (which holds the measured peaks of the runs in
+  /// docs/results.md, "Memory: predicted and measured peaks"), for drives unlike them.
   static constexpr double kMargin = 1.2;
 };
 

@@ -37,6 +37,7 @@ public:
   std::size_t size() const override { return frames_.size(); }
   std::string frameName(std::size_t i) const override { return frames_.at(i).name; }
   Frame load(std::size_t i, bool with_color = true) const override;
+  pcl::PointCloud<pcl::PointXYZI>::Ptr loadScan(std::size_t i) const override;
   const PoseList& poses() const override { return poses_; }
   std::string posesName() const override { return "poses file '" + poses_file_ + "'"; }
   std::string description() const override { return dir_; }
@@ -52,6 +53,9 @@ private:
     std::string scan, left, right, color;
   };
   void findFrames();
+  void checkIndex(std::size_t i) const;
+  /// A scan file's points as a frame's scan: in the LiDAR's frame, stamped with frame i's time.
+  pcl::PointCloud<pcl::PointXYZI>::Ptr frameScan(pcl::PointCloud<pcl::PointXYZI>&& points, std::size_t i) const;
   void readTimes();
   void readPoses();
 

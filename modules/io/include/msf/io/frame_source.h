@@ -54,6 +54,9 @@ public:
   /// skips the colour camera. Safe to call from another thread than the one that made the
   /// source. Throws IOError naming a missing or malformed file.
   virtual Frame load(std::size_t i, bool with_color = true) const = 0;
+  /// Frame i's scan alone, as load() gives it (Frame::scan), without reading its images: for
+  /// what reads every frame's scan before a run (the memory prediction). Throws as load() does.
+  virtual pcl::PointCloud<pcl::PointXYZI>::Ptr loadScan(std::size_t i) const { return load(i, false).scan; }
 
   /// Frame i's time, seconds from the source's first frame (Frame::timestamp), without loading it.
   virtual double timestamp(std::size_t i) const = 0;

@@ -56,8 +56,11 @@ public:
   /// Loads scan, images and pose of frame i; throws IOError naming a missing file.
   /// Set `with_color` false to skip reading camera 2.
   Frame load(std::size_t i, bool with_color = true) const override;
+  pcl::PointCloud<pcl::PointXYZI>::Ptr loadScan(std::size_t i) const override;
 
 private:
+  void checkIndex(std::size_t i) const;
+
   Layout layout_ = Layout::Odometry;
   std::string dir_, gt_dir_;
   Calibration calibration_;
