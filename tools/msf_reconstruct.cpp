@@ -622,7 +622,7 @@ int main(int argc, char** argv) {
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
-            "depth_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
+            "depth_NNNNNN.png, sky_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
             "run's output (replaced); anything else in it is refused")
       .value("-config", "FILE",
              [&](const std::string& path) {

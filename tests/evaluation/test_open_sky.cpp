@@ -138,13 +138,13 @@ TEST(OpenSkyCoverage, CountsTheSkyPixelsASheetCovers) {
   EXPECT_THROW(coverage.addMask(2, cv::Mat(kHeight, kWidth, CV_8UC3)), InvalidInputError);
 }
 
-TEST(OpenSkyCoverage, DrawsTheSkyBlueAndItsCoveredPixelsRed) {
+TEST(OpenSkyCoverage, DrawsTheSkyCyanAndItsCoveredPixelsRed) {
   cv::Mat mask(kHeight, kWidth, CV_8UC1, cv::Scalar(0)), rendered(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
   mask.rowRange(0, 40).setTo(255);
   rendered.rowRange(0, 20).setTo(10.f);
   const cv::Mat picture =
       OpenSkyCoverage::drawCoverage(cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(100)), mask, rendered);
   EXPECT_EQ(picture.at<cv::Vec3b>(10, 5), cv::Vec3b(50, 50, 177));  // covered sky: red
-  EXPECT_EQ(picture.at<cv::Vec3b>(30, 5), cv::Vec3b(177, 50, 50));  // open sky: blue
+  EXPECT_EQ(picture.at<cv::Vec3b>(30, 5), cv::Vec3b(177, 177, 50)); // open sky: cyan
   EXPECT_EQ(picture.at<cv::Vec3b>(60, 5), cv::Vec3b(100, 100, 100)); // no sky: the image
 }

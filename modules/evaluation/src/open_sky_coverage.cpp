@@ -118,8 +118,8 @@ cv::Mat OpenSkyCoverage::drawCoverage(const cv::Mat& image, const cv::Mat& mask,
     const float* z = rendered.ptr<float>(v);
     cv::Vec3b* p = out.ptr<cv::Vec3b>(v);
     for (int u = 0; u < out.cols; ++u)
-      if (m[u]) // half the pixel, half pure blue (sky) or red (a surface over the sky)
-        p[u] = p[u] / 2 + (z[u] > 0.f ? cv::Vec3b(0, 0, 127) : cv::Vec3b(127, 0, 0));
+      if (m[u]) // half the pixel, half cyan (sky: it shows on a deep blue sky too) or red (a surface over it)
+        p[u] = p[u] / 2 + (z[u] > 0.f ? cv::Vec3b(0, 0, 127) : cv::Vec3b(127, 127, 0));
   }
   return out;
 }

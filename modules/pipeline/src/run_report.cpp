@@ -509,7 +509,7 @@ void RunReport::writeOpenSky(std::ostream& s) const {
       << ") | " << num(c.covered_depth_median_m, 1) << " m |\n";
   s << "\n";
   if (!sky_pictures.empty())
-    s << "The sky in blue, where the mesh covers it in red:\n\n";
+    s << "The sky in cyan, where the mesh covers it in red:\n\n";
   for (const auto& picture : sky_pictures)
     s << "![" << picture << "](" << picture << ")\n\n";
 }

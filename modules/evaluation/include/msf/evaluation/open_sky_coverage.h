@@ -53,7 +53,7 @@ public:
   SkyCoverage scoreMesh(const TriangleMesh& mesh);
 
   /// A picture of one frame: `image` (CV_8UC1 or CV_8UC3 of the camera's size) with its open
-  /// sky tinted blue and the sky a mesh covers (`rendered`: depth, > 0 where a surface is) in
+  /// sky tinted cyan and the sky a mesh covers (`rendered`: depth, > 0 where a surface is) in
   /// red. Throws InvalidInputError for images of another size.
   static cv::Mat drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered);
 

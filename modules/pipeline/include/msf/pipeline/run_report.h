@@ -67,7 +67,7 @@ public:
   std::size_t frames_requested = 0;
   bool interrupted = false;
   /// Optional outputs a second stop signal left out (msf_reconstruct: "compare_sources",
-  /// "mesh_preview", "mesh_accuracy", "reconstruction_evaluation"), in the order skipped.
+  /// "mesh_preview", "mesh_accuracy", "reconstruction_evaluation", "open_sky"), in the order skipped.
   std::vector<std::string> skipped;
   double wall_s = 0;
   double first_frame_s = 0;       ///< when the first frame was done, from the start
