@@ -20,6 +20,7 @@
 #include <msf/pipeline/ring_holdout.h>
 #include <msf/pipeline/run_outputs.h>
 #include <msf/pipeline/run_report.h>
+#include <msf/pipeline/sky_scoring.h>
 #include <msf/pipeline/source_maps.h>
 #include <msf/pipeline/synthetic_scoring.h>
 #include <msf/synthetic/synthetic_generator.h>
@@ -150,6 +151,15 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
     print_info("  no ghost figure: %s\n", e.no_ghosts.c_str());
 }
 
+/// The console's protocol 6 lines: the open sky each mesh covers.
+void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky) {
+  for (const auto& [name, c] : open_sky)
+    print_info("  open sky covered by %-11s %.2f %% of %zu pixels in %zu frames (mean per frame %.2f %%, worst "
+               "%.2f %% at frame %zu), at a median depth of %.1f m\n",
+               name.c_str(), 100 * c.share, c.sky_pixels, c.frames, 100 * c.mean_frame_share, 100 * c.worst_share,
+               c.worst_frame, c.covered_depth_median_m);
+}
+
 void printSummary(const msf::RunReport& report, const std::string& out) {
   print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
   print_value("%.1f fps", report.framesPerSecond());
@@ -164,6 +174,7 @@ void printSummary(const msf::RunReport& report, const std::string& out) {
                100 * report.mesh_accuracy.completeness, report.mesh_accuracy.threshold_m);
   if (!report.map_evaluation.rows.empty())
     printMapEvaluation(report.map_evaluation);
+  printOpenSky(report.open_sky);
   print_info("Report: ");
   print_value("%s/report.md\n", out.c_str());
 }
@@ -206,6 +217,8 @@ public:
     print_info("%s%s; poses: %s\n", request_.holdout ? ", held-out rings removed from every scan" : "",
                request_.compare_sources ? ", with a map of each source alone" : "", poses_.description().c_str());
     engine_->setFrameFilter([this](msf::Frame& frame) {
+      if (sky_)
+        sky_->addFrame(frame); // from the whole scan
       if (request_.holdout)
         holdout_.split(frame);
       poses_.apply(frame);
@@ -371,6 +384,9 @@ private:
           msf::PinholeCamera::fromCalibration(source_.calibration(), 0), source_.calibration().focalBaseline(),
           on_rig_.integrator.max_depth_m, holdout_.config().d1);
     moving_split_ = !request_.holdout && truth_ && truth_->truth().hasMovingMasks();
+    // Protocol 6 renders the whole mesh too.
+    if (!streaming())
+      sky_ = std::make_unique<msf::SkyScoring>(source_.calibration(), config_.projection, panel_frames_);
     if (request_.compare_sources)
       source_maps_ = std::make_unique<msf::SourceMaps>(on_rig_, source_.calibration());
   }
@@ -381,6 +397,11 @@ private:
                               r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms,
                               msf::residentMemoryMb()});
     used_poses_.push_back(r.T_world_cam0);
+    if (sky_) {
+      sky_->setPose(r.index, r.T_world_cam0);
+      pose_of_[r.index] = r.T_world_cam0;
+      name_of_[r.index] = r.name;
+    }
     cv::Mat true_depth;
     if (truth_) {
       true_depth = truth_->depth(r.name);
@@ -588,6 +609,27 @@ private:
                              : "no synthetic ground truth: the places of moving objects are unknown";
       msf::summarizeMapEvaluation(*evaluation_, scores, e);
     }
+    scoreOpenSky(meshes);
+  }
+
+  /// Protocol 6: the open sky each mesh covers, and pictures of the fused mesh's.
+  void scoreOpenSky(const std::map<std::string, msf::SyntheticScoring::MeshToScore>& meshes) {
+    if (!sky_ || meshes.empty())
+      return;
+    if (hurried()) {
+      report_.skipped.push_back("open_sky");
+      return;
+    }
+    TicToc tt;
+    tt.tic();
+    print_highlight("Rendering the mesh%s at every frame's pose over the open sky ", meshes.size() > 1 ? "es" : "");
+    std::map<std::string, const msf::TriangleMesh*> to_score;
+    for (const auto& [name, m] : meshes)
+      to_score[name] = m.mesh;
+    report_.open_sky = sky_->score(to_score);
+    if (meshes.count("mesh"))
+      report_.sky_pictures = sky_->drawPictures(stage_, *meshes.at("mesh").mesh, pose_of_, name_of_);
+    msf::tool::printDone(tt.toc(), to_score.size());
   }
 
   const Request& request_;
@@ -603,6 +645,9 @@ private:
   msf::RunReport report_;
   std::unique_ptr<msf::SyntheticScoring> truth_;
   std::unique_ptr<msf::ReconstructionEvaluation> evaluation_;
+  std::unique_ptr<msf::SkyScoring> sky_;
+  std::map<std::size_t, Eigen::Isometry3d> pose_of_; // of the frames integrated, for protocol 6's pictures
+  std::map<std::size_t, std::string> name_of_;
   bool moving_split_ = false;
   std::unique_ptr<msf::SourceMaps> source_maps_;
   std::unique_ptr<msf::Reconstructor> engine_, paper_;
@@ -627,7 +672,7 @@ int main(int argc, char** argv) {
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
-            "depth_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
+            "depth_NNNNNN.png, sky_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
             "run's output (replaced); anything else in it is refused")
       .value("-config", "FILE",
              [&](const std::string& path) {

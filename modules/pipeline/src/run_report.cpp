@@ -18,6 +18,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <iterator>
 #include <sstream>
 
 namespace msf {
@@ -317,6 +318,18 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     }
     s << "\n    }\n  }";
   }
+  s << ",\n  \"open_sky\": ";
+  if (open_sky.empty())
+    s << "null";
+  for (auto it = open_sky.begin(); it != open_sky.end(); ++it) {
+    const SkyCoverage& c = it->second;
+    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": {\"frames\": " << c.frames
+      << ", \"sky_pixels\": " << c.sky_pixels << ", \"covered_pixels\": " << c.covered_pixels
+      << ", \"share\": " << num(c.share, 6) << ", \"mean_frame_share\": " << num(c.mean_frame_share, 6)
+      << ", \"worst_share\": " << num(c.worst_share, 6) << ", \"worst_frame\": " << c.worst_frame
+      << ", \"covered_depth_median_m\": " << num(c.covered_depth_median_m, 2) << "}"
+      << (std::next(it) == open_sky.end() ? "\n  }" : "");
+  }
   s << ",\n  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
   writeText(path, s.str());
 }
@@ -429,6 +442,8 @@ void RunReport::writeMarkdown(const std::string& path) const {
   }
   if (!map_evaluation.rows.empty())
     writeMapEvaluation(s);
+  if (!open_sky.empty())
+    writeOpenSky(s);
   if (!depth_panels.empty()) {
     s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
          " (and the fused depth's error where ground truth exists).\n\n";
@@ -479,6 +494,24 @@ void RunReport::writeClassTable(std::ostream& s) const {
     s << "\n";
   }
   s << "\n";
+}
+
+void RunReport::writeOpenSky(std::ostream& s) const {
+  s << "## The open sky (evaluation protocol 6)\n\n"
+    << "Each frame's open sky: bright, blank (grey standard deviation over 5x5 pixels), grey-white or blue pixels "
+       "above the highest LiDAR return of their columns, connected to the image's top edge, less a 3-pixel border "
+       "(msf::SkyMask). Each mesh rendered at every frame's pose should leave them empty; the share it covers:\n\n"
+    << "| mesh | frames | sky pixels | covered | mean per frame | worst frame | median depth of the cover |\n"
+    << "|---|---|---|---|---|---|---|\n";
+  for (const auto& [name, c] : open_sky)
+    s << "| " << name << " | " << c.frames << " | " << c.sky_pixels << " | " << num(100 * c.share, 2) << " % | "
+      << num(100 * c.mean_frame_share, 2) << " % | " << num(100 * c.worst_share, 2) << " % (frame " << c.worst_frame
+      << ") | " << num(c.covered_depth_median_m, 1) << " m |\n";
+  s << "\n";
+  if (!sky_pictures.empty())
+    s << "The sky in cyan, where the mesh covers it in red:\n\n";
+  for (const auto& picture : sky_pictures)
+    s << "![" << picture << "](" << picture << ")\n\n";
 }
 
 void RunReport::writeMapEvaluation(std::ostream& s) const {
