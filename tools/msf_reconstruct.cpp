@@ -135,7 +135,9 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
     if (r.has_accuracy)
       print_info("   accuracy %.3f m, completeness %.1f %%", r.accuracy.accuracy_mean_m, 100 * r.accuracy.completeness);
     if (r.has_ghosts)
-      print_info(", ghosts %.2f %%", 100 * r.ghosts.share);
+      print_info(", ghosts %.2f %%, crumbs %zu", 100 * r.ghosts.share, r.crumbs.crumbs);
+    if (r.has_seen_through)
+      print_info(", small pieces seen through %zu", r.seen_through.seen_through);
     print_info("\n");
   }
   // The fused mesh's surest surface as complete as each other mesh (its weight curve).
@@ -592,8 +594,11 @@ private:
       TicToc tt;
       tt.tic();
       print_highlight("Rendering the mesh%s at every frame's pose ", meshes.size() > 1 ? "es" : "");
-      for (const auto& [name, m] : meshes)
+      std::map<std::string, msf::SeenThroughPieces> seen_through;
+      for (const auto& [name, m] : meshes) {
         evaluation_->scoreMesh(name, *m.mesh);
+        seen_through[name] = evaluation_->seenThroughPieces(*m.mesh);
+      }
       msf::tool::printDone(tt.toc(), evaluation_->frames() * meshes.size());
       msf::RunReport::MapEvaluation& e = report_.map_evaluation;
       e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
@@ -607,7 +612,7 @@ private:
       if (!any_ghosts)
         e.no_ghosts = truth_ ? truth_->noGhostsReason()
                              : "no synthetic ground truth: the places of moving objects are unknown";
-      msf::summarizeMapEvaluation(*evaluation_, scores, e);
+      msf::summarizeMapEvaluation(*evaluation_, scores, seen_through, e);
     }
     scoreOpenSky(meshes);
   }

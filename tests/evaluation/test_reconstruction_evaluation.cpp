@@ -1,7 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-// Evaluation protocol 4 on analytic scenes with known answers, and the ghost metric on
-// hand-made vertices.
+// Evaluation protocol 4 on analytic scenes with known answers, and the ghost and crumb metrics
+// on hand-made meshes.
 #include <msf/common/exceptions.h>
+#include <msf/evaluation/crumb_metric.h>
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
 
@@ -33,6 +34,33 @@ TriangleMesh square(float x, float y, float z, float side) {
 }
 
 cv::Mat constantDepth(float z) { return cv::Mat(80, 100, CV_32FC1, cv::Scalar(z)); }
+
+/// `pieces` side by side in one mesh, each a connected piece of its own.
+TriangleMesh joined(const std::vector<TriangleMesh>& pieces) {
+  TriangleMesh mesh;
+  for (const TriangleMesh& piece : pieces) {
+    const auto offset = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), piece.vertices.begin(), piece.vertices.end());
+    for (const auto& t : piece.triangles)
+      mesh.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  mesh.colors.resize(mesh.vertices.size());
+  return mesh;
+}
+
+/// A strip of 2 n triangles along x, from (x, y, z) to (x + n step, y + step, z): one piece.
+TriangleMesh strip(float x, float y, float z, int n, float step) {
+  TriangleMesh mesh;
+  for (int i = 0; i <= n; ++i) {
+    mesh.vertices.push_back({x + i * step, y, z});
+    mesh.vertices.push_back({x + i * step, y + step, z});
+  }
+  for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(n); ++i) {
+    mesh.triangles.push_back({2 * i, 2 * i + 2, 2 * i + 1});
+    mesh.triangles.push_back({2 * i + 1, 2 * i + 2, 2 * i + 3});
+  }
+  return mesh;
+}
 
 /// Pixels whose centre sees the world point x in [x0, x1], y in [y0, y1] at depth z, from the origin.
 int footprint(float z, float x0, float x1, float y0, float y1) {
@@ -162,4 +190,61 @@ TEST(GhostMetric, CountsVerticesFarFromTheStaticSurfaceWhereAMovingObjectWas) {
   EXPECT_THROW(measureGhosts(vertices, ground, MovingSpace(), 0.2), InvalidInputError);
   EXPECT_THROW(measureGhosts(vertices, ground, was_moving, 0.0), InvalidInputError);
   EXPECT_EQ(measureGhosts({}, ground, was_moving).share, 0.0);
+}
+
+TEST(CrumbMetric, CountsSmallPiecesOffTheStaticSurfaceWhereAMovingObjectWas) {
+  // The static surface: the ground y = 0 and a bollard's face, the square x in [9.9, 10.1],
+  // y in [-1, 0] at z = 5. A car drove through the box x in [0, 2], y in [-2, 0], z in [5, 9].
+  const SurfaceDistance truth({{-50.f, 0.f, -50.f}, {50.f, 0.f, -50.f}, {50.f, 0.f, 50.f}, {-50.f, 0.f, 50.f},
+                               {9.9f, -1.f, 5.f}, {10.1f, -1.f, 5.f}, {10.1f, 0.f, 5.f}, {9.9f, 0.f, 5.f}},
+                              {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}});
+  const MovingSpace was_moving = [](const Eigen::Vector3f& p) {
+    return p.x() >= 0.f && p.x() <= 2.f && p.y() >= -2.f && p.y() <= 0.f && p.z() >= 5.f && p.z() <= 9.f;
+  };
+  const TriangleMesh mesh = joined({
+      strip(0.5f, -1.f, 6.f, 3, 0.1f),      // a crumb of the car, 1 m above the road: 6 triangles
+      strip(0.5f, -1.f, 7.f, 30, 0.04f),    // the car's side, 60 triangles: a ghost, not a crumb
+      strip(9.9f, -0.5f, 5.f, 2, 0.1f),     // the bollard's face: small, on the static surface
+      strip(0.5f, -0.05f, 8.f, 3, 0.1f),    // the road under the car: small, within 0.2 m of it
+      strip(20.f, -3.f, 6.f, 2, 0.1f),      // a floating speck where no car was
+      strip(-20.f, 0.f, 6.f, 40, 0.1f),     // the road: a large piece
+  });
+  const CrumbMetrics m = measureCrumbs(mesh, truth, was_moving, 50, 0.2);
+  EXPECT_EQ(m.pieces, 6u);
+  EXPECT_EQ(m.small_pieces, 4u);
+  EXPECT_EQ(m.crumbs, 1u);
+  EXPECT_EQ(m.crumb_triangles, 6u);
+  EXPECT_EQ(m.specks, 1u);
+  EXPECT_EQ(m.max_triangles, 50u);
+  EXPECT_DOUBLE_EQ(m.distance_m, 0.2);
+  // Under a larger bar for "small", the car's side is a crumb too.
+  EXPECT_EQ(measureCrumbs(mesh, truth, was_moving, 100, 0.2).crumbs, 2u);
+  EXPECT_THROW(measureCrumbs(mesh, truth, MovingSpace(), 50, 0.2), InvalidInputError);
+  EXPECT_THROW(measureCrumbs(mesh, truth, was_moving, 50, 0.0), InvalidInputError);
+  EXPECT_THROW(measureCrumbs(mesh, truth, was_moving, 0, 0.2), InvalidInputError);
+}
+
+TEST(ReconstructionEvaluation, SmallPiecesInFrontOfTheTrueDepthAreSeenThrough) {
+  // Ground truth: a wall at 10 m. A small piece floats at 5 m (the truth lies behind it: seen
+  // through), another lies on the wall, a large piece floats at 5 m, a small one is out of view.
+  ReconstructionEvaluation evaluation(camera(), kFocalBaseline, 40.0);
+  evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(10.f));
+  const TriangleMesh mesh = joined({
+      strip(-1.f, -1.f, 5.f, 4, 0.1f),      // 8 triangles in front of the wall
+      strip(1.f, 1.f, 10.f, 4, 0.1f),       // 8 triangles on it
+      strip(-2.f, 0.5f, 5.f, 30, 0.02f),    // 60 triangles in front of it
+      strip(100.f, 0.f, 5.f, 4, 0.1f),      // out of the image
+  });
+  const SeenThroughPieces seen = evaluation.seenThroughPieces(mesh, 50);
+  EXPECT_EQ(seen.pieces, 4u);
+  EXPECT_EQ(seen.small_pieces, 3u);
+  EXPECT_EQ(seen.seen_through, 1u);
+  EXPECT_EQ(seen.triangles, 8u);
+  EXPECT_EQ(seen.max_triangles, 50u);
+  // A bar above 60 triangles takes in the large piece too; a wall at 5.05 m is within D1.
+  EXPECT_EQ(evaluation.seenThroughPieces(mesh, 61).seen_through, 2u);
+  ReconstructionEvaluation near_wall(camera(), kFocalBaseline, 40.0);
+  near_wall.addGroundTruth(0, Eigen::Isometry3d::Identity(), constantDepth(5.05f));
+  EXPECT_EQ(near_wall.seenThroughPieces(mesh, 50).seen_through, 0u);
+  EXPECT_THROW(evaluation.seenThroughPieces(mesh, 0), InvalidInputError);
 }

@@ -91,6 +91,13 @@ TEST(ReconstructEvaluation, HoldoutOnKittiScoresTheMeshesBesideTheFusedDepth) {
             jsonNumber(rowOf(json, "fused"), "d1_all", "within_range"));
   // Where the mesh has depth, it is the held-out surface most of the time.
   EXPECT_LT(jsonNumber(rowOf(json, "mesh"), "d1_estimated", "within_range"), 0.2);
+  // Its small pieces the held-out rings see through: some of its small pieces, at most.
+  const std::string mesh_row = rowOf(json, "mesh");
+  const double small_pieces = jsonNumber(mesh_row, "small_pieces", "seen_through");
+  EXPECT_GT(small_pieces, 0.0);
+  EXPECT_LE(small_pieces, jsonNumber(mesh_row, "all_pieces", "seen_through"));
+  EXPECT_LE(jsonNumber(mesh_row, "pieces", "seen_through"), small_pieces);
+  EXPECT_EQ(jsonNumber(mesh_row, "max_triangles", "seen_through"), 50);
   for (const char* file : {"mesh.ply", "mesh_lidar.ply", "mesh_stereo.ply", "config.yaml", "report.md"})
     EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
   EXPECT_NE(readFile(out.file("report.md")).find("evaluation protocol 4"), std::string::npos);
@@ -141,6 +148,12 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_GT(ghosts, 0.0);
   EXPECT_LT(ghosts, 0.5);
   EXPECT_GT(jsonNumber(mesh, "vertices", "ghosts"), 1000.0);
+  // Crumbs and specks are small pieces, which are pieces.
+  const double small_pieces = jsonNumber(mesh, "small_pieces", "crumbs");
+  EXPECT_LE(jsonNumber(mesh, "crumbs", "crumbs") + jsonNumber(mesh, "specks", "crumbs"), small_pieces);
+  EXPECT_LE(small_pieces, jsonNumber(mesh, "pieces", "crumbs"));
+  EXPECT_EQ(jsonNumber(mesh, "max_triangles", "crumbs"), 50);
+  EXPECT_NE(readFile(out.file("report.md")).find("| ghosts | crumbs | specks |"), std::string::npos);
   EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
   // Split by the class of the nearest true surface (gt/scene_classes.txt): the parts add up
   // to the mean (each rounded to 4 digits), and the road is there, meshed nearly whole.

@@ -82,6 +82,23 @@ TEST(MeshComponents, PiecesJoinThroughASharedVertexOnly) {
   EXPECT_TRUE(mesh.vertices.empty());
 }
 
+TEST(MeshComponents, EachVertexIsLabelledByItsPiecesSmallestVertex) {
+  // Two strips of 3 and 4 vertex pairs, and a vertex no triangle uses.
+  TriangleMesh mesh;
+  addStrip(mesh, 2, 0.f, 1);
+  addStrip(mesh, 3, 1.f, 2);
+  mesh.vertices.emplace_back(9.f, 9.f, 9.f);
+  const std::vector<std::uint32_t> label = componentLabels(mesh);
+  ASSERT_EQ(label.size(), 15u);
+  for (std::uint32_t v = 0; v < 6; ++v)
+    EXPECT_EQ(label[v], 0u);
+  for (std::uint32_t v = 6; v < 14; ++v)
+    EXPECT_EQ(label[v], 6u);
+  EXPECT_EQ(label[14], 14u);
+  mesh.triangles.push_back({0, 1, 15});
+  EXPECT_THROW(componentLabels(mesh), InvalidInputError);
+}
+
 TEST(MeshComponents, ZeroOrOneKeepsEverything) {
   TriangleMesh mesh;
   addStrip(mesh, 1, 0.f, 1);

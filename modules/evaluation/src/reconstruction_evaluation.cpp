@@ -1,8 +1,11 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
+#include <msf/reconstruction/mesh_components.h>
 
+#include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace msf {
 
@@ -100,6 +103,81 @@ void ReconstructionEvaluation::scoreMesh(const std::string& source, const Triang
     rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_);
     score(r, truth, rendered_);
   }
+}
+
+SeenThroughPieces ReconstructionEvaluation::seenThroughPieces(const TriangleMesh& mesh,
+                                                              std::size_t max_triangles) const {
+  if (max_triangles == 0)
+    throw InvalidInputError("protocol 4: a small piece must be allowed at least one triangle");
+  SeenThroughPieces out;
+  out.max_triangles = max_triangles;
+  const std::vector<std::uint32_t> piece = componentLabels(mesh);
+  std::unordered_map<std::uint32_t, std::size_t> triangles;
+  for (const auto& t : mesh.triangles)
+    ++triangles[piece[t[0]]];
+  out.pieces = triangles.size();
+  std::vector<std::uint32_t> small_vertices;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const auto it = triangles.find(piece[v]);
+    if (it != triangles.end() && it->second < max_triangles)
+      small_vertices.push_back(static_cast<std::uint32_t>(v));
+  }
+
+  // Per small vertex: 1 met ground truth, 2 was seen through.
+  std::vector<std::uint8_t> state(small_vertices.size(), 0);
+  const std::lock_guard<std::mutex> lock(mutex_);
+  cv::Mat truth_depth(camera_.height, camera_.width, CV_32FC1);
+  const auto width = static_cast<std::uint32_t>(camera_.width);
+  for (const auto& [frame, truth] : frames_) {
+    truth_depth.setTo(0.f);
+    for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
+      const std::uint32_t pixel = truth.pixels[k] & ~kMoving;
+      truth_depth.at<float>(static_cast<int>(pixel / width), static_cast<int>(pixel % width)) = truth.depth[k];
+    }
+    const Eigen::Isometry3f T_cam_world = truth.T_world_cam.inverse().cast<float>();
+    for (std::size_t i = 0; i < small_vertices.size(); ++i)
+      state[i] = std::max(state[i], seenThrough(T_cam_world * mesh.vertices[small_vertices[i]], truth_depth));
+  }
+
+  std::unordered_map<std::uint32_t, std::pair<std::size_t, std::size_t>> met_seen; // per small piece
+  for (std::size_t i = 0; i < small_vertices.size(); ++i) {
+    auto& [met, seen] = met_seen[piece[small_vertices[i]]];
+    met += state[i] > 0;
+    seen += state[i] > 1;
+  }
+  for (const auto& [label, count] : triangles)
+    if (count < max_triangles) {
+      ++out.small_pieces;
+      const auto& [met, seen] = met_seen[label];
+      if (2 * seen > met) {
+        ++out.seen_through;
+        out.triangles += count;
+      }
+    }
+  return out;
+}
+
+std::uint8_t ReconstructionEvaluation::seenThrough(const Eigen::Vector3f& p_cam, const cv::Mat& truth_depth) const {
+  if (!(p_cam.z() > 0.f))
+    return 0;
+  const int u = static_cast<int>(std::lround(camera_.fx * p_cam.x() / p_cam.z() + camera_.cx));
+  const int v = static_cast<int>(std::lround(camera_.fy * p_cam.y() / p_cam.z() + camera_.cy));
+  if (u < 1 || v < 1 || u >= camera_.width - 1 || v >= camera_.height - 1)
+    return 0;
+  const double vertex_disparity = focal_baseline_ / p_cam.z();
+  bool met = false;
+  for (int dv = -1; dv <= 1; ++dv)
+    for (int du = -1; du <= 1; ++du) {
+      const float z = truth_depth.at<float>(v + dv, u + du);
+      if (!(z > 0.f))
+        continue;
+      met = true;
+      const double true_disparity = focal_baseline_ / z;
+      const double in_front = vertex_disparity - true_disparity; // > 0: the vertex is nearer
+      if (!(in_front > d1_.abs_px && in_front > d1_.rel * true_disparity))
+        return 1;
+    }
+  return met ? 2 : 0;
 }
 
 std::size_t ReconstructionEvaluation::frames() const {

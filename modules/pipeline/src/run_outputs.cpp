@@ -61,6 +61,7 @@ void writeTrajectory(const std::string& dir, const PoseList& used, const std::ve
 
 void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
                             const std::map<std::string, SyntheticScoring::MeshScores>& mesh_scores,
+                            const std::map<std::string, SeenThroughPieces>& seen_through,
                             RunReport::MapEvaluation& out) {
   out.frames = evaluation.frames();
   out.gt_pixels = evaluation.groundTruthPixels();
@@ -76,6 +77,12 @@ void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
           row.accuracy = it->second.accuracy;
           row.has_ghosts = it->second.has_ghosts;
           row.ghosts = it->second.ghosts;
+          row.crumbs = it->second.crumbs;
+        }
+        const auto seen = seen_through.find(source);
+        if (seen != seen_through.end()) {
+          row.has_seen_through = true;
+          row.seen_through = seen->second;
         }
         out.rows.push_back(row);
       }

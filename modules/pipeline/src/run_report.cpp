@@ -313,7 +313,15 @@ void RunReport::writeSummaryJson(const std::string& path) const {
       if (r.has_ghosts)
         s << ",\n" << in << "\"ghosts\": {\"share\": " << num(r.ghosts.share, 6) << ", \"ghost_vertices\": "
           << r.ghosts.ghost_vertices << ", \"vertices\": " << r.ghosts.vertices << ", \"distance_m\": "
-          << num(r.ghosts.distance_m) << "}";
+          << num(r.ghosts.distance_m) << "},\n"
+          << in << "\"crumbs\": {\"crumbs\": " << r.crumbs.crumbs << ", \"crumb_triangles\": " << r.crumbs.crumb_triangles
+          << ", \"specks\": " << r.crumbs.specks << ", \"small_pieces\": " << r.crumbs.small_pieces
+          << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles << "}";
+      if (r.has_seen_through)
+        s << ",\n" << in << "\"seen_through\": {\"pieces\": " << r.seen_through.seen_through << ", \"triangles\": "
+          << r.seen_through.triangles << ", \"small_pieces\": " << r.seen_through.small_pieces
+          << ", \"all_pieces\": " << r.seen_through.pieces << ", \"max_triangles\": " << r.seen_through.max_triangles
+          << "}";
       s << "\n      }";
     }
     s << "\n    }\n  }";
@@ -525,13 +533,14 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
          "farther."
     << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
     << "\n\n";
-  bool accuracy = false, ghosts = false;
+  bool accuracy = false, ghosts = false, seen = false;
   for (const auto& r : e.rows)
-    accuracy |= r.has_accuracy, ghosts |= r.has_ghosts;
+    accuracy |= r.has_accuracy, ghosts |= r.has_ghosts, seen |= r.has_seen_through;
   auto table = [&](const char* what, auto in_range, auto all) {
     s << "| " << what << " | pixels in range | coverage | D1 | D1 on estimates | MAE m | pixels | coverage | D1 | MAE m |"
-      << (accuracy ? " accuracy m | completeness |" : "") << (ghosts ? " ghosts |" : "") << "\n|---|---|---|---|---|---|---|---|---|---|"
-      << (accuracy ? "---|---|" : "") << (ghosts ? "---|" : "") << "\n";
+      << (accuracy ? " accuracy m | completeness |" : "") << (ghosts ? " ghosts | crumbs | specks |" : "") << (seen ? " pieces seen through |" : "")
+      << "\n|---|---|---|---|---|---|---|---|---|---|" << (accuracy ? "---|---|" : "") << (ghosts ? "---|---|---|" : "")
+      << (seen ? "---|" : "") << "\n";
     for (const auto& r : e.rows) {
       const DepthMetrics &a = in_range(r.score), &b = all(r.score);
       s << "| " << r.score.source << " | " << a.gt_pixels << " | " << num(a.coverage, 3) << " | "
@@ -543,7 +552,11 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
                                    " % |"
                              : " | |");
       if (ghosts)
-        s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % |" : " |");
+        s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % | " + std::to_string(r.crumbs.crumbs) + " | " +
+                                 std::to_string(r.crumbs.specks) + " |"
+                           : " | | |");
+      if (seen)
+        s << (r.has_seen_through ? " " + std::to_string(r.seen_through.seen_through) + " |" : " |");
       s << "\n";
     }
     s << "\n";
@@ -583,7 +596,14 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
     s << "No ghost figure: " << e.no_ghosts << ".\n";
   else if (ghosts)
     s << "Ghosts: share of the mesh's vertices farther than " << num(e.rows.front().ghosts.distance_m)
-      << " m from the static true surface inside the space a moving object occupied.\n";
+      << " m from the static true surface inside the space a moving object occupied; crumbs (specks): pieces of "
+         "fewer than "
+      << e.rows.front().crumbs.max_triangles
+      << " triangles mostly that far from it, inside that space (elsewhere).\n";
+  if (seen)
+    s << "Pieces seen through: pieces of fewer than " << e.rows.front().seen_through.max_triangles
+      << " triangles most of whose vertices lie in front of the true depth by more than D1's threshold at some "
+         "frame: the ground truth saw through them.\n";
   s << "\n";
 }
 

@@ -8,6 +8,7 @@ namespace msf {
 
 namespace {
 constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
+constexpr std::size_t kCrumbTriangles = 50; // a piece this small is a speck to the eye (a few voxels' faces)
 } // namespace
 
 SyntheticScoring::SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes)
@@ -90,6 +91,7 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
                               classes_ ? &*classes_ : nullptr);
     if (was_moving) {
       s.ghosts = measureGhosts(m.mesh->vertices, *static_surface, was_moving, kGhostDistanceM);
+      s.crumbs = measureCrumbs(*m.mesh, *static_surface, was_moving, kCrumbTriangles, kGhostDistanceM);
       s.has_ghosts = true;
     }
   }

@@ -36,6 +36,24 @@ private:
 };
 } // namespace
 
+std::vector<std::uint32_t> componentLabels(const TriangleMesh& mesh) {
+  const std::size_t n = mesh.vertices.size();
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (const std::uint32_t v : mesh.triangles[t])
+      if (v >= n)
+        throw InvalidInputError("mesh triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
+                                " of " + std::to_string(n));
+  DisjointSets sets(n);
+  for (const auto& t : mesh.triangles) {
+    sets.join(t[0], t[1]);
+    sets.join(t[0], t[2]);
+  }
+  std::vector<std::uint32_t> label(n);
+  for (std::size_t v = 0; v < n; ++v)
+    label[v] = sets.find(static_cast<std::uint32_t>(v));
+  return label;
+}
+
 ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight) {
   const std::size_t n = mesh.vertices.size();
   if (mesh.colors.size() != n)
@@ -45,26 +63,17 @@ ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_t
   if (weighted && mesh.weights.size() != n)
     throw InvalidInputError("mesh has " + std::to_string(n) + " vertices but " + std::to_string(mesh.weights.size()) +
                             " weights");
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (const std::uint32_t v : mesh.triangles[t])
-      if (v >= n)
-        throw InvalidInputError("mesh triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
-                                " of " + std::to_string(n));
 
-  DisjointSets sets(n);
-  for (const auto& t : mesh.triangles) {
-    sets.join(t[0], t[1]);
-    sets.join(t[0], t[2]);
-  }
-  // Triangles per piece, counted at the piece's root; a piece with a vertex of keep_weight or
+  const std::vector<std::uint32_t> piece = componentLabels(mesh);
+  // Triangles per piece, counted at the piece's label; a piece with a vertex of keep_weight or
   // more counts as large.
   std::vector<std::uint32_t> size(n, 0);
   for (const auto& t : mesh.triangles)
-    ++size[sets.find(t[0])];
+    ++size[piece[t[0]]];
   if (weighted && keep_weight > 0.f)
     for (std::size_t v = 0; v < n; ++v)
       if (mesh.weights[v] >= keep_weight) {
-        std::uint32_t& s = size[sets.find(static_cast<std::uint32_t>(v))];
+        std::uint32_t& s = size[piece[v]];
         s = s > 0 ? std::max<std::uint32_t>(s, static_cast<std::uint32_t>(min_triangles)) : 0;
       }
 
@@ -82,7 +91,7 @@ ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_t
   std::vector<std::uint32_t> index(n, kDropped);
   std::uint32_t kept = 0;
   for (std::size_t v = 0; v < n; ++v)
-    if (size[sets.find(static_cast<std::uint32_t>(v))] >= min_triangles) {
+    if (size[piece[v]] >= min_triangles) {
       index[v] = kept;
       mesh.vertices[kept] = mesh.vertices[v];
       mesh.colors[kept] = mesh.colors[v];

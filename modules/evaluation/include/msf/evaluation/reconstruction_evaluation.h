@@ -28,6 +28,16 @@ struct ReconstructionScore {
   DepthMetrics moving_within_range;
 };
 
+/// The small pieces of a mesh that the ground truth sees through: crumbs on real frames, where
+/// no one knows where moving objects were.
+struct SeenThroughPieces {
+  std::size_t pieces = 0;        ///< connected pieces of the mesh
+  std::size_t small_pieces = 0;  ///< of those, with fewer than max_triangles triangles
+  std::size_t seen_through = 0;  ///< small pieces in front of the true depth (see seenThroughPieces)
+  std::size_t triangles = 0;     ///< their triangles
+  std::size_t max_triangles = 0; ///< what "small" means
+};
+
 /// Evaluation protocol 4 (docs/design.md): the reconstruction against ground truth it never saw.
 /// The ground truth of each frame (protocol 2's held-out rings projected into camera 0, or a
 /// synthetic sequence's exact depth) is kept as the list of its pixels, not as images, so a
@@ -64,6 +74,12 @@ public:
   void scoreDepth(const std::string& source, std::size_t frame, const cv::Mat& depth);
   /// Renders `mesh` at every frame's pose and scores it as row `source`.
   void scoreMesh(const std::string& source, const TriangleMesh& mesh);
+  /// The pieces of `mesh` with fewer than `max_triangles` triangles that lie in front of the
+  /// ground truth: a vertex is seen through when, at some frame, the true depth is known in the
+  /// 3x3 pixels it projects to and all of it lies behind the vertex by more than D1's
+  /// threshold (the held-out ring passed through it); a piece is, when more than half of its
+  /// vertices that met ground truth were. Throws InvalidInputError when max_triangles is 0.
+  SeenThroughPieces seenThroughPieces(const TriangleMesh& mesh, std::size_t max_triangles = 50) const;
 
   std::size_t frames() const;
   /// Ground-truth pixels kept over all frames (static and moving).
@@ -86,6 +102,9 @@ private:
   Row& row(const std::string& source);
   void score(Row& row, const FrameTruth& truth, const cv::Mat& depth) const;
   void checkImage(const cv::Mat& image, int type, const std::string& what) const;
+  /// 2 when all true depth around p_cam's pixel lies behind it (D1), 1 when some does not, 0
+  /// when it has none.
+  std::uint8_t seenThrough(const Eigen::Vector3f& p_cam, const cv::Mat& truth_depth) const;
 
   PinholeCamera camera_;
   double focal_baseline_, max_depth_m_;

@@ -28,9 +28,11 @@ void writeTrajectory(const std::string& dir, const PoseList& used, const std::ve
                      RunReport& report);
 
 /// Protocol 4's rows for the report: each source the evaluation scored, in a fixed order, with
-/// its mesh's accuracy and ghosts where the ground truth gave them.
+/// its mesh's accuracy and ghosts where the ground truth gave them, and the small pieces the
+/// ground truth sees through.
 void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
                             const std::map<std::string, SyntheticScoring::MeshScores>& mesh_scores,
+                            const std::map<std::string, SeenThroughPieces>& seen_through,
                             RunReport::MapEvaluation& out);
 
 } // namespace msf

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/evaluation/crumb_metric.h>
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
@@ -43,8 +44,11 @@ public:
       ReconstructionScore score;   ///< source "mesh", "fused", "mesh_lidar" or "mesh_stereo"
       bool has_accuracy = false;   ///< a mesh against the true surface (synthetic)
       MeshAccuracy accuracy;
-      bool has_ghosts = false;     ///< a mesh where moving objects were
+      bool has_ghosts = false;     ///< a mesh where moving objects were: ghosts and crumbs
       GhostMetrics ghosts;
+      CrumbMetrics crumbs;
+      bool has_seen_through = false; ///< a mesh: its small pieces the ground truth sees through
+      SeenThroughPieces seen_through;
     };
     std::string truth;             ///< what the ground truth is, in words
     double range_m = 0;            ///< "within range": true depth <= this (tsdf_integrator.max_depth_m)

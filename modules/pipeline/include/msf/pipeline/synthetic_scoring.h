@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/evaluation/crumb_metric.h>
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
@@ -51,8 +52,9 @@ public:
   };
   struct MeshScores {
     MeshAccuracy accuracy;
-    bool has_ghosts = false;
+    bool has_ghosts = false;  ///< ghosts and crumbs: the dataset has moving-object boxes
     GhostMetrics ghosts;
+    CrumbMetrics crumbs;
   };
   /// Each mesh against the true surface; `voxel_size_m` sets the completeness threshold (2
   /// voxels) and the margin around moving boxes (a voxel).

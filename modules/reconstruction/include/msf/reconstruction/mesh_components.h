@@ -3,6 +3,8 @@
 #include <msf/reconstruction/marching_cubes.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 namespace msf {
 
@@ -13,6 +15,11 @@ struct ComponentFilterStats {
   std::size_t triangles_removed = 0;
   std::size_t vertices_removed = 0;
 };
+
+/// The connected piece of each vertex of `mesh` (triangles joined through shared vertices),
+/// named by the piece's smallest vertex index; a vertex no triangle uses is a piece of its own.
+/// Throws InvalidInputError when a triangle names a vertex the mesh does not have.
+std::vector<std::uint32_t> componentLabels(const TriangleMesh& mesh);
 
 /// Removes the connected pieces of `mesh` (triangles joined through shared vertices) that have
 /// fewer than `min_triangles` triangles, with the vertices only they use. Such specks come
