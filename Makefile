@@ -8,9 +8,10 @@ KITTI_DIR ?= $(abspath ../shared/data/kitti)
 DEMO_OUT ?= out/demo
 
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
-# time: GNU time, which the bad-input matrix measures each case's memory with.
+# time: GNU time, which the bad-input matrix measures each case's memory with; python3-yaml:
+# PyYAML, which a test reads and writes the configuration files with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
-                libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time
+                libflann-dev libboost-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev python3-yaml pcl-tools time
 # Only `make fuzz` needs these: clang's libFuzzer, and an OpenMP runtime for clang (the
 # project's code no longer uses OpenMP, but the fuzz build was not tried without it).
 FUZZ_PACKAGES := clang libomp-dev
