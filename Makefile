@@ -1,4 +1,5 @@
-# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | demo | bench | install | clean
+# Thin wrapper over CMake: make deps | build | test | test-sanitize | fuzz | config-files | demo | bench | install |
+# clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -20,7 +21,8 @@ BENCH_PACKAGES := python3-open3d python3-numpy
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-bench deps-fuzz build test test-sanitize test-sanitize-fast fuzz demo bench install clean \
+        config-files
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -28,10 +30,12 @@ SANITIZE_BUILD_DIR ?= build-sanitize
 SANITIZE_FLAGS := -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
                   -fno-omit-frame-pointer
 # `make fuzz`: each libFuzzer target of fuzz/ runs FUZZ_SECONDS from a seed corpus made of
-# the KITTI sample; crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/.
+# the KITTI sample (and the configuration files); crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/.
+# Inputs are at most 64 KB, the config target's 1 MiB: a YAML file nested deeply enough to
+# reach yaml-cpp's depth guard in every form is larger than 64 KB.
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := cloud calibration poses velodyne
+FUZZ_TARGETS := cloud calibration poses velodyne config
 
 all: build
 
@@ -102,13 +106,20 @@ fuzz: deps-fuzz
 	@for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/findings/$$t; \
 	  echo "== fuzz_$$t: $(FUZZ_SECONDS) s"; \
-	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=65536 \
+	  max_len=65536; [ $$t = config ] && max_len=1048576; \
+	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=$$max_len \
 	    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
 	    -artifact_prefix=$(FUZZ_BUILD_DIR)/findings/$$t/ \
 	    $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/seeds/$$t 2>&1 | \
 	    tee $(FUZZ_BUILD_DIR)/fuzz_$$t.log | grep -E "^(#[0-9]+ *DONE|stat::number_of_executed_units|stat::average_exec_per_sec|==[0-9]+==ERROR|SUMMARY)" ; \
 	  test $${PIPESTATUS[0]} -eq 0 || { echo "fuzz_$$t found a crash: $(FUZZ_BUILD_DIR)/findings/$$t/"; exit 1; }; \
 	done
+
+# The files made from the configuration keys' declarations in the code: config/kitti.yaml,
+# synthetic.yaml, paper.yaml and docs/configuration.md (a test fails when one is out of date).
+config-files: $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j$(JOBS) --target msf_config
+	$(BUILD_DIR)/bin/msf_config -write .
 
 demo: deps
 	$(MAKE) build

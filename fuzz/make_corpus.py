@@ -3,8 +3,9 @@
 
     make_corpus.py KITTI_DIR OUT_DIR
 
-Writes OUT_DIR/<target>/<seed> for the targets cloud, calibration, poses and velodyne; the
-first byte of a seed picks the format where a target reads several (see fuzz_*.cpp).
+Writes OUT_DIR/<target>/<seed> for the targets cloud, calibration, poses, velodyne and config
+(its seeds are the project's own configuration files); the first byte of a seed picks the
+format where a target reads several (see fuzz_*.cpp).
 """
 import os
 import struct
@@ -85,3 +86,11 @@ poses = read(os.path.join(kitti, "odometry", "poses", "04.txt")).splitlines(True
 put("poses", "poses.txt", b"\1" + b"".join(poses[:20]))
 oxts = os.path.join(raw, "2011_09_26_drive_0009_sync", "oxts", "data")
 put("poses", "oxts.txt", b"\0" + read(os.path.join(oxts, sorted(os.listdir(oxts))[0])))
+
+# Configurations: the shipped files, flow style, and a file nested 33000 levels deep (66 KB),
+# beyond yaml-cpp's depth guard, whose mutations keep the fuzzer at that guard.
+source = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+for name in ("kitti", "synthetic", "paper"):
+    put("config", name + ".yaml", read(os.path.join(source, "config", name + ".yaml")))
+put("config", "flow.yaml", b"stereo: {block_size_px: 7, mode: sgbm_3way}\nlambda_study: {noise_mm: [0, 5.5]}\n")
+put("config", "deep.yaml", b"stereo:\n  p1: " + b"[" * 33000 + b"]" * 33000 + b"\n")

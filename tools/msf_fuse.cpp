@@ -1,7 +1,7 @@
 // Paper step 4: fuses an interpolated LiDAR cloud and a stereo cloud of one camera (both
 // organized, same size) into one organized cloud, per pixel (eq. 6 or inverse variance).
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/depth_fusion.h>
@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
       "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "fusion", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config, section fusion")
       .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
              "paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)")
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
     const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
 
     TicToc tt;

@@ -2,7 +2,7 @@
 // poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
 // -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/fusion_config.h>
@@ -67,11 +67,10 @@ int main(int argc, char** argv) {
              "and pixels")
       .value("-config", "FILE",
              [&](const std::string& path) {
-               const msf::ConfigFile file(path);
-               volume_config.read(file.section("tsdf_volume"));
-               config.read(file.section("tsdf_integrator"));
-               fusion.read(file.section("fusion"));
-               file.rejectUnknownKeys();
+               const msf::ConfigFile file = msf::openConfigFile(path);
+               file.read(volume_config);
+               file.read(config);
+               file.read(fusion);
              },
              "YAML with sections tsdf_volume, tsdf_integrator and fusion (the LiDAR's range noise); the options "
              "below override it")
@@ -113,8 +112,8 @@ int main(int argc, char** argv) {
     msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
     msf::TsdfIntegrator integrator(volume, config);
     if (print_config) {
-      volume_config.print(std::cout);
-      config.print(std::cout);
+      msf::printConfig(std::cout, volume_config);
+      msf::printConfig(std::cout, config);
     }
 
     msf::PoseList poses = msf::loadOdometryPoses(poses_path);

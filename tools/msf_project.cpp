@@ -1,6 +1,6 @@
 // Paper step 1: a Velodyne scan into an organized cloud of one camera's image.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
                              "per pixel, reflectance kept, NaN where no return lands.");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML camera file")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "projection", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config, section projection; the options below override it")
       .value("-camera", "N", config.camera,
              "rectified camera 0..3 (default: {default}, or projection.camera of -config)")

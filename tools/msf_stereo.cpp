@@ -2,7 +2,7 @@
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
       .value("-prior", "PATH", prior_path,
              "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
              "real returns (distance 0) guide it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "stereo", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config, section stereo (every SGBM parameter); the options below override it")
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
     config.validate();
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     TicToc tt;
     tt.tic();

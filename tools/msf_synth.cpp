@@ -1,5 +1,5 @@
 // Writes a synthetic street in KITTI's odometry layout, with exact ground truth.
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/common/stop_signals.h>
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
       "    synthetic.yaml (scene.ply is the static world; moving_* are the driving cars)\n"
       "Every msf_* tool reads DIR (or DIR/sequences/00) as a sequence. Byte-identical for a seed.");
   cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
       .value("-frames", "N", config.frames, "number of frames (default {default})")
       .value("-seed", "S", config.seed, "random seed, a whole number >= 0 (default {default})")
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     if (output.empty())
       throw msf::InvalidInputError("no output folder: give -o DIR");
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     TicToc tt;
     tt.tic();

@@ -187,6 +187,14 @@ yaml(f + "/nan.yaml", nan=True)
 yaml(f + "/huge.yaml", w=100000, h=100000)
 # OpenCV 4.6's YAML parser loops forever on an indented top level (fuzz_calibration).
 open(f + "/indented.yaml", "w").write("%YAML:1.0\n k: 4\na: -\n")
+# Configurations that are no configuration, or a wrong one.
+open(f + "/typo_section.yaml", "w").write("tsdf_volumes:\n  voxel_size_m: 0.05\n")
+open(f + "/threads_wrap.yaml", "w").write("interpolation:\n  threads: 4294967297\n")
+open(f + "/empty.yaml", "w").write("")
+open(f + "/list.yaml", "w").write("- stereo\n- fusion\n")
+open(f + "/twice.yaml", "w").write("stereo:\n  p1: 8\n  p1: 9\n")
+open(f + "/deep.yaml", "w").write("stereo:\n  p1: " + "[" * 33000 + "]" * 33000 + "\n")
+open(f + "/long_number.yaml", "w").write("stereo:\n  p1: " + "7" * 5000000 + "\n")
 # Poses: one line each.
 I = "1 0 0 0 0 1 0 0 0 0 1 0"
 open(f + "/pose.txt", "w").write(I + "\n")
@@ -244,7 +252,7 @@ if [ $have_kitti = 1 ]; then
 fi
 
 # ---- limits checked before allocating ---------------------------------------------------
-check "interpolate -threads 100000" 1 "interpolation.threads \(-threads\) must be 0.*256, not 100000" -- \
+check "interpolate -threads 100000" 1 "interpolation.threads must be in 0..256, not 100000" -- \
   msf_interpolate "$F/sparse.pcd" o.pcd -threads 100000
 check "interpolate -threads -1" 1 "threads.*not -1" -- msf_interpolate "$F/sparse.pcd" o.pcd -threads -1
 check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_info "$F/bomb.pcd"
@@ -258,7 +266,7 @@ check "integrate -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e-6
 check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 64 voxels" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -trunc 1e6
-check "integrate -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100, got 1000000" -- \
+check "integrate -sweeps 1000000" 1 "tsdf_integrator.sweeps must be in 0..100, not 1000000" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps 1000000
 check "integrate: rotation scaled by 1000" 1 "pose_scaled.txt' line 1 is not a rigid transform" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose_scaled.txt" -o v.pcd
@@ -269,7 +277,22 @@ check "integrate: pose beyond the volume's reach" 1 "beyond the volume's .* m at
 check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
 check "lambda_study -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_lambda_study -o out -voxel 1e-6
-check "lambda_study -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100" -- msf_lambda_study -o out -sweeps 1000000
+check "lambda_study -sweeps 1000000" 1 "lambda_study.sweeps must be in 0..100" -- msf_lambda_study -o out -sweeps 1000000
+
+# ---- configuration files ------------------------------------------------------------------
+check "mesh -config: a misspelt section" 1 "typo_section.yaml' line 1: 'tsdf_volumes' is not a section of the configuration" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/typo_section.yaml"
+check "interpolate -config: threads 4294967297" 1 "threads_wrap.yaml' line 2: interpolation.threads must be a whole number in 0..256, not 4294967297" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -config "$F/threads_wrap.yaml"
+check "mesh -config: an empty file" 1 "config '.*empty.yaml' is empty" -- msf_mesh "$F/dense.pcd" o.ply -config "$F/empty.yaml"
+check "mesh -config: a list" 1 "list.yaml' line 1: a config file is a map of sections" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/list.yaml"
+check "mesh -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears twice \(lines 2 and 3\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/twice.yaml"
+check "mesh -config: nested 33000 levels" 1 "deep.yaml' is not valid YAML: line .* levels deep \(yaml-cpp's limit\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/deep.yaml"
+check "mesh -config: a number of 5 million digits" 1 "long_number.yaml' line 2: stereo.p1 must be a whole number in 0..2147483647, not 7777.*\(5000000 characters\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/long_number.yaml"
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \

@@ -7,6 +7,7 @@
 #include <cfloat>
 #include <climits>
 #include <cmath>
+#include <utility>
 
 namespace msf {
 
@@ -16,13 +17,14 @@ const char* kindOf(const YAML::Node& node) {
   return node.IsSequence() ? "a sequence" : node.IsMap() ? "a map" : node.IsScalar() ? "a single value" : "empty";
 }
 
-/// The value of `key` in the map `map`, an invalid node when absent (a lookup that cannot insert).
-YAML::Node valueOf(const YAML::Node& map, const std::string& key) {
+/// The key node and the value of `key` in the map `map`, invalid nodes when absent (a lookup
+/// that cannot insert).
+std::pair<YAML::Node, YAML::Node> entryOf(const YAML::Node& map, const std::string& key) {
   if (map.IsMap())
     for (const auto& entry : map)
       if (entry.first.IsScalar() && entry.first.Scalar() == key)
-        return entry.second;
-  return YAML::Node(YAML::NodeType::Undefined);
+        return {entry.first, entry.second};
+  return {YAML::Node(YAML::NodeType::Undefined), YAML::Node(YAML::NodeType::Undefined)};
 }
 
 /// True when `text` names `name` as a whole word ("stereo.p1" is not "stereo.p").
@@ -99,24 +101,25 @@ void ConfigFile::requireKnownSections(const std::vector<std::string>& known) con
   }
 }
 
-void ConfigFile::rethrowInFile(const ConfigError& error, const std::string& section) const {
+void ConfigFile::rethrowInFile(const ConfigError& error) const {
   const std::string message = error.what();
-  const YAML::Node keys = valueOf(root_, section);
-  if (keys.IsMap())
-    for (const auto& key : keys)
-      if (names(message, section + "." + key.first.Scalar()))
-        throw ConfigError(yamlWhere("config", path_, key.first) + message);
+  if (root_.IsMap())
+    for (const auto& section : root_)
+      if (section.second.IsMap())
+        for (const auto& key : section.second)
+          if (key.first.IsScalar() && names(message, section.first.Scalar() + "." + key.first.Scalar()))
+            throw ConfigError(yamlWhere("config", path_, key.first) + message);
   throw ConfigError("config '" + path_ + "': " + message);
 }
 
 KeyReader::KeyReader(const ConfigFile& file, const char* section)
-    : file_(file), section_(section), node_(valueOf(file.root_, section)) {}
+    : file_(file), section_(section), node_(entryOf(file.root_, section).second) {}
 
 YAML::Node KeyReader::find(const char* key) {
   declared_.emplace_back(key);
-  const YAML::Node value = valueOf(node_, key);
-  if (value.IsDefined() && value.IsNull())
-    fail(value, key, "has no value (write one, or delete the line to keep the default)");
+  const auto [name, value] = entryOf(node_, key);
+  if (value.IsDefined() && value.IsNull()) // an empty value is marked where the next line starts: name the key's
+    fail(name, key, "has no value (write one, or delete the line to keep the default)");
   return value;
 }
 

@@ -149,11 +149,28 @@ void KeyRangeCheck::operator()(const char* name, const std::vector<double>& valu
 
 } // namespace detail
 
+void printComment(std::ostream& out, const std::string& indent, const std::string& text) {
+  constexpr std::size_t kWidth = 100;
+  std::string line;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t space = text.find(' ', at);
+    const std::string word = text.substr(at, space == std::string::npos ? std::string::npos : space - at);
+    at = space == std::string::npos ? text.size() : space + 1;
+    if (!line.empty() && indent.size() + 2 + line.size() + 1 + word.size() > kWidth) {
+      out << indent << "# " << line << "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  out << indent << "# " << line << "\n";
+}
+
 void printSection(std::ostream& out, const std::string& section, const std::vector<KeyText>& keys, bool comments) {
   out << section << ":\n";
   for (const KeyText& key : keys) {
     if (comments)
-      out << "  # " << key.meaning << (key.range.empty() ? "" : " [" + key.range + "]") << "\n";
+      printComment(out, "  ", key.meaning + (key.range.empty() ? "" : " [" + key.range + "]"));
     out << "  " << key.name << ": " << key.value << "\n";
   }
 }

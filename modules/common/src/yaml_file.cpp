@@ -186,6 +186,18 @@ std::optional<bool> yamlBool(const YAML::Node& node) {
   return std::nullopt;
 }
 
+namespace {
+/// True for a plain scalar written as a number, in range or not.
+bool numberLike(const YAML::Node& node) {
+  if (!plainScalar(node, "float") && !plainScalar(node, "int"))
+    return false;
+  const std::string& s = node.Scalar();
+  const std::string word = s.substr(!s.empty() && (s[0] == '-' || s[0] == '+') ? 1 : 0);
+  return realSyntax(s) || word == ".inf" || word == ".Inf" || word == ".INF" || s == ".nan" || s == ".NaN" ||
+         s == ".NAN";
+}
+} // namespace
+
 std::string yamlQuoted(const YAML::Node& node) {
   if (node.IsSequence())
     return "a sequence";
@@ -196,7 +208,7 @@ std::string yamlQuoted(const YAML::Node& node) {
   constexpr std::size_t kShown = 40;
   const std::string& s = node.Scalar();
   std::string text = s.size() > kShown ? s.substr(0, kShown) + "..." : s;
-  if (!yamlReal(node) && !yamlBool(node))
+  if (!numberLike(node) && !yamlBool(node))
     text = "'" + text + "'";
   return s.size() > kShown ? text + " (" + std::to_string(s.size()) + " characters)" : text;
 }

@@ -165,7 +165,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
   std::ostringstream yaml;
   yaml << "%YAML:1.0\n";
-  config_.print(yaml);
+  printConfig(yaml, config_);
   writeText(gt / "synthetic.yaml", yaml.str());
   writeText(gt / "README.txt", kGroundTruthReadme);
   SurfaceClasses classes;

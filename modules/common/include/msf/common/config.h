@@ -47,9 +47,9 @@ public:
     return config;
   }
 
-  /// `error`, from validate() after a section was read, as a ConfigError that names the file
-  /// and the line of the first key of `section` that it names.
-  [[noreturn]] void rethrowInFile(const ConfigError& error, const std::string& section) const;
+  /// `error`, from a validate() after the file was read, as a ConfigError that names the file
+  /// and the line of the first "section.key" of the file that its message names.
+  [[noreturn]] void rethrowInFile(const ConfigError& error) const;
 
 private:
   friend class KeyReader;
@@ -110,7 +110,7 @@ void ConfigFile::read(Config& config) const {
   try {
     config.validate();
   } catch (const ConfigError& e) {
-    rethrowInFile(e, Config::kSection);
+    rethrowInFile(e);
   }
 }
 

@@ -179,8 +179,11 @@ void checkKeyRanges(const Config& config) {
   copy.keys(check);
 }
 
+/// `text` as YAML comment lines ("# ...") after `indent`, wrapped at 100 columns.
+void printComment(std::ostream& out, const std::string& indent, const std::string& text);
+
 /// A section as a config file holds it: "section:", then "  key: value" for each key; with
-/// `comments`, each key's meaning and range on the line above it.
+/// `comments`, each key's meaning and [range] on the lines above it.
 void printSection(std::ostream& out, const std::string& section, const std::vector<KeyText>& keys,
                   bool comments = false);
 
