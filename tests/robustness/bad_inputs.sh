@@ -194,7 +194,11 @@ open(f + "/empty.yaml", "w").write("")
 open(f + "/list.yaml", "w").write("- stereo\n- fusion\n")
 open(f + "/twice.yaml", "w").write("stereo:\n  p1: 8\n  p1: 9\n")
 open(f + "/deep.yaml", "w").write("stereo:\n  p1: " + "[" * 33000 + "]" * 33000 + "\n")
-open(f + "/long_number.yaml", "w").write("stereo:\n  p1: " + "7" * 5000000 + "\n")
+open(f + "/unclosed.yaml", "w").write("stereo: {p1: 8, p2: 90\nfusion:\n  method: paper\n")
+open(f + "/unknown_key.yaml", "w").write("stereo:\n  block_size: 7\n")
+open(f + "/wrong_type.yaml", "w").write("# a comment\nstereo: {left_right_check: maybe}\n")
+open(f + "/out_of_range.yaml", "w").write("synthetic:\n  frames: 3\n  lidar_dropout: 1.5\n")
+open(f + "/long_number.yaml", "w").write("stereo:\n  p1: " + "7" * 1000000 + "\n")
 # Poses: one line each.
 I = "1 0 0 0 0 1 0 0 0 0 1 0"
 open(f + "/pose.txt", "w").write(I + "\n")
@@ -276,7 +280,7 @@ check "integrate: pose beyond the volume's reach" 1 "beyond the volume's .* m at
   msf_integrate "$F/dense.pcd" -poses "$F/pose_reach.txt" -o v.pcd -voxel 0.001 -trunc 0.003
 check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
-check "lambda_study -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_lambda_study -o out -voxel 1e-6
+check "lambda_study -voxel 1e-6" 1 "lambda_study.voxel_size_m must be in 0.001..10, not 1.0e-06" -- msf_lambda_study -o out -voxel 1e-6
 check "lambda_study -sweeps 1000000" 1 "lambda_study.sweeps must be in 0..100" -- msf_lambda_study -o out -sweeps 1000000
 
 # ---- configuration files ------------------------------------------------------------------
@@ -291,7 +295,17 @@ check "mesh -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears twi
   msf_mesh "$F/dense.pcd" o.ply -config "$F/twice.yaml"
 check "mesh -config: nested 33000 levels" 1 "deep.yaml' is not valid YAML: line .* levels deep \(yaml-cpp's limit\)" -- \
   msf_mesh "$F/dense.pcd" o.ply -config "$F/deep.yaml"
-check "mesh -config: a number of 5 million digits" 1 "long_number.yaml' line 2: stereo.p1 must be a whole number in 0..2147483647, not 7777.*\(5000000 characters\)" -- \
+check "synth -config: malformed YAML" 1 "unclosed.yaml' is not valid YAML: line [0-9]+, column [0-9]+: " -- \
+  msf_synth -o out -config "$F/unclosed.yaml"
+check "synth -config: an unknown key" 1 "unknown_key.yaml' line 2: 'stereo.block_size' is not a key of section 'stereo' \(its keys: engine, mode" -- \
+  msf_synth -o out -config "$F/unknown_key.yaml"
+check "synth -config: a wrong type" 1 "wrong_type.yaml' line 2: stereo.left_right_check must be true or false, not 'maybe'" -- \
+  msf_synth -o out -config "$F/wrong_type.yaml"
+check "synth -config: a value out of range" 1 "out_of_range.yaml' line 3: synthetic.lidar_dropout must be a finite number in \[0, 1\), not 1.5" -- \
+  msf_synth -o out -config "$F/out_of_range.yaml"
+check "synth -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears twice" -- \
+  msf_synth -o out -config "$F/twice.yaml"
+check "mesh -config: a number of a million digits" 1 "long_number.yaml' line 2: stereo.p1 must be a whole number in 0..2147483647, not 7777.*\(1000000 characters\)" -- \
   msf_mesh "$F/dense.pcd" o.ply -config "$F/long_number.yaml"
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
@@ -343,7 +357,7 @@ if [ $have_kitti = 1 ]; then
   printf '%%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.001\n  truncation_m: 0.003\n' >"$F/mm_voxels.yaml"
   check "reconstruct: 1 mm voxels, -max_memory 1000" 1 "predicted to need up to [0-9]+ MiB .* over the memory budget of 1000 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -config "$F/mm_voxels.yaml" -max_memory 1000 -o out
-  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
+  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 3, column 4" -- \
     msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
   check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \
