@@ -93,6 +93,10 @@ TEST(Config, ReadsPlainYamlAsPeopleAndPyYamlWriteItAndOpenCvFiles) {
   EXPECT_EQ(opencv.gap_px, 8);
   EXPECT_TRUE(opencv.on);
   EXPECT_EQ(readStage("%YAML 1.1\n---\nstage:\n  on: 1\n").on, true);
+  // Anchors and aliases: a value written once and referred to.
+  const StageConfig aliased = readStage("other: {scale: &s 7}\nstage:\n  gap_px: *s\n  values: &v [3, 4]\n");
+  EXPECT_EQ(aliased.gap_px, 7);
+  EXPECT_EQ(aliased.values, (std::vector<double>{3, 4}));
 }
 
 TEST(Config, EveryBadValueIsAnErrorNamingTheFileTheLineAndTheKey) {

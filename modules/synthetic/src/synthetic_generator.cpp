@@ -163,8 +163,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   }
   writeText(seq / "times.txt", times.str());
   saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
-  std::ostringstream yaml;
-  yaml << "%YAML:1.0\n";
+  std::ostringstream yaml; // plain YAML, which msf_synth -config reads back to the same dataset
   printConfig(yaml, config_);
   writeText(gt / "synthetic.yaml", yaml.str());
   writeText(gt / "README.txt", kGroundTruthReadme);
