@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Sourced by the bench scripts: the checks of their arguments, each exiting 1 with a message
 # that names the script and what is missing.
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Per-pixel depth fusion per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370):
 // the cloud class DepthFusion<PointXYZID, PointXYZRGBConfidence, PointXYZRGBWeight> and the
 // image-level DepthImageFusion, for both methods, and the facade extension after it

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Guided SGBM (stereo.guidance lidar) beside unguided, per KITTI frame (odometry 04, frames
 // 0-9 in turn, 1226 x 370), both narrowed by the interpolated LiDAR as the pipeline does.
 // BM_SgbmStereo: SgbmStereo::computeDisparity (the default five paths, hints from the sparse
@@ -75,7 +76,7 @@ void BM_SgbmStereo(benchmark::State& state, const char* guidance) {
 }
 
 void BM_MatcherOneCore(benchmark::State& state, bool guided) {
-  if (!msf::SemiGlobalMatcher::isAvailable()) {
+  if (!msf::SemiGlobalMatcher::usesAvx2()) {
     state.SkipWithError("this CPU has no AVX2");
     return;
   }

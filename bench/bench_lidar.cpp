@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The LiDAR branch per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370): paper
 // steps 1 + 2 (projection and compound interpolation) beside the IP-Basic baseline on the
 // same projection, in the same run. Each benchmark is 20 repetitions of the 10 frames;

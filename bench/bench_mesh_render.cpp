@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Depth rendering of a mesh into a KITTI-sized image (1241x376), what evaluation protocol 4
 // does at every frame's pose (MeshRasterizer, buffers kept between calls as msf_reconstruct
 // keeps them):

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // LiDAR odometry per KITTI frame (odometry 04, frames 0-9 in turn, ~120k returns a scan): each
 // frame registered to the local map of the frames before it, from a fresh odometry every
 // 10 frames (the first frame only starts the map). One thread: the registration has no

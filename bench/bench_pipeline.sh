@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# msf_reconstruct end to end on KITTI odometry 04 frames 0-9 (issue #7's target: >= 10 fps
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+# msf_reconstruct end to end on KITTI odometry 04 frames 0-9 (the target: >= 10 fps
 # on 2 cores, peak memory <= 2 GB): RUNS runs, then the median frames per second (over the
 # whole run, and after the first frame), the median per-stage times, the median CPU time of
 # the process and the largest peak memory over the runs.

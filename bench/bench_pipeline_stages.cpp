@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The stages of msf_reconstruct on KITTI odometry 04 frames 0-9 with config/kitti.yaml, each
 // alone on the pipeline's own input (the fused depth and the scans of Reconstructor::computeDepth,
 // the dataset's poses), in process CPU time per frame: the figure that tells whether a change

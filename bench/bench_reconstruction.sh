@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Evaluation protocol 4 on the three datasets the integrator is tuned on: msf_reconstruct
 # -holdout -compare_sources on KITTI odometry 04 frames 0-9 and raw drive 0009 frames 0-4, and
 # msf_reconstruct -compare_sources on a 40-frame synthetic street (exact depth, true surface).

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // SGBM stereo per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370, 2 threads),
 // each with both engines side by side (stereo.engine: native = our AVX2 SemiGlobalMatcher,
 // opencv = cv::StereoSGBM): the baseline docs/results.md quotes (3-way, 128 disparities, block 5), the
@@ -5,9 +6,9 @@
 // explicit left-right check. Times are of SgbmStereo::computeDisparity (matching,
 // conversion, confidence); cpu_ms_all_threads is the process CPU time per frame (all threads).
 // BM_MatcherOneCore: the matchers alone on one thread, 128 disparities (cv::StereoSGBM, and
-// SemiGlobalMatcher with its AVX2 and its AVX-512 kernel), 3-way and with five paths
-// (MODE_SGBM, stereo.mode sgbm): per-core cost, steadier than wall time on a machine shared
-// with other work. BM_Sgbm5WayLidarRange: the LiDAR-narrowed rows with five paths.
+// SemiGlobalMatcher with its AVX2, AVX-512 and portable kernels), 3-way, with five paths
+// (MODE_SGBM, stereo.mode sgbm) and ground_3way (stereo.unguided_mode): per-core cost, steadier
+// than wall time on a machine shared with other work. BM_Sgbm5WayLidarRange: the LiDAR-narrowed rows with five paths.
 // Post-processing, side by side: the native rows again with OpenCV's serial speckle filter
 // and distance transform (native_opencv_tail; setParallelPostFilterEnabled(false)), and
 // BM_PostFilter, that tail alone (OpenCV's median, speckle filter, conversion to float,
@@ -155,31 +156,33 @@ void BM_Sgbm3WayLidarRangeLrCheck(benchmark::State& state, const char* engine) {
 
 void BM_Sgbm5WayLidarRange(benchmark::State& state, const char* engine) { run(state, inMode("sgbm"), true, engine); }
 
-/// `five_paths`: the diagonal paths too (OpenCV's MODE_SGBM).
-void BM_MatcherOneCore(benchmark::State& state, const char* kernel, bool five_paths) {
+/// `kernel`: opencv (cv::StereoSGBM), or the native matcher's avx512, avx2 or portable kernel;
+/// `paths`: sgbm_3way, sgbm (five paths, OpenCV's MODE_SGBM) or ground_3way (native only).
+void BM_MatcherOneCore(benchmark::State& state, const char* kernel, const char* paths) {
   const Data& d = data();
-  const std::string name = kernel;
+  const std::string name = kernel, mode = paths;
   const msf::SgbmConfig config;
   msf::SemiGlobalMatcher::Params params;
   params.num_disparities = config.num_disparities_px;
   params.p1 = config.resolvedP1();
   params.p2 = config.resolvedP2();
-  params.diagonal_paths = five_paths;
+  params.diagonal_paths = mode == "sgbm";
+  params.p1_rise = mode == "ground_3way" ? config.resolvedP1Rise() : 0;
   msf::SemiGlobalMatcher native(params);
   const cv::Ptr<cv::StereoSGBM> opencv = cv::StereoSGBM::create(
       0, params.num_disparities, params.block_size, params.p1, params.p2, params.disp12_max_diff,
       params.pre_filter_cap, params.uniqueness_ratio, params.speckle_window_size, params.speckle_range,
-      five_paths ? cv::StereoSGBM::MODE_SGBM : cv::StereoSGBM::MODE_SGBM_3WAY);
-  if (name != "opencv" && !msf::SemiGlobalMatcher::isAvailable()) {
+      mode == "sgbm" ? cv::StereoSGBM::MODE_SGBM : cv::StereoSGBM::MODE_SGBM_3WAY);
+  if ((name == "avx2" || name == "avx512") && !msf::SemiGlobalMatcher::usesAvx2()) {
     state.SkipWithError("this CPU has no AVX2");
     return;
   }
-  msf::SemiGlobalMatcher::setAvx512Enabled(name == "avx512");
   if (name == "avx512" && !msf::SemiGlobalMatcher::usesAvx512()) {
-    msf::SemiGlobalMatcher::setAvx512Enabled(true);
     state.SkipWithError("this CPU has no AVX-512BW");
     return;
   }
+  msf::SemiGlobalMatcher::setAvx2Enabled(name != "portable");
+  msf::SemiGlobalMatcher::setAvx512Enabled(name == "avx512");
   const msf::bench::OneThread one_thread;
   cv::Mat disparity;
   std::size_t i = 0;
@@ -190,23 +193,26 @@ void BM_MatcherOneCore(benchmark::State& state, const char* kernel, bool five_pa
     else
       native.compute(d.left[f], d.right[f], disparity);
   }
+  msf::SemiGlobalMatcher::setAvx2Enabled(true);
   msf::SemiGlobalMatcher::setAvx512Enabled(true);
 }
 
 } // namespace
 
-BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv, "opencv", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2, "avx2", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512, "avx512", false)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, opencv_5paths, "opencv", true)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx2_5paths, "avx2", true)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);
-BENCHMARK_CAPTURE(BM_MatcherOneCore, avx512_5paths, "avx512", true)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(10);
+// The matchers alone, one thread, 128 disparities: OpenCV's 3-way and five paths, the native
+// kernels for each, and ground_3way (the default without guidance).
+#define MSF_MATCHER_ONE_CORE(row, kernel, paths)                                                                       \
+  BENCHMARK_CAPTURE(BM_MatcherOneCore, row, kernel, paths)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10)
+MSF_MATCHER_ONE_CORE(opencv, "opencv", "sgbm_3way");
+MSF_MATCHER_ONE_CORE(avx2, "avx2", "sgbm_3way");
+MSF_MATCHER_ONE_CORE(avx512, "avx512", "sgbm_3way");
+MSF_MATCHER_ONE_CORE(portable, "portable", "sgbm_3way");
+MSF_MATCHER_ONE_CORE(opencv_5paths, "opencv", "sgbm");
+MSF_MATCHER_ONE_CORE(avx2_5paths, "avx2", "sgbm");
+MSF_MATCHER_ONE_CORE(avx512_5paths, "avx512", "sgbm");
+MSF_MATCHER_ONE_CORE(avx2_ground_3way, "avx2", "ground_3way");
+MSF_MATCHER_ONE_CORE(avx512_ground_3way, "avx512", "ground_3way");
+MSF_MATCHER_ONE_CORE(portable_ground_3way, "portable", "ground_3way");
 
 // Each case's engines one after the other, so that both see the same machine load.
 BENCHMARK_CAPTURE(BM_Sgbm3Way128, opencv, "opencv")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(10);

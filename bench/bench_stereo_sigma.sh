@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Is the fusion's stereo sigma right? SGBM's disparity error by its confidence, against the
 # sigma the fusion assumes for that confidence (fusion.stereo_sigma_min_px / max_px), on the
 # three datasets the pipeline is tuned on:
@@ -8,7 +9,7 @@
 #     counts against stereo there, which the robust sigma ignores and the outlier share does not);
 #   - the synthetic street (msf_synth, 40 frames) frames 5, 20 and 35 against their exact
 #     disparity (config/synthetic.yaml).
-# Prints msf_eval_disparity -confidence's table for each (docs/results.md, session 15).
+# Prints msf_eval_disparity -confidence's table for each (docs/results.md, "The stereo sigma against SGBM's measured error").
 #
 # Usage: bench/bench_stereo_sigma.sh BIN_DIR KITTI_DIR [OUT]
 #   OUT keeps the disparities, clouds and truths (and the street, which later runs reuse).

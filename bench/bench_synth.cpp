@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The synthetic street's frame (msf_synth): camera 0 (grey, with its depth and ids), camera 2
 // (colour) and the LiDAR scan, at frames 100, 500 and 900 of a 1000-frame street in turn,
 // single-threaded, CPU time. A 1000-frame drive renders two grey and two colour cameras and

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // TSDF integration and meshing on KITTI odometry 04 frames 0-9 (SGBM depth, 0.1 m voxels,
 // 0.3 m truncation), side by side with Open3D 0.16's ScalableTSDFVolume on the very same
 // depth images and poses (bench/open3d_tsdf.py, run by this program when Debian's

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The KITTI sample the benchmarks time: odometry sequence 04, frames 0-9 (../shared/data/kitti;
 // KITTI data is never copied into the repository).

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Open3D 0.16 ScalableTSDFVolume on the same depth images and poses as bench_tsdf.
 
 bench_tsdf writes a folder with depth/NNNNNN.png (KITTI 16-bit depth, metres x 256),

@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # One place for the warnings every target of ours is built with (as errors).
 option(MSF_WARNINGS_AS_ERRORS "Treat compiler warnings as errors" ON)
 

@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # msf_add_module(<name> [DEPS ...] [PRIVATE_DEPS ...])
 # Builds modules/<name>/src/*.cpp into the library msf_<name> (alias MSFusion::<name>),
 # exported for find_package(MSFusion). Headers live in modules/<name>/include/msf/<name>/.

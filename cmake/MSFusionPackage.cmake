@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Installs and exports the CMake package: find_package(MSFusion) gives MSFusion::<module>.
 include(CMakePackageConfigHelpers)
 get_property(MSF_EXPORTED_MODULES GLOBAL PROPERTY MSF_MODULE_TARGETS)

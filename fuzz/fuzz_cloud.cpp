@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // PCD and PLY header and body readers (msf::loadCloudBlob, msf::loadCloud). The first byte
 // picks the format, the rest is the file.
 #include "fuzz_input.h"

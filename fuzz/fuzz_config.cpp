@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A configuration file, read as every tool reads one: the whole file checked (sections, keys,
 // values) and PipelineConfig read from it. Inputs reach yaml-cpp's depth guard (see make fuzz's
 // max_len for this target).

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The readers take paths: each input is written to a file in a private folder on tmpfs
 // (/dev/shm when it exists), named as the reader expects.

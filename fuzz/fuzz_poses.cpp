@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // KITTI odometry poses (poses/XX.txt) and raw OXTS records (oxts/data/*.txt, one a file).
 #include "fuzz_input.h"
 

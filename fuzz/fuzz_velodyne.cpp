@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The KITTI velodyne .bin reader (x y z reflectance float32 records).
 #include "fuzz_input.h"
 

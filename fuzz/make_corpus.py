@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Seed corpora of the fuzz targets, from the KITTI sample (../shared/data/kitti).
 
     make_corpus.py KITTI_DIR OUT_DIR
 
-Writes OUT_DIR/<target>/<seed> for the targets cloud, calibration, poses, velodyne and config
-(its seeds are the project's own configuration files); the first byte of a seed picks the
-format where a target reads several (see fuzz_*.cpp).
+Writes OUT_DIR/<target>/<seed> for the targets cloud, ply, calibration, poses, velodyne and
+config (its seeds are the project's own configuration files); the first byte of a seed picks
+the format or reader where a target has several (see fuzz_*.cpp).
 """
 import os
 import struct
@@ -64,6 +65,32 @@ def ply(fmt):
 put("cloud", "ascii.ply", b"\1" + ply("ascii"))
 put("cloud", "binary.ply", b"\1" + ply("binary_little_endian"))
 
+# PLY (fuzz_ply, first byte even: cloud, odd: mesh): the clouds above with colour; an
+# organized 8x8 cloud as PCL writes it (obj_info num_cols and num_rows, a range_grid of the
+# points, two of them missing); a mesh of triangles over the first points; and a header of
+# comments near the 64 KB the header check reads, for mutations to cross it.
+def ply_rgb(fmt, header_extra=""):
+    head = ("ply\nformat %s 1.0\n%selement vertex 64\nproperty float x\nproperty float y\nproperty float z\n"
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n" % (fmt, header_extra))
+    if fmt == "ascii":
+        return head.encode() + "".join("%g %g %g 200 100 50\n" % p[:3] for p in pts).encode()
+    return head.encode() + b"".join(struct.pack("<3f3B", *p[:3], 200, 100, 50) for p in pts)
+put("ply", "ascii.ply", b"\0" + ply_rgb("ascii"))
+put("ply", "binary.ply", b"\0" + ply_rgb("binary_little_endian"))
+kept = [i for i in range(64) if i not in (5, 40)]
+organized = ("ply\nformat binary_little_endian 1.0\ncomment PCL generated\nobj_info num_cols 8\nobj_info num_rows 8\n"
+             "element vertex %d\nproperty float x\nproperty float y\nproperty float z\nproperty float intensity\n"
+             "element range_grid 64\nproperty list uchar int vertex_indices\nend_header\n" % len(kept)).encode()
+organized += b"".join(struct.pack("<4f", *pts[i]) for i in kept)
+organized += b"".join(b"\0" if i not in kept else struct.pack("<Bi", 1, kept.index(i)) for i in range(64))
+put("ply", "organized.ply", b"\0" + organized)
+faces = [(i, i + 1, i + 8) for i in range(40)]
+mesh = ("ply\nformat binary_little_endian 1.0\nelement vertex 64\nproperty float x\nproperty float y\n"
+        "property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n" % len(faces)).encode()
+mesh += b"".join(struct.pack("<3f", *p[:3]) for p in pts) + b"".join(struct.pack("<B3i", 3, *f) for f in faces)
+put("ply", "mesh.ply", b"\1" + mesh)
+put("ply", "long_header.ply", b"\0" + ply_rgb("ascii", "comment %s\n" % ("x" * 60) * 900))
+
 # Calibrations: odometry, object (made of the odometry one), raw folder, YAML.
 odo = read(os.path.join(seq, "calib.txt"))
 put("calibration", "odometry.txt", b"\0" + odo)
@@ -80,6 +107,14 @@ def mat(name, rows, cols, values):
 yaml = "%YAML:1.0\n---\n" + "".join(mat("P%d" % i, 3, 4, lines["P%d" % i].split()) for i in range(4))
 yaml += "image_width: 1226\nimage_height: 370\n" + mat("T_cam0_velo", 4, 4, lines["Tr"].split() + ["0", "0", "0", "1"])
 put("calibration", "camera.yaml", b"\3" + yaml.encode())
+# A rig file (detected by its keys), and one nested 33000 levels deep (66 KB), beyond yaml-cpp's
+# depth guard, whose mutations keep the fuzzer at that guard.
+rig = ("image_width: 1226\nimage_height: 370\nleft: {P: [%s]}\nright: {P: [%s]}\nlidar:\n  T_cam_lidar: [%s]\n"
+       "  rings: 4\n  beam_elevations_deg: [-15, -5, 5, 15]\n  sweeping: true\n" %
+       (", ".join(lines["P0"].split()), ", ".join(lines["P1"].split()),
+        ", ".join(lines["Tr"].split() + ["0", "0", "0", "1"])))
+put("calibration", "rig.yaml", b"\3" + rig.encode())
+put("calibration", "deep_rig.yaml", b"\3image_width: 640\nleft: " + b"[" * 33000 + b"]" * 33000 + b"\n")
 
 # Poses: 20 odometry poses; one OXTS record.
 poses = read(os.path.join(kitti, "odometry", "poses", "04.txt")).splitlines(True)

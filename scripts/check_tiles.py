@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Checks that every tile mesh of a streamed run (OUT/tiles/*.ply, msf_reconstruct -stream) is a
 # complete binary PLY: its header parses and the file holds exactly the vertices and triangles
 # the header declares, every index within the tile. Prints tiles, triangles and the farthest

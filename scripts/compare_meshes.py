@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # Compares two binary little-endian PLY meshes as sets of triangles by vertex position (each
 # rotated to start at its least vertex, orientation kept), and their boundary edges (edges of
 # one triangle) by position: equal up to order and welding. Then, as written: vertices, vertices

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # make demo: the main job on the built-in default data — msf_reconstruct generates the
 # synthetic street (20 frames, with exact ground truth) and reconstructs it.
 # Usage: scripts/demo.sh BIN_DIR OUT_DIR

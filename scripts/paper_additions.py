@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """What each of the project's additions to the paper adds (docs/paper.md).
 
 config/paper.yaml lists, key by key, what the paper does where the project's defaults

@@ -1,3 +1,4 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # msf_readme_block(<readme> <name> <language> <out_code> <out_line>)
 # The code of the first ```<language> block between <!-- example:<name>:begin --> and
 # <!-- example:<name>:end --> in <readme>, and the README line it starts on (for #line, so

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The configuration: a file checked and printed in full, and the files made from the keys'
 // declarations (config/*.yaml, docs/configuration.md) written.
 #include <msf/common/atomic_file.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The KITTI 2015 devkit's disparity evaluation of one estimate: D1 (3 px and 5 %) for
 // background, foreground and all pixels, the paper's eq. 8 mean absolute error, density.
 // Given two folders, every frame of the estimate folder against its ground truth, summed

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_eval_odometry: evaluation protocol 5 of an estimated trajectory against a reference,
 // with a picture of both from above.
 #include <msf/common/atomic_file.h>
@@ -26,7 +27,7 @@ msf::PoseList loadReference(const std::string& path, const std::string& frames_t
     const msf::Sequence sequence(path);
     if (!sequence.hasPoses())
       throw msf::InvalidInputError("dataset '" + path + "' has no poses (odometry poses/XX.txt, raw oxts/ or gt/) to compare with");
-    all = sequence.poses();
+    all = sequence.referencePoses(); // the truth, when the dataset's poses are a synthetic INS's
   } else {
     all = msf::loadOdometryPoses(path);
   }

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 4: fuses an interpolated LiDAR cloud and a stereo cloud of one camera (both
 // organized, same size) into one organized cloud, per pixel (eq. 6 or inverse variance).
 #include <msf/common/atomic_file.h>
@@ -10,6 +11,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/impl/cloud_io.hpp>
+#include <msf/pipeline/rig_adaptation.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <pcl/common/io.h>
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
   std::string calib_path, image_size_text, color_path, left_path;
   bool print_config = false;
   msf::DepthFusionConfig config;
+  msf::RigAdaptationConfig rig;
   msf::tool::CommandLine cli(
       "msf_fuse", "<lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]",
       "Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one organized cloud with "
@@ -76,9 +79,11 @@ int main(int argc, char** argv) {
       "'distance' (pixels to the nearest real return; without it every point counts as a real return). stereo.pcd: "
       "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
-             "YAML config, section fusion")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
+             "YAML config, sections fusion and rig (the windows in rows between LiDAR rings follow the rig's "
+             "beams, as in msf_reconstruct)")
       .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
              "paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)")
       .value("-color", "PATH", color_path, "colour camera image (image_2) to colour every fused point by projection")
@@ -95,9 +100,10 @@ int main(int argc, char** argv) {
     const cv::Size image_size = msf::parseImageSize(image_size_text);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
+    msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
     if (print_config)
       msf::printConfig(std::cout, config);
-    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
 
     TicToc tt;
     tt.tic();

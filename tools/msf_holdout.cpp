@@ -1,8 +1,10 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Evaluation protocol 2 (docs/design.md): ring hold-out on real KITTI scans. One row per
 // method: the table a user compares depth methods with. On a synthetic sequence (gt/ beside
 // it, protocol 3) the whole scan is the input and every pixel of gt/depth_0 is ground truth,
 // reported for all, background and foreground pixels (the paper's Table 1).
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
@@ -260,8 +262,7 @@ std::string formatRegionTable(const std::vector<RegionResults>& results) {
 }
 
 void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& results) {
-  msf::writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  msf::writeStreamAtomically(path, [&](std::ostream& out) {
     out << "method,region,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
            "imae_per_km,irmse_per_km,median_ms\n";
     out.precision(6);
@@ -273,9 +274,6 @@ void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& r
             << m.coverage << ',' << m.d1_all << ',' << m.d1_estimated << ',' << m.disparity_mae_px << ',' << m.mae_m
             << ',' << m.rmse_m << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << h.median_ms << '\n';
       }
-    out.flush();
-    if (!out)
-      throw msf::IOError("cannot write '" + path + "'");
   });
 }
 

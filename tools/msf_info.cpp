@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Prints what a .pcd holds: size, organization, fields, valid points, depth range.
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
@@ -46,7 +47,7 @@ void describe(const std::string& path) {
   if (!has_xyz)
     return;
   pcl::PointCloud<pcl::PointXYZ> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(blob, cloud, path);
   std::size_t valid = 0;
   float zmin = std::numeric_limits<float>::max(), zmax = -zmin, rmin = zmin, rmax = -zmin;
   for (const auto& p : cloud) {

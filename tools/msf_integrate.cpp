@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_integrate: fuses organized depth clouds (camera frame, NaN = no depth) seen from known
 // poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
 // -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.
@@ -11,6 +12,7 @@
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -46,6 +48,7 @@ int main(int argc, char** argv) {
   msf::TsdfVolume::Config volume_config;
   msf::TsdfIntegrator::Config config;
   msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
+  msf::RigAdaptationConfig rig;
   bool carving = false, no_carving = false, print_config = false;
   msf::tool::CommandLine cli(
       "msf_integrate", "<depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]",
@@ -65,15 +68,18 @@ int main(int argc, char** argv) {
       .value("-calib", "PATH", calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
+      .value("-rig", "FILE", calib, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-config", "FILE",
              [&](const std::string& path) {
                const msf::ConfigFile file = msf::openConfigFile(path);
                file.read(volume_config);
                file.read(config);
                file.read(fusion);
+               file.read(rig);
              },
-             "YAML with sections tsdf_volume, tsdf_integrator and fusion (the LiDAR's range noise); the options "
-             "below override it")
+             "YAML with sections tsdf_volume, tsdf_integrator, fusion (the LiDAR's range noise) and rig (with "
+             "-calib, max_depth_m at most stereo's trusted depth, as in msf_reconstruct); the options below override "
+             "it")
       .value("-voxel", "M", volume_config.voxel_size_m, "voxel size in metres (default {default})")
       .value("-trunc", "M", volume_config.truncation_m, "truncation distance in metres (default {default})")
       .value("-lambda", "L", config.lambda, "eq. 7 regularization (default {default}, the paper's KITTI value is 5)")
@@ -109,6 +115,13 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-carving and -no_carving together: choose one");
     if (carving || no_carving)
       config.space_carving = carving;
+    msf::PinholeCamera camera;
+    msf::Calibration calibration;
+    if (cli.given("-calib") || cli.given("-rig")) {
+      calibration = msf::loadCalibration(calib);
+      camera = msf::PinholeCamera::fromCalibration(calibration);
+      msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
+    }
     msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
     msf::TsdfIntegrator integrator(volume, config);
     if (print_config) {
@@ -131,15 +144,9 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " + std::to_string(poses.size()) +
                                    " poses in '" + poses_path + "' (one pose per cloud; -frames a:b selects poses)");
 
-    msf::PinholeCamera camera;
-    msf::Calibration calibration;
-    if (cli.given("-calib")) {
-      calibration = msf::loadCalibration(calib);
-      camera = msf::PinholeCamera::fromCalibration(calibration);
-    }
     std::vector<std::string> scans;
     if (cli.given("-scans")) {
-      if (!cli.given("-calib"))
+      if (!(cli.given("-calib") || cli.given("-rig")))
         throw msf::InvalidInputError("-scans needs -calib: the LiDAR's pose is the camera's times its extrinsics");
       calibration.requireVelodyne();
       if (!config.space_carving || !(config.scan_carving_m > 0.0))

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 2: compound interpolation of a projected LiDAR scan (or a baseline).
 #include <msf/common/atomic_file.h>
 #include <msf/pipeline/config_catalog.h>
@@ -7,6 +8,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/io/velodyne_io.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/compound_interpolation.h>
 #include <msf/range_image/ip_basic_completion.h>
 #include <msf/range_image/lidar_completion.h>
@@ -16,6 +18,7 @@
 #include <pcl/console/print.h>
 
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +40,7 @@ int main(int argc, char** argv) {
   msf::ProjectionConfig projection;
   msf::InterpolationConfig interpolation;
   msf::IpBasicConfig ip_basic;
+  msf::RigAdaptationConfig rig;
   bool no_gaussian = false;
   msf::tool::CommandLine cli(
       "msf_interpolate", "<in.pcd> <out.pcd> [options]\n<scan.bin|scan.pcd> <out.pcd> -calib PATH [options]",
@@ -53,15 +57,20 @@ int main(int argc, char** argv) {
                file.read(projection);
                file.read(interpolation);
                file.read(ip_basic);
+               file.read(rig);
              },
-             "YAML config, sections interpolation, projection, ip_basic")
+             "YAML config, sections interpolation, projection, ip_basic, rig (with -calib, the gaps in rows between "
+             "LiDAR rings follow the rig's beams, as in msf_reconstruct)")
       .value("-calib", "PATH", calib_path,
              "calibration: camera of the cloud (else recovered from its points); needed for a scan")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-camera", "N", projection.camera, "rectified camera 0..3 of -calib (default {default})")
       .value("-short_gap", "N", interpolation.slice.short_gap_px,
-             "gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px)")
-      .value("-max_gap", "N", interpolation.slice.max_gap_px, "longer gaps stay empty (interpolation.max_gap_px)")
+             "gaps of at most N empty pixels take the zero-slope cubic (interpolation.short_gap_px; KITTI's rows, "
+             "scaled to the beams of -calib's rig as the config's are)")
+      .value("-max_gap", "N", interpolation.slice.max_gap_px,
+             "longer gaps stay empty (interpolation.max_gap_px; scaled as -short_gap)")
       .flag("-no_gaussian", no_gaussian, "no Gaussian hole filling after the slices (interpolation.gaussian: false)")
       .value("-threads", "N", interpolation.threads, "at most N threads of OpenCV's pool (0: all)");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
@@ -76,6 +85,10 @@ int main(int argc, char** argv) {
 
     const msf::CompletionMethod method = msf::parseCompletionMethod(method_name);
     const cv::Size image_size = msf::parseImageSize(image_size_text);
+    const std::optional<msf::Calibration> calibration =
+        calib_path.empty() ? std::nullopt : std::optional(msf::loadCalibration(calib_path, image_size));
+    if (calibration)
+      msf::adaptToRig(interpolation, msf::rigAdaptation(rig, *calibration));
     projection.validate();
     if (no_gaussian)
       interpolation.gaussian = false;
@@ -105,10 +118,10 @@ int main(int argc, char** argv) {
     print_highlight("Interpolating ");
     print_info("(%s%s) ", msf::toString(method), is_scan ? ", from the scan" : "");
     if (is_scan) {
-      if (calib_path.empty())
+      if (!calibration)
         throw msf::InvalidInputError("'" + in + "' is a scan (not an organized cloud): give -calib to project it, "
                                      "or project it first with msf_project");
-      msf::LidarCompletion completion(msf::loadCalibration(calib_path, image_size), method, projection, interpolation, ip_basic);
+      msf::LidarCompletion completion(*calibration, method, projection, interpolation, ip_basic);
       completion.compute(*input, dense);
     } else {
       pcl::PointCloud<msf::PointXYZID>::Ptr sparse(new pcl::PointCloud<msf::PointXYZID>);
@@ -116,8 +129,8 @@ int main(int argc, char** argv) {
       for (auto& p : *sparse)
         p.distance = std::isfinite(p.z) ? 0.f : std::numeric_limits<float>::infinity();
       msf::PinholeCamera camera;
-      if (!calib_path.empty())
-        camera = msf::PinholeCamera::fromCalibration(msf::loadCalibration(calib_path, image_size), projection.camera);
+      if (calibration)
+        camera = msf::PinholeCamera::fromCalibration(*calibration, projection.camera);
       if (ip) {
         msf::IpBasicCompletion<msf::PointXYZID> filter;
         filter.setConfig(ip_basic);

@@ -1,5 +1,7 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Converts KITTI Velodyne .bin scans to PointXYZI .pcd clouds, in file order.
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/common/tool.h>
@@ -37,8 +39,8 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
   if (ascii) {
     if (cloud.empty())
       throw msf::InvalidInputError("cannot write '" + out + "': the scan has no finite point");
-    msf::writeAtomically(out, [&](const std::string& tmp) {
-      if (pcl::PCDWriter().writeASCII(tmp, cloud) != 0)
+    msf::writeThroughPipeAtomically(out, [&](const std::string& sink) {
+      if (pcl::PCDWriter().writeASCII(sink, cloud) != 0)
         throw msf::IOError("cannot write cloud '" + out + "'");
     });
   } else {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_lambda_study: paper Fig. 5 — surface error of the regularized TSDF fusion (eq. 7)
 // against lambda and depth noise on a synthetic scene with exact ground truth.
 #include <msf/common/atomic_file.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_mesh: marching cubes over a TSDF volume written by msf_integrate; a welded, coloured
 // mesh saved as binary PLY, OBJ or VTK by the output's extension.
 #include <msf/common/atomic_file.h>

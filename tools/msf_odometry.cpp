@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_odometry: camera 0's trajectory of a sequence from its LiDAR scans (the tracking module),
 // in KITTI's poses format.
 #include <msf/pipeline/config_catalog.h>
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
     const std::vector<std::size_t> frames = sequence.indices(msf::FrameRange::parse(frames_text));
     const msf::Calibration& calibration = sequence.calibration();
     const Eigen::Isometry3d T_world_cam0_first =
-        sequence.hasPoses() ? sequence.poses()[frames.front()] : Eigen::Isometry3d::Identity();
+        sequence.hasPoses() ? sequence.referencePoses()[frames.front()] : Eigen::Isometry3d::Identity();
 
     print_highlight("Tracking ");
     print_value("%zu", frames.size());
@@ -119,8 +120,8 @@ int main(int argc, char** argv) {
     if (sequence.hasPoses()) {
       msf::PoseList reference;
       for (std::size_t i : frames)
-        reference.push_back(sequence.poses()[i]);
-      print_info("Against %s:\n", sequence.posesName().c_str());
+        reference.push_back(sequence.referencePoses()[i]);
+      print_info("Against %s:\n", sequence.referencePosesName().c_str());
       printMetrics(msf::evaluateOdometry(T_world_cam0, reference));
     }
     return 0;

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Writes the depth of an organized cloud as an image: a KITTI 16-bit depth PNG (default),
 // a KITTI disparity PNG, or a false-colour picture with a legend in metres.
 #include <msf/common/atomic_file.h>
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
                              "default a KITTI 16-bit depth PNG (metres x 256, 0 = none).");
   cli.flag("-disparity", disparity, "KITTI 16-bit disparity PNG (pixels x 256), needs -calib")
       .value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .flag("-color", colour, "8-bit false-colour picture with a legend in metres")
       .value("-range", "MIN,MAX",
              [&](const std::string& text) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 1: a Velodyne scan into an organized cloud of one camera's image.
 #include <msf/common/atomic_file.h>
 #include <msf/pipeline/config_catalog.h>
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
                              "organized PointXYZI cloud of a camera's image, in its rectified frame: nearest return "
                              "per pixel, reflectance kept, NaN where no return lands.");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML camera file")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config, section projection; the options below override it")

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The main job: a dataset (or the built-in synthetic street) to a coloured mesh, with a report
 // of speed and, where ground truth exists, accuracy. A door over the library's engine
 // (msf::Reconstructor): a reader feeds it, writers and evaluations take what it gives.
@@ -10,6 +11,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
+#include <msf/io/world_frame.h>
 #include <msf/pipeline/frame_panel.h>
 #include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/fused_cloud.h>
@@ -18,6 +20,7 @@
 #include <msf/pipeline/ring_holdout.h>
 #include <msf/pipeline/run_outputs.h>
 #include <msf/pipeline/run_report.h>
+#include <msf/pipeline/sky_scoring.h>
 #include <msf/pipeline/source_maps.h>
 #include <msf/pipeline/synthetic_scoring.h>
 #include <msf/synthetic/synthetic_generator.h>
@@ -45,7 +48,8 @@ constexpr int kMaxPanels = 100;
 
 /// What the command line asks for beyond the configuration.
 struct Request {
-  std::string out = "msf_out", frames = "0:", poses, config_path, dataset;
+  std::string out = "msf_out", frames = "0:", poses, config_path, dataset, world = "camera";
+  msf::DatasetOptions reader;
   int panels = 3;
   bool save_depth = false, holdout = false, compare_sources = false, compare_paper = false;
 };
@@ -117,39 +121,6 @@ std::string generateDefaultStreet(const std::string& dir) {
   return dir;
 }
 
-/// The memory budget against the run's predicted peak, before any frame is read: an explicit
-/// budget (tsdf_volume.max_memory_mb > 0) refuses a run predicted to exceed it; the default
-/// one (three quarters of RAM) warns, since the prediction is an upper bound that grows with
-/// the space the cameras swept, not with the surface they saw. With estimated poses nothing is
-/// known before the run: the volume's own check at each growth stays.
-void checkMemoryBudget(const msf::Reconstructor& engine, const msf::PoseList& poses, int maps, bool scores_every_frame,
-                       msf::RunReport& report) {
-  const double budget_mb = static_cast<double>(engine.volume().maxMemoryBytes()) / (1024.0 * 1024.0);
-  const bool explicit_budget = engine.config().volume.max_memory_mb > 0;
-  if (poses.empty()) {
-    print_info("Memory: the poses are estimated as the run goes, so its peak is not predicted; the TSDF volume "
-               "stops the run at the first frame whose blocks would exceed the budget (%.0f MiB)\n",
-               budget_mb);
-    return;
-  }
-  const msf::MemoryPrediction p = engine.predictMemory(poses, maps, scores_every_frame);
-  report.predicted_memory_mb = p.total_mb;
-  print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
-             p.describe().c_str(), budget_mb, explicit_budget ? "" : " (three quarters of RAM)", p.ms);
-  if (p.total_mb <= budget_mb)
-    return;
-  if (explicit_budget)
-    throw msf::InvalidInputError(
-        "the run is predicted to need up to " + std::to_string(static_cast<long long>(std::ceil(p.total_mb))) +
-        " MiB at its peak (" + p.describe() + "), over the memory budget of " +
-        std::to_string(static_cast<long long>(budget_mb)) +
-        " MiB (tsdf_volume.max_memory_mb, -max_memory): use fewer frames, larger voxels, a streamed map (-stream R) "
-        "or a larger budget");
-  print_warn("the run is predicted to need up to %.0f MiB at its peak, over three quarters of RAM (%.0f MiB): the "
-             "prediction is an upper bound; the run stops at the first frame whose blocks would not fit\n",
-             p.total_mb, budget_mb);
-}
-
 /// The console's protocol 4 table: per source, coverage, D1 (missing = bad) and MAE within
 /// the map's range and over all ground-truth pixels (static ones, when the dataset says which).
 void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
@@ -180,6 +151,15 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
     print_info("  no ghost figure: %s\n", e.no_ghosts.c_str());
 }
 
+/// The console's protocol 6 lines: the open sky each mesh covers.
+void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky) {
+  for (const auto& [name, c] : open_sky)
+    print_info("  open sky covered by %-11s %.2f %% of %zu pixels in %zu frames (mean per frame %.2f %%, worst "
+               "%.2f %% at frame %zu), at a median depth of %.1f m\n",
+               name.c_str(), 100 * c.share, c.sky_pixels, c.frames, 100 * c.mean_frame_share, 100 * c.worst_share,
+               c.worst_frame, c.covered_depth_median_m);
+}
+
 void printSummary(const msf::RunReport& report, const std::string& out) {
   print_info("%zu frames in %.2f s: ", report.frames.size(), report.wall_s);
   print_value("%.1f fps", report.framesPerSecond());
@@ -194,6 +174,7 @@ void printSummary(const msf::RunReport& report, const std::string& out) {
                100 * report.mesh_accuracy.completeness, report.mesh_accuracy.threshold_m);
   if (!report.map_evaluation.rows.empty())
     printMapEvaluation(report.map_evaluation);
+  printOpenSky(report.open_sky);
   print_info("Report: ");
   print_value("%s/report.md\n", out.c_str());
 }
@@ -208,7 +189,9 @@ public:
         frames_(source.indices(msf::FrameRange::parse(request.frames))),
         poses_(request.poses, source, frames_),
         holdout_(source, msf::HoldoutConfig{config.rings, config.projection, {}}),
-        panel_frames_(spread(frames_, request.panels)) {
+        panel_frames_(spread(frames_, request.panels)),
+        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world))),
+        on_rig_(msf::adaptToRig(config, source.calibration())) {
     if (!source.hasColor())
       print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
                  source.description().c_str());
@@ -217,16 +200,10 @@ public:
       holdout_.split(first);
       holdout_.take(first.index);
     }
+    engine_ = makeEngine();
+    planMemory();
     describeReport();
     makeEvaluations();
-    msf::Reconstructor::Options options;
-    options.poses = poses_.mode();
-    options.stream_directory = streaming() ? stage_ : "";
-    options.keep_sparse = !panel_frames_.empty(); // the panels show the projected scan
-    engine_ = std::make_unique<msf::Reconstructor>(source.calibration(), config_, options);
-    checkMemoryBudget(*engine_, poses_.knownPoses(frames_),
-                      1 + (request.compare_sources ? 2 : 0) + (request.compare_paper ? 1 : 0), evaluation_ != nullptr,
-                      report_);
   }
 
   /// The frames through the engine; returns whether the run was interrupted.
@@ -240,6 +217,8 @@ public:
     print_info("%s%s; poses: %s\n", request_.holdout ? ", held-out rings removed from every scan" : "",
                request_.compare_sources ? ", with a map of each source alone" : "", poses_.description().c_str());
     engine_->setFrameFilter([this](msf::Frame& frame) {
+      if (sky_)
+        sky_->addFrame(frame); // from the whole scan
       if (request_.holdout)
         holdout_.split(frame);
       poses_.apply(frame);
@@ -271,8 +250,9 @@ public:
     report_.pose_ms = engine_->odometryMs();
     const char* used_name = poses_.kind() == msf::PoseSource::Kind::Estimated ? "estimated"
                             : poses_.kind() == msf::PoseSource::Kind::File    ? "poses file"
+                            : poses_.kind() == msf::PoseSource::Kind::Refined ? "refined"
                                                                               : "dataset";
-    msf::writeTrajectory(stage_, used_poses_, frames_, used_name, source_, report_);
+    msf::writeTrajectory(stage_, used_poses_, frames_, used_name, source_, T_out_world_, report_);
     report_.peak_memory_mb = msf::peakMemoryMb();
     report_.writeFramesCsv(path("frames.csv"));
     if (!report_.frames.empty())
@@ -288,6 +268,92 @@ public:
 
 private:
   bool streaming() const { return config_.streaming.enabled(); }
+  /// Whether the run may stream its map: every evaluation it was asked for works on a streamed one.
+  bool mayStream() const {
+    return !streaming() && !request_.holdout && !request_.compare_sources && !request_.compare_paper;
+  }
+  /// Whether the run keeps each frame's ground truth to score the whole mesh at the end (makeEvaluations).
+  bool keepsEveryFrame() const { return !streaming() && (request_.holdout || !source_.groundTruthDir().empty()); }
+  int maps() const { return 1 + (request_.compare_sources ? 2 : 0) + (request_.compare_paper ? 1 : 0); }
+
+  std::unique_ptr<msf::Reconstructor> makeEngine() const {
+    msf::Reconstructor::Options options;
+    options.poses = poses_.mode();
+    options.stream_directory = streaming() ? stage_ : "";
+    options.keep_sparse = !panel_frames_.empty(); // the panels show the projected scan
+    return std::make_unique<msf::Reconstructor>(source_.calibration(), config_, options);
+  }
+
+  /// The memory budget against the run's predicted peak, before the run: a run over it whose
+  /// evaluations allow it streams its map (streamOnItsOwn); otherwise an explicit budget
+  /// (tsdf_volume.max_memory_mb > 0) refuses it, the default one (three quarters of RAM) warns.
+  /// With estimated poses nothing is known before the run: the volume's own check at each
+  /// growth stays.
+  void planMemory() {
+    const double budget_mb = static_cast<double>(engine_->volume().maxMemoryBytes()) / (1024.0 * 1024.0);
+    const msf::PoseList poses = poses_.knownPoses(frames_);
+    if (poses.empty()) {
+      print_info("Memory: the poses are estimated as the run goes, so its peak is not predicted; the TSDF volume "
+                 "stops the run at the first frame whose blocks would exceed the budget (%.0f MiB)\n",
+                 budget_mb);
+      return;
+    }
+    const msf::MemoryEvidence evidence = engine_->measureMemory(source_, frames_, poses);
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    report_.predicted_memory_mb = p.total_mb;
+    print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
+               p.describe().c_str(), budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", p.ms);
+    if (p.total_mb <= budget_mb)
+      return;
+    if (mayStream())
+      return streamOnItsOwn(p, evidence, budget_mb);
+    const std::string whole = streaming() ? "" : ", and the run needs the whole map in memory (" + wholeMapReason() + ")";
+    if (explicitBudget())
+      throw msf::InvalidInputError("the run is predicted to need up to " + mib(p.total_mb) + " MiB at its peak (" +
+                                   p.describe() + "), over the memory budget of " + mib(budget_mb, false) +
+                                   " MiB (tsdf_volume.max_memory_mb, -max_memory)" + whole +
+                                   ": use fewer frames, larger voxels, " +
+                                   (streaming() ? "a smaller active radius" : "a streamed map (-stream R)") +
+                                   " or a larger budget");
+    print_warn("the run is predicted to need up to %.0f MiB at its peak, over three quarters of RAM (%.0f MiB)%s: "
+               "the run stops at the first frame whose blocks would not fit\n",
+               p.total_mb, budget_mb, whole.c_str());
+  }
+
+  /// A run predicted over the budget streams its map with the least active radius the
+  /// integrator allows (its reach plus a tile: every block a frame changes stays in memory,
+  /// and no more); an explicit budget that even the streamed run would exceed refuses it. The
+  /// in-memory prediction's evidence serves: the streamed engine differs in its window only.
+  void streamOnItsOwn(const msf::MemoryPrediction& in_memory, const msf::MemoryEvidence& evidence, double budget_mb) {
+    const double radius = std::ceil(engine_->minimumStreamingRadius());
+    config_.streaming.active_radius_m = radius;
+    engine_ = makeEngine();
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    report_.predicted_memory_mb = p.total_mb;
+    if (explicitBudget() && p.total_mb > budget_mb)
+      throw msf::InvalidInputError(
+          "the run is predicted to need up to " + mib(in_memory.total_mb) + " MiB at its peak in memory and " +
+          mib(p.total_mb) + " MiB streamed with an active radius of " + mib(radius, false) + " m (" + p.describe() +
+          "), over the memory budget of " + mib(budget_mb, false) +
+          " MiB (tsdf_volume.max_memory_mb, -max_memory): use fewer frames, larger voxels or a larger budget");
+    print_info("Memory: predicted %.0f MiB in memory, over the budget of %.0f MiB%s: streaming the map with an "
+               "active radius of %.0f m (tiles in %s/tiles); predicted peak streamed %.0f MiB (%s)\n",
+               in_memory.total_mb, budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", radius,
+               request_.out.c_str(), p.total_mb, p.describe().c_str());
+    if (p.total_mb > budget_mb)
+      print_warn("even streamed, the run is predicted over three quarters of RAM (%.0f MiB): the run stops at the "
+                 "first frame whose blocks would not fit\n",
+                 budget_mb);
+  }
+
+  bool explicitBudget() const { return config_.volume.max_memory_mb > 0; }
+  std::string wholeMapReason() const {
+    return request_.holdout ? "-holdout" : request_.compare_sources ? "-compare_sources" : "-compare_paper";
+  }
+  /// A figure in MiB for a message, rounded up (a prediction) or down (a budget).
+  static std::string mib(double mb, bool up = true) {
+    return std::to_string(static_cast<long long>(up ? std::ceil(mb) : std::floor(mb)));
+  }
   std::string path(const std::string& name) const { return (fs::path(stage_) / name).string(); }
 
   void describeReport() {
@@ -296,6 +362,7 @@ private:
     report_.layout = !source_.groundTruthDir().empty()                                   ? "synthetic"
                      : sequence && sequence->layout() == msf::Sequence::Layout::Raw ? "raw"
                      : sequence                                                     ? "odometry"
+                     : msf::isRosBag(source_.description())                         ? "ros bag"
                                                                                     : "generic";
     report_.frames_requested = frames_.size();
     report_.voxel_size_m = config_.volume.voxel_size_m;
@@ -315,10 +382,13 @@ private:
     if (!streaming() && (request_.holdout || truth_))
       evaluation_ = std::make_unique<msf::ReconstructionEvaluation>(
           msf::PinholeCamera::fromCalibration(source_.calibration(), 0), source_.calibration().focalBaseline(),
-          config_.integrator.max_depth_m, holdout_.config().d1);
+          on_rig_.integrator.max_depth_m, holdout_.config().d1);
     moving_split_ = !request_.holdout && truth_ && truth_->truth().hasMovingMasks();
+    // Protocol 6 renders the whole mesh too.
+    if (!streaming())
+      sky_ = std::make_unique<msf::SkyScoring>(source_.calibration(), config_.projection, panel_frames_);
     if (request_.compare_sources)
-      source_maps_ = std::make_unique<msf::SourceMaps>(config_, source_.calibration());
+      source_maps_ = std::make_unique<msf::SourceMaps>(on_rig_, source_.calibration());
   }
 
   /// After each frame is integrated, on the engine's integration thread.
@@ -327,10 +397,15 @@ private:
                               r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms,
                               msf::residentMemoryMb()});
     used_poses_.push_back(r.T_world_cam0);
+    if (sky_) {
+      sky_->setPose(r.index, r.T_world_cam0);
+      pose_of_[r.index] = r.T_world_cam0;
+      name_of_[r.index] = r.name;
+    }
     cv::Mat true_depth;
     if (truth_) {
       true_depth = truth_->depth(r.name);
-      truth_->addFrame(r, true_depth, source_.calibration(), config_.integrator.max_depth_m);
+      truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m);
     }
     if (evaluation_) {
       if (request_.holdout)
@@ -442,8 +517,10 @@ private:
     if (streaming()) {
       if (report_.triangles == 0)
         print_warn("\nno surface was reconstructed: mesh.ply is not written\n");
+      else if (!T_out_world_.matrix().isIdentity())
+        msf::StreamingMap::transformMeshFile(path(report_.mesh_file), T_out_world_);
     } else if (!mesh_->triangles.empty()) {
-      msf::saveMesh(path(report_.mesh_file), polygons_["mesh"]);
+      saveInOutputWorld(report_.mesh_file, polygons_["mesh"]);
       engine_->volume().save(path(report_.volume_file));
     } else {
       print_warn("\nno surface was reconstructed: mesh.ply and volume.pcd are not written\n");
@@ -470,7 +547,16 @@ private:
     if (mesh.triangles.empty())
       return;
     mesh.toPolygonMesh(polygons_[name]);
-    msf::saveMesh(path(name + ".ply"), polygons_[name]);
+    saveInOutputWorld(name + ".ply", polygons_[name]);
+  }
+
+  /// A mesh file in the output's world (-world); `mesh` stays in the map's, for the scores.
+  void saveInOutputWorld(const std::string& name, const pcl::PolygonMesh& mesh) const {
+    if (T_out_world_.matrix().isIdentity())
+      return msf::saveMesh(path(name), mesh);
+    pcl::PolygonMesh moved = mesh;
+    msf::transformMesh(moved, T_out_world_);
+    msf::saveMesh(path(name), moved);
   }
 
   /// The meshes against the true surface (synthetic) and protocol 4 (rendered at every pose).
@@ -513,7 +599,7 @@ private:
       e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
                                        std::to_string(config_.rings.heldout_remainder) + ") projected into camera 0"
                                  : "the synthetic sequence's exact depth (gt/depth_0)";
-      e.range_m = config_.integrator.max_depth_m;
+      e.range_m = on_rig_.integrator.max_depth_m;
       e.moving_split = moving_split_;
       bool any_ghosts = false;
       for (const auto& [name, s] : scores)
@@ -523,19 +609,45 @@ private:
                              : "no synthetic ground truth: the places of moving objects are unknown";
       msf::summarizeMapEvaluation(*evaluation_, scores, e);
     }
+    scoreOpenSky(meshes);
+  }
+
+  /// Protocol 6: the open sky each mesh covers, and pictures of the fused mesh's.
+  void scoreOpenSky(const std::map<std::string, msf::SyntheticScoring::MeshToScore>& meshes) {
+    if (!sky_ || meshes.empty())
+      return;
+    if (hurried()) {
+      report_.skipped.push_back("open_sky");
+      return;
+    }
+    TicToc tt;
+    tt.tic();
+    print_highlight("Rendering the mesh%s at every frame's pose over the open sky ", meshes.size() > 1 ? "es" : "");
+    std::map<std::string, const msf::TriangleMesh*> to_score;
+    for (const auto& [name, m] : meshes)
+      to_score[name] = m.mesh;
+    report_.open_sky = sky_->score(to_score);
+    if (meshes.count("mesh"))
+      report_.sky_pictures = sky_->drawPictures(stage_, *meshes.at("mesh").mesh, pose_of_, name_of_);
+    msf::tool::printDone(tt.toc(), to_score.size());
   }
 
   const Request& request_;
-  const msf::PipelineConfig& config_;
+  msf::PipelineConfig config_; // streamOnItsOwn may set its streaming radius
   const msf::FrameSource& source_;
   std::string stage_;
   std::vector<std::size_t> frames_;
   msf::PoseSource poses_;
   msf::RingHoldout holdout_;
   std::set<std::size_t> panel_frames_;
+  Eigen::Isometry3d T_out_world_; // -world: from the map's world to the outputs'
+  msf::PipelineConfig on_rig_; // the engine's configuration on the source's rig (adaptToRig): the map's range, the source maps'
   msf::RunReport report_;
   std::unique_ptr<msf::SyntheticScoring> truth_;
   std::unique_ptr<msf::ReconstructionEvaluation> evaluation_;
+  std::unique_ptr<msf::SkyScoring> sky_;
+  std::map<std::size_t, Eigen::Isometry3d> pose_of_; // of the frames integrated, for protocol 6's pictures
+  std::map<std::size_t, std::string> name_of_;
   bool moving_split_ = false;
   std::unique_ptr<msf::SourceMaps> source_maps_;
   std::unique_ptr<msf::Reconstructor> engine_, paper_;
@@ -553,13 +665,14 @@ int main(int argc, char** argv) {
   msf::PipelineConfig config;
   msf::tool::CommandLine cli(
       "msf_reconstruct", "[DATASET_DIR] [options]",
-      "Reconstructs a KITTI odometry sequence, a KITTI raw drive or a synthetic sequence (msf_synth) into a coloured "
-      "mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "Reconstructs a dataset (a folder of the generic layout with a rig file, a KITTI odometry sequence or raw drive, "
+      "a synthetic sequence of msf_synth, a ROS 1 bag in kitti2bag's layout or with the topics named below: "
+      "docs/ros.md) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
       "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
       "(20 frames) in a temporary folder and reconstructs it.");
   cli.value("-o", "DIR", request.out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
-            "depth_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
+            "depth_NNNNNN.png, sky_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
             "run's output (replaced); anything else in it is refused")
       .value("-config", "FILE",
              [&](const std::string& path) {
@@ -567,11 +680,20 @@ int main(int argc, char** argv) {
                request.config_path = path;
              },
              "YAML configuration (config/kitti.yaml); the options below override it")
+      .value("-rig", "FILE", request.reader.rig,
+             "a rig file (docs/usage.md, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
+             "without rig.yaml, and used instead of a dataset's own (a bag's CameraInfo and LiDAR extrinsic too)")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
+      .value("-world", "W", request.world,
+             "camera: the outputs in camera 0 of the first frame (x right, y down, z forward; the default) | z_up: "
+             "x forward, y left, z up (ROS): mesh*.ply, poses.txt, poses_tum.txt (volume.pcd and a streamed map's "
+             "tiles/ and tsdf/ stay the map's own store, in camera 0)")
       .value("-poses", "P", request.poses,
-             "dataset: the dataset's poses (the default when it has them) | estimate: LiDAR odometry as each frame is "
-             "loaded (the default without them; section odometry) | a KITTI poses file, line i for frame i. "
-             "OUT/poses.txt holds the poses used")
+             "dataset: the dataset's poses as they are (the default for ground truth: KITTI odometry, synthetic) | "
+             "refine: the dataset's GPS/INS poses refined by LiDAR odometry, their motion the prediction and a soft "
+             "constraint of their accuracy (the default for KITTI raw's OXTS; section odometry, prior_*) | "
+             "estimate: LiDAR odometry as each frame is loaded (the default without poses; section odometry) | "
+             "a KITTI poses file, line i for frame i. OUT/poses.txt holds the poses used")
       .value("-voxel", "V", config.volume.voxel_size_m, "voxel size in metres (tsdf_volume.voxel_size_m)")
       .value("-lambda", "L", config.integrator.lambda, "regularization of eq. 7 (tsdf_integrator.lambda)")
       .value("-panels", "N", request.panels,
@@ -581,11 +703,23 @@ int main(int argc, char** argv) {
              "keep only R metres around the camera in memory (streaming.active_radius_m; at least the integrator's "
              "reach + a tile, 101 m with the shipped configs): the rest is meshed into OUT/tiles/X_Y_Z.ply and its TSDF "
              "written to OUT/tsdf/ as it leaves; mesh.ply is their union (no volume.pcd, no mesh scores, no preview; "
-             "msf_mesh -store OUT meshes the TSDF again). See docs/streaming.md")
+             "msf_mesh OUT out.ply meshes the TSDF again). See docs/streaming.md")
       .value("-max_memory", "MB", config.volume.max_memory_mb,
              "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
              "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "
              "the TSDF volume also stops the run at the first frame whose blocks would not fit")
+      .value("-lidar_topic", "T", request.reader.bag.lidar_topic, "a bag's LiDAR scans, PointCloud2 (default {default})")
+      .value("-left_topic", "T", request.reader.bag.left_topic,
+             "a bag's left rectified image (default {default}); each image's CameraInfo is its sibling camera_info")
+      .value("-right_topic", "T", request.reader.bag.right_topic, "a bag's right rectified image (default {default})")
+      .value("-color_topic", "T", request.reader.bag.color_topic,
+             "a bag's colour image (default {default}, when the bag has it; '' for none)")
+      .value("-world_frame", "F", request.reader.bag.world_frame,
+             "a bag's tf frame of the poses (default: camera_init, kitti2bag's, when the bag has it, else the root "
+             "of the left camera's tf tree)")
+      .value("-max_offset", "S", request.reader.bag.max_offset_s,
+             "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
+             "{default})")
       .flag("-save_depth", request.save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
       .flag("-holdout", request.holdout,
             "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
@@ -632,15 +766,18 @@ int main(int argc, char** argv) {
     msf::FrameRange::parse(request.frames); // a malformed range before any folder is made
 
     // OUT is replaced as a whole: an input inside it is refused.
-    const bool poses_file = request.poses != "dataset" && request.poses != "estimate";
+    const bool poses_file = !request.poses.empty() && request.poses != "dataset" && request.poses != "estimate" &&
+                            request.poses != "refine";
     installStopHandler();
     msf::OutputFolder output(request.out, "msf_reconstruct",
-                             {request.dataset, request.config_path, poses_file ? request.poses : ""});
+                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});
     // The default street is generated inside the staging folder (a killed run's goes with it
     // at the next run) and removed before the commit.
     const fs::path street = fs::path(output.dir()) / ".street";
-    const std::unique_ptr<msf::FrameSource> source =
-        msf::openDataset(request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset);
+    const std::unique_ptr<msf::FrameSource> source = msf::openDataset(
+        request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, request.reader);
+    for (const std::string& note : source->notes())
+      print_warn("%s: %s\n", source->description().c_str(), note.c_str());
     if (request.save_depth)
       fs::create_directories(fs::path(output.dir()) / "depth");
 

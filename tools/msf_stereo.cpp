@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 3: SGBM (5-path or 3-way) on a rectified grey pair to an organized cloud in camera 0
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
@@ -9,6 +10,7 @@
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/point_types.h>
 #include <msf/range_image/real_returns.h>
 #include <msf/stereo/point_types.h>
@@ -45,12 +47,12 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
     if (guided)
       print_warn("%s has no field 'distance' (as msf_interpolate writes): matching is not guided\n", path.c_str());
     pcl::PointCloud<pcl::PointXYZ> cloud;
-    pcl::fromPCLPointCloud2(blob, cloud);
+    msf::fromCloudBlob(std::move(blob), cloud, path);
     prior = msf::cloudToDepthImage(cloud);
     return;
   }
   pcl::PointCloud<msf::PointXYZID> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
+  msf::fromCloudBlob(std::move(blob), cloud, path);
   prior = msf::cloudToDepthImage(cloud);
   cv::Mat distance(prior.size(), CV_32FC1);
   for (int v = 0; v < distance.rows; ++v)
@@ -65,12 +67,14 @@ int main(int argc, char** argv) {
   std::string calib_path, image_size_text, color_path, disparity_path, prior_path;
   bool print_config = false;
   msf::SgbmConfig config;
+  msf::RigAdaptationConfig rig;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
-      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.mode; stereo.engine: the native AVX2 kernel or "
-      "OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
+      "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.unguided_mode, or stereo.mode where -prior "
+      "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
       "is no match).");
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
+      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
       .value("-color", "PATH", color_path,
              "colour camera image (image_2), projected for each point's colour; without it the colour is the left "
@@ -79,12 +83,15 @@ int main(int argc, char** argv) {
       .value("-prior", "PATH", prior_path,
              "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
              "real returns (distance 0) guide it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
-             "YAML config, section stereo (every SGBM parameter); the options below override it")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
+             "YAML config, sections stereo (every SGBM parameter; the options below override it) and rig (the keys "
+             "in rows between LiDAR rings follow the rig's beams, as in msf_reconstruct)")
       .value("-num_disparities", "N", config.num_disparities_px,
              "search range without a prior (multiple of 16; default {default})")
       .value("-block_size", "N", config.block_size_px, "odd block size (default {default})")
-      .value("-mode", "NAME", config.mode, "sgbm (5 paths, default) | sgbm_3way | hh | hh4")
+      .value("-mode", "NAME", [&](const std::string& mode) { config.mode = config.unguided_mode = mode; },
+             "the paths, guided or not: ground_3way | sgbm (5 paths) | sgbm_3way | hh | hh4 (default: sgbm guided by "
+             "-prior, ground_3way without)")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
       .flag("-print_config", print_config, "print the stereo settings in use");
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
@@ -99,6 +106,8 @@ int main(int argc, char** argv) {
     if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
       throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
     config.validate();
+    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
+    msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
     if (print_config)
       msf::printConfig(std::cout, config);
 
@@ -106,7 +115,6 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Loading ");
     print_value("%s %s ", files[0].c_str(), files[1].c_str());
-    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     const cv::Mat left = msf::readImage(files[0], cv::IMREAD_GRAYSCALE);
     const cv::Mat right = msf::readImage(files[1], cv::IMREAD_GRAYSCALE);
     cv::Mat color;

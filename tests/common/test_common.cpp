@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
@@ -165,7 +166,14 @@ TEST(Tool, NumbersAreReadStrictly) {
   rejected("-x", "inf", "-x needs a number, not 'inf'");
   rejected("-n", "2.5e1", "-n needs a whole number, not '2.5e1'");
   rejected("-n", "cubic", "-n needs a whole number, not 'cubic'");
-  rejected("-n", "99999999999", "-n needs a whole number");
+  // Past int's range: refused as such, not wrapped; a value of 5 million digits is named by its length.
+  rejected("-n", "99999999999", "-n must be a whole number in -2147483648 .. 2147483647, not '99999999999'");
+  rejected("-n", "-99999999999", "-n must be a whole number in -2147483648 .. 2147483647");
+  rejected("-n", std::string(5000000, '9'), "-n must be a whole number in -2147483648 .. 2147483647, not "
+                                            "'999999999999999999999999...' (5000000 characters)");
+  rejected("-x", "1e999", "-x needs a finite number within the range of a double, not '1e999'");
+  rejected("-xf", "1e39", "-xf needs a finite number within the range of a float, not '1e39'");
+  rejected("-x", std::string(5000000, 'a'), "-x needs a number, not 'aaaaaaaaaaaaaaaaaaaaaaaa...' (5000000 characters)");
 }
 
 TEST(Tool, OptionsApplyInTheOrderDeclaredAndTheFirstOfARepeatedOneStays) {

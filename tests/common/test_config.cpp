@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Configuration files read with yaml-cpp through keys declared once (config_keys.h, config.h).
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>

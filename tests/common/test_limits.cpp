@@ -1,4 +1,5 @@
-// Issue 19: the limits hostile inputs are checked against.
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The limits hostile inputs are checked against.
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 
@@ -27,6 +28,13 @@ TEST(Limits, ImageSizes) {
   EXPECT_THROW(msf::limits::checkImageSize(0, 10, "i"), msf::InvalidInputError);
   EXPECT_NE(errorOf([] { msf::limits::checkImageSize(30000, 20000, "image 'a.png'"); }).find("image 'a.png'"),
             std::string::npos);
+  // Within the side, but not the area: an 8192-wide stereo pair or an 8192x8192 projection ran
+  // for minutes in gigabytes.
+  EXPECT_NO_THROW(msf::limits::checkImageSize(8192, 2048, "i"));
+  EXPECT_NO_THROW(msf::limits::checkImageSize(4096, 4096, "i"));
+  EXPECT_EQ(errorOf([] { msf::limits::checkImageSize(8192, 2472, "image 'l.png'"); }),
+            "image 'l.png': image size 8192x2472 has 20250624 pixels, more than the 16777216 (4096x4096) a frame may "
+            "have: each of its stages would take gigabytes and minutes");
 }
 
 TEST(Limits, RigidTransforms) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // OutputFolder: a run's outputs replace only what an earlier run wrote, never a user's file.
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>

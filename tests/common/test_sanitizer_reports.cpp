@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The check that a tool run by a test printed no sanitizer report (runCommand, runTool,
 // bad_inputs.sh), tested on the real reports of msf_sanitizer_report_helper: a program built
 // with -fsanitize=address,undefined in every build (tests/CMakeLists.txt) that overflows an int,

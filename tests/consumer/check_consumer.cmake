@@ -1,7 +1,8 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 # ctest script: install the build tree into a scratch prefix, then configure, build and run a
-# consumer project made of the README's library example: its C++ block (example.cpp) and its
-# CMake block (CMakeLists.txt), between <!-- example:consumer:begin --> and ...:end -->.
-# In: BUILD_DIR, README, WORK_DIR, KITTI_DIR; CONSUMER_CXX_FLAGS and CONSUMER_LINK_FLAGS, the
+# consumer project made of the library example of docs/library.md: its C++ block (example.cpp)
+# and its CMake block (CMakeLists.txt), between <!-- example:consumer:begin --> and ...:end -->.
+# In: BUILD_DIR, README (the document holding the example), WORK_DIR, KITTI_DIR; CONSUMER_CXX_FLAGS and CONSUMER_LINK_FLAGS, the
 # build's own (make test-sanitize's -fsanitize: the installed libraries need its runtime, and
 # the templates both sides instantiate must be compiled alike).
 file(REMOVE_RECURSE ${WORK_DIR})

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Depth-completion and disparity metrics on hand-made images with known answers.
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/depth_metrics.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The bounds of a per-pixel fusion of two depth images, on hand-made pixels.
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/fusion_bounds.h>

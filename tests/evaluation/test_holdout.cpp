@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Protocol 2 (ring hold-out) on the real KITTI sample: the split, the runner with oracle
 // methods, the published IP-Basic figures, the targets, and the msf_holdout tool.
 #include <msf/common/exceptions.h>

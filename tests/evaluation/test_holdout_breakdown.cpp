@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The hold-out breakdown: which ground-truth pixels camera 0 cannot see, and the regions
 // msf_holdout -breakdown reports (hand-made images with known answers, then KITTI).
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Evaluation protocol 4 on analytic scenes with known answers, and the ghost metric on
 // hand-made vertices.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Evaluation protocol 3 in the tools: msf_holdout in full-image mode on a synthetic sequence
 // (rows all / background / foreground) and msf_eval_disparity over folders.
 #include <msf/io/image_io.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // supportAtDepthEdges: a fused disparity between the two surfaces of a depth edge takes the
 // nearest real return's; elsewhere nothing changes.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // extendFacades: a LiDAR-backed wall goes on upward over the blank pixels above it, and nothing
 // else does: not the road, not a textured surface, not the sky.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/fusion/point_types.h>
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>

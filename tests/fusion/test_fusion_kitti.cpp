@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Fusion on real KITTI frames under protocol 2 (docs/design.md) (ring hold-out): the fused depth
 // must beat each of its inputs, and the rows of msf_holdout must say so too.
 #include <msf/evaluation/depth_metrics.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
 #include <msf/io/velodyne_io.h>
@@ -183,7 +184,9 @@ TEST(Calibration, ImageSizeText) {
                 .find("image size 99999999999x5 is outside 1x1 .. 8192x8192"),
             std::string::npos);
   EXPECT_THROW(msf::parseImageSize("8193x375"), msf::InvalidInputError);
-  EXPECT_EQ(msf::parseImageSize("8192x8192"), cv::Size(8192, 8192));
+  EXPECT_EQ(msf::parseImageSize("8192x2048"), cv::Size(8192, 2048));
+  EXPECT_NE(msf::test::errorOf([] { msf::parseImageSize("8192x8192"); }).find("has 67108864 pixels, more than the"),
+            std::string::npos);
 }
 
 TEST_F(CalibrationErrors, WrongMatrixSizeNamesKeyAndCount) {

@@ -1,4 +1,5 @@
-// Issue 19: files whose headers, values or shapes are hostile end in an error naming the
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// Files whose headers, values or shapes are hostile end in an error naming the
 // file and what is wrong, before anything large is allocated.
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
@@ -17,6 +18,7 @@
 #include <fstream>
 #include <iterator>
 #include <regex>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -166,6 +168,53 @@ TEST_F(HostileCalibration, ZeroBaselineIsAnErrorWhereItIsUsed) {
   c.source = "mono";
   EXPECT_NE(errorOf([&] { c.focalBaseline(); }).find("'mono': the grey pair's focal length x baseline is 0"),
             std::string::npos); // ...until a disparity needs it
+}
+
+TEST_F(HostileCalibration, ASwappedOrImplausibleStereoPairIsAnErrorWhereItIsUsed) {
+  const auto stereoError = [&](double p1_tx, double p1_fx = 60, double p1_ty = 0) {
+    msf::Calibration c = good;
+    c.P[1](0, 3) = p1_tx;
+    c.P[1](0, 0) = p1_fx;
+    c.P[1](1, 3) = p1_ty;
+    EXPECT_EQ(errorLoading(c), "(no error)"); // what projects a scan needs is there
+    c.source = "rig";
+    return errorOf([&] { c.focalBaseline(); });
+  };
+  EXPECT_EQ(stereoError(-30), "(no error)");
+  // Swapped images: the right camera's centre left of the left one's.
+  EXPECT_NE(stereoError(30).find("'rig': camera 1 is 0.5 m left of camera 0 (P1's fourth value 30 is positive"),
+            std::string::npos);
+  // A baseline of a nanometre or of 990 km (within the translation limit) is a unit or digit slip.
+  EXPECT_NE(stereoError(-60e-9).find("'rig': the grey pair's baseline is 1e-09 m, outside 0.001 .. 10 m"),
+            std::string::npos);
+  EXPECT_NE(stereoError(-60 * 990e3).find("the grey pair's baseline is 990000 m, outside 0.001 .. 10 m"),
+            std::string::npos);
+  // A rectified pair shares its intrinsics and differs along x only.
+  EXPECT_NE(stereoError(-30, 61).find("'rig': P1's fx 61 is not P0's 60"), std::string::npos);
+  EXPECT_NE(stereoError(-30, 60, 3).find("P1 is shifted up, down or along the axis from P0"), std::string::npos);
+}
+
+TEST_F(HostileCalibration, AKeyGivenTwiceIsAnError) {
+  // The last P0 won: which one the user meant is unknown.
+  write(dir.file("calib.txt"), "P0: 700 0 600 0 0 700 180 0 0 0 1 0\nP1: 700 0 600 -380 0 700 180 0 0 0 1 0\n"
+                               "P2: 700 0 600 0 0 700 180 0 0 0 1 0\nP3: 700 0 600 0 0 700 180 0 0 0 1 0\n"
+                               "P0: 710 0 600 0 0 710 180 0 0 0 1 0\nTr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  EXPECT_EQ(errorOf([&] { msf::loadCalibration(dir.file("calib.txt")); }),
+            "calibration '" + dir.file("calib.txt") + "': key 'P0' is given twice, on lines 1 and 5");
+}
+
+TEST_F(HostileCalibration, AYamlMatrixOfAnIntegerTypeIsRefused) {
+  // dt u: OpenCV clipped 707.09 to 255 and -379.8 to 0.
+  msf::saveCalibrationYaml(good, dir.file("c.yaml"));
+  std::ifstream in(dir.file("c.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("dt: d"), 5, "dt: u");
+  write(dir.file("u.yaml"), yaml);
+  EXPECT_NE(errorOf([&] { msf::loadCalibration(dir.file("u.yaml")); })
+                .find("u.yaml': key 'P0' has dt 'u', not d (float64) or f (float32)"),
+            std::string::npos);
 }
 
 TEST_F(HostileCalibration, ValueThatIsNotANumberIsNamed) {
@@ -329,6 +378,14 @@ TEST(FuzzRegressions, APlyOfNoVertexLoadsAsAnEmptyCloud) {
   EXPECT_EQ(cloud.width * cloud.height, 0u);
 }
 
+TEST(FuzzRegressions, APlyHeaderLineStartingWithABlankIsRefusedBeforePclAssertsOnIt) {
+  // fuzz_cloud: ' obj_info x' passed the header check (which split the line at blanks) and PCL's
+  // PLYReader, which asserts that the line's first word is obj_info, aborted the program.
+  EXPECT_NE(cloudFindingError("crash-7c247a34df5eacb31f4f9a6e61a64e328c9a51a2").find("c.ply' is not a valid .ply file (bad header): line 3 ' obj_info x': a line "
+                                         "that starts with a blank"),
+            std::string::npos);
+}
+
 TEST(FuzzRegressions, APlyElementCountThatIsNotAWholeNumberIsRefusedBeforePclSizesTheCloud) {
   // fuzz_cloud (the fourth 600 s run): a binary .ply with `element vertex -7`, which PCL's
   // parser reads into a std::size_t as 2^64 - 7 and sized the cloud from (~52 GB). Its second
@@ -418,6 +475,15 @@ TEST(HostileClouds, PlyHeadersAreReadStrictly) {
       {binary + "element vertex 0\n" + xyz + "element face 100\nproperty list uchar int vertex_indices\n"
                 "end_header\n",
        "declares 100 face elements in its header, which need at least 100 bytes, but the file has 64"},
+      // PCL's reader asserts that an obj_info line starts with obj_info: a blank before it aborted.
+      {binary + " obj_info x\nelement vertex 2\n" + xyz + "end_header\n",
+       "line 3 ' obj_info x': a line that starts with a blank"},
+      {binary + "element vertex 2\n\tproperty float x\nend_header\n", "a line that starts with a blank"},
+      // obj_info num_cols x num_rows size the cloud before a vertex is read.
+      {binary + "obj_info num_cols 100000\nobj_info num_rows 100000\nelement vertex 2\n" + xyz + "end_header\n",
+       "obj_info num_cols 100000 x num_rows 100000 make 10000000000 points, not its 2 vertices"},
+      {binary + "obj_info num_cols 99999999999\nelement vertex 2\n" + xyz + "end_header\n",
+       "num_cols '99999999999' is not a whole number 0 .. 2147483647"},
       // ascii: each vertex is a line of 3 values, at least 6 bytes.
       {"ply\nformat ascii 1.0\nelement vertex 11\n" + xyz + "end_header\n",
        "declares 11 vertex elements in its header, which need at least 66 bytes, but the file has 64"},

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The foundation's tools, run as a user runs them.
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>

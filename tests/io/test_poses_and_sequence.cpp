@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
@@ -6,10 +7,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 namespace fs = std::filesystem;
 
 namespace {
+
+using msf::test::errorOf;
 
 std::string odometrySequence() { return msf::test::kittiDir() + "/odometry/sequences/04"; }
 std::string rawDrive() { return msf::test::kittiDir() + "/raw/2011_09_26/2011_09_26_drive_0009_sync"; }
@@ -125,6 +129,117 @@ TEST(Sequence, MissingScanIsNamed) {
   } catch (const msf::IOError& e) {
     EXPECT_NE(std::string(e.what()).find("velodyne/000000.bin"), std::string::npos) << e.what();
   }
+}
+
+/// A copy of odometry 04 (links) with the frames `numbers` only, its times.txt and its poses.
+std::string odometryWithFrames(const msf::test::TempDir& dir, const std::vector<int>& numbers) {
+  const fs::path from = odometrySequence();
+  const fs::path seq = fs::path(dir.path()) / "sequences" / "04";
+  for (const char* sub : {"image_0", "image_1", "image_2", "velodyne"})
+    fs::create_directories(seq / sub);
+  fs::create_directories(fs::path(dir.path()) / "poses");
+  fs::create_symlink(from / "calib.txt", seq / "calib.txt");
+  fs::create_symlink(from / "times.txt", seq / "times.txt");
+  fs::create_symlink(from.parent_path().parent_path() / "poses" / "04.txt", fs::path(dir.path()) / "poses" / "04.txt");
+  char name[16];
+  for (const int i : numbers) {
+    for (const char* cam : {"image_0", "image_1", "image_2"}) {
+      std::snprintf(name, sizeof name, "%06d.png", i);
+      fs::create_symlink(from / cam / name, seq / cam / name);
+    }
+    std::snprintf(name, sizeof name, "%06d.bin", i);
+    fs::create_symlink(from / "velodyne" / name, seq / "velodyne" / name);
+  }
+  return seq.string();
+}
+
+TEST(Sequence, FramesAreMatchedToPosesAndTimesByTheirNumberAcrossAGap) {
+  // Frames 0, 1, 3, 4 (2 is missing): frame 3 has line 3's pose and time, not line 2's (which
+  // is 1.3 m back), and -frames counts by the files' numbers.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const msf::Sequence full(odometrySequence());
+  const msf::Sequence gap(odometryWithFrames(dir, {0, 1, 3, 4}));
+  ASSERT_EQ(gap.size(), 4u);
+  EXPECT_EQ(gap.frameName(2), "000003");
+  EXPECT_TRUE(gap.poses()[2].isApprox(full.poses()[3]));
+  EXPECT_TRUE(gap.poses()[3].isApprox(full.poses()[4]));
+  const msf::Frame f = gap.load(2, false);
+  EXPECT_TRUE(f.T_world_cam0.isApprox(full.poses()[3]));
+  EXPECT_DOUBLE_EQ(f.timestamp, full.load(3, false).timestamp);
+  const auto picked = gap.indices(msf::FrameRange::parse("2:4"));
+  EXPECT_EQ(picked, (std::vector<std::size_t>{2, 3}));
+  EXPECT_NE(errorOf([&] { gap.indices(msf::FrameRange::parse("2:2")); }).find("selects no frame"), std::string::npos);
+  EXPECT_NE(errorOf([&] { gap.indices(msf::FrameRange::parse("0:5")); }).find("goes beyond the last frame"),
+            std::string::npos);
+}
+
+TEST(Sequence, AFrameBeyondThePosesIsNamed) {
+  // Frame 12 of a sequence whose poses have 10 lines: an error naming the frame, not the pose
+  // of the line before.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string seq = odometryWithFrames(dir, {0, 1});
+  for (const char* cam : {"image_0", "image_1"})
+    fs::create_symlink(odometrySequence() + "/" + cam + "/000002.png", fs::path(seq) / cam / "000012.png");
+  const std::string e = errorOf([&] { msf::Sequence s(seq); });
+  EXPECT_NE(e.find("frame 000012 has no entry in poses '"), std::string::npos) << e;
+  EXPECT_NE(e.find("04.txt', which has 10 (frames 0..9)"), std::string::npos) << e;
+}
+
+TEST(Sequence, StrayFilesBesideTheFramesAreNotFrames) {
+  // macOS and editors leave files in image folders: .DS_Store (first by name: the image size
+  // was read from it), a resource fork ._000000.png, a README, a copy.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string seq = odometryWithFrames(dir, {0, 1, 2});
+  for (const char* stray : {"image_0/.DS_Store", "image_0/._000000.png", "image_0/README", "image_0/000001 (copy).png",
+                            "velodyne/.DS_Store", "image_1/notes.txt"})
+    std::ofstream(fs::path(seq) / stray) << "not an image";
+  const msf::Sequence s(seq);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_EQ(s.frameName(0), "000000");
+  EXPECT_EQ(s.calibration().image_size, cv::Size(1226, 370));
+  EXPECT_EQ(s.load(2, false).left.size(), cv::Size(1226, 370));
+}
+
+TEST(Sequence, ARawDriveMatchesOxtsRecordsByTheFramesName) {
+  // A raw drive whose frame 2 is missing: frame 3 has OXTS record 3's pose (the record before
+  // was kept before); a record missing for a frame is named.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const msf::Sequence full(rawDrive());
+  const fs::path date = fs::path(dir.path()) / "2011_09_26";
+  const fs::path drive = date / "2011_09_26_drive_0009_sync";
+  for (const char* f : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt", "calib_imu_to_velo.txt"}) {
+    fs::create_directories(date);
+    fs::create_symlink(fs::path(rawDrive()).parent_path() / f, date / f);
+  }
+  for (const char* sub : {"image_00", "image_01"}) {
+    fs::create_directories(drive / sub / "data");
+    fs::create_symlink(fs::path(rawDrive()) / sub / "timestamps.txt", drive / sub / "timestamps.txt");
+  }
+  fs::create_directories(drive / "velodyne_points" / "data");
+  fs::create_directories(drive / "oxts" / "data");
+  char name[16];
+  for (const int i : {0, 1, 3, 4}) {
+    std::snprintf(name, sizeof name, "%010d", i);
+    for (const char* sub : {"image_00", "image_01"})
+      fs::create_symlink(fs::path(rawDrive()) / sub / "data" / (std::string(name) + ".png"),
+                         drive / sub / "data" / (std::string(name) + ".png"));
+    fs::create_symlink(fs::path(rawDrive()) / "velodyne_points" / "data" / (std::string(name) + ".bin"),
+                       drive / "velodyne_points" / "data" / (std::string(name) + ".bin"));
+    if (i != 4)
+      fs::create_symlink(fs::path(rawDrive()) / "oxts" / "data" / (std::string(name) + ".txt"),
+                         drive / "oxts" / "data" / (std::string(name) + ".txt"));
+  }
+  const std::string e = errorOf([&] { msf::Sequence s(drive.string()); });
+  EXPECT_NE(e.find("frame 0000000004 has no OXTS record: '"), std::string::npos) << e;
+  fs::create_symlink(fs::path(rawDrive()) / "oxts" / "data" / "0000000004.txt", drive / "oxts" / "data" / "0000000004.txt");
+  const msf::Sequence gap(drive.string());
+  ASSERT_EQ(gap.size(), 4u);
+  EXPECT_TRUE(gap.poses()[2].isApprox(full.poses()[3], 1e-9));
+  EXPECT_NEAR(gap.load(2, false).timestamp, full.load(3, false).timestamp, 1e-9);
 }
 
 TEST(Sequence, FolderOfNeitherLayoutIsAnError) {

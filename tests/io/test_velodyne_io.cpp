@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/velodyne_io.h>
@@ -64,6 +65,31 @@ TEST(VelodyneIo, NonFiniteRecordsAreDroppedAndCounted) {
   ASSERT_EQ(cloud.size(), 2u);
   EXPECT_EQ(cloud[1].y, 5.f);
   EXPECT_EQ(cloud[1].intensity, 0.25f);
+}
+
+TEST(VelodyneIo, AScanOfOnlyNonFiniteRecordsSaysSo) {
+  // NaN reflectance everywhere: every record dropped, and the tools blamed the calibration.
+  msf::test::TempDir dir;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  writeRecords(dir.file("s.bin"), {1, 2, 3, nan, 4, 5, 6, nan});
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  EXPECT_EQ(msf::test::errorOf([&] { msf::loadVelodyneBin(dir.file("s.bin"), cloud); }),
+            "scan '" + dir.file("s.bin") + "': each of its 2 records has a value that is not finite (NaN or inf in x, "
+            "y, z or reflectance)");
+  writeRecords(dir.file("empty.bin"), {});
+  EXPECT_EQ(msf::loadVelodyneBin(dir.file("empty.bin"), cloud).records, 0u);
+  EXPECT_TRUE(cloud.empty());
+}
+
+TEST(VelodyneIo, AFileTooLargeForAScanIsRefusedBeforeItIsRead) {
+  // 2 GB of holes: read whole before anything looked at it.
+  msf::test::TempDir dir;
+  { std::ofstream(dir.file("huge.bin")); }
+  std::filesystem::resize_file(dir.file("huge.bin"), std::uintmax_t{2} << 30);
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  EXPECT_EQ(msf::test::errorOf([&] { msf::loadVelodyneBin(dir.file("huge.bin"), cloud); }),
+            "scan '" + dir.file("huge.bin") + "' has 134217728 records (2147483648 bytes), more than the 16777216 a "
+            "scan may hold: not one LiDAR scan");
 }
 
 TEST(VelodyneIo, TruncatedFileNamesFileAndSize) {

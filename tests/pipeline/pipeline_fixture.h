@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What the pipeline's tests share: a small synthetic street made once per build, and reading
 // the tools' summary.json.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """PyYAML (Debian's python3-yaml) and msfusion read each other's configuration files.
 
 usage: pyyaml_config.py MSF_CONFIG SOURCE_DIR WORK_DIR

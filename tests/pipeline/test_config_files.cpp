@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The project's configuration files: made from the keys' declarations, read whole by every tool.
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The engine as a library object: fed frame by frame it gives msf_reconstruct's map, byte for
 // byte; its thread budget changes nothing but the time.
 #include <msf/io/cloud_io.h>

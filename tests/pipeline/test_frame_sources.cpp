@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // What the pipeline hands to evaluation protocol 4: frames changed before any stage sees
 // them (the ring hold-out), and each source's depth as a frame to integrate alone.
 #include <msf/common/exceptions.h>

@@ -1,4 +1,5 @@
-// The paper as published, as a configuration (issue 18, part 1): config/paper.yaml is
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The paper as published, as a configuration: config/paper.yaml is
 // PipelineConfig::paper(), and its rows on the shared KITTI frames are the ones docs/paper.md
 // shows (the table between its test:paper_rows markers is this test's oracle).
 #include <msf/common/exceptions.h>
@@ -37,6 +38,7 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   EXPECT_TRUE(c.interpolation.gaussian);
   EXPECT_EQ(c.stereo.engine, "opencv");
   EXPECT_EQ(c.stereo.mode, "sgbm_3way");
+  EXPECT_EQ(c.stereo.unguided_mode, "sgbm_3way");
   EXPECT_FALSE(c.stereo.lidarGuidance());
   EXPECT_FALSE(c.stereo.prior_search_range);
   EXPECT_FALSE(c.scheduling.stereo_prior);

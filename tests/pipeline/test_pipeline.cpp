@@ -1,9 +1,11 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The pipeline on a small synthetic sequence: same depth as the chain of tools, a sane
 // summary, a clean stop, and clear errors.
 #include <msf/common/output_folder.h>
 #include <msf/common/config.h>
 #include <msf/common/yaml_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/version.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/organized_conversion.h>
@@ -109,6 +111,11 @@ TEST_F(PipelineTest, ReconstructWritesItsOutputsWithSaneFigures) {
                            "report.md", "depth_000000.png", "depth_000003.png"})
     EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
   const std::string json = readFile(out.file("summary.json"));
+  // The run names the build that made it.
+  EXPECT_NE(json.find(std::string("\"msfusion\": {\"version\": \"") + msf::versionString() + "\", \"commit\": \"" +
+                      msf::gitCommit() + "\"}"),
+            std::string::npos)
+      << json;
   EXPECT_EQ(jsonNumber(json, "frames"), 4);
   EXPECT_GT(jsonNumber(json, "frames_per_second"), 0.0);
   // The first frame is done before the run ends, and the three after it take the rest.
@@ -265,7 +272,7 @@ TEST_F(PipelineTest, ASecondCtrlCStillLeavesAValidMeshAndSummary) {
   EXPECT_EQ(WEXITSTATUS(status), 130) << output;
   const std::string json = expectInterruptedOutputs(dir, out);
   // Stopped twice: the mesh is not scored, and the summary says what was skipped.
-  EXPECT_NE(json.find("\"skipped\": [\"mesh_preview\", \"mesh_accuracy\", \"reconstruction_evaluation\"]"),
+  EXPECT_NE(json.find("\"skipped\": [\"mesh_preview\", \"mesh_accuracy\", \"reconstruction_evaluation\", \"open_sky\"]"),
             std::string::npos)
       << json;
   EXPECT_NE(json.find("\"mesh_accuracy\": null"), std::string::npos) << json;
@@ -471,6 +478,26 @@ TEST(BoundedQueue, BlocksWhenFullAndDrainsAfterClose) {
   EXPECT_EQ(queue.pop().value(), 2);
   EXPECT_EQ(queue.pop().value(), 3);
   EXPECT_FALSE(queue.pop().has_value());
+}
+
+TEST(BoundedQueue, PushNewestDropsTheOldestAndNeverBlocks) {
+  msf::BoundedQueue<int> queue(2);
+  EXPECT_FALSE(queue.pushNewest(1));
+  EXPECT_FALSE(queue.pushNewest(2));
+  EXPECT_TRUE(queue.pushNewest(3)); // full: 1 makes room
+  EXPECT_TRUE(queue.pushNewest(4)); // and 2
+  EXPECT_EQ(queue.pop().value(), 3);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(queue.popFor(std::chrono::seconds(5)).value(), 4);
+  EXPECT_FALSE(queue.popFor(std::chrono::milliseconds(20)).has_value()); // empty: runs out
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_FALSE(queue.drained());
+  EXPECT_FALSE(queue.pushNewest(5));
+  queue.close();
+  EXPECT_FALSE(queue.pushNewest(6)); // closed: refused
+  EXPECT_EQ(queue.popFor(std::chrono::seconds(5)).value(), 5);
+  EXPECT_TRUE(queue.drained());
+  EXPECT_FALSE(queue.popFor(std::chrono::seconds(5)).has_value()); // at once
 }
 
 } // namespace

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The README's engine example, compiled from README.md itself (tests/CMakeLists.txt copies the
 // block between <!-- example:engine:begin --> and <!-- example:engine:end --> into the build
 // tree) and run on the test street: the README cannot drift from the API.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_reconstruct's evaluation protocol 4: -holdout on real KITTI frames, the synthetic
 // ground truth with moving objects marked, -compare_sources, -compare_paper, and clear errors
 // that leave no output.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/pipeline/run_report.h>
 
 #include <gtest/gtest.h>

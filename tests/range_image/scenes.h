@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Small synthetic range images with known geometry for the range_image tests.
 #include <msf/io/calibration.h>

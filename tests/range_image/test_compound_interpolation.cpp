@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The pcl::Filter on organized clouds: invariants, rays, distance, camera, errors.
 #include "scenes.h"
 

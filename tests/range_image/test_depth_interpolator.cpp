@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The image-level core: organized invariants, planes, edges, threads.
 #include "scenes.h"
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The exact Euclidean distance to the nearest sample, against brute force.
 #include <msf/common/exceptions.h>
 #include <msf/range_image/distance_transform.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Steps 1 and 2 from a scan: the image path and the cloud path agree; the canvas helps.
 #include "scenes.h"
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 1 on hand-placed points with known pixels, and on a real KITTI scan.
 #include "scenes.h"
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_project and msf_interpolate on a real scan, and their errors.
 #include <msf/io/cloud_io.h>
 #include <msf/range_image/point_types.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // realReturns: the real LiDAR returns (distance 0) of an interpolated depth image.
 #include <msf/common/exceptions.h>
 #include <msf/range_image/real_returns.h>

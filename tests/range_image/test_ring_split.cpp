@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Ring ids by azimuth wraps (protocol 2) on hand-made sweeps and a real KITTI scan.
 #include <msf/common/exceptions.h>
 #include <msf/io/sequence.h>
@@ -35,6 +36,35 @@ TEST(RingSplit, IdsCountAzimuthWraps) {
   ASSERT_EQ(ids.size(), scan.size());
   for (std::size_t i = 0; i < scan.size(); ++i)
     EXPECT_EQ(ids[i], static_cast<int>(scan[i].intensity)) << i;
+}
+
+// A 32-beam LiDAR (an HDL-32E's elevations) whose points come in no ring order: each point's
+// ring is the beam nearest its elevation, and the split holds out the beams the ids say.
+TEST(RingSplit, IdsFromBeamElevationsFollowThePointsNotTheirOrder) {
+  std::vector<double> elevations;
+  for (int b = 0; b < 32; ++b)
+    elevations.push_back(-30.67 + b * (41.34 / 31));
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  std::vector<int> beams;
+  for (int k = 0; k < 640; ++k) {
+    const int beam = (k * 7) % 32; // interleaved, as a sensor's packets are
+    const double azimuth = 0.01 * k, range = 5.0 + k % 40;
+    const double elevation = (elevations[beam] + 0.3 * ((k % 3) - 1) * (41.34 / 31) / 2) * M_PI / 180; // within half a gap
+    pcl::PointXYZI p;
+    p.x = static_cast<float>(range * std::cos(elevation) * std::cos(azimuth));
+    p.y = static_cast<float>(range * std::cos(elevation) * std::sin(azimuth));
+    p.z = static_cast<float>(range * std::sin(elevation));
+    scan.push_back(p);
+    beams.push_back(beam);
+  }
+  EXPECT_EQ(msf::ringIdsFromElevations(scan, elevations), beams);
+  pcl::PointCloud<pcl::PointXYZI> input, heldout;
+  EXPECT_EQ(msf::splitRings(scan, beams, msf::RingSplitConfig{}, input, heldout), 32);
+  EXPECT_EQ(heldout.size(), 160u); // beams 2, 6, .., 30: 8 of 32
+  EXPECT_EQ(input.size() + heldout.size(), scan.size());
+  EXPECT_THROW(msf::ringIdsFromElevations(scan, {}), msf::InvalidInputError);
+  EXPECT_THROW(msf::splitRings(scan, std::vector<int>(3, 0), msf::RingSplitConfig{}, input, heldout),
+               msf::InvalidInputError);
 }
 
 TEST(RingSplit, HeldOutRingsAreIdModFourEqualTwoByDefault) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Analytic slices: what each interpolant must reproduce exactly, and what must stay empty.
 #include <msf/common/exceptions.h>
 #include <msf/range_image/slice_interpolation.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Analytic scenes and cameras shared by the reconstruction tests.
 #include <msf/reconstruction/analytic_scene.h>
@@ -67,6 +68,22 @@ inline AnalyticScene makeScene(SceneKind kind) {
                      .toRotationMatrix());
     scene.addHalfSpace(Eigen::Vector3d(0, 0, -1), -3.6);
     break;
+  }
+  return scene;
+}
+
+/// A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
+/// either side every few metres, each a little different, so that no two tiles look alike.
+inline AnalyticScene corridor(double length, double wall = 4.0) {
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5);  // floor: y >= 1.5
+  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -wall); // x >= wall
+  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -wall);  // x <= -wall
+  for (int i = 0; i * 3.0 < length; ++i) {
+    const double side = i % 2 ? 1.0 : -1.0;
+    scene.addBox(Eigen::Vector3d(side * (wall - 1.2 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
+                 Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
+                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
   }
   return scene;
 }

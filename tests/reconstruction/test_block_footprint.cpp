@@ -1,4 +1,5 @@
-// BlockFootprint, the TSDF term of the memory prediction (Pipeline::predictMemory): it holds
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// BlockFootprint, the TSDF term of the memory prediction (Reconstructor::predictMemory): it holds
 // every block the integrator really allocates, it is not far above a view's own volume, and
 // 1000 frames take well under a second.
 #include "test_support.h"

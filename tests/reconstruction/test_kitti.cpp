@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The reconstruction on the real KITTI sample (odometry 04): LiDAR scans through their
 // sensor origin, and SGBM depth images, each checked against LiDAR points.
 #include "test_support.h"

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "test_support.h"
 
 #include <msf/common/config.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // MeshRasterizer against analytic depth: exact at pixel centres, first surface, both faces,
 // clipped at the near plane, nothing behind the camera, watertight, independent of threads.
 #include <msf/common/exceptions.h>

@@ -1,8 +1,9 @@
-// The README's integration example, compiled from README.md itself: tests/CMakeLists.txt
-// copies the block between <!-- example:tsdf:begin --> and <!-- example:tsdf:end --> into the
-// build tree as readme_tsdf_example.h (with #line, so compiler messages point into the
-// README), and it is run here on a small synthetic sequence, so that the README cannot drift
-// from the API.
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The integration example of docs/library.md, compiled from the document itself:
+// tests/CMakeLists.txt copies the block between <!-- example:tsdf:begin --> and
+// <!-- example:tsdf:end --> into the build tree as readme_tsdf_example.h (with #line, so
+// compiler messages point into the document), and it is run here on a small synthetic
+// sequence, so that the documentation cannot drift from the API.
 #include "readme_tsdf_example.h" // reconstruct(clouds, poses_txt, out_dir)
 
 #include "scenes.h"

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "scenes.h"
 #include "test_support.h"
 
@@ -14,27 +15,12 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 using namespace msf;
 
 namespace {
-
-// A corridor along +z (world y down): a floor, two walls 4 m off the axis, and boxes on
-// either side every few metres, each a little different, so that no two tiles look alike.
-AnalyticScene corridor(double length, double wall = 4.0) {
-  AnalyticScene scene;
-  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5);  // floor: y >= 1.5
-  scene.addHalfSpace(Eigen::Vector3d(-1, 0, 0), -wall); // x >= wall
-  scene.addHalfSpace(Eigen::Vector3d(1, 0, 0), -wall);  // x <= -wall
-  for (int i = 0; i * 3.0 < length; ++i) {
-    const double side = i % 2 ? 1.0 : -1.0;
-    scene.addBox(Eigen::Vector3d(side * (wall - 1.2 - 0.1 * (i % 3)), 1.0, 3.0 * i + 1.0),
-                 Eigen::Vector3d(0.5, 0.5 + 0.1 * (i % 4), 0.4 + 0.05 * (i % 5)),
-                 Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()).toRotationMatrix());
-  }
-  return scene;
-}
 
 constexpr double kVoxel = 0.2, kTruncation = 0.5, kMaxDepth = 8.0;
 constexpr double kTile = 2 * TsdfBlock::kSide * kVoxel; // tile_blocks 2
@@ -88,7 +74,7 @@ double minimumRadius(const Corridor& setup = Corridor()) {
 /// back from the union the map writes (as written: welded by the map), else meshed in memory.
 DriveResult integrateDrive(const std::vector<Eigen::Isometry3d>& poses, double length, const std::string& directory = "",
                    double radius = 0.0, const Corridor& setup = Corridor()) {
-  const AnalyticScene scene = corridor(length + 10, setup.wall);
+  const AnalyticScene scene = test::corridor(length + 10, setup.wall);
   TsdfVolume volume(kVoxel, kTruncation);
   TsdfIntegrator integrator(volume, integratorConfig());
   MarchingCubes::Config mesher;
@@ -271,6 +257,37 @@ TEST(StreamingMap, StoreReloadsAndMeshesAgainToTheSameMesh) {
                                                 Eigen::Vector3d(10, 10, 6));
   EXPECT_GT(part, 0u);
   EXPECT_LT(part, memory.mesh.triangles.size());
+}
+
+TEST(StreamingMap, AStoreIndexListingATileTwiceIsRefused) {
+  // Meshed twice, every triangle of the tile was doubled.
+  const double length = 10.0;
+  test::TempDir dir;
+  integrateDrive(drive(length, 0.5), length, dir.path(), minimumRadius() + 0.2);
+  const std::string index = dir.path() + "/tsdf/index.txt";
+  std::ifstream in(index);
+  std::string text, line, first_tile;
+  std::size_t tiles = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("tiles ", 0) == 0) {
+      tiles = std::stoul(line.substr(6));
+      line = "tiles " + std::to_string(tiles + 1);
+    } else if (tiles > 0 && first_tile.empty()) {
+      first_tile = line;
+    }
+    text += line + "\n";
+  }
+  in.close();
+  ASSERT_GT(tiles, 1u);
+  std::ofstream(index) << text << first_tile << "\n";
+  std::istringstream xyz(first_tile);
+  int x = 0, y = 0, z = 0;
+  xyz >> x >> y >> z;
+  const std::string e = test::errorOf([&] { StreamingMap::loadStore(dir.path()); });
+  EXPECT_EQ(e, "TSDF store index '" + index + "' lists tile " + std::to_string(x) + "_" + std::to_string(y) + "_" +
+                   std::to_string(z) + " twice (tiles 1 and " + std::to_string(tiles + 1) + ")");
+  EXPECT_THROW(StreamingMap::remesh(dir.path(), MarchingCubes::Config(), dir.file("m.ply")), IOError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
 }
 
 TEST(StreamingMap, ALoopBackIntoStreamedSpaceReadsItBackAndDoublesNoSurface) {

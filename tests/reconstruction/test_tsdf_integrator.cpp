@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "scenes.h"
 #include "test_support.h"
 
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 using namespace msf;
@@ -114,6 +116,19 @@ TEST(TsdfIntegrator, LambdaReducesTheErrorOfNoisyDepth) {
   const double regularized = reconstruct(SceneKind::Sphere, 0.03, 5.0).error;
   std::printf("  sigma 30 mm: lambda 0 -> %.2f mm, lambda 5 -> %.2f mm\n", plain * 1e3, regularized * 1e3);
   EXPECT_LT(regularized, 0.8 * plain);
+}
+
+TEST(TsdfIntegrator, LambdaBeyondItsPlausibleRangeIsRefused) {
+  // -lambda 1e300 flattened the surface to a 6-triangle mesh with exit code 0.
+  TsdfIntegrator::Config config;
+  config.lambda = TsdfIntegrator::Config::kMaxLambda;
+  EXPECT_NO_THROW(config.validate());
+  for (const double lambda : {1e300, 2e6, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    config.lambda = lambda;
+    EXPECT_NE(test::errorOf([&] { config.validate(); }).find("tsdf_integrator.lambda (-lambda) must be 0 .. 1e6"),
+              std::string::npos)
+        << lambda;
+  }
 }
 
 TEST(TsdfIntegrator, InverseVarianceLambdaSmoothsWhatIsUncertainAndKeepsWhatIsKnown) {

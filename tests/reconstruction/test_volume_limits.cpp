@@ -1,4 +1,5 @@
-// Issue 19: volume sizes, sweeps, poses and memory that would run away end in an error
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// Volume sizes, sweeps, poses and memory that would run away end in an error
 // naming the key or option, before the volume allocates.
 #include "test_support.h"
 

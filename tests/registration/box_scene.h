@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A street of axis-aligned boxes (road, two kerbs, parked cars, posts) scanned by a spinning
 // LiDAR: rays at fixed elevations and azimuths from the sensor's pose, so the pattern of

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The bad-input matrix of issue 19: hostile or mistaken inputs against the msf_* tools.
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+# The bad-input matrix: hostile or mistaken inputs against the msf_* tools.
 # Every case must end in under 5 s and under 500 MB, with the exit code it expects (1: a
 # clear error; 0: a result, e.g. with a warning) and a message matching a pattern that names
 # the option, key or file at fault; a failed run must leave no output file behind.
@@ -162,12 +163,42 @@ with open(f + "/negative.ply", "w") as o:
     o.write("ply\nformat binary_little_endian 1.0\nelement vertex -7\nproperty float x\n"
             "property float y\nproperty float z\nend_header\n")
     o.write("\0" * 1300)
+# Coordinates written as int32 and as float64 (PCL read them as zeros), and a float64 no float holds.
+def binary_pcd(path, size, type_, values, fmt):
+    with open(path, "wb") as o:
+        o.write(("VERSION 0.7\nFIELDS x y z\nSIZE %s %s %s\nTYPE %s %s %s\nCOUNT 1 1 1\nWIDTH %d\nHEIGHT %d\n"
+                 "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA binary\n" % (size, size, size, type_, type_, type_, W, H, W * H)).encode())
+        o.write(b"".join(struct.pack("<3" + fmt, *v) for v in values))
+binary_pcd(f + "/int32.pcd", 4, "I", [(u - 4, v - 3, 5 + u) for v in range(H) for u in range(W)], "i")
+binary_pcd(f + "/double.pcd", 8, "F", [((u - 3.5) * 0.1, (v - 2.5) * 0.1, 5.25) for v in range(H) for u in range(W)], "d")
+binary_pcd(f + "/double_huge.pcd", 8, "F", [(0, 0, 1e300 if (u, v) == (3, 2) else 5) for v in range(H) for u in range(W)], "d")
+# PLY headers PCL's reader aborts on or sizes a cloud from.
+xyz = "property float x\nproperty float y\nproperty float z\n"
+open(f + "/blank_obj_info.ply", "w").write("ply\nformat ascii 1.0\n obj_info x\nelement vertex 1\n" + xyz + "end_header\n1 2 3\n")
+open(f + "/grid.ply", "w").write("ply\nformat ascii 1.0\nobj_info num_cols 100000\nobj_info num_rows 100000\n"
+                                 "element vertex 1\n" + xyz + "end_header\n1 2 3\n")
+# A small scan, and one whose every reflectance is NaN.
+with open(f + "/scan.bin", "wb") as o:
+    o.write(b"".join(struct.pack("<4f", 5.0, 0.1 * i, 0.0, 0.5) for i in range(1000)))
+with open(f + "/nan_reflectance.bin", "wb") as o:
+    o.write(b"".join(struct.pack("<4f", 5.0, 0.1 * i, 0.0, float("nan")) for i in range(100)))
+# A store whose index lists a tile twice (every triangle of it was doubled).
+import os
+os.makedirs(f + "/store/tsdf")
+open(f + "/store/tsdf/index.txt", "w").write("msfusion-tsdf-store 1\nvoxel_size_m 0.1\ntruncation_m 0.3\nblock_side 8\n"
+                                             "tile_blocks 4\ntiles 3\n0 0 0\n1 0 0\n0 0 0\n")
+# A folder where a tool's output file would go.
+os.makedirs(f + "/folder.png/inside")
 # A PNG whose header says 30000 x 20000 (the pixels are never read).
 import zlib
 def chunk(kind, data):
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
 with open(f + "/huge.png", "wb") as o:
     o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 30000, 20000, 8, 0, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b""))
+# ... and 8192 x 2472: within 8192 a side, but a pair of them ran for minutes in gigabytes.
+with open(f + "/wide.png", "wb") as o:
+    o.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 8192, 2472, 8, 0, 0, 0, 0)) +
             chunk(b"IDAT", zlib.compress(b"\0" * 1000)) + chunk(b"IEND", b""))
 # Calibrations (the project's YAML): good, and each fault on its own.
 def yaml(path, fx=60.0, tx1=-30.0, w=8, h=6, nan=False):
@@ -181,6 +212,18 @@ def yaml(path, fx=60.0, tx1=-30.0, w=8, h=6, nan=False):
         o.write("T_cam0_velo: !!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n"
                 "   data: [ 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1. ]\n")
 yaml(f + "/camera.yaml")
+yaml(f + "/swapped.yaml", tx1=30.0)
+yaml(f + "/nano_baseline.yaml", tx1=-60e-9)
+yaml(f + "/far_baseline.yaml", tx1=-60 * 990e3)
+with open(f + "/camera.yaml") as i:
+    text = i.read()
+open(f + "/p1_fx.yaml", "w").write(text.replace("P1: !!opencv-matrix\n   rows: 3\n   cols: 4\n   dt: d\n   data: [ 60.0,",
+                                               "P1: !!opencv-matrix\n   rows: 3\n   cols: 4\n   dt: d\n   data: [ 61.0,"))
+open(f + "/dt_u.yaml", "w").write(text.replace("dt: d", "dt: u", 1))
+# A KITTI calib.txt whose P0 is given twice (the last won).
+P = "60 0 3.5 %s 0 60 2.5 0 0 0 1 0"
+open(f + "/twice.txt", "w").write("P0: %s\nP1: %s\nP2: %s\nP3: %s\nP0: %s\nTr: 1 0 0 0 0 1 0 0 0 0 1 0\n" % (
+    P % 0, P % -30, P % 0, P % -30, (P % 0).replace("60", "70", 1)))
 yaml(f + "/fx0.yaml", fx=0.0)
 yaml(f + "/baseline0.yaml", tx1=0.0)
 yaml(f + "/nan.yaml", nan=True)
@@ -216,6 +259,8 @@ png(f + "/gt_empty.png", W, H, 16, 0)
 png(f + "/est.png", W, H, 16, 256 * 5)
 png(f + "/small.png", W, H, 8, 128)
 EOF
+# 2 GB of holes: a scan file read whole before anything looked at it.
+truncate -s 2G "$F/huge.bin"
 
 if [ $have_kitti = 1 ]; then
   K=$T/k
@@ -253,6 +298,14 @@ if [ $have_kitti = 1 ]; then
   dataset odo_missing_color 2 2
   mkdir -p "$K/odo_missing_color/sequences/04/image_2"
   ln -s "$SEQ/image_2/000001.png" "$K/odo_missing_color/sequences/04/image_2/000001.png"
+  # Files beside the frames that are not frames; a frame (000012) beyond the 3 poses.
+  dataset odo_stray 2 2
+  echo "not an image" >"$K/odo_stray/sequences/04/image_0/.DS_Store"
+  echo "frames of drive 04" >"$K/odo_stray/sequences/04/image_0/README"
+  echo "not a scan" >"$K/odo_stray/sequences/04/velodyne/.DS_Store"
+  dataset odo_beyond_poses 3 3
+  for c in image_0 image_1; do ln -s "$SEQ/$c/000002.png" "$K/odo_beyond_poses/sequences/04/$c/000012.png"; done
+  ln -s "$SEQ/velodyne/000002.bin" "$K/odo_beyond_poses/sequences/04/velodyne/000012.bin"
 fi
 
 # ---- limits checked before allocating ---------------------------------------------------
@@ -282,6 +335,16 @@ check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
 check "lambda_study -voxel 1e-6" 1 "lambda_study.voxel_size_m must be in 0.001..10, not 1.0e-06" -- msf_lambda_study -o out -voxel 1e-6
 check "lambda_study -sweeps 1000000" 1 "lambda_study.sweeps must be in 0..100" -- msf_lambda_study -o out -sweeps 1000000
+printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  rings: 32\n' >"$F/rings_only.yaml"
+check "synth -rig: rings without their elevations" 1 "rings_only.yaml': lidar.rings 32 without lidar.beam_elevations_deg" -- \
+  msf_synth -o out -frames 1 -rig "$F/rings_only.yaml"
+check "synth -lidar hdl16" 1 "synthetic.lidar_model must be hdl64e \| hdl32e \| beams, not 'hdl16'" -- \
+  msf_synth -o out -frames 1 -lidar hdl16
+check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg must hold 1..1024 elevations for lidar_model beams, not 0" -- \
+  msf_synth -o out -frames 1 -lidar beams
+check "synth -camera kitti -focal 500" 1 "option -focal sets a pinhole camera, but -camera is 'kitti'" -- \
+  msf_synth -o out -frames 1 -camera kitti -focal 500
+check "synth -baseline 0" 1 "synthetic.baseline_m must be in \(0, 10\], not 0.0" -- msf_synth -o out -frames 1 -baseline 0
 
 # ---- configuration files ------------------------------------------------------------------
 check "mesh -config: a misspelt section" 1 "typo_section.yaml' line 1: 'tsdf_volumes' is not a section of the configuration" -- \
@@ -319,6 +382,10 @@ check "pcd2png: a depth of 1e30 m saturates, said" 0 "1 pixel of the depth beyon
   msf_pcd2png "$F/far.pcd" d.png
 check "stereo: 30000x20000 PNG header" 1 "huge.png': image size 30000x20000 is outside 1x1 .. 8192x8192" -- \
   msf_stereo "$F/huge.png" "$F/huge.png" o.pcd -calib "$F/camera.yaml"
+check "stereo: an 8192x2472 pair" 1 "wide.png': image size 8192x2472 has 20250624 pixels, more than the 16777216 \(4096x4096\)" -- \
+  msf_stereo "$F/wide.png" "$F/wide.png" o.pcd -calib "$F/camera.yaml"
+check "project -image_size 8192x8192" 1 "the image size given: image size 8192x8192 has 67108864 pixels, more than the 16777216" -- \
+  msf_project "$F/scan.bin" o.pcd -calib "$F/camera.yaml" -image_size 8192x8192
 check "interpolate: empty (all-NaN) cloud" 1 "allnan.pcd' lands in the image: the cloud has no finite point" -- \
   msf_interpolate "$F/allnan.pcd" o.pcd -calib "$F/camera.yaml"
 check "interpolate: empty cloud, no calibration" 1 "too few valid points \(0\)" -- msf_interpolate "$F/allnan.pcd" o.pcd
@@ -327,6 +394,101 @@ check "fuse: a LiDAR depth of 1e30 m" 1 "LiDAR cloud has a depth of 1000000015.*
   msf_fuse "$F/far.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera.yaml"
 check "eval_disparity: ground truth with no valid pixel" 1 "gt_empty.png' has no valid pixel" -- \
   msf_eval_disparity "$F/gt_empty.png" "$F/est.png"
+
+# ---- nothing silently wrong, messages that name the fault --------------------------------
+check "interpolate -threads 4294967297" 1 "-threads must be a whole number in -2147483648 .. 2147483647, not '4294967297'" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -threads 4294967297
+# One argument may hold 128 KB (Linux's MAX_ARG_STRLEN): 100000 digits, named by their length.
+check "integrate -sweeps of 100000 digits" 1 "-sweeps must be a whole number in .*, not '9{24}\.\.\.' \(100000 characters\)" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps "$(printf '9%.0s' $(seq 100000))"
+check "integrate -voxel 1e999" 1 "-voxel needs a finite number within the range of a double, not '1e999'" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e999
+check "integrate -lambda 1e300" 1 "tsdf_integrator.lambda \(-lambda\) must be 0 .. 1e6 \(beyond, eq. 7 flattens" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -lambda 1e300
+check "info: x y z as int32" 0 "valid: +48 \(100.0 %\)" -- msf_info "$F/int32.pcd"
+check "pcd2png: x y z as float64" 0 "\[done, [0-9.]+ ms : 48 points\]" -- msf_pcd2png "$F/double.pcd" d.png
+check "info: a float64 no float32 holds" 1 "double_huge.pcd': field 'z' \(float64\) of point 19 is 1e\+300, which float32 cannot hold" -- \
+  msf_info "$F/double_huge.pcd"
+check "info: ' obj_info x' in a .ply header" 1 "blank_obj_info.ply' is not a valid .ply file \(bad header\): line 3 ' obj_info x': a line that starts with a blank" -- \
+  msf_info "$F/blank_obj_info.ply"
+check "info: obj_info 100000 x 100000 in a .ply" 1 "obj_info num_cols 100000 x num_rows 100000 make 10000000000 points, not its 1 vertices" -- \
+  msf_info "$F/grid.ply"
+check "pcd2png -calib with P0 twice" 1 "twice.txt': key 'P0' is given twice, on lines 1 and 5" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/twice.txt"
+check "pcd2png -calib, images swapped" 1 "swapped.yaml': camera 1 is 0.5 m left of camera 0" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/swapped.yaml"
+check "pcd2png -calib, baseline 1e-9 m" 1 "nano_baseline.yaml': the grey pair's baseline is 1e-09 m, outside 0.001 .. 10 m" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/nano_baseline.yaml"
+check "pcd2png -calib, baseline 990 km" 1 "far_baseline.yaml': the grey pair's baseline is 990000 m, outside 0.001 .. 10 m" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/far_baseline.yaml"
+check "pcd2png -calib, P1's fx not P0's" 1 "p1_fx.yaml': P1's fx 61 is not P0's 60: the cameras of a rectified pair" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/p1_fx.yaml"
+check "pcd2png -calib, a matrix of dt u" 1 "dt_u.yaml': key 'P0' has dt 'u', not d \(float64\) or f \(float32\)" -- \
+  msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/dt_u.yaml"
+check "mesh: a store index listing a tile twice" 1 "index.txt' lists tile 0_0_0 twice \(tiles 1 and 3\)" -- \
+  msf_mesh "$F/store" m.ply
+check "project: a 2 GB sparse scan file" 1 "huge.bin' has 134217728 records \(2147483648 bytes\), more than the 16777216 a scan may hold" -- \
+  msf_project "$F/huge.bin" o.pcd -calib "$F/camera.yaml"
+check "project: NaN reflectance everywhere" 1 "nan_reflectance.bin': each of its 100 records has a value that is not finite" -- \
+  msf_project "$F/nan_reflectance.bin" o.pcd -calib "$F/camera.yaml"
+check "pcd2png: the output is a folder" 1 "folder.png': rename failed: Is a directory" -- \
+  msf_pcd2png "$F/dense.pcd" "$F/folder.png"
+check "info --version" 0 "^msf_info \(msfusion\) [0-9]+\.[0-9]+\.[0-9]+, commit ([0-9a-f]{12}(-dirty)?|unknown)$" -- msf_info --version
+
+# ---- every write checked to the end: a full disk -----------------------------------------
+# A small tmpfs, filled: each writer meets ENOSPC at its first block. Mounting needs root, as CI
+# runs; elsewhere the cases are skipped, saying so.
+FULL=$T/full
+mkdir -p "$FULL"
+if mount -t tmpfs -o size=64k tmpfs "$FULL" 2>/dev/null; then
+  trap 'umount "$FULL" 2>/dev/null; rm -rf "$T"' EXIT
+  head -c 1000000 /dev/zero >"$FULL/.filler" 2>/dev/null
+  "$BIN/msf_integrate" "$F/dense.pcd" -poses "$F/pose.txt" -o "$F/volume.pcd" -voxel 0.05 >/dev/null 2>&1
+  for ext in ply obj vtk; do
+    check "mesh -> .$ext on a full disk" 1 "cannot write '$FULL/m.$ext': No space left on device" -- \
+      msf_mesh "$F/volume.pcd" "$FULL/m.$ext"
+  done
+  check "pcd2png on a full disk" 1 "cannot write '$FULL/d.png': No space left on device" -- \
+    msf_pcd2png "$F/dense.pcd" "$FULL/d.png"
+  check "kitti2pcd -ascii on a full disk" 1 "cannot write '$FULL/s.pcd': No space left on device" -- \
+    msf_kitti2pcd "$F/scan.bin" "$FULL/s.pcd" -ascii
+  if [ $have_kitti = 1 ]; then
+    check "odometry -o on a full disk" 1 "cannot write '$FULL/poses.txt': No space left on device" -- \
+      msf_odometry "$SEQ" -frames 0:1 -o "$FULL/poses.txt"
+  else
+    skip "odometry-full-disk"
+  fi
+  if [ -n "$(ls -A "$FULL" | grep -v -x .filler)" ]; then
+    failures=$((failures + 1))
+    echo "FAIL  full disk: a truncated file was left: $(ls -A "$FULL" | grep -v -x .filler | tr '\n' ' ')"
+  fi
+  umount "$FULL"
+elif [ "${CI:-}" = true ]; then
+  echo "FAIL  full disk: cannot mount a small tmpfs at $FULL (CI=true runs as root and requires it)"
+  failures=$((failures + 1))
+else
+  for c in mesh-ply-full mesh-obj-full mesh-vtk-full pcd2png-full kitti2pcd-ascii-full odometry-full; do
+    skipped=$((skipped + 1))
+    printf 'skip  %-44s (cannot mount a tmpfs: not root)\n' "$c"
+  done
+fi
+
+# ---- many drives, one map (msf_batch, msf_merge, msf_eval_mesh; msf_synth's shared street) --
+check "batch: no place to run the tasks" 1 "say where the tasks run, once: -slurm .* -local N" -- \
+  msf_batch -o out "$F"
+check "batch -run before a plan" 1 "batch plan '.*out/plan.txt' does not exist" -- msf_batch -o out -run drive:0
+check "batch -run a task of no kind" 1 "task 'drives:1' is not drive:N, merge:N, mesh:N or finish" -- \
+  msf_batch -o "$F" -run drives:1
+check "batch: a folder that holds no drive" 1 "dataset '.*' holds no sequence" -- msf_batch -o out -local 1 "$F"
+printf '%s\n' "$F/dense.pcd" >"$F/drives.txt"
+check "batch -list with a line that is no drive" 1 "drive list '.*drives.txt' line 1: '.*dense.pcd' is not a sequence" -- \
+  msf_batch -o out -local 1 -list "$F/drives.txt"
+check "merge: a folder without a store" 1 "TSDF store index '.*/tsdf/index.txt' does not exist" -- \
+  msf_merge -o map "$F" "$F"
+check "synth -reverse off the street's start" 1 "synthetic.start_m' = 3.* leaves the street's start" -- \
+  msf_synth -o out -frames 10 -start_m 3 -reverse
+check "synth -street_m shorter than the drive" 1 "synthetic.street_length_m' = 5.* is shorter than the drive" -- \
+  msf_synth -o out -frames 20 -street_m 5
 
 if [ $have_kitti = 1 ]; then
   SCAN=$SEQ/velodyne/000000.bin
@@ -341,6 +503,12 @@ if [ $have_kitti = 1 ]; then
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
+  printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"
+  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig.stereo_min_disparity_px must be in 0..1000.*not -1" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_negative.yaml"
+  printf '%%YAML:1.0\nrig:\n  scale_ring_row: false\n' >"$F/rig_misspelt.yaml"
+  check "interpolate -config: rig.scale_ring_row (misspelt)" 1 "scale_ring_row" -- \
+    msf_interpolate "$SCAN" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_misspelt.yaml"
   check "P1 holds '1.0x'" 1 "key 'P1' has a value that is not a number: '1.0x'" -- \
     msf_project "$SCAN" o.pcd -calib "$K/p1x/calib.txt"
   check "reconstruct -frames 0:100000" 1 "frame range 0:100000 goes beyond the last frame" -- \
@@ -348,8 +516,11 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
-  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB .* over the memory budget of 1 MiB" -- \
+  check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB at its peak in memory and [0-9]+ MiB streamed .* over the memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -o out
+  # A budget the run would fit only streamed, for a run that needs the whole map in memory.
+  check "reconstruct -compare_sources -max_memory 300" 1 "over the memory budget of 300 MiB .*, and the run needs the whole map in memory \(-compare_sources\)" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -compare_sources -max_memory 300 -o out
   # Estimated poses: nothing to predict from; the volume stops the run at its first growth.
   check "reconstruct -max_memory 1 -poses estimate" 1 "the TSDF volume needs .* over its memory budget of 1 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -max_memory 1 -poses estimate -o out
@@ -368,6 +539,16 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$K/odo_empty_scan/sequences/04" -panels 0 -o out
   check "reconstruct: a missing colour image" 1 "frame 000000: colour image '.*image_2/000000.png' is missing" -- \
     msf_reconstruct "$K/odo_missing_color/sequences/04" -panels 0 -o out
+  check "reconstruct -poses refined (a typo)" 1 "-poses 'refined': no such file, and not one of dataset, refine" -- \
+    msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -poses refined -o out
+  mkdir -p "$K/no_poses/sequences/04"
+  for f in calib.txt times.txt image_0 image_1 image_2 velodyne; do ln -s "$SEQ/$f" "$K/no_poses/sequences/04/$f"; done
+  check "reconstruct -poses refine without poses" 1 "-poses refine: '.*no_poses/sequences/04' has no poses" -- \
+    msf_reconstruct "$K/no_poses/sequences/04" -frames 0:0 -panels 0 -poses refine -o out
+  check "odometry: .DS_Store and a README in image_0" 0 "Saving .*p.txt" -- \
+    msf_odometry "$K/odo_stray/sequences/04" -o p.txt
+  check "odometry: a frame beyond the poses" 1 "frame 000012 has no entry in poses '.*04.txt', which has 3 \(frames 0..2\)" -- \
+    msf_odometry "$K/odo_beyond_poses/sequences/04" -o p.txt
   check "reconstruct: NaN in a pose" 1 "poses '.*04.txt' line 2: value 4 'nan' is not finite" -- \
     msf_reconstruct "$K/odo_nan/sequences/04" -o out
   # kitti2pcd -input_dir: a truncated scan among good ones converts nothing.
@@ -423,6 +604,14 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/seq"
   check "synth -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_synth -frames 1 -o "$D/home"
+  check "batch -o over a user's folder" 1 "holds '(data.csv|notes.txt|my.yaml|photo.png)', which is not a batch's" -- \
+    msf_batch -o "$D/home" -local 1 "$SEQ"
+  check "batch: a drive whose poses are not known" 1 "drive 'seq' .* has no poses: a batch merges drives whose poses share a world" -- \
+    msf_batch -o out -local 1 "$D/seq"
+  check "batch -stream below the integrator's reach" 1 "streaming.active_radius_m 30 is below .* the integrator's reach" -- \
+    msf_batch -o out -local 1 -stream 30 "$SEQ"
+  check "eval_mesh: a sequence without synthetic truth" 1 "is not a synthetic sequence \(no gt/\)" -- \
+    msf_eval_mesh "$F/bomb.ply" "$SEQ"
   check "kitti2pcd -output_dir over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_kitti2pcd -input_dir "$D/seq/velodyne" -output_dir "$D/home"
   check "lambda_study -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
@@ -438,7 +627,8 @@ else
            reconstruct-frames reconstruct-panels reconstruct-voxel reconstruct-max-memory reconstruct-config-indented reconstruct-voxel-small reconstruct-scans \
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out \
            dataloss-dot dataloss-image2 dataloss-poses dataloss-poses-input dataloss-config-input dataloss-dataset \
-           dataloss-synth dataloss-kitti2pcd dataloss-lambda; do
+           dataloss-synth dataloss-kitti2pcd dataloss-lambda odometry-stray-files odometry-beyond-poses \
+           dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth; do
     skip "$c"
   done
 fi

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Disparity images for the tests of the stereo post-processing routines, each checked
 // against the OpenCV function it replaces: KITTI's, and synthetic ones with known regions.

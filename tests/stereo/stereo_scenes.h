@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Hand-made rectified pairs with known disparity, shared by the stereo tests.
 #include <msf/io/calibration.h>
@@ -45,9 +46,11 @@ inline SyntheticPair makeSyntheticPair(cv::Size size, float background_px, float
   for (int v = 0; v < texture.rows; ++v)
     for (int u = 0; u < texture.cols; ++u)
       texture.at<std::uint8_t>(v, u) = static_cast<std::uint8_t>(grey(rng));
-  // A second texture for the square, so its edges are real depth edges.
+  // A second texture for the square, so its edges are real depth edges: from an RNG of its own
+  // in OpenCV's initial state (cv::randu's in a fresh process), so that a pair does not depend
+  // on what ran before it.
   cv::Mat texture2 = texture.clone();
-  cv::randu(texture2, 0, 256);
+  cv::RNG().fill(texture2, cv::RNG::UNIFORM, 0, 256);
   // The right view reads up to column u + d + margin: the textures get d + 1 more columns.
   // They hold the start of the next row, which is what the reads past a row's end used to
   // see (so the images the tests were tuned on do not change); the last row's, which read

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "stereo_scenes.h"
 
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Guided semi-global matching: sparse disparity hints (projected LiDAR returns) in the
 // native matcher's costs, the hints made from a sparse depth, and SgbmStereo's plumbing.
 #include <msf/common/exceptions.h>
@@ -21,7 +22,7 @@ constexpr float kBackgroundPx = 12.f, kSquarePx = 30.f;
 
 #define MSF_REQUIRE_AVX2()                                                                    \
   do {                                                                                        \
-    if (!msf::SemiGlobalMatcher::isAvailable())                                               \
+    if (!msf::SemiGlobalMatcher::usesAvx2())                                                  \
       GTEST_SKIP() << "this CPU has no AVX2: the native matcher is not run";                  \
   } while (0)
 
@@ -117,25 +118,6 @@ TEST(GuidedMatching, WithoutHintsTheOutputIsBitIdentical) {
   EXPECT_EQ(cv::countNonZero(reference != zero_gain), 0);
 }
 
-TEST(GuidedMatching, Avx512AndAvx2KernelsGiveTheSameGuidedDisparities) {
-  MSF_REQUIRE_AVX2();
-  if (!msf::SemiGlobalMatcher::usesAvx512())
-    GTEST_SKIP() << "this CPU has no AVX-512BW";
-  const FlatBandPair scene = makeFlatBandPair();
-  const cv::Mat hints = ringHints(scene.pair.disparity, 3, 0.4f);
-  for (const int disparities : {32, 64}) {
-    msf::SemiGlobalMatcher::Params params = guidedParams();
-    params.num_disparities = disparities;
-    msf::SemiGlobalMatcher matcher(params);
-    cv::Mat wide, narrow;
-    matcher.compute(scene.pair.left, scene.pair.right, wide, hints);
-    msf::SemiGlobalMatcher::setAvx512Enabled(false);
-    matcher.compute(scene.pair.left, scene.pair.right, narrow, hints);
-    msf::SemiGlobalMatcher::setAvx512Enabled(true);
-    EXPECT_EQ(cv::countNonZero(wide != narrow), 0) << disparities;
-  }
-}
-
 TEST(GuidedMatching, BadGuidanceAndParametersAreRejected) {
   MSF_REQUIRE_AVX2();
   const auto pair = msf::test::makeSyntheticPair(kSize, kBackgroundPx, kSquarePx);
@@ -222,9 +204,9 @@ cv::Mat ringDepth(const cv::Mat& truth, const msf::Calibration& calibration, int
 
 msf::SgbmConfig guidedConfig() {
   msf::SgbmConfig config;
-  // Three paths, so that only the hints fill the band: five carry the texture beside it in
-  // along their diagonals (unguided, 0.78 of the band right).
-  config.mode = "sgbm_3way";
+  // Three paths, guided or not, so that only the hints fill the band: five carry the texture
+  // beside it in along their diagonals (unguided, 0.78 of the band right).
+  config.mode = config.unguided_mode = "sgbm_3way";
   config.num_disparities_px = 48;
   config.guidance = "lidar";
   config.guidance_gain = 200;

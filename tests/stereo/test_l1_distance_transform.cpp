@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // l1DistanceTransform against cv::distanceTransform(mask, DIST_L1, 3): identical values on
 // KITTI disparity masks and random masks of every density and awkward size.
 #include <msf/common/exceptions.h>

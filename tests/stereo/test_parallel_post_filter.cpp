@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The stereo post-processing with our parallel routines gives exactly what OpenCV's serial
 // functions give (setParallelPostFilterEnabled(false)): the matcher's disparity and the
 // stereo confidence, on a synthetic pair and on KITTI.
@@ -70,7 +71,7 @@ cv::Mat referenceConfidence(const cv::Mat& disparity, const msf::StereoConfidenc
 TEST(ParallelPostFilter, EnabledByDefault) { EXPECT_TRUE(msf::parallelPostFilterEnabled()); }
 
 TEST(ParallelPostFilter, MatcherGivesOpenCvsResultOnASyntheticPair) {
-  if (!msf::SemiGlobalMatcher::isAvailable())
+  if (!msf::SemiGlobalMatcher::usesAvx2())
     GTEST_SKIP() << "this CPU has no AVX2: the native matcher is not run";
   const auto pair = msf::test::makeSyntheticPair(cv::Size(320, 160), 10.f, 24.f);
   const auto [opencv, ours] = openCvAndOurs([&] { return matched(pair.left, pair.right, 48); });
@@ -92,7 +93,7 @@ TEST(ParallelPostFilter, ConfidenceGivesOpenCvsResult) {
 
 TEST(ParallelPostFilter, MatcherAndConfidenceGiveOpenCvsResultOnKitti) {
   MSF_REQUIRE_KITTI();
-  if (!msf::SemiGlobalMatcher::isAvailable())
+  if (!msf::SemiGlobalMatcher::usesAvx2())
     GTEST_SKIP() << "this CPU has no AVX2: the native matcher is not run";
   const std::string seq = msf::test::kittiDir() + "/odometry/sequences/04/";
   const cv::Mat left = msf::readImage(seq + "image_0/000002.png", cv::IMREAD_GRAYSCALE);

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/image_io.h>
 #include <msf/stereo/semi_global_matcher.h>
@@ -20,7 +21,7 @@ const cv::Size kSize(320, 160);
 
 #define MSF_REQUIRE_AVX2()                                                                    \
   do {                                                                                        \
-    if (!msf::SemiGlobalMatcher::isAvailable())                                               \
+    if (!msf::SemiGlobalMatcher::usesAvx2())                                                  \
       GTEST_SKIP() << "this CPU has no AVX2: the native matcher is not run";                  \
   } while (0)
 
@@ -253,33 +254,6 @@ TEST(SemiGlobalMatcher, SameResultWhateverTheThreadCountAndOnReuse) {
   }
 }
 
-TEST(SemiGlobalMatcher, Avx512AndAvx2KernelsGiveTheSameDisparities) {
-  MSF_REQUIRE_AVX2();
-  if (!msf::SemiGlobalMatcher::usesAvx512())
-    GTEST_SKIP() << "this CPU has no AVX-512BW";
-  // A noisy pair, so that ties and ambiguous pixels occur.
-  auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
-  cv::Mat noise(kSize, CV_8SC1);
-  cv::randn(noise, 0, 8);
-  cv::add(pair.right, noise, pair.right, cv::noArray(), CV_8U);
-  for (const bool diagonal : {false, true})
-    for (const int disparities : {32, 64}) {
-      msf::SemiGlobalMatcher::Params params = smallParams();
-      params.num_disparities = disparities;
-      params.min_disparity = 3;
-      params.diagonal_paths = diagonal;
-      msf::SemiGlobalMatcher matcher(params);
-      cv::Mat wide, narrow;
-      matcher.compute(pair.left, pair.right, wide);
-      msf::SemiGlobalMatcher::setAvx512Enabled(false);
-      EXPECT_FALSE(msf::SemiGlobalMatcher::usesAvx512());
-      matcher.compute(pair.left, pair.right, narrow);
-      msf::SemiGlobalMatcher::setAvx512Enabled(true);
-      EXPECT_EQ(cv::countNonZero(wide != narrow), 0) << disparities << " diagonal " << diagonal;
-      EXPECT_GT(cv::countNonZero(wide > 2 * 16), kSize.area() / 2);
-    }
-}
-
 TEST(SemiGlobalMatcher, BadInputAndParametersAreRejected) {
   const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
   msf::SemiGlobalMatcher matcher(smallParams());
@@ -306,45 +280,50 @@ TEST(SemiGlobalMatcher, BadInputAndParametersAreRejected) {
   EXPECT_TRUE(rejects([](auto& p) { p.p2 = p.p1; }, "p2"));
   EXPECT_TRUE(rejects([](auto& p) { p.pre_filter_cap = 0; }, "pre_filter_cap"));
   EXPECT_TRUE(rejects([](auto& p) { p.uniqueness_ratio = 101; }, "uniqueness_ratio"));
+  EXPECT_TRUE(rejects([](auto& p) { p.p1_rise = p.p2; }, "p1_rise"));
+  EXPECT_TRUE(rejects([](auto& p) { p.p1_rise = -1; }, "p1_rise"));
 }
 
-TEST(SemiGlobalMatcher, WithoutAvx2SgbmStereoFallsBackToOpenCv) {
-  const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
+/// The engine SgbmStereo ran for `engine` and unguided `mode` on `pair`, and its disparity.
+std::pair<std::string, cv::Mat> engineAndDisparity(const msf::test::SyntheticPair& pair, const std::string& engine,
+                                                   const std::string& mode) {
   msf::SgbmConfig config;
   config.num_disparities_px = 48;
-  config.engine = "opencv";
-  msf::SgbmStereo opencv(config);
-  opencv.setInputImages(pair.left, pair.right);
-  opencv.computeDisparity();
-  EXPECT_EQ(opencv.getEngineUsed(), "opencv");
+  config.engine = engine;
+  config.unguided_mode = mode;
+  msf::SgbmStereo stereo(config);
+  stereo.setInputImages(pair.left, pair.right);
+  stereo.computeDisparity();
+  return {stereo.getEngineUsed(), stereo.getDisparity().clone()};
+}
 
-  config.engine = "native";
-  msf::SgbmStereo native(config);
-  native.setInputImages(pair.left, pair.right);
+TEST(SemiGlobalMatcher, WithoutAvx2SgbmStereoFallsBackToOpenCvForItsModes) {
+  const auto pair = msf::test::makeSyntheticPair(kSize, 12.f, 30.f);
+  const auto [opencv_engine, opencv] = engineAndDisparity(pair, "opencv", "sgbm_3way");
+  EXPECT_EQ(opencv_engine, "opencv");
+  cv::Mat ground_portable;
   {
     const Avx2Disabled off;
-    EXPECT_FALSE(msf::SemiGlobalMatcher::isAvailable());
-    native.computeDisparity();
-    EXPECT_EQ(native.getEngineUsed(), "opencv");
-    EXPECT_EQ(cv::countNonZero(native.getDisparity() != opencv.getDisparity()), 0);
-    cv::Mat fixed;
-    EXPECT_THROW(msf::SemiGlobalMatcher().compute(pair.left, pair.right, fixed), msf::InvalidInputError);
+    EXPECT_FALSE(msf::SemiGlobalMatcher::usesAvx2());
+    const auto [engine, disparity] = engineAndDisparity(pair, "native", "sgbm_3way");
+    EXPECT_EQ(engine, "opencv");
+    EXPECT_EQ(cv::countNonZero(disparity != opencv), 0);
+    // OpenCV has no ground_3way: the portable kernel runs it.
+    const auto [ground_engine, ground] = engineAndDisparity(pair, "native", "ground_3way");
+    EXPECT_EQ(ground_engine, "native");
+    ground_portable = ground;
   }
-  if (msf::SemiGlobalMatcher::isAvailable()) {
-    native.computeDisparity();
-    EXPECT_EQ(native.getEngineUsed(), "native");
+  if (msf::SemiGlobalMatcher::usesAvx2()) {
+    EXPECT_EQ(engineAndDisparity(pair, "native", "sgbm_3way").first, "native");
+    EXPECT_EQ(cv::countNonZero(engineAndDisparity(pair, "native", "ground_3way").second != ground_portable), 0);
   }
-  // sgbm (five paths) runs natively; hh and hh4 on OpenCV.
-  config.mode = "sgbm";
-  msf::SgbmStereo five_paths(config);
-  five_paths.setInputImages(pair.left, pair.right);
-  five_paths.computeDisparity();
-  EXPECT_EQ(five_paths.getEngineUsed(), msf::SemiGlobalMatcher::isAvailable() ? "native" : "opencv");
-  config.mode = "hh";
-  msf::SgbmStereo eight_paths(config);
-  eight_paths.setInputImages(pair.left, pair.right);
-  eight_paths.computeDisparity();
-  EXPECT_EQ(eight_paths.getEngineUsed(), "opencv");
+  // sgbm (five paths) runs natively where the AVX2 kernel does; hh and hh4 on OpenCV.
+  EXPECT_EQ(engineAndDisparity(pair, "native", "sgbm").first, msf::SemiGlobalMatcher::usesAvx2() ? "native" : "opencv");
+  EXPECT_EQ(engineAndDisparity(pair, "native", "hh").first, "opencv");
+  // Engine opencv runs its 3-way for ground_3way.
+  const auto [opencv_ground_engine, opencv_ground] = engineAndDisparity(pair, "opencv", "ground_3way");
+  EXPECT_EQ(opencv_ground_engine, "opencv");
+  EXPECT_EQ(cv::countNonZero(opencv_ground != opencv), 0);
 }
 
 TEST(SemiGlobalMatcher, SgbmStereoMatchesTheLeftBorderWithTheNativeEngine) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
@@ -274,18 +275,22 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
   const std::string path = dir.file("c.yaml");
   {
     std::ofstream out(path);
-    out << "%YAML:1.0\nstereo:\n  engine: opencv\n  mode: hh\n  num_disparities_px: 64\n  block_size_px: 7\n  p1: 100\n  p2: 900\n"
-           "  left_right_check: true\n  confidence_hole_distance_px: 9.5\n";
+    out << "%YAML:1.0\nstereo:\n  engine: opencv\n  mode: hh\n  unguided_mode: sgbm\n  num_disparities_px: 64\n"
+           "  block_size_px: 7\n  p1: 100\n  p2: 900\n  left_right_check: true\n  confidence_hole_distance_px: 9.5\n";
   }
   msf::SgbmConfig config;
   msf::ConfigFile(path).read(config);
   EXPECT_EQ(config.engine, "opencv");
   EXPECT_FALSE(config.nativeEngine());
   EXPECT_EQ(config.mode, "hh");
+  EXPECT_EQ(config.unguided_mode, "sgbm");
+  EXPECT_EQ(config.modeFor(true), "hh");
+  EXPECT_EQ(config.modeFor(false), "sgbm");
   EXPECT_EQ(config.num_disparities_px, 64);
   EXPECT_EQ(config.block_size_px, 7);
   EXPECT_EQ(config.resolvedP1(), 100);
   EXPECT_EQ(config.resolvedP2(), 900);
+  EXPECT_EQ(config.resolvedP1Rise(), 3 * 7 * 7);
   EXPECT_TRUE(config.left_right_check);
   EXPECT_FLOAT_EQ(config.confidence.hole_distance_px, 9.5f);
   EXPECT_EQ(config.uniqueness_ratio_pct, 10); // untouched default
@@ -306,6 +311,9 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
   EXPECT_TRUE(fails("num_disparities_px: 100", "stereo.num_disparities_px"));
   EXPECT_TRUE(fails("block_size_px: 4", "stereo.block_size_px"));
   EXPECT_TRUE(fails("mode: fast", "stereo.mode"));
+  EXPECT_TRUE(fails("unguided_mode: ground", "stereo.unguided_mode"));
+  EXPECT_TRUE(fails("p1_rise: -1", "stereo.p1_rise"));
+  EXPECT_TRUE(fails("p1_rise: 800", "stereo.p1_rise")); // not below p2 (800 at block 5)
   EXPECT_TRUE(fails("engine: gpu", "stereo.engine"));
   EXPECT_TRUE(fails("p1: 500\n  p2: 400", "stereo.p2"));
   EXPECT_TRUE(fails("num_disparities_px: many", "stereo.num_disparities_px"));

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // filterSpecklesParallel against cv::filterSpeckles: identical on KITTI disparities and on
 // synthetic images, whatever the number of threads; hand-made regions with known fates,
 // among them regions that cross many row bands.

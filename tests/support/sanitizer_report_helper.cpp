@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // A program that makes a real sanitizer report, built with -fsanitize=address,undefined in every
 // build (tests/CMakeLists.txt), so that the tests of the report check (sanitizerReport, runCommand,
 // bad_inputs.sh --sanitizer-report) read what AddressSanitizer, LeakSanitizer and

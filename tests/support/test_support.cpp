@@ -1,15 +1,19 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "test_support.h"
 
 #include <msf/common/exceptions.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <regex>
 #include <sstream>
+#include <sys/mount.h>
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
@@ -55,6 +59,33 @@ TempDir::TempDir() {
 TempDir::~TempDir() {
   std::error_code ec;
   fs::remove_all(path_, ec);
+}
+
+FullFilesystem::FullFilesystem(std::size_t free_bytes, std::size_t size_bytes) {
+  const std::string mount_point = dir_.file("fs");
+  fs::create_directory(mount_point);
+  if (::mount("tmpfs", mount_point.c_str(), "tmpfs", 0, ("size=" + std::to_string(size_bytes)).c_str()) != 0) {
+    why_ = std::strerror(errno);
+    return;
+  }
+  mounted_ = true;
+  // The filler takes all but free_bytes (tmpfs counts whole pages).
+  std::ofstream filler(file(".filler"), std::ios::binary);
+  const std::string page(4096, 'x');
+  for (std::size_t used = 0; used + free_bytes + page.size() <= size_bytes && filler.write(page.data(), page.size());)
+    used += page.size();
+}
+
+FullFilesystem::~FullFilesystem() {
+  if (mounted_)
+    ::umount2(dir_.file("fs").c_str(), MNT_DETACH);
+}
+
+std::size_t FullFilesystem::countEntries() const {
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir_.file("fs")))
+    n += e.path().filename() != ".filler";
+  return n;
 }
 
 namespace {

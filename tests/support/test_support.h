@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <gtest/gtest.h>
 
@@ -31,6 +32,27 @@ public:
 
 private:
   std::string path_;
+};
+
+/// A small filesystem of its own (a tmpfs mounted on a fresh folder, unmounted when the object
+/// goes away), filled to `free_bytes` of free space, for writes that meet a full disk as they
+/// would a real one. Mounting needs root: mounted() is false otherwise, with why().
+class FullFilesystem {
+public:
+  explicit FullFilesystem(std::size_t free_bytes = 0, std::size_t size_bytes = 256 * 1024);
+  ~FullFilesystem();
+  FullFilesystem(const FullFilesystem&) = delete;
+  FullFilesystem& operator=(const FullFilesystem&) = delete;
+  bool mounted() const { return mounted_; }
+  const std::string& why() const { return why_; }
+  std::string file(const std::string& name) const { return dir_.file("fs/" + name); }
+  /// The entries of the filesystem other than the filler.
+  std::size_t countEntries() const;
+
+private:
+  TempDir dir_;
+  bool mounted_ = false;
+  std::string why_;
 };
 
 struct CommandResult {
@@ -68,6 +90,18 @@ std::string errorOf(const std::function<void()>& call);
 std::size_t countEntries(const std::string& folder);
 
 } // namespace msf::test
+
+/// Declares `name`, a FullFilesystem(free_bytes), at the start of a test: skips when it cannot be
+/// mounted (not root), but fails under CI=true, which runs as root.
+#define MSF_FULL_FILESYSTEM(name, free_bytes)                                                 \
+  ::msf::test::FullFilesystem name(free_bytes);                                               \
+  do {                                                                                        \
+    if (!name.mounted()) {                                                                    \
+      if (::msf::test::underCi())                                                             \
+        FAIL() << "cannot mount a small tmpfs (" << name.why() << "); CI=true requires it";  \
+      GTEST_SKIP() << "cannot mount a small tmpfs (" << name.why() << "): needs root";        \
+    }                                                                                         \
+  } while (0)
 
 /// Use at the start of a test that needs the real KITTI sample: skips when it is absent,
 /// but fails under CI=true, so CI never passes by skipping.

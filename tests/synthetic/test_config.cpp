@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/synthetic_config.h>
@@ -70,6 +71,9 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   c.moving_cars_oncoming = 3;
   c.oncoming_car_speed_mps = 8.5;
   c.oncoming_group_period_s = 6;
+  c.lidar_model = "beams";
+  c.lidar_beam_elevations_deg = {-15.0, 0.1 + 0.2, 7.5};
+  c.camera = "pinhole";
   std::ostringstream out;
   msf::printConfig(out, c);
   const SyntheticConfig back = read(out.str());
@@ -81,6 +85,10 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   EXPECT_EQ(back.moving_cars_oncoming, 3);
   EXPECT_EQ(back.oncoming_car_speed_mps, 8.5);
   EXPECT_EQ(back.oncoming_group_period_s, 6.0);
+  EXPECT_EQ(back.lidar_model, "beams");
+  EXPECT_EQ(back.lidar_beam_elevations_deg, (std::vector<double>{-15.0, 0.1 + 0.2, 7.5}));
+  EXPECT_EQ(back.camera, "pinhole");
+  EXPECT_TRUE(back.principal_point_px.empty()); // printed as [], read back as none
 }
 
 TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The written dataset: KITTI's odometry layout that the project's readers open unchanged,
 // ground truth that matches the renderer, byte-identical output for a seed, no partial output.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Moving cars of the synthetic street: where the traffic drives, that the cameras and the
 // LiDAR see each car where its box says at the frame's time, the moving mask, the static
 // ground-truth mesh, the box file, and the static street left as it was.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Geometry, hierarchy, textures and random numbers of the generator, on known answers.
 #include "synthetic_fixture.h"
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The generator checks itself: LiDAR against the depth ground truth, SGBM on the rendered
 // pair against the disparity ground truth, the ring structure of the scans.
 #include "synthetic_fixture.h"

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_synth: writes a dataset; bad input is an error naming the culprit, with no output.
 #include "test_support.h"
 

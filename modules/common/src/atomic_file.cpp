@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 
@@ -86,8 +87,9 @@ void writeAtomically(const std::string& path, const std::function<void(const std
   }
   fs::rename(tmp, target, ec);
   if (ec) {
+    const std::string reason = ec.message(); // before the cleanup overwrites ec
     fs::remove(tmp, ec);
-    throw IOError("cannot write '" + path + "': rename failed: " + ec.message());
+    throw IOError("cannot write '" + path + "': rename failed: " + reason);
   }
 }
 

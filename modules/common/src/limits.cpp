@@ -1,19 +1,12 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
+#include <msf/common/message_text.h>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace msf::limits {
-
-namespace {
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-} // namespace
 
 void checkThreads(int threads, const std::string& name) {
   if (threads < 0 || threads > kMaxThreads)
@@ -26,6 +19,11 @@ void checkImageSize(long long width, long long height, const std::string& what) 
     throw InvalidInputError(what + ": image size " + std::to_string(width) + "x" + std::to_string(height) +
                             " is outside 1x1 .. " + std::to_string(kMaxImageSide) + "x" +
                             std::to_string(kMaxImageSide));
+  if (width * height > kMaxImagePixels)
+    throw InvalidInputError(what + ": image size " + std::to_string(width) + "x" + std::to_string(height) + " has " +
+                            std::to_string(width * height) + " pixels, more than the " +
+                            std::to_string(kMaxImagePixels) + " (4096x4096) a frame may have: each of its stages "
+                            "would take gigabytes and minutes");
 }
 
 void checkRigid(const Eigen::Isometry3d& T, const std::string& what) {
@@ -39,16 +37,16 @@ void checkRigid(const Eigen::Isometry3d& T, const std::string& what) {
   const double det = R.determinant();
   if (orthonormality > kRotationTolerance || std::abs(det - 1.0) > kRotationTolerance)
     throw InvalidInputError(what + " is not a rigid transform: its rotation is not orthonormal (|R^T R - I| = " +
-                            str(orthonormality) + ", det R = " + str(det) + ", tolerance " +
-                            str(kRotationTolerance) + ")");
+                            number(orthonormality) + ", det R = " + number(det) + ", tolerance " +
+                            number(kRotationTolerance) + ")");
   const double t = M.topRightCorner<3, 1>().cwiseAbs().maxCoeff();
   if (t > kMaxTranslationM)
-    throw InvalidInputError(what + " has a translation of " + str(t) + " m, beyond " + str(kMaxTranslationM) + " m");
+    throw InvalidInputError(what + " has a translation of " + number(t) + " m, beyond " + number(kMaxTranslationM) + " m");
 }
 
 std::int64_t checkedRound(double value, std::int64_t lo, std::int64_t hi, const std::string& what) {
   if (!std::isfinite(value) || value < static_cast<double>(lo) - 0.5 || value > static_cast<double>(hi) + 0.5)
-    throw InvalidInputError(what + " " + str(value) + " is outside " + std::to_string(lo) + " .. " +
+    throw InvalidInputError(what + " " + number(value) + " is outside " + std::to_string(lo) + " .. " +
                             std::to_string(hi));
   return std::clamp<std::int64_t>(std::llround(value), lo, hi);
 }

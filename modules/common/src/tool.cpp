@@ -1,5 +1,8 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/common/tool.h>
+#include <msf/common/version.h>
 
 #include <pcl/console/print.h>
 
@@ -11,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <type_traits>
@@ -31,6 +35,17 @@ int run(const char* name, const std::function<int()>& body) {
   return 1;
 }
 
+bool wantsVersion(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (!std::strcmp(argv[i], "--version") || !std::strcmp(argv[i], "-version"))
+      return true;
+  return false;
+}
+
+std::string versionLine(const std::string& name) {
+  return name + " (msfusion) " + versionString() + ", commit " + gitCommit();
+}
+
 bool wantsHelp(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (!std::strcmp(argv[i], "-h") || !std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-help"))
@@ -41,7 +56,7 @@ bool wantsHelp(int argc, char** argv) {
 namespace {
 
 [[noreturn]] void notANumber(const std::string& option, const std::string& text, const char* kind) {
-  throw InvalidInputError(option + " needs " + kind + ", not '" + text + "'");
+  throw InvalidInputError(option + " needs " + kind + ", not " + quoted(text));
 }
 
 template <typename T>
@@ -51,13 +66,21 @@ T parseNumber(const std::string& option, const std::string& text) {
   errno = 0;
   if constexpr (std::is_same_v<T, int>) {
     const long v = std::strtol(begin, &end, 10);
-    if (end == begin || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX)
+    if (end == begin || *end != '\0')
       notANumber(option, text, "a whole number");
+    // A value past int's range is refused, not wrapped or clamped.
+    if (errno == ERANGE || v < INT_MIN || v > INT_MAX)
+      throw InvalidInputError(option + " must be a whole number in " + std::to_string(INT_MIN) + " .. " +
+                              std::to_string(INT_MAX) + ", not " + quoted(text));
     return static_cast<int>(v);
   } else {
     const double v = std::strtod(begin, &end);
-    if (end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+    if (end == begin || *end != '\0' || (!std::isfinite(v) && errno != ERANGE)) // "nan", "inf" as such
       notANumber(option, text, "a number");
+    // Overflow gives inf and underflow a subnormal or 0 with ERANGE: neither is the value given.
+    if (errno == ERANGE || std::abs(v) > std::numeric_limits<T>::max())
+      throw InvalidInputError(option + " needs a finite number within the range of a " +
+                              (std::is_same_v<T, float> ? "float" : "double") + ", not " + quoted(text));
     return static_cast<T>(v);
   }
 }
@@ -195,6 +218,7 @@ void CommandLine::printHelp(const char* program) const {
   }
   for (const std::string& note : notes_)
     pcl::console::print_info("%s", wrap(note, 2).c_str());
+  pcl::console::print_info("%s\n", versionLine(name_).c_str());
 }
 
 Arguments CommandLine::parse(int argc, char** argv) {
@@ -240,6 +264,10 @@ std::vector<std::string> CommandLine::flags() const {
 }
 
 int CommandLine::run(int argc, char** argv, int min_arguments, const std::function<int(const Arguments&)>& body) {
+  if (wantsVersion(argc, argv) && !wantsHelp(argc, argv)) {
+    std::printf("%s\n", versionLine(name_).c_str());
+    return 0;
+  }
   const bool help = wantsHelp(argc, argv);
   if (help || argc - 1 < min_arguments) {
     printHelp(argv[0]);

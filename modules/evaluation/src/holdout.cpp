@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/evaluation/holdout.h>
@@ -10,6 +12,20 @@
 
 namespace msf {
 
+namespace {
+
+/// Each point's ring: from the data when the scan carries it, else from the rig's beam
+/// elevations, else from the sensor's order (KITTI's files: ring after ring).
+std::vector<int> scanRingIds(const Frame& frame, const Calibration& calibration) {
+  if (!frame.point_ring.empty())
+    return std::vector<int>(frame.point_ring.begin(), frame.point_ring.end());
+  if (!calibration.lidar.beam_elevations_deg.empty())
+    return ringIdsFromElevations(*frame.scan, calibration.lidar.beam_elevations_deg);
+  return ringIds(*frame.scan);
+}
+
+} // namespace
+
 HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration, const HoldoutConfig& config) {
   if (config.projection.camera != 0)
     throw ConfigError("protocol 2 evaluates in camera 0; projection.camera is " +
@@ -19,7 +35,7 @@ HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration
   HoldoutFrame out;
   auto input = pcl::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
   pcl::PointCloud<pcl::PointXYZI> heldout;
-  out.ring_count = splitRings(*frame.scan, config.rings, *input, heldout);
+  out.ring_count = splitRings(*frame.scan, scanRingIds(frame, calibration), config.rings, *input, heldout);
   out.heldout_points = heldout.size();
   const LidarProjector projector(calibration, config.projection);
   projector.projectToImage(heldout, out.gt_depth);
@@ -174,8 +190,7 @@ std::string formatHoldoutBreakdown(const std::vector<HoldoutResult>& results) {
 }
 
 void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& results) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out << "method,frames,gt_pixels,estimated,coverage,d1_all,d1_estimated,disparity_mae_px,mae_m,rmse_m,"
            "imae_per_km,irmse_per_km,median_ms,gross_share,gross_mae_part_m\n";
     out.precision(6);
@@ -186,9 +201,6 @@ void writeHoldoutCsv(const std::string& path, const std::vector<HoldoutResult>& 
           << ',' << m.imae_per_km << ',' << m.irmse_per_km << ',' << r.median_ms << ',' << m.gross_share << ','
           << m.gross_mae_part_m << '\n';
     }
-    out.flush();
-    if (!out)
-      throw IOError("cannot write '" + path + "'");
   });
 }
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/holdout_breakdown.h>
 #include <msf/io/organized_conversion.h>

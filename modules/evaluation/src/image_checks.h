@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The evaluation's check of an image compared with a ground truth, private to the module.
 #include <msf/common/exceptions.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/fusion/impl/depth_fusion.hpp>
 
 #include <pcl/point_types.h>

@@ -1,9 +1,13 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/yaml_check.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
+#include <msf/common/message_text.h>
 #include <msf/io/calibration.h>
+#include <msf/io/rig_file.h>
 #include <msf/io/image_io.h>
 
 #include <opencv2/core/persistence.hpp>
@@ -55,13 +59,19 @@ public:
     if (!in)
       throw IOError("calibration '" + path + "' cannot be read");
     std::string line;
-    while (std::getline(in, line)) {
+    std::map<std::string, int> line_of;
+    for (int line_no = 1; std::getline(in, line); ++line_no) {
       const auto colon = line.find(':');
       if (colon == std::string::npos)
         continue;
       std::string key = line.substr(0, colon);
       key.erase(0, key.find_first_not_of(" \t"));
       key.erase(key.find_last_not_of(" \t\r") + 1);
+      // A key given twice (a pasted line, two files joined): which one is meant is unknown.
+      const auto [first, fresh] = line_of.emplace(key, line_no);
+      if (!fresh)
+        throw CalibrationError("calibration '" + path + "': key '" + key + "' is given twice, on lines " +
+                               std::to_string(first->second) + " and " + std::to_string(line_no));
       std::istringstream values(line.substr(colon + 1));
       std::vector<double> numbers;
       std::string token, bad;
@@ -154,13 +164,15 @@ cv::Size imageSizeOf(const fs::path& image) {
   return readImage(image.string()).size();
 }
 
-fs::path firstFile(const fs::path& dir) {
+/// The first .png of `dir` by name: a frame image, not a stray file (.DS_Store, a README).
+fs::path firstImage(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     return {};
   fs::path first;
   for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file() && (first.empty() || e.path() < first))
+    if (e.is_regular_file(ec) && e.path().extension() == ".png" && e.path().stem().string()[0] != '.' &&
+        (first.empty() || e.path() < first))
       first = e.path();
   return first;
 }
@@ -173,7 +185,7 @@ Calibration fromOdometry(const KeyValueFile& f) {
   c.has_velodyne = f.has("Tr");
   if (c.has_velodyne)
     c.T_cam0_velo = f.transform3x4("Tr");
-  c.image_size = imageSizeOf(firstFile(fs::path(f.path()).parent_path() / "image_0"));
+  c.image_size = imageSizeOf(firstImage(fs::path(f.path()).parent_path() / "image_0"));
   return c;
 }
 
@@ -227,6 +239,13 @@ cv::Mat readMatrixYaml(const cv::FileStorage& in, const std::string& key, int ro
                            (r < 0 || c < 0 ? std::string("not a matrix with integer rows and cols")
                                            : std::to_string(r) + "x" + std::to_string(c)) +
                            ", expected " + std::to_string(rows) + "x" + std::to_string(cols));
+  // OpenCV converts the values to the matrix's type: 'u' clips them to 0..255, the integer
+  // types drop their decimals.
+  const cv::FileNode type = node["dt"];
+  const std::string dt = type.isString() ? type.string() : std::string();
+  if (dt != "d" && dt != "f")
+    throw CalibrationError("calibration '" + path + "': key '" + key + "' has dt '" + dt +
+                           "', not d (float64) or f (float32): OpenCV would clip or round its values to that type");
   const cv::FileNode data = node["data"];
   if (!data.isSeq() || data.size() != static_cast<std::size_t>(rows) * cols)
     throw CalibrationError("calibration '" + path + "': key '" + key + "' needs " + std::to_string(rows * cols) +
@@ -308,6 +327,8 @@ Calibration readCalibration(const std::string& path) {
                   "' has neither calib_cam_to_cam.txt (KITTI raw) nor calib.txt (KITTI odometry)");
   }
   const std::string ext = fileExtension(path);
+  if ((ext == ".yaml" || ext == ".yml") && isRigFile(path))
+    return loadRigFile(path);
   if (ext == ".yaml" || ext == ".yml" || ext == ".xml")
     return fromYaml(path);
   if (p.filename() == "calib_cam_to_cam.txt")
@@ -353,11 +374,40 @@ void Calibration::validate() const {
 }
 
 double Calibration::focalBaseline() const {
+  const std::string where = "calibration '" + source + "'";
   const double fb = fx(0) * baselineGrey();
   if (!(fb > 0.0) || !std::isfinite(fb))
-    throw CalibrationError("calibration '" + source + "': the grey pair's focal length x baseline is " +
-                           std::to_string(fb) + " (P0 and P1 must have fx > 0 and different centres) ");
+    throw CalibrationError(where + ": the grey pair's focal length x baseline is " + std::to_string(fb) +
+                           " (P0 and P1 must have fx > 0 and different centres) ");
+  checkRectifiedPair(0, 1);
+  const double step = cameraCenter(1).x() - cameraCenter(0).x();
+  if (step < 0.0)
+    throw CalibrationError(where + ": camera 1 is " + number(-step) + " m left of camera 0 (P1's fourth value " +
+                           number(P[1](0, 3)) + " is positive; a rectified right camera has -fx x baseline there): "
+                           "the grey images or the sign are swapped");
+  const double baseline = baselineGrey();
+  if (baseline < limits::kMinBaselineM || baseline > limits::kMaxBaselineM)
+    throw CalibrationError(where + ": the grey pair's baseline is " + number(baseline) + " m, outside " +
+                           number(limits::kMinBaselineM) + " .. " + number(limits::kMaxBaselineM) +
+                           " m (below a millimetre a pair sees no depth; no rig is 10 m wide): a unit or a digit "
+                           "is wrong");
   return fb;
+}
+
+void Calibration::checkRectifiedPair(int a, int b) const {
+  const char* names[] = {"fx", "fy", "cx", "cy"};
+  const double values[2][4] = {{fx(a), fy(a), cx(a), cy(a)}, {fx(b), fy(b), cx(b), cy(b)}};
+  for (int k = 0; k < 4; ++k)
+    if (!(std::abs(values[0][k] - values[1][k]) <= limits::kRectifiedIntrinsicsTolerancePx))
+      throw CalibrationError("calibration '" + source + "': P" + std::to_string(b) + "'s " + names[k] + " " +
+                             number(values[1][k]) + " is not P" + std::to_string(a) + "'s " + number(values[0][k]) +
+                             ": the cameras of a rectified pair share their intrinsics");
+  // P(1,3) = fy ty and P(2,3) = tz: a row shift of the tolerance at a metre at most.
+  if (!(std::abs(P[b](1, 3) - P[a](1, 3)) <= limits::kRectifiedIntrinsicsTolerancePx) ||
+      !(std::abs(P[b](2, 3) - P[a](2, 3)) <= limits::kRectifiedIntrinsicsTolerancePx / fy(a)))
+    throw CalibrationError("calibration '" + source + "': P" + std::to_string(b) + " is shifted up, down or along "
+                           "the axis from P" + std::to_string(a) + " (its fourth column's second or third value "
+                           "differs): the cameras of a rectified pair differ along x only");
 }
 
 Calibration loadCalibration(const std::string& path) {
@@ -401,33 +451,30 @@ cv::Size parseImageSize(const std::string& text) {
 }
 
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    cv::FileStorage out(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-    if (!out.isOpened())
-      throw IOError("cannot write calibration '" + path + "'");
-    for (int i = 0; i < 4; ++i) {
-      cv::Mat P(3, 4, CV_64F);
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c)
-          P.at<double>(r, c) = calibration.P[i](r, c);
-      out << "P" + std::to_string(i) << P;
-    }
-    out << "image_width" << calibration.image_size.width;
-    out << "image_height" << calibration.image_size.height;
-    if (calibration.has_velodyne) {
-      cv::Mat T(4, 4, CV_64F);
-      for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c)
-          T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
-      out << "T_cam0_velo" << T;
-    }
-    out.release();
-  });
+  // Formatted in memory, then written checked (FileStorage does not check its writes).
+  cv::FileStorage out(path, cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  for (int i = 0; i < 4; ++i) {
+    cv::Mat P(3, 4, CV_64F);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c)
+        P.at<double>(r, c) = calibration.P[i](r, c);
+    out << "P" + std::to_string(i) << P;
+  }
+  out << "image_width" << calibration.image_size.width;
+  out << "image_height" << calibration.image_size.height;
+  if (calibration.has_velodyne) {
+    cv::Mat T(4, 4, CV_64F);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
+    out << "T_cam0_velo" << T;
+  }
+  const std::string text = out.releaseAndGetString();
+  writeStreamAtomically(path, [&](std::ostream& stream) { stream << text; });
 }
 
 void saveOdometryCalibration(const Calibration& calibration, const std::string& path) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out << std::scientific << std::setprecision(12);
     auto row = [&](const std::string& key, const Eigen::Matrix<double, 3, 4>& M) {
       out << key << ":";
@@ -440,8 +487,6 @@ void saveOdometryCalibration(const Calibration& calibration, const std::string& 
       row("P" + std::to_string(i), calibration.P[i]);
     if (calibration.has_velodyne)
       row("Tr", calibration.T_cam0_velo.matrix().topRows<3>());
-    if (!out)
-      throw IOError("cannot write calibration '" + path + "'");
   });
 }
 

@@ -1,4 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/checked_write.h>
 #include <msf/io/impl/cloud_io.hpp>
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
 
 #include <pcl/io/obj_io.h>
 #include <pcl/io/vtk_io.h>
@@ -362,6 +367,7 @@ void checkPlyHeader(const std::string& path, const std::string& what) {
   std::vector<Element> elements;
   std::string format;
   bool crlf = false, ended = false;
+  std::uint64_t grid_cols = 0, grid_rows = 0; // obj_info num_cols, num_rows
   while (!ended) {
     if (header_bytes >= (1u << 16) || !std::getline(in, line)) {
       line_no = 0;
@@ -387,9 +393,24 @@ void checkPlyHeader(const std::string& path, const std::string& what) {
     const std::vector<std::string> words = wordsOf(line, " \t\v\f"); // isspace, less the CR taken off above
     if (words.empty())
       continue; // PCL passes over a line of blanks
+    // PCL's reader splits an obj_info line at blanks and asserts that the first word is
+    // obj_info: a blank before it aborts the program (fuzz/fuzz_cloud).
+    if (std::strchr(" \t\v\f", line[0]))
+      bad("a line that starts with a blank");
     const std::string& key = words[0];
-    if (key == "comment" || key == "obj_info")
+    if (key == "comment")
       continue;
+    if (key == "obj_info") {
+      // num_cols x num_rows size the cloud's data before any vertex is read (atoi: a number
+      // past int is undefined), so they are checked against the elements below.
+      if (words.size() >= 3 && (words[1] == "num_cols" || words[1] == "num_rows")) {
+        const long long v = headerInteger(words[2], 0, std::numeric_limits<std::int32_t>::max());
+        if (v < 0 || words[2].find_first_not_of("0123456789") != std::string::npos)
+          bad(words[1] + " '" + shownLine(words[2]) + "' is not a whole number 0 .. 2147483647");
+        (words[1] == "num_cols" ? grid_cols : grid_rows) = static_cast<std::uint64_t>(v);
+      }
+      continue;
+    }
     if (key == "end_header") {
       if (words.size() != 1)
         bad("end_header takes nothing after it");
@@ -437,6 +458,22 @@ void checkPlyHeader(const std::string& path, const std::string& what) {
   }
   if (format.empty())
     bad("no format line before end_header");
+  if (grid_cols > 0 && grid_rows > 0) {
+    // PCL's own files: cols x rows is the vertex count (a dense cloud) or the range_grid's.
+    const auto count = [&](const char* name) {
+      for (const auto& e : elements)
+        if (e.name == name)
+          return e.count;
+      return std::uint64_t{0};
+    };
+    const std::uint64_t cells = grid_cols * grid_rows;
+    if (cells != count("vertex") && cells != count("range_grid"))
+      throw IOError(what + " '" + path + "' is not a valid .ply file (bad header): obj_info num_cols " +
+                    std::to_string(grid_cols) + " x num_rows " + std::to_string(grid_rows) + " make " +
+                    std::to_string(cells) + " points, not its " + std::to_string(count("vertex")) + " vertices" +
+                    (count("range_grid") ? " nor its " + std::to_string(count("range_grid")) + " range_grid items"
+                                         : std::string()));
+  }
   const std::uintmax_t size = fileSize(path);
   const std::uintmax_t available = size > header_bytes ? size - header_bytes : 0;
   const bool ascii = format == "ascii";
@@ -497,6 +534,11 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
     } else if (ext == ".ply") {
       checkPlyHeader(path, "cloud");
       result = pcl::PLYReader().read(path, blob);
+      // A camera element's viewport in the body resizes the cloud after its data was sized.
+      if (result >= 0 && blob.data.size() != static_cast<std::uint64_t>(blob.width) * blob.height * blob.point_step)
+        throw IOError("cloud '" + path + "': its " + std::to_string(blob.data.size()) + " bytes of points are not " +
+                      std::to_string(blob.width) + " x " + std::to_string(blob.height) + " points of " +
+                      std::to_string(blob.point_step) + " bytes (a camera viewport that contradicts the header?)");
     } else {
       throw IOError("cloud '" + path + "' is neither .pcd nor .ply");
     }
@@ -509,18 +551,49 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
     throw IOError("cloud '" + path + "' cannot be parsed as " + ext.substr(1));
 }
 
+void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
+                   const Eigen::Quaternionf& orientation) {
+  const std::string ext = fileExtension(path);
+  if (ext != ".pcd" && ext != ".ply")
+    throw IOError("cannot write '" + path + "': a cloud is written as .pcd or .ply");
+  if (ext == ".ply") {
+    writeThroughPipeAtomically(path, [&](const std::string& sink) {
+      if (pcl::PLYWriter().write(sink, blob, origin, orientation, true, false) != 0)
+        throw IOError("cannot write cloud '" + path + "'");
+    });
+    return;
+  }
+  // The compressed format keeps its sizes in 32 bits, and PCL's writer needs room for half as
+  // much again (it refuses, or its template version crashes, beyond).
+  std::uint64_t point_bytes = 0;
+  for (const auto& f : blob.fields)
+    if (f.name != "_")
+      point_bytes += static_cast<std::uint64_t>(f.count) * pcl::getFieldSize(f.datatype);
+  const std::uint64_t points = static_cast<std::uint64_t>(blob.width) * blob.height;
+  constexpr std::uint64_t kMaxCompressedData = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
+  if (points * point_bytes > kMaxCompressedData)
+    throw IOError("cannot write '" + path + "': its " + std::to_string(points) + " points of " +
+                  std::to_string(point_bytes) + " bytes make " + std::to_string(points * point_bytes) +
+                  " bytes, more than a binary_compressed .pcd holds (" + std::to_string(kMaxCompressedData) +
+                  ": its sizes are 32-bit)");
+  writeStreamAtomically(path, [&](std::ostream& out) {
+    if (pcl::PCDWriter().writeBinaryCompressed(out, blob, origin, orientation) != 0)
+      throw IOError("cannot write cloud '" + path + "'");
+  });
+}
+
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh) {
   const std::string ext = fileExtension(path);
   if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
     throw IOError("cannot write mesh '" + path + "': use .ply, .obj or .vtk");
-  writeAtomically(path, [&](const std::string& tmp) {
+  writeThroughPipeAtomically(path, [&](const std::string& sink) {
     int result = -1;
     if (ext == ".ply")
-      result = pcl::io::savePLYFileBinary(tmp, mesh);
+      result = pcl::io::savePLYFileBinary(sink, mesh);
     else if (ext == ".obj")
-      result = pcl::io::saveOBJFile(tmp, mesh);
+      result = pcl::io::saveOBJFile(sink, mesh);
     else
-      result = pcl::io::saveVTKFile(tmp, mesh);
+      result = pcl::io::saveVTKFile(sink, mesh);
     if (result != 0)
       throw IOError("cannot write mesh '" + path + "'");
   });
@@ -546,6 +619,7 @@ void loadMesh(const std::string& path, pcl::PolygonMesh& mesh) {
 
 #define MSF_INSTANTIATE_CLOUD_IO(T)                                                \
   template void loadCloud<T>(const std::string&, pcl::PointCloud<T>&);            \
+  template void fromCloudBlob<T>(pcl::PCLPointCloud2, pcl::PointCloud<T>&, const std::string&); \
   template void saveCloud<T>(const std::string&, const pcl::PointCloud<T>&);
 MSF_INSTANTIATE_CLOUD_IO(pcl::PointXYZ)
 MSF_INSTANTIATE_CLOUD_IO(pcl::PointXYZI)

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/io/frame_source.h>
 
 #include <string>
@@ -18,7 +20,7 @@ FrameRange FrameRange::parse(const std::string& text) {
       used = 0;
     }
     if (used != s.size() || v < 0)
-      throw InvalidInputError("frame range '" + text + "' is not 'a:b' with whole numbers a <= b");
+      throw InvalidInputError("frame range " + quoted(text) + " is not 'a:b' with whole numbers a <= b");
     return v;
   };
   const auto colon = text.find(':');
@@ -31,7 +33,7 @@ FrameRange FrameRange::parse(const std::string& text) {
     r.last = toInt(text.substr(colon + 1), -1);
   }
   if (r.last >= 0 && r.last < r.first)
-    throw InvalidInputError("frame range '" + text + "' ends before it starts");
+    throw InvalidInputError("frame range " + quoted(text) + " ends before it starts");
   return r;
 }
 
@@ -40,21 +42,39 @@ const PoseList& FrameSource::poses() const {
   return none;
 }
 
+long long frameNumber(const std::string& name) {
+  if (name.empty() || name.size() > 18 || name.find_first_not_of("0123456789") != std::string::npos)
+    return -1;
+  return std::stoll(name);
+}
+
 std::vector<std::size_t> FrameSource::indices(const FrameRange& range) const {
-  // A last frame beyond the sequence is an error, as in msf_integrate: clamping it ran
-  // fewer frames than asked without a word.
-  if (range.first >= static_cast<int>(size()))
-    throw InvalidInputError("frame range " + std::to_string(range.first) + ":" +
-                            (range.last < 0 ? std::string() : std::to_string(range.last)) + " selects no frame of '" +
-                            description() + "' (" + std::to_string(size()) + " frames)");
-  if (range.last >= static_cast<int>(size()))
-    throw InvalidInputError("frame range " + std::to_string(range.first) + ":" + std::to_string(range.last) +
-                            " goes beyond the last frame of '" + description() + "' (" + std::to_string(size()) +
-                            " frames, 0:" + std::to_string(size() - 1) + ")");
-  const int last = range.last < 0 ? static_cast<int>(size()) - 1 : range.last;
+  // The range counts frame numbers (the files' names), which skip the frames a sequence lacks.
+  // A last frame beyond the sequence is an error, as in msf_integrate: clamping it ran fewer
+  // frames than asked without a word.
+  if (size() == 0)
+    throw InvalidInputError("'" + description() + "' has no frames");
+  const auto number = [&](std::size_t i) {
+    const long long n = frameNumber(frameName(i));
+    return n >= 0 ? n : static_cast<long long>(i);
+  };
+  const long long last_number = number(size() - 1);
+  const std::string frames =
+      std::to_string(size()) + " frames, " + frameName(0) + ".." + frameName(size() - 1);
+  const std::string asked =
+      std::to_string(range.first) + ":" + (range.last < 0 ? std::string() : std::to_string(range.last));
+  if (range.first > last_number)
+    throw InvalidInputError("frame range " + asked + " selects no frame of '" + description() + "' (" + frames + ")");
+  if (range.last > last_number)
+    throw InvalidInputError("frame range " + asked + " goes beyond the last frame of '" + description() + "' (" +
+                            frames + ")");
+  const long long last = range.last < 0 ? last_number : range.last;
   std::vector<std::size_t> out;
-  for (int i = range.first; i <= last; ++i)
-    out.push_back(static_cast<std::size_t>(i)); // not empty: FrameRange::parse orders first <= last
+  for (std::size_t i = 0; i < size(); ++i)
+    if (number(i) >= range.first && number(i) <= last)
+      out.push_back(i);
+  if (out.empty())
+    throw InvalidInputError("frame range " + asked + " selects no frame of '" + description() + "' (" + frames + ")");
   return out;
 }
 

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <opencv2/core.hpp>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
@@ -55,16 +57,17 @@ cv::Mat readImage(const std::string& path, int flags) {
 void writeImage(const std::string& path, const cv::Mat& image) {
   if (image.empty())
     throw InvalidInputError("cannot write '" + path + "': the image is empty");
-  writeAtomically(path, [&](const std::string& tmp) {
-    bool ok = false;
-    try {
-      ok = cv::imwrite(tmp, image);
-    } catch (const cv::Exception& e) {
-      throw IOError("cannot write image '" + path + "': " + e.err);
-    }
-    if (!ok)
-      throw IOError("cannot write image '" + path + "'");
-  });
+  // Encoded in memory, then written checked (OpenCV's encoders do not check their writes).
+  std::vector<uchar> bytes;
+  bool ok = false;
+  try {
+    ok = cv::imencode(fileExtension(path), image, bytes);
+  } catch (const cv::Exception& e) {
+    throw IOError("cannot write image '" + path + "': " + e.err);
+  }
+  if (!ok)
+    throw IOError("cannot write image '" + path + "'");
+  writeBytesAtomically(path, bytes.data(), bytes.size());
 }
 
 namespace {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/impl/pinhole_camera.hpp>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/io/poses.h>
@@ -59,16 +61,13 @@ PoseList loadOdometryPoses(const std::string& path) {
 }
 
 void saveOdometryPoses(const std::string& path, const PoseList& T_world_cam0) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out << std::scientific << std::setprecision(9);
     for (const auto& T : T_world_cam0) {
       for (int n = 0; n < 12; ++n)
         out << (n ? " " : "") << T.matrix()(n / 4, n % 4);
       out << '\n';
     }
-    if (!out)
-      throw IOError("cannot write poses '" + path + "'");
   });
 }
 
@@ -80,14 +79,20 @@ std::vector<OxtsRecord> loadOxts(const std::string& oxts_data_dir) {
       files.push_back(e.path());
   std::sort(files.begin(), files.end());
   std::vector<OxtsRecord> records;
-  for (const auto& f : files) {
-    std::ifstream in(f);
-    OxtsRecord r;
-    if (!(in >> r.lat >> r.lon >> r.alt >> r.roll >> r.pitch >> r.yaw))
-      throw IOError("oxts '" + f.string() + "': expected at least 6 numbers (lat lon alt roll pitch yaw)");
-    records.push_back(r);
-  }
+  for (const auto& f : files)
+    records.push_back(loadOxtsRecord(f.string()));
   return records;
+}
+
+OxtsRecord loadOxtsRecord(const std::string& path) {
+  std::ifstream in(path);
+  OxtsRecord r;
+  if (!(in >> r.lat >> r.lon >> r.alt >> r.roll >> r.pitch >> r.yaw))
+    throw IOError("oxts '" + path + "': expected at least 6 numbers (lat lon alt roll pitch yaw)");
+  for (const double v : {r.lat, r.lon, r.alt, r.roll, r.pitch, r.yaw})
+    if (!std::isfinite(v))
+      throw IOError("oxts '" + path + "': a value of lat lon alt roll pitch yaw is not finite");
+  return r;
 }
 
 PoseList oxtsToCameraPoses(const std::vector<OxtsRecord>& oxts, const Calibration& calibration) {

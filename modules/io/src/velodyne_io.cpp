@@ -1,5 +1,8 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/velodyne_io.h>
 
 #include <cmath>
@@ -17,6 +20,10 @@ VelodyneReadStats loadVelodyneBin(const std::string& path, pcl::PointCloud<pcl::
   if (bytes % kRecord != 0)
     throw IOError("scan '" + path + "' has " + std::to_string(bytes) +
                   " bytes, not a multiple of 16 (float32 x, y, z, reflectance): truncated or not a KITTI .bin");
+  if (bytes / kRecord > limits::kMaxScanPoints)
+    throw IOError("scan '" + path + "' has " + std::to_string(bytes / kRecord) + " records (" + std::to_string(bytes) +
+                  " bytes), more than the " + std::to_string(limits::kMaxScanPoints) +
+                  " a scan may hold: not one LiDAR scan");
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!file)
     throw IOError("scan '" + path + "' cannot be opened");
@@ -41,6 +48,10 @@ VelodyneReadStats loadVelodyneBin(const std::string& path, pcl::PointCloud<pcl::
     p.intensity = r[3];
     cloud.push_back(p);
   }
+  // Said as such: the tools would otherwise report a scan that lands nowhere (a wrong calibration).
+  if (cloud.empty() && stats.records > 0)
+    throw IOError("scan '" + path + "': each of its " + std::to_string(stats.records) +
+                  " records has a value that is not finite (NaN or inf in x, y, z or reflectance)");
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;
@@ -53,13 +64,7 @@ void saveVelodyneBin(const std::string& path, const pcl::PointCloud<pcl::PointXY
   for (const auto& p : cloud) {
     raw.insert(raw.end(), {p.x, p.y, p.z, p.intensity});
   }
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(tmp.c_str(), "wb"), &std::fclose);
-    if (!file)
-      throw IOError("cannot write scan '" + path + "'");
-    if (std::fwrite(raw.data(), sizeof(float), raw.size(), file.get()) != raw.size() || std::fflush(file.get()) != 0)
-      throw IOError("cannot write scan '" + path + "': disk full?");
-  });
+  writeBytesAtomically(path, raw.data(), raw.size() * sizeof(float));
 }
 
 } // namespace msf

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/impl/organized_conversion.hpp> // depthImageToCloud for the fused point type
 #include <msf/pipeline/fused_cloud.h>
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
@@ -29,6 +30,7 @@ PipelineConfig PipelineConfig::paper() {
   // Step 3: OpenCV's SGBM on the grey pair alone, over the full disparity range.
   c.stereo.engine = "opencv";
   c.stereo.mode = "sgbm_3way";
+  c.stereo.unguided_mode = "sgbm_3way";
   c.stereo.guidance = "none";
   c.stereo.prior_search_range = false;
   c.scheduling.stereo_prior = false;

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/common/parallel.h>
 #include <msf/fusion/depth_image_fusion.h>
@@ -9,6 +10,7 @@
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
 #include <msf/reconstruction/block_footprint.h>
+#include <msf/reconstruction/scan_band_blocks.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
@@ -25,23 +27,30 @@ namespace msf {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-// The memory model of predictMemory beside the TSDF volume's bound, from msf_reconstruct's RSS
-// per frame (frames.csv) and peak (summary.json) on KITTI odometry 04 (frames 0-9), raw 0009
-// (0-4) and the synthetic street (40 frames); docs/robustness.md, "Memory budget".
-// The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas:
-// ~200 measured (RSS after the first frame, less the process, the frames in flight and the volume).
-constexpr double kStageBytesPerPixel = 240;
-// A frame in flight (images, scan, depth images): 17 measured (queue_capacity 1 to 4 on 04:
-// 6 more frames in flight, +50 MiB).
+// The memory model of predictMemory beside the TSDF volume, from msf_reconstruct's RSS per frame
+// (frames.csv) and peak (summary.json) on KITTI and the synthetic street (docs/robustness.md,
+// "Memory budget"; the figures in docs/results.md).
+// The stages' own buffers (SGBM's strips, the LiDAR canvas, fusion), per pixel of the canvas,
+// and the heap the calibration frames' buffers leave behind.
+constexpr double kStageBytesPerPixel = 340;
+// A frame in flight (images, scan, depth images).
 constexpr double kFrameBytesPerPixel = 24;
-// A frame whose ground truth the run keeps to score the mesh at the end (protocol 4): 7.6
-// measured on the street (the RSS growth per frame beyond the volume's).
+// A frame whose ground truth the run keeps to score the mesh at the end (protocol 4).
 constexpr double kScoredFrameBytesPerPixel = 12;
-// What the end of an in-memory run adds, in units of the footprint's volume bytes: the mesh,
-// its per-block cache, the copy written and the volume.pcd cloud took 2.6 to 3.2 times the
-// real volume's bytes, and the real volume was 1/10 to 1/12 of the footprint on the three runs
-// (a view's frustum holds free space as well as surfaces): 0.27 to 0.32 of the footprint's.
-constexpr double kEndOfRunFraction = 0.5;
+// What the end of an in-memory run adds (the mesh, its per-block cache, the copy written and
+// the volume.pcd cloud), in units of the predicted volume's bytes: above the most measured in
+// units of the real volume's, since the predicted volume can be as little as the real one.
+constexpr double kEndOfRunShare = 6.5;
+// A streamed run's tiles meshed as they leave, in units of the window's volume bytes.
+constexpr double kStreamedEndShare = 1.0;
+// A map of one source alone or of the paper's method (-compare_sources, -compare_paper), its
+// mesh included, in units of the fused map's volume bytes.
+constexpr double kOtherMapShare = 1.6;
+// The blocks the scans' bands predict, grown against the spread of the measured share between
+// frames (the calibration frames are a few of the run's).
+constexpr double kBlockMargin = 1.15;
+// Frames integrated to measure the share of the fused depth's blocks in the scans' bands.
+constexpr int kCalibrationFrames = 3;
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -60,7 +69,7 @@ Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& confi
     : Reconstructor(rig, config, Options()) {}
 
 Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options)
-    : calibration_(rig), config_(config), options_(options), mesher_(config.mesher) {
+    : calibration_(rig), config_(adaptToRig(config, rig)), options_(options), mesher_(config.mesher) {
   config_.validate();
   calibration_.requireImageSize();
   if (options_.threads < 0)
@@ -197,6 +206,7 @@ bool Reconstructor::tracks(const Frame& first) const {
   case PoseMode::Given:
     return false;
   case PoseMode::Odometry:
+  case PoseMode::Refine:
     return true;
   case PoseMode::Auto:
     break;
@@ -215,9 +225,25 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
   if (!frame.scan)
     throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan to track");
   const auto start = Clock::now();
-  const Eigen::Isometry3d T_velo0_velo = odometry_->registerScan(*frame.scan, scan_name);
+  const std::optional<Eigen::Isometry3d> measured = measuredMotion(frame);
+  const Eigen::Isometry3d T_velo0_velo =
+      odometry_->registerScan(*frame.scan, scan_name, measured ? &*measured : nullptr);
   odometry_ms_.push_back(msSince(start));
   return cameraPose(T_velo0_velo, calibration_.T_cam0_velo, T_world_cam0_first_);
+}
+
+std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& frame) {
+  if (options_.poses != PoseMode::Refine)
+    return std::nullopt;
+  if (!frame.has_pose)
+    throw InvalidInputError("frame " + std::to_string(frame.index) +
+                            " has no pose to refine (PoseMode Refine refines each frame's own pose with its scan)");
+  const Eigen::Isometry3d T_world_velo = frame.T_world_cam0 * calibration_.T_cam0_velo;
+  if (odometry_->poses().empty()) // the first scan is the odometry's origin: any motion marks it as measured
+    T_world_velo_measured_last_ = T_world_velo;
+  const Eigen::Isometry3d motion = T_world_velo_measured_last_.inverse() * T_world_velo;
+  T_world_velo_measured_last_ = T_world_velo;
+  return motion;
 }
 
 FrameResult Reconstructor::addFrame(const Frame& frame) {
@@ -254,6 +280,11 @@ void Reconstructor::startStreaming() {
                       "or truncation_sigmas 0 (with per-pixel weights the band grows as a pixel's weight falls)");
   streaming_ = std::make_unique<StreamingMap>(*volume_, config_.streaming, config_.mesher, reach,
                                               options_.stream_directory);
+}
+
+double Reconstructor::minimumStreamingRadius() const {
+  return integrator_->reach(stages_->lidar.projector().canvasCamera()) +
+         config_.streaming.tile_blocks * TsdfBlock::kSide * config_.volume.voxel_size_m;
 }
 
 std::size_t Reconstructor::finishStreaming(const std::string& mesh_path) {
@@ -414,20 +445,113 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
 }
 
 std::string MemoryPrediction::describe() const {
-  char text[512];
+  char blocks_text[256];
+  if (blocks_per_band_block > 0.0 && blocks < footprint_blocks)
+    std::snprintf(blocks_text, sizeof blocks_text, "%zu blocks%s (%zu within the scans' bands x %.2f measured)",
+                  blocks_in_memory, blocks_in_memory == blocks ? "" : " in memory at once", band_blocks,
+                  blocks_per_band_block);
+  else
+    std::snprintf(blocks_text, sizeof blocks_text, "%zu blocks%s (the bound: every block the views meet)",
+                  blocks_in_memory, blocks_in_memory == blocks ? "" : " in memory at once");
+  char text[640];
   std::snprintf(text, sizeof text,
-                "TSDF volume %.0f MiB for %zu blocks%s, frames and stage buffers %.0f MiB, mesh and files at the "
-                "end %.0f MiB, the process before the run %.0f MiB",
-                volume_mb, blocks_in_memory,
-                blocks_in_memory == footprint_blocks ? "" : " in memory at once", frames_mb, mesh_mb, process_mb);
+                "TSDF volume %.0f MiB for %s, frames and stage buffers %.0f MiB, mesh and files at the end %.0f MiB, "
+                "the process before the run %.0f MiB",
+                volume_mb, blocks_text, frames_mb, mesh_mb, process_mb);
   return text;
 }
 
-MemoryPrediction Reconstructor::predictMemory(const PoseList& T_world_cam0, int maps, bool scores_every_frame) const {
+ScanBandBlocks Reconstructor::scanBands() const {
+  // The band reaches a truncation either side of a return, as a pixel's band does at least.
+  return ScanBandBlocks(config_.volume.voxel_size_m, config_.volume.truncation_m, config_.integrator.min_depth_m,
+                        integrator_->allocationDepth());
+}
+
+ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                          const PoseList& T_world_cam0) const {
+  const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
+  ScanBandBlocks bands = scanBands();
+  for (std::size_t k = 0; k < frames.size(); ++k)
+    bands.addScan(*source.loadScan(frames[k]), calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+  return bands;
+}
+
+double Reconstructor::blocksPerBandBlock(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                         const PoseList& T_world_cam0) {
+  const ThreadBudget budget(options_.threads);
+  const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
+  double most = 0.0;
+  std::size_t last = frames.size();
+  for (int c = 0; c < kCalibrationFrames && !frames.empty(); ++c) {
+    const std::size_t k = (frames.size() - 1) * static_cast<std::size_t>(c) / (kCalibrationFrames - 1);
+    if (k == last)
+      continue; // fewer frames than calibration frames: each once
+    last = k;
+    Frame frame = source.load(frames[k]);
+    ScanBandBlocks bands = scanBands();
+    bands.addScan(*frame.scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+    // The depth from this engine's own stages, whose buffers the run then reuses; integrated
+    // into a volume of its own (the scan's carving updates only blocks that exist).
+    FrameResult result = computeDepth(frame);
+    TsdfVolume volume(config_.volume.voxel_size_m, config_.volume.truncation_m);
+    volume.setMaxMemoryMb(config_.volume.max_memory_mb);
+    TsdfIntegrator integrator(volume, config_.integrator);
+    try {
+      integrator.integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), T_world_cam0[k]);
+    } catch (const InvalidInputError&) {
+      return 0.0; // a frame whose blocks do not fit the volume's budget: no measure, the bound stays
+    }
+    if (bands.blocks() > 0)
+      most = std::max(most, static_cast<double>(volume.numBlocks()) / static_cast<double>(bands.blocks()));
+  }
+  return most;
+}
+
+namespace {
+/// The most of count(centre, radius) over the cameras of a run, taken every `step` metres or more
+/// with the radius grown by the step, so that the frames between are covered.
+template <typename Count>
+std::size_t mostWithin(const PoseList& T_world_cam0, double radius, double step, Count count) {
+  Eigen::Vector3d last = T_world_cam0.front().translation();
+  std::size_t most = count(last, radius + step);
+  for (const Eigen::Isometry3d& T : T_world_cam0)
+    if ((T.translation() - last).norm() >= step) {
+      last = T.translation();
+      most = std::max(most, count(last, radius + step));
+    }
+  return most;
+}
+} // namespace
+
+std::size_t Reconstructor::predictedBlocks(std::size_t band_blocks, std::size_t footprint_blocks,
+                                           double blocks_per_band_block) const {
+  if (!(blocks_per_band_block > 0.0))
+    return footprint_blocks;
+  const double blocks = std::ceil(kBlockMargin * blocks_per_band_block * static_cast<double>(band_blocks));
+  return std::min(footprint_blocks, static_cast<std::size_t>(blocks));
+}
+
+std::size_t Reconstructor::blocksInWindow(const MemoryEvidence& evidence) const {
+  // A tile stays while its box grown by a block is within the active radius of the camera: its
+  // blocks are within the radius plus the box's diagonal; the step keeps 1000 frames to a few
+  // hundred balls.
+  const double block_m = TsdfBlock::kSide * config_.volume.voxel_size_m;
+  const double tile_m = config_.streaming.tile_blocks * block_m;
+  const double radius = config_.streaming.active_radius_m + std::sqrt(3.0) * (tile_m + block_m);
+  const double step = std::max(tile_m, radius / 8.0);
+  return mostWithin(evidence.T_world_cam0, radius, step, [&](const Eigen::Vector3d& centre, double r) {
+    return predictedBlocks(evidence.bands.blocksWithin(centre, r), evidence.footprint.blocksWithin(centre, r),
+                           evidence.blocks_per_band_block);
+  });
+}
+
+MemoryEvidence Reconstructor::measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                            const PoseList& T_world_cam0) {
   const auto start = Clock::now();
-  MemoryPrediction p;
-  p.frames = T_world_cam0.size();
-  constexpr double kMiB = 1024.0 * 1024.0;
+  if (frames.size() != T_world_cam0.size())
+    throw InvalidInputError("predictMemory: " + std::to_string(frames.size()) + " frames but " +
+                            std::to_string(T_world_cam0.size()) + " poses");
+  const double process_mb = residentMemoryMb(); // before the calibration frames, whose buffers the run reuses
   // The frames integrated are at most the LiDAR's canvas (the image and its margin), and a
   // frame allocates blocks only in its view, from min_depth_m to allocationDepth().
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
@@ -438,43 +562,51 @@ MemoryPrediction Reconstructor::predictMemory(const PoseList& T_world_cam0, int 
   BlockFootprint footprint(config_.volume.voxel_size_m);
   for (const Eigen::Isometry3d& T : T_world_cam0)
     footprint.addView(canvas, T, config_.integrator.min_depth_m, far_m);
-  p.footprint_blocks = footprint.blocks();
-  p.blocks_in_memory = p.footprint_blocks;
-  if (config_.streaming.enabled() && !T_world_cam0.empty()) {
-    // A tile stays while its box grown by a block is within the active radius of the camera:
-    // its blocks are within the radius plus the box's diagonal. The cameras are taken every
-    // `step` metres or more, the radius grown by the step, so that the frames between are
-    // covered; the step keeps 1000 frames to a few hundred balls.
-    const double block_m = TsdfBlock::kSide * config_.volume.voxel_size_m;
-    const double tile_m = config_.streaming.tile_blocks * block_m;
-    const double radius = config_.streaming.active_radius_m + std::sqrt(3.0) * (tile_m + block_m);
-    const double step = std::max(tile_m, radius / 8.0);
-    Eigen::Vector3d last = T_world_cam0.front().translation();
-    std::size_t most = footprint.blocksWithin(last, radius + step);
-    for (const Eigen::Isometry3d& T : T_world_cam0)
-      if ((T.translation() - last).norm() >= step) {
-        last = T.translation();
-        most = std::max(most, footprint.blocksWithin(last, radius + step));
-      }
-    p.blocks_in_memory = std::min(most, p.footprint_blocks);
-  }
-  p.volume_mb = maps * static_cast<double>(TsdfVolume::bytesFor(p.blocks_in_memory)) / kMiB;
+  MemoryEvidence evidence{T_world_cam0, std::move(footprint), scanBandsOf(source, frames, T_world_cam0)};
+  evidence.blocks_per_band_block = blocksPerBandBlock(source, frames, T_world_cam0);
+  evidence.process_mb = process_mb;
+  evidence.ms = msSince(start);
+  return evidence;
+}
+
+MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, int maps,
+                                              bool scores_every_frame) const {
+  const auto start = Clock::now();
+  MemoryPrediction p;
+  p.frames = evidence.T_world_cam0.size();
+  p.process_mb = evidence.process_mb;
+  p.footprint_blocks = evidence.footprint.blocks();
+  p.band_blocks = evidence.bands.blocks();
+  p.blocks_per_band_block = evidence.blocks_per_band_block;
+  p.blocks = predictedBlocks(p.band_blocks, p.footprint_blocks, p.blocks_per_band_block);
+  p.blocks_in_memory = p.blocks;
+  if (config_.streaming.enabled() && p.frames > 0)
+    p.blocks_in_memory = std::min(p.blocks, blocksInWindow(evidence));
+  constexpr double kMiB = 1024.0 * 1024.0;
+  const double map_mb = static_cast<double>(TsdfVolume::bytesFor(p.blocks_in_memory)) / kMiB;
+  p.volume_mb = map_mb * (1.0 + kOtherMapShare * (maps - 1));
   // The frames in flight: one in each of the three stages (loading, depth, integration) and
-  // queue_capacity in each of the two queues between them, over the stages' own buffers; and
-  // the frames whose ground truth the caller keeps.
+  // queue_capacity in each of the two queues between them (no more than the run's frames), over
+  // the stages' own buffers; and the frames whose ground truth the caller keeps.
+  const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   const double pixels = static_cast<double>(canvas.width) * canvas.height;
-  const double in_flight = 3.0 + 2.0 * config_.scheduling.queue_capacity;
+  const double in_flight =
+      std::min(static_cast<double>(p.frames), 3.0 + 2.0 * config_.scheduling.queue_capacity);
   p.frames_mb = pixels *
                 (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel +
                  (scores_every_frame ? kScoredFrameBytesPerPixel * static_cast<double>(p.frames) : 0.0)) /
                 kMiB;
-  // The end of the run: an in-memory map is meshed and written whole (a streamed one tile by
-  // tile as the camera moves on, within the window's volume).
-  p.mesh_mb = config_.streaming.enabled() ? 0.0 : kEndOfRunFraction * p.volume_mb;
-  p.process_mb = residentMemoryMb();
+  // The end of the run: an in-memory map is meshed and written whole, a streamed one tile by
+  // tile as the camera moves on, within the window's volume.
+  p.mesh_mb = (config_.streaming.enabled() ? kStreamedEndShare : kEndOfRunShare) * map_mb;
   p.total_mb = p.process_mb + p.volume_mb + p.frames_mb + p.mesh_mb;
-  p.ms = msSince(start);
+  p.ms = evidence.ms + msSince(start);
   return p;
+}
+
+MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) {
+  return predictMemory(measureMemory(source, frames, T_world_cam0), maps, scores_every_frame);
 }
 
 const TriangleMesh& Reconstructor::mesh() {

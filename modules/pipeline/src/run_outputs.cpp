@@ -1,6 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>
+#include <msf/io/tum_poses.h>
+#include <msf/io/world_frame.h>
 #include <msf/pipeline/mesh_renderer.h>
 #include <msf/pipeline/run_outputs.h>
 
@@ -26,21 +29,31 @@ void writeMeshPreview(const std::string& dir, const TriangleMesh& mesh, const Ca
 }
 
 void writeTrajectory(const std::string& dir, const PoseList& used, const std::vector<std::size_t>& frames,
-                     const std::string& used_name, const FrameSource& source, RunReport& report) {
+                     const std::string& used_name, const FrameSource& source, const Eigen::Isometry3d& T_out_world,
+                     RunReport& report) {
   if (used.empty())
     return;
-  saveOdometryPoses((fs::path(dir) / report.poses_file).string(), used);
-  std::vector<std::pair<std::string, PoseList>> trajectories{{used_name, used}};
-  if (source.hasPoses() && used_name != "dataset") {
-    PoseList reference;
+  StampedPoses out{{}, transformPoses(used, T_out_world)};
+  for (std::size_t k = 0; k < used.size(); ++k)
+    out.timestamps.push_back(source.timestamp(frames[k]));
+  saveOdometryPoses((fs::path(dir) / report.poses_file).string(), out.poses);
+  saveTumPoses((fs::path(dir) / "poses_tum.txt").string(), out);
+  const auto ofFrames = [&](const PoseList& all) {
+    PoseList chosen;
     for (std::size_t k = 0; k < used.size() && k < frames.size(); ++k)
-      reference.push_back(source.poses()[frames[k]]);
-    trajectories.emplace_back("dataset", reference);
-    if (used.size() > 1) {
-      report.trajectory_metrics = evaluateOdometry(used, reference);
-      report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
-      report.trajectory_reference = source.posesName();
-    }
+      chosen.push_back(all[frames[k]]);
+    return chosen;
+  };
+  const bool separate_truth = &source.referencePoses() != &source.poses();
+  std::vector<std::pair<std::string, PoseList>> trajectories{{used_name, used}};
+  if (source.hasPoses() && used_name != "dataset")
+    trajectories.emplace_back("dataset", ofFrames(source.poses()));
+  if (separate_truth)
+    trajectories.emplace_back("truth", ofFrames(source.referencePoses()));
+  if (source.hasPoses() && (used_name != "dataset" || separate_truth) && used.size() > 1) {
+    report.trajectory_metrics = evaluateOdometry(used, ofFrames(source.referencePoses()));
+    report.has_trajectory_metrics = report.trajectory_metrics.path_length_m > 0.0;
+    report.trajectory_reference = source.referencePosesName();
   }
   report.trajectory_plot_file = "trajectory.png";
   writeImage((fs::path(dir) / report.trajectory_plot_file).string(), plotTrajectoriesFromAbove(trajectories));

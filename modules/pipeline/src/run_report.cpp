@@ -1,7 +1,10 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/config_keys.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/json_text.h>
 #include <msf/common/line_plot.h>
+#include <msf/common/version.h>
 #include <msf/common/statistics.h>
 #include <msf/common/yaml_file.h>
 #include <msf/io/image_io.h>
@@ -15,6 +18,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <iterator>
 #include <sstream>
 
 namespace msf {
@@ -50,21 +54,6 @@ std::vector<double> column(const std::vector<RunReport::FrameRow>& rows, const S
   for (const auto& r : rows)
     values.push_back(c.get(r));
   return values;
-}
-
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\')
-      out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else
-      out += c;
-  }
-  return out + "\"";
 }
 
 std::string num(double v, int precision = 4) {
@@ -235,6 +224,8 @@ void RunReport::writeFramesCsv(const std::string& path) const {
 void RunReport::writeSummaryJson(const std::string& path) const {
   std::ostringstream s;
   s << "{\n"
+    << "  \"msfusion\": {\"version\": " << jsonString(versionString()) << ", \"commit\": " << jsonString(gitCommit())
+    << "},\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
     << "  \"layout\": " << jsonString(layout) << ",\n"
     << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);
@@ -325,6 +316,18 @@ void RunReport::writeSummaryJson(const std::string& path) const {
       s << "\n      }";
     }
     s << "\n    }\n  }";
+  }
+  s << ",\n  \"open_sky\": ";
+  if (open_sky.empty())
+    s << "null";
+  for (auto it = open_sky.begin(); it != open_sky.end(); ++it) {
+    const SkyCoverage& c = it->second;
+    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": {\"frames\": " << c.frames
+      << ", \"sky_pixels\": " << c.sky_pixels << ", \"covered_pixels\": " << c.covered_pixels
+      << ", \"share\": " << num(c.share, 6) << ", \"mean_frame_share\": " << num(c.mean_frame_share, 6)
+      << ", \"worst_share\": " << num(c.worst_share, 6) << ", \"worst_frame\": " << c.worst_frame
+      << ", \"covered_depth_median_m\": " << num(c.covered_depth_median_m, 2) << "}"
+      << (std::next(it) == open_sky.end() ? "\n  }" : "");
   }
   s << ",\n  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
   writeText(path, s.str());
@@ -438,6 +441,8 @@ void RunReport::writeMarkdown(const std::string& path) const {
   }
   if (!map_evaluation.rows.empty())
     writeMapEvaluation(s);
+  if (!open_sky.empty())
+    writeOpenSky(s);
   if (!depth_panels.empty()) {
     s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
          " (and the fused depth's error where ground truth exists).\n\n";
@@ -490,6 +495,24 @@ void RunReport::writeClassTable(std::ostream& s) const {
   s << "\n";
 }
 
+void RunReport::writeOpenSky(std::ostream& s) const {
+  s << "## The open sky (evaluation protocol 6)\n\n"
+    << "Each frame's open sky: bright, blank (grey standard deviation over 5x5 pixels), grey-white or blue pixels "
+       "above the highest LiDAR return of their columns, connected to the image's top edge, less a 3-pixel border "
+       "(msf::SkyMask). Each mesh rendered at every frame's pose should leave them empty; the share it covers:\n\n"
+    << "| mesh | frames | sky pixels | covered | mean per frame | worst frame | median depth of the cover |\n"
+    << "|---|---|---|---|---|---|---|\n";
+  for (const auto& [name, c] : open_sky)
+    s << "| " << name << " | " << c.frames << " | " << c.sky_pixels << " | " << num(100 * c.share, 2) << " % | "
+      << num(100 * c.mean_frame_share, 2) << " % | " << num(100 * c.worst_share, 2) << " % (frame " << c.worst_frame
+      << ") | " << num(c.covered_depth_median_m, 1) << " m |\n";
+  s << "\n";
+  if (!sky_pictures.empty())
+    s << "The sky in cyan, where the mesh covers it in red:\n\n";
+  for (const auto& picture : sky_pictures)
+    s << "![" << picture << "](" << picture << ")\n\n";
+}
+
 void RunReport::writeMapEvaluation(std::ostream& s) const {
   const MapEvaluation& e = map_evaluation;
   s << "## The map against ground truth it never saw (evaluation protocol 4)\n\n"
@@ -497,7 +520,8 @@ void RunReport::writeMapEvaluation(std::ostream& s) const {
     << " frames. Each mesh is rendered into camera 0 at every frame's pose (the first surface along each pixel's ray) "
        "and scored at the ground-truth pixels beside the per-frame fused depth; a missing estimate counts as bad in "
        "D1. Within range: true depth at most "
-    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`), the map holds nothing farther."
+    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`, at most the depth of `rig.stereo_min_disparity_px`), the map holds nothing "
+         "farther."
     << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
     << "\n\n";
   bool accuracy = false, ghosts = false;

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/cloud_io.h>
 #include <msf/pipeline/synthetic_scoring.h>
 

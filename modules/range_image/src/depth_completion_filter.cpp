@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Explicit instantiations of the completion filters for the project's point types
 // (PCL's precompile pattern); other types include the impl with MSF_NO_PRECOMPILE.
 #include <msf/io/impl/pinhole_camera.hpp>

@@ -1,6 +1,8 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/range_image/ring_split.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -27,10 +29,35 @@ std::vector<int> ringIds(const pcl::PointCloud<pcl::PointXYZI>& scan) {
   return ids;
 }
 
+std::vector<int> ringIdsFromElevations(const pcl::PointCloud<pcl::PointXYZI>& scan,
+                                       const std::vector<double>& elevations_deg) {
+  if (elevations_deg.empty())
+    throw InvalidInputError("ring ids from elevations: the LiDAR's beam elevations are not given");
+  std::vector<int> ids(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const auto& p = scan[i];
+    const double elevation = std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI;
+    // The nearest beam: the first above, or the one below it when that is nearer.
+    const auto above = std::lower_bound(elevations_deg.begin(), elevations_deg.end(), elevation);
+    auto nearest = above == elevations_deg.end() ? above - 1 : above;
+    if (above != elevations_deg.begin() && above != elevations_deg.end() && elevation - above[-1] < *above - elevation)
+      nearest = above - 1;
+    ids[i] = static_cast<int>(nearest - elevations_deg.begin());
+  }
+  return ids;
+}
+
 int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const RingSplitConfig& config,
                pcl::PointCloud<pcl::PointXYZI>& input, pcl::PointCloud<pcl::PointXYZI>& heldout) {
+  return splitRings(scan, ringIds(scan), config, input, heldout);
+}
+
+int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const std::vector<int>& ids, const RingSplitConfig& config,
+               pcl::PointCloud<pcl::PointXYZI>& input, pcl::PointCloud<pcl::PointXYZI>& heldout) {
   config.validate();
-  const std::vector<int> ids = ringIds(scan);
+  if (ids.size() != scan.size())
+    throw InvalidInputError("ring split: " + std::to_string(ids.size()) + " ring ids for a scan of " +
+                            std::to_string(scan.size()) + " points");
   pcl::PointCloud<pcl::PointXYZI> in, out; // the outputs may alias the scan
   in.reserve(scan.size());
   out.reserve(scan.size() / static_cast<std::size_t>(config.modulo) + 1);
@@ -44,7 +71,7 @@ int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const RingSplitConfi
   }
   input.swap(in);
   heldout.swap(out);
-  return ids.empty() ? 0 : ids.back() + 1;
+  return ids.empty() ? 0 : *std::max_element(ids.begin(), ids.end()) + 1;
 }
 
 } // namespace msf

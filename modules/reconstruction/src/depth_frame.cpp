@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/reconstruction/impl/depth_frame.hpp>
 #include <msf/io/point_types.h>
 

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/common/line_plot.h>
@@ -121,15 +123,12 @@ std::vector<LambdaStudy::Cell> LambdaStudy::runAll() const {
 }
 
 void LambdaStudy::writeCsv(const std::string& path, const std::vector<Cell>& cells) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out << "noise_mm,lambda,mae_mm,vertices,integrate_ms_per_frame,sweeps_per_frame\n" << std::fixed;
     for (const Cell& c : cells)
       out << std::setprecision(1) << c.noise_mm << ',' << std::setprecision(2) << c.lambda << ',' << std::setprecision(3)
           << c.mae_mm << ',' << c.vertices << ',' << std::setprecision(2) << c.integrate_ms << ',' << std::setprecision(1)
           << c.sweeps << '\n';
-    if (!out.flush())
-      throw IOError("cannot write '" + path + "'");
   });
 }
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // PCL's header draws its cube with y and z swapped against Bourke's page, but the tables only
 // name corners and edges, and edges 0-11 join the same corners in both: (0,1) (1,2) (2,3)
 // (3,0) (4,5) (5,6) (6,7) (7,4) (0,4) (1,5) (2,6) (3,7). marching_cubes.cpp places the

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/reconstruction/scan_free_space.h>
 
 #include <opencv2/imgproc.hpp>

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/reconstruction/streaming_map.h>
@@ -10,7 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <map>
+#include <set>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -26,8 +28,6 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr int kSide = TsdfBlock::kSide;
-constexpr char kBlockMagic[8] = {'M', 'S', 'F', 'B', 'L', 'K', '0', '1'};
-constexpr const char* kIndexTag = "msfusion-tsdf-store 1";
 constexpr std::int64_t kTileBias = 1 << 20;
 
 std::string number(double v) {
@@ -37,112 +37,8 @@ std::string number(double v) {
   return ss.str();
 }
 
-std::string tileName(const GridIndex& t) {
-  return std::to_string(t.x()) + "_" + std::to_string(t.y()) + "_" + std::to_string(t.z());
-}
-
-/// The store's parameters, from DIR/tsdf/index.txt.
-struct StoreIndex {
-  double voxel_size = 0, truncation = 0;
-  int tile_blocks = 0;
-  std::vector<GridIndex> tiles;
-};
-
-StoreIndex readIndex(const std::string& directory) {
-  const std::string path = (fs::path(directory) / "tsdf" / "index.txt").string();
-  requireFile(path, "TSDF store index");
-  std::ifstream in(path);
-  std::string line;
-  StoreIndex index;
-  int side = 0;
-  std::size_t count = 0;
-  std::string k1, k2, k3, k4, k5;
-  if (!std::getline(in, line) || line != kIndexTag ||
-      !(in >> k1 >> index.voxel_size >> k2 >> index.truncation >> k3 >> side >> k4 >> index.tile_blocks >> k5 >>
-        count) ||
-      k1 != "voxel_size_m" || k2 != "truncation_m" || k3 != "block_side" || k4 != "tile_blocks" || k5 != "tiles" ||
-      side != kSide || !(index.voxel_size > 0) || !(index.truncation > 0) || index.tile_blocks < 1)
-    throw IOError("TSDF store index '" + path + "' is not one a StreamingMap wrote (first line '" + kIndexTag + "')");
-  for (std::size_t i = 0; i < count; ++i) {
-    GridIndex t;
-    if (!(in >> t.x() >> t.y() >> t.z()))
-      throw IOError("TSDF store index '" + path + "' lists " + std::to_string(count) + " tiles but ends after " +
-                    std::to_string(i));
-    index.tiles.push_back(t);
-  }
-  return index;
-}
-
-std::string blockPath(const std::string& directory, const GridIndex& tile) {
-  return (fs::path(directory) / "tsdf" / (tileName(tile) + ".blk")).string();
-}
 std::string meshPath(const std::string& tiles, const GridIndex& tile) {
-  return (fs::path(tiles) / (tileName(tile) + ".ply")).string();
-}
-
-/// Block file: magic, voxel size and truncation (float64), block side and block count
-/// (int32), then per block its index (3 x int32), its sign bits (2 bytes and 2 of padding)
-/// and its 512 voxels as in memory (12 bytes each, the integrator's flags zeroed; they are
-/// zero between frames anyway), little-endian as the host.
-void writeBlocks(const std::string& path, double voxel_size, double truncation, const std::vector<const TsdfBlock*>& blocks) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(kBlockMagic, sizeof(kBlockMagic));
-    const std::int32_t header[2] = {kSide, static_cast<std::int32_t>(blocks.size())};
-    out.write(reinterpret_cast<const char*>(&voxel_size), sizeof(double));
-    out.write(reinterpret_cast<const char*>(&truncation), sizeof(double));
-    out.write(reinterpret_cast<const char*>(header), sizeof(header));
-    std::array<TsdfVoxel, TsdfBlock::kVoxels> voxels;
-    for (const TsdfBlock* block : blocks) {
-      const std::int32_t index[3] = {block->index.x(), block->index.y(), block->index.z()};
-      out.write(reinterpret_cast<const char*>(index), sizeof(index));
-      // The sign bits as the integrator left them (they may be set for voxels that changed
-      // sign since: recomputing them would carve less than the map in memory does).
-      const std::uint8_t bits[4] = {block->signs, block->negative_subblocks, 0, 0};
-      out.write(reinterpret_cast<const char*>(bits), sizeof(bits));
-      voxels = block->voxels;
-      for (TsdfVoxel& v : voxels)
-        v.flags = 0;
-      out.write(reinterpret_cast<const char*>(voxels.data()), sizeof(voxels));
-    }
-    if (!out.flush())
-      throw IOError("cannot write TSDF blocks '" + path + "': disk full?");
-  });
-}
-
-/// Calls `add(index, voxels)` for each block of a block file.
-template <typename Add>
-void readBlocks(const std::string& path, double voxel_size, double truncation, Add&& add) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw IOError("cannot read TSDF blocks '" + path + "'");
-  char magic[8];
-  double vs = 0, trunc = 0;
-  std::int32_t header[2] = {0, 0};
-  in.read(magic, sizeof(magic));
-  in.read(reinterpret_cast<char*>(&vs), sizeof(double));
-  in.read(reinterpret_cast<char*>(&trunc), sizeof(double));
-  in.read(reinterpret_cast<char*>(header), sizeof(header));
-  if (!in || std::memcmp(magic, kBlockMagic, sizeof(magic)) != 0 || header[0] != kSide || header[1] < 0)
-    throw IOError("TSDF blocks '" + path + "' are not a block file of msfusion");
-  if (std::abs(vs - voxel_size) > 1e-9 * voxel_size || std::abs(trunc - truncation) > 1e-9 * truncation)
-    throw IOError("TSDF blocks '" + path + "' have voxel size " + number(vs) + " m and truncation " + number(trunc) +
-                  " m, the store " + number(voxel_size) + " and " + number(truncation));
-  TsdfBlock block;
-  for (std::int32_t b = 0; b < header[1]; ++b) {
-    std::int32_t index[3];
-    std::uint8_t bits[4];
-    in.read(reinterpret_cast<char*>(index), sizeof(index));
-    in.read(reinterpret_cast<char*>(bits), sizeof(bits));
-    in.read(reinterpret_cast<char*>(block.voxels.data()), sizeof(block.voxels));
-    if (!in)
-      throw IOError("TSDF blocks '" + path + "' end after " + std::to_string(b) + " of " + std::to_string(header[1]) +
-                    " blocks");
-    block.index = GridIndex(index[0], index[1], index[2]);
-    block.signs = bits[0];
-    block.negative_subblocks = bits[1];
-    add(block.index, block);
-  }
+  return (fs::path(tiles) / (TsdfStore::tileName(tile) + ".ply")).string();
 }
 
 /// Puts a block read from disk (or copied) into `volume`.
@@ -300,8 +196,7 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
       throw IOError("mesh '" + path + "': more than 2^32 vertices");
     welder.number(buffer.data(), counts[i].vertices, first[i], index, fresh);
   }
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
+  writeStreamAtomically(path, [&](std::ostream& out) {
     const std::string header = plyHeader(welder.next(), faces);
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
     for (std::size_t i = 0; i < present.size(); ++i) {
@@ -334,8 +229,6 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
       }
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
     }
-    if (!out.flush())
-      throw IOError("cannot write mesh '" + path + "': disk full?");
   });
   return faces;
 }
@@ -343,20 +236,16 @@ std::size_t writeUnion(const std::vector<std::string>& tiles, const std::string&
 /// Blocks of tiles on disk, read on demand for the layer around the tiles being meshed.
 class TileCache {
 public:
-  TileCache(std::string directory, double voxel_size, double truncation)
-      : directory_(std::move(directory)), voxel_size_(voxel_size), truncation_(truncation) {}
+  explicit TileCache(const TsdfStore& store) : store_(store) {}
   /// The voxels of block `index` of stored tile `tile`, or nullptr when the tile lacks it.
   const TsdfBlock* find(const GridIndex& tile, const GridIndex& index) {
-    const std::string name = tileName(tile);
+    const std::string name = TsdfStore::tileName(tile);
     auto it = tiles_.find(name);
     if (it == tiles_.end()) {
       if (tiles_.size() >= 32)
         tiles_.clear(); // a tile's neighbours come in runs: a small cache holds them
       auto& blocks = tiles_[name];
-      readBlocks(blockPath(directory_, tile), voxel_size_, truncation_,
-                 [&](const GridIndex& b, const TsdfBlock& v) {
-                   blocks.emplace(key(b), std::make_unique<TsdfBlock>(v));
-                 });
+      store_.readTile(tile, [&](const TsdfBlock& v) { blocks.emplace(key(v.index), std::make_unique<TsdfBlock>(v)); });
       it = tiles_.find(name);
     }
     auto b = it->second.find(key(index));
@@ -368,16 +257,11 @@ private:
     return (static_cast<std::uint64_t>(b.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(b.y() + kTileBias) << 21) |
            static_cast<std::uint64_t>(b.z() + kTileBias);
   }
-  std::string directory_;
-  double voxel_size_, truncation_;
+  const TsdfStore& store_;
   std::unordered_map<std::string,
                      std::unordered_map<std::uint64_t, std::unique_ptr<TsdfBlock>>>
       tiles_;
 };
-
-GridIndex tileOfBlock(const GridIndex& b, int tile_blocks) {
-  return {floorDiv(b.x(), tile_blocks), floorDiv(b.y(), tile_blocks), floorDiv(b.z(), tile_blocks)};
-}
 
 /// Meshes tile `tile` whose blocks are `blocks` (indices) with the layer around it that its
 /// cubes read (MarchingCubes::readNeighbours), each block taken from `memory` when there, else
@@ -397,7 +281,7 @@ std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks
         putBlock(part, b, *block, stamp);
         return;
       }
-    const GridIndex t = tileOfBlock(b, tile_blocks);
+    const GridIndex t = TsdfStore::tileOf(b, tile_blocks);
     if (on_disk(t))
       if (const auto* voxels = cache.find(t, b))
         putBlock(part, b, *voxels, stamp);
@@ -406,7 +290,7 @@ std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks
     copy(b);
   for (const GridIndex& b : blocks)
     for (const GridIndex& d : mesher.readNeighbours())
-      if (tileOfBlock(b + d, tile_blocks) != tile)
+      if (TsdfStore::tileOf(b + d, tile_blocks) != tile)
         copy(b + d);
   TriangleMesh mesh;
   mesher.extractBlocks(part, blocks, mesh);
@@ -424,17 +308,23 @@ std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks
 
 void StreamingMap::Config::validate() const { checkKeyRanges(*this); }
 
+void StreamingMap::Config::requireRadius(double reach_m, double voxel_size_m) const {
+  const double tile_m = tile_blocks * kSide * voxel_size_m;
+  if (active_radius_m < reach_m + tile_m)
+    throw ConfigError("streaming.active_radius_m " + number(active_radius_m) + " is below " +
+                      number(reach_m + tile_m) + " m, the integrator's reach (" + number(reach_m) +
+                      " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
+                      number(tile_m) + " m)");
+}
+
 StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const MarchingCubes::Config& mesher,
                            double reach_m, const std::string& directory)
-    : volume_(volume), config_(config), mesher_(mesher), reach_m_(reach_m), directory_(directory) {
+    : volume_(volume), config_(config), mesher_(mesher), reach_m_(reach_m), directory_(directory),
+      store_(directory, volume.voxelSize(), volume.truncation(), config.tile_blocks) {
   config_.validate();
   if (!config_.enabled())
     throw ConfigError("StreamingMap: streaming.active_radius_m is 0 (off)");
-  if (config_.active_radius_m < minimumRadius())
-    throw ConfigError("streaming.active_radius_m " + number(config_.active_radius_m) + " is below " +
-                      number(minimumRadius()) + " m, the integrator's reach (" + number(reach_m_) +
-                      " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
-                      number(config_.tile_blocks * kSide * volume_.voxelSize()) + " m)");
+  config_.requireRadius(reach_m_, volume_.voxelSize());
   ensureOutputDirectory(directory_);
   for (const char* sub : {"tsdf", "tiles"}) {
     const fs::path p = fs::path(directory_) / sub;
@@ -457,7 +347,7 @@ std::string StreamingMap::tilesDirectory() const { return (fs::path(directory_) 
 double StreamingMap::minimumRadius() const { return reach_m_ + config_.tile_blocks * kSide * volume_.voxelSize(); }
 
 StreamingMap::TileKey StreamingMap::tileOf(const GridIndex& block) const {
-  const GridIndex t = tileOfBlock(block, config_.tile_blocks);
+  const GridIndex t = TsdfStore::tileOf(block, config_.tile_blocks);
   return (static_cast<std::uint64_t>(t.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(t.y() + kTileBias) << 21) |
          static_cast<std::uint64_t>(t.z() + kTileBias);
 }
@@ -491,7 +381,7 @@ void StreamingMap::readBackAround(const std::vector<GridIndex>& blocks) {
   std::vector<TileKey> back;
   GridIndex last(std::numeric_limits<int>::min(), 0, 0);
   for (const GridIndex& b : blocks) {
-    const GridIndex t = tileOfBlock(b, n);
+    const GridIndex t = TsdfStore::tileOf(b, n);
     const GridIndex local = b - t * n;
     int lo[3], hi[3];
     bool inner = true;
@@ -525,14 +415,14 @@ void StreamingMap::readBack(std::vector<TileKey> back) {
   const std::uint64_t stamp = volume_.beginGeneration();
   const MovingBlocks moving(moving_blocks_);
   for (const TileKey t : back) {
-    readBlocks(blockPath(directory_, tileIndex(t)), volume_.voxelSize(), volume_.truncation(),
-               [&](const GridIndex& b, const TsdfBlock& voxels) {
-                 // A block of an evicted tile is never in memory: allocating one reads its tile first.
-                 if (volume_.findBlock(b))
-                   throw std::logic_error("StreamingMap: block " + tileName(b) + " of a tile on disk is in memory");
-                 putBlock(volume_, b, voxels, stamp);
-                 ++stats_.blocks_reloaded;
-               });
+    store_.readTile(tileIndex(t), [&](const TsdfBlock& voxels) {
+      // A block of an evicted tile is never in memory: allocating one reads its tile first.
+      if (volume_.findBlock(voxels.index))
+        throw std::logic_error("StreamingMap: block " + TsdfStore::tileName(voxels.index) +
+                               " of a tile on disk is in memory");
+      putBlock(volume_, voxels.index, voxels, stamp);
+      ++stats_.blocks_reloaded;
+    });
     evicted_.erase(t);
     ++stats_.tiles_reloaded;
     // The tiles whose cubes read this tile's blocks (MarchingCubes::readNeighbours) may change their mesh.
@@ -583,14 +473,14 @@ void StreamingMap::evict(const std::vector<TileKey>& tiles_in) {
       it->second.push_back(block->index);
   }
   const double vs = volume_.voxelSize(), trunc = volume_.truncation();
-  TileCache cache(directory_, vs, trunc);
+  TileCache cache(store_);
   const auto on_disk = [&](const GridIndex& t) { return evicted_.count(tileOf(t * config_.tile_blocks)) > 0; };
   std::vector<GridIndex> freed;
   for (const TileKey t : tiles) {
     std::vector<GridIndex>& mine = blocks[t];
     const GridIndex ti = tileIndex(t);
     if (evicted_.count(t)) // allocating a block of a tile on disk reads the tile back first
-      throw std::logic_error("StreamingMap: tile " + tileName(ti) + " is on disk and has blocks in memory");
+      throw std::logic_error("StreamingMap: tile " + TsdfStore::tileName(ti) + " is on disk and has blocks in memory");
     std::sort(mine.begin(), mine.end(), [](const GridIndex& a, const GridIndex& b) {
       return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
     });
@@ -598,7 +488,7 @@ void StreamingMap::evict(const std::vector<TileKey>& tiles_in) {
     std::vector<const TsdfBlock*> pointers;
     for (const GridIndex& b : mine)
       pointers.push_back(volume_.findBlock(b));
-    writeBlocks(blockPath(directory_, ti), vs, trunc, pointers);
+    store_.writeTile(ti, pointers);
     stored_.insert(t);
     evicted_.insert(t);
     stale_.erase(t);
@@ -610,24 +500,11 @@ void StreamingMap::evict(const std::vector<TileKey>& tiles_in) {
   writeIndex();
 }
 
-void StreamingMap::writeIndex() const {
-  std::vector<TileKey> keys(stored_.begin(), stored_.end());
-  std::sort(keys.begin(), keys.end());
-  std::ostringstream ss;
-  ss.precision(17);
-  ss << kIndexTag << "\nvoxel_size_m " << volume_.voxelSize() << "\ntruncation_m " << volume_.truncation()
-     << "\nblock_side " << kSide << "\ntile_blocks " << config_.tile_blocks << "\ntiles " << keys.size() << "\n";
-  for (const TileKey k : keys) {
-    const GridIndex t = tileIndex(k);
-    ss << t.x() << " " << t.y() << " " << t.z() << "\n";
-  }
-  const std::string text = ss.str();
-  writeAtomically((fs::path(directory_) / "tsdf" / "index.txt").string(), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw IOError("cannot write the TSDF store index in '" + directory_ + "': disk full?");
-  });
+void StreamingMap::writeIndex() {
+  std::vector<GridIndex> tiles;
+  for (const TileKey k : stored_)
+    tiles.push_back(tileIndex(k));
+  store_.writeIndex(std::move(tiles));
 }
 
 std::size_t StreamingMap::finish(const std::string& mesh_path) {
@@ -639,65 +516,72 @@ std::size_t StreamingMap::finish(const std::string& mesh_path) {
     evict(std::vector<TileKey>(tiles.begin(), tiles.end()));
   std::vector<TileKey> stale(stale_.begin(), stale_.end());
   std::sort(stale.begin(), stale.end());
-  TileCache cache(directory_, volume_.voxelSize(), volume_.truncation());
+  TileCache cache(store_);
   const auto on_disk = [&](const GridIndex& t) { return evicted_.count(tileOf(t * config_.tile_blocks)) > 0; };
   for (const TileKey t : stale) {
     std::vector<GridIndex> mine;
-    readBlocks(blockPath(directory_, tileIndex(t)), volume_.voxelSize(), volume_.truncation(),
-               [&](const GridIndex& b, const TsdfBlock&) { mine.push_back(b); });
+    store_.readTile(tileIndex(t), [&](const TsdfBlock& b) { mine.push_back(b.index); });
     meshTile(tileIndex(t), mine, nullptr, on_disk, cache, mesher_, config_.tile_blocks, volume_.voxelSize(),
              volume_.truncation(), tilesDirectory());
     ++stats_.tiles_remeshed;
   }
   stale_.clear();
-  std::vector<TileKey> keys(stored_.begin(), stored_.end());
-  std::sort(keys.begin(), keys.end());
-  std::vector<std::string> meshes;
-  for (const TileKey k : keys)
-    meshes.push_back(meshPath(tilesDirectory(), tileIndex(k)));
-  const std::size_t triangles = writeUnion(meshes, mesh_path, volume_.voxelSize(), config_.tile_blocks * kSide);
+  const std::size_t triangles = unionOfTiles(store_, store_.tiles(), tilesDirectory(), mesh_path);
   stats_.stream_ms += msSince(t0);
   return triangles;
 }
 
 TsdfVolume StreamingMap::loadStore(const std::string& directory) {
-  const StoreIndex index = readIndex(directory);
-  TsdfVolume volume(index.voxel_size, index.truncation);
+  const TsdfStore store = TsdfStore::open(directory);
+  TsdfVolume volume(store.voxelSize(), store.truncation());
   const std::uint64_t stamp = volume.beginGeneration();
-  for (const GridIndex& t : index.tiles)
-    readBlocks(blockPath(directory, t), index.voxel_size, index.truncation,
-               [&](const GridIndex& b, const TsdfBlock& voxels) {
-                 putBlock(volume, b, voxels, stamp);
-               });
+  for (const GridIndex& t : store.tiles())
+    store.readTile(t, [&](const TsdfBlock& voxels) { putBlock(volume, voxels.index, voxels, stamp); });
   return volume;
+}
+
+std::size_t StreamingMap::meshTiles(const TsdfStore& store, const MarchingCubes::Config& mesher_config,
+                                    const std::vector<GridIndex>& tiles, const std::string& tiles_directory) {
+  const MarchingCubes mesher(mesher_config);
+  TileCache cache(store);
+  std::set<GridIndex, decltype(&TsdfStore::tileOrder)> stored(store.tiles().begin(), store.tiles().end(),
+                                                              &TsdfStore::tileOrder);
+  const auto on_disk = [&](const GridIndex& t) { return stored.count(t) > 0; };
+  std::size_t triangles = 0;
+  for (const GridIndex& t : tiles) {
+    std::vector<GridIndex> mine;
+    store.readTile(t, [&](const TsdfBlock& b) { mine.push_back(b.index); });
+    triangles += meshTile(t, mine, nullptr, on_disk, cache, mesher, store.tileBlocks(), store.voxelSize(),
+                          store.truncation(), tiles_directory);
+  }
+  return triangles;
+}
+
+std::size_t StreamingMap::unionOfTiles(const TsdfStore& store, const std::vector<GridIndex>& tiles,
+                                       const std::string& tiles_directory, const std::string& mesh_path) {
+  std::vector<GridIndex> sorted = tiles;
+  std::sort(sorted.begin(), sorted.end(), TsdfStore::tileOrder);
+  std::vector<std::string> meshes;
+  for (const GridIndex& t : sorted)
+    meshes.push_back(meshPath(tiles_directory, t));
+  return writeUnion(meshes, mesh_path, store.voxelSize(), store.tileBlocks() * kSide);
 }
 
 std::size_t StreamingMap::remesh(const std::string& directory, const MarchingCubes::Config& mesher_config,
                                  const std::string& mesh_path, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  const StoreIndex index = readIndex(directory);
-  const MarchingCubes mesher(mesher_config);
+  const TsdfStore store = TsdfStore::open(directory);
   // The tiles' folder is an output folder of its own: replaced only when an earlier remesh wrote it.
   OutputFolder tiles_folder(mesh_path + ".tiles", "msf_mesh", {directory});
-  const std::string tiles = tiles_folder.dir();
-  TileCache cache(directory, index.voxel_size, index.truncation);
-  std::map<std::tuple<int, int, int>, bool> stored;
-  for (const GridIndex& t : index.tiles)
-    stored[{t.x(), t.y(), t.z()}] = true;
-  const auto on_disk = [&](const GridIndex& t) { return stored.count({t.x(), t.y(), t.z()}) > 0; };
   const bool region = (lo.array() <= hi.array()).all();
-  const double tile_m = index.tile_blocks * kSide * index.voxel_size;
-  std::vector<std::string> meshes;
-  for (const GridIndex& t : index.tiles) {
+  const double tile_m = store.tileSizeM();
+  std::vector<GridIndex> chosen;
+  for (const GridIndex& t : store.tiles()) {
     const Eigen::Vector3d tlo = t.cast<double>() * tile_m, thi = tlo + Eigen::Vector3d::Constant(tile_m);
-    if (region && ((thi.array() < lo.array()).any() || (tlo.array() > hi.array()).any()))
-      continue;
-    std::vector<GridIndex> mine;
-    readBlocks(blockPath(directory, t), index.voxel_size, index.truncation,
-               [&](const GridIndex& b, const TsdfBlock&) { mine.push_back(b); });
-    meshTile(t, mine, nullptr, on_disk, cache, mesher, index.tile_blocks, index.voxel_size, index.truncation, tiles);
-    meshes.push_back(meshPath(tiles, t));
+    if (!region || ((thi.array() >= lo.array()).all() && (tlo.array() <= hi.array()).all()))
+      chosen.push_back(t);
   }
-  const std::size_t triangles = writeUnion(meshes, mesh_path, index.voxel_size, index.tile_blocks * kSide);
+  meshTiles(store, mesher_config, chosen, tiles_folder.dir());
+  const std::size_t triangles = unionOfTiles(store, chosen, tiles_folder.dir(), mesh_path);
   tiles_folder.commit();
   return triangles;
 }
@@ -716,12 +600,17 @@ void StreamingMap::writeMesh(const std::string& path, const TriangleMesh& mesh) 
     std::memcpy(p + 1, t.data(), 12);
     p += kFaceBytes;
   }
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    if (!out.flush())
-      throw IOError("cannot write mesh '" + path + "': disk full?");
-  });
+  writeBytesAtomically(path, data.data(), data.size());
+}
+
+void StreamingMap::transformMeshFile(const std::string& path, const Eigen::Isometry3d& T) {
+  TriangleMesh mesh;
+  readMesh(path, mesh);
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  for (auto& v : mesh.vertices)
+    v = R * v + t;
+  writeMesh(path, mesh);
 }
 
 void StreamingMap::readMesh(const std::string& path, TriangleMesh& mesh) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
@@ -153,6 +154,10 @@ const char* toString(TsdfIntegrator::Solve solve) { return wordOf(TsdfIntegrator
 TsdfIntegrator::Solve parseSolve(const std::string& text) { return parseWord(TsdfIntegrator::kSolves, text, "solve"); }
 
 void TsdfIntegrator::Config::validate() const {
+  // Before the range check: the message says what a lambda beyond the range does.
+  if (!(lambda >= 0.0 && lambda <= kMaxLambda))
+    throw ConfigError("tsdf_integrator.lambda (-lambda) must be 0 .. 1e6 (beyond, eq. 7 flattens the surface "
+                      "instead of smoothing it), got " + configValue(lambda));
   checkKeyRanges(*this);
   if (!(max_depth_m > min_depth_m))
     throw ConfigError("tsdf_integrator: need min_depth_m < max_depth_m, got " + configValue(min_depth_m) + " and " +

@@ -1,5 +1,7 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/cloud_io.hpp>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -359,32 +361,23 @@ void TsdfVolume::save(const std::string& path) const {
   toCloud(cloud);
   if (cloud.empty())
     throw InvalidInputError("cannot write volume '" + path + "': it has no observed voxel");
-  writeAtomically(path, [&](const std::string& tmp) {
-    // PCL writes the file; the parameters go into a comment line after its first line,
-    // which PCD readers (pcl_viewer included) skip.
-    const std::string raw = tmp + ".raw.pcd";
-    std::string bytes;
-    try {
-      if (pcl::PCDWriter().writeBinaryCompressed(raw, cloud) != 0)
-        throw IOError("cannot write volume '" + path + "'");
-      std::ifstream in(raw, std::ios::binary);
-      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-      std::remove(raw.c_str());
-    } catch (...) {
-      std::remove(raw.c_str());
-      throw;
-    }
-    const auto eol = bytes.find('\n');
-    if (eol == std::string::npos)
-      throw IOError("cannot write volume '" + path + "': PCL wrote no header");
-    const std::string comment = std::string(kHeaderTag) + " voxel_size_m " + number(voxel_size_) + " truncation_m " +
-                                number(truncation_) + "\n";
-    std::ofstream out(tmp, std::ios::binary);
+  // PCL formats the file; the parameters go into a comment line after its first line, which
+  // PCD readers (pcl_viewer included) skip.
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(cloud, blob);
+  std::ostringstream formatted;
+  if (pcl::PCDWriter().writeBinaryCompressed(formatted, blob) != 0)
+    throw IOError("cannot write volume '" + path + "'");
+  const std::string bytes = formatted.str();
+  const auto eol = bytes.find('\n');
+  if (eol == std::string::npos)
+    throw IOError("cannot write volume '" + path + "': PCL wrote no header");
+  const std::string comment = std::string(kHeaderTag) + " voxel_size_m " + number(voxel_size_) + " truncation_m " +
+                              number(truncation_) + "\n";
+  writeStreamAtomically(path, [&](std::ostream& out) {
     out.write(bytes.data(), static_cast<std::streamsize>(eol + 1));
     out.write(comment.data(), static_cast<std::streamsize>(comment.size()));
     out.write(bytes.data() + eol + 1, static_cast<std::streamsize>(bytes.size() - eol - 1));
-    if (!out.flush())
-      throw IOError("cannot write volume '" + path + "': disk full?");
   });
 }
 

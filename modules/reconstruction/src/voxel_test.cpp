@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The portable voxel test (see voxel_test.h) and the choice of a kernel.
 #include "voxel_test.h"
 

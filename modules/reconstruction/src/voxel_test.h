@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The nearest-pixel test of TsdfIntegrator::integrate's voxels, a 4^3 sub-block at a time: a
 // portable kernel (4 lanes, GCC/Clang vector extensions) and, on x86-64, AVX2 (8 lanes: two
 // rows of voxels) and AVX-512 (16: four rows) ones in voxel_test_simd.cpp, picked at run time.

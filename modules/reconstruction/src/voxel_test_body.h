@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The body of the wide voxel tests (voxel_test_simd.cpp), included once per instruction set
 // inside its namespace and target pragmas; V is the set's vector type and operations.
 // No include guard: meant to be included more than once.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The wide voxel tests (see voxel_test.h): the portable kernel's float operations, lane for
 // lane and in the same order, on two rows of a sub-block at once (AVX2, 8 lanes) or four (AVX-512,
 // 16), with gathers for the pixels' depths and bands and compressing stores for the candidates.

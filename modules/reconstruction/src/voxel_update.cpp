@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The portable update of a block's candidates (see voxel_update.h) and the choice of a kernel.
 #include "voxel_update.h"
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The update of the voxels that passed TsdfIntegrator::integrate's voxel test, a block at a
 // time: a portable kernel (one candidate at a time) and, on x86-64, AVX2 (8) and AVX-512 (16)
 // ones in voxel_test_simd.cpp, picked with the test's (TsdfIntegrator::voxelTestLanes). Every

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The body of the wide voxel updates (voxel_test_simd.cpp), included once per instruction set
 // inside its namespace and target pragmas after the voxel test's, with the same V.
 // No include guard: meant to be included more than once.

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/registration/adaptive_threshold.h>
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/registration/nearest_cache.h>
 #include <msf/registration/voxel_table.h>
 

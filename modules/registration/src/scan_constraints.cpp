@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/registration/scan_constraints.h>
 #include <msf/registration/plane_fit.h>
 #include <msf/registration/voxel_downsample.h>

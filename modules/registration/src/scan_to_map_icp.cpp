@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/registration/scan_to_map_icp.h>
 
@@ -24,12 +25,47 @@ Eigen::Isometry3d exponential(const Vector6d& delta) {
   return T;
 }
 
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+/// Adds the prior's Gauss-Newton term at T to H and g, for the left update T <- exp(delta) T:
+/// the error E = P^-1 T as e = [E_t; log E_R], whose Jacobian is [[R_p^T, -R_p^T [t]x], [0, R^T]],
+/// weighed by the prior's information in units of a scan pair's (point_sigma_m).
+void addPrior(const PosePrior& prior, const Eigen::Isometry3d& T, double point_sigma_m, Matrix6d& H, Vector6d& g) {
+  const Eigen::Isometry3d E = prior.T_world_sensor.inverse() * T;
+  const Eigen::AngleAxisd rotation(E.linear());
+  Vector6d e;
+  e << E.translation(), rotation.angle() * rotation.axis();
+  const Eigen::Matrix3d R_p_t = prior.T_world_sensor.linear().transpose();
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = R_p_t;
+  J.topRightCorner<3, 3>() = -R_p_t * skew(T.translation());
+  J.bottomRightCorner<3, 3>() = T.linear().transpose();
+  const double s2 = point_sigma_m * point_sigma_m;
+  Vector6d information;
+  information << Eigen::Vector3d::Constant(s2 / (prior.translation_sigma_m * prior.translation_sigma_m)),
+      Eigen::Vector3d::Constant(s2 / (prior.rotation_sigma_rad * prior.rotation_sigma_rad));
+  H += J.transpose() * information.asDiagonal() * J;
+  g += J.transpose() * information.asDiagonal() * e;
+}
+
 } // namespace
 
 IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, const Eigen::Isometry3d& initial_guess,
                          const IcpSettings& settings, NearestCache* neighbors) {
   IcpResult result;
   result.T_world_sensor = initial_guess;
+  if (map.empty()) { // no pair: the prior alone, or nothing to align to
+    if (!settings.prior)
+      throw InvalidInputError("scan-to-map ICP: the map is empty; no point of " + std::to_string(points_sensor.size()) +
+                              " has a map point within " + std::to_string(settings.max_correspondence_m) + " m");
+    result.T_world_sensor = settings.prior->T_world_sensor;
+    result.converged = true;
+    return result;
+  }
   const double scale2 = settings.kernel_scale_m * settings.kernel_scale_m;
   LocalMap::Neighbor neighbor;
   // After the first iteration the points move by millimetres: most keep their neighbour.
@@ -79,8 +115,7 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
       const double d2 = neighbor.distance2;
       const double weight = 1.0 / ((1.0 + d2 / scale2) * (1.0 + d2 / scale2));
       const Eigen::Vector3d r = w - neighbor.point;
-      Eigen::Matrix3d W; // [w]x
-      W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+      const Eigen::Matrix3d W = skew(w);
       H_tt.diagonal().array() += weight;
       H_tr -= weight * W;
       H_rr -= weight * W * W;
@@ -89,7 +124,7 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     }
     result.correspondences = pairs;
     result.planes = planes;
-    if (pairs < 6)
+    if (pairs < 6 && !settings.prior)
       throw InvalidInputError("scan-to-map ICP: " + std::to_string(pairs) + " of " +
                               std::to_string(points_sensor.size()) + " points have a map point within " +
                               std::to_string(settings.max_correspondence_m) + " m; at least 6 are needed");
@@ -99,6 +134,8 @@ IcpResult alignScanToMap(const PointList& points_sensor, const LocalMap& map, co
     Vector6d g;
     g << g_t, g_r;
     g += g_plane;
+    if (settings.prior)
+      addPrior(*settings.prior, result.T_world_sensor, settings.kernel_scale_m, H, g);
     const Vector6d delta = H.ldlt().solve(-g);
     result.T_world_sensor = exponential(delta) * result.T_world_sensor;
     // Back onto the rotations: rounding leaves R slightly off, and the constant-velocity

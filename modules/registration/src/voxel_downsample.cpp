@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/registration/voxel_downsample.h>
 #include <msf/registration/voxel_table.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/stereo/parallel_post_filter.h>
 
 #include <atomic>

@@ -1,9 +1,11 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The vectorised core of SemiGlobalMatcher (private to the stereo module): one horizontal
 // strip of rows of OpenCV's 3-way semi-global block matching (5-way with the diagonal paths
-// from above, as its MODE_SGBM). Kept free of OpenCV and of the standard library's templates
-// so that its kernels can be compiled for AVX2 and AVX-512 without lending such copies of
-// inline functions to the rest of the program.
+// from above, as its MODE_SGBM; with p1_rise, the ground prior of the paths from above). Kept
+// free of OpenCV and of the standard library's templates so that its kernels can be compiled
+// for AVX2 and AVX-512 without lending such copies of inline functions to the rest of the
+// program. Every kernel gives the same result to the bit.
 #include <cstddef>
 #include <cstdint>
 
@@ -26,6 +28,10 @@ struct SgmStrip {
   int num_disparities{16};            ///< a positive multiple of 16
   int block_radius{2};                ///< (block_size - 1) / 2
   int p1{200}, p2{800};               ///< p2 > p1 > 0
+  /// The paths from above (top-to-bottom, and the diagonal ones) charge p1_rise rather than
+  /// p1 where the disparity is one pixel higher than at the pixel above: the ground comes
+  /// nearer row by row down the image. 0 < p1_rise < p2; p1: OpenCV's paths.
+  int p1_rise{200};
   int prefilter_cap{63};              ///< OpenCV's ftzero: max(pre_filter_cap, 15) | 1
   int uniqueness_ratio{10};           ///< percent; 0 = off
   int disp12_max_diff{1};             ///< pseudo left-right check, >= 0
@@ -55,6 +61,8 @@ std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities,
 void sgmStripAvx2(const SgmStrip& strip);
 /// The same with AVX-512BW (32 disparities per instruction); the same result.
 void sgmStripAvx512(const SgmStrip& strip);
+/// The same in portable C++ (16 disparities per step, as AVX2's lanes); the same result.
+void sgmStripPortable(const SgmStrip& strip);
 
 /// True when this build has the AVX2 kernel and the CPU runs AVX2.
 bool sgmAvx2Available();

@@ -1,7 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The kernel of SemiGlobalMatcher, written once over a vector type V (semi_global_kernel_simd.cpp
 // includes it twice: V = 16 x int16 AVX2 lanes and V = 32 x int16 AVX-512BW lanes, each under
-// its own target pragma and namespace). No include guard, on purpose; no includes, so that
-// nothing but these functions is compiled for the wider instruction set.
+// its own target pragma and namespace; semi_global_kernel_portable.cpp once more over 16 lanes
+// in plain arrays). No include guard, on purpose; no includes, so that nothing but these
+// functions is compiled for the wider instruction set.
 //
 // Per row, with r the block radius and D the number of disparities (padded to whole vectors
 // with lanes that cost the maximum):
@@ -14,8 +16,10 @@
 //     distance from the hint is added to the block costs, so that the paths carry the hint on;
 //  4. paths: left-to-right and top-to-bottom in one pass (with diagonal_paths, top-left and
 //     top-right too), right-to-left in a second pass that also picks the disparity
-//     (uniqueness, parabolic sub-pixel, pseudo left-right check).
+//     (uniqueness, parabolic sub-pixel, pseudo left-right check). The paths from above may
+//     charge a rise of the disparity by one pixel less than a fall (p1_rise, the ground prior).
 
+// MSF_SIMD_UNROLL(n): the including file's unrolling of a loop over the disparities.
 using Reg = typename V::Reg;
 constexpr int kLanes = V::kLanes; // 16-bit lanes per vector
 constexpr int kBytes = 2 * kLanes;
@@ -165,7 +169,7 @@ MSF_SIMD_INLINE void updateColumn(const Strip& strip, const std::uint8_t* add, c
   std::int16_t* column = strip.at<std::int16_t>(layout.column_sums) + static_cast<std::size_t>(xi) * D;
   if constexpr (kSubtract) {
     const PixelCost cost_sub(sub, x, reversed_first);
-#pragma GCC unroll 4
+MSF_SIMD_UNROLL(4)
     for (int d = 0; d < D; d += kBytes) {
       Reg low, high;
       V::widenDifference(cost_add(d), cost_sub(d), low, high);
@@ -195,6 +199,14 @@ MSF_SIMD void addRowToColumnSums(const Strip& strip, const std::uint8_t* add) {
 /// previous pixel.
 MSF_SIMD_INLINE Reg pathStep(Reg cost, Reg below, Reg above, Reg same, Reg p1, Reg previous_min_p2, Reg previous_min) {
   const Reg m = V::min16(V::adds16(V::min16(below, above), p1), V::min16(same, previous_min_p2));
+  return V::adds16(cost, V::sub16(m, previous_min));
+}
+
+/// The same with its own penalty for a rise: L(d-1) + p1_rise, where the disparity is one
+/// pixel higher than at the previous pixel.
+MSF_SIMD_INLINE Reg pathStepRising(Reg cost, Reg below, Reg above, Reg same, Reg p1_rise, Reg p1, Reg previous_min_p2,
+                                   Reg previous_min) {
+  const Reg m = V::min16(V::min16(V::adds16(below, p1_rise), V::adds16(above, p1)), V::min16(same, previous_min_p2));
   return V::adds16(cost, V::sub16(m, previous_min));
 }
 
@@ -259,11 +271,17 @@ struct PathSweep {
     previous_min_p2 = V::set16(with_p2 > 0x7FFF ? 0x7FFF : with_p2);
   }
 
-  /// New costs of vector k from `cost`, stored in place; returns them.
-  MSF_SIMD_INLINE Reg step(int k, Reg cost, Reg p1) {
+  /// New costs of vector k from `cost`, stored in place; returns them. kRising: a rise of
+  /// the disparity by one pixel costs `p1_rise` rather than `p1`.
+  template <bool kRising>
+  MSF_SIMD_INLINE Reg step(int k, Reg cost, Reg p1, Reg p1_rise) {
     const Reg next = k + 1 < count ? V::load(costs + kLanes * (k + 1)) : V::set16(0x7FFF);
-    const Reg result =
-        pathStep(cost, V::below(previous, current), V::above(current, next), current, p1, previous_min_p2, previous_min);
+    const Reg below = V::below(previous, current), above = V::above(current, next);
+    Reg result;
+    if constexpr (kRising)
+      result = pathStepRising(cost, below, above, current, p1_rise, p1, previous_min_p2, previous_min);
+    else
+      result = pathStep(cost, below, above, current, p1, previous_min_p2, previous_min);
     V::store(costs + kLanes * k, result);
     minimum = V::min16(minimum, result);
     previous = current;
@@ -307,7 +325,7 @@ MSF_SIMD_INLINE Reg nextCost(const Strip& strip, std::int16_t* box, const std::i
 /// pixel's costs overwrite its predecessor's, in place, and the pixels of one row use
 /// distinct slots. A path entering at the first (top-left) or last column (top-right) starts
 /// with L = C, whatever its slot held. `shift`: the row's index in the strip modulo width1.
-template <bool kOutput>
+template <bool kOutput, bool kRising>
 MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int shift, std::int16_t* sums_x, const int K) {
   const Layout& layout = strip.layout;
   const int D = kLanes * K, width1 = layout.width1;
@@ -326,13 +344,14 @@ MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int shift, std::i
     right_minima[right_slot] = 0;
   }
   const std::int16_t* costs = strip.at<std::int16_t>(layout.costs);
-  const Reg p1 = V::set16(strip.s.p1);
+  const Reg p1 = V::set16(strip.s.p1), p1_rise = V::set16(strip.s.p1_rise);
   PathSweep from_left(top_left, K, left_minima[left_slot], strip.s.p2);
   PathSweep from_right(top_right, K, right_minima[right_slot], strip.s.p2);
-#pragma GCC unroll 8
+MSF_SIMD_UNROLL(8)
   for (int k = 0; k < K; ++k) {
     const Reg cost = V::load(costs + kLanes * k);
-    const Reg both = V::adds16(from_left.step(k, cost, p1), from_right.step(k, cost, p1));
+    const Reg both =
+        V::adds16(from_left.step<kRising>(k, cost, p1, p1_rise), from_right.step<kRising>(k, cost, p1, p1_rise));
     if constexpr (kOutput)
       V::store(sums_x + kLanes * k, V::adds16(V::load(sums_x + kLanes * k), both));
   }
@@ -341,12 +360,13 @@ MSF_SIMD_INLINE void diagonalPaths(const Strip& strip, int xi, int shift, std::i
 }
 
 /// Left-to-right and top-to-bottom paths of one row (and the diagonal ones with
-/// kDiagonal); their sum goes to `sums` (output rows). `row`: the row's index in the strip.
+/// kDiagonal; kRising: the paths from above with p1_rise); their sum goes to `sums` (output
+/// rows). `row`: the row's index in the strip.
 /// K (vectors of disparities) is a compile-time constant where forwardPassK is
 /// instantiated for it, so that the sweep over disparities unrolls.
 /// With `add` (and `sub`), each column's sums first move down one row: the block row
 /// entering is `add`, the one leaving `sub` (fused here so the sums are read once).
-template <bool kOutput, bool kDiagonal>
+template <bool kOutput, bool kDiagonal, bool kRising>
 MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub,
                                     const Guide& guide, int row, const int K) {
   const Layout& layout = strip.layout;
@@ -359,7 +379,7 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
   std::uint16_t* top_minima = strip.at<std::uint16_t>(layout.top_minima);
   std::int16_t* costs = strip.at<std::int16_t>(layout.costs);
   const int diagonal_shift = row % layout.width1;
-  const Reg p1 = V::set16(strip.s.p1);
+  const Reg p1 = V::set16(strip.s.p1), p1_rise = V::set16(strip.s.p1_rise);
   const int p2 = strip.s.p2;
   if (add)
     for (int xi = 0; xi <= r && xi <= last; ++xi)
@@ -381,21 +401,21 @@ MSF_SIMD_INLINE void forwardPassFor(const Strip& strip, const std::uint8_t* add,
     PathSweep left_path(left, K, left_min, p2);
     std::int16_t* sums_x = sums + static_cast<std::size_t>(xi) * D;
     const Guide::Pixel pixel = guide.at(xi + layout.min_x);
-#pragma GCC unroll 8
+MSF_SIMD_UNROLL(8)
     for (int k = 0; k < K; ++k) {
       const Reg cost = guide.guided(nextCost(strip, box, entering, leaving, step, k, K), pixel, k);
       if constexpr (kDiagonal)
         V::store(costs + kLanes * k, cost);
-      const Reg t = top_path.step(k, cost, p1);
+      const Reg t = top_path.step<kRising>(k, cost, p1, p1_rise);
       if constexpr (kOutput)
-        V::store(sums_x + kLanes * k, V::adds16(left_path.step(k, cost, p1), t));
+        V::store(sums_x + kLanes * k, V::adds16(left_path.step<false>(k, cost, p1, p1), t));
     }
     if constexpr (kOutput)
       left_min = V::horizontalMin(left_path.minimum);
     top_minima[xi] = static_cast<std::uint16_t>(V::horizontalMin(top_path.minimum));
     // In a loop of their own: with the two above, the paths' state outgrows the registers.
     if constexpr (kDiagonal)
-      diagonalPaths<kOutput>(strip, xi, diagonal_shift, sums_x, K);
+      diagonalPaths<kOutput, kRising>(strip, xi, diagonal_shift, sums_x, K);
   }
 }
 
@@ -440,10 +460,10 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
     // Per lane: the smallest total so far and the vector k where it was (the first on ties).
     Reg best_cost = V::set16(0x7FFF), best_k = V::set16(0);
     const Guide::Pixel pixel = guide.at(xi + layout.min_x);
-#pragma GCC unroll 8
+MSF_SIMD_UNROLL(8)
     for (int k = 0; k < K; ++k) {
       const Reg cost = guide.guided(nextCost(strip, box, entering, leaving, step, k, K), pixel, k);
-      const Reg sum = V::adds16(right_path.step(k, cost, p1), V::load(sums_x + kLanes * k));
+      const Reg sum = V::adds16(right_path.step<false>(k, cost, p1, p1), V::load(sums_x + kLanes * k));
       V::store(total + kLanes * k, sum);
       best_k = V::whereLess(sum, best_cost, V::set16(k), best_k);
       best_cost = V::min16(best_cost, sum);
@@ -486,10 +506,11 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
   }
 }
 
-template <bool kOutput, bool kDiagonal, int KC>
+template <bool kOutput, bool kDiagonal, bool kRising, int KC>
 MSF_SIMD void forwardPassK(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide,
                            int row) {
-  forwardPassFor<kOutput, kDiagonal>(strip, add, sub, guide, row, KC > 0 ? KC : strip.layout.num_disparities / kLanes);
+  const int vectors = KC > 0 ? KC : strip.layout.num_disparities / kLanes;
+  forwardPassFor<kOutput, kDiagonal, kRising>(strip, add, sub, guide, row, vectors);
 }
 
 template <int KC>
@@ -500,33 +521,43 @@ MSF_SIMD void backwardPassK(const Strip& strip, std::int16_t* out, const Guide& 
 /// `add`, `sub`: the block rows entering and leaving (none at the strip's first row);
 /// `out`: the disparity row, none on warm-up rows; `guide`: the row's hints; `row`: the
 /// row's index in the strip.
-template <bool kDiagonal, int KC>
+template <bool kDiagonal, bool kRising, int KC>
 MSF_SIMD void matchRow(const Strip& strip, const std::uint8_t* add, const std::uint8_t* sub, const Guide& guide,
                        int row, std::int16_t* out) {
   if (!out) {
-    forwardPassK<false, kDiagonal, KC>(strip, add, sub, guide, row);
+    forwardPassK<false, kDiagonal, kRising, KC>(strip, add, sub, guide, row);
     return;
   }
-  forwardPassK<true, kDiagonal, KC>(strip, add, sub, guide, row);
+  forwardPassK<true, kDiagonal, kRising, KC>(strip, add, sub, guide, row);
   backwardPassK<KC>(strip, out, guide);
 }
 
 using RowMatcher = void (*)(const Strip&, const std::uint8_t*, const std::uint8_t*, const Guide&, int, std::int16_t*);
 
-/// The passes of one row, unrolled for up to 128 disparities.
-template <bool kDiagonal>
+/// The passes of one row, unrolled for up to 128 disparities (where V unrolls them).
+template <bool kDiagonal, bool kRising>
 MSF_SIMD RowMatcher rowMatcherFor(int vectors) {
+  if constexpr (!V::kUnrolled)
+    return matchRow<kDiagonal, kRising, 0>;
   switch (vectors) {
-  case 1: return matchRow<kDiagonal, 1>;
-  case 2: return matchRow<kDiagonal, 2>;
-  case 3: return matchRow<kDiagonal, 3>;
-  case 4: return matchRow<kDiagonal, 4>;
-  case 5: return matchRow<kDiagonal, 5>;
-  case 6: return matchRow<kDiagonal, 6>;
-  case 7: return matchRow<kDiagonal, 7>;
-  case 8: return matchRow<kDiagonal, 8>;
-  default: return matchRow<kDiagonal, 0>;
+  case 1: return matchRow<kDiagonal, kRising, 1>;
+  case 2: return matchRow<kDiagonal, kRising, 2>;
+  case 3: return matchRow<kDiagonal, kRising, 3>;
+  case 4: return matchRow<kDiagonal, kRising, 4>;
+  case 5: return matchRow<kDiagonal, kRising, 5>;
+  case 6: return matchRow<kDiagonal, kRising, 6>;
+  case 7: return matchRow<kDiagonal, kRising, 7>;
+  case 8: return matchRow<kDiagonal, kRising, 8>;
+  default: return matchRow<kDiagonal, kRising, 0>;
   }
+}
+
+/// The row matcher of the strip's paths: OpenCV's (p1_rise = p1) or with the ground prior.
+MSF_SIMD RowMatcher rowMatcher(const SgmStrip& s, int vectors) {
+  const bool rising = s.p1_rise != s.p1;
+  if (s.diagonal_paths)
+    return rising ? rowMatcherFor<true, true>(vectors) : rowMatcherFor<true, false>(vectors);
+  return rising ? rowMatcherFor<false, true>(vectors) : rowMatcherFor<false, false>(vectors);
 }
 
 /// Row y of the guidance, or nullptr when none of its matched columns has a hint (most rows
@@ -573,7 +604,7 @@ MSF_SIMD void runStrip(const SgmStrip& s) {
   std::int16_t* disp2 = strip.at<std::int16_t>(layout.disp2);
   std::int16_t* disp2_cost = strip.at<std::int16_t>(layout.disp2_cost);
 
-  const RowMatcher match_row = s.diagonal_paths ? rowMatcherFor<true>(D / kLanes) : rowMatcherFor<false>(D / kLanes);
+  const RowMatcher match_row = rowMatcher(s, D / kLanes);
   const bool guided = s.guidance && s.guidance_gain > 0 && s.guidance_max_penalty > 0;
   for (int y = s.row_begin; y < s.row_end; ++y) {
     const std::uint8_t* add = y > s.row_begin ? strip.preparedRow(y + r) : nullptr;

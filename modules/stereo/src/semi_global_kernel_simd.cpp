@@ -1,9 +1,12 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The vector kernels of SemiGlobalMatcher: OpenCV's StereoSGBM (MODE_SGBM_3WAY, or with the
-// two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection
-// (semi_global_kernel_body.h), compiled twice, for AVX2 (16 disparities per instruction) and
-// AVX-512BW (32). Only the code between the target pragmas uses those instruction sets, so
-// this file builds for any x86-64 and the caller picks a kernel at run time.
+// two diagonal paths from above, MODE_SGBM's five) cost, aggregation and winner selection, and
+// the ground prior of the paths from above (semi_global_kernel_body.h), compiled twice, for
+// AVX2 (16 disparities per instruction) and AVX-512BW (32). Only the code between the target
+// pragmas uses those instruction sets, so this file builds for any x86-64 and the caller picks
+// a kernel at run time (semi_global_kernel_portable.cpp where the CPU has neither).
 #include "semi_global_kernel.h"
+#include "semi_global_layout.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -13,68 +16,6 @@
 #include <cstring>
 
 namespace msf::detail {
-
-namespace {
-
-constexpr std::size_t kAlign = 64;
-constexpr std::size_t alignUp(std::size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
-
-/// Byte offsets of the buffers of one strip inside its workspace.
-struct Layout {
-  int width1{0};       ///< columns that can be matched: [min_x, min_x + width1)
-  int min_x{0};
-  int num_disparities{0}; ///< searched, padded to whole vectors: the stride of the buffers
-  int ring{0};         ///< prepared rows kept (2r + 2: the row entering and the one leaving)
-  std::size_t column_sums{0}, top{0}, sums{0}, top_minima{0}, box{0}, left{0}, right{0}, total{0};
-  std::size_t prep{0}, prep_rows{0}, disp2{0}, disp2_cost{0};
-  /// The diagonal paths' rows and minima, and the pixel's block costs they read (empty
-  /// without diagonal paths).
-  std::size_t top_left{0}, top_right{0}, top_left_minima{0}, top_right_minima{0}, costs{0};
-  std::size_t bytes{0};
-
-  Layout(int width, int min_disparity, int searched_disparities, int padded_disparities, int block_radius,
-         bool diagonal_paths)
-      : num_disparities(padded_disparities) {
-    const int max_disparity = min_disparity + searched_disparities;
-    min_x = max_disparity > 0 ? max_disparity : 0;
-    const int max_x = width + (min_disparity < 0 ? min_disparity : 0);
-    width1 = max_x > min_x ? max_x - min_x : 0;
-    ring = 2 * block_radius + 2;
-    const std::size_t volume_row = alignUp(sizeof(std::int16_t) * static_cast<std::size_t>(width1) * num_disparities);
-    const std::size_t line = alignUp(sizeof(std::int16_t) * static_cast<std::size_t>(num_disparities));
-    std::size_t at = 0;
-    const auto take = [&at](std::size_t n) {
-      const std::size_t here = at;
-      at += alignUp(n);
-      return here;
-    };
-    column_sums = take(volume_row);
-    top = take(volume_row);
-    sums = take(volume_row);
-    top_minima = take(sizeof(std::uint16_t) * static_cast<std::size_t>(width1));
-    box = take(line);
-    left = take(line);
-    right = take(line);
-    total = take(line);
-    prep = take(static_cast<std::size_t>(ring) * kPrepArrays * kSgmPrepStride);
-    prep_rows = take(sizeof(int) * static_cast<std::size_t>(ring));
-    disp2 = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
-    disp2_cost = take(sizeof(std::int16_t) * static_cast<std::size_t>(width));
-    const std::size_t diagonal = diagonal_paths ? 1 : 0;
-    top_left = take(diagonal * volume_row);
-    top_right = take(diagonal * volume_row);
-    top_left_minima = take(diagonal * sizeof(std::uint16_t) * static_cast<std::size_t>(width1));
-    top_right_minima = take(diagonal * sizeof(std::uint16_t) * static_cast<std::size_t>(width1));
-    costs = take(diagonal * line);
-    bytes = at + kAlign; // the caller's pointer is aligned here
-  }
-
-  /// Per prepared row: for each image, the prefiltered row and its Birchfield-Tomasi minimum
-  /// and maximum, then the raw row and its minimum and maximum; the right image reversed.
-  static constexpr int kPrepArrays = 12;
-};
-
-} // namespace
 
 std::size_t sgmWorkspaceBytes(int width, int min_disparity, int num_disparities, int block_radius,
                               bool diagonal_paths) {
@@ -98,6 +39,8 @@ bool sgmAvx512Available() {
 // noinline: one symbol per stage in a profile; each is called once per row or more rarely.
 #define MSF_SIMD __attribute__((noinline))
 #define MSF_SIMD_INLINE __attribute__((always_inline)) inline
+#define MSF_SIMD_PRAGMA(x) _Pragma(#x)
+#define MSF_SIMD_UNROLL(n) MSF_SIMD_PRAGMA(GCC unroll n)
 
 #pragma GCC push_options
 #pragma GCC target("avx2")
@@ -109,6 +52,7 @@ struct V {
   using Reg = __m256i;
   static constexpr int kLanes = 16;
   static constexpr int kMaskBitsPerLane = 2; // movemask_epi8 gives one bit per byte
+  static constexpr bool kUnrolled = true;   // a row matcher per number of vectors
   MSF_SIMD_INLINE static Reg load(const void* p) { return _mm256_loadu_si256(static_cast<const __m256i*>(p)); }
   MSF_SIMD_INLINE static void store(void* p, Reg v) { _mm256_storeu_si256(static_cast<__m256i*>(p), v); }
   MSF_SIMD_INLINE static Reg set16(int v) { return _mm256_set1_epi16(static_cast<short>(v)); }
@@ -191,6 +135,7 @@ struct V {
   using Reg = __m512i;
   static constexpr int kLanes = 32;
   static constexpr int kMaskBitsPerLane = 1;
+  static constexpr bool kUnrolled = true;
   MSF_SIMD_INLINE static Reg load(const void* p) { return _mm512_loadu_si512(p); }
   MSF_SIMD_INLINE static void store(void* p, Reg v) { _mm512_storeu_si512(p, v); }
   MSF_SIMD_INLINE static Reg set16(int v) { return _mm512_set1_epi16(static_cast<short>(v)); }
@@ -259,7 +204,7 @@ struct V {
 void sgmStripAvx2(const SgmStrip& strip) { avx2::runStrip(strip); }
 void sgmStripAvx512(const SgmStrip& strip) { avx512::runStrip(strip); }
 
-#else // not x86: no kernel; SemiGlobalMatcher is never selected
+#else // not x86: no vector kernel; the portable one runs
 
 bool sgmAvx2Available() { return false; }
 bool sgmAvx512Available() { return false; }

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "semi_global_kernel.h"
 
 #include <msf/common/parallel.h>
@@ -30,7 +31,7 @@ std::atomic<bool> avx512_enabled{true};
 }
 } // namespace
 
-bool SemiGlobalMatcher::isAvailable() {
+bool SemiGlobalMatcher::usesAvx2() {
   static const bool cpu_has_avx2 = detail::sgmAvx2Available();
   return cpu_has_avx2 && avx2_enabled.load();
 }
@@ -39,7 +40,7 @@ void SemiGlobalMatcher::setAvx2Enabled(bool enabled) { avx2_enabled.store(enable
 
 bool SemiGlobalMatcher::usesAvx512() {
   static const bool cpu_has_avx512 = detail::sgmAvx512Available();
-  return isAvailable() && cpu_has_avx512 && avx512_enabled.load();
+  return usesAvx2() && cpu_has_avx512 && avx512_enabled.load();
 }
 
 void SemiGlobalMatcher::setAvx512Enabled(bool enabled) { avx512_enabled.store(enabled); }
@@ -55,6 +56,8 @@ void SemiGlobalMatcher::setParams(const Params& params) {
     bad("p2", "must be greater than p1 > 0 (p1 " + std::to_string(params.p1) + ", p2 " + std::to_string(params.p2) + ")");
   if (params.p2 > 0x7FFF)
     bad("p2", "must be at most 32767, not " + std::to_string(params.p2));
+  if (params.p1_rise < 0 || params.p1_rise >= params.p2)
+    bad("p1_rise", "must be in 0..p2 - 1 (0: p1), not " + std::to_string(params.p1_rise));
   if (params.pre_filter_cap < 1 || params.pre_filter_cap > 63)
     bad("pre_filter_cap", "must be in 1..63, not " + std::to_string(params.pre_filter_cap));
   if (params.uniqueness_ratio < 0 || params.uniqueness_ratio > 100)
@@ -90,8 +93,6 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   if (left.cols > maxWidth())
     throw InvalidInputError("SemiGlobalMatcher: the images are " + std::to_string(left.cols) +
                             " px wide, more than the " + std::to_string(maxWidth()) + " it matches");
-  if (!isAvailable())
-    throw InvalidInputError("SemiGlobalMatcher: this CPU has no AVX2 (use OpenCV's StereoSGBM)");
   const Params& p = params_;
   if (!guidance.empty()) {
     if (guidance.type() != CV_16SC1 || guidance.size() != left.size())
@@ -130,6 +131,7 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   job.block_radius = radius;
   job.p1 = p.p1;
   job.p2 = p.p2;
+  job.p1_rise = p.p1_rise > 0 ? p.p1_rise : p.p1;
   job.prefilter_cap = std::max(p.pre_filter_cap, 15) | 1;
   job.uniqueness_ratio = p.uniqueness_ratio;
   job.disp12_max_diff = p.disp12_max_diff > 0 ? p.disp12_max_diff : 1; // as OpenCV 4.6: never off
@@ -144,7 +146,9 @@ void SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, cv::M
   job.disparity_step = raw_.step[0] / sizeof(std::int16_t);
   // AVX-512 where the disparities fill whole 32-lane vectors; with 16 left over its padding
   // lanes cost as much as it saves (80 disparities: 55 ms either way, one core).
-  const auto kernel = usesAvx512() && p.num_disparities % 32 == 0 ? detail::sgmStripAvx512 : detail::sgmStripAvx2;
+  const auto kernel = !usesAvx2()                                    ? detail::sgmStripPortable
+                      : usesAvx512() && p.num_disparities % 32 == 0 ? detail::sgmStripAvx512
+                                                                      : detail::sgmStripAvx2;
   parallelFor(
       cv::Range(0, strips),
       [&](const cv::Range& range) {

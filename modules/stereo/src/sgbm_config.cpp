@@ -1,20 +1,25 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/stereo/sgbm_config.h>
 
 #include <opencv2/calib3d.hpp>
 
+#include <iterator>
+
 namespace msf {
 
-int SgbmConfig::opencvMode() const {
-  if (mode == "sgbm_3way")
+int SgbmConfig::opencvMode(bool guided) const {
+  const std::string& name = modeFor(guided);
+  if (name == "sgbm_3way" || name == "ground_3way")
     return cv::StereoSGBM::MODE_SGBM_3WAY;
-  if (mode == "sgbm")
+  if (name == "sgbm")
     return cv::StereoSGBM::MODE_SGBM;
-  if (mode == "hh")
+  if (name == "hh")
     return cv::StereoSGBM::MODE_HH;
-  if (mode == "hh4")
+  if (name == "hh4")
     return cv::StereoSGBM::MODE_HH4;
-  throw ConfigError("stereo.mode must be sgbm | sgbm_3way | hh | hh4, not '" + mode + "'");
+  throw ConfigError(std::string("stereo.") + (guided ? "mode" : "unguided_mode") + " must be " +
+                    wordList(kModes, std::size(kModes)) + ", not '" + name + "'");
 }
 
 void SgbmConfig::validate() const {
@@ -26,6 +31,9 @@ void SgbmConfig::validate() const {
     bad("block_size_px", "must be odd, not " + std::to_string(block_size_px));
   if (resolvedP2() <= resolvedP1())
     bad("p2", "must be greater than p1 (" + std::to_string(resolvedP2()) + " <= " + std::to_string(resolvedP1()) + ")");
+  if (resolvedP1Rise() >= resolvedP2())
+    bad("p1_rise", "must be less than p2 (" + std::to_string(resolvedP1Rise()) + " >= " + std::to_string(resolvedP2()) +
+                       ")");
   confidence.validate();
 }
 

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
@@ -86,7 +87,7 @@ void SgbmStereo::checkInputs() const {
     throw InvalidInputError("SgbmStereo: images " + sizeText(left_) + " are narrower than the disparity range");
 }
 
-bool SgbmStereo::nativeRuns(int width) const {
+bool SgbmStereo::nativeRuns(int width, const std::string& mode) const {
   if (!config_.nativeEngine())
     return false;
   if (width > SemiGlobalMatcher::maxWidth()) {
@@ -97,18 +98,21 @@ bool SgbmStereo::nativeRuns(int width) const {
     });
     return false;
   }
-  if (config_.mode != "sgbm_3way" && config_.mode != "sgbm") {
+  if (mode == "ground_3way")
+    return true; // ours alone: where the CPU has no AVX2, the portable kernel gives the same result
+  if (mode != "sgbm_3way" && mode != "sgbm") {
     static std::once_flag noted;
     std::call_once(noted, [&] {
-      std::cerr << "msf: note: stereo.engine native implements modes sgbm_3way and sgbm; mode " << config_.mode
+      std::cerr << "msf: note: stereo.engine native implements modes ground_3way, sgbm_3way and sgbm; mode " << mode
                 << " runs on OpenCV's StereoSGBM\n";
     });
     return false;
   }
-  if (!SemiGlobalMatcher::isAvailable()) {
+  if (!SemiGlobalMatcher::usesAvx2()) {
     static std::once_flag noted;
     std::call_once(noted, [] {
-      std::cerr << "msf: note: stereo.engine native needs AVX2, which this CPU lacks; using OpenCV's StereoSGBM\n";
+      std::cerr << "msf: note: this CPU has no AVX2; OpenCV's StereoSGBM runs modes sgbm_3way and sgbm (the same "
+                   "algorithm, faster there than the native portable kernel)\n";
     });
     return false;
   }
@@ -117,19 +121,22 @@ bool SgbmStereo::nativeRuns(int width) const {
 
 void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints,
                             cv::Mat& fixed) {
-  if (nativeRuns(left.cols)) {
+  const bool guided = !hints.empty();
+  const std::string& mode = config_.modeFor(guided);
+  if (nativeRuns(left.cols, mode)) {
     SemiGlobalMatcher::Params params;
     params.min_disparity = config_.min_disparity_px;
     params.num_disparities = num_disparities;
     params.block_size = config_.block_size_px;
     params.p1 = config_.resolvedP1();
     params.p2 = config_.resolvedP2();
+    params.p1_rise = mode == "ground_3way" ? config_.resolvedP1Rise() : 0;
     params.pre_filter_cap = config_.pre_filter_cap;
     params.uniqueness_ratio = config_.uniqueness_ratio_pct;
     params.speckle_window_size = config_.speckle_window_size_px;
     params.speckle_range = config_.speckle_range_px;
     params.disp12_max_diff = config_.disp12_max_diff_px;
-    params.diagonal_paths = config_.mode == "sgbm";
+    params.diagonal_paths = mode == "sgbm";
     params.guidance_gain = config_.guidance_gain;
     params.guidance_max_penalty = config_.guidance_max_penalty;
     native_.setParams(params);
@@ -137,7 +144,13 @@ void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_d
     engine_used_ = "native";
     return;
   }
-  if (!hints.empty()) {
+  if (mode == "ground_3way") {
+    static std::once_flag noted;
+    std::call_once(noted, [] {
+      std::cerr << "msf: note: OpenCV's StereoSGBM has no ground_3way mode; its sgbm_3way runs\n";
+    });
+  }
+  if (guided) {
     static std::once_flag noted;
     std::call_once(noted, [] {
       std::cerr << "msf: note: OpenCV's StereoSGBM runs instead of the native matcher and takes no guidance; "
@@ -146,7 +159,7 @@ void SgbmStereo::runMatcher(const cv::Mat& left, const cv::Mat& right, int num_d
   }
   if (!matcher_)
     matcher_ = cv::StereoSGBM::create();
-  matcher_->setMode(config_.opencvMode());
+  matcher_->setMode(config_.opencvMode(guided));
   matcher_->setMinDisparity(config_.min_disparity_px);
   matcher_->setNumDisparities(num_disparities);
   matcher_->setBlockSize(config_.block_size_px);

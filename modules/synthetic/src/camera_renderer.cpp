@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/counter_rng.h>

@@ -1,5 +1,7 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/lidar_simulator.h>
+#include <msf/synthetic/synthetic_rig.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -10,9 +12,6 @@ namespace msf::synthetic {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kLasersPerBlock = 32;
-constexpr double kUpperSpacingDeg = 1.0 / 3.0; // KITTI's upper block
-constexpr double kBlockGapDeg = 0.5;
 
 struct Sample {
   float x, y, z, intensity;
@@ -22,13 +21,8 @@ struct Sample {
 
 LidarSimulator::LidarSimulator(const SyntheticConfig& config) : config_(config) {
   config_.validate();
-  const double top = config_.lidar_upper_elevation_deg;
-  const double upper_last = top - (kLasersPerBlock - 1) * kUpperSpacingDeg;
-  const double lower_first = upper_last - kBlockGapDeg, bottom = config_.lidar_lower_elevation_deg;
-  for (int i = 0; i < kLasersPerBlock; ++i)
-    elevations_deg_.push_back(top - i * kUpperSpacingDeg);
-  for (int i = 0; i < kLasersPerBlock; ++i)
-    elevations_deg_.push_back(lower_first + (bottom - lower_first) * i / (kLasersPerBlock - 1));
+  const std::vector<double> lowest_first = lidarBeamElevationsDeg(config_);
+  elevations_deg_.assign(lowest_first.rbegin(), lowest_first.rend());
   steps_ = static_cast<int>(std::floor(360.0 / config_.lidar_azimuth_step_deg));
 }
 

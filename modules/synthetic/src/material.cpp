@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/material.h>
 #include <msf/synthetic/procedural_noise.h>
 #include <msf/synthetic/scene.h>

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/scene_mesh.h>
 
 #include <pcl/conversions.h>

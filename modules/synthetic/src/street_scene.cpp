@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/car.h>
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/kitti_rig.h>

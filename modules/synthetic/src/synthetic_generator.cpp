@@ -1,16 +1,21 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/velodyne_io.h>
-#include <msf/synthetic/kitti_rig.h>
+#include <msf/io/rig_file.h>
+#include <msf/synthetic/ins_error.h>
 #include <msf/synthetic/scene_mesh.h>
 #include <msf/synthetic/street_scene.h>
+#include <msf/synthetic/synthetic_rig.h>
 #include <msf/synthetic/synthetic_generator.h>
 #include <msf/synthetic/trajectory.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -45,21 +50,30 @@ std::string frameName(std::size_t i) {
   return name;
 }
 
-/// How far along the street the drive goes (a loop comes back).
-double farthestZ(const PoseList& poses) {
-  double z = 0.0;
-  for (const auto& T : poses)
-    z = std::max(z, T.translation().z());
-  return z;
+/// How far the street is built along z: config.street_length_m (shared by the drives of one
+/// world), or as far as this drive goes (a loop comes back). Throws ConfigError naming the keys
+/// when the drive leaves the street (below z = 0, or beyond street_length_m).
+double streetEnd(const SyntheticConfig& config, const PoseList& poses) {
+  double lo = 0.0, hi = 0.0;
+  for (const auto& T : poses) {
+    lo = std::min(lo, T.translation().z());
+    hi = std::max(hi, T.translation().z());
+  }
+  if (lo < 0.0)
+    throw ConfigError("config keys 'synthetic.start_m' = " + std::to_string(config.start_m) +
+                      " and 'reverse' make a drive that leaves the street's start (it reaches z = " +
+                      std::to_string(lo) + " m): start a reversed drive at least as far along as it drives");
+  if (config.street_length_m == 0.0)
+    return hi;
+  if (hi > config.street_length_m + 1e-9)
+    throw ConfigError("config key 'synthetic.street_length_m' = " + std::to_string(config.street_length_m) +
+                      " is shorter than the drive, which reaches z = " + std::to_string(hi) +
+                      " m (start_m, frames, speed_mps): the drive must lie on the street");
+  return config.street_length_m;
 }
 
 void writeText(const fs::path& path, const std::string& text) {
-  writeAtomically(path.string(), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw IOError("cannot write '" + path.string() + "'");
-  });
+  writeStreamAtomically(path.string(), [&](std::ostream& out) { out << text; });
 }
 
 const char* kGroundTruthReadme =
@@ -75,15 +89,17 @@ const char* kGroundTruthReadme =
     "scene_classes.txt     what each vertex of scene.ply is (ground, building, car, pole, person, tree), in runs\n"
     "                      of vertices: first_vertex vertex_count class\n"
     "synthetic.yaml        the generator's configuration\n"
+    "poses.txt             with ins_poses: the true T_world_cam0 (poses/00.txt then holds them as a GPS/INS\n"
+    "                      measures them, with a drifting heading and a wandering position)\n"
     "Every pixel is exact: the value of the ray through the pixel centre.\n";
 
 } // namespace
 
 SyntheticGenerator::SyntheticGenerator(const SyntheticConfig& config)
     : config_(validated(config)),
-      calibration_(kittiRig()),
+      calibration_(syntheticRig(config_)),
       poses_(streetTrajectory(config_)),
-      scene_(buildStreetScene(config_, farthestZ(poses_))),
+      scene_(buildStreetScene(config_, streetEnd(config_, poses_))),
       renderer_(calibration_, config_),
       lidar_(config_) {}
 
@@ -155,6 +171,7 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
       throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
 
   saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
+  saveRigFile(calibration_, (seq / "rig.yaml").string());
   std::ostringstream times;
   for (int i = 0; i < config_.frames; ++i) {
     char line[32];
@@ -162,11 +179,19 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     times << line;
   }
   writeText(seq / "times.txt", times.str());
-  saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+  if (config_.ins_poses) {
+    saveOdometryPoses((staging / "poses" / "00.txt").string(), insPoses(poses_, config_));
+    saveOdometryPoses((gt / "poses.txt").string(), poses_);
+  } else {
+    saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+  }
   std::ostringstream yaml; // plain YAML, which msf_synth -config reads back to the same dataset
   printConfig(yaml, config_);
   writeText(gt / "synthetic.yaml", yaml.str());
-  writeText(gt / "README.txt", kGroundTruthReadme);
+  std::string readme = kGroundTruthReadme;
+  if (config_.placed()) // the world is the street's, where this drive does not start
+    readme.replace(readme.find("(camera 0 at frame 0)"), 21, "(the street's: camera 0 where a drive from its start begins)");
+  writeText(gt / "README.txt", readme);
   SurfaceClasses classes;
   saveMesh((gt / "scene.ply").string(), mesh(&classes));
   writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/car.h>
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/traffic.h>
@@ -5,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace msf::synthetic {
 
@@ -28,9 +30,23 @@ void addCar(SequentialRng& rng, Scene& scene, std::uint32_t id, float lane_x, do
                             static_cast<float>(speed_mps));
 }
 
-} // namespace
+/// The movers from `first` on, laid out along a drive from the street's start, carried to the
+/// drive's place `T_world_drive` (a turn about y adds to their heading).
+void carryToDrive(const Eigen::Isometry3d& T_world_drive, std::vector<MovingObject>& movers, std::size_t first) {
+  const Eigen::Matrix3d R = T_world_drive.linear();
+  const float turn = static_cast<float>(std::atan2(R(0, 2), R(2, 2)));
+  for (std::size_t i = first; i < movers.size(); ++i) {
+    const MovingObject& m = movers[i];
+    const V3 s = m.originAt(0.0);
+    const Eigen::Vector3d start = T_world_drive * Eigen::Vector3d(s.x, s.y, s.z);
+    movers[i] = MovingObject(m.object(), m.solids(),
+                             {static_cast<float>(start.x()), static_cast<float>(start.y()), static_cast<float>(start.z())},
+                             m.yaw() + turn, m.speedMps());
+  }
+}
 
-void addTraffic(const SyntheticConfig& config, Scene& scene) {
+/// The cars of a drive from the street's start, heading +z in the right-hand lane.
+void addTrafficAlongDrive(const SyntheticConfig& config, Scene& scene) {
   const auto seed = static_cast<std::uint64_t>(config.seed);
   const double v = config.speed_mps;
   // The cameras drive along the street (z = v t) for the drive, or a loop's first leg: the
@@ -77,6 +93,15 @@ void addTraffic(const SyntheticConfig& config, Scene& scene) {
       }
     }
   }
+}
+
+} // namespace
+
+void addTraffic(const SyntheticConfig& config, Scene& scene) {
+  const std::size_t first = scene.movers.size();
+  addTrafficAlongDrive(config, scene);
+  if (config.placed())
+    carryToDrive(driveTransform(config), scene.movers, first);
 }
 
 } // namespace msf::synthetic

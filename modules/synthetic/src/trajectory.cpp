@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/synthetic/scene.h>
 #include <msf/synthetic/trajectory.h>
 
@@ -9,6 +10,16 @@ namespace {
 constexpr double kSwayAmplitudeM = 0.4;
 constexpr double kSwayWavelengthM = 150.0;
 constexpr double kTwoPi = 6.283185307179586;
+/// The path laid out from the street's start carried to the drive's place (unchanged, bit for
+/// bit, for a drive from the start).
+PoseList placed(const SyntheticConfig& config, PoseList poses) {
+  if (!config.placed())
+    return poses;
+  const Eigen::Isometry3d T_world_drive = driveTransform(config);
+  for (Eigen::Isometry3d& T : poses)
+    T = T_world_drive * T;
+  return poses;
+}
 } // namespace
 
 int loopOutFrames(const SyntheticConfig& config) {
@@ -31,7 +42,7 @@ PoseList streetTrajectory(const SyntheticConfig& config) {
     poses.push_back(T);
   }
   if (!config.loop)
-    return poses;
+    return placed(config, std::move(poses));
   // The turn: a half circle to the left, from the right-hand lane to the other one (a lane
   // apart), the heading along it; then back along the other lane, without sway.
   const Eigen::Vector3d start = poses.back().translation();
@@ -52,7 +63,18 @@ PoseList streetTrajectory(const SyntheticConfig& config) {
     T.translation() = back - Eigen::Vector3d(0, 0, step * j);
     poses.push_back(T);
   }
-  return poses;
+  return placed(config, std::move(poses));
+}
+
+Eigen::Isometry3d driveTransform(const SyntheticConfig& config) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().z() = config.start_m;
+  if (config.reverse) {
+    // Turned about the vertical through the road's axis: the right-hand lane becomes the left.
+    T.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    T.translation().x() = 2.0 * StreetLayout().road_center_x;
+  }
+  return T;
 }
 
 std::vector<double> frameTimes(const SyntheticConfig& config) {

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <cstddef>
 #include <functional>
@@ -13,6 +14,10 @@ int run(const char* name, const std::function<int()>& body);
 
 /// True when -h, --help or -help is among the arguments.
 bool wantsHelp(int argc, char** argv);
+/// True when --version or -version is among the arguments.
+bool wantsVersion(int argc, char** argv);
+/// "<name> (msfusion) <version>, commit <commit>": what --version prints, and the help's last line.
+std::string versionLine(const std::string& name);
 
 /// A tool's command line, each option declared once: its name, whether it takes a value,
 /// its help and where its value goes. The help, the check that every option given is
@@ -68,7 +73,8 @@ public:
   /// The names of the flags, in the order declared.
   std::vector<std::string> flags() const;
 
-  /// A tool's main: the help and exit code 0 on -h (wantsHelp), the help and 1 with fewer than
+  /// A tool's main: versionLine() and exit code 0 on --version (wantsVersion), the help and
+  /// exit code 0 on -h (wantsHelp), the help and 1 with fewer than
   /// `min_arguments` arguments, else parse() and `body` with the positional arguments under
   /// run(), whose exceptions become "<name>: error: ..." and 1.
   int run(int argc, char** argv, int min_arguments, const std::function<int(const Arguments&)>& body);

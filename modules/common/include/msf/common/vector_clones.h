@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // MSF_VECTOR_CLONES before a function whose loops vectorize: GCC compiles it twice, for
 // x86-64's baseline (SSE2) and for AVX2 (twice the lanes), and the loader picks the copy the

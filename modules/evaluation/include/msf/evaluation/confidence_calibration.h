@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/fusion/fusion_config.h>
 
@@ -13,7 +14,7 @@ namespace msf {
 /// ground truth, beside the sigma the fusion assumes for that confidence (stereoSigmaPx:
 /// fusion.stereo_sigma_min_px and stereo_sigma_max_px). The check of the fusion's uncertainty
 /// model on a user's data (msf_eval_disparity -confidence, bench/bench_stereo_sigma.sh; the
-/// figures in docs/results.md, session 15).
+/// figures in docs/results.md).
 ///
 /// Errors are kept in a histogram per confidence bin (1/64 px over +-32 px; larger errors in
 /// the end cells), so that a sequence of any length costs the same memory, and the robust

@@ -1,9 +1,11 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <Eigen/Geometry>
 #include <opencv2/core/types.hpp>
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace msf {
 
@@ -23,6 +25,13 @@ struct Calibration {
   /// is then the identity and means nothing
   bool has_velodyne = true;
   std::string source;                       ///< where it was read from, for messages
+  /// What the rig says of its LiDAR beyond the extrinsic (a rig file's `lidar:`); KITTI's
+  /// calibrations leave it unknown, and the stages take the rings from the scan's order.
+  struct Lidar {
+    int rings = 0;                          ///< beams, 0 = unknown
+    std::vector<double> beam_elevations_deg; ///< one per ring, lowest first; empty = unknown
+    bool sweeping = true;                   ///< a spinning LiDAR: each scan swept over its period
+  } lidar;
 
   double fx(int camera = 0) const { return P[camera](0, 0); }
   double fy(int camera = 0) const { return P[camera](1, 1); }
@@ -36,10 +45,17 @@ struct Calibration {
   double baseline(int camera_a, int camera_b) const;
   double baselineGrey() const { return baseline(0, 1); }
   double baselineColor() const { return baseline(2, 3); }
-  /// f * B of the grey pair, so that depth = focalBaseline() / disparity.
-  /// Throws CalibrationError naming `source` when it is not > 0 and finite (fx 0, NaN, or
-  /// cameras 0 and 1 at one centre): a disparity made of it would be silently zero.
+  /// f * B of the grey pair, so that depth = focalBaseline() / disparity; what every stereo
+  /// stage asks first. Throws CalibrationError naming `source` when the grey pair cannot be a
+  /// rectified stereo pair: f B not > 0 and finite (fx 0, NaN, cameras 0 and 1 at one centre:
+  /// a disparity made of it would be silently zero), camera 1 left of camera 0 (swapped images
+  /// or sign: the disparities would be of the wrong sign), a baseline outside
+  /// limits::kMinBaselineM .. kMaxBaselineM (a unit slip), or checkRectifiedPair(0, 1).
   double focalBaseline() const;
+  /// Throws CalibrationError naming `source` and the value unless cameras a and b share their
+  /// intrinsics (fx, fy, cx, cy within limits::kRectifiedIntrinsicsTolerancePx) and differ
+  /// along x only, as the cameras of a rectified pair do.
+  void checkRectifiedPair(int a, int b) const;
   /// Throws CalibrationError naming `source` when the image size is unknown.
   cv::Size requireImageSize() const;
   /// Throws CalibrationError naming `source` when it holds the cameras only (no LiDAR

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/io/poses.h>
@@ -53,12 +54,25 @@ public:
   /// skips the colour camera. Safe to call from another thread than the one that made the
   /// source. Throws IOError naming a missing or malformed file.
   virtual Frame load(std::size_t i, bool with_color = true) const = 0;
+  /// Frame i's scan alone, as load() gives it (Frame::scan), without reading its images: for
+  /// what reads every frame's scan before a run (the memory prediction). Throws as load() does.
+  virtual pcl::PointCloud<pcl::PointXYZI>::Ptr loadScan(std::size_t i) const { return load(i, false).scan; }
 
+  /// Frame i's time, seconds from the source's first frame (Frame::timestamp), without loading it.
+  virtual double timestamp(std::size_t i) const = 0;
   /// The source's own poses T_world_cam0, one per frame, or none.
   virtual const PoseList& poses() const;
   bool hasPoses() const { return !poses().empty(); }
   /// Where poses() come from, in words ("the odometry ground truth").
   virtual std::string posesName() const { return "the dataset's poses"; }
+  /// Whether poses() are a GPS/INS's measurement (KITTI raw's OXTS), which the scans can
+  /// correct, rather than a ground truth: msf_reconstruct refines them by default.
+  virtual bool posesAreMeasured() const { return false; }
+  /// The poses a trajectory is scored against (protocol 5): the true ones when the source
+  /// knows them apart from poses() (a synthetic drive with INS-like poses), else poses().
+  virtual const PoseList& referencePoses() const { return poses(); }
+  /// Where referencePoses() come from, in words.
+  virtual std::string referencePosesName() const { return posesName(); }
   /// The source in words for messages and reports: its folder or file.
   virtual std::string description() const = 0;
   /// Frame i's scan in words for messages ("scan '.../000042.bin'").
@@ -70,9 +84,17 @@ public:
   virtual bool sweepingScans() const { return true; }
   /// Folder of synthetic ground truth, "" when there is none.
   virtual std::string groundTruthDir() const { return {}; }
+  /// What the reader skipped or assumed, one line each, for the tool to print (a bag's frames
+  /// left out for want of an image, say).
+  virtual std::vector<std::string> notes() const { return {}; }
 
-  /// Indices of a range; throws InvalidInputError when it selects no frame or goes beyond the last.
+  /// Indices of the frames whose numbers (frameNumber of their names, else their index) lie in
+  /// the range; throws InvalidInputError when it selects no frame or goes beyond the last.
   std::vector<std::size_t> indices(const FrameRange& range) const;
 };
+
+/// A frame's number from its name ("000042" -> 42); -1 for a name that is not all digits
+/// (a stray file: "README", "000042 (copy)").
+long long frameNumber(const std::string& name);
 
 } // namespace msf

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <opencv2/core/mat.hpp>
 
@@ -11,7 +12,8 @@ namespace msf {
 /// flags: cv::ImreadModes (default: as stored).
 cv::Mat readImage(const std::string& path, int flags = -1);
 
-/// cv::imwrite through a temporary file and a rename; throws IOError on failure.
+/// Encodes by the extension (cv::imencode) and writes atomically, checked to the end
+/// (msf/common/checked_write.h); throws IOError naming the file and the reason on failure.
 void writeImage(const std::string& path, const cv::Mat& image);
 
 /// KITTI 16-bit PNG (value = metres or pixels x 256, 0 = none) to CV_32F (0 = none).

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The point types of the stages' organized clouds, registered with PCL (so .pcd files keep
 // their field names and pcl_viewer opens them). Here, in the module every stage builds on, so

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 
@@ -24,7 +25,13 @@ struct OxtsRecord {
   double roll = 0, pitch = 0, yaw = 0;  ///< radians
 };
 
-/// Reads oxts/data/*.txt of a raw drive folder (sorted by name).
+/// Reads one OXTS record file (oxts/data/NNNNNNNNNN.txt); throws IOError naming it when its
+/// first six values are not finite numbers.
+OxtsRecord loadOxtsRecord(const std::string& path);
+
+/// Reads oxts/data/*.txt of a raw drive folder (sorted by name). A Sequence takes each
+/// frame's record by the frame's name instead, so that a gap in the records is not filled by
+/// the next one.
 std::vector<OxtsRecord> loadOxts(const std::string& oxts_data_dir);
 
 /// Converts OXTS records to T_world_cam0 with the KITTI raw devkit's Mercator formulation

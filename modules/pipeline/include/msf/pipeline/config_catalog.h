@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config.h>
 #include <msf/pipeline/pipeline_config.h>
@@ -38,6 +39,15 @@ ConfigFile openConfigText(const std::string& text, const std::string& name);
 template <class Config>
 void readConfigSection(const std::string& path, Config& config) {
   openConfigFile(path).read(config);
+}
+
+/// -config of a tool that runs one stage on a rig: section Config::kSection of the file at `path`
+/// into `stage` and section `rig` into `rig` (adaptToRig), the file checked whole.
+template <class Config>
+void readStageAndRig(const std::string& path, Config& stage, RigAdaptationConfig& rig) {
+  const ConfigFile file = openConfigFile(path);
+  file.read(stage);
+  file.read(rig);
 }
 
 } // namespace msf

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/pipeline/depth_panel.h>
 #include <msf/pipeline/reconstructor.h>

@@ -1,4 +1,6 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/io/bag_options.h>
 #include <msf/io/frame_source.h>
 
 #include <memory>
@@ -12,11 +14,18 @@ struct DatasetOptions {
   /// A calibration or rig file (-calib / -rig): required by layouts that carry none, and
   /// overriding the dataset's own otherwise. "" = the dataset's.
   std::string rig;
+  /// A ROS bag's topics and frames (kitti2bag's by default); for bags only.
+  BagOptions bag;
 };
 
-/// Opens a dataset by what the path holds: a KITTI odometry sequence (or a root with one
-/// sequence, as msf_synth writes), a KITTI raw drive. Throws IOError naming the path and the
+/// Opens a dataset by what the path holds: a folder of the generic layout (FolderSource:
+/// left/, right/, lidar/ and a rig file), a KITTI odometry sequence (or a root with one
+/// sequence, as msf_synth writes), a KITTI raw drive, or a ROS 1 bag (a file that starts as one
+/// does: msf::BagSource, in builds with the ros module). Throws IOError naming the path and the
 /// layouts it knows when it is none of them.
 std::unique_ptr<FrameSource> openDataset(const std::string& path, const DatasetOptions& options = {});
+
+/// Whether `path` is a ROS 1 bag file (its first bytes are "#ROSBAG V").
+bool isRosBag(const std::string& path);
 
 } // namespace msf

@@ -1,7 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/fusion/fusion_config.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/ring_split.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -54,6 +56,7 @@ struct PipelineConfig {
   SchedulingConfig scheduling;
   StreamingMap::Config streaming; ///< the map in bounded memory (off by default)
   LidarOdometry::Config odometry; ///< the poses of msf_reconstruct -poses estimate (PoseSource)
+  RigAdaptationConfig rig;        ///< how the keys above follow the rig the stages run on (adaptToRig)
 
   /// Calls visit(section) for each section of `config` (a PipelineConfig, const or not) in the
   /// order print() writes them.
@@ -70,6 +73,7 @@ struct PipelineConfig {
     visit(config.scheduling);
     visit(config.streaming);
     visit(config.odometry);
+    visit(config.rig);
   }
 
   /// The paper as published (Ali, Rajput et al. 2019), without the project's additions:

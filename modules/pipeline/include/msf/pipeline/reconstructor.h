@@ -1,8 +1,11 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/frame_source.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/reconstruction/block_footprint.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/scan_band_blocks.h>
 #include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -11,29 +14,48 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace msf {
 
 /// What a run is predicted to hold at its peak, before it starts (Reconstructor::predictMemory), in
-/// MiB: an upper bound on the TSDF volume from the poses alone (the blocks of every frame's
-/// view up to the integrator's allocation depth, BlockFootprint), plus a model of the rest
-/// (per pixel of the frames in flight, and a fraction of the volume for the mesh and files
-/// written at the end) measured on KITTI and the synthetic street (docs/robustness.md,
+/// MiB. The TSDF volume's blocks are the blocks within the truncation band of the scans' returns
+/// in view (ScanBandBlocks, from the scans and the poses), times the blocks the fused depth
+/// allocates per such block, measured by integrating a few of the run's frames, and never more
+/// than the blocks of every frame's view (BlockFootprint, the bound from the poses alone); the
+/// rest is a model (per pixel of the frames in flight, and a share of the volume for the mesh
+/// and files written at the end) measured on KITTI and the synthetic street (docs/robustness.md,
 /// "Memory budget").
 struct MemoryPrediction {
   std::size_t frames = 0;
-  std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all
+  std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all: the bound
+  std::size_t band_blocks = 0;       ///< blocks within the band of the scans' returns in view, in all
+  double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
+  std::size_t blocks = 0;            ///< blocks the run is predicted to allocate, in all
   std::size_t blocks_in_memory = 0;  ///< at once: all of them, or with -stream the most within the window
   double process_mb = 0;  ///< the process when predicting (libraries, calibration, config)
-  double volume_mb = 0;   ///< the TSDF volume's blocks, map and block list at blocks_in_memory
+  double volume_mb = 0;   ///< the TSDF volumes' blocks, maps and block lists at blocks_in_memory
   double frames_mb = 0;   ///< images, scans, depth and stage buffers of the frames in flight
-  double mesh_mb = 0;     ///< the end of an in-memory run: the mesh, its cache, the copies written
+  double mesh_mb = 0;     ///< the end of the run: the mesh, its cache, the copies written
   double total_mb = 0;    ///< the sum: the predicted peak
   double ms = 0;          ///< time the prediction took
   /// The terms in words, one line: "TSDF volume 800 MiB for 120000 blocks, frames and stage ...".
   std::string describe() const;
+};
+
+/// What the memory prediction measures from a run's data before it starts
+/// (Reconstructor::measureMemory): the blocks of the views, the blocks within the scans' bands,
+/// the share the fused depth adds on the calibration frames, and the process. Measured once, it
+/// serves the predictions of the run in memory and streamed alike.
+struct MemoryEvidence {
+  PoseList T_world_cam0;             ///< the run's poses, one per frame
+  BlockFootprint footprint;          ///< the blocks every frame's view meets: the bound
+  ScanBandBlocks bands;              ///< the blocks within the band of the scans' returns in view
+  double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
+  double process_mb = 0;             ///< the process before the calibration frames
+  double ms = 0;                     ///< time the measure took
 };
 
 /// Milliseconds each stage spent on one frame. lidar = projection + interpolation;
@@ -76,7 +98,7 @@ struct FrameResult {
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration);
 
-/// The reconstruction engine: the whole method (the README's data flow) as one object that
+/// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
 /// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected
 /// onto the image grown by a margin, so gaps across the image's border are bridged) and SGBM
@@ -105,6 +127,12 @@ public:
     Auto,     ///< the frame's own pose; LiDAR odometry for a run whose first frame has none
     Given,    ///< the frame's own pose; a frame without one is an error
     Odometry, ///< LiDAR odometry, in the world of the first frame's pose when it has one
+    /// The frame's own pose (a GPS/INS's) as a prior that the LiDAR odometry refines: its motion
+    /// since the previous frame is the scan's prediction and a soft constraint weighed by its
+    /// accuracy (odometry.prior_*_sigma_*), so the scans correct a drifting heading and a scene
+    /// they cannot pin down (a tunnel, an open field) keeps the prior's motion; in the world of
+    /// the first frame's pose. A frame without a pose is an error.
+    Refine,
   };
 
   struct Options {
@@ -181,21 +209,35 @@ public:
   /// A streamed map (Options::stream_directory): writes the tiles still in memory and the
   /// union of all as `mesh_path`; the volume is empty afterwards. Returns the triangles written.
   std::size_t finishStreaming(const std::string& mesh_path);
-  /// The peak memory of run() over frames seen from `T_world_cam0` (their poses, known before
-  /// the run: a dataset's or a file's; not estimated ones), predicted without reading the
-  /// frames: see MemoryPrediction. With streaming, the volume term is the most blocks of the
-  /// footprint within the active radius (grown by a tile) of any frame's camera. `maps` is the
-  /// number of volumes the caller fills from the same frames (msf_reconstruct
-  /// -compare_sources: 3); `scores_every_frame`: the caller keeps each frame's ground truth
-  /// to the end (protocol 4). Throws ConfigError when the integrator's band has no bound
-  /// (reach() is infinite), InvalidInputError for views too large to enumerate.
-  MemoryPrediction predictMemory(const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false) const;
+  /// What the peak memory of run() over `frames` of `source` seen from `T_world_cam0` (one per
+  /// frame, known before the run: a dataset's or a file's; not estimated ones) is predicted from:
+  /// it reads every frame's scan, and computes the depth of a few frames (with this object's
+  /// stages) and integrates it into a volume of their own. Throws ConfigError when the
+  /// integrator's band has no bound (reach() is infinite), InvalidInputError for views too large
+  /// to enumerate or frames and poses of different counts.
+  MemoryEvidence measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                               const PoseList& T_world_cam0);
+  /// The peak memory of run() predicted from `evidence` (measured by an engine of the same volume,
+  /// integrator and projection configuration, streamed or not): see MemoryPrediction. With
+  /// streaming, the volume term is the most blocks within the active radius (grown by a tile) of
+  /// any frame's camera. `maps` is the number of volumes the caller fills from the same frames
+  /// (msf_reconstruct -compare_sources: 3); `scores_every_frame`: the caller keeps each frame's
+  /// ground truth to the end (protocol 4).
+  MemoryPrediction predictMemory(const MemoryEvidence& evidence, int maps = 1, bool scores_every_frame = false) const;
+  /// Both: measureMemory, then predictMemory from it.
+  MemoryPrediction predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
+                                 const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false);
+
+  /// The least streaming.active_radius_m a streamed map of this run accepts: the integrator's
+  /// reach over the LiDAR's canvas plus a tile (StreamingMap::minimumRadius).
+  double minimumStreamingRadius() const;
 
   /// The streaming map, or nullptr when the map stays in memory.
   const StreamingMap* streaming() const { return streaming_.get(); }
   /// Milliseconds the odometry took for each frame it tracked (empty when it did not run).
   const std::vector<double>& odometryMs() const { return odometry_ms_; }
 
+  /// The configuration the stages run with: the one given, adapted to the rig (adaptToRig).
   const PipelineConfig& config() const { return config_; }
   const Calibration& calibration() const { return calibration_; }
   const Options& options() const { return options_; }
@@ -217,7 +259,21 @@ private:
   bool tracks(const Frame& first) const;
   /// The odometry's pose of the frame's scan; frames in order.
   Eigen::Isometry3d track(const Frame& frame, const std::string& scan_name);
+  /// PoseMode::Refine: the LiDAR's motion since the previous frame by the frames' own poses
+  /// (the identity for the first); nullopt in the other modes.
+  std::optional<Eigen::Isometry3d> measuredMotion(const Frame& frame);
   void startStreaming();
+  // The memory prediction's steps (predictMemory).
+  ScanBandBlocks scanBands() const;
+  ScanBandBlocks scanBandsOf(const FrameSource& source, const std::vector<std::size_t>& frames,
+                             const PoseList& T_world_cam0) const;
+  /// The blocks a frame's fused depth allocates per block of its scan's band, the most over a few
+  /// frames spread over the run; 0 when none could be measured.
+  double blocksPerBandBlock(const FrameSource& source, const std::vector<std::size_t>& frames,
+                            const PoseList& T_world_cam0);
+  std::size_t predictedBlocks(std::size_t band_blocks, std::size_t footprint_blocks,
+                              double blocks_per_band_block) const;
+  std::size_t blocksInWindow(const MemoryEvidence& evidence) const;
 
   Calibration calibration_;
   PipelineConfig config_;
@@ -233,6 +289,7 @@ private:
   // The odometry (PoseMode): made at the first frame it tracks, anchored at that frame's pose.
   std::unique_ptr<LidarOdometry> odometry_;
   Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_velo_measured_last_ = Eigen::Isometry3d::Identity();  // PoseMode::Refine's prior
   std::vector<double> odometry_ms_;
   std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
   bool add_tracks_ = false;

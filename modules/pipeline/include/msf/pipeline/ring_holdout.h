@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/evaluation/holdout.h>
 #include <msf/io/frame_source.h>

@@ -1,8 +1,10 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/evaluation/odometry_metrics.h>
+#include <msf/evaluation/open_sky_coverage.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/pipeline/reconstructor.h>
 
@@ -65,13 +67,13 @@ public:
   std::size_t frames_requested = 0;
   bool interrupted = false;
   /// Optional outputs a second stop signal left out (msf_reconstruct: "compare_sources",
-  /// "mesh_preview", "mesh_accuracy", "reconstruction_evaluation"), in the order skipped.
+  /// "mesh_preview", "mesh_accuracy", "reconstruction_evaluation", "open_sky"), in the order skipped.
   std::vector<std::string> skipped;
   double wall_s = 0;
   double first_frame_s = 0;       ///< when the first frame was done, from the start
   double mesh_ms = 0;
   double peak_memory_mb = 0;
-  /// The peak predicted before the run (Pipeline::predictMemory); < 0 when the poses were not
+  /// The peak predicted before the run (Reconstructor::predictMemory); < 0 when the poses were not
   /// known before it (estimated), written as null.
   double predicted_memory_mb = -1;
   std::size_t observed_voxels = 0, blocks = 0, vertices = 0, triangles = 0;
@@ -84,6 +86,10 @@ public:
   bool has_mesh_accuracy = false;
   MeshAccuracy mesh_accuracy;
   MapEvaluation map_evaluation;
+  /// Evaluation protocol 6: the open sky each mesh covers, by mesh ("mesh", "mesh_lidar", ...),
+  /// and the pictures of it (sky_NNNNNN.png); empty when not measured.
+  std::map<std::string, SkyCoverage> open_sky;
+  std::vector<std::string> sky_pictures;
   /// The effective configuration (PipelineConfig::print: every key of every section, after
   /// defaults, the file and the flags), written into summary.json; "" leaves it out.
   std::string config_yaml;
@@ -106,6 +112,7 @@ public:
 
 private:
   void writeMapEvaluation(std::ostream& out) const;
+  void writeOpenSky(std::ostream& out) const;
   /// The meshes' accuracy and completeness by the class of the true surface (when known).
   void writeClassTable(std::ostream& out) const;
 };

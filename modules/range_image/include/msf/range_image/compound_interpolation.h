@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/range_image/depth_completion_filter.h>
 #include <msf/range_image/depth_interpolator.h>

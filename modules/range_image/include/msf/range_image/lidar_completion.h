@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/range_image/compound_interpolation.h>

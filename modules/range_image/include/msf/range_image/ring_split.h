@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config_keys.h>
 
@@ -33,10 +34,22 @@ struct RingSplitConfig {
 /// an id holds the left half (azimuth > 0) of one laser and the right half of the one before.
 std::vector<int> ringIds(const pcl::PointCloud<pcl::PointXYZI>& scan);
 
+/// Ring id of each point from its elevation above the sensor's horizontal plane: the index of
+/// the nearest of the beams' elevations (degrees, lowest beam first), for a LiDAR whose points
+/// carry no ring and are not stored ring after ring.
+std::vector<int> ringIdsFromElevations(const pcl::PointCloud<pcl::PointXYZI>& scan,
+                                       const std::vector<double>& elevations_deg);
+
 /// Splits a scan (file order) into the points of input rings and of held-out rings, both in
 /// file order; headers are copied. Returns the number of ring ids (wraps + 1).
 /// Throws ConfigError for an invalid config.
 int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const RingSplitConfig& config,
+               pcl::PointCloud<pcl::PointXYZI>& input, pcl::PointCloud<pcl::PointXYZI>& heldout);
+
+/// The same with each point's ring id given (from the data, or ringIdsFromElevations); returns
+/// the number of ring ids (the largest + 1). Throws InvalidInputError when the ids are not one
+/// per point.
+int splitRings(const pcl::PointCloud<pcl::PointXYZI>& scan, const std::vector<int>& ids, const RingSplitConfig& config,
                pcl::PointCloud<pcl::PointXYZI>& input, pcl::PointCloud<pcl::PointXYZI>& heldout);
 
 } // namespace msf

@@ -1,5 +1,7 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/tsdf_store.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Core>
@@ -54,6 +56,9 @@ public:
     bool enabled() const { return active_radius_m > 0.0; }
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
+    /// Throws ConfigError when the active radius is below `reach_m` (TsdfIntegrator::reach)
+    /// plus a tile of `voxel_size_m` voxels: a tile would be freed and read back at once.
+    void requireRadius(double reach_m, double voxel_size_m) const;
   };
 
   struct Stats {
@@ -102,10 +107,24 @@ public:
   /// The blocks of a store as one volume (a region of a drive, or a short one: all of it is
   /// in memory). Throws IOError as remesh.
   static TsdfVolume loadStore(const std::string& directory);
+  /// Meshes `tiles` of `store`, each with the layer around it read from the store's other
+  /// tiles, into `tiles_directory`/X_Y_Z.ply (written atomically; a tile without a triangle
+  /// has no file), one tile in memory at a time: tasks that mesh parts of one store side by
+  /// side write the tiles a remesh would. Returns the triangles written.
+  static std::size_t meshTiles(const TsdfStore& store, const MarchingCubes::Config& mesher,
+                               const std::vector<GridIndex>& tiles, const std::string& tiles_directory);
+  /// The welded union of the meshes of `tiles` in `tiles_directory` (those with a file) as one
+  /// binary PLY at `mesh_path`, read one tile at a time (none written without a triangle).
+  /// Returns its triangles. Throws IOError naming a tile mesh that is not one meshTiles wrote.
+  static std::size_t unionOfTiles(const TsdfStore& store, const std::vector<GridIndex>& tiles,
+                                  const std::string& tiles_directory, const std::string& mesh_path);
 
   /// Reads a PLY that writeMesh or finish wrote (binary, x y z float, red green blue uchar,
   /// triangles). Throws IOError naming the file when it is not one.
   static void readMesh(const std::string& path, TriangleMesh& mesh);
+  /// Moves the vertices of a PLY that writeMesh or finish wrote by T, in place (atomically):
+  /// the union of a streamed map in another world (msf_reconstruct -world z_up).
+  static void transformMeshFile(const std::string& path, const Eigen::Isometry3d& T);
   /// Writes `mesh` as such a PLY, atomically.
   static void writeMesh(const std::string& path, const TriangleMesh& mesh);
   /// Merges vertices at the same position (bit for bit), e.g. of tiles/*.ply put together
@@ -124,7 +143,7 @@ private:
   void readBack(std::vector<TileKey> tiles);
   /// The volume's BlockSource: reads back the evicted tiles within a block of `blocks`.
   void readBackAround(const std::vector<GridIndex>& blocks);
-  void writeIndex() const;
+  void writeIndex();
   std::string tilesDirectory() const;
 
   TsdfVolume& volume_;
@@ -132,6 +151,7 @@ private:
   MarchingCubes mesher_;
   double reach_m_;
   std::string directory_;
+  TsdfStore store_;                      ///< DIR/tsdf
   std::unordered_set<TileKey> stored_;   ///< tiles with a block file
   std::unordered_set<TileKey> evicted_;  ///< stored tiles whose blocks are not in memory
   std::unordered_set<TileKey> stale_;    ///< evicted tiles whose mesh read blocks that were read back since

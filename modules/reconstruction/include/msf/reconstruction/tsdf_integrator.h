@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config_keys.h>
 #include <msf/common/parallel.h>
@@ -122,6 +123,10 @@ public:
     SignedDistance signed_distance = SignedDistance::Plane;
     PlaneDistanceConfig plane;
     double lambda = 0.0;
+    /// Beyond it eq. 7 no longer regularizes but erases: a voxel's own mean counts less than a
+    /// millionth against its neighbours' (a hundredth at max_weight with inverse_variance), and
+    /// the surface is flattened to nothing; the float sums near their range long before 1e300.
+    static constexpr double kMaxLambda = 1e6;
     /// Uniform: lambda is a pure number. InverseVariance: x = argmin sum_i W_i (x_i - y_i)^2 +
     /// lambda sum_ij (x_i - x_j)^2, W_i the voxel's weight, lambda in m^-2: a LiDAR-backed voxel
     /// (W ~ 1000) barely moves, a far stereo-only one (W ~ 10) takes its neighbours' mean, so
@@ -171,7 +176,9 @@ public:
       k("signed_distance", signed_distance, kSignedDistances,
         "plane: distance to the observed surface's tangent plane | projective: along the optical axis (the paper)");
       plane.keys(k);
-      k("lambda", lambda, atLeast(0), "eq. 7's regularization weight (0: the plain weighted mean; the paper: 5)");
+      k("lambda", lambda, between(0, kMaxLambda),
+        "eq. 7's regularization weight (0: the plain weighted mean; the paper: 5; beyond 1e6 it flattens the "
+        "surface)");
       k("lambda_data", lambda_data, kLambdaData,
         "uniform: eq. 7 as written | inverse_variance: each mean counts by its weight, lambda in m^-2");
       k("sweeps", sweeps, between(0, kMaxSweeps), "Gauss-Seidel sweeps per frame over the voxels it changed");

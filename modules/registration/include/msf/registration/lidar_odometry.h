@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config_keys.h>
 #include <msf/io/poses.h>
@@ -7,6 +8,7 @@
 #include <msf/registration/nearest_cache.h>
 #include <msf/registration/point_list.h>
 #include <msf/registration/scan_constraints.h>
+#include <msf/registration/scan_to_map_icp.h>
 #include <msf/registration/voxel_downsample.h>
 
 #include <Eigen/Geometry>
@@ -55,6 +57,12 @@ public:
     double convergence = 1e-4;
     /// KITTI's scans have 0.016 or more, the synthetic street 0.003 or more, a single plane 0.
     double min_constraint = 1e-3;
+    /// A measured motion's accuracy per scan (registerPoints with a prior: a GPS/INS's poses),
+    /// one standard deviation: the weight of its soft constraint, where each scan pair counts
+    /// as a measurement of the robust kernel's scale. 0.1 degrees is an OXTS RT3003's stated
+    /// heading accuracy; 0.1 m lets the scans correct the motion a heading error turns aside.
+    double prior_translation_sigma_m = 0.1;
+    double prior_rotation_sigma_deg = 0.1;
 
     template <class Keys>
     void keys(Keys& k) {
@@ -73,6 +81,11 @@ public:
       k("convergence", convergence, above(0), "ICP stops when a step moves the pose less than this");
       k("min_constraint", min_constraint, Range{0, 1, false, true},
         "a scan whose planes pin a degree of freedom down less than this (smallest eigenvalue) is an error");
+      k("prior_translation_sigma_m", prior_translation_sigma_m, above(0),
+        "a measured motion's (a GPS/INS's poses: -poses refine) accuracy per scan, one standard deviation: the "
+        "weight of its soft constraint on the registration, m");
+      k("prior_rotation_sigma_deg", prior_rotation_sigma_deg, above(0),
+        "the same for the measured motion's rotation, degrees");
     }
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
@@ -100,14 +113,22 @@ public:
   /// skipped. Throws InvalidInputError starting with `name` for a scan without a finite point
   /// in range, one whose planes leave a degree of freedom unconstrained, or one that does not
   /// overlap the map; the odometry is then unchanged.
+  ///
+  /// `measured_motion`, when given, is the sensor's motion since the previous scan as a GPS/INS
+  /// measured it (T_previous_current): the prediction instead of the constant velocity, and a
+  /// soft constraint on the registration (Config::prior_*_sigma_*, PosePrior). A scan that
+  /// cannot be registered then takes the measured motion instead of being an error (the first
+  /// scan's motion only says it is measured: its pose is the world's origin).
   template <typename PointT>
-  Eigen::Isometry3d registerScan(const pcl::PointCloud<PointT>& scan, const std::string& name = "scan") {
+  Eigen::Isometry3d registerScan(const pcl::PointCloud<PointT>& scan, const std::string& name = "scan",
+                                 const Eigen::Isometry3d* measured_motion = nullptr) {
     scan_.resize(scan.size()); // non-finite ones too: registerPoints counts them in its message
     for (std::size_t i = 0; i < scan.size(); ++i)
       scan_[i] = Eigen::Vector3d(scan[i].x, scan[i].y, scan[i].z);
-    return registerPoints(scan_, name);
+    return registerPoints(scan_, name, measured_motion);
   }
-  Eigen::Isometry3d registerPoints(const PointList& points_sensor, const std::string& name = "scan");
+  Eigen::Isometry3d registerPoints(const PointList& points_sensor, const std::string& name = "scan",
+                                   const Eigen::Isometry3d* measured_motion = nullptr);
 
   /// T_world_sensor of every scan registered.
   const PoseList& poses() const { return poses_; }
@@ -116,6 +137,18 @@ public:
   const Config& config() const { return config_; }
 
 private:
+  /// The scan's pose from the prediction: scan-to-map ICP (on the first scan's own map for the
+  /// second scan of a sweeping LiDAR, once its motion deskews both).
+  Eigen::Isometry3d align(const PointList& points_sensor, const std::string& name, const Eigen::Isometry3d& prediction,
+                          const PosePrior* prior, Stats& stats);
+  /// The scan's constraints; throws when its planes leave a degree of freedom unconstrained and
+  /// no prior holds it.
+  ScanConstraints checkConstraints(const std::string& name, Stats& stats, bool has_prior) const;
+  /// The first scan's returns in range, kept until the second scan's motion deskews them.
+  void keepFirstReturns(const PointList& points_sensor);
+  /// Adds the scan at `pose` to the map and to the poses.
+  Eigen::Isometry3d accept(const Eigen::Isometry3d& pose, Stats& stats);
+
   Config config_;
   LocalMap map_;
   AdaptiveThreshold threshold_;
@@ -130,6 +163,14 @@ private:
   VoxelDownsampler downsampler_;
   NearestCache neighbors_;
 };
+
+/// `registered` with its departure from `prior` (in the prior's frame, rotations as the metres
+/// they move a point at the scan's lever) removed along the directions the scan's planes leave
+/// free (eigenvalues of `constraints` at or below `min_constraint`): there the prior holds, not
+/// what spurious pairs (a ring on a tunnel's floor) pulled the registration to. Solution
+/// remapping (Zhang, Kaess and Singh, ICRA 2016).
+Eigen::Isometry3d keepPriorWhereFree(const Eigen::Isometry3d& prior, const Eigen::Isometry3d& registered,
+                                     const ScanConstraints& constraints, double min_constraint);
 
 /// `config` with deskew auto resolved for `sequence`: none for a synthetic sequence (msf_synth's
 /// LiDAR takes a snapshot at the frame's pose), sweep for KITTI's.

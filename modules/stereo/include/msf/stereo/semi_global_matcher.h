@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/parallel.h>
 #include <opencv2/core/mat.hpp>
@@ -12,7 +13,8 @@ namespace msf {
 /// has it): the algorithm of OpenCV's StereoSGBM in MODE_SGBM_3WAY with the same parameters
 /// and output, 2.2x (AVX2) to 3x (AVX-512) as fast per core as the Debian build of OpenCV 4.6
 /// (whose SGBM is compiled for SSE2 only) on a KITTI frame at 128 disparities; with
-/// diagonal_paths, the five paths of its MODE_SGBM.
+/// diagonal_paths, the five paths of its MODE_SGBM; with p1_rise, a ground prior of its own
+/// (Params::p1_rise). A portable kernel gives the same result on CPUs without AVX2.
 ///
 /// Cost: Birchfield-Tomasi dissimilarity of the Sobel-x prefiltered images (clipped at
 /// pre_filter_cap) plus a quarter of that of the raw images, summed over block_size^2;
@@ -27,8 +29,7 @@ namespace msf {
 ///   SemiGlobalMatcher matcher(params);
 ///   matcher.compute(left, right, disparity); // CV_16S, disparity x 16
 ///
-/// Needs AVX2 (isAvailable()); buffers are kept between calls, so after the first frame of
-/// a size nothing is allocated.
+/// Buffers are kept between calls, so after the first frame of a size nothing is allocated.
 class SemiGlobalMatcher {
 public:
   using Ptr = std::shared_ptr<SemiGlobalMatcher>;
@@ -41,6 +42,13 @@ public:
     int block_size = 5;        ///< odd, 1..11
     int p1 = 200;              ///< > 0
     int p2 = 800;              ///< > p1
+    /// The ground prior: the paths from above (top-to-bottom, and the diagonal ones) charge
+    /// p1_rise rather than p1 for a disparity one pixel higher than at the pixel above. Down
+    /// the image the ground, and what stands on it, comes nearer row by row (on KITTI a pixel
+    /// of disparity every three rows); with p1 for such a rise, the paths from above hold the
+    /// disparity of the rows above (SGM's fronto-parallel bias) and outvote the rows' paths.
+    /// 0 or p1: OpenCV's paths; else 1..p2 - 1.
+    int p1_rise = 0;
     int pre_filter_cap = 63;   ///< 1..63 (OpenCV uses max(cap, 15) | 1)
     int uniqueness_ratio = 10; ///< percent, 0..100; 0 = off
     int speckle_window_size = 100; ///< 0 = no speckle filter
@@ -66,10 +74,12 @@ public:
   SemiGlobalMatcher() = default;
   explicit SemiGlobalMatcher(const Params& params) { setParams(params); }
 
-  /// True when this build has the AVX2 kernel, the CPU runs it and it is not disabled.
-  static bool isAvailable();
-  /// Disables (false) or re-enables the AVX2 kernel process-wide, so that tests and
-  /// benchmarks can run the OpenCV fallback on a machine with AVX2.
+  /// True when compute() runs the AVX2 kernel (or the AVX-512 one): this build has it, the
+  /// CPU runs it and it is not disabled. Else the portable kernel runs, with the same result.
+  static bool usesAvx2();
+  /// Disables (false) or re-enables the AVX2 and AVX-512 kernels process-wide, so that tests
+  /// and benchmarks can run the portable kernel (and SgbmStereo its OpenCV fallback) on a
+  /// machine with AVX2.
   static void setAvx2Enabled(bool enabled);
   /// True when compute() runs the AVX-512BW kernel (32 disparities per instruction, the
   /// same result as the AVX2 one, ~12 % faster at 128 disparities) for a number of
@@ -88,7 +98,7 @@ public:
   /// Disparity of the left image (CV_16S, disparity x 16, (min_disparity - 1) x 16 where
   /// none; the first min_disparity + num_disparities columns have none, as OpenCV's).
   /// Throws InvalidInputError for images that are empty, not 8-bit grey, of different sizes
-  /// or wider than maxWidth(), and when the CPU has no AVX2.
+  /// or wider than maxWidth().
   void compute(const cv::Mat& left, const cv::Mat& right, cv::Mat& disparity);
   /// The same, guided by `guidance` (Poggi et al., "Guided Stereo Matching", CVPR 2019):
   /// CV_16SC1 of the images' size, disparity x 16 of the left view, <= 0 where there is no

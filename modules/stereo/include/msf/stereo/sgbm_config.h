@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config_keys.h>
 #include <msf/stereo/semi_global_matcher.h>
@@ -8,23 +9,29 @@
 namespace msf {
 
 /// Every parameter of SgbmStereo: section `stereo` of a config file. The defaults: OpenCV's
-/// 5-path SGBM (mode sgbm) on 128 disparities with 5x5 blocks, narrowed by a LiDAR depth prior
-/// and guided by its returns when they are given (the paper's configuration is the 3-way mode,
-/// unguided).
+/// 5-path SGBM (mode sgbm) where the LiDAR's returns guide it, the 3-way paths with the ground
+/// prior (unguided_mode ground_3way) where nothing does, on 128 disparities with 5x5 blocks,
+/// narrowed by a LiDAR depth prior when one is given (the paper's configuration is OpenCV's
+/// 3-way mode, unguided).
 struct SgbmConfig {
   static constexpr const char* kSection = "stereo";
   static constexpr const char* kAbout = "SgbmStereo (paper step 3): semi-global matching of the grey pair";
-  /// native: our AVX2 / AVX-512 matcher (SemiGlobalMatcher), OpenCV's algorithm and parameters;
-  /// on a CPU without AVX2, or for hh and hh4, it falls back to OpenCV with a one-time note.
+  /// native: our AVX2 / AVX-512 matcher (SemiGlobalMatcher), OpenCV's algorithm and parameters,
+  /// and ground_3way; for hh and hh4, and for sgbm and sgbm_3way on a CPU without AVX2, it falls
+  /// back to OpenCV with a one-time note.
   std::string engine = "native";
-  /// Guided by the LiDAR, five paths beat three on KITTI and on the synthetic streets; unguided
-  /// they lose (docs/results.md).
+  /// Guided by the LiDAR, five paths beat three on KITTI and on the synthetic streets
+  /// (docs/results.md, "Depth at held-out LiDAR rings").
   std::string mode = "sgbm";
+  /// Unguided, ground_3way beats OpenCV's 3-way, where five paths lose to it (docs/results.md,
+  /// "The unguided matcher").
+  std::string unguided_mode = "ground_3way";
   int min_disparity_px = 0;
   int num_disparities_px = 128;
   int block_size_px = 5;
   int p1 = 0;
   int p2 = 0;
+  int p1_rise = 0;
   int pre_filter_cap = 63;
   int uniqueness_ratio_pct = 10;
   int speckle_window_size_px = 100;
@@ -56,18 +63,27 @@ struct SgbmConfig {
   int color_camera = 2;
   StereoConfidenceConfig confidence;
 
+  static constexpr const char* kModes[] = {"sgbm", "sgbm_3way", "ground_3way", "hh", "hh4"};
+
   template <class Keys>
   void keys(Keys& k) {
     k("engine", engine, {"native", "opencv"},
       "the matcher: ours (AVX2, OpenCV's algorithm, 2-3x faster) or OpenCV's cv::StereoSGBM");
-    k("mode", mode, {"sgbm", "sgbm_3way", "hh", "hh4"},
-      "SGBM's paths: 5 (left, right, top and the diagonals from above), 3, 8 (hh) or 4 (hh4)");
+    k("mode", mode, kModes,
+      "SGBM's paths where the LiDAR's returns guide the matching (guidance lidar and returns given): 5 (sgbm: "
+      "left, right, top and the diagonals from above), 3, 3 with the ground prior, 8 (hh) or 4 (hh4)");
+    k("unguided_mode", unguided_mode, kModes,
+      "the paths where nothing guides it (msf_stereo alone, guidance none); ground_3way: OpenCV's 3-way paths, the "
+      "top-to-bottom one with the ground prior (p1_rise; native engine only, engine opencv runs sgbm_3way)");
     k("min_disparity_px", min_disparity_px, anyNumber(), "smallest disparity searched, px");
     k("num_disparities_px", num_disparities_px, atLeast(16),
       "disparities searched without a LiDAR prior, px (a multiple of 16)");
     k("block_size_px", block_size_px, between(1, 11), "matched block's side, px (odd)");
     k("p1", p1, atLeast(0), "smoothness penalty of a +-1 px step (0: 8 * block_size_px^2)");
     k("p2", p2, atLeast(0), "penalty of a larger step, above p1 (0: 32 * block_size_px^2)");
+    k("p1_rise", p1_rise, atLeast(0),
+      "ground_3way's penalty of a disparity one pixel higher than the row above's along the top-to-bottom path, "
+      "below p2 (0: 3 * block_size_px^2)");
     k("pre_filter_cap", pre_filter_cap, between(1, 63), "clip of the prefiltered image's gradient");
     k("uniqueness_ratio_pct", uniqueness_ratio_pct, between(0, 100),
       "the best cost must beat the second best by this margin, %");
@@ -100,8 +116,11 @@ struct SgbmConfig {
   /// P1 and P2 with the 0 defaults resolved for single-channel images.
   int resolvedP1() const { return p1 > 0 ? p1 : 8 * block_size_px * block_size_px; }
   int resolvedP2() const { return p2 > 0 ? p2 : 32 * block_size_px * block_size_px; }
-  /// OpenCV's cv::StereoSGBM mode constant of `mode`.
-  int opencvMode() const;
+  int resolvedP1Rise() const { return p1_rise > 0 ? p1_rise : 3 * block_size_px * block_size_px; }
+  /// The mode that runs: `mode` when guided, else `unguided_mode`.
+  const std::string& modeFor(bool guided) const { return guided ? mode : unguided_mode; }
+  /// OpenCV's cv::StereoSGBM mode constant of modeFor(guided) (ground_3way: its 3-way).
+  int opencvMode(bool guided) const;
   /// True when engine is native (whether or not the CPU can run it).
   bool nativeEngine() const { return engine == "native"; }
   /// True when guidance is lidar (false for none).

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/stereo/semi_global_matcher.h>
@@ -15,8 +16,10 @@ class StereoSGBM;
 namespace msf {
 
 /// Dense stereo depth (paper step 3): semi-global block matching on a rectified grey pair
-/// (config.engine: our AVX2 SemiGlobalMatcher, or OpenCV's StereoSGBM), to a disparity image, a per-pixel confidence (stereo_confidence.h) and an organized cloud in
-/// the rectified frame of camera 0 with z = f B / d, coloured from the colour camera.
+/// (config.engine: our SemiGlobalMatcher, or OpenCV's StereoSGBM; config.mode guided by the
+/// LiDAR, config.unguided_mode without), to a disparity image, a per-pixel confidence
+/// (stereo_confidence.h) and an organized cloud in the rectified frame of camera 0 with
+/// z = f B / d, coloured from the colour camera.
 ///
 ///   msf::SgbmStereo stereo;
 ///   stereo.setCalibration(calibration);
@@ -82,15 +85,15 @@ public:
   /// Number of disparities searched by the last computeDisparity() (narrowed by the prior).
   int getSearchedDisparities() const { return searched_disparities_; }
   /// The engine that ran the last computeDisparity(): "native" or "opencv" (the fallback
-  /// where native was asked for but the CPU has no AVX2, the mode is hh or hh4 or the
-  /// images are wider than SemiGlobalMatcher::maxWidth()).
+  /// where native was asked for but the mode is hh or hh4, or sgbm or sgbm_3way on a CPU
+  /// without AVX2, or the images are wider than SemiGlobalMatcher::maxWidth()).
   const std::string& getEngineUsed() const { return engine_used_; }
 
 private:
   cv::Mat match(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints);
   void runMatcher(const cv::Mat& left, const cv::Mat& right, int num_disparities, const cv::Mat& hints,
                   cv::Mat& fixed);
-  bool nativeRuns(int width) const;
+  bool nativeRuns(int width, const std::string& mode) const;
   void checkInputs() const;
 
   Config config_;

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/synthetic/scene_snapshot.h>
 #include <msf/synthetic/synthetic_config.h>
@@ -11,14 +12,13 @@
 
 namespace msf::synthetic {
 
-/// A Velodyne HDL-64E: 64 lasers in two blocks as on KITTI's unit (the upper 32 spaced 1/3
-/// degree down from lidar_upper_elevation_deg, the lower 32 evenly down to
-/// lidar_lower_elevation_deg), each sweeping the azimuth from -pi to pi in
+/// A spinning LiDAR of the beams lidarBeamElevationsDeg gives (KITTI's HDL-64E by default,
+/// an HDL-32E, or any list), each sweeping the azimuth from -pi to pi in
 /// lidar_azimuth_step_deg steps. The scan is a snapshot at the frame's pose and time (no
 /// motion of the sensor or of moving objects during the sweep), so it agrees exactly with
 /// the camera's ground truth.
 /// Points are written ring after ring, top laser first, each ring one sweep of rising
-/// atan2(y, x): the ring split of protocol 2 (docs/design.md) finds exactly 64 rings.
+/// atan2(y, x): the ring split of protocol 2 (docs/design.md) finds exactly one ring a beam.
 /// Each return: range + Gaussian noise, lost with probability lidar_dropout (and half the
 /// time on glass), none from the sky or beyond lidar_max_range_m; intensity from the
 /// surface's infrared reflectivity and incidence angle, in KITTI's 0..1 with 0.01 steps

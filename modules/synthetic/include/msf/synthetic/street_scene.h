@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/synthetic/scene.h>
 #include <msf/synthetic/synthetic_config.h>

@@ -1,7 +1,9 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/config_keys.h>
 
 #include <string>
+#include <vector>
 
 namespace msf::synthetic {
 
@@ -24,6 +26,14 @@ struct SyntheticConfig {
   double lidar_azimuth_step_deg = 0.18; ///< KITTI's files: ~2000 points a ring at 10 Hz
   double lidar_upper_elevation_deg = 2.0;
   double lidar_lower_elevation_deg = -24.9;
+  std::string lidar_model = "hdl64e";
+  std::vector<double> lidar_beam_elevations_deg;
+  std::string camera = "kitti";
+  int image_width_px = 640;
+  int image_height_px = 480;
+  double focal_px = 500.0;
+  std::vector<double> principal_point_px;
+  double baseline_m = 0.12;
   double textureless_share = 0.2;
   double parked_car_share = 0.6;
   double mesh_max_edge_m = 1.0;
@@ -34,6 +44,18 @@ struct SyntheticConfig {
   double oncoming_group_period_s = 4.0;
   bool loop = false;
   static constexpr int kLoopTurnFrames = 10;
+  // The dataset's poses as a GPS/INS measures them (see insPoses in ins_error.h): poses/00.txt
+  // then carries the error and gt/poses.txt the truth.
+  bool ins_poses = false;
+  double ins_heading_drift_deg_per_s = 0.3;
+  double ins_position_error_m = 1.0;
+  // The drive's place in a street shared with other drives (the same seed and street_length_m
+  // give the same static world; the poses are in that world's frame).
+  double start_m = 0.0;
+  bool reverse = false;
+  double street_length_m = 0.0;
+  /// Whether the drive is placed otherwise than from the street's start, heading +z.
+  bool placed() const { return start_m != 0.0 || reverse; }
 
   template <class Keys>
   void keys(Keys& k) {
@@ -50,9 +72,21 @@ struct SyntheticConfig {
       "farthest return, m (above lidar_min_range_m; the depth PNG's limit is 256 m)");
     k("lidar_min_range_m", lidar_min_range_m, above(0), "nearest return, m");
     k("lidar_azimuth_step_deg", lidar_azimuth_step_deg, between(0.01, 5), "azimuth between two returns of a ring, deg");
-    k("lidar_upper_elevation_deg", lidar_upper_elevation_deg, Range{-60, 30}, "elevation of the highest of the 64 lasers, deg");
+    k("lidar_upper_elevation_deg", lidar_upper_elevation_deg, Range{-60, 30},
+      "hdl64e: elevation of the highest of the 64 lasers, deg");
     k("lidar_lower_elevation_deg", lidar_lower_elevation_deg, Range{-60, 30},
-      "elevation of the lowest, deg (more than 11 below the highest: the upper block spans 10.33)");
+      "hdl64e: elevation of the lowest, deg (more than 11 below the highest: the upper block spans 10.33)");
+    k("lidar_model", lidar_model, {"hdl64e", "hdl32e", "beams"},
+      "the LiDAR: KITTI's hdl64e, a 32-beam hdl32e (-30.67..+10.67 deg), or the beams of lidar_beam_elevations_deg");
+    k("lidar_beam_elevations_deg", lidar_beam_elevations_deg, Range{-90, 90, true, true},
+      "lidar_model beams: one elevation per ring (1..1024), lowest first, rising, deg");
+    k("camera", camera, {"kitti", "pinhole"},
+      "the cameras: KITTI's, or a grey pair of the pinhole keys below (the colour camera the grey left one)");
+    k("image_width_px", image_width_px, between(16, 8192), "pinhole: image width, px");
+    k("image_height_px", image_height_px, between(16, 8192), "pinhole: image height, px");
+    k("focal_px", focal_px, between(1, 100000), "pinhole: focal length fx = fy, px");
+    k("principal_point_px", principal_point_px, anyNumber(), "pinhole: [cx, cy], px ([]: the image's centre)");
+    k("baseline_m", baseline_m, Range{0, 10, true, false}, "pinhole: the grey pair's baseline, m");
     k("textureless_share", textureless_share, between(0, 1), "share of building lots with blank walls");
     k("parked_car_share", parked_car_share, between(0, 1), "share of parking slots taken");
     k("mesh_max_edge_m", mesh_max_edge_m, between(0.05, 20), "triangle size of gt/scene.ply's flat faces, m");
@@ -63,9 +97,23 @@ struct SyntheticConfig {
     k("oncoming_group_period_s", oncoming_group_period_s, between(1, 3600), "a group is met every this many seconds");
     k("loop", loop,
       "drive out, turn round across the road (10 frames) and drive back in the other lane to where the drive began");
+    k("ins_poses", ins_poses,
+      "poses/00.txt as a GPS/INS measures the drive (the error below), gt/poses.txt the true poses");
+    k("ins_heading_drift_deg_per_s", ins_heading_drift_deg_per_s, between(0, 10),
+      "ins_poses: the heading error grows at this rate from frame 0, deg/s");
+    k("ins_position_error_m", ins_position_error_m, between(0, 10),
+      "ins_poses: RMS of the position's smooth wander, m");
+    k("start_m", start_m, between(0, 5000), "the drive starts this far along the street (world z), m");
+    k("reverse", reverse, "the drive heads -z in the other lane, from start_m back");
+    k("street_length_m", street_length_m, between(0, 5000),
+      "the street's length from world z 0, m (0: to the farthest point of the drive); drives of the same seed "
+      "and length share the static world");
   }
   /// Throws ConfigError naming the first key with a value out of range.
   void validate() const;
+  /// The same, the camera and LiDAR keys' checks between keys alone after the ranges (what a
+  /// rig made from the config needs).
+  void validateRig() const;
 };
 
 } // namespace msf::synthetic

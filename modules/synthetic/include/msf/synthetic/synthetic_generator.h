@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/io/calibration.h>
 #include <msf/io/poses.h>
@@ -31,7 +32,7 @@ struct SyntheticFrame {
   cv::Mat moving;     ///< camera 0, CV_8U: 255 where the pixel sees a moving object, else 0
 };
 
-/// The synthetic KITTI-format generator: KITTI's rig (kittiRig) driving down a street
+/// The synthetic KITTI-format generator: a rig (syntheticRig: KITTI's by default) driving down a street
 /// (buildStreetScene, with its moving cars) along streetTrajectory, rendered by
 /// CameraRenderer and LidarSimulator at each frame's time. Deterministic: one seed, one
 /// byte-identical dataset.
@@ -66,7 +67,7 @@ public:
   /// renders) and its number of LiDAR points.
   using Progress = std::function<void(std::size_t frame, double seconds, std::size_t points)>;
 
-  /// Writes the dataset under `root` (see README: KITTI odometry layout plus gt/) as an
+  /// Writes the dataset under `root` (see docs/usage.md, "Data layouts": KITTI odometry layout plus gt/) as an
   /// OutputFolder: the tree is written into a hidden folder beside `root` and moved into
   /// place at the end, so a failure (or an exception from `progress`) leaves `root` as it
   /// was. `root` may be absent, empty, or a dataset written before (replaced); anything else

@@ -1,3 +1,4 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/synthetic/scene.h>
 #include <msf/synthetic/synthetic_config.h>
@@ -16,7 +17,8 @@ namespace msf::synthetic {
 ///    oncoming_group_period_s, the next ones every 9..10.5 m of lane, so that in a short
 ///    sequence they pass early and the road they covered is seen empty afterwards.
 /// Deterministic in config.seed, from counter-based streams of their own: the static
-/// street does not change with these settings.
+/// street does not change with these settings. For a placed drive (start_m, reverse) the cars
+/// are laid out so along its own path and carried with it (driveTransform).
 void addTraffic(const SyntheticConfig& config, Scene& scene);
 
 } // namespace msf::synthetic

@@ -1,12 +1,12 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/cloud_io.h>
+#include <msf/io/field_conversion.h>
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/conversions.h>
-#include <pcl/io/pcd_io.h>
-#include <pcl/io/ply_io.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -18,6 +18,11 @@ template <typename PointT>
 void loadCloud(const std::string& path, pcl::PointCloud<PointT>& cloud) {
   pcl::PCLPointCloud2 blob;
   loadCloudBlob(path, blob);
+  fromCloudBlob(std::move(blob), cloud, path);
+}
+
+template <typename PointT>
+void fromCloudBlob(pcl::PCLPointCloud2 blob, pcl::PointCloud<PointT>& cloud, const std::string& path) {
   std::vector<pcl::PCLPointField> wanted;
   pcl::for_each_type<typename pcl::traits::fieldList<PointT>::type>(pcl::detail::FieldAdder<PointT>(wanted));
   for (const auto& field : wanted) {
@@ -34,25 +39,17 @@ void loadCloud(const std::string& path, pcl::PointCloud<PointT>& cloud) {
     cloud.header = blob.header;
     return;
   }
+  convertFieldTypes(blob, wanted, path);
   pcl::fromPCLPointCloud2(blob, cloud);
 }
 
 template <typename PointT>
 void saveCloud(const std::string& path, const pcl::PointCloud<PointT>& cloud) {
-  const std::string ext = fileExtension(path);
-  if (ext != ".pcd" && ext != ".ply")
-    throw IOError("cannot write '" + path + "': a cloud is written as .pcd or .ply");
   if (cloud.empty())
     throw InvalidInputError("cannot write '" + path + "': the cloud is empty");
-  writeAtomically(path, [&](const std::string& tmp) {
-    int result = -1;
-    if (ext == ".pcd")
-      result = pcl::PCDWriter().writeBinaryCompressed(tmp, cloud);
-    else
-      result = pcl::PLYWriter().write(tmp, cloud, true, false);
-    if (result != 0)
-      throw IOError("cannot write cloud '" + path + "'");
-  });
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(cloud, blob);
+  saveCloudBlob(path, blob, cloud.sensor_origin_, cloud.sensor_orientation_);
 }
 
 } // namespace msf

@@ -1,0 +1,64 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+#include <opencv2/core/mat.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace msf {
+
+/// The open sky of one camera image (evaluation protocol 6): the pixels where the camera looked
+/// past every surface. Found from the image and the LiDAR alone, so it needs no ground truth:
+///  1. sky-like pixels: bright (grey at least the minimum brightness, an overexposed sky
+///     included), blank (the grey's standard deviation over 5x5 pixels at most the maximum
+///     texture: leaves, branches, poles and edges have more) and, when the image has colour,
+///     grey-white or blue (HSV saturation at most the maximum, or a hue between cyan and
+///     violet: a red roof or green leaves are neither);
+///  2. above the LiDAR: a pixel lies above the highest return projected into any column
+///     within the column window of its own (a wall, a roof or a tree returns; the sky does not,
+///     and the scan's columns are sparser than the image's);
+///  3. connected to the image's top edge (8-neighbours; a white wall or a car below a
+///     surface is not sky);
+///  4. eroded by the border, so that a surface's outline blurred by the image or by the voxels
+///     of a map does not count as covering the sky.
+/// The steps are OpenCV's (cvtColor, boxFilter, inRange, connectedComponents, erode).
+class SkyMask {
+public:
+  using Ptr = std::shared_ptr<SkyMask>;
+
+  /// Grey level (0-255) a sky pixel has at least.
+  void setMinBrightness(double grey) { min_brightness_ = grey; }
+  double getMinBrightness() const { return min_brightness_; }
+  /// Standard deviation of the grey over 5x5 pixels a sky pixel has at most.
+  void setMaxTexture(double grey) { max_texture_ = grey; }
+  double getMaxTexture() const { return max_texture_; }
+  /// HSV saturation (0-255) a grey-white sky pixel has at most (a blue one may have more).
+  void setMaxSaturation(double saturation) { max_saturation_ = saturation; }
+  double getMaxSaturation() const { return max_saturation_; }
+  /// Columns on each side whose highest LiDAR return also bounds a pixel's column.
+  void setColumnWindow(int columns) { column_window_ = columns; }
+  int getColumnWindow() const { return column_window_; }
+  /// Pixels taken off the mask's outline.
+  void setBorder(int pixels) { border_ = pixels; }
+  int getBorder() const { return border_; }
+
+  /// The mask (CV_8UC1, 255 = open sky) of `image` (CV_8UC1 grey or CV_8UC3 BGR) given the
+  /// LiDAR's returns projected into the same camera (`returns`: CV_32FC1 of the image's size,
+  /// > 0 where a return lands). Throws InvalidInputError for another type or size, or
+  /// ConfigError for a setting out of range (a negative window or border).
+  cv::Mat compute(const cv::Mat& image, const cv::Mat& returns) const;
+
+private:
+  /// Step 1: bright, blank and sky-coloured pixels (255).
+  cv::Mat skyLike(const cv::Mat& image) const;
+  /// Step 2: per column, the first row below the highest return in its window (0: none above).
+  std::vector<int> lidarTop(const cv::Mat& returns) const;
+
+  double min_brightness_ = 110.0;
+  double max_texture_ = 6.0;
+  double max_saturation_ = 70.0;
+  int column_window_ = 8;
+  int border_ = 3;
+};
+
+} // namespace msf

@@ -1,0 +1,132 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/exceptions.h>
+#include <msf/evaluation/open_sky_coverage.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+
+namespace msf {
+
+namespace {
+
+std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+} // namespace
+
+OpenSkyCoverage::OpenSkyCoverage(const PinholeCamera& camera) : camera_(camera) {
+  if (!camera.valid())
+    throw InvalidInputError("protocol 6: invalid camera (" + std::to_string(camera.width) + "x" +
+                            std::to_string(camera.height) + " px, fx " + std::to_string(camera.fx) + ")");
+}
+
+void OpenSkyCoverage::addMask(std::size_t frame, const cv::Mat& mask) {
+  if (mask.type() != CV_8UC1 || mask.cols != camera_.width || mask.rows != camera_.height)
+    throw InvalidInputError("protocol 6: the sky mask of frame " + std::to_string(frame) + " is a " + sizeText(mask) +
+                            " image of type " + std::to_string(mask.type()) + ", expected CV_8UC1 of the camera's " +
+                            std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+  FrameSky sky;
+  for (int v = 0; v < mask.rows; ++v) {
+    const std::uint8_t* m = mask.ptr<std::uint8_t>(v);
+    for (int u = 0; u < mask.cols;) {
+      if (!m[u]) {
+        ++u;
+        continue;
+      }
+      const int start = u;
+      while (u < mask.cols && m[u])
+        ++u;
+      sky.runs.push_back(static_cast<std::uint32_t>(v * mask.cols + start));
+      sky.runs.push_back(static_cast<std::uint32_t>(u - start));
+      sky.pixels += static_cast<std::size_t>(u - start);
+    }
+  }
+  sky.runs.shrink_to_fit();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  FrameSky& kept = frames_[frame];
+  if (kept.has_mask)
+    throw InvalidInputError("protocol 6: the sky mask of frame " + std::to_string(frame) + " is given twice");
+  sky.has_mask = true;
+  sky.has_pose = kept.has_pose;
+  sky.T_world_cam = kept.T_world_cam;
+  kept = std::move(sky);
+}
+
+void OpenSkyCoverage::setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam) {
+  if (!T_world_cam.matrix().allFinite())
+    throw InvalidInputError("protocol 6: the pose of frame " + std::to_string(frame) + " is not finite");
+  const std::lock_guard<std::mutex> lock(mutex_);
+  FrameSky& sky = frames_[frame];
+  sky.T_world_cam = T_world_cam;
+  sky.has_pose = true;
+}
+
+SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  SkyCoverage out;
+  double share_sum = 0;
+  std::vector<float> covered_depth;
+  for (const auto& [index, sky] : frames_) {
+    if (!sky.has_pose || !sky.has_mask)
+      continue;
+    ++out.frames;
+    if (sky.pixels == 0)
+      continue;
+    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_);
+    const float* depth = rendered_.ptr<float>(0);
+    std::size_t covered = 0;
+    for (std::size_t r = 0; r < sky.runs.size(); r += 2)
+      for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
+        if (depth[p] > 0.f) {
+          ++covered;
+          covered_depth.push_back(depth[p]);
+        }
+    const double share = static_cast<double>(covered) / static_cast<double>(sky.pixels);
+    out.frame_share[index] = share;
+    out.sky_pixels += sky.pixels;
+    out.covered_pixels += covered;
+    share_sum += share;
+    if (share > out.worst_share || out.frame_share.size() == 1) {
+      out.worst_share = share;
+      out.worst_frame = index;
+    }
+  }
+  if (!covered_depth.empty()) {
+    const auto middle = covered_depth.begin() + static_cast<long>(covered_depth.size() / 2);
+    std::nth_element(covered_depth.begin(), middle, covered_depth.end());
+    out.covered_depth_median_m = *middle;
+  }
+  if (out.sky_pixels > 0) {
+    out.share = static_cast<double>(out.covered_pixels) / static_cast<double>(out.sky_pixels);
+    out.mean_frame_share = share_sum / static_cast<double>(out.frame_share.size());
+  }
+  return out;
+}
+
+cv::Mat OpenSkyCoverage::drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered) {
+  if (mask.size() != image.size() || rendered.size() != image.size() || mask.type() != CV_8UC1 ||
+      rendered.type() != CV_32FC1)
+    throw InvalidInputError("protocol 6: the picture needs a CV_8UC1 mask and a CV_32FC1 rendering of the image's " +
+                            sizeText(image) + ", got " + sizeText(mask) + " and " + sizeText(rendered));
+  cv::Mat out;
+  if (image.channels() == 1)
+    cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
+  else
+    out = image.clone();
+  for (int v = 0; v < out.rows; ++v) {
+    const std::uint8_t* m = mask.ptr<std::uint8_t>(v);
+    const float* z = rendered.ptr<float>(v);
+    cv::Vec3b* p = out.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < out.cols; ++u)
+      if (m[u]) // half the pixel, half cyan (sky: it shows on a deep blue sky too) or red (a surface over it)
+        p[u] = p[u] / 2 + (z[u] > 0.f ? cv::Vec3b(0, 0, 127) : cv::Vec3b(127, 127, 0));
+  }
+  return out;
+}
+
+std::size_t OpenSkyCoverage::frames() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return frames_.size();
+}
+
+} // namespace msf

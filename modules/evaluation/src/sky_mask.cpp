@@ -1,0 +1,99 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/exceptions.h>
+#include <msf/evaluation/sky_mask.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <string>
+
+namespace msf {
+
+namespace {
+
+/// OpenCV's 8-bit hue (degrees / 2) from cyan to violet: a clear sky's.
+constexpr double kBlueHueMin = 85.0, kBlueHueMax = 135.0;
+/// Side of the window of the texture's standard deviation.
+constexpr int kTextureWindow = 5;
+
+std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+} // namespace
+
+cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
+  cv::Mat grey;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else
+    grey = image;
+  cv::Mat grey_f, mean, mean_sq;
+  grey.convertTo(grey_f, CV_32F);
+  const cv::Size window(kTextureWindow, kTextureWindow);
+  cv::boxFilter(grey_f, mean, CV_32F, window, cv::Point(-1, -1), true, cv::BORDER_REFLECT);
+  cv::boxFilter(grey_f.mul(grey_f), mean_sq, CV_32F, window, cv::Point(-1, -1), true, cv::BORDER_REFLECT);
+  const cv::Mat variance = mean_sq - mean.mul(mean);
+  cv::Mat sky = (grey >= min_brightness_) & (variance <= max_texture_ * max_texture_);
+  if (image.channels() == 3) {
+    cv::Mat hsv, grey_white, blue;
+    cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);
+    cv::inRange(hsv, cv::Scalar(0, 0, 0), cv::Scalar(180, max_saturation_, 255), grey_white);
+    cv::inRange(hsv, cv::Scalar(kBlueHueMin, 0, 0), cv::Scalar(kBlueHueMax, 255, 255), blue);
+    sky &= grey_white | blue;
+  }
+  return sky;
+}
+
+std::vector<int> SkyMask::lidarTop(const cv::Mat& returns) const {
+  std::vector<int> highest(static_cast<std::size_t>(returns.cols), returns.rows);
+  for (int v = returns.rows - 1; v >= 0; --v) {
+    const float* z = returns.ptr<float>(v);
+    for (int u = 0; u < returns.cols; ++u)
+      if (z[u] > 0.f)
+        highest[static_cast<std::size_t>(u)] = v;
+  }
+  std::vector<int> top(highest.size());
+  for (int u = 0; u < returns.cols; ++u) {
+    const auto first = highest.begin() + std::max(0, u - column_window_);
+    const auto last = highest.begin() + std::min(returns.cols, u + column_window_ + 1);
+    top[static_cast<std::size_t>(u)] = *std::min_element(first, last);
+  }
+  return top;
+}
+
+cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
+  if (returns.type() != CV_32FC1 || returns.size() != image.size())
+    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1 of the image's " + sizeText(image) +
+                            ", not " + sizeText(returns) + " of type " + std::to_string(returns.type()));
+  if (column_window_ < 0 || border_ < 0)
+    throw ConfigError("sky mask: the column window and the border must be >= 0, not " +
+                      std::to_string(column_window_) + " and " + std::to_string(border_));
+  cv::Mat sky = skyLike(image);
+  const std::vector<int> top = lidarTop(returns);
+  for (int v = 0; v < sky.rows; ++v) {
+    std::uint8_t* s = sky.ptr<std::uint8_t>(v);
+    for (int u = 0; u < sky.cols; ++u)
+      if (v >= top[static_cast<std::size_t>(u)])
+        s[u] = 0;
+  }
+  // Step 3: the components that touch the top row.
+  cv::Mat labels;
+  const int count = cv::connectedComponents(sky, labels, 8, CV_32S);
+  std::vector<std::uint8_t> open(static_cast<std::size_t>(count), 0);
+  const int* top_row = labels.ptr<int>(0);
+  for (int u = 0; u < labels.cols; ++u)
+    open[static_cast<std::size_t>(top_row[u])] = top_row[u] != 0;
+  for (int v = 0; v < sky.rows; ++v) {
+    const int* l = labels.ptr<int>(v);
+    std::uint8_t* s = sky.ptr<std::uint8_t>(v);
+    for (int u = 0; u < sky.cols; ++u)
+      s[u] = open[static_cast<std::size_t>(l[u])] ? 255 : 0;
+  }
+  if (border_ > 0)
+    cv::erode(sky, sky, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
+              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  return sky;
+}
+
+} // namespace msf

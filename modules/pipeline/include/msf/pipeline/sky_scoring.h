@@ -1,0 +1,57 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+#include <msf/evaluation/open_sky_coverage.h>
+#include <msf/evaluation/sky_mask.h>
+#include <msf/io/calibration.h>
+#include <msf/io/frame_source.h>
+#include <msf/range_image/lidar_projector.h>
+
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace msf {
+
+/// Evaluation protocol 6 over a run: each frame's open sky (SkyMask of the colour image, or the
+/// grey one without colour, and of the whole scan projected into camera 0) before any stage
+/// sees the frame, its pose after integration, and after the run the meshes rendered at every
+/// pose (OpenSkyCoverage). Pictures of chosen frames show the sky and what covers it.
+/// addFrame runs on the engine's loading thread, setPose on its integration thread.
+class SkyScoring {
+public:
+  /// `picture_frames`: frames whose image and mask are kept for drawPictures.
+  SkyScoring(const Calibration& calibration, const ProjectionConfig& projection, std::set<std::size_t> picture_frames);
+
+  /// The frame's open sky, from its whole scan (call it before a ring hold-out takes rings away).
+  void addFrame(const Frame& frame);
+  /// The open sky of a frame (CV_8UC1, 255 = sky): SkyMask of its colour image where it has
+  /// camera 0's size, else of the grey one, and of its whole scan projected into camera 0.
+  cv::Mat maskOf(const Frame& frame);
+  void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam) { coverage_.setPose(frame, T_world_cam); }
+  /// Each mesh (by name: "mesh", "mesh_lidar", ...) rendered at every pose.
+  std::map<std::string, SkyCoverage> score(const std::map<std::string, const TriangleMesh*>& meshes);
+  /// sky_NNNNNN.png in `dir` for each picture frame with a pose (OpenSkyCoverage::drawCoverage
+  /// with `mesh`); returns the file names written.
+  std::vector<std::string> drawPictures(const std::string& dir, const TriangleMesh& mesh,
+                                        const std::map<std::size_t, Eigen::Isometry3d>& poses,
+                                        const std::map<std::size_t, std::string>& names);
+
+private:
+  const cv::Mat& imageOf(const Frame& frame) const;
+
+  struct Picture {
+    cv::Mat image, mask;
+  };
+  PinholeCamera camera_;
+  LidarProjector projector_;
+  SkyMask mask_;
+  OpenSkyCoverage coverage_;
+  std::set<std::size_t> picture_frames_;
+  std::mutex mutex_;
+  std::map<std::size_t, Picture> pictures_;
+  cv::Mat returns_;
+};
+
+} // namespace msf

@@ -1,0 +1,369 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include "reconstruction_node.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/io/bag_options.h>
+#include <msf/io/cloud_io.h>
+#include <msf/pipeline/fused_cloud.h>
+#include <msf/ros/message_conversions.h>
+
+#include <pcl_conversions/pcl_conversions.h>
+#include <visualization_msgs/Marker.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace msf {
+
+namespace {
+
+std::string cameraInfoTopic(const std::string& image_topic) {
+  const std::size_t slash = image_topic.rfind('/');
+  return (slash == std::string::npos ? std::string() : image_topic.substr(0, slash + 1)) + "camera_info";
+}
+
+const std::map<std::string, Reconstructor::PoseMode> kPoseModes{
+    {"auto", Reconstructor::PoseMode::Auto}, {"tf", Reconstructor::PoseMode::Given},
+    {"odometry", Reconstructor::PoseMode::Odometry}, {"refine", Reconstructor::PoseMode::Refine}};
+
+/// Reads one parameter when it is set; a value of another type is an error, not the default.
+template <typename T>
+void readParam(const ros::NodeHandle& nh, const std::string& name, T& value, const char* type) {
+  if (nh.hasParam(name) && !nh.getParam(name, value))
+    throw ConfigError("parameter " + nh.resolveName(name) + " must be " + type);
+}
+
+/// Every parameter set under the node's private namespace is one it knows: a typo is an error.
+void refuseUnknownParams(const ros::NodeHandle& nh, const std::set<std::string>& known) {
+  std::vector<std::string> names;
+  ros::param::getParamNames(names);
+  const std::string prefix = nh.getNamespace() + "/";
+  std::string list;
+  for (const std::string& name : known)
+    list += (list.empty() ? "" : ", ") + name;
+  for (const std::string& name : names) {
+    if (name.compare(0, prefix.size(), prefix) != 0)
+      continue;
+    const std::string key = name.substr(prefix.size(), name.find('/', prefix.size()) - prefix.size());
+    if (!known.count(key))
+      throw ConfigError("unknown parameter " + prefix + key + " (the node's parameters: " + list + ")");
+  }
+}
+
+} // namespace
+
+NodeParameters::NodeParameters() {
+  const BagOptions kitti2bag;
+  lidar_topic = kitti2bag.lidar_topic;
+  left_topic = kitti2bag.left_topic;
+  right_topic = kitti2bag.right_topic;
+  color_topic = kitti2bag.color_topic;
+}
+
+NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
+  NodeParameters p;
+  refuseUnknownParams(nh, {"lidar_topic", "left_topic", "right_topic", "color_topic", "world_frame", "poses", "config",
+                           "rig", "threads", "sweeping_scans", "queue_size", "sync_slop_s", "tf_timeout_s",
+                           "mesh_rate_hz", "mesh_path"});
+  for (auto [name, value] : {std::pair{"lidar_topic", &p.lidar_topic}, {"left_topic", &p.left_topic},
+                             {"right_topic", &p.right_topic}, {"color_topic", &p.color_topic},
+                             {"world_frame", &p.world_frame}, {"poses", &p.poses}, {"config", &p.config},
+                             {"rig", &p.rig}, {"mesh_path", &p.mesh_path}})
+    readParam(nh, name, *value, "a string");
+  readParam(nh, "threads", p.threads, "an integer");
+  readParam(nh, "queue_size", p.queue_size, "an integer");
+  readParam(nh, "sweeping_scans", p.sweeping_scans, "true or false");
+  for (auto [name, value] : {std::pair{"sync_slop_s", &p.sync_slop_s}, {"tf_timeout_s", &p.tf_timeout_s},
+                             {"mesh_rate_hz", &p.mesh_rate_hz}})
+    readParam(nh, name, *value, "a number");
+  const auto check = [&](bool ok, const std::string& name, const std::string& range, auto value) {
+    std::ostringstream text;
+    text << value;
+    if (!ok)
+      throw ConfigError("parameter " + nh.resolveName(name) + " must be " + range + ", not " + text.str());
+  };
+  check(kPoseModes.count(p.poses) > 0, "poses", "auto, tf, odometry or refine", "'" + p.poses + "'");
+  check(p.threads >= 0, "threads", ">= 0", p.threads);
+  check(p.queue_size >= 1 && p.queue_size <= 8, "queue_size", "1..8 frames", p.queue_size);
+  check(p.sync_slop_s > 0, "sync_slop_s", "> 0", p.sync_slop_s);
+  check(p.tf_timeout_s >= 0, "tf_timeout_s", ">= 0", p.tf_timeout_s);
+  check(p.mesh_rate_hz >= 0, "mesh_rate_hz", ">= 0", p.mesh_rate_hz);
+  if (p.lidar_topic.empty() || p.left_topic.empty() || p.right_topic.empty())
+    throw ConfigError("parameters " + nh.resolveName("lidar_topic") + ", left_topic and right_topic must be set");
+  if (!p.mesh_path.empty()) {
+    p.mesh_path = std::filesystem::absolute(p.mesh_path).string(); // the node's folder is ROS_HOME
+    std::error_code ec;
+    if (std::filesystem::exists(p.mesh_path, ec))
+      throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": '" + p.mesh_path +
+                        "' exists, and a mesh is never written over a file");
+  }
+  return p;
+}
+
+ReconstructionNode::ReconstructionNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
+    : params_(NodeParameters::read(private_nh)), tf_listener_(tf_buffer_),
+      queue_(static_cast<std::size_t>(params_.queue_size)) {
+  try {
+    config_ = PipelineConfig::load(params_.config); // "" = the defaults
+    config_.validate();
+  } catch (const Error& e) {
+    throw ConfigError("parameter " + private_nh.resolveName("config") + ": " + e.what());
+  }
+  depth_pub_ = private_nh.advertise<Image>("depth", 2);
+  weight_pub_ = private_nh.advertise<Image>("weight", 2);
+  points_pub_ = private_nh.advertise<Cloud>("points", 2);
+  mesh_pub_ = private_nh.advertise<visualization_msgs::Marker>("mesh", 1, true);
+  subscribe(nh); // the callbacks run in ros::spin, after this
+  last_mesh_ = Clock::now();
+  worker_ = std::thread(&ReconstructionNode::work, this);
+  ROS_INFO("msf_ros_node: %s + %s + %s%s%s, poses: %s (world frame '%s'), %d frame%s waiting at most", params_.lidar_topic.c_str(),
+           params_.left_topic.c_str(), params_.right_topic.c_str(), params_.color_topic.empty() ? "" : " + ",
+           params_.color_topic.c_str(), params_.poses.c_str(), params_.world_frame.c_str(), params_.queue_size,
+           params_.queue_size == 1 ? "" : "s");
+}
+
+void ReconstructionNode::subscribe(ros::NodeHandle& nh) {
+  // Deep enough for a frame's messages to meet however the transport orders them; the sync's
+  // callback only queues, so these never fill.
+  constexpr std::uint32_t kQueue = 5, kSyncQueue = 10;
+  cloud_sub_.subscribe(nh, params_.lidar_topic, kQueue);
+  cloud_sub_.registerCallback([this](const Cloud::ConstPtr&) { ++scans_; });
+  left_sub_.subscribe(nh, params_.left_topic, kQueue);
+  left_info_sub_.subscribe(nh, cameraInfoTopic(params_.left_topic), kQueue);
+  right_sub_.subscribe(nh, params_.right_topic, kQueue);
+  right_info_sub_.subscribe(nh, cameraInfoTopic(params_.right_topic), kQueue);
+  const ros::Duration slop(params_.sync_slop_s);
+  if (params_.color_topic.empty()) {
+    stereo_sync_ = std::make_unique<message_filters::Synchronizer<StereoPolicy>>(
+        StereoPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_);
+    stereo_sync_->getPolicy()->setMaxIntervalDuration(slop);
+    stereo_sync_->registerCallback(&ReconstructionNode::onStereo, this);
+    return;
+  }
+  color_sub_.subscribe(nh, params_.color_topic, kQueue);
+  color_info_sub_.subscribe(nh, cameraInfoTopic(params_.color_topic), kQueue);
+  color_sync_ = std::make_unique<message_filters::Synchronizer<ColorPolicy>>(
+      ColorPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_, color_sub_,
+      color_info_sub_);
+  color_sync_->getPolicy()->setMaxIntervalDuration(slop);
+  color_sync_->registerCallback(&ReconstructionNode::onColor, this);
+}
+
+void ReconstructionNode::onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left,
+                                  const Info::ConstPtr& left_info, const Image::ConstPtr& right,
+                                  const Info::ConstPtr& right_info) {
+  enqueue({cloud, left, right, nullptr, left_info, right_info, nullptr});
+}
+
+void ReconstructionNode::onColor(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left,
+                                 const Info::ConstPtr& left_info, const Image::ConstPtr& right,
+                                 const Info::ConstPtr& right_info, const Image::ConstPtr& color,
+                                 const Info::ConstPtr& color_info) {
+  enqueue({cloud, left, right, color, left_info, right_info, color_info});
+}
+
+void ReconstructionNode::enqueue(Pending pending) {
+  if (frames_++ == 0)
+    first_arrival_ = Clock::now();
+  last_arrival_ = Clock::now();
+  if (queue_.pushNewest(std::move(pending)))
+    drop("the engine was busy: the oldest of " + std::to_string(params_.queue_size) +
+         " waiting frames made room for the newest");
+}
+
+void ReconstructionNode::work() {
+  while (!queue_.drained()) {
+    if (std::optional<Pending> pending = queue_.popFor(untilMeshDue())) {
+      try {
+        process(*pending);
+      } catch (const std::exception& e) {
+        ROS_ERROR("msf_ros_node: the frame of the scan at %.3f s: %s", pending->cloud->header.stamp.toSec(), e.what());
+        drop("the engine refused it (the error is logged)");
+      }
+    }
+    if (untilMeshDue() == Clock::duration::zero())
+      publishMesh();
+  }
+  if (meshed_frames_ != reconstructed_ && params_.mesh_rate_hz > 0)
+    publishMesh(); // the whole map, however recently the last one went
+}
+
+void ReconstructionNode::process(const Pending& pending) {
+  if (!engine_ && !startEngine(pending))
+    return;
+  Frame frame = frameFromMessages(pending);
+  if (!placeFrame(frame, pending.left->header))
+    return;
+  const Clock::time_point start = Clock::now();
+  const FrameResult result = engine_->addFrame(frame);
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  (reconstructed_ == 0 ? first_frame_ms_ : later_frames_ms_) += ms;
+  if (reconstructed_++ == 0)
+    tracking_ = !frame.has_pose; // PoseMode::Auto: the odometry tracks a run whose first frame has no pose
+  ROS_DEBUG("msf_ros_node: frame %zu (scan at %.3f s) in %.0f ms", frame.index, pending.cloud->header.stamp.toSec(), ms);
+  last_header_ = pending.left->header;
+  publish(result, pending.left->header);
+}
+
+bool ReconstructionNode::startEngine(const Pending& pending) {
+  const cv::Size size(static_cast<int>(pending.left->width), static_cast<int>(pending.left->height));
+  Calibration rig;
+  if (!params_.rig.empty()) {
+    rig = loadCalibration(params_.rig, size);
+  } else {
+    const std::string &lidar = pending.cloud->header.frame_id, &camera = pending.left->header.frame_id;
+    Eigen::Isometry3d T_cam0_velo = Eigen::Isometry3d::Identity();
+    std::string error;
+    if (lidar != camera && !lookUp(camera, lidar, ros::Time(0), T_cam0_velo, error)) {
+      ROS_ERROR_THROTTLE(5.0, "msf_ros_node: no tf from the LiDAR's frame '%s' to the left camera's '%s' (%s): publish "
+                              "it (/tf_static) or give the rig's calibration in ~rig",
+                         lidar.c_str(), camera.c_str(), error.c_str());
+      drop("no LiDAR extrinsic yet (tf from the scan's frame to the left camera's)");
+      return false;
+    }
+    rig = rigFromCameraInfo(*pending.left_info, *pending.right_info, pending.color_info.get(), T_cam0_velo, size,
+                            "the CameraInfo on " + cameraInfoTopic(params_.left_topic));
+  }
+  Reconstructor::Options options;
+  options.poses = kPoseModes.at(params_.poses);
+  options.threads = params_.threads;
+  options.sweeping_scans = params_.sweeping_scans;
+  engine_ = std::make_unique<Reconstructor>(rig, config_, options);
+  tracking_ = params_.poses == "odometry";
+  first_scan_ns_ = stampNs(pending.cloud->header.stamp);
+  ROS_INFO("msf_ros_node: rig %dx%d, fx %.1f px, baseline %.3f m; reconstructing", size.width, size.height, rig.fx(0),
+           rig.baselineGrey());
+  return true;
+}
+
+Frame ReconstructionNode::frameFromMessages(const Pending& pending) const {
+  Frame frame;
+  scanFromMessage(*pending.cloud, frame, "the scan on '" + params_.lidar_topic + "'");
+  stampFrame(frame, reconstructed_, stampNs(pending.cloud->header.stamp), first_scan_ns_,
+             pending.cloud->header.frame_id);
+  frame.left = greyFromMessage(*pending.left, "the image on '" + params_.left_topic + "'");
+  frame.right = greyFromMessage(*pending.right, "the image on '" + params_.right_topic + "'");
+  if (pending.color)
+    frame.color = colorFromMessage(*pending.color, "the image on '" + params_.color_topic + "'");
+  return frame;
+}
+
+bool ReconstructionNode::placeFrame(Frame& frame, const std_msgs::Header& camera_header) {
+  if (tracking_)
+    return true;
+  std::string error;
+  frame.has_pose = lookUp(params_.world_frame, camera_header.frame_id, camera_header.stamp, frame.T_world_cam0, error);
+  // Without a pose, only the first frame of PoseMode::Auto goes on: the odometry tracks from it.
+  if (frame.has_pose || (params_.poses == "auto" && reconstructed_ == 0))
+    return true;
+  ROS_WARN_THROTTLE(5.0, "msf_ros_node: no tf from '%s' to '%s' at %.3f s: %s", params_.world_frame.c_str(),
+                    camera_header.frame_id.c_str(), camera_header.stamp.toSec(), error.c_str());
+  drop("no pose (tf from the world frame to the left camera at the frame's stamp)");
+  return false;
+}
+
+bool ReconstructionNode::lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
+                                Eigen::Isometry3d& T, std::string& error) const {
+  try {
+    T = isometryFromTransform(
+        tf_buffer_.lookupTransform(target, source, stamp, ros::Duration(params_.tf_timeout_s)).transform);
+    return true;
+  } catch (const tf2::TransformException& e) {
+    error = e.what();
+    return false;
+  }
+}
+
+void ReconstructionNode::publish(const FrameResult& result, const std_msgs::Header& camera_header) {
+  if (depth_pub_.getNumSubscribers() > 0) { // REP 118: NaN where there is no depth
+    cv::Mat depth = result.fused.depth.clone();
+    depth.setTo(std::numeric_limits<float>::quiet_NaN(), depth <= 0);
+    depth_pub_.publish(imageToMessage(depth, camera_header));
+  }
+  if (weight_pub_.getNumSubscribers() > 0)
+    weight_pub_.publish(imageToMessage(result.fused.weight, camera_header));
+  if (points_pub_.getNumSubscribers() > 0) {
+    Cloud points;
+    pcl::toROSMsg(fusedCloud(result.fused, engine_->calibration()), points);
+    points.header = camera_header;
+    points_pub_.publish(points);
+  }
+}
+
+ReconstructionNode::Clock::duration ReconstructionNode::untilMeshDue() const {
+  if (params_.mesh_rate_hz <= 0 || reconstructed_ == meshed_frames_)
+    return std::chrono::hours(1); // nothing new to mesh: wait for a frame
+  const auto due = last_mesh_ + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(1.0 / params_.mesh_rate_hz));
+  return std::max(Clock::duration::zero(), due - Clock::now());
+}
+
+void ReconstructionNode::publishMesh() {
+  last_mesh_ = Clock::now();
+  if (mesh_pub_.getNumSubscribers() == 0)
+    return; // meshing costs: only for a listener (the file at shutdown meshes anyway)
+  meshed_frames_ = reconstructed_;
+  std_msgs::Header header = last_header_;
+  header.frame_id = params_.world_frame;
+  mesh_pub_.publish(meshToMarker(engine_->mesh(), header));
+}
+
+void ReconstructionNode::drop(const std::string& reason) {
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  ++dropped_[reason];
+  ROS_WARN_THROTTLE(5.0, "msf_ros_node: frame dropped: %s (%zu dropped for this reason so far)", reason.c_str(),
+                    dropped_[reason]);
+}
+
+void ReconstructionNode::saveMesh() {
+  if (params_.mesh_path.empty())
+    return;
+  if (!engine_ || engine_->mesh().triangles.empty()) {
+    ROS_WARN("msf_ros_node: no surface was reconstructed: '%s' is not written", params_.mesh_path.c_str());
+    return;
+  }
+  const TriangleMesh& mesh = engine_->mesh();
+  pcl::PolygonMesh polygons;
+  mesh.toPolygonMesh(polygons);
+  msf::saveMesh(params_.mesh_path, polygons);
+  ROS_INFO("msf_ros_node: mesh of %zu triangles saved to '%s'", mesh.triangles.size(), params_.mesh_path.c_str());
+}
+
+std::string ReconstructionNode::summary() const {
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  std::size_t dropped = 0;
+  std::string reasons;
+  for (const auto& [reason, n] : dropped_) {
+    dropped += n;
+    reasons += "\n  " + std::to_string(n) + ": " + reason;
+  }
+  const std::size_t unmatched = scans_ - frames_;
+  if (unmatched > 0)
+    reasons += "\n  " + std::to_string(unmatched) + " scans had no stereo pair (and CameraInfo) within " +
+               std::to_string(params_.sync_slop_s) + " s of their stamp: not frames";
+  char times[160] = "";
+  if (reconstructed_ > 1 && frames_ > 1)
+    std::snprintf(times, sizeof times, "\n  the engine: %.0f ms a frame (the first %.0f ms); the frames came every %.0f ms",
+                  later_frames_ms_ / static_cast<double>(reconstructed_ - 1), first_frame_ms_,
+                  std::chrono::duration<double, std::milli>(last_arrival_ - first_arrival_).count() /
+                      static_cast<double>(frames_ - 1));
+  return std::to_string(scans_) + " scans received, " + std::to_string(frames_) + " frames, " +
+         std::to_string(reconstructed_) + " reconstructed, " + std::to_string(dropped) + " dropped" + reasons + times;
+}
+
+ReconstructionNode::~ReconstructionNode() {
+  queue_.close();
+  worker_.join(); // after the frames still waiting
+  try {
+    saveMesh();
+  } catch (const std::exception& e) {
+    ROS_ERROR("msf_ros_node: the mesh is not saved: %s", e.what());
+  }
+  ROS_INFO("msf_ros_node: %s", summary().c_str());
+}
+
+} // namespace msf

@@ -1,0 +1,128 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// The reconstruction engine (msf::Reconstructor) as a ROS 1 node: messages in, the engine's
+// depth, points and mesh out. All the method lives in the library; this converts and schedules.
+#include <msf/pipeline/bounded_queue.h>
+#include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/reconstructor.h>
+
+#include <message_filters/subscriber.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/synchronizer.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace msf {
+
+/// The node's private parameters, read once at start (config/kitti_bag.yaml lists them all).
+/// The topics default to the layout kitti2bag and msf_kitti2bag write.
+struct NodeParameters {
+  std::string lidar_topic;   ///< sensor_msgs/PointCloud2
+  std::string left_topic;    ///< rectified grey or colour Image; its CameraInfo is the sibling camera_info
+  std::string right_topic;
+  std::string color_topic;   ///< "" = no colour camera
+  std::string world_frame = "camera_init"; ///< tf frame of the poses and of the mesh
+  std::string poses = "auto";              ///< auto | tf | odometry (Reconstructor::PoseMode)
+  std::string config;        ///< the engine's YAML configuration ("" = its defaults)
+  std::string rig;           ///< a calibration file instead of CameraInfo and the tf extrinsic
+  int threads = 0;           ///< the engine's threads (0 = all cores)
+  bool sweeping_scans = true; ///< scans swept over their period: the odometry deskews them
+  int queue_size = 1;        ///< frames waiting for the engine; when full the oldest is dropped
+  double sync_slop_s = 0.05; ///< the largest spread of stamps within one frame's messages
+  double tf_timeout_s = 0.2; ///< how long a frame waits for its pose and the first for the extrinsic
+  double mesh_rate_hz = 1.0; ///< mesh marker refresh (0 = none)
+  std::string mesh_path;     ///< the mesh saved at shutdown (.ply/.obj/.vtk), "" = none
+
+  NodeParameters();
+  /// Reads the private parameters; throws ConfigError naming the parameter for an unknown
+  /// name, a wrong type or a value out of range, and for a mesh_path that exists.
+  static NodeParameters read(const ros::NodeHandle& private_nh);
+};
+
+class ReconstructionNode {
+public:
+  ReconstructionNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
+  /// Finishes the frames waiting, saves the mesh (mesh_path) and logs what was dropped and why.
+  ~ReconstructionNode();
+
+private:
+  using Cloud = sensor_msgs::PointCloud2;
+  using Image = sensor_msgs::Image;
+  using Info = sensor_msgs::CameraInfo;
+  using Clock = std::chrono::steady_clock;
+  /// One frame's messages as the sync gave them; converted on the worker thread.
+  struct Pending {
+    Cloud::ConstPtr cloud;
+    Image::ConstPtr left, right, color;
+    Info::ConstPtr left_info, right_info, color_info;
+  };
+  using StereoPolicy = message_filters::sync_policies::ApproximateTime<Cloud, Image, Info, Image, Info>;
+  using ColorPolicy = message_filters::sync_policies::ApproximateTime<Cloud, Image, Info, Image, Info, Image, Info>;
+
+  void subscribe(ros::NodeHandle& nh);
+  void onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
+                const Image::ConstPtr& right, const Info::ConstPtr& right_info);
+  void onColor(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
+               const Image::ConstPtr& right, const Info::ConstPtr& right_info, const Image::ConstPtr& color,
+               const Info::ConstPtr& color_info);
+  /// The sync's callback: queues the frame; when the queue is full its oldest frame is dropped.
+  void enqueue(Pending pending);
+  /// The worker thread: one frame at a time through the engine, the mesh marker when due.
+  void work();
+  void process(const Pending& pending);
+  /// The engine, made at the first frame: its rig from that frame's CameraInfo and the tf
+  /// extrinsic (or the rig file). False when the extrinsic is not there yet.
+  bool startEngine(const Pending& pending);
+  Frame frameFromMessages(const Pending& pending) const;
+  /// The frame's pose from tf, unless the engine tracks it; false when it needs one and tf has none.
+  bool placeFrame(Frame& frame, const std_msgs::Header& camera_header);
+  bool lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
+              Eigen::Isometry3d& T, std::string& error) const;
+  void publish(const FrameResult& result, const std_msgs::Header& camera_header);
+  Clock::duration untilMeshDue() const;
+  void publishMesh();
+  void drop(const std::string& reason);
+  void saveMesh();
+  std::string summary() const;
+
+  NodeParameters params_;
+  PipelineConfig config_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  message_filters::Subscriber<Cloud> cloud_sub_;
+  message_filters::Subscriber<Image> left_sub_, right_sub_, color_sub_;
+  message_filters::Subscriber<Info> left_info_sub_, right_info_sub_, color_info_sub_;
+  std::unique_ptr<message_filters::Synchronizer<StereoPolicy>> stereo_sync_;
+  std::unique_ptr<message_filters::Synchronizer<ColorPolicy>> color_sync_;
+  ros::Publisher depth_pub_, weight_pub_, points_pub_, mesh_pub_;
+
+  BoundedQueue<Pending> queue_;
+  std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
+  Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
+  mutable std::mutex drops_mutex_;
+  std::map<std::string, std::size_t> dropped_; // reason -> frames
+
+  // The worker thread's own.
+  std::unique_ptr<Reconstructor> engine_;
+  bool tracking_ = false; // the engine's odometry gives the poses
+  std::int64_t first_scan_ns_ = 0;
+  std_msgs::Header last_header_;
+  Clock::time_point last_mesh_;
+  std::size_t meshed_frames_ = 0;
+  double first_frame_ms_ = 0, later_frames_ms_ = 0; // the engine's time
+  std::thread worker_;
+};
+
+} // namespace msf

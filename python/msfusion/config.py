@@ -1,0 +1,72 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+"""The configuration of every stage from a YAML file of config/ and keys given in Python."""
+import os
+import tempfile
+
+from ._core import Config
+
+
+def load_config(path=None, overrides=None):
+    """A Config: the defaults in code, the sections of the YAML file `path` (config/kitti.yaml
+    lists every key) over them, and `overrides` over both, as {"section": {"key": value}} or
+    {"section.key": value}:
+
+        msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": 0.2, "tsdf_integrator": {"lambda": 5.0}})
+
+    The library reads the result as it reads a file, so a key it does not know, a wrong type
+    or a value out of range is a ConfigError that names it."""
+    config = Config.load(path) if path else Config()
+    if not overrides:
+        return config
+    sections = _sections(config.yaml())
+    for key, value in overrides.items():
+        if isinstance(value, dict):
+            for name, item in value.items():
+                sections.setdefault(key, {})[name] = _yaml_value(item)
+        else:
+            section, dot, name = key.partition(".")
+            if not dot or not name:
+                raise ValueError(f"override '{key}' must be 'section.key' or a section's dict of keys")
+            sections.setdefault(section, {})[name] = _yaml_value(value)
+    return _load_text(_yaml_text(sections))
+
+
+def _sections(text):
+    """Config.yaml()'s text as {section: {key: value text}}: a section's name at column 0, its
+    keys indented, one a line."""
+    sections, current = {}, None
+    for line in text.splitlines():
+        if not line.strip() or line.startswith("%") or line.lstrip().startswith("#"):
+            continue
+        name, _, value = line.strip().partition(":")
+        if not line[0].isspace():
+            current = sections.setdefault(name, {})
+        elif current is not None:
+            current[name] = value.strip()
+    return sections
+
+
+def _yaml_value(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_yaml_value(v) for v in value) + "]"
+    return str(value)
+
+
+def _yaml_text(sections):
+    lines = []
+    for section, keys in sections.items():
+        lines.append(f"{section}:")
+        lines.extend(f"  {name}: {value}" for name, value in keys.items())
+    return "\n".join(lines) + "\n"
+
+
+def _load_text(text):
+    with tempfile.TemporaryDirectory(prefix="msfusion_config_") as folder:
+        path = os.path.join(folder, "config.yaml")
+        with open(path, "w") as f:
+            f.write(text)
+        return Config.load(path)

@@ -1,0 +1,62 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+// numpy arrays in and out of the library's types: inputs are viewed in place (a cv::Mat over
+// the array's buffer), outputs own the cv::Mat they came from (a capsule frees it with the
+// array), so no image is copied on its way through the binding.
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <mutex>
+#include <utility>
+
+namespace msf::python {
+
+namespace py = pybind11;
+
+/// A cv::Mat over `array`'s buffer, no copy: (H,W) for one channel, (H,W,C) for `channels`
+/// > 1. `type` is CV_8UC1, CV_8UC3, CV_32FC1... Throws InvalidInputError naming `name` when
+/// `array` is not a numpy array, has another dtype or shape, or is not C-contiguous. An
+/// `expected` size other than 0x0 is checked too. The array must outlive the view.
+cv::Mat imageView(const py::handle& array, const char* name, int type, cv::Size expected = {});
+
+/// The same for an optional argument: an empty cv::Mat for None.
+cv::Mat optionalImageView(const py::handle& array, const char* name, int type, cv::Size expected = {});
+
+/// A one-channel cv::Mat of N rows over a C-contiguous array of shape (N, C), no copy, with
+/// min_columns <= C <= max_columns (points: x y z and maybe reflectance; triangles). `depth`:
+/// CV_32F, CV_32S, CV_8U... Throws InvalidInputError naming `name` as imageView.
+cv::Mat rowsView(const py::handle& array, const char* name, int depth, int min_columns, int max_columns);
+
+/// A LiDAR scan from rowsView's (N, 3) or (N, 4) x y z [reflectance]: a copy, as PCL's
+/// points are 32 bytes (reflectance 0 for (N, 3)).
+pcl::PointCloud<pcl::PointXYZI>::Ptr scanFromPoints(const cv::Mat& points);
+/// A scan as an (N, 4) float32 array of x y z reflectance (a copy).
+py::object toArray(const pcl::PointCloud<pcl::PointXYZI>& scan);
+
+/// An array that owns `mat` (its buffer is shared, not copied): (H,W) or (H,W,C); None for
+/// an empty `mat`. A region of interest is copied, so that every output is C-contiguous.
+py::object toArray(cv::Mat mat);
+/// A view of `mat`, kept alive by `owner` (the Python object that holds the cv::Mat); None
+/// for an empty `mat`, a copy for a region of interest.
+py::object viewOf(const cv::Mat& mat, const py::handle& owner);
+
+/// A 4x4 rigid transform (any float dtype; the translation in metres). Throws
+/// InvalidInputError naming `name` for another shape or a transform that is not rigid.
+Eigen::Isometry3d poseFrom(const py::handle& array, const char* name);
+/// A 4x4 float64 array.
+py::array_t<double> toArray(const Eigen::Isometry3d& pose);
+
+/// Runs `work` with the GIL released and `mutex` held: heavy calls let other Python threads
+/// run, and calls on one object from several threads take turns (the stages keep buffers).
+template <typename Work>
+auto withoutGil(std::mutex& mutex, Work&& work) {
+  py::gil_scoped_release release;
+  std::lock_guard<std::mutex> lock(mutex);
+  return std::forward<Work>(work)();
+}
+
+} // namespace msf::python

@@ -1,0 +1,107 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The rig: msf::Calibration (read from a KITTI odometry calib.txt, a raw date folder, an object
+// calib file or the project's YAML, the format detected) and the pinhole camera of one image.
+#include "bindings.h"
+
+#include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
+
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace msf::python {
+
+namespace {
+
+cv::Size sizeFrom(const std::optional<std::pair<int, int>>& image_size) {
+  return image_size ? cv::Size(image_size->first, image_size->second) : cv::Size();
+}
+
+Calibration load(const std::string& path, const std::optional<std::pair<int, int>>& image_size) {
+  py::gil_scoped_release release;
+  return loadCalibration(path, sizeFrom(image_size));
+}
+
+py::array_t<double> projections(const Calibration& c) {
+  py::array_t<double> P(std::vector<py::ssize_t>{4, 3, 4});
+  auto out = P.mutable_unchecked<3>();
+  for (int i = 0; i < 4; ++i)
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 4; ++col)
+        out(i, r, col) = c.P[i](r, col);
+  return P;
+}
+
+std::string describe(const Calibration& c) {
+  return "Calibration('" + c.source + "', " + std::to_string(c.image_size.width) + "x" +
+         std::to_string(c.image_size.height) + ", fx " + std::to_string(c.fx()) + ", baseline " +
+         std::to_string(c.baselineGrey()) + " m" + (c.has_velodyne ? "" : ", cameras only") + ")";
+}
+
+void bindPinholeCamera(py::module_& m) {
+  py::class_<PinholeCamera>(m, "PinholeCamera",
+                            "The intrinsics of one rectified camera: pixel (u, v) with depth z is the point "
+                            "((u - cx) z / fx, (v - cy) z / fy, z).")
+      .def(py::init([](float fx, float fy, float cx, float cy, int width, int height) {
+             return PinholeCamera{fx, fy, cx, cy, width, height};
+           }),
+           py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"), py::arg("height"))
+      .def_readwrite("fx", &PinholeCamera::fx)
+      .def_readwrite("fy", &PinholeCamera::fy)
+      .def_readwrite("cx", &PinholeCamera::cx)
+      .def_readwrite("cy", &PinholeCamera::cy)
+      .def_readwrite("width", &PinholeCamera::width)
+      .def_readwrite("height", &PinholeCamera::height)
+      .def_property_readonly("K", [](const PinholeCamera& c) {
+        Eigen::Matrix3d K;
+        K << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1;
+        return K;
+      }, "The 3x3 intrinsic matrix.")
+      .def("__repr__", [](const PinholeCamera& c) {
+        return "PinholeCamera(fx=" + std::to_string(c.fx) + ", fy=" + std::to_string(c.fy) + ", cx=" +
+               std::to_string(c.cx) + ", cy=" + std::to_string(c.cy) + ", width=" + std::to_string(c.width) +
+               ", height=" + std::to_string(c.height) + ")";
+      });
+}
+
+} // namespace
+
+void bindCalibration(py::module_& m) {
+  bindPinholeCamera(m);
+  py::class_<Calibration>(m, "Calibration",
+                          "A rig: four rectified cameras (KITTI 0, 1 grey left/right; 2, 3 colour) sharing one image "
+                          "plane, and the LiDAR. Every projection maps points of camera 0's rectified frame to pixels.")
+      .def_static("load", &load, py::arg("path"), py::arg("image_size") = py::none(),
+                  "Reads a KITTI odometry calib.txt (or its sequence folder), a KITTI raw date folder, a KITTI "
+                  "object calib file or the project's YAML rig file, the format detected. image_size (width, "
+                  "height) where no image lies beside the file. Raises CalibrationError naming a missing key, "
+                  "IOError for a missing path.")
+      .def_property_readonly("image_size", [](const Calibration& c) {
+        return std::make_pair(c.image_size.width, c.image_size.height);
+      }, "(width, height) of the rectified images; (0, 0) when unknown.")
+      .def_property_readonly("P", &projections, "The projection matrices of cameras 0..3, shape (4, 3, 4).")
+      .def_property_readonly("T_cam0_velo", [](const Calibration& c) { return toArray(c.T_cam0_velo); },
+                             "The LiDAR's pose in camera 0's rectified frame, 4x4.")
+      .def_property_readonly("has_velodyne", [](const Calibration& c) { return c.has_velodyne; },
+                             "False for a calibration of the cameras only (no LiDAR extrinsics).")
+      .def_property_readonly("source", [](const Calibration& c) { return c.source; }, "Where it was read from.")
+      .def("K", &Calibration::K, py::arg("camera") = 0, "The 3x3 intrinsic matrix of a camera (0..3).")
+      .def("baseline", &Calibration::baseline, py::arg("camera_a") = 0, py::arg("camera_b") = 1,
+           "Distance between two optical centres in metres.")
+      .def_property_readonly("focal_baseline", &Calibration::focalBaseline,
+                             "f * B of the grey pair: depth = focal_baseline / disparity.")
+      .def("camera", &PinholeCamera::fromCalibration, py::arg("camera") = 0,
+           "The PinholeCamera of a camera (0..3) of the rig.")
+      .def("save_yaml", &saveCalibrationYaml, py::arg("path"),
+           "Writes the project's YAML rig file (read back by Calibration.load).")
+      .def("__repr__", &describe);
+  m.def("load_calibration", &load, py::arg("path"), py::arg("image_size") = py::none(),
+        "Calibration.load: a KITTI calib.txt, raw date folder, object calib file or the project's YAML rig.");
+}
+
+} // namespace msf::python

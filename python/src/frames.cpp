@@ -1,0 +1,179 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// Frames in: msf::Frame as msfusion.Frame (loaded from a source, or made from arrays: grey pair,
+// scan, colour image, pose), and msf::FrameSource (msf::Sequence: a KITTI odometry sequence or
+// raw drive, or the synthetic street; open_dataset) as an iterable of frames.
+#include "bindings.h"
+#include "frame_object.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/io/sequence.h>
+#include <msf/pipeline/open_dataset.h>
+
+#include <opencv2/imgproc.hpp>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+namespace msf::python {
+
+namespace {
+
+FrameObject fromArrays(const py::handle& left, const py::handle& right, const py::handle& scan,
+                       const py::handle& color, const py::handle& pose, std::size_t index, double timestamp,
+                       const std::string& name) {
+  FrameObject object;
+  Frame& frame = object.frame;
+  frame.index = index;
+  frame.timestamp = timestamp;
+  frame.left = imageView(left, "left", CV_8UC1);
+  frame.right = imageView(right, "right", CV_8UC1, frame.left.size());
+  const cv::Mat points = rowsView(scan, "scan", CV_32F, 3, 4);
+  const cv::Mat rgb = optionalImageView(color, "color", CV_8UC3);
+  if (!pose.is_none()) {
+    frame.T_world_cam0 = poseFrom(pose, "pose");
+    frame.has_pose = true;
+  }
+  {
+    py::gil_scoped_release release;
+    frame.scan = scanFromPoints(points);
+    if (!rgb.empty())
+      cv::cvtColor(rgb, frame.color, cv::COLOR_RGB2BGR); // the library's order
+  }
+  object.name = name.empty() ? std::to_string(index) : name;
+  object.arrays = py::make_tuple(left, right);
+  return object;
+}
+
+FrameObject load(const FrameSource& source, long long i, bool with_color) {
+  const auto size = static_cast<long long>(source.size());
+  if (i < -size || i >= size)
+    throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(size));
+  const auto index = static_cast<std::size_t>(i < 0 ? i + size : i);
+  FrameObject object;
+  {
+    py::gil_scoped_release release;
+    object.frame = source.load(index, with_color);
+  }
+  object.name = source.frameName(index);
+  object.arrays = py::none();
+  return object;
+}
+
+/// for frame in source: loads frame after frame.
+struct FrameIterator {
+  py::object source;  // keeps the FrameSource alive
+  std::size_t next = 0;
+};
+
+py::object posesOf(const FrameSource& source) {
+  if (!source.hasPoses())
+    return py::none();
+  const PoseList& poses = source.poses();
+  py::array_t<double> out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(poses.size()), 4, 4});
+  auto o = out.mutable_unchecked<3>();
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        o(static_cast<py::ssize_t>(i), r, c) = poses[i].matrix()(r, c);
+  return std::move(out);
+}
+
+void bindFrame(py::module_& m) {
+  py::class_<FrameObject>(m, "Frame",
+                          "One frame: the rectified grey pair of cameras 0 and 1, the LiDAR scan, the colour camera's "
+                          "image and the pose of camera 0 (T_world_cam0), if any.")
+      .def(py::init(&fromArrays), py::arg("left"), py::arg("right"), py::arg("scan"), py::arg("color") = py::none(),
+           py::arg("pose") = py::none(), py::arg("index") = 0, py::arg("timestamp") = 0.0, py::arg("name") = "",
+           "A frame from arrays: left, right (H, W) uint8 grey (viewed, not copied), scan (N, 4) float32 x y z "
+           "reflectance in the LiDAR's frame or (N, 3), color (H', W', 3) uint8 RGB of the colour camera, pose "
+           "4x4 T_world_cam0 (None: no pose).")
+      .def_property_readonly("index", [](const FrameObject& f) { return f.frame.index; })
+      .def_property_readonly("name", [](const FrameObject& f) { return f.name; }, "File stem ('000042').")
+      .def_property_readonly("timestamp", [](const FrameObject& f) { return f.frame.timestamp; },
+                             "Seconds from the sequence's first frame.")
+      .def_property_readonly("left", [](const py::handle& self) {
+        return viewOf(self.cast<const FrameObject&>().frame.left, self);
+      }, "Camera 0's grey image, (H, W) uint8 (a view).")
+      .def_property_readonly("right", [](const py::handle& self) {
+        return viewOf(self.cast<const FrameObject&>().frame.right, self);
+      }, "Camera 1's grey image, (H, W) uint8 (a view).")
+      .def_property_readonly("color", [](const FrameObject& f) -> py::object {
+        if (f.frame.color.empty())
+          return py::none();
+        cv::Mat rgb;
+        cv::cvtColor(f.frame.color, rgb, cv::COLOR_BGR2RGB);
+        return toArray(rgb);
+      }, "The colour camera's image, (H, W, 3) uint8 RGB (a copy), or None.")
+      .def_property_readonly("scan", [](const FrameObject& f) -> py::object {
+        if (!f.frame.scan)
+          return py::none();
+        return toArray(*f.frame.scan);
+      }, "The LiDAR scan, (N, 4) float32 x y z reflectance in the LiDAR's frame (a copy).")
+      .def_property_readonly("pose", [](const FrameObject& f) -> py::object {
+        if (!f.frame.has_pose)
+          return py::none();
+        return toArray(f.frame.T_world_cam0);
+      }, "T_world_cam0, 4x4 float64, or None.")
+      .def("__repr__", [](const FrameObject& f) {
+        return "Frame('" + f.name + "', " + std::to_string(f.frame.left.cols) + "x" + std::to_string(f.frame.left.rows) +
+               ", " + std::to_string(f.frame.scan ? f.frame.scan->size() : 0) + " points" +
+               (f.frame.has_pose ? "" : ", no pose") + ")";
+      });
+}
+
+void bindSources(py::module_& m) {
+  py::class_<FrameIterator>(m, "_FrameIterator")
+      .def("__iter__", [](const py::handle& self) { return self; })
+      .def("__next__", [](FrameIterator& it) {
+        const FrameSource& source = it.source.cast<const FrameSource&>();
+        if (it.next >= source.size())
+          throw py::stop_iteration();
+        return load(source, static_cast<long long>(it.next++), true);
+      });
+  py::class_<FrameSource>(m, "FrameSource",
+                          "Where frames come from (a dataset folder): its rig, its frames by index or one after "
+                          "the other, and its poses, if any.")
+      .def("__len__", &FrameSource::size)
+      .def("__getitem__", [](const FrameSource& s, long long i) { return load(s, i, true); }, py::arg("index"))
+      .def("load", &load, py::arg("index"), py::arg("with_color") = true,
+           "Frame `index`; with_color=False skips reading the colour camera.")
+      .def("__iter__", [](const py::object& self) { return FrameIterator{self, 0}; })
+      .def_property_readonly("calibration", &FrameSource::calibration)
+      .def_property_readonly("poses", &posesOf, "(N, 4, 4) float64 T_world_cam0 per frame, or None.")
+      .def("frame_name", &FrameSource::frameName, py::arg("index"))
+      .def("__repr__", [](const FrameSource& s) {
+        return "FrameSource('" + s.description() + "', " + std::to_string(s.size()) + " frames)";
+      });
+  py::class_<Sequence, FrameSource>(m, "Sequence",
+                                    "A dataset on disk, its layout detected: a KITTI odometry sequence (sequences/XX "
+                                    "with poses/XX.txt), a KITTI raw drive (YYYY_MM_DD_drive_NNNN_sync, calibration "
+                                    "in the date folder, poses from OXTS) or msf_synth's synthetic street. "
+                                    "Indexing loads a Frame; iterating loads one after the other.")
+      .def(py::init<const std::string&>(), py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+           "Raises IOError naming the folder when it is no known layout.")
+      .def_property_readonly("directory", &Sequence::directory)
+      .def_property_readonly("layout", [](const Sequence& s) {
+        return s.layout() == Sequence::Layout::Raw ? "raw" : "odometry";
+      })
+      .def("__repr__", [](const Sequence& s) {
+        return "Sequence('" + s.directory() + "', " + std::to_string(s.size()) + " frames)";
+      });
+  m.def("open_dataset", [](const std::string& path, const std::string& rig) {
+    py::gil_scoped_release release;
+    DatasetOptions options;
+    options.rig = rig;
+    return openDataset(path, options);
+  }, py::arg("path"), py::arg("rig") = "",
+        "The FrameSource of a dataset folder, its layout detected (as msf_reconstruct reads it); rig: a "
+        "calibration or rig file for layouts without one, or to override the dataset's.");
+}
+
+} // namespace
+
+void bindFrames(py::module_& m) {
+  bindFrame(m);
+  bindSources(m);
+}
+
+} // namespace msf::python

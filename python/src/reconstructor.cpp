@@ -1,0 +1,248 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// The engine (msf::Reconstructor) as msfusion.Reconstructor: frames one call at a time on the
+// caller's thread (add_frame: depth, pose, integration; mesh()), or a source's frames overlapped
+// on the engine's threads (run), each frame's depth images given back as a FrameResult.
+#include "bindings.h"
+#include "frame_object.h"
+
+#include <msf/common/exceptions.h>
+#include <msf/pipeline/reconstructor.h>
+
+#include <opencv2/imgproc.hpp>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace msf::python {
+
+namespace {
+
+struct Engine {
+  Engine(const Calibration& rig, const PipelineConfig& config, const Reconstructor::Options& options)
+      : engine(rig, config, options) {}
+  Reconstructor engine;
+  std::mutex mutex;
+};
+
+Reconstructor::PoseMode parsePoseMode(const std::string& text) {
+  if (text == "auto")
+    return Reconstructor::PoseMode::Auto;
+  if (text == "given")
+    return Reconstructor::PoseMode::Given;
+  if (text == "odometry")
+    return Reconstructor::PoseMode::Odometry;
+  if (text == "refine")
+    return Reconstructor::PoseMode::Refine;
+  throw InvalidInputError("poses must be auto, given, odometry or refine, not '" + text + "'");
+}
+
+std::unique_ptr<Engine> makeEngine(const Calibration& rig, const PipelineConfig& config, const std::string& poses,
+                                   int threads, bool sweeping_scans, const std::string& stream_directory) {
+  Reconstructor::Options options;
+  options.poses = parsePoseMode(poses);
+  options.threads = threads;
+  options.sweeping_scans = sweeping_scans;
+  options.stream_directory = stream_directory;
+  py::gil_scoped_release release;
+  return std::make_unique<Engine>(rig, config, options);
+}
+
+/// The result a Python object keeps: its own copy of the left image when that is a view of the
+/// caller's array, which may be gone before the result is.
+FrameResult keepable(FrameResult result, const FrameObject& frame) {
+  if (!frame.arrays.is_none())
+    result.left = result.left.clone();
+  result.name = frame.name;
+  return result;
+}
+
+FrameResult addFrame(Engine& e, const FrameObject& frame) {
+  return keepable(withoutGil(e.mutex, [&] { return e.engine.addFrame(frame.frame); }), frame);
+}
+
+FrameResult computeDepth(Engine& e, const FrameObject& frame) {
+  return keepable(withoutGil(e.mutex, [&] { return e.engine.computeDepth(frame.frame); }), frame);
+}
+
+void integrate(Engine& e, FrameResult& result) {
+  withoutGil(e.mutex, [&] { e.engine.integrate(result); });
+}
+
+TriangleMesh mesh(Engine& e) {
+  return withoutGil(e.mutex, [&] { return e.engine.mesh(); }); // a copy: the engine keeps its own
+}
+
+/// Reconstructor::run on a thread of its own while this one, the caller's, waits without the GIL
+/// and looks for signals every 0.1 s: Ctrl-C stops the run after the frame being integrated (as
+/// msf_reconstruct does) and is raised once the run has ended. `on_frame` gets each FrameResult
+/// on the engine's integration thread, with the GIL.
+py::dict run(Engine& e, const FrameSource& source, std::optional<std::vector<std::size_t>> frames,
+             const py::object& on_frame) {
+  std::vector<std::size_t> indices(source.size());
+  std::iota(indices.begin(), indices.end(), std::size_t(0));
+  if (frames)
+    indices = *frames;
+  for (const std::size_t i : indices)
+    if (i >= source.size())
+      throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(source.size()));
+  Reconstructor::FrameCallback callback;
+  if (!on_frame.is_none())
+    callback = [&](FrameResult& result) {
+      py::gil_scoped_acquire gil;
+      on_frame(std::move(result));
+    };
+  std::atomic<bool> stop{false};
+  std::optional<py::error_already_set> interrupt;
+  Reconstructor::RunStats stats;
+  std::exception_ptr failure;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> engine_lock(e.mutex);
+    std::mutex done_mutex;
+    std::condition_variable done_signal;
+    bool done = false;
+    std::thread runner([&] {
+      try {
+        stats = e.engine.run(source, indices, callback, &stop);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(done_mutex);
+      done = true;
+      done_signal.notify_one();
+    });
+    std::unique_lock<std::mutex> lock(done_mutex);
+    while (!done_signal.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) {
+      lock.unlock();
+      {
+        py::gil_scoped_acquire gil;
+        if (!interrupt && PyErr_CheckSignals() != 0) {
+          interrupt.emplace(); // takes the raised error (KeyboardInterrupt) off the interpreter
+          stop = true;
+        }
+      }
+      lock.lock();
+    }
+    lock.unlock();
+    runner.join();
+  }
+  if (interrupt)
+    throw *interrupt;
+  if (failure)
+    std::rethrow_exception(failure);
+  py::dict out;
+  out["frames_done"] = stats.frames_done;
+  out["wall_s"] = stats.wall_s;
+  out["first_frame_s"] = stats.first_frame_s;
+  out["interrupted"] = stats.interrupted;
+  return out;
+}
+
+/// A property of FrameResult viewing one of its images.
+template <cv::Mat FrameResult::*image>
+py::object imageOf(const py::handle& self) {
+  return viewOf(self.cast<const FrameResult&>().*image, self);
+}
+
+void bindFrameResult(py::module_& m) {
+  py::class_<FrameResult>(m, "FrameResult",
+                          "What one frame produced: depth images of camera 0, (H, W) float32 metres (0 = none), "
+                          "each a view of the result (no copy), and the pose it was integrated at.")
+      .def_property_readonly("index", [](const FrameResult& r) { return r.index; })
+      .def_property_readonly("name", [](const FrameResult& r) { return r.name; })
+      .def_property("pose", [](const FrameResult& r) -> py::object {
+        return r.has_pose ? py::object(toArray(r.T_world_cam0)) : py::none();
+      }, [](FrameResult& r, const py::handle& pose) {
+        r.has_pose = !pose.is_none();
+        r.T_world_cam0 = r.has_pose ? poseFrom(pose, "pose") : Eigen::Isometry3d::Identity();
+      }, "T_world_cam0 (4x4): the frame's, or the odometry's after add_frame; settable before integrate().")
+      .def_property_readonly("depth", [](const py::handle& self) {
+        return viewOf(self.cast<const FrameResult&>().fused.depth, self);
+      }, "The fused depth (step 4).")
+      .def_property_readonly("weight", [](const py::handle& self) {
+        return viewOf(self.cast<const FrameResult&>().fused.weight, self);
+      }, "The fused depth's inverse variance, m^-2.")
+      .def_property_readonly("free_space_weight", [](const py::handle& self) {
+        return viewOf(self.cast<const FrameResult&>().fused.free_space_weight, self);
+      }, "The weight of the free space in front of each fused depth.")
+      .def_property_readonly("color", [](const FrameResult& r) -> py::object {
+        if (r.fused.color.empty())
+          return py::none();
+        cv::Mat rgb;
+        cv::cvtColor(r.fused.color, rgb, cv::COLOR_BGR2RGB);
+        return toArray(rgb);
+      }, "The colour of each fused pixel, (H, W, 3) uint8 RGB (a copy).")
+      .def_property_readonly("left", &imageOf<&FrameResult::left>, "Camera 0's grey image.")
+      .def_property_readonly("lidar_depth", &imageOf<&FrameResult::lidar_depth>, "The interpolated LiDAR (step 2).")
+      .def_property_readonly("lidar_distance", &imageOf<&FrameResult::lidar_distance>,
+                             "Pixels from each pixel to the nearest real LiDAR return.")
+      .def_property_readonly("stereo_depth", &imageOf<&FrameResult::stereo_depth>, "SGBM's depth (step 3).")
+      .def_property_readonly("stereo_confidence", &imageOf<&FrameResult::stereo_confidence>,
+                             "SGBM's confidence in [0, 1].")
+      .def_property_readonly("times", [](const FrameResult& r) {
+        const StageTimes& t = r.times;
+        py::dict times;
+        times["load_ms"] = t.load_ms;
+        times["lidar_ms"] = t.lidar_ms;
+        times["stereo_ms"] = t.stereo_ms;
+        times["depth_ms"] = t.depth_ms;
+        times["fusion_ms"] = t.fusion_ms;
+        times["integrate_ms"] = t.integrate_ms;
+        return times;
+      }, "Milliseconds per stage.")
+      .def("__repr__", [](const FrameResult& r) {
+        return "FrameResult('" + r.name + "', " + std::to_string(r.fused.depth.cols) + "x" +
+               std::to_string(r.fused.depth.rows) + (r.has_pose ? "" : ", no pose") + ")";
+      });
+}
+
+} // namespace
+
+void bindReconstructor(py::module_& m) {
+  bindFrameResult(m);
+  py::class_<Engine>(m, "Reconstructor",
+                     "The engine: LiDAR completion and SGBM fused per pixel, each frame's pose (its own, or "
+                     "LiDAR odometry's), the regularized TSDF volume and its mesh. The same classes and "
+                     "settings as msf_reconstruct, so the same depth and mesh.")
+      .def(py::init(&makeEngine), py::arg("calibration"), py::arg("config") = PipelineConfig(),
+           py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("sweeping_scans") = true,
+           py::arg("stream_directory") = "",
+           "poses: auto (the frame's own pose; LiDAR odometry when the first frame has none), given (a frame "
+           "without one is an error), odometry (always) or refine (the frames' own poses, a GPS/INS's, as the "
+           "prior the LiDAR odometry refines). threads: of this engine's parallel loops, 0 = all "
+           "cores. sweeping_scans: the scans are swept over their period (a spinning LiDAR; the odometry "
+           "deskews them). stream_directory: where a streamed map (streaming.active_radius_m > 0) writes its "
+           "tiles. Raises ConfigError for an invalid config, CalibrationError for a rig without an image size.")
+      .def("add_frame", &addFrame, py::arg("frame"),
+           "A Frame's depth (steps 1-4), its pose and its integration into the map (step 5): its FrameResult, "
+           "whose depth, weight and pose are the fused depth, its inverse variance and the pose used.")
+      .def("compute_depth", &computeDepth, py::arg("frame"),
+           "Steps 1-4 of a Frame, nothing added to the map. Raises InvalidInputError for images or a scan that "
+           "do not fit the rig.")
+      .def("integrate", &integrate, py::arg("result"),
+           "Step 5: a compute_depth result at its pose into the map. Raises InvalidInputError without a pose.")
+      .def("mesh", &mesh, "The map's Mesh, meshing again only the blocks changed since the last call.")
+      .def("run", &run, py::arg("source"), py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
+           "The frames of a source (a Sequence; all, or the indices given) overlapped on the engine's "
+           "threads: the same map as add_frame frame by frame, faster. on_frame(result) is called after each "
+           "frame is integrated, in order. Ctrl-C stops after the frame being integrated. Returns frames_done, "
+           "wall_s, first_frame_s and interrupted.")
+      .def_property_readonly("calibration", [](Engine& e) { return e.engine.calibration(); })
+      .def_property_readonly("config", [](Engine& e) { return e.engine.config(); })
+      .def_property_readonly("num_blocks", [](Engine& e) {
+        return withoutGil(e.mutex, [&] { return e.engine.volume().numBlocks(); });
+      }, "Blocks of 8^3 voxels the map holds.")
+      .def_property_readonly("odometry_ms", [](Engine& e) { return e.engine.odometryMs(); },
+                             "Milliseconds the odometry took for each frame it tracked.");
+}
+
+} // namespace msf::python

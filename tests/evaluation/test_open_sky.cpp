@@ -1,0 +1,150 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// Evaluation protocol 6: the sky mask on drawn images with known answers and on a hand-checked
+// KITTI frame, and the share of it a mesh covers.
+#include <msf/common/exceptions.h>
+#include <msf/evaluation/open_sky_coverage.h>
+#include <msf/evaluation/sky_mask.h>
+#include <msf/io/sequence.h>
+#include <msf/range_image/lidar_projector.h>
+
+#include <test_support.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+using namespace msf;
+
+namespace {
+
+constexpr int kWidth = 200, kHeight = 100;
+
+/// A drawn street scene (BGR): a blue sky with a brightening gradient over rows 0-59, a
+/// textured green crown reaching the top edge over columns 20-59, a white wall over columns
+/// 140-179 from row 30, a blue patch walled in by texture at rows 40-49 of columns 90-109,
+/// and a grey road from row 60.
+cv::Mat drawnScene() {
+  cv::Mat image(kHeight, kWidth, CV_8UC3);
+  for (int v = 0; v < kHeight; ++v)
+    image.row(v).setTo(v < 60 ? cv::Scalar(230, 170 + v / 2, 120 + v / 2) : cv::Scalar(100, 100, 100));
+  cv::Mat crown = image(cv::Rect(20, 0, 40, 50));
+  cv::randu(crown, cv::Scalar(20, 60, 20), cv::Scalar(90, 200, 90));
+  image(cv::Rect(140, 30, 40, 30)).setTo(cv::Scalar(235, 235, 235));
+  cv::Mat fence = image(cv::Rect(80, 30, 40, 30));
+  cv::randu(fence, cv::Scalar(0, 0, 0), cv::Scalar(255, 255, 255));
+  image(cv::Rect(90, 40, 20, 10)).setTo(cv::Scalar(230, 190, 140));
+  return image;
+}
+
+/// LiDAR returns on the road, the crown's lower half and the wall's lower rows.
+cv::Mat drawnReturns() {
+  cv::Mat returns(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  for (int v = 62; v < kHeight; v += 4)
+    returns.row(v).setTo(10.f);
+  for (int v = 26; v < 60; v += 4) {
+    returns(cv::Rect(20, v, 40, 1)).setTo(8.f);
+    returns(cv::Rect(80, v, 40, 1)).setTo(9.f);
+    returns(cv::Rect(140, v, 40, 1)).setTo(12.f);
+  }
+  return returns;
+}
+
+bool sky(const cv::Mat& mask, int u, int v) { return mask.at<std::uint8_t>(v, u) != 0; }
+
+PinholeCamera camera() {
+  PinholeCamera c;
+  c.width = kWidth, c.height = kHeight;
+  c.fx = c.fy = 100.f;
+  c.cx = 99.5f, c.cy = 49.5f;
+  return c;
+}
+
+/// A square facing the camera at depth z over world x in [x0, x1], y in [y0, y1].
+TriangleMesh square(float x0, float x1, float y0, float y1, float z) {
+  TriangleMesh mesh;
+  mesh.vertices = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return mesh;
+}
+
+} // namespace
+
+TEST(SkyMask, KeepsTheOpenSkyAndNothingBelowOrAroundIt) {
+  const cv::Mat mask = SkyMask().compute(drawnScene(), drawnReturns());
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  EXPECT_TRUE(sky(mask, 100, 5));    // top centre
+  EXPECT_TRUE(sky(mask, 120, 20));   // above the fence's returns
+  EXPECT_TRUE(sky(mask, 190, 10));   // the top right corner's sky
+  EXPECT_FALSE(sky(mask, 40, 5));    // the crown: textured
+  EXPECT_FALSE(sky(mask, 160, 40));  // the white wall: under returns
+  EXPECT_FALSE(sky(mask, 100, 45));  // blue, blank, but walled in by the fence and under its returns
+  EXPECT_FALSE(sky(mask, 100, 80));  // the road
+  EXPECT_FALSE(sky(mask, 62, 10));   // within the border of the crown's edge
+  EXPECT_TRUE(sky(mask, 66, 10));    // past it
+}
+
+TEST(SkyMask, AWallWithoutReturnsIsSkyButAColouredOneIsNot) {
+  // No return anywhere: a white wall as bright as the sky beside it (grey 175: no edge between
+  // them) is taken for sky; a red one of that grey is not. The brighter white wall of the
+  // drawn scene is not either: its edge against the sky is texture, which cuts it off the top.
+  const cv::Mat none(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  cv::Mat image = drawnScene();
+  EXPECT_FALSE(sky(SkyMask().compute(image, none), 160, 40));
+  image(cv::Rect(140, 30, 40, 30)).setTo(cv::Scalar(175, 175, 175));
+  EXPECT_TRUE(sky(SkyMask().compute(image, none), 160, 40));
+  image(cv::Rect(140, 30, 40, 30)).setTo(cv::Scalar(140, 140, 255));
+  EXPECT_FALSE(sky(SkyMask().compute(image, none), 160, 40));
+  // Grey only: brightness, texture and the LiDAR decide.
+  cv::Mat grey;
+  cv::cvtColor(drawnScene(), grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat mask = SkyMask().compute(grey, drawnReturns());
+  EXPECT_TRUE(sky(mask, 100, 5));
+  EXPECT_FALSE(sky(mask, 40, 5));
+  EXPECT_FALSE(sky(mask, 160, 40));
+}
+
+TEST(SkyMask, RefusesImagesOfAnotherTypeOrSize) {
+  const cv::Mat returns = drawnReturns();
+  EXPECT_THROW(SkyMask().compute(cv::Mat(kHeight, kWidth, CV_32FC3), returns), InvalidInputError);
+  EXPECT_THROW(SkyMask().compute(drawnScene(), cv::Mat(kHeight, kWidth - 1, CV_32FC1)), InvalidInputError);
+  SkyMask mask;
+  mask.setBorder(-1);
+  EXPECT_THROW(mask.compute(drawnScene(), returns), ConfigError);
+}
+
+TEST(OpenSkyCoverage, CountsTheSkyPixelsASheetCovers) {
+  // The sky: the top 40 rows. A sheet at 10 m over world y in [-5, -3] (rows 0-19 at f 100)
+  // covers half of them; at the next frame's pose, 1 m lower (y down), rows 0-9: a quarter.
+  cv::Mat mask(kHeight, kWidth, CV_8UC1, cv::Scalar(0));
+  mask.rowRange(0, 40).setTo(255);
+  OpenSkyCoverage coverage(camera());
+  coverage.addMask(0, mask);
+  coverage.setPose(0, Eigen::Isometry3d::Identity());
+  Eigen::Isometry3d lowered = Eigen::Isometry3d::Identity();
+  lowered.translation().y() = 1.0;
+  coverage.setPose(1, lowered); // the pose first, the mask after
+  coverage.addMask(1, mask);
+  const SkyCoverage c = coverage.scoreMesh(square(-20.f, 20.f, -5.f, -3.f, 10.f));
+  EXPECT_EQ(c.frames, 2u);
+  EXPECT_EQ(c.sky_pixels, 2u * 40 * kWidth);
+  EXPECT_EQ(c.covered_pixels, 20u * kWidth + 10u * kWidth);
+  EXPECT_NEAR(c.share, 30.0 / 80.0, 1e-12);
+  EXPECT_NEAR(c.mean_frame_share, (0.5 + 0.25) / 2, 1e-12);
+  EXPECT_NEAR(c.worst_share, 0.5, 1e-12);
+  EXPECT_EQ(c.worst_frame, 0u);
+  // A mesh below the sky covers none of it.
+  EXPECT_EQ(coverage.scoreMesh(square(-20.f, 20.f, 1.f, 4.f, 10.f)).covered_pixels, 0u);
+  EXPECT_THROW(coverage.addMask(0, mask), InvalidInputError);
+  EXPECT_THROW(coverage.addMask(2, cv::Mat(kHeight, kWidth, CV_8UC3)), InvalidInputError);
+}
+
+TEST(OpenSkyCoverage, DrawsTheSkyCyanAndItsCoveredPixelsRed) {
+  cv::Mat mask(kHeight, kWidth, CV_8UC1, cv::Scalar(0)), rendered(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  mask.rowRange(0, 40).setTo(255);
+  rendered.rowRange(0, 20).setTo(10.f);
+  const cv::Mat picture =
+      OpenSkyCoverage::drawCoverage(cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(100)), mask, rendered);
+  EXPECT_EQ(picture.at<cv::Vec3b>(10, 5), cv::Vec3b(50, 50, 177));  // covered sky: red
+  EXPECT_EQ(picture.at<cv::Vec3b>(30, 5), cv::Vec3b(177, 177, 50)); // open sky: cyan
+  EXPECT_EQ(picture.at<cv::Vec3b>(60, 5), cv::Vec3b(100, 100, 100)); // no sky: the image
+}

@@ -1,0 +1,220 @@
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+"""Shapes, dtypes and errors: what the binding takes and gives, and how it refuses."""
+import gc
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import msfusion
+
+
+@pytest.fixture(scope="module")
+def calibration(odometry04):
+    return msfusion.load_calibration(os.path.join(odometry04, "calib.txt"))
+
+
+@pytest.fixture(scope="module")
+def sequence(odometry04):
+    return msfusion.Sequence(odometry04)
+
+
+@pytest.fixture(scope="module")
+def frame(sequence):
+    return sequence[0]
+
+
+def test_errors_are_library_kinds_and_python_builtins():
+    assert issubclass(msfusion.Error, RuntimeError)
+    assert issubclass(msfusion.IOError, msfusion.Error) and issubclass(msfusion.IOError, OSError)
+    for kind in (msfusion.ConfigError, msfusion.CalibrationError, msfusion.InvalidInputError):
+        assert issubclass(kind, msfusion.Error) and issubclass(kind, ValueError)
+    with pytest.raises(msfusion.IOError, match="/nonexistent/calib.txt"):
+        msfusion.load_calibration("/nonexistent/calib.txt")
+    with pytest.raises(OSError):
+        msfusion.Sequence("/nonexistent/sequence")
+
+
+def test_a_calibration_missing_a_key_names_it(odometry04, tmp_path):
+    lines = open(os.path.join(odometry04, "calib.txt")).read().splitlines()
+    (tmp_path / "calib.txt").write_text("\n".join(l for l in lines if not l.startswith("P2")) + "\n")
+    with pytest.raises(msfusion.CalibrationError, match="P2"):
+        msfusion.load_calibration(str(tmp_path / "calib.txt"))
+
+
+def test_the_calibration_is_the_files(calibration, odometry04, tmp_path):
+    rows = {l.split(":")[0]: np.array(l.split(":")[1].split(), dtype=float)
+            for l in open(os.path.join(odometry04, "calib.txt")) if ":" in l}
+    assert calibration.image_size == (1226, 370)  # the size of image_0/000000.png beside it
+    assert calibration.P.shape == (4, 3, 4)
+    for i in range(4):
+        np.testing.assert_array_equal(calibration.P[i], rows[f"P{i}"].reshape(3, 4))
+    np.testing.assert_array_equal(calibration.T_cam0_velo[:3], rows["Tr"].reshape(3, 4))
+    assert calibration.focal_baseline == pytest.approx(-rows["P1"][3])
+    camera = calibration.camera(0)
+    assert (camera.width, camera.height, camera.fx) == (1226, 370, pytest.approx(rows["P0"][0]))
+    calibration.save_yaml(str(tmp_path / "rig.yaml"))  # the project's YAML rig reads back the same
+    again = msfusion.load_calibration(str(tmp_path / "rig.yaml"))
+    np.testing.assert_allclose(again.P, calibration.P, rtol=1e-12)
+    assert again.image_size == calibration.image_size
+
+
+def test_a_raw_date_folder_is_a_calibration(kitti_dir):
+    calibration = msfusion.load_calibration(os.path.join(kitti_dir, "raw", "2011_09_26"))
+    assert calibration.image_size == (1242, 375) and calibration.has_velodyne
+
+
+def test_a_sequence_is_an_iterable_of_frames(kitti_dir, odometry04):
+    drive = msfusion.Sequence(os.path.join(kitti_dir, "raw", "2011_09_26", "2011_09_26_drive_0009_sync"))
+    assert (len(drive), drive.layout, drive.poses.shape) == (5, "raw", (5, 4, 4))
+    frames = list(drive)
+    assert [f.name for f in frames] == [f"{i:010d}" for i in range(5)]
+    last = frames[-1]
+    assert last.left.shape == (375, 1242) and last.left.dtype == np.uint8
+    assert last.color.shape == (375, 1242, 3) and last.color.dtype == np.uint8
+    assert last.scan.ndim == 2 and last.scan.shape[1] == 4 and last.scan.dtype == np.float32
+    np.testing.assert_array_equal(last.pose, drive.poses[4])
+    np.testing.assert_array_equal(drive[-1].left, last.left)
+    odometry = msfusion.Sequence(odometry04)
+    scan = np.fromfile(os.path.join(odometry04, "velodyne", "000007.bin"), np.float32).reshape(-1, 4)
+    np.testing.assert_array_equal(odometry[7].scan, scan)  # the .bin as it is on disk
+    np.testing.assert_allclose(odometry.poses[0], np.eye(4), atol=1e-9)  # poses/04.txt starts at the identity
+    with pytest.raises(IndexError):
+        odometry[10]
+    opened = msfusion.open_dataset(odometry04)  # as msf_reconstruct opens it: the Sequence under FrameSource
+    assert isinstance(opened, msfusion.Sequence) and isinstance(opened, msfusion.FrameSource) and len(opened) == 10
+    with pytest.raises(msfusion.IOError, match="/nonexistent/drive"):
+        msfusion.open_dataset("/nonexistent/drive")
+
+
+def test_stage_outputs_are_owned_contiguous_arrays(calibration, frame):
+    lidar = msfusion.LidarCompletion(calibration)
+    depth, distance = lidar.compute_depth(frame.scan)
+    for image in (depth, distance):
+        assert image.shape == (370, 1226) and image.dtype == np.float32
+        assert image.flags.c_contiguous and image.flags.owndata is False and image.flags.writeable
+    del lidar  # the arrays own their memory, not the stage
+    assert np.count_nonzero(depth) > depth.size / 2 and np.all(distance[depth > 0] >= 0)
+    stereo_depth, confidence = msfusion.SgbmStereo(calibration).compute_depth(frame.left, frame.right)
+    assert stereo_depth.shape == confidence.shape == (370, 1226)
+    assert 0 <= confidence.min() and confidence.max() <= 1
+    fused = msfusion.DepthFusion(calibration).fuse(depth, distance, stereo_depth, confidence, free_space=True)
+    assert len(fused) == 3 and all(a.shape == (370, 1226) and a.dtype == np.float32 for a in fused)
+
+
+def test_inputs_are_viewed_and_results_are_views(frame):
+    left, right = frame.left.copy(), frame.right.copy()
+    made = msfusion.Frame(left, right, frame.scan)
+    assert np.shares_memory(made.left, left) and np.shares_memory(made.right, right)
+    assert np.shares_memory(frame.left, frame.left)  # a loaded frame's image is a view of the frame
+    assert made.pose is None and made.color is None and made.scan.shape == frame.scan.shape
+
+
+def test_a_result_outlives_the_arrays_of_its_frame(calibration, frame):
+    left = frame.left.copy()
+    expected = left.copy()
+    made = msfusion.Frame(left, frame.right.copy(), frame.scan, pose=frame.pose)
+    result = msfusion.Reconstructor(calibration).add_frame(made)
+    del made, left  # numpy unmaps a buffer this large: a view of it would now fault
+    gc.collect()
+    np.testing.assert_array_equal(result.left, expected)
+
+
+def test_wrong_arrays_are_errors_naming_the_argument(calibration, frame):
+    stereo = msfusion.SgbmStereo(calibration)
+    fusion = msfusion.DepthFusion(calibration)
+    depth = np.zeros((370, 1226), np.float32)
+    cases = [
+        (lambda: stereo.compute_depth(frame.left.astype(np.float32), frame.right), "left must be uint8, got float32"),
+        (lambda: stereo.compute_depth(frame.left[:, :100], frame.right), "left must be C-contiguous"),
+        (lambda: stereo.compute_depth(frame.left, frame.right[:100].copy()), "right is 1226x100 .W x H., expected 1226x370"),
+        (lambda: stereo.compute_depth(frame.left.tolist(), frame.right), "left must be a numpy array, got list"),
+        (lambda: fusion.fuse(depth.astype(np.float64), None, depth, None), "lidar_depth must be float32, got float64"),
+        (lambda: fusion.fuse(depth, None, depth[None], None), r"stereo_depth must have shape \(H, W\), got \(1, 370, 1226\)"),
+        (lambda: fusion.fuse(depth, depth.T, depth, None), "lidar_distance must be C-contiguous"),
+        (lambda: msfusion.LidarCompletion(calibration).compute_depth(frame.scan[:, :2].copy()),
+         r"scan must have shape \(N, 3\) or \(N, 4\), got \(\d+, 2\)"),
+        (lambda: msfusion.LidarCompletion(calibration, method="bilinear"), "bilinear"),
+    ]
+    for call, message in cases:
+        with pytest.raises(msfusion.InvalidInputError, match=message):
+            call()
+
+
+def test_poses_must_be_rigid():
+    volume = msfusion.TsdfVolume()
+    camera = msfusion.PinholeCamera(100, 100, 50, 40, 100, 80)
+    depth = np.full((80, 100), 2.0, np.float32)
+    with pytest.raises(msfusion.InvalidInputError, match=r"pose must have shape \(4, 4\)"):
+        volume.integrate(depth, np.eye(3), camera)
+    scaled = np.diag([2.0, 2.0, 2.0, 1.0])
+    with pytest.raises(msfusion.InvalidInputError, match="pose"):
+        volume.integrate(depth, scaled, camera)
+    with pytest.raises(msfusion.InvalidInputError, match="camera must be a msfusion.PinholeCamera"):
+        volume.integrate(depth, np.eye(4), "camera 0")
+
+
+def test_a_frame_without_pose_takes_the_odometrys_or_is_refused(calibration, sequence):
+    def bare(i):  # the frame as a driver without poses gives it
+        f = sequence[i]
+        return msfusion.Frame(f.left, f.right, f.scan, index=i)
+
+    given = msfusion.Reconstructor(calibration, poses="given")
+    with pytest.raises(msfusion.InvalidInputError, match="has no pose"):
+        given.add_frame(bare(0))
+    result = given.compute_depth(bare(0))
+    assert result.pose is None and result.depth.shape == (370, 1226)
+    result.pose = np.eye(4)  # given one, it is integrated
+    given.integrate(result)
+    assert given.num_blocks > 0
+    auto = msfusion.Reconstructor(calibration)  # poses="auto": the LiDAR odometry's, from the first frame's
+    poses = [auto.add_frame(bare(i)).pose for i in range(3)]
+    np.testing.assert_allclose(poses[0], np.eye(4), atol=1e-6)
+    assert np.linalg.norm(poses[2][:3, 3] - sequence.poses[2][:3, 3]) < 0.1  # the vehicle drove ~2 m
+    assert len(auto.odometry_ms) == 3
+    with pytest.raises(msfusion.InvalidInputError, match="poses must be auto, given, odometry or refine, not 'gps'"):
+        msfusion.Reconstructor(calibration, poses="gps")
+
+
+def test_config_overrides_are_read_as_a_file_reads():
+    config = msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": 0.2, "tsdf_integrator": {"lambda": 5.0}})
+    assert config.voxel_size == 0.2 and "lambda: 5" in config.yaml()
+    assert msfusion.TsdfVolume(config).voxel_size == 0.2
+    with pytest.raises(msfusion.ConfigError, match="voxel_size_m"):
+        msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": -1.0})
+    with pytest.raises(msfusion.ConfigError, match="no_such_key"):
+        msfusion.load_config(overrides={"fusion.no_such_key": 1})
+    with pytest.raises(msfusion.IOError, match="/nonexistent.yaml"):
+        msfusion.load_config("/nonexistent.yaml")
+
+
+def test_heavy_calls_release_the_gil(calibration, frame):
+    """Python code runs while a stage works: a loop of ~0.1 s of bytecode ends while five stereo
+    matches (~1 s) are still running. Were the GIL held, the loop would run only between two
+    matches, ~5 ms each time (the switch interval), and end after the worker."""
+
+    def spin(n):
+        for _ in range(n):
+            pass
+
+    start = time.perf_counter()
+    spin(1_000_000)
+    loop = int(1_000_000 * 0.1 / (time.perf_counter() - start))
+    stereo = msfusion.SgbmStereo(calibration)
+    started, done = threading.Event(), threading.Event()
+
+    def match():
+        started.set()
+        for _ in range(5):
+            stereo.compute_depth(frame.left, frame.right)
+        done.set()
+
+    worker = threading.Thread(target=match)
+    worker.start()
+    started.wait()
+    time.sleep(0.02)  # inside the first match
+    spin(loop)
+    assert not done.is_set(), "the Python loop waited for the stereo matches: the GIL was held"
+    worker.join()

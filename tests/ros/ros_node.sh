@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+# msf_ros_node against a real ROS master: a roscore of its own on a free port, a bag of KITTI
+# odometry 04 frames 0..LAST written by msf_kitti2bag, the node and the player started by
+# launch/kitti_bag.launch, what the node publishes recorded by `rosbag record`; then
+#  - its refusals of bad parameters,
+#  - each frame's depth and weight image, fused points and the mesh marker checked against the
+#    engine on the same frames (check_node_output),
+#  - the mesh the node saves on shutdown equal, byte for byte, to msf_reconstruct's of the bag
+#    (both read the poses and the extrinsic through tf's quaternions, so no rounding differs),
+#  - the node's account at shutdown: every frame reconstructed, none dropped,
+#  - nothing it started left running (ros_session.sh).
+#   ros_node.sh BUILD_DIR KITTI_DIR [LAST_FRAME]
+set -euo pipefail
+build=$1
+kitti=$2
+last=${3:-3}
+frames=$((last + 1))
+sequence=$kitti/odometry/sequences/04
+if [ ! -d "$sequence" ]; then
+  if [ "${CI:-}" = true ]; then
+    echo "KITTI odometry 04 not found in '$kitti'; CI=true requires it" >&2
+    exit 1
+  fi
+  echo "SKIPPED: KITTI odometry 04 not found in '$kitti' (set MSF_KITTI_DIR)"
+  exit 77
+fi
+source "$(dirname "$0")/ros_session.sh"
+ros_session_start "$build"
+"$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -o "$work/04.bag" >/dev/null
+ros_session_wait_master
+
+# Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
+refuse() { # NAME EXPECTED _param:=value...
+  local name=$1 expected=$2 out status=0
+  shift 2
+  out=$(timeout 30 "$build/bin/msf_ros_node" __name:="$name" "$@" 2>&1) || status=$?
+  [ "$status" = 1 ] && [[ "$out" == *"msf_ros_node: error: $expected"* ]] ||
+    fail "msf_ros_node $*: exit $status, '$out' (expected exit 1 and '$expected')"
+  echo "ok: msf_ros_node $* refused: $expected"
+}
+touch "$work/mine.ply"
+refuse bad_path "parameter /bad_path/mesh_path: '$work/mine.ply' exists, and a mesh is never written over a file" \
+  _mesh_path:="$work/mine.ply"
+[ ! -s "$work/mine.ply" ] || fail "the node wrote over '$work/mine.ply'"
+refuse bad_name "unknown parameter /bad_name/queue_sise" _queue_sise:=2
+refuse bad_type "parameter /bad_type/queue_size must be an integer" _queue_size:=two
+refuse bad_range "parameter /bad_range/queue_size must be 1..8 frames, not 20" _queue_size:=20
+refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refine, not 'gps'" _poses:=gps
+refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
+
+# The recorder first, so that it hears the first frame; then the node, and the player, which
+# waits for the node's subscriptions. queue_size: every frame, however slow the machine.
+background record rosbag record -q -O "$work/published.bag" /msf_ros_node/depth /msf_ros_node/weight \
+  /msf_ros_node/points /msf_ros_node/mesh
+recorder=$started
+background depth_seen rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
+counter=$started
+background launch roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames \
+  mesh_path:="$work/node_mesh.ply"
+launcher=$started
+
+# The node is done when it has published a depth image per frame: rostopic echo -n exits then.
+for ((k = 0; ; ++k)); do
+  kill -0 "$counter" 2>/dev/null || break
+  ((k < 600)) || fail "the node published $(grep -c '^---' "$work/depth_seen.log") depth images of $frames in 60 s"
+  sleep 0.1
+done
+stop_group "$launcher" 30 # the node publishes the last mesh marker, saves the mesh, gives its account
+stop_group "$recorder" 10
+node_lines "$work/launch.log"
+
+account=$(node_lines "$work/launch.log" | grep -a "scans received")
+[[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||
+  fail "the node's account at shutdown is not every frame reconstructed: '$account'"
+[ -f "$work/node_mesh.ply" ] || fail "the node saved no mesh"
+
+"$build/tests/check_node_output" "$work/04.bag" "$work/published.bag" "$work/node_mesh.ply" ||
+  fail "what the node published is not the engine's"
+
+"$build/bin/msf_reconstruct" "$work/04.bag" -panels 0 -o "$work/reconstruct" >"$work/reconstruct.log" 2>&1 ||
+  fail "msf_reconstruct: $(tail -5 "$work/reconstruct.log")"
+cmp "$work/node_mesh.ply" "$work/reconstruct/mesh.ply" ||
+  fail "the node's mesh differs from msf_reconstruct's of the same bag"
+echo "ok: the node's mesh is msf_reconstruct's, byte for byte ($(stat -c %s "$work/node_mesh.ply") bytes)"
+
+ros_session_stop
+echo "ok: roscore, the node, the player and the recorder stopped; no process left"
