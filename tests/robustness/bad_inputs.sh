@@ -504,7 +504,7 @@ if [ $have_kitti = 1 ]; then
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
   printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"
-  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig.stereo_min_disparity_px must be in 0..1000.*not -1" -- \
+  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig_negative.yaml. line 3: rig.stereo_min_disparity_px must be a finite number in 0..1000, not -1.0" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_negative.yaml"
   printf '%%YAML:1.0\nrig:\n  scale_ring_row: false\n' >"$F/rig_misspelt.yaml"
   check "interpolate -config: rig.scale_ring_row (misspelt)" 1 "scale_ring_row" -- \
