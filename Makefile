@@ -1,5 +1,6 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | demo | bench | docs | install | clean
+# Thin wrapper over CMake: make deps | deps-slurm | build | test | test-sanitize | fuzz | config-files | demo | bench |
+# docs | install | clean
 SHELL := /bin/bash
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -17,7 +18,8 @@ PYTHON_PACKAGES := pybind11-dev python3-dev python3-numpy python3-pytest python3
 ROS_PACKAGES := ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-msgs-dev libmessage-filters-dev \
                 libsensor-msgs-dev libvisualization-msgs-dev libcv-bridge-dev libpcl-conversions-dev procps
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
-# time: GNU time, which the bad-input matrix measures each case's memory with.
+# time: GNU time, which the bad-input matrix measures each case's memory with; python3-yaml:
+# PyYAML, which a test reads and writes the configuration files with.
 APT_PACKAGES := build-essential cmake pkg-config libpcl-dev libopencv-dev libeigen3-dev \
                 libflann-dev libboost-dev libgtest-dev libbenchmark-dev pcl-tools time \
                 libyaml-cpp-dev $(PYTHON_PACKAGES) $(ROS_PACKAGES)
@@ -34,7 +36,8 @@ DOCS_PACKAGES := doxygen
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-slurm deps-bench deps-fuzz deps-docs docs build test test-sanitize test-sanitize-fast fuzz demo bench install clean
+.PHONY: all deps deps-slurm deps-bench deps-fuzz deps-docs docs build test test-sanitize test-sanitize-fast fuzz demo bench \
+        install clean config-files
 
 # `make test-sanitize`: the whole suite built with AddressSanitizer and UndefinedBehavior-
 # Sanitizer (float-cast-overflow included), the first report fatal.
@@ -42,13 +45,16 @@ SANITIZE_BUILD_DIR ?= build-sanitize
 SANITIZE_FLAGS := -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
                   -fno-omit-frame-pointer
 # `make fuzz`: each libFuzzer target of fuzz/ runs FUZZ_SECONDS from a seed corpus made of
-# the KITTI sample; crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/. Inputs are up to
-# 64 KB, and up to FUZZ_PLY_MAX_LEN for ply, whose header check reads 64 KB: larger inputs
-# reach that limit and what lies beyond it.
+# the KITTI sample (and the configuration files); crashes land in $(FUZZ_BUILD_DIR)/findings/<target>/.
+# Inputs are up to 64 KB, up to FUZZ_PLY_MAX_LEN for ply, whose header check reads 64 KB, and
+# up to FUZZ_YAML_MAX_LEN for config and calibration (the YAML readers: configuration, rig and
+# camera files): larger inputs reach those limits and what lies beyond them (a YAML file nested
+# deeply enough to reach yaml-cpp's depth guard in every form is larger than 64 KB).
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := cloud ply calibration poses velodyne
+FUZZ_TARGETS := cloud ply calibration poses velodyne config
 FUZZ_PLY_MAX_LEN ?= 262144
+FUZZ_YAML_MAX_LEN ?= 1048576
 
 all: build
 
@@ -124,7 +130,8 @@ fuzz: deps-fuzz
 	python3 fuzz/make_corpus.py $(KITTI_DIR) $(FUZZ_BUILD_DIR)/seeds
 	@for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(FUZZ_BUILD_DIR)/corpus/$$t $(FUZZ_BUILD_DIR)/findings/$$t; \
-	  max_len=65536; [ $$t = ply ] && max_len=$(FUZZ_PLY_MAX_LEN); \
+	  case $$t in ply) max_len=$(FUZZ_PLY_MAX_LEN);; config | calibration) max_len=$(FUZZ_YAML_MAX_LEN);; \
+	    *) max_len=65536;; esac; \
 	  echo "== fuzz_$$t: $(FUZZ_SECONDS) s, inputs up to $$max_len bytes"; \
 	  ASAN_OPTIONS=detect_leaks=0 $(FUZZ_BUILD_DIR)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=$$max_len \
 	    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
@@ -133,6 +140,12 @@ fuzz: deps-fuzz
 	    tee $(FUZZ_BUILD_DIR)/fuzz_$$t.log | grep -E "^(#[0-9]+ *DONE|stat::number_of_executed_units|stat::average_exec_per_sec|==[0-9]+==ERROR|SUMMARY)" ; \
 	  test $${PIPESTATUS[0]} -eq 0 || { echo "fuzz_$$t found a crash: $(FUZZ_BUILD_DIR)/findings/$$t/"; exit 1; }; \
 	done
+
+# The files made from the configuration keys' declarations in the code: config/kitti.yaml,
+# synthetic.yaml, paper.yaml and docs/configuration.md (a test fails when one is out of date).
+config-files: $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j$(JOBS) --target msf_config
+	$(BUILD_DIR)/bin/msf_config -write .
 
 demo: deps
 	$(MAKE) build

@@ -1,8 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The calibration parsers: KITTI odometry calib.txt, object calib/NNNNNN.txt, raw date folder
 // (calib_cam_to_cam.txt + calib_velo_to_cam.txt [+ calib_imu_to_velo.txt]) and the YAML
-// camera file. The first byte picks the format; for a raw folder the rest is split at the
-// bytes "\n===\n" into its files.
+// camera or rig file (a rig file, detected by its keys, is read with yaml-cpp). The first byte
+// picks the format; for a raw folder the rest is split at the bytes "\n===\n" into its files.
 #include "fuzz_input.h"
 
 #include <msf/io/calibration.h>

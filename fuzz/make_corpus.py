@@ -4,8 +4,9 @@
 
     make_corpus.py KITTI_DIR OUT_DIR
 
-Writes OUT_DIR/<target>/<seed> for the targets cloud, ply, calibration, poses and velodyne;
-the first byte of a seed picks the format or reader where a target has several (see fuzz_*.cpp).
+Writes OUT_DIR/<target>/<seed> for the targets cloud, ply, calibration, poses, velodyne and
+config (its seeds are the project's own configuration files); the first byte of a seed picks
+the format or reader where a target has several (see fuzz_*.cpp).
 """
 import os
 import struct
@@ -106,9 +107,25 @@ def mat(name, rows, cols, values):
 yaml = "%YAML:1.0\n---\n" + "".join(mat("P%d" % i, 3, 4, lines["P%d" % i].split()) for i in range(4))
 yaml += "image_width: 1226\nimage_height: 370\n" + mat("T_cam0_velo", 4, 4, lines["Tr"].split() + ["0", "0", "0", "1"])
 put("calibration", "camera.yaml", b"\3" + yaml.encode())
+# A rig file (detected by its keys), and one nested 33000 levels deep (66 KB), beyond yaml-cpp's
+# depth guard, whose mutations keep the fuzzer at that guard.
+rig = ("image_width: 1226\nimage_height: 370\nleft: {P: [%s]}\nright: {P: [%s]}\nlidar:\n  T_cam_lidar: [%s]\n"
+       "  rings: 4\n  beam_elevations_deg: [-15, -5, 5, 15]\n  sweeping: true\n" %
+       (", ".join(lines["P0"].split()), ", ".join(lines["P1"].split()),
+        ", ".join(lines["Tr"].split() + ["0", "0", "0", "1"])))
+put("calibration", "rig.yaml", b"\3" + rig.encode())
+put("calibration", "deep_rig.yaml", b"\3image_width: 640\nleft: " + b"[" * 33000 + b"]" * 33000 + b"\n")
 
 # Poses: 20 odometry poses; one OXTS record.
 poses = read(os.path.join(kitti, "odometry", "poses", "04.txt")).splitlines(True)
 put("poses", "poses.txt", b"\1" + b"".join(poses[:20]))
 oxts = os.path.join(raw, "2011_09_26_drive_0009_sync", "oxts", "data")
 put("poses", "oxts.txt", b"\0" + read(os.path.join(oxts, sorted(os.listdir(oxts))[0])))
+
+# Configurations: the shipped files, flow style, and a file nested 33000 levels deep (66 KB),
+# beyond yaml-cpp's depth guard, whose mutations keep the fuzzer at that guard.
+source = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+for name in ("kitti", "synthetic", "paper"):
+    put("config", name + ".yaml", read(os.path.join(source, "config", name + ".yaml")))
+put("config", "flow.yaml", b"stereo: {block_size_px: 7, mode: sgbm_3way}\nlambda_study: {noise_mm: [0, 5.5]}\n")
+put("config", "deep.yaml", b"stereo:\n  p1: " + b"[" * 33000 + b"]" * 33000 + b"\n")

@@ -5,7 +5,7 @@
 // over the pixels of all frames (a synthetic sequence's gt/disp_0, split by gt/obj_map_0).
 // With -confidence, also the error by the matcher's confidence beside the fusion's sigma model.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/confidence_calibration.h>
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
              "NNNNNN.pcd; adds the error by confidence beside the sigma the fusion assumes for it")
       .value("-config", "FILE",
              [&](const std::string& path) {
-               msf::readConfigSection(path, "fusion", model);
+               msf::readConfigSection(path, model);
                config_given = true;
              },
              "YAML config, section fusion: the sigma model of -confidence (stereo_sigma_min_px, stereo_sigma_max_px)");

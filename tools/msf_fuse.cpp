@@ -2,7 +2,7 @@
 // Paper step 4: fuses an interpolated LiDAR cloud and a stereo cloud of one camera (both
 // organized, same size) into one organized cloud, per pixel (eq. 6 or inverse variance).
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/depth_fusion.h>
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
       .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, "fusion", config, rig); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
              "YAML config, sections fusion and rig (the windows in rows between LiDAR rings follow the rig's "
              "beams, as in msf_reconstruct)")
       .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
     const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     TicToc tt;
     tt.tic();

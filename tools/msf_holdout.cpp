@@ -5,7 +5,7 @@
 // reported for all, background and foreground pixels (the paper's Table 1).
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/common/tool.h>
@@ -42,19 +42,11 @@ struct MethodEntry {
   std::function<msf::HoldoutMethod(const msf::ConfigFile&)> make;
 };
 
-/// A stage's configuration: section `name` of `file`, defaults where a key is absent.
-template <typename Config>
-Config sectionOf(const msf::ConfigFile& file, const char* name) {
-  Config config;
-  config.read(file.section(name));
-  return config;
-}
-
 /// A LiDAR method: the input rings completed by `method` (projection on the canvas included).
 msf::HoldoutMethod lidar(const msf::ConfigFile& file, msf::CompletionMethod method) {
-  const auto projection = sectionOf<msf::ProjectionConfig>(file, "projection");
-  const auto interpolation = sectionOf<msf::InterpolationConfig>(file, "interpolation");
-  const auto ip_basic = sectionOf<msf::IpBasicConfig>(file, "ip_basic");
+  const auto projection = file.get<msf::ProjectionConfig>();
+  const auto interpolation = file.get<msf::InterpolationConfig>();
+  const auto ip_basic = file.get<msf::IpBasicConfig>();
   std::shared_ptr<msf::LidarCompletion> completion; // made at the first frame, which has the calibration
   return [=](const msf::HoldoutInput& in) mutable {
     if (!completion)
@@ -74,9 +66,9 @@ enum class StereoInput {
 
 /// SGBM on the grey pair (section stereo); the time of the LiDAR it uses counts too.
 msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
-  auto config = sectionOf<msf::SgbmConfig>(file, "stereo");
+  auto config = file.get<msf::SgbmConfig>();
   config.guidance = input == StereoInput::Guided ? "lidar" : "none";
-  const auto projection = sectionOf<msf::ProjectionConfig>(file, "projection");
+  const auto projection = file.get<msf::ProjectionConfig>();
   auto completion = lidar(file, msf::CompletionMethod::Compound);
   auto sgbm = std::make_shared<msf::SgbmStereo>(config);
   std::shared_ptr<msf::LidarProjector> projector;
@@ -128,11 +120,10 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
 
 /// The same with the sections of `file` (section fusion, its method forced to `method` when given).
 msf::HoldoutMethod fused(const msf::ConfigFile& file, std::optional<msf::FusionMethod> method) {
-  auto fusion = sectionOf<msf::DepthFusionConfig>(file, "fusion");
+  auto fusion = file.get<msf::DepthFusionConfig>();
   fusion.method = method.value_or(fusion.method);
-  return fusedWith(sectionOf<msf::ProjectionConfig>(file, "projection"),
-                   sectionOf<msf::InterpolationConfig>(file, "interpolation"),
-                   sectionOf<msf::SgbmConfig>(file, "stereo"), fusion);
+  return fusedWith(file.get<msf::ProjectionConfig>(), file.get<msf::InterpolationConfig>(),
+                   file.get<msf::SgbmConfig>(), fusion);
 }
 
 /// The paper as published (PipelineConfig::paper, config/paper.yaml), whatever -config says:
@@ -346,10 +337,10 @@ int main(int argc, char** argv) {
     if (!csv_path.empty() && msf::fileExtension(csv_path) != ".csv")
       throw msf::InvalidInputError("-csv '" + csv_path + "' must end in .csv");
 
-    const msf::ConfigFile config_file = config_path.empty() ? msf::ConfigFile() : msf::ConfigFile(config_path);
+    const msf::ConfigFile config_file = config_path.empty() ? msf::ConfigFile() : msf::openConfigFile(config_path);
     msf::HoldoutConfig config;
-    config.rings.read(config_file.section("rings"));
-    config.projection.read(config_file.section("projection"));
+    config_file.read(config.rings);
+    config_file.read(config.projection);
     msf::HoldoutEvaluation evaluation(config);
     evaluation.setBreakdown(breakdown);
     std::vector<std::pair<std::string, msf::HoldoutMethod>> methods;
@@ -372,7 +363,6 @@ int main(int argc, char** argv) {
         throw msf::InvalidInputError("-bounds needs two methods separated by a comma, got '" + bounds_text + "'");
       evaluation.addFusionBounds(pair[0], pair[1]);
     }
-    config_file.rejectUnknownKeys(); // the sections the methods read
 
     const auto frames = sequence.indices(msf::FrameRange::parse(frames_text));
     print_highlight("Evaluating ");

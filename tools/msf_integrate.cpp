@@ -3,7 +3,7 @@
 // poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
 // -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/fusion_config.h>
@@ -71,12 +71,11 @@ int main(int argc, char** argv) {
       .value("-rig", "FILE", calib, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-config", "FILE",
              [&](const std::string& path) {
-               const msf::ConfigFile file(path);
-               volume_config.read(file.section("tsdf_volume"));
-               config.read(file.section("tsdf_integrator"));
-               fusion.read(file.section("fusion"));
-               rig.read(file.section("rig"));
-               file.rejectUnknownKeys();
+               const msf::ConfigFile file = msf::openConfigFile(path);
+               file.read(volume_config);
+               file.read(config);
+               file.read(fusion);
+               file.read(rig);
              },
              "YAML with sections tsdf_volume, tsdf_integrator, fusion (the LiDAR's range noise) and rig (with "
              "-calib, max_depth_m at most stereo's trusted depth, as in msf_reconstruct); the options below override "
@@ -126,8 +125,8 @@ int main(int argc, char** argv) {
     msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
     msf::TsdfIntegrator integrator(volume, config);
     if (print_config) {
-      volume_config.print(std::cout);
-      config.print(std::cout);
+      msf::printConfig(std::cout, volume_config);
+      msf::printConfig(std::cout, config);
     }
 
     msf::PoseList poses = msf::loadOdometryPoses(poses_path);

@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 2: compound interpolation of a projected LiDAR scan (or a baseline).
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
@@ -53,12 +53,11 @@ int main(int argc, char** argv) {
             "compound (default, paper step 2) | linear | cubic | ipbasic | ipbasic_multiscale")
       .value("-config", "FILE",
              [&](const std::string& path) {
-               const msf::ConfigFile file(path);
-               projection.read(file.section("projection"));
-               interpolation.read(file.section("interpolation"));
-               ip_basic.read(file.section("ip_basic"));
-               rig.read(file.section("rig"));
-               file.rejectUnknownKeys();
+               const msf::ConfigFile file = msf::openConfigFile(path);
+               file.read(projection);
+               file.read(interpolation);
+               file.read(ip_basic);
+               file.read(rig);
              },
              "YAML config, sections interpolation, projection, ip_basic, rig (with -calib, the gaps in rows between "
              "LiDAR rings follow the rig's beams, as in msf_reconstruct)")

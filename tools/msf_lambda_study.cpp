@@ -2,7 +2,7 @@
 // msf_lambda_study: paper Fig. 5 — surface error of the regularized TSDF fusion (eq. 7)
 // against lambda and depth noise on a synthetic scene with exact ground truth.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/common/tool.h>
@@ -26,7 +26,7 @@ namespace {
 int run(const msf::LambdaStudy::Config& config, const std::string& out_dir) {
   const msf::LambdaStudy study(config); // validates: a bad value leaves no output folder
   msf::OutputFolder output(out_dir, "msf_lambda_study");
-  config.print(std::cout);
+  msf::printConfig(std::cout, config);
 
   std::vector<msf::LambdaStudy::Cell> cells;
   TicToc tt;
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
       "Fuses noisy depth of a synthetic scene (smooth parts, edges, sharp boundaries) with each lambda of eq. 7 and "
       "writes DIR/lambda_study.csv and DIR/lambda_study.png (paper Fig. 5).");
   cli.value("-o", "DIR", out_dir, "output folder: absent, empty, or one an earlier study wrote (replaced)")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "lambda_study", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML with a section lambda_study (noise_mm, lambdas, frames, ...)")
       .value("-frames", "N", config.frames, "frames fused per cell (default {default})")
       .value("-voxel", "M", config.voxel_size_m, "voxel size in metres (default {default})")

@@ -2,7 +2,7 @@
 // msf_mesh: marching cubes over a TSDF volume written by msf_integrate; a welded, coloured
 // mesh saved as binary PLY, OBJ or VTK by the output's extension.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/cloud_io.h>
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
       "Extracts the zero surface of a TSDF volume (msf_integrate) by marching cubes. STORE_DIR is the output folder "
       "of msf_reconstruct -stream (its tsdf/index.txt and block files): meshed tile by tile in bounded memory into "
       "mesh.ply (a PLY only) and its tiles into mesh.ply.tiles/.");
-  cli.value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "marching_cubes", config); },
+  cli.value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
             "YAML with a section marching_cubes; the options below override it")
       .value("-min_weight", "W", config.min_weight,
              "voxels with weight <= W (m^-2, an inverse variance) make no triangles (default {default})")

@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_odometry: camera 0's trajectory of a sequence from its LiDAR scans (the tracking module),
 // in KITTI's poses format.
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/common/tool.h>
@@ -63,9 +63,9 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("no output file: give -o poses.txt");
     msf::LidarOdometry::Config config;
     if (!config_path.empty())
-      msf::readConfigSection(config_path, "odometry", config);
+      msf::readConfigSection(config_path, config);
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     const msf::Sequence sequence(positional.front());
     const std::vector<std::size_t> frames = sequence.indices(msf::FrameRange::parse(frames_text));

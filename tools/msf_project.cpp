@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 1: a Velodyne scan into an organized cloud of one camera's image.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML camera file")
       .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "projection", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config, section projection; the options below override it")
       .value("-camera", "N", config.camera,
              "rectified camera 0..3 (default: {default}, or projection.camera of -config)")

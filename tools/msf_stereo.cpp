@@ -3,7 +3,7 @@
 // (x y z rgb confidence), coloured from the colour camera, and optionally the disparity as a
 // KITTI 16-bit PNG.
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
       .value("-prior", "PATH", prior_path,
              "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
              "real returns (distance 0) guide it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, "stereo", config, rig); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
              "YAML config, sections stereo (every SGBM parameter; the options below override it) and rig (the keys "
              "in rows between LiDAR rings follow the rig's beams, as in msf_reconstruct)")
       .value("-num_disparities", "N", config.num_disparities_px,
@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
     const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
     msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     TicToc tt;
     tt.tic();

@@ -1,6 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Writes a synthetic street in KITTI's odometry layout, with exact ground truth.
-#include <msf/common/config.h>
+#include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/common/stop_signals.h>
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
       "(e.g. msf_synth -o A -street_m 120 -frames 30; msf_synth -o B -street_m 120 -start_m 20 -frames 30; msf_synth "
       "-o C -street_m 120 -start_m 100 -reverse -frames 30).");
   cli.value("-o", "DIR", output, "output folder: absent, empty, or one msf_synth wrote before (replaced; anything else in it is refused)")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, "synthetic", config); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readConfigSection(path, config); },
              "YAML config; its `synthetic` section sets every key (see config/synthetic.yaml)")
       .value("-rig", "FILE",
              [&](const std::string& path) { msf::synthetic::applyRig(msf::loadRigFile(path), config); },
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     if (output.empty())
       throw msf::InvalidInputError("no output folder: give -o DIR");
     if (print_config)
-      config.print(std::cout);
+      msf::printConfig(std::cout, config);
 
     TicToc tt;
     tt.tic();

@@ -57,7 +57,7 @@ def _yaml_value(value):
 
 
 def _yaml_text(sections):
-    lines = ["%YAML:1.0"]
+    lines = []
     for section, keys in sections.items():
         lines.append(f"{section}:")
         lines.extend(f"  {name}: {value}" for name, value in keys.items())

@@ -183,16 +183,14 @@ TEST(DepthFusionPaper, AsWrittenTheStereoWeightCancels) {
 }
 
 TEST(DepthFusionPaper, PaperWeightsKeyIsNamedWhenWrong) {
-  cv::FileStorage fs("%YAML:1.0\nfusion:\n  paper_weights: literal\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
   msf::DepthFusionConfig config;
   try {
-    config.read(fs["fusion"]);
+    msf::ConfigFile::fromText("fusion:\n  paper_weights: literal\n", "c.yaml").read(config);
     ADD_FAILURE() << "paper_weights: literal was accepted";
   } catch (const msf::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("fusion.paper_weights"), std::string::npos) << e.what();
   }
-  cv::FileStorage ok("%YAML:1.0\nfusion:\n  paper_weights: as_written\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
-  config.read(ok["fusion"]);
+  msf::ConfigFile::fromText("fusion:\n  paper_weights: as_written\n", "c.yaml").read(config);
   EXPECT_EQ(config.paper_weights, msf::PaperWeights::AsWritten);
 }
 
@@ -556,19 +554,19 @@ TEST(DepthFusionConfig, ReadsTheFusionSectionAndRejectsBadValues) {
   const std::string path = dir.file("c.yaml");
   std::ofstream(path) << "%YAML:1.0\nfusion:\n  method: paper\n  paper_lidar_gain: 2.5\n  disagreement_k_sigma: 4\n";
   msf::DepthFusionConfig config;
-  config.read(msf::ConfigFile(path).section("fusion"));
+  msf::ConfigFile(path).read(config);
   EXPECT_EQ(config.method, msf::FusionMethod::Paper);
   EXPECT_FLOAT_EQ(config.paper_lidar_gain, 2.5f);
   EXPECT_FLOAT_EQ(config.disagreement_k_sigma, 4.f);
   EXPECT_FLOAT_EQ(config.stereo_sigma_min_px, msf::DepthFusionConfig{}.stereo_sigma_min_px); // default kept
   std::ostringstream printed;
-  config.print(printed);
+  msf::printConfig(printed, config);
   EXPECT_NE(printed.str().find("method: paper"), std::string::npos);
   auto fails = [&](const std::string& body, const std::string& key) {
     std::ofstream(path) << "%YAML:1.0\nfusion:\n  " << body << "\n";
     return errorOf([&] {
              msf::DepthFusionConfig c;
-             c.read(msf::ConfigFile(path).section("fusion"));
+             msf::ConfigFile(path).read(c);
            }).find(key) != std::string::npos;
   };
   EXPECT_TRUE(fails("method: average", "fusion.method"));

@@ -293,7 +293,7 @@ TEST(FacadeExtension, BadInputIsAClearError) {
   msf::DepthFusionConfig config;
   config.facade_max_normal_y = 2.f;
   EXPECT_EQ(msf::test::errorOf([&] { config.validate(); }),
-            "config key 'fusion.facade_max_normal_y' must be within [0, 1]");
+            "fusion.facade_max_normal_y must be in 0..1, not 2.0");
   config = {};
   config.facade_anchor_sigma_m = 0.f;
   EXPECT_THROW(config.validate(), msf::ConfigError);

@@ -179,7 +179,7 @@ TEST(FuseTool, BadInputFailsAndLeavesNoOutput) {
   // Unknown method, missing -calib, unknown option.
   r = msf::test::runTool("msf_fuse", f.lidar + " " + f.stereo + " " + f.out + " -calib " + f.calib + " -method mean");
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.err.find("paper or uncertainty, not 'mean'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("fusion method must be uncertainty | paper, not 'mean'"), std::string::npos) << r.err;
   r = msf::test::runTool("msf_fuse", f.lidar + " " + f.stereo + " " + f.out);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("-calib"), std::string::npos) << r.err;

@@ -63,6 +63,13 @@ TEST(RigFile, ReadsTheCamerasTheBaselineAndTheLidar) {
   EXPECT_FALSE(c.lidar.sweeping);
 }
 
+TEST(RigFile, AFileWithOpenCvsFirstLineReads) {
+  msf::test::TempDir dir;
+  const msf::Calibration c = msf::loadCalibration(write(dir, "rig.yaml", std::string("%YAML:1.0\n") + kRig));
+  EXPECT_EQ(c.image_size, cv::Size(640, 480));
+  EXPECT_EQ(c.lidar.rings, 4);
+}
+
 TEST(RigFile, WrittenAndReadBackIsTheSameCalibration) {
   msf::test::TempDir dir;
   const msf::Calibration c = msf::loadRigFile(write(dir, "rig.yaml", kRig));
@@ -102,6 +109,10 @@ TEST(RigFile, EachFaultIsRefusedNamingTheKey) {
       {edited("left: {fx: 500.0, fy: 501.0, cx: 320.5, cy: 240.25}",
               "left: {P: [500, 0, 320, 7, 0, 500, 240, 0, 0, 0, 1, 0]}"),
        "left.P must have no translation column"},
+      // yaml-cpp keeps both and a lookup sees the first: refused, as in a config file.
+      {edited("baseline_m: 0.12", "baseline_m: 0.12\nbaseline_m: 0.5"),
+       "baseline_m appears twice (lines 5 and 6)"},
+      {edited("  rings: 4", "  rings: 4\n  rings: 8"), "lidar.rings appears twice (lines 11 and 12)"},
   };
   for (const auto& c : cases) {
     const std::string path = write(dir, "bad.yaml", c.text);
@@ -109,6 +120,9 @@ TEST(RigFile, EachFaultIsRefusedNamingTheKey) {
     EXPECT_NE(error.find(c.message), std::string::npos) << "expected: " << c.message << "\ngot: " << error;
     EXPECT_NE(error.find(path), std::string::npos) << error;
   }
+  const std::string deep = write(dir, "deep.yaml", "image_width: " + std::string(5000, '[') + std::string(5000, ']'));
+  EXPECT_NE(msf::test::errorOf([&] { msf::loadRigFile(deep); }).find("levels deep (yaml-cpp's limit)"),
+            std::string::npos);
   const std::string not_yaml = write(dir, "broken.yaml", "image_width: [640\nleft: {fx");
   EXPECT_NE(msf::test::errorOf([&] { msf::loadRigFile(not_yaml); }).find("is not valid YAML"), std::string::npos);
 }

@@ -216,11 +216,11 @@ TEST(DepthInterpolator, RejectsBadImagesAndBadConfigs) {
 }
 
 TEST(DepthInterpolator, ReadsItsYamlSection) {
-  cv::FileStorage fs("%YAML:1.0\ninterpolation: { method: linear, max_gap_px: 12, short_gap_px: 2, combine: average, "
-                     "gaussian: false, inverse_depth: false }\n",
-                     cv::FileStorage::READ | cv::FileStorage::MEMORY);
   msf::InterpolationConfig c;
-  c.read(fs["interpolation"]);
+  msf::ConfigFile::fromText("interpolation: { method: linear, max_gap_px: 12, short_gap_px: 2, combine: average, "
+                            "gaussian: false, inverse_depth: false }\n",
+                            "c.yaml")
+      .read(c);
   EXPECT_EQ(c.slice.interpolant, msf::SliceInterpolant::Linear);
   EXPECT_EQ(c.slice.max_gap_px, 12);
   EXPECT_EQ(c.slice.short_gap_px, 2);
@@ -228,9 +228,8 @@ TEST(DepthInterpolator, ReadsItsYamlSection) {
   EXPECT_FALSE(c.gaussian);
   EXPECT_FALSE(c.slice.inverse_depth);
   EXPECT_EQ(c.column_seed_gap_px, 3); // default kept
-  cv::FileStorage bad("%YAML:1.0\ninterpolation: { combine: median }\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
   try {
-    c.read(bad["interpolation"]);
+    msf::ConfigFile::fromText("interpolation: { combine: median }\n", "c.yaml").read(c);
     FAIL();
   } catch (const msf::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("median"), std::string::npos);

@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "test_support.h"
 
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/lambda_study.h>
 
@@ -36,13 +37,12 @@ TEST(LambdaStudy, ConfigIsReadAndChecked) {
   test::TempDir dir;
   std::ofstream(dir.file("study.yaml")) << "%YAML:1.0\nlambda_study:\n  noise_mm: [0, 10]\n  lambdas: [0, 2.5]\n  frames: 3\n";
   LambdaStudy::Config c;
-  cv::FileStorage fs(dir.file("study.yaml"), cv::FileStorage::READ);
-  c.read(fs["lambda_study"]);
+  ConfigFile(dir.file("study.yaml")).read(c);
   EXPECT_EQ(c.noise_mm, (std::vector<double>{0, 10}));
   EXPECT_EQ(c.lambdas, (std::vector<double>{0, 2.5}));
   EXPECT_EQ(c.frames, 3);
   std::ostringstream printed;
-  c.print(printed);
+  printConfig(printed, c);
   EXPECT_NE(printed.str().find("lambdas: [0, 2.5]"), std::string::npos) << printed.str();
   c.frames = 0;
   EXPECT_THROW(LambdaStudy{c}, ConfigError);

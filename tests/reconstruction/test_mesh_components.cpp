@@ -208,7 +208,7 @@ TEST(MeshComponents, ConfigRejectsANegativeSize) {
     MarchingCubes mesher(config);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("marching_cubes.min_component_triangles must be >= 0, got -1"),
+    EXPECT_NE(std::string(e.what()).find("marching_cubes.min_component_triangles must be >= 0, not -1"),
               std::string::npos)
         << e.what();
   }

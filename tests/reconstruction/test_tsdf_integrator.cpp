@@ -2,6 +2,7 @@
 #include "scenes.h"
 #include "test_support.h"
 
+#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/point_types.h>
@@ -890,10 +891,9 @@ TEST(TsdfIntegrator, ArgminSolveReachesTheMinimizerOfEquation7) {
 TEST(TsdfIntegrator, SolveKeysAreNamedWhenWrong) {
   for (const std::string key :
        {"solve: exact", "argmin_tolerance_m: 0", "argmin_max_sweeps: 0", "lambda_data: weighted"}) {
-    cv::FileStorage fs("%YAML:1.0\ntsdf_integrator:\n  " + key + "\n", cv::FileStorage::READ | cv::FileStorage::MEMORY);
     TsdfIntegrator::Config config;
     try {
-      config.read(fs["tsdf_integrator"]);
+      ConfigFile::fromText("tsdf_integrator:\n  " + key + "\n", "c.yaml").read(config);
       ADD_FAILURE() << key << " was accepted";
     } catch (const ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find("tsdf_integrator." + key.substr(0, key.find(':'))), std::string::npos)

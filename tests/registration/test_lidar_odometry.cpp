@@ -282,12 +282,11 @@ TEST(LidarOdometryConfig, ReadsPrintsAndRejectsBadValues) {
   config.point_to_plane = false;
   config.min_constraint = 0.004;
   std::ostringstream printed;
-  config.print(printed);
-  cv::FileStorage fs("%YAML:1.0\n" + printed.str(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  msf::printConfig(printed, config);
   msf::LidarOdometry::Config again;
-  again.read(fs["odometry"]);
+  msf::ConfigFile::fromText(printed.str(), "odometry.yaml").read(again);
   std::ostringstream printed_again;
-  again.print(printed_again);
+  msf::printConfig(printed_again, again);
   EXPECT_EQ(printed_again.str(), printed.str());
   EXPECT_EQ(again.voxel_size_m, 0.75);
   EXPECT_FALSE(again.point_to_plane);

@@ -230,6 +230,18 @@ yaml(f + "/nan.yaml", nan=True)
 yaml(f + "/huge.yaml", w=100000, h=100000)
 # OpenCV 4.6's YAML parser loops forever on an indented top level (fuzz_calibration).
 open(f + "/indented.yaml", "w").write("%YAML:1.0\n k: 4\na: -\n")
+# Configurations that are no configuration, or a wrong one.
+open(f + "/typo_section.yaml", "w").write("tsdf_volumes:\n  voxel_size_m: 0.05\n")
+open(f + "/threads_wrap.yaml", "w").write("interpolation:\n  threads: 4294967297\n")
+open(f + "/empty.yaml", "w").write("")
+open(f + "/list.yaml", "w").write("- stereo\n- fusion\n")
+open(f + "/twice.yaml", "w").write("stereo:\n  p1: 8\n  p1: 9\n")
+open(f + "/deep.yaml", "w").write("stereo:\n  p1: " + "[" * 33000 + "]" * 33000 + "\n")
+open(f + "/unclosed.yaml", "w").write("stereo: {p1: 8, p2: 90\nfusion:\n  method: paper\n")
+open(f + "/unknown_key.yaml", "w").write("stereo:\n  block_size: 7\n")
+open(f + "/wrong_type.yaml", "w").write("# a comment\nstereo: {left_right_check: maybe}\n")
+open(f + "/out_of_range.yaml", "w").write("synthetic:\n  frames: 3\n  lidar_dropout: 1.5\n")
+open(f + "/long_number.yaml", "w").write("stereo:\n  p1: " + "7" * 1000000 + "\n")
 # Poses: one line each.
 I = "1 0 0 0 0 1 0 0 0 0 1 0"
 open(f + "/pose.txt", "w").write(I + "\n")
@@ -297,7 +309,7 @@ if [ $have_kitti = 1 ]; then
 fi
 
 # ---- limits checked before allocating ---------------------------------------------------
-check "interpolate -threads 100000" 1 "interpolation.threads \(-threads\) must be 0.*256, not 100000" -- \
+check "interpolate -threads 100000" 1 "interpolation.threads must be in 0..256, not 100000" -- \
   msf_interpolate "$F/sparse.pcd" o.pcd -threads 100000
 check "interpolate -threads -1" 1 "threads.*not -1" -- msf_interpolate "$F/sparse.pcd" o.pcd -threads -1
 check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_info "$F/bomb.pcd"
@@ -311,7 +323,7 @@ check "integrate -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e-6
 check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 64 voxels" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -trunc 1e6
-check "integrate -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100, got 1000000" -- \
+check "integrate -sweeps 1000000" 1 "tsdf_integrator.sweeps must be in 0..100, not 1000000" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps 1000000
 check "integrate: rotation scaled by 1000" 1 "pose_scaled.txt' line 1 is not a rigid transform" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose_scaled.txt" -o v.pcd
@@ -321,18 +333,43 @@ check "integrate: pose beyond the volume's reach" 1 "beyond the volume's .* m at
   msf_integrate "$F/dense.pcd" -poses "$F/pose_reach.txt" -o v.pcd -voxel 0.001 -trunc 0.003
 check "integrate -max_memory 1" 1 "over its memory budget of 1 MiB" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -max_memory 1 -voxel 0.001 -trunc 0.05
-check "lambda_study -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_lambda_study -o out -voxel 1e-6
-check "lambda_study -sweeps 1000000" 1 "sweeps \(-sweeps\) must be 0..100" -- msf_lambda_study -o out -sweeps 1000000
+check "lambda_study -voxel 1e-6" 1 "lambda_study.voxel_size_m must be in 0.001..10, not 1.0e-06" -- msf_lambda_study -o out -voxel 1e-6
+check "lambda_study -sweeps 1000000" 1 "lambda_study.sweeps must be in 0..100" -- msf_lambda_study -o out -sweeps 1000000
 printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  rings: 32\n' >"$F/rings_only.yaml"
 check "synth -rig: rings without their elevations" 1 "rings_only.yaml': lidar.rings 32 without lidar.beam_elevations_deg" -- \
   msf_synth -o out -frames 1 -rig "$F/rings_only.yaml"
-check "synth -lidar hdl16" 1 "synthetic.lidar_model' = hdl16 is unknown \(known: hdl64e, hdl32e, beams\)" -- \
+check "synth -lidar hdl16" 1 "synthetic.lidar_model must be hdl64e \| hdl32e \| beams, not 'hdl16'" -- \
   msf_synth -o out -frames 1 -lidar hdl16
-check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg' = 0 beams must hold 1..1024" -- \
+check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg must hold 1..1024 elevations for lidar_model beams, not 0" -- \
   msf_synth -o out -frames 1 -lidar beams
 check "synth -camera kitti -focal 500" 1 "option -focal sets a pinhole camera, but -camera is 'kitti'" -- \
   msf_synth -o out -frames 1 -camera kitti -focal 500
-check "synth -baseline 0" 1 "synthetic.baseline_m' = 0 must be in \(0, 10\]" -- msf_synth -o out -frames 1 -baseline 0
+check "synth -baseline 0" 1 "synthetic.baseline_m must be in \(0, 10\], not 0.0" -- msf_synth -o out -frames 1 -baseline 0
+
+# ---- configuration files ------------------------------------------------------------------
+check "mesh -config: a misspelt section" 1 "typo_section.yaml' line 1: 'tsdf_volumes' is not a section of the configuration" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/typo_section.yaml"
+check "interpolate -config: threads 4294967297" 1 "threads_wrap.yaml' line 2: interpolation.threads must be a whole number in 0..256, not 4294967297" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -config "$F/threads_wrap.yaml"
+check "mesh -config: an empty file" 1 "config '.*empty.yaml' is empty" -- msf_mesh "$F/dense.pcd" o.ply -config "$F/empty.yaml"
+check "mesh -config: a list" 1 "list.yaml' line 1: a config file is a map of sections" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/list.yaml"
+check "mesh -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears twice \(lines 2 and 3\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/twice.yaml"
+check "mesh -config: nested 33000 levels" 1 "deep.yaml' is not valid YAML: line .* levels deep \(yaml-cpp's limit\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/deep.yaml"
+check "synth -config: malformed YAML" 1 "unclosed.yaml' is not valid YAML: line [0-9]+, column [0-9]+: " -- \
+  msf_synth -o out -config "$F/unclosed.yaml"
+check "synth -config: an unknown key" 1 "unknown_key.yaml' line 2: 'stereo.block_size' is not a key of section 'stereo' \(its keys: engine, mode" -- \
+  msf_synth -o out -config "$F/unknown_key.yaml"
+check "synth -config: a wrong type" 1 "wrong_type.yaml' line 2: stereo.left_right_check must be true or false, not 'maybe'" -- \
+  msf_synth -o out -config "$F/wrong_type.yaml"
+check "synth -config: a value out of range" 1 "out_of_range.yaml' line 3: synthetic.lidar_dropout must be a finite number in \[0, 1\), not 1.5" -- \
+  msf_synth -o out -config "$F/out_of_range.yaml"
+check "synth -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears twice" -- \
+  msf_synth -o out -config "$F/twice.yaml"
+check "mesh -config: a number of a million digits" 1 "long_number.yaml' line 2: stereo.p1 must be a whole number in 0..2147483647, not 7777.*\(1000000 characters\)" -- \
+  msf_mesh "$F/dense.pcd" o.ply -config "$F/long_number.yaml"
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \
@@ -467,7 +504,7 @@ if [ $have_kitti = 1 ]; then
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
   printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"
-  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig.stereo_min_disparity_px must be in 0..1000.*not -1" -- \
+  check "stereo -config: rig.stereo_min_disparity_px -1" 1 "rig_negative.yaml. line 3: rig.stereo_min_disparity_px must be a finite number in 0..1000, not -1.0" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -config "$F/rig_negative.yaml"
   printf '%%YAML:1.0\nrig:\n  scale_ring_row: false\n' >"$F/rig_misspelt.yaml"
   check "interpolate -config: rig.scale_ring_row (misspelt)" 1 "scale_ring_row" -- \
@@ -491,7 +528,7 @@ if [ $have_kitti = 1 ]; then
   printf '%%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.001\n  truncation_m: 0.003\n' >"$F/mm_voxels.yaml"
   check "reconstruct: 1 mm voxels, -max_memory 1000" 1 "predicted to need up to [0-9]+ MiB .* over the memory budget of 1000 MiB" -- \
     msf_reconstruct "$SEQ" -frames 0:0 -panels 0 -config "$F/mm_voxels.yaml" -max_memory 1000 -o out
-  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 2" -- \
+  check "reconstruct -config with an indented top level" 1 "config '.*indented.yaml' is not valid YAML: line 3, column 4" -- \
     msf_reconstruct "$SEQ" -config "$F/indented.yaml" -o out
   check "reconstruct -voxel 1e-6" 1 "voxel_size_m \(-voxel, the voxel size\) must be" -- msf_reconstruct "$SEQ" -voxel 1e-6 -o out
   check "reconstruct: 3 images and 4 scans" 1 "has 3 images in camera 0's folder but 4 .bin files" -- \

@@ -279,7 +279,7 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
            "  block_size_px: 7\n  p1: 100\n  p2: 900\n  left_right_check: true\n  confidence_hole_distance_px: 9.5\n";
   }
   msf::SgbmConfig config;
-  config.read(msf::ConfigFile(path).section("stereo"));
+  msf::ConfigFile(path).read(config);
   EXPECT_EQ(config.engine, "opencv");
   EXPECT_FALSE(config.nativeEngine());
   EXPECT_EQ(config.mode, "hh");
@@ -295,14 +295,14 @@ TEST(SgbmConfig, ReadsTheStereoSectionAndRejectsBadValues) {
   EXPECT_FLOAT_EQ(config.confidence.hole_distance_px, 9.5f);
   EXPECT_EQ(config.uniqueness_ratio_pct, 10); // untouched default
   std::ostringstream printed;
-  config.print(printed);
+  msf::printConfig(printed, config);
   EXPECT_NE(printed.str().find("num_disparities_px: 64"), std::string::npos);
 
   auto fails = [&](const std::string& body, const std::string& key) {
     std::ofstream(path) << "%YAML:1.0\nstereo:\n  " << body << "\n";
     msf::SgbmConfig c;
     try {
-      c.read(msf::ConfigFile(path).section("stereo"));
+      msf::ConfigFile(path).read(c);
     } catch (const msf::ConfigError& e) {
       return std::string(e.what()).find(key) != std::string::npos;
     }

@@ -14,10 +14,7 @@ namespace {
 
 using msf::synthetic::SyntheticConfig;
 
-cv::FileNode section(const std::string& yaml, cv::FileStorage& storage) {
-  storage.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  return storage["synthetic"];
-}
+SyntheticConfig read(const std::string& yaml) { return msf::ConfigFile::fromText(yaml, "c.yaml").get<SyntheticConfig>(); }
 
 TEST(SyntheticConfig, DefaultsAreValidAndKittiLike) {
   const SyntheticConfig c;
@@ -33,16 +30,12 @@ TEST(SyntheticConfig, DefaultsAreValidAndKittiLike) {
 }
 
 TEST(SyntheticConfig, ReadOverridesOnlyThePresentKeys) {
-  cv::FileStorage fs;
-  SyntheticConfig c;
-  c.read(section("%YAML:1.0\nsynthetic:\n  frames: 3\n  lidar_dropout: 0.1\n", fs));
+  const SyntheticConfig c = read("%YAML:1.0\nsynthetic:\n  frames: 3\n  lidar_dropout: 0.1\n");
   EXPECT_EQ(c.frames, 3);
   EXPECT_DOUBLE_EQ(c.lidar_dropout, 0.1);
   EXPECT_EQ(c.seed, SyntheticConfig().seed);
   // An absent section changes nothing.
-  SyntheticConfig d;
-  d.read(cv::FileNode());
-  EXPECT_EQ(d.frames, 10);
+  EXPECT_EQ(read("other:\n  frames: 3\n").frames, 10);
 }
 
 TEST(SyntheticConfig, BadValuesNameTheirKey) {
@@ -59,10 +52,8 @@ TEST(SyntheticConfig, BadValuesNameTheirKey) {
         Case{"moving_cars_oncoming: 2.5", "synthetic.moving_cars_oncoming"},
         Case{"oncoming_car_speed_mps: 0", "synthetic.oncoming_car_speed_mps"},
         Case{"oncoming_group_period_s: 0.5", "synthetic.oncoming_group_period_s"}}) {
-    cv::FileStorage fs;
-    SyntheticConfig c;
     try {
-      c.read(section(std::string("%YAML:1.0\nsynthetic:\n  ") + bad.yaml + "\n", fs));
+      read(std::string("synthetic:\n  ") + bad.yaml + "\n");
       ADD_FAILURE() << bad.yaml << " was accepted";
     } catch (const msf::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find(bad.key), std::string::npos) << e.what();
@@ -84,11 +75,8 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
   c.lidar_beam_elevations_deg = {-15.0, 0.1 + 0.2, 7.5};
   c.camera = "pinhole";
   std::ostringstream out;
-  out << "%YAML:1.0\n";
-  c.print(out);
-  cv::FileStorage fs;
-  SyntheticConfig back;
-  back.read(section(out.str(), fs));
+  msf::printConfig(out, c);
+  const SyntheticConfig back = read(out.str());
   EXPECT_EQ(back.frames, 4);
   EXPECT_EQ(back.image_noise_sigma, 1.5);
   EXPECT_EQ(back.lidar_range_noise_m, 0.1 + 0.2);
@@ -106,9 +94,7 @@ TEST(SyntheticConfig, PrintIsReadableYaml) {
 TEST(SyntheticConfig, ProjectConfigFileHasAValidSection) {
   const std::string path = msf::test::sourceDir() + "/config/synthetic.yaml";
   ASSERT_TRUE(msf::test::fileExists(path)) << path;
-  SyntheticConfig c;
-  c.read(msf::ConfigFile(path).section("synthetic"));
-  EXPECT_EQ(c.scene, "street");
+  EXPECT_EQ(msf::ConfigFile(path).get<SyntheticConfig>().scene, "street");
 }
 
 } // namespace

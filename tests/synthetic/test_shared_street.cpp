@@ -94,12 +94,13 @@ TEST(SharedStreet, ADriveOffTheStreetIsAClearError) {
   // Beyond the street's length.
   e = msf::test::errorOf([] { SyntheticGenerator(drive(78, false)); });
   EXPECT_NE(e.find("synthetic.street_length_m"), std::string::npos) << e;
-  // The keys are printed only when set: a drive from the start writes the config as before.
+  // The placement is printed with the rest, so gt/synthetic.yaml reproduces the drive.
   std::ostringstream plain, placed;
-  SyntheticConfig().print(plain);
-  drive(25, true).print(placed);
-  EXPECT_EQ(plain.str().find("start_m"), std::string::npos);
-  EXPECT_NE(placed.str().find("reverse: true"), std::string::npos);
+  msf::printConfig(plain, SyntheticConfig());
+  msf::printConfig(placed, drive(25, true));
+  EXPECT_NE(plain.str().find("  reverse: false\n"), std::string::npos) << plain.str();
+  EXPECT_NE(placed.str().find("  start_m: 25.0\n"), std::string::npos) << placed.str();
+  EXPECT_NE(placed.str().find("  reverse: true\n"), std::string::npos) << placed.str();
 }
 
 } // namespace

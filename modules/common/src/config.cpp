@@ -1,211 +1,236 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/atomic_file.h>
-#include <opencv2/core.hpp>
 #include <msf/common/config.h>
-#include <msf/common/yaml_check.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/yaml_file.h>
 
 #include <algorithm>
-#include <charconv>
-#include <fstream>
-#include <mutex>
-#include <sstream>
-#include <set>
-#include <vector>
+#include <cctype>
+#include <cfloat>
+#include <climits>
+#include <cmath>
+#include <utility>
 
 namespace msf {
 
-void requireYamlTopLevelAtColumnZero(const std::string& path, const std::string& what) {
-  // The top level's first line is among the file's first 64 KB, or the file is no YAML of ours.
-  std::string head(1 << 16, '\0');
-  std::ifstream file(path, std::ios::binary);
-  file.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(file.gcount()));
-  std::istringstream in(head);
-  std::string line;
-  for (std::size_t line_no = 1; std::getline(in, line); ++line_no) {
-    if (!line.empty() && line.back() == '\r')
-      line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#' || line[0] == '%')
-      continue; // blank, a comment, a directive (%YAML:1.0)
-    auto refuse = [&](const std::string& why) {
-      throw IOError(what + " '" + path + "' is not valid YAML: line " + std::to_string(line_no) + ": " + why +
-                    " (the top level must start at column 0 of its own line: OpenCV's parser can loop forever "
-                    "on an indented one)");
-    };
-    if (line.rfind("---", 0) == 0) {
-      if (line.find_first_not_of(" \t", 3) == std::string::npos)
-        continue;
-      refuse("content on the '---' line");
-    }
-    if (first > 0)
-      refuse("the top level is indented by " + std::to_string(first) + " character" + (first > 1 ? "s" : ""));
-    return;
+namespace {
+
+const char* kindOf(const YAML::Node& node) {
+  return node.IsSequence() ? "a sequence" : node.IsMap() ? "a map" : node.IsScalar() ? "a single value" : "empty";
+}
+
+/// The key node and the value of `key` in the map `map`, invalid nodes when absent (a lookup
+/// that cannot insert).
+std::pair<YAML::Node, YAML::Node> entryOf(const YAML::Node& map, const std::string& key) {
+  if (map.IsMap())
+    for (const auto& entry : map)
+      if (entry.first.IsScalar() && entry.first.Scalar() == key)
+        return {entry.first, entry.second};
+  return {YAML::Node(YAML::NodeType::Undefined), YAML::Node(YAML::NodeType::Undefined)};
+}
+
+/// True when `text` names `name` as a whole word ("stereo.p1" is not "stereo.p").
+bool names(const std::string& text, const std::string& name) {
+  for (std::size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
+    const std::size_t end = at + name.size();
+    if (end == text.size() || !(std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_'))
+      return true;
+  }
+  return false;
+}
+
+} // namespace
+
+ConfigFile::ConfigFile(const std::string& path) : path_(path), root_(loadYamlFile(path, "config")) {
+  checkStructure();
+}
+
+ConfigFile ConfigFile::fromText(const std::string& text, const std::string& name) {
+  ConfigFile file;
+  file.path_ = name;
+  file.root_ = parseYamlText(text, name, "config");
+  file.checkStructure();
+  return file;
+}
+
+void ConfigFile::checkStructure() const {
+  const std::string file = "config '" + path_ + "'";
+  if (root_.IsNull())
+    throw IOError(file + " is empty: a config file holds sections of keys (a line 'stereo:', then "
+                         "'  block_size_px: 5' below it)");
+  if (!root_.IsMap())
+    throw IOError(yamlWhere("config", path_, root_) + "a config file is a map of sections (a line 'stereo:', "
+                  "then its keys below it), not " + kindOf(root_));
+  if (const auto repeated = findRepeatedKey(root_))
+    throw ConfigError(file + " line " + std::to_string(repeated->second_line) + ": section '" + repeated->key +
+                      "' appears twice (lines " + std::to_string(repeated->first_line) + " and " +
+                      std::to_string(repeated->second_line) + ")");
+  for (const auto& section : root_) {
+    if (!section.first.IsScalar())
+      throw ConfigError(yamlWhere("config", path_, section.first) + "a section's name must be a word, not " +
+                        kindOf(section.first));
+    const std::string name = section.first.Scalar();
+    if (!section.second.IsMap() && !section.second.IsNull())
+      throw ConfigError(yamlWhere("config", path_, section.second) + "section '" + name +
+                        "' must hold keys (key: value), one per line, not " + kindOf(section.second));
+    if (const auto repeated = findRepeatedKey(section.second))
+      throw ConfigError(file + " line " + std::to_string(repeated->second_line) + ": '" + name + "." + repeated->key +
+                        "' appears twice (lines " + std::to_string(repeated->first_line) + " and " +
+                        std::to_string(repeated->second_line) + ")");
   }
 }
 
-ConfigFile::ConfigFile(const std::string& path) : path_(path) {
-  requireFile(path, "config");
-  requireYamlTopLevelAtColumnZero(path, "config");
-  try {
-    storage_.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw IOError("config '" + path + "' is not valid YAML: " + e.err);
-  }
-  if (!storage_.isOpened())
-    throw IOError("config '" + path + "' cannot be opened as YAML");
-  rejectRepeatedKeys(storage_.root(), "");
-}
-
-void ConfigFile::rejectRepeatedKeys(const cv::FileNode& map, const std::string& prefix) const {
-  // OpenCV keeps a repeated key and reads only its first value: a section pasted twice
-  // would silently hide the edits made to its second copy.
-  if (!map.isMap())
-    return;
+std::vector<std::string> ConfigFile::sections() const {
   std::vector<std::string> names;
-  for (auto it = map.begin(); it != map.end(); ++it) {
-    const cv::FileNode node = *it;
-    const std::string name = prefix + node.name();
-    if (std::find(names.begin(), names.end(), name) != names.end())
-      throw ConfigError("config '" + path_ + "': '" + name + "' appears twice (only the first would be read)");
-    names.push_back(name);
-    rejectRepeatedKeys(node, name + ".");
-  }
+  if (root_.IsMap())
+    for (const auto& section : root_)
+      names.push_back(section.first.Scalar());
+  return names;
 }
 
-namespace {
-std::string keyName(const cv::FileNode& node, const char* key) {
-  const std::string section = node.name();
-  return section.empty() ? std::string(key) : section + "." + key;
-}
-
-/// Every "section.key" a readKey call has asked for in this process: the keys some stage reads.
-struct KnownKeys {
-  std::mutex mutex;
-  std::set<std::string> names;
-};
-KnownKeys& knownKeys() {
-  static KnownKeys keys;
-  return keys;
-}
-} // namespace
-
-cv::FileNode ConfigFile::section(const std::string& name) const {
-  if (!storage_.isOpened())
-    return cv::FileNode();
-  if (std::find(sections_read_.begin(), sections_read_.end(), name) == sections_read_.end())
-    sections_read_.push_back(name);
-  return storage_[name];
-}
-
-std::vector<std::string> knownConfigKeys(const std::string& section) {
-  KnownKeys& known = knownKeys();
-  const std::lock_guard<std::mutex> lock(known.mutex);
-  std::vector<std::string> keys;
-  for (auto k = known.names.lower_bound(section + "."); k != known.names.end() && k->rfind(section + ".", 0) == 0; ++k)
-    keys.push_back(k->substr(section.size() + 1));
-  return keys;
-}
-
-void ConfigFile::rejectUnknownKeys() const {
-  if (!storage_.isOpened())
+void ConfigFile::requireKnownSections(const std::vector<std::string>& known) const {
+  if (!root_.IsMap())
     return;
-  for (const std::string& name : sections_read_) {
-    const cv::FileNode section = storage_[name];
-    if (section.empty() || section.isNone())
+  for (const auto& section : root_) {
+    const std::string& name = section.first.Scalar();
+    if (std::find(known.begin(), known.end(), name) != known.end())
       continue;
-    if (!section.isMap())
-      throw ConfigError("config '" + path_ + "': section '" + name + "' must hold keys (key: value), one per line");
-    const std::vector<std::string> known = knownConfigKeys(name);
-    for (auto it = section.begin(); it != section.end(); ++it) {
-      if (std::binary_search(known.begin(), known.end(), (*it).name()))
-        continue;
-      std::string keys;
-      for (const std::string& k : known)
-        keys += (keys.empty() ? "" : ", ") + k;
-      throw ConfigError("config '" + path_ + "': '" + name + "." + (*it).name() + "' is not a key of section '" +
-                        name + "' (its keys: " + keys + ")");
-    }
+    std::string list;
+    for (const std::string& k : known)
+      list += (list.empty() ? "" : ", ") + k;
+    throw ConfigError(yamlWhere("config", path_, section.first) + "'" + name +
+                      "' is not a section of the configuration (its sections: " + list + ")");
   }
 }
 
-std::string configValue(bool value) { return value ? "true" : "false"; }
-
-std::string configValue(int value) { return std::to_string(value); }
-
-namespace {
-template <typename Real>
-std::string shortestReal(Real value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  std::string text(buffer, result.ptr);
-  if (text.find_first_of(".en") == std::string::npos)
-    text += ".0"; // a real number stays one: 5.0, not the integer 5
-  return text;
+void ConfigFile::rethrowInFile(const ConfigError& error) const {
+  const std::string message = error.what();
+  if (root_.IsMap())
+    for (const auto& section : root_)
+      if (section.second.IsMap())
+        for (const auto& key : section.second)
+          if (key.first.IsScalar() && names(message, section.first.Scalar() + "." + key.first.Scalar()))
+            throw ConfigError(yamlWhere("config", path_, key.first) + message);
+  throw ConfigError("config '" + path_ + "': " + message);
 }
-} // namespace
 
-std::string configValue(float value) { return shortestReal(value); }
+KeyReader::KeyReader(const ConfigFile& file, const char* section)
+    : file_(file), section_(section), node_(entryOf(file.root_, section).second) {}
 
-std::string configValue(double value) { return shortestReal(value); }
+YAML::Node KeyReader::find(const char* key) {
+  declared_.emplace_back(key);
+  const auto [name, value] = entryOf(node_, key);
+  if (value.IsDefined() && value.IsNull()) // an empty value is marked where the next line starts: name the key's
+    fail(name, key, "has no value (write one, or delete the line to keep the default)");
+  return value;
+}
 
-template <typename T>
-void readKey(const cv::FileNode& node, const char* key, T& value) {
-  if (node.empty() || !node.isMap())
+void KeyReader::fail(const YAML::Node& where, const char* key, const std::string& why) const {
+  throw ConfigError(yamlWhere("config", file_.path_, where) + section_ + "." + key + " " + why);
+}
+
+void KeyReader::operator()(const char* key, bool& value, const char*) {
+  const YAML::Node node = find(key);
+  if (!node.IsDefined())
     return;
-  {
-    KnownKeys& known = knownKeys();
-    const std::lock_guard<std::mutex> lock(known.mutex);
-    known.names.insert(keyName(node, key));
-  }
-  const cv::FileNode item = node[key];
-  if (item.empty() || item.isNone())
+  if (const std::optional<bool> b = yamlBool(node)) {
+    value = *b;
     return;
-  if constexpr (std::is_same_v<T, std::vector<double>>) {
-    if (!item.isSeq())
-      throw ConfigError("config key '" + keyName(node, key) + "' must be a sequence of numbers");
-    std::vector<double> values;
-    for (const auto& v : item) {
-      if (!v.isReal() && !v.isInt())
-        throw ConfigError("config key '" + keyName(node, key) + "' must be a sequence of numbers");
-      values.push_back(v.real());
-    }
-    value = std::move(values);
-  } else if constexpr (std::is_same_v<T, std::string>) {
-    if (!item.isString())
-      throw ConfigError("config key '" + keyName(node, key) + "' must be a string");
-    value = static_cast<std::string>(item);
-  } else if constexpr (std::is_same_v<T, bool>) {
-    if (item.isInt()) {
-      value = static_cast<int>(item) != 0;
-    } else if (item.isString()) {
-      const std::string s = item;
-      if (s == "true" || s == "on" || s == "yes") value = true;
-      else if (s == "false" || s == "off" || s == "no") value = false;
-      else throw ConfigError("config key '" + keyName(node, key) + "' must be true or false, not '" + s + "'");
-    } else {
-      throw ConfigError("config key '" + keyName(node, key) + "' must be true or false");
-    }
-  } else {
-    if (!item.isReal() && !item.isInt())
-      throw ConfigError("config key '" + keyName(node, key) + "' must be a number");
-    if constexpr (std::is_integral_v<T>) {
-      const double v = item.real();
-      if (item.isReal() && v != static_cast<double>(static_cast<long long>(v)))
-        throw ConfigError("config key '" + keyName(node, key) + "' must be a whole number");
-      value = static_cast<T>(item.isInt() ? static_cast<int>(item) : v);
-    } else {
-      value = static_cast<T>(item.isInt() ? static_cast<double>(static_cast<int>(item)) : item.real());
-    }
   }
+  const std::optional<long long> number = yamlInteger(node);
+  if (!number || (*number != 0 && *number != 1))
+    fail(node, key, "must be true or false, not " + yamlQuoted(node));
+  value = *number == 1;
 }
 
-template void readKey<int>(const cv::FileNode&, const char*, int&);
-template void readKey<bool>(const cv::FileNode&, const char*, bool&);
-template void readKey<float>(const cv::FileNode&, const char*, float&);
-template void readKey<double>(const cv::FileNode&, const char*, double&);
-template void readKey<std::string>(const cv::FileNode&, const char*, std::string&);
-template void readKey<std::vector<double>>(const cv::FileNode&, const char*, std::vector<double>&);
+long long KeyReader::whole(const char* key, const YAML::Node& node, Range range, double lowest, double highest) {
+  // The type's own bounds join the declared range, so that 4294967297 is out of range, not wrapped.
+  if (range.min < lowest)
+    range = {lowest, range.max, false, range.max_open};
+  if (range.max > highest)
+    range = {range.min, highest, range.min_open, false};
+  std::optional<long long> value = yamlInteger(node);
+  if (!value)
+    if (const std::optional<double> real = yamlReal(node); real && std::isfinite(*real) &&
+                                                             *real == std::trunc(*real) && std::fabs(*real) < 1e18)
+      value = static_cast<long long>(*real); // 4.0, 1e3: whole numbers written as reals
+  if (!value || !range.contains(static_cast<double>(*value)))
+    fail(node, key, "must be a whole number in " + range.text() + ", not " + yamlQuoted(node));
+  return *value;
+}
+
+void KeyReader::operator()(const char* key, int& value, const Range& range, const char*) {
+  if (const YAML::Node node = find(key); node.IsDefined())
+    value = static_cast<int>(whole(key, node, range, INT_MIN, INT_MAX));
+}
+
+void KeyReader::operator()(const char* key, unsigned& value, const Range& range, const char*) {
+  if (const YAML::Node node = find(key); node.IsDefined())
+    value = static_cast<unsigned>(whole(key, node, range, 0, UINT_MAX));
+}
+
+double KeyReader::real(const char* key, const YAML::Node& node, const Range& range, double largest) {
+  const std::optional<double> value = yamlReal(node);
+  if (value && std::isfinite(*value) && std::fabs(*value) <= largest && range.contains(*value))
+    return *value;
+  const std::string bounds = range.text();
+  const bool interval = std::isfinite(range.min) && std::isfinite(range.max);
+  fail(node, key, "must be a finite number" + (bounds.empty() ? "" : (interval ? " in " : " ") + bounds) +
+                      ", not " + yamlQuoted(node));
+}
+
+void KeyReader::operator()(const char* key, float& value, const Range& range, const char*) {
+  if (const YAML::Node node = find(key); node.IsDefined())
+    value = static_cast<float>(real(key, node, range, FLT_MAX));
+}
+
+void KeyReader::operator()(const char* key, double& value, const Range& range, const char*) {
+  if (const YAML::Node node = find(key); node.IsDefined())
+    value = real(key, node, range, DBL_MAX);
+}
+
+void KeyReader::operator()(const char* key, std::vector<double>& value, const Range& range, const char*) {
+  const YAML::Node node = find(key);
+  if (!node.IsDefined())
+    return;
+  if (!node.IsSequence())
+    fail(node, key, "must be a sequence of numbers ([1, 2.5]), not " + yamlQuoted(node));
+  std::vector<double> values;
+  for (const YAML::Node& item : node)
+    values.push_back(real(key, item, range, DBL_MAX));
+  value = std::move(values);
+}
+
+std::optional<std::size_t> KeyReader::word(const char* key, const char* const* words, std::size_t n) {
+  const YAML::Node node = find(key);
+  if (!node.IsDefined())
+    return std::nullopt;
+  if (node.IsScalar())
+    for (std::size_t i = 0; i < n; ++i)
+      if (node.Scalar() == words[i])
+        return i;
+  fail(node, key, "must be " + wordList(words, n) + ", not " + yamlQuoted(node));
+}
+
+void KeyReader::removed(const char* key, const char* why) {
+  const YAML::Node node = find(key);
+  if (node.IsDefined())
+    fail(node, key, std::string("was removed: ") + why);
+}
+
+void KeyReader::finish() const {
+  if (!node_.IsMap())
+    return;
+  for (const auto& entry : node_) {
+    const std::string name = entry.first.IsScalar() ? entry.first.Scalar() : "";
+    if (std::find(declared_.begin(), declared_.end(), name) != declared_.end())
+      continue;
+    std::string keys;
+    for (const std::string& k : declared_)
+      keys += (keys.empty() ? "" : ", ") + k;
+    throw ConfigError(yamlWhere("config", file_.path_, entry.first) + "'" + section_ + "." +
+                      (name.empty() ? std::string(kindOf(entry.first)) : name) + "' is not a key of section '" +
+                      section_ + "' (its keys: " + keys + ")");
+  }
+}
 
 } // namespace msf

@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/yaml_file.h>
 #include <msf/io/rig_file.h>
 
 #include <yaml-cpp/yaml.h>
@@ -17,14 +18,12 @@ namespace {
 /// A rig file's nodes with the file's name for every message.
 class RigReader {
 public:
-  explicit RigReader(const std::string& path) : path_(path) {
-    try {
-      root_ = YAML::LoadFile(path);
-    } catch (const YAML::Exception& e) {
-      throw IOError("rig file '" + path + "' is not valid YAML: " + e.what());
-    }
+  /// The file read as configuration files are (loadYamlFile): its size and nesting bounded, a key
+  /// written twice refused (a lookup would see the first only).
+  explicit RigReader(const std::string& path) : path_(path), root_(loadYamlFile(path, "rig file")) {
     if (!root_.IsMap())
       throw CalibrationError("rig file '" + path + "' is not a map of keys (image_width, left, lidar, ...)");
+    refuseRepeatedKeys(root_, "");
   }
 
   const YAML::Node& root() const { return root_; }
@@ -88,6 +87,16 @@ public:
   }
 
 private:
+  void refuseRepeatedKeys(const YAML::Node& map, const std::string& prefix) const {
+    if (const auto repeated = findRepeatedKey(map))
+      throw CalibrationError(yamlWhere("rig file", path_, map) + prefix + repeated->key + " appears twice (lines " +
+                             std::to_string(repeated->first_line) + " and " +
+                             std::to_string(repeated->second_line) + ")");
+    for (const auto& entry : map)
+      if (entry.second.IsMap())
+        refuseRepeatedKeys(entry.second, prefix + entry.first.Scalar() + ".");
+  }
+
   std::string path_;
   YAML::Node root_;
 };
@@ -167,9 +176,9 @@ std::vector<double> rowMajor(const Calibration::Projection& P) {
 
 bool isRigFile(const std::string& path) {
   try {
-    const YAML::Node root = YAML::LoadFile(path);
+    const YAML::Node root = loadYamlFile(path, "rig file");
     return root.IsMap() && root["image_width"] && root["left"];
-  } catch (const YAML::Exception&) {
+  } catch (const Error&) {
     return false;
   }
 }

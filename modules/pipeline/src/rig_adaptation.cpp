@@ -1,32 +1,14 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/config.h>
-#include <msf/common/exceptions.h>
+#include <msf/common/config_keys.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/pipeline/rig_adaptation.h>
 
 #include <algorithm>
 #include <cmath>
-#include <ostream>
 
 namespace msf {
 
-void RigAdaptationConfig::read(const cv::FileNode& node) {
-  readKey(node, "stereo_min_disparity_px", stereo_min_disparity_px);
-  readKey(node, "scale_ring_rows", scale_ring_rows);
-  validate();
-}
-
-void RigAdaptationConfig::validate() const {
-  if (!(stereo_min_disparity_px >= 0.0 && stereo_min_disparity_px <= 1000.0))
-    throw ConfigError("rig.stereo_min_disparity_px must be in 0..1000 (0: tsdf_integrator.max_depth_m alone), not " +
-                      configValue(stereo_min_disparity_px));
-}
-
-void RigAdaptationConfig::print(std::ostream& out) const {
-  out << "rig:\n"
-      << "  stereo_min_disparity_px: " << configValue(stereo_min_disparity_px) << "\n"
-      << "  scale_ring_rows: " << configValue(scale_ring_rows) << "\n";
-}
+void RigAdaptationConfig::validate() const { checkKeyRanges(*this); }
 
 namespace {
 

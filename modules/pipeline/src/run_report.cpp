@@ -1,15 +1,15 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
-#include <msf/common/config.h>
+#include <msf/common/config_keys.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/json_text.h>
 #include <msf/common/line_plot.h>
 #include <msf/common/version.h>
 #include <msf/common/statistics.h>
+#include <msf/common/yaml_file.h>
 #include <msf/io/image_io.h>
 #include <msf/pipeline/run_report.h>
 
-#include <opencv2/core/persistence.hpp>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -137,39 +137,38 @@ std::string skippedSentence(const std::vector<std::string>& skipped) {
   return " Stopped a second time: skipped " + list + ".";
 }
 
-/// A value of a configuration as JSON: numbers as numbers, true / false as booleans, words
-/// as strings, sequences as arrays.
-std::string configValueJson(const cv::FileNode& node) {
-  if (node.isInt())
-    return std::to_string(static_cast<int>(node));
-  if (node.isReal()) {
-    const double v = node.real();
-    return std::isfinite(v) ? configValue(v) : "null";
-  }
-  if (node.isString()) {
-    const std::string word = node;
-    return word == "true" || word == "false" ? word : jsonString(word);
-  }
-  if (node.isSeq()) {
+/// A value of a configuration as JSON: numbers as numbers, booleans as booleans, words as
+/// strings, sequences as arrays.
+std::string configValueJson(const YAML::Node& node) {
+  if (node.IsSequence()) {
     std::string out = "[";
-    for (auto it = node.begin(); it != node.end(); ++it)
-      out += (it == node.begin() ? "" : ", ") + configValueJson(*it);
+    for (std::size_t i = 0; i < node.size(); ++i)
+      out += (i ? ", " : "") + configValueJson(node[i]);
     return out + "]";
   }
-  return "null";
+  if (const std::optional<long long> whole = yamlInteger(node))
+    return std::to_string(*whole);
+  if (const std::optional<double> real = yamlReal(node))
+    return std::isfinite(*real) ? configValue(*real) : "null";
+  if (const std::optional<bool> flag = yamlBool(node))
+    return *flag ? "true" : "false";
+  return node.IsScalar() ? jsonString(node.Scalar()) : "null";
 }
 
 /// The configuration file `yaml` (sections of keys, as PipelineConfig::print writes it) as
 /// a JSON object, a section a line.
 std::string configJson(const std::string& yaml) {
-  const cv::FileStorage storage(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  const cv::FileNode root = storage.root();
+  const YAML::Node root = parseYamlText(yaml, "config.yaml", "config");
   std::string out = "{";
-  for (auto section = root.begin(); section != root.end(); ++section) {
-    out += std::string(section == root.begin() ? "" : ",") + "\n    " + jsonString((*section).name()) + ": {";
-    const cv::FileNode keys = *section;
-    for (auto key = keys.begin(); key != keys.end(); ++key)
-      out += std::string(key == keys.begin() ? "" : ", ") + jsonString((*key).name()) + ": " + configValueJson(*key);
+  bool first_section = true;
+  for (const auto& section : root) {
+    out += std::string(first_section ? "" : ",") + "\n    " + jsonString(section.first.Scalar()) + ": {";
+    first_section = false;
+    bool first_key = true;
+    for (const auto& key : section.second) {
+      out += std::string(first_key ? "" : ", ") + jsonString(key.first.Scalar()) + ": " + configValueJson(key.second);
+      first_key = false;
+    }
     out += "}";
   }
   return out + "\n  }";

@@ -1,12 +1,9 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
-#include <msf/common/config.h>
+#include <msf/common/config_keys.h>
 #include <msf/common/exceptions.h>
-#include <msf/common/limits.h>
 #include <msf/common/vector_clones.h>
 #include <msf/range_image/depth_interpolator.h>
-
-#include <ostream>
 
 #include <opencv2/core/utility.hpp>
 
@@ -17,103 +14,21 @@
 
 namespace msf {
 
-CombineRule parseCombineRule(const std::string& name) {
-  if (name == "average")
-    return CombineRule::Average;
-  if (name == "shorter_gap")
-    return CombineRule::ShorterGap;
-  if (name == "gap_weighted")
-    return CombineRule::GapWeighted;
-  if (name == "nearest")
-    return CombineRule::Nearest;
-  throw ConfigError("interpolation.combine '" + name + "' is not average, shorter_gap, gap_weighted or nearest");
-}
-
-const char* toString(CombineRule rule) {
-  switch (rule) {
-  case CombineRule::Average:
-    return "average";
-  case CombineRule::GapWeighted:
-    return "gap_weighted";
-  case CombineRule::Nearest:
-    return "nearest";
-  default:
-    return "shorter_gap";
-  }
-}
-
-void InterpolationConfig::print(std::ostream& out) const {
-  out << "interpolation:\n"
-      << "  method: " << toString(slice.interpolant) << "\n"
-      << "  short_gap_px: " << configValue(slice.short_gap_px) << "\n"
-      << "  max_gap_px: " << configValue(slice.max_gap_px) << "\n"
-      << "  edge_test: " << configValue(slice.edge_test) << "\n"
-      << "  jump_abs_m: " << configValue(slice.jump_abs_m) << "\n"
-      << "  jump_rel: " << configValue(slice.jump_rel) << "\n"
-      << "  jump_inv_per_m: " << configValue(slice.jump_inv_per_m) << "\n"
-      << "  cubic_alpha: " << configValue(slice.cubic_alpha) << "\n"
-      << "  cubic_beta: " << configValue(slice.cubic_beta) << "\n"
-      << "  inverse_depth: " << configValue(slice.inverse_depth) << "\n"
-      << "  column_seed_gap_px: " << configValue(column_seed_gap_px) << "\n"
-      << "  combine: " << toString(combine) << "\n"
-      << "  gaussian: " << configValue(gaussian) << "\n"
-      << "  gaussian_size_px: " << configValue(gaussian_size_px) << "\n"
-      << "  gaussian_sigma_px: " << configValue(gaussian_sigma_px) << "\n"
-      << "  gaussian_min_weight: " << configValue(gaussian_min_weight) << "\n"
-      << "  gaussian_smooth_valid: " << configValue(gaussian_smooth_valid) << "\n"
-      << "  threads: " << configValue(threads) << "\n";
-}
-
-void InterpolationConfig::read(const cv::FileNode& node) {
-  std::string method = toString(slice.interpolant), rule = toString(combine);
-  readKey(node, "method", method);
-  slice.interpolant = parseSliceInterpolant(method);
-  readKey(node, "short_gap_px", slice.short_gap_px);
-  readKey(node, "max_gap_px", slice.max_gap_px);
-  readKey(node, "edge_test", slice.edge_test);
-  readKey(node, "jump_abs_m", slice.jump_abs_m);
-  readKey(node, "jump_rel", slice.jump_rel);
-  readKey(node, "cubic_alpha", slice.cubic_alpha);
-  readKey(node, "cubic_beta", slice.cubic_beta);
-  readKey(node, "inverse_depth", slice.inverse_depth);
-  readKey(node, "jump_inv_per_m", slice.jump_inv_per_m);
-  readKey(node, "column_seed_gap_px", column_seed_gap_px);
-  readKey(node, "combine", rule);
-  combine = parseCombineRule(rule);
-  readKey(node, "gaussian", gaussian);
-  readKey(node, "gaussian_size_px", gaussian_size_px);
-  readKey(node, "gaussian_sigma_px", gaussian_sigma_px);
-  readKey(node, "gaussian_min_weight", gaussian_min_weight);
-  readKey(node, "gaussian_smooth_valid", gaussian_smooth_valid);
-  readKey(node, "threads", threads);
-  validate();
-}
+const char* toString(CombineRule rule) { return wordOf(kCombineRules, rule); }
 
 void InterpolationConfig::validate() const {
+  checkKeyRanges(*this);
   auto fail = [](const std::string& key, const std::string& rule) {
     throw ConfigError("interpolation." + key + " " + rule);
   };
-  if (slice.max_gap_px < 0)
-    fail("max_gap_px", "must be >= 0, not " + std::to_string(slice.max_gap_px));
-  if (slice.short_gap_px < 0 || slice.short_gap_px > slice.max_gap_px)
+  if (slice.short_gap_px > slice.max_gap_px)
     fail("short_gap_px", "must be 0..max_gap_px (" + std::to_string(slice.max_gap_px) + "), not " +
                              std::to_string(slice.short_gap_px));
-  if (!(slice.jump_abs_m >= 0.f))
-    fail("jump_abs_m", "must be >= 0");
-  if (!(slice.jump_rel >= 0.f))
-    fail("jump_rel", "must be >= 0");
-  if (!(slice.jump_inv_per_m >= 0.f))
-    fail("jump_inv_per_m", "must be >= 0");
-  if (column_seed_gap_px < 0 || column_seed_gap_px > slice.max_gap_px)
+  if (column_seed_gap_px > slice.max_gap_px)
     fail("column_seed_gap_px", "must be 0..max_gap_px (" + std::to_string(slice.max_gap_px) + "), not " +
                                    std::to_string(column_seed_gap_px));
-  if (!(gaussian_size_px >= 1 && gaussian_size_px % 2 == 1 && gaussian_size_px <= 31))
-    fail("gaussian_size_px", "must be odd, 1..31, not " + std::to_string(gaussian_size_px));
-  if (!(gaussian_sigma_px > 0.f))
-    fail("gaussian_sigma_px", "must be > 0");
-  if (!(gaussian_min_weight > 0.f && gaussian_min_weight <= 1.f))
-    fail("gaussian_min_weight", "must be in (0, 1]");
-  limits::checkThreads(threads, "interpolation.threads (-threads)");
+  if (gaussian_size_px % 2 == 0)
+    fail("gaussian_size_px", "must be odd, not " + std::to_string(gaussian_size_px));
 }
 
 DepthInterpolator::DepthInterpolator(const InterpolationConfig& config) { setConfig(config); }

@@ -1,5 +1,4 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/range_image/ip_basic.h>
 
@@ -9,52 +8,22 @@
 namespace msf {
 
 IpBasicVariant parseIpBasicVariant(const std::string& name) {
-  if (name == "fast")
-    return IpBasicVariant::Fast;
-  if (name == "multiscale")
-    return IpBasicVariant::Multiscale;
-  throw ConfigError("ip_basic.variant '" + name + "' is not fast or multiscale");
+  if (const auto variant = choiceOf(kIpBasicVariants, name))
+    return *variant;
+  throw ConfigError("ip_basic.variant '" + name + "' is not " + wordList(kIpBasicVariants));
 }
 
 IpBasicBlur parseIpBasicBlur(const std::string& name) {
-  if (name == "none")
-    return IpBasicBlur::None;
-  if (name == "gaussian")
-    return IpBasicBlur::Gaussian;
-  if (name == "bilateral")
-    return IpBasicBlur::Bilateral;
-  throw ConfigError("ip_basic.blur '" + name + "' is not none, gaussian or bilateral");
+  if (const auto blur = choiceOf(kIpBasicBlurs, name))
+    return *blur;
+  throw ConfigError("ip_basic.blur '" + name + "' is not " + wordList(kIpBasicBlurs));
 }
 
-const char* toString(IpBasicVariant variant) { return variant == IpBasicVariant::Fast ? "fast" : "multiscale"; }
+const char* toString(IpBasicVariant variant) { return wordOf(kIpBasicVariants, variant); }
 
-const char* toString(IpBasicBlur blur) {
-  return blur == IpBasicBlur::None ? "none" : blur == IpBasicBlur::Gaussian ? "gaussian" : "bilateral";
-}
+const char* toString(IpBasicBlur blur) { return wordOf(kIpBasicBlurs, blur); }
 
-void IpBasicConfig::print(std::ostream& out) const {
-  out << "ip_basic:\n"
-      << "  variant: " << toString(variant) << "\n"
-      << "  max_depth_m: " << configValue(max_depth_m) << "\n"
-      << "  extrapolate: " << configValue(extrapolate) << "\n"
-      << "  blur: " << toString(blur) << "\n";
-}
-
-void IpBasicConfig::read(const cv::FileNode& node) {
-  std::string v = toString(variant), b = toString(blur);
-  readKey(node, "variant", v);
-  variant = parseIpBasicVariant(v);
-  readKey(node, "max_depth_m", max_depth_m);
-  readKey(node, "extrapolate", extrapolate);
-  readKey(node, "blur", b);
-  blur = parseIpBasicBlur(b);
-  validate();
-}
-
-void IpBasicConfig::validate() const {
-  if (!(max_depth_m > 1.f))
-    throw ConfigError("ip_basic.max_depth_m must be > 1, not " + std::to_string(max_depth_m));
-}
+void IpBasicConfig::validate() const { checkKeyRanges(*this); }
 
 namespace {
 

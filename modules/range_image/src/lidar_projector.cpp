@@ -1,11 +1,9 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
-#include <msf/common/config.h>
+#include <msf/common/config_keys.h>
 #include <msf/common/exceptions.h>
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/point_types.h>
-
-#include <ostream>
 
 #include <opencv2/core/utility.hpp>
 
@@ -16,32 +14,11 @@
 
 namespace msf {
 
-void ProjectionConfig::print(std::ostream& out) const {
-  out << "projection:\n"
-      << "  camera: " << configValue(camera) << "\n"
-      << "  min_range_m: " << configValue(min_range_m) << "\n"
-      << "  max_range_m: " << configValue(max_range_m) << "\n"
-      << "  margin_px: " << configValue(margin_px) << "\n";
-}
-
-void ProjectionConfig::read(const cv::FileNode& node) {
-  readKey(node, "camera", camera);
-  readKey(node, "min_range_m", min_range_m);
-  readKey(node, "max_range_m", max_range_m);
-  readKey(node, "margin_px", margin_px);
-  validate();
-}
-
 void ProjectionConfig::validate() const {
-  if (camera < 0 || camera > 3)
-    throw ConfigError("projection.camera must be 0..3, not " + std::to_string(camera));
-  if (!(min_range_m >= 0.f))
-    throw ConfigError("projection.min_range_m must be >= 0, not " + std::to_string(min_range_m));
+  checkKeyRanges(*this);
   if (!(max_range_m > min_range_m))
-    throw ConfigError("projection.max_range_m (" + std::to_string(max_range_m) +
-                      ") must be greater than projection.min_range_m (" + std::to_string(min_range_m) + ")");
-  if (margin_px < 0 || margin_px > 256)
-    throw ConfigError("projection.margin_px must be 0..256, not " + std::to_string(margin_px));
+    throw ConfigError("projection.max_range_m (" + configValue(max_range_m) +
+                      ") must be greater than projection.min_range_m (" + configValue(min_range_m) + ")");
 }
 
 LidarProjector::LidarProjector(const Calibration& calibration, const ProjectionConfig& config) {

@@ -1,9 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/range_image/ring_split.h>
-
-#include <ostream>
 
 #include <algorithm>
 #include <cmath>
@@ -11,22 +8,9 @@
 
 namespace msf {
 
-void RingSplitConfig::print(std::ostream& out) const {
-  out << "rings:\n"
-      << "  modulo: " << configValue(modulo) << "\n"
-      << "  heldout_remainder: " << configValue(heldout_remainder) << "\n";
-}
-
-void RingSplitConfig::read(const cv::FileNode& node) {
-  readKey(node, "modulo", modulo);
-  readKey(node, "heldout_remainder", heldout_remainder);
-  validate();
-}
-
 void RingSplitConfig::validate() const {
-  if (modulo < 2)
-    throw ConfigError("rings.modulo must be >= 2 (some rings must stay input), not " + std::to_string(modulo));
-  if (heldout_remainder < 0 || heldout_remainder >= modulo)
+  checkKeyRanges(*this);
+  if (heldout_remainder >= modulo)
     throw ConfigError("rings.heldout_remainder must be 0.." + std::to_string(modulo - 1) + ", not " +
                       std::to_string(heldout_remainder));
 }

@@ -5,26 +5,12 @@
 namespace msf {
 
 SliceInterpolant parseSliceInterpolant(const std::string& name) {
-  if (name == "compound")
-    return SliceInterpolant::Compound;
-  if (name == "linear")
-    return SliceInterpolant::Linear;
-  if (name == "cubic")
-    return SliceInterpolant::Cubic;
-  throw ConfigError("slice interpolant '" + name + "' is not compound, linear or cubic");
+  if (const auto interpolant = choiceOf(kSliceInterpolants, name))
+    return *interpolant;
+  throw ConfigError("slice interpolant '" + name + "' is not " + wordList(kSliceInterpolants));
 }
 
-const char* toString(SliceInterpolant interpolant) {
-  switch (interpolant) {
-  case SliceInterpolant::Linear:
-    return "linear";
-  case SliceInterpolant::Cubic:
-    return "cubic";
-  default:
-    return "compound";
-  }
-}
-
+const char* toString(SliceInterpolant interpolant) { return wordOf(kSliceInterpolants, interpolant); }
 
 void interpolateSlice(const float* in, std::ptrdiff_t stride, int n, const SliceParams& params, float* out,
                       std::uint8_t* gap) {

@@ -1,7 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/common/line_plot.h>
@@ -38,63 +37,12 @@ Eigen::Isometry3d arcPose(int i, int n) {
 
 } // namespace
 
-void LambdaStudy::Config::read(const cv::FileNode& node) {
-  readKey(node, "noise_mm", noise_mm);
-  readKey(node, "lambdas", lambdas);
-  readKey(node, "frames", frames);
-  readKey(node, "voxel_size_m", voxel_size_m);
-  readKey(node, "truncation_m", truncation_m);
-  readKey(node, "sweeps", sweeps);
-  std::string solve_name = toString(solve);
-  readKey(node, "solve", solve_name);
-  try {
-    solve = parseSolve(solve_name);
-  } catch (const ConfigError&) {
-    throw ConfigError("lambda_study.solve must be sweeps or argmin, not '" + solve_name + "'");
-  }
-  readKey(node, "width", width);
-  readKey(node, "height", height);
-  readKey(node, "focal_px", focal_px);
-  int s = static_cast<int>(seed);
-  readKey(node, "seed", s);
-  seed = static_cast<unsigned>(s);
+void LambdaStudy::Config::validate() const {
+  checkKeyRanges(*this);
+  TsdfVolume::validate(voxel_size_m, truncation_m, 0.0);
 }
 
-void LambdaStudy::Config::print(std::ostream& out) const {
-  auto list = [&](const std::vector<double>& v) {
-    std::ostringstream ss;
-    ss << "[";
-    for (std::size_t i = 0; i < v.size(); ++i)
-      ss << (i ? ", " : "") << v[i];
-    return ss.str() + "]";
-  };
-  out << "lambda_study:\n  noise_mm: " << list(noise_mm) << "\n  lambdas: " << list(lambdas) << "\n  frames: " << frames
-      << "\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m << "\n  sweeps: " << sweeps
-      << "\n  solve: " << toString(solve)
-      << "\n  width: " << width << "\n  height: " << height << "\n  focal_px: " << focal_px << "\n  seed: " << seed
-      << "\n";
-}
-
-LambdaStudy::LambdaStudy(const Config& config) : config_(config), scene_(scene()) {
-  if (config.frames < 1)
-    throw ConfigError("lambda_study.frames must be >= 1, got " + std::to_string(config.frames));
-  if (config.frames > 10000)
-    throw ConfigError("lambda_study.frames must be at most 10000, got " + std::to_string(config.frames));
-  if (config.width < 2 || config.height < 2 || !(config.focal_px > 0) || !std::isfinite(config.focal_px) ||
-      config.width > limits::kMaxImageSide || config.height > limits::kMaxImageSide)
-    throw ConfigError("lambda_study: width and height must be 2.." + std::to_string(limits::kMaxImageSide) +
-                      " and focal_px positive");
-  if (config.sweeps < 0 || config.sweeps > TsdfIntegrator::Config::kMaxSweeps)
-    throw ConfigError("lambda_study.sweeps (-sweeps) must be 0.." + std::to_string(TsdfIntegrator::Config::kMaxSweeps) +
-                      ", got " + std::to_string(config.sweeps));
-  for (const double s : config.noise_mm)
-    if (!(s >= 0))
-      throw ConfigError("lambda_study.noise_mm must be >= 0, got " + std::to_string(s));
-  for (const double l : config.lambdas)
-    if (!(l >= 0))
-      throw ConfigError("lambda_study.lambdas must be >= 0, got " + std::to_string(l));
-  TsdfVolume(config.voxel_size_m, config.truncation_m); // validates both
-}
+LambdaStudy::LambdaStudy(const Config& config) : config_((config.validate(), config)), scene_(scene()) {}
 
 AnalyticScene LambdaStudy::scene() {
   AnalyticScene s;

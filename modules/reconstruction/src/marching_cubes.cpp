@@ -1,6 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/mesh_components.h>
@@ -420,39 +419,7 @@ void assembleParts(std::vector<std::pair<GridIndex, const MarchingCubes::BlockMe
 
 } // namespace
 
-void MarchingCubes::Config::read(const cv::FileNode& node) {
-  readKey(node, "min_weight", min_weight);
-  readKey(node, "max_unseen_corners", max_unseen_corners);
-  readKey(node, "smoothing_lambda", smoothing_lambda);
-  readKey(node, "min_component_triangles", min_component_triangles);
-  readKey(node, "component_keep_weight", component_keep_weight);
-  validate();
-}
-
-void MarchingCubes::Config::validate() const {
-  if (!(min_weight >= 0.f))
-    throw ConfigError("marching_cubes.min_weight must be >= 0, got " + std::to_string(min_weight));
-  if (max_unseen_corners < 0 || max_unseen_corners > 4)
-    throw ConfigError("marching_cubes.max_unseen_corners must be in 0..4 (0: off), got " +
-                      std::to_string(max_unseen_corners));
-  if (!(smoothing_lambda >= 0.f) || !std::isfinite(smoothing_lambda))
-    throw ConfigError("marching_cubes.smoothing_lambda must be >= 0 (m^-2; 0: off), got " +
-                      std::to_string(smoothing_lambda));
-  if (!(component_keep_weight >= 0.f) || !std::isfinite(component_keep_weight))
-    throw ConfigError("marching_cubes.component_keep_weight must be >= 0 (m^-2; 0: no piece is kept for its "
-                      "weight), got " + std::to_string(component_keep_weight));
-  if (min_component_triangles < 0)
-    throw ConfigError("marching_cubes.min_component_triangles must be >= 0, got " +
-                      std::to_string(min_component_triangles));
-}
-
-void MarchingCubes::Config::print(std::ostream& out) const {
-  out << "marching_cubes:\n  min_weight: " << configValue(min_weight)
-      << "\n  max_unseen_corners: " << configValue(max_unseen_corners)
-      << "\n  smoothing_lambda: " << configValue(smoothing_lambda)
-      << "\n  min_component_triangles: " << configValue(min_component_triangles)
-      << "\n  component_keep_weight: " << configValue(component_keep_weight) << "\n";
-}
+void MarchingCubes::Config::validate() const { checkKeyRanges(*this); }
 
 MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
 

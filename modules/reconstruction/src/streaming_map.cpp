@@ -1,7 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/reconstruction/streaming_map.h>
@@ -307,19 +306,7 @@ std::size_t meshTile(const GridIndex& tile, const std::vector<GridIndex>& blocks
 
 } // namespace
 
-void StreamingMap::Config::read(const cv::FileNode& node) {
-  readKey(node, "active_radius_m", active_radius_m);
-  readKey(node, "tile_blocks", tile_blocks);
-  validate();
-}
-
-void StreamingMap::Config::validate() const {
-  if (!(active_radius_m >= 0.0) || !std::isfinite(active_radius_m))
-    throw ConfigError("streaming.active_radius_m must be >= 0 (0: the whole map in memory), got " +
-                      number(active_radius_m));
-  if (tile_blocks < 1 || tile_blocks > 64)
-    throw ConfigError("streaming.tile_blocks must be in 1..64, got " + std::to_string(tile_blocks));
-}
+void StreamingMap::Config::validate() const { checkKeyRanges(*this); }
 
 void StreamingMap::Config::requireRadius(double reach_m, double voxel_size_m) const {
   const double tile_m = tile_blocks * kSide * voxel_size_m;
@@ -328,11 +315,6 @@ void StreamingMap::Config::requireRadius(double reach_m, double voxel_size_m) co
                       number(reach_m + tile_m) + " m, the integrator's reach (" + number(reach_m) +
                       " m: how far from the camera it changes blocks, TsdfIntegrator::reach) plus a tile (" +
                       number(tile_m) + " m)");
-}
-
-void StreamingMap::Config::print(std::ostream& out) const {
-  out << "streaming:\n  active_radius_m: " << configValue(active_radius_m)
-      << "\n  tile_blocks: " << configValue(tile_blocks) << "\n";
 }
 
 StreamingMap::StreamingMap(TsdfVolume& volume, const Config& config, const MarchingCubes::Config& mesher,

@@ -1,6 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/reconstruction/plane_distance.h>
@@ -121,164 +120,52 @@ bool sphereInView(const Eigen::Vector3f& c, float radius, const PinholeCamera& c
 
 } // namespace
 
-const char* toString(TsdfIntegrator::Weighting weighting) {
-  switch (weighting) {
-  case TsdfIntegrator::Weighting::Constant: return "constant";
-  case TsdfIntegrator::Weighting::InverseSquare: return "inverse_square";
-  case TsdfIntegrator::Weighting::PerPixel: return "per_pixel";
-  }
-  return "?";
+namespace {
+template <class E, std::size_t N>
+E parseWord(const Choice<E> (&choices)[N], const std::string& text, const char* key) {
+  if (const auto value = choiceOf(choices, text))
+    return *value;
+  throw ConfigError(std::string("tsdf_integrator.") + key + " must be " + wordList(choices) + ", not '" + text + "'");
+}
+} // namespace
+
+const char* toString(TsdfIntegrator::Weighting weighting) { return wordOf(TsdfIntegrator::kWeightings, weighting); }
+
+TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
+  return parseWord(TsdfIntegrator::kWeightings, text, "weighting");
 }
 
 const char* toString(TsdfIntegrator::SignedDistance distance) {
-  return distance == TsdfIntegrator::SignedDistance::Plane ? "plane" : "projective";
+  return wordOf(TsdfIntegrator::kSignedDistances, distance);
 }
 
 TsdfIntegrator::SignedDistance parseSignedDistance(const std::string& text) {
-  if (text == "plane") return TsdfIntegrator::SignedDistance::Plane;
-  if (text == "projective") return TsdfIntegrator::SignedDistance::Projective;
-  throw ConfigError("TSDF signed distance '" + text + "' is not plane or projective");
+  return parseWord(TsdfIntegrator::kSignedDistances, text, "signed_distance");
 }
 
-TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
-  if (text == "constant") return TsdfIntegrator::Weighting::Constant;
-  if (text == "inverse_square") return TsdfIntegrator::Weighting::InverseSquare;
-  if (text == "per_pixel") return TsdfIntegrator::Weighting::PerPixel;
-  throw ConfigError("TSDF weighting '" + text + "' is not constant, inverse_square or per_pixel");
-}
-
-const char* toString(TsdfIntegrator::LambdaData data) {
-  return data == TsdfIntegrator::LambdaData::InverseVariance ? "inverse_variance" : "uniform";
-}
+const char* toString(TsdfIntegrator::LambdaData data) { return wordOf(TsdfIntegrator::kLambdaData, data); }
 
 TsdfIntegrator::LambdaData parseLambdaData(const std::string& text) {
-  if (text == "uniform") return TsdfIntegrator::LambdaData::Uniform;
-  if (text == "inverse_variance") return TsdfIntegrator::LambdaData::InverseVariance;
-  throw ConfigError("tsdf_integrator.lambda_data '" + text + "' is not uniform or inverse_variance");
+  return parseWord(TsdfIntegrator::kLambdaData, text, "lambda_data");
 }
 
-const char* toString(TsdfIntegrator::Solve solve) {
-  return solve == TsdfIntegrator::Solve::Argmin ? "argmin" : "sweeps";
-}
+const char* toString(TsdfIntegrator::Solve solve) { return wordOf(TsdfIntegrator::kSolves, solve); }
 
-TsdfIntegrator::Solve parseSolve(const std::string& text) {
-  if (text == "sweeps") return TsdfIntegrator::Solve::Sweeps;
-  if (text == "argmin") return TsdfIntegrator::Solve::Argmin;
-  throw ConfigError("tsdf_integrator.solve '" + text + "' is not sweeps or argmin");
-}
-
-void TsdfIntegrator::Config::read(const cv::FileNode& node) {
-  std::string w = toString(weighting);
-  readKey(node, "weighting", w);
-  weighting = parseWeighting(w);
-  readKey(node, "max_weight", max_weight);
-  readKey(node, "depth_sigma_m", depth_sigma_m);
-  readKey(node, "min_pixel_weight", min_pixel_weight);
-  readKey(node, "truncation_sigmas", truncation_sigmas);
-  readKey(node, "space_carving", space_carving);
-  readKey(node, "carving_weight", carving_weight);
-  readKey(node, "scan_carving_m", scan_carving_m);
-  readKey(node, "weight_dropoff", weight_dropoff);
-  readKey(node, "silhouette_band", silhouette_band);
-  std::string distance = toString(signed_distance);
-  readKey(node, "signed_distance", distance);
-  signed_distance = parseSignedDistance(distance);
-  readKey(node, "plane_step_px", plane.step_px);
-  readKey(node, "plane_max_curvature", plane.max_curvature);
-  readKey(node, "plane_min_scale", plane.min_scale);
-  readKey(node, "lambda", lambda);
-  std::string data = toString(lambda_data);
-  readKey(node, "lambda_data", data);
-  lambda_data = parseLambdaData(data);
-  readKey(node, "sweeps", sweeps);
-  std::string solve_name = toString(solve);
-  readKey(node, "solve", solve_name);
-  solve = parseSolve(solve_name);
-  readKey(node, "argmin_tolerance_m", argmin_tolerance_m);
-  readKey(node, "argmin_max_sweeps", argmin_max_sweeps);
-  readKey(node, "min_depth_m", min_depth_m);
-  readKey(node, "max_depth_m", max_depth_m);
-  readKey(node, "precise_max_depth_m", precise_max_depth_m);
-  readKey(node, "interpolate_depth", interpolate_depth);
-  readKey(node, "allocation_stride", allocation_stride);
-  validate();
-}
+TsdfIntegrator::Solve parseSolve(const std::string& text) { return parseWord(TsdfIntegrator::kSolves, text, "solve"); }
 
 void TsdfIntegrator::Config::validate() const {
-  if (!(max_weight > 0.f))
-    throw ConfigError("tsdf_integrator.max_weight must be > 0, got " + std::to_string(max_weight));
+  // Before the range check: the message says what a lambda beyond the range does.
   if (!(lambda >= 0.0 && lambda <= kMaxLambda))
     throw ConfigError("tsdf_integrator.lambda (-lambda) must be 0 .. 1e6 (beyond, eq. 7 flattens the surface "
                       "instead of smoothing it), got " + configValue(lambda));
-  if (allocation_stride < 1)
-    throw ConfigError("tsdf_integrator.allocation_stride must be >= 1, got " + std::to_string(allocation_stride));
-  if (!(depth_sigma_m > 0.0) || !std::isfinite(depth_sigma_m))
-    throw ConfigError("tsdf_integrator.depth_sigma_m must be > 0, got " + std::to_string(depth_sigma_m));
-  if (!(min_pixel_weight >= 0.f) || !std::isfinite(min_pixel_weight))
-    throw ConfigError("tsdf_integrator.min_pixel_weight must be >= 0, got " + std::to_string(min_pixel_weight));
-  if (!(truncation_sigmas >= 0.0) || !std::isfinite(truncation_sigmas))
-    throw ConfigError("tsdf_integrator.truncation_sigmas must be >= 0, got " + std::to_string(truncation_sigmas));
-  if (!(carving_weight >= 0.0) || !std::isfinite(carving_weight))
-    throw ConfigError("tsdf_integrator.carving_weight must be >= 0, got " + std::to_string(carving_weight));
-  if (!(scan_carving_m >= 0.0) || !(scan_carving_m <= kMaxDepthM))
-    throw ConfigError("tsdf_integrator.scan_carving_m must be in [0, " + std::to_string(kMaxDepthM) + "] (0 = off), got " +
-                      std::to_string(scan_carving_m));
-  if (plane.step_px < 1 || plane.step_px > 64)
-    throw ConfigError("tsdf_integrator.plane_step_px must be in 1..64, got " + std::to_string(plane.step_px));
-  if (!(plane.max_curvature >= 0.f) || !std::isfinite(plane.max_curvature))
-    throw ConfigError("tsdf_integrator.plane_max_curvature must be >= 0, got " + std::to_string(plane.max_curvature));
-  if (!(plane.min_scale > 0.f && plane.min_scale <= 1.f))
-    throw ConfigError("tsdf_integrator.plane_min_scale must be in (0, 1], got " + std::to_string(plane.min_scale));
-  if (sweeps < 0 || sweeps > kMaxSweeps)
-    throw ConfigError("tsdf_integrator.sweeps (-sweeps) must be 0.." + std::to_string(kMaxSweeps) + ", got " +
-                      std::to_string(sweeps));
-  if (!(argmin_tolerance_m > 0.0) || !std::isfinite(argmin_tolerance_m))
-    throw ConfigError("tsdf_integrator.argmin_tolerance_m must be > 0, got " + std::to_string(argmin_tolerance_m));
-  if (argmin_max_sweeps < 1 || argmin_max_sweeps > kMaxArgminSweeps)
-    throw ConfigError("tsdf_integrator.argmin_max_sweeps must be 1.." + std::to_string(kMaxArgminSweeps) + ", got " +
-                      std::to_string(argmin_max_sweeps));
-  if (!(max_depth_m <= kMaxDepthM))
-    throw ConfigError("tsdf_integrator.max_depth_m must be at most " + std::to_string(kMaxDepthM) + " m, got " +
-                      std::to_string(max_depth_m));
-  if (!(precise_max_depth_m >= 0.0) || !(precise_max_depth_m <= kMaxDepthM))
-    throw ConfigError("tsdf_integrator.precise_max_depth_m must be in [0, " + std::to_string(kMaxDepthM) +
-                      "] m (0: max_depth_m for all depth), got " + std::to_string(precise_max_depth_m));
-  if (!(min_depth_m >= 0.0) || !(max_depth_m > min_depth_m))
-    throw ConfigError("tsdf_integrator: need 0 <= min_depth_m < max_depth_m, got " + std::to_string(min_depth_m) +
-                      " and " + std::to_string(max_depth_m));
+  checkKeyRanges(*this);
+  if (!(max_depth_m > min_depth_m))
+    throw ConfigError("tsdf_integrator: need min_depth_m < max_depth_m, got " + configValue(min_depth_m) + " and " +
+                      configValue(max_depth_m));
 }
 
 double TsdfIntegrator::Config::farthestDepth() const {
   return weighting == Weighting::PerPixel ? std::max(max_depth_m, precise_max_depth_m) : max_depth_m;
-}
-
-void TsdfIntegrator::Config::print(std::ostream& out) const {
-  out << "tsdf_integrator:\n"
-      << "  weighting: " << toString(weighting) << "\n"
-      << "  max_weight: " << configValue(max_weight) << "\n"
-      << "  depth_sigma_m: " << configValue(depth_sigma_m) << "\n"
-      << "  min_pixel_weight: " << configValue(min_pixel_weight) << "\n"
-      << "  truncation_sigmas: " << configValue(truncation_sigmas) << "\n"
-      << "  space_carving: " << configValue(space_carving) << "\n"
-      << "  carving_weight: " << configValue(carving_weight) << "\n"
-      << "  scan_carving_m: " << configValue(scan_carving_m) << "\n"
-      << "  weight_dropoff: " << configValue(weight_dropoff) << "\n"
-      << "  silhouette_band: " << configValue(silhouette_band) << "\n"
-      << "  signed_distance: " << toString(signed_distance) << "\n"
-      << "  plane_step_px: " << configValue(plane.step_px) << "\n"
-      << "  plane_max_curvature: " << configValue(plane.max_curvature) << "\n"
-      << "  plane_min_scale: " << configValue(plane.min_scale) << "\n"
-      << "  lambda: " << configValue(lambda) << "\n"
-      << "  lambda_data: " << toString(lambda_data) << "\n"
-      << "  sweeps: " << configValue(sweeps) << "\n"
-      << "  solve: " << toString(solve) << "\n"
-      << "  argmin_tolerance_m: " << configValue(argmin_tolerance_m) << "\n"
-      << "  argmin_max_sweeps: " << configValue(argmin_max_sweeps) << "\n"
-      << "  min_depth_m: " << configValue(min_depth_m) << "\n"
-      << "  max_depth_m: " << configValue(max_depth_m) << "\n"
-      << "  precise_max_depth_m: " << configValue(precise_max_depth_m) << "\n"
-      << "  interpolate_depth: " << configValue(interpolate_depth) << "\n"
-      << "  allocation_stride: " << configValue(allocation_stride) << "\n";
 }
 
 TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : volume_(volume) {}

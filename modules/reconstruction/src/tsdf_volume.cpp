@@ -2,7 +2,6 @@
 #include <msf/common/parallel.h>
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/cloud_io.hpp>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -51,11 +50,9 @@ constexpr std::size_t kChunkBytes = std::size_t(2) << 20; // a huge page on x86-
 constexpr std::size_t kBlocksPerChunk = kChunkBytes / sizeof(TsdfBlock);
 } // namespace
 
-void TsdfVolume::Config::read(const cv::FileNode& node) {
-  readKey(node, "voxel_size_m", voxel_size_m);
-  readKey(node, "truncation_m", truncation_m);
-  readKey(node, "max_memory_mb", max_memory_mb);
-  validate(voxel_size_m, truncation_m, max_memory_mb);
+void TsdfVolume::Config::validate() const {
+  TsdfVolume::validate(voxel_size_m, truncation_m, max_memory_mb); // names the tools' options too
+  checkKeyRanges(*this);
 }
 
 void TsdfVolume::validate(double voxel_size_m, double truncation_m, double max_memory_mb) {
@@ -79,11 +76,6 @@ void TsdfVolume::setMaxMemoryMb(double max_memory_mb) {
     max_memory_bytes_ = pages > 0 && page > 0 ? static_cast<std::size_t>(pages) / 4 * 3 * static_cast<std::size_t>(page)
                                               : std::size_t(8) << 30;
   }
-}
-
-void TsdfVolume::Config::print(std::ostream& out) const {
-  out << "tsdf_volume:\n  voxel_size_m: " << voxel_size_m << "\n  truncation_m: " << truncation_m
-      << "\n  max_memory_mb: " << max_memory_mb << "\n";
 }
 
 TsdfVolume::TsdfVolume(double voxel_size_m, double truncation_m)

@@ -1,5 +1,4 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/config.h>
 #include <msf/common/exceptions.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/registration/scan_to_map_icp.h>
@@ -7,68 +6,14 @@
 #include <msf/registration/voxel_downsample.h>
 
 #include <cmath>
-#include <ostream>
 
 namespace msf {
 
-void LidarOdometry::Config::read(const cv::FileNode& node) {
-  readKey(node, "voxel_size_m", voxel_size_m);
-  readKey(node, "min_range_m", min_range_m);
-  readKey(node, "max_range_m", max_range_m);
-  readKey(node, "max_points_per_voxel", max_points_per_voxel);
-  readKey(node, "point_to_plane", point_to_plane);
-  readKey(node, "deskew", deskew);
-  readKey(node, "initial_threshold_m", initial_threshold_m);
-  readKey(node, "min_correction_m", min_correction_m);
-  readKey(node, "max_iterations", max_iterations);
-  readKey(node, "convergence", convergence);
-  readKey(node, "min_constraint", min_constraint);
-  readKey(node, "prior_translation_sigma_m", prior_translation_sigma_m);
-  readKey(node, "prior_rotation_sigma_deg", prior_rotation_sigma_deg);
-  validate();
-}
-
 void LidarOdometry::Config::validate() const {
-  auto positive = [](double value, const char* key) {
-    if (!(value > 0.0) || !std::isfinite(value))
-      throw ConfigError(std::string("odometry.") + key + " must be > 0, got " + std::to_string(value));
-  };
-  positive(voxel_size_m, "voxel_size_m");
-  positive(max_range_m, "max_range_m");
-  positive(initial_threshold_m, "initial_threshold_m");
-  positive(convergence, "convergence");
-  positive(prior_translation_sigma_m, "prior_translation_sigma_m");
-  positive(prior_rotation_sigma_deg, "prior_rotation_sigma_deg");
-  if (!(min_range_m >= 0.0) || !(min_range_m < max_range_m))
-    throw ConfigError("odometry.min_range_m must be >= 0 and below max_range_m (" + std::to_string(max_range_m) +
-                      "), got " + std::to_string(min_range_m));
-  if (max_points_per_voxel < 1)
-    throw ConfigError("odometry.max_points_per_voxel must be >= 1, got " + std::to_string(max_points_per_voxel));
-  if (!(min_correction_m >= 0.0))
-    throw ConfigError("odometry.min_correction_m must be >= 0, got " + std::to_string(min_correction_m));
-  if (max_iterations < 1)
-    throw ConfigError("odometry.max_iterations must be >= 1, got " + std::to_string(max_iterations));
-  if (deskew != "auto" && deskew != "sweep" && deskew != "none")
-    throw ConfigError("odometry.deskew must be auto, sweep or none, got '" + deskew + "'");
-  if (!(min_constraint >= 0.0 && min_constraint < 1.0))
-    throw ConfigError("odometry.min_constraint must be in [0, 1), got " + std::to_string(min_constraint));
-}
-
-void LidarOdometry::Config::print(std::ostream& out) const {
-  out << "odometry:\n"
-      << "  voxel_size_m: " << configValue(voxel_size_m) << "\n"
-      << "  min_range_m: " << configValue(min_range_m) << "\n"
-      << "  max_range_m: " << configValue(max_range_m) << "\n"
-      << "  max_points_per_voxel: " << configValue(max_points_per_voxel) << "\n"
-      << "  point_to_plane: " << configValue(point_to_plane) << "\n"
-      << "  deskew: " << deskew << "\n"
-      << "  initial_threshold_m: " << configValue(initial_threshold_m) << "\n"
-      << "  min_correction_m: " << configValue(min_correction_m) << "\n"
-      << "  max_iterations: " << configValue(max_iterations) << "\n"
-      << "  convergence: " << configValue(convergence) << "\n"
-      << "  min_constraint: " << configValue(min_constraint) << "\n"
-      << "  prior_translation_sigma_m: " << configValue(prior_translation_sigma_m) << "\n"
-      << "  prior_rotation_sigma_deg: " << configValue(prior_rotation_sigma_deg) << "\n";
+  checkKeyRanges(*this);
+  if (!(min_range_m < max_range_m))
+    throw ConfigError("odometry.min_range_m must be below max_range_m (" + configValue(max_range_m) + "), got " +
+                      configValue(min_range_m));
 }
 
 LidarOdometry::LidarOdometry() : LidarOdometry(Config{}) {}

@@ -16,15 +16,9 @@
 namespace msf {
 
 void StereoConfidenceConfig::validate() const {
-  if (!(hole_distance_px > 0.f))
-    throw ConfigError("config key 'stereo.confidence_hole_distance_px' must be > 0");
-  if (range_window_px < 1 || range_window_px % 2 == 0)
-    throw ConfigError("config key 'stereo.confidence_range_window_px' must be odd and >= 1, not " +
-                      std::to_string(range_window_px));
-  if (!(range_free_px >= 0.f))
-    throw ConfigError("config key 'stereo.confidence_range_free_px' must be >= 0");
-  if (!(range_scale_px > 0.f))
-    throw ConfigError("config key 'stereo.confidence_range_scale_px' must be > 0");
+  checkKeyRanges(*this);
+  if (range_window_px % 2 == 0)
+    throw ConfigError("stereo.confidence_range_window_px must be odd, not " + std::to_string(range_window_px));
 }
 
 namespace {

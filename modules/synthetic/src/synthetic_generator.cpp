@@ -185,9 +185,8 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   } else {
     saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
   }
-  std::ostringstream yaml;
-  yaml << "%YAML:1.0\n";
-  config_.print(yaml);
+  std::ostringstream yaml; // plain YAML, which msf_synth -config reads back to the same dataset
+  printConfig(yaml, config_);
   writeText(gt / "synthetic.yaml", yaml.str());
   std::string readme = kGroundTruthReadme;
   if (config_.placed()) // the world is the street's, where this drive does not start

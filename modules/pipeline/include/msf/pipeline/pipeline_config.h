@@ -16,58 +16,81 @@
 
 namespace msf {
 
+class ConfigFile;
+
 /// Section `tsdf_volume`: the grid of the map.
-struct VolumeConfig {
-  double voxel_size_m = 0.1;
-  double truncation_m = 0.3;
-  double max_memory_mb = 0.0; ///< the volume's memory budget, 0 = three quarters of RAM (TsdfVolume::Config)
+using VolumeConfig = TsdfVolume::Config;
 
-  void read(const cv::FileNode& node);
-  /// Throws ConfigError naming the key of a value out of range.
-  void validate() const;
-  void print(std::ostream& out) const;
-};
-
-/// Section `pipeline`: how the stages are scheduled and what is kept.
+/// Section `pipeline`: how msf_reconstruct schedules the stages.
 struct SchedulingConfig {
-  int queue_capacity = 2;        ///< frames waiting between two stages
-  bool stereo_prior = true;      ///< SGBM narrowed by the interpolated LiDAR (stereo.prior_search_range)
-  int mesh_every_n_frames = 0;   ///< > 0: refresh the mesh incrementally every n frames
-  void read(const cv::FileNode& node);
+  static constexpr const char* kSection = "pipeline";
+  static constexpr const char* kAbout = "msf_reconstruct: how the stages are scheduled over their threads";
+  int queue_capacity = 2;
+  bool stereo_prior = true;
+  int mesh_every_n_frames = 0;
+
+  template <class Keys>
+  void keys(Keys& k) {
+    k("queue_capacity", queue_capacity, atLeast(1), "frames waiting between two stages");
+    k("stereo_prior", stereo_prior,
+      "SGBM searches only the disparities the interpolated LiDAR allows (stereo.prior_search_range)");
+    k("mesh_every_n_frames", mesh_every_n_frames, atLeast(0), "refresh the mesh incrementally every n frames (0: never)");
+    k.removed("lidar_threads", "the LiDAR steps run on OpenCV's pool like the other stages (serially on the loader "
+                               "while another stage's loop holds it); delete the key");
+  }
   void validate() const;
-  void print(std::ostream& out) const;
 };
 
 /// Every stage's configuration, read from one YAML file (config/kitti.yaml), one section
 /// per stage, with the defaults of each stage's own Config where a key is absent.
 struct PipelineConfig {
-  ProjectionConfig projection;              ///< `projection`
-  InterpolationConfig interpolation;        ///< `interpolation`
-  /// `rings`: not a stage's; the ring hold-out of msf_reconstruct -holdout (protocols 2 and 4)
+  ProjectionConfig projection;
+  InterpolationConfig interpolation;
+  /// Not a stage's: the ring hold-out of msf_reconstruct -holdout (protocols 2 and 4).
   RingSplitConfig rings;
-  SgbmConfig stereo;                        ///< `stereo`
-  DepthFusionConfig fusion;                 ///< `fusion`
-  VolumeConfig volume;                      ///< `tsdf_volume`
-  TsdfIntegrator::Config integrator;        ///< `tsdf_integrator`
-  MarchingCubes::Config mesher;             ///< `marching_cubes`
-  SchedulingConfig scheduling;              ///< `pipeline`
-  StreamingMap::Config streaming;           ///< `streaming`: the map in bounded memory (off by default)
-  /// `odometry`: the poses of msf_reconstruct -poses estimate (PoseSource)
-  LidarOdometry::Config odometry;
-  /// `rig`: how the keys above follow the rig the stages run on (adaptToRig)
-  RigAdaptationConfig rig;
+  SgbmConfig stereo;
+  DepthFusionConfig fusion;
+  VolumeConfig volume;
+  TsdfIntegrator::Config integrator;
+  MarchingCubes::Config mesher;
+  SchedulingConfig scheduling;
+  StreamingMap::Config streaming; ///< the map in bounded memory (off by default)
+  LidarOdometry::Config odometry; ///< the poses of msf_reconstruct -poses estimate (PoseSource)
+  RigAdaptationConfig rig;        ///< how the keys above follow the rig the stages run on (adaptToRig)
+
+  /// Calls visit(section) for each section of `config` (a PipelineConfig, const or not) in the
+  /// order print() writes them.
+  template <class Self, class Visit>
+  static void forEachSection(Self& config, Visit&& visit) {
+    visit(config.projection);
+    visit(config.interpolation);
+    visit(config.rings);
+    visit(config.stereo);
+    visit(config.fusion);
+    visit(config.volume);
+    visit(config.integrator);
+    visit(config.mesher);
+    visit(config.scheduling);
+    visit(config.streaming);
+    visit(config.odometry);
+    visit(config.rig);
+  }
 
   /// The paper as published (Ali, Rajput et al. 2019), without the project's additions:
   /// config/paper.yaml, and docs/paper.md for what each setting switches off and its effect.
   static PipelineConfig paper();
 
-  /// Defaults overridden by the sections present in `path` ("" = all defaults).
-  /// Throws IOError for a missing file, ConfigError naming a bad key.
+  /// Defaults overridden by the sections present in `path` ("" = all defaults), the whole
+  /// file checked (openConfigFile). Throws IOError for a file that is not a config file,
+  /// ConfigError naming the file, line and key of a bad section, key or value.
   static PipelineConfig load(const std::string& path);
+  /// Overrides the keys `file` holds in each section, then validates. Throws ConfigError
+  /// naming the file, line and key.
+  void read(const ConfigFile& file);
   /// Throws ConfigError naming the first invalid key of any stage.
   void validate() const;
-  /// Every key of every section above, as a YAML config file that load() reads back to the
-  /// same configuration: what a run used, in full (each section's own print()).
+  /// Every key of every section above, as a YAML config file that load() (and PyYAML) reads
+  /// back to the same configuration: what a run used, in full.
   void print(std::ostream& out) const;
 };
 

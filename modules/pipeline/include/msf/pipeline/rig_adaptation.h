@@ -1,16 +1,13 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/fusion/fusion_config.h>
-#include <msf/common/config.h>
+#include <msf/common/config_keys.h>
 #include <msf/io/calibration.h>
 #include <msf/io/rig_geometry.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/stereo/sgbm_config.h>
 
-#include <opencv2/core/persistence.hpp>
-
-#include <iosfwd>
 #include <string>
 
 namespace msf {
@@ -20,18 +17,24 @@ struct PipelineConfig;
 /// Section `rig`: how the stages follow the rig they run on (docs/design.md, "Any rig").
 /// The keys of the other sections are KITTI's sizes; adaptToRig turns them into the rig's.
 struct RigAdaptationConfig {
-  /// Depth not known to within the truncation by its own weight (stereo's) is integrated, and the
-  /// map scored, up to the depth of this disparity of the grey pair, f·B / it, and at most
-  /// tsdf_integrator.max_depth_m; 0: max_depth_m alone.
+  static constexpr const char* kSection = "rig";
+  static constexpr const char* kAbout = "how the keys of the other sections (KITTI's sizes) follow the rig the "
+                                        "stages run on (adaptToRig; docs/design.md, \"Any rig\")";
   double stereo_min_disparity_px = 8.0;
-  /// Keys counted in rows between the LiDAR's rings scale by the rig's rows per ring over KITTI's
-  /// (RigGeometry::ringScale; 1 when the rig lists no beams).
   bool scale_ring_rows = true;
 
-  void read(const cv::FileNode& node);
+  template <class Keys>
+  void keys(Keys& k) {
+    k("stereo_min_disparity_px", stereo_min_disparity_px, between(0, 1000),
+      "depth not known to within the truncation by its own weight (stereo's) is integrated, and the map scored, up "
+      "to the depth of this disparity of the grey pair, f*B / it, and at most tsdf_integrator.max_depth_m; 0: "
+      "max_depth_m alone");
+    k("scale_ring_rows", scale_ring_rows,
+      "keys counted in rows between the LiDAR's rings scale by the rig's rows per ring over KITTI's (1 when the rig "
+      "lists no beams)");
+  }
   /// Throws ConfigError naming the key out of range.
   void validate() const;
-  void print(std::ostream& out) const;
 };
 
 /// What the rig gives the keys (rigAdaptation), and what adaptToRig derived, for the run's report.
@@ -52,16 +55,6 @@ void adaptToRig(InterpolationConfig& interpolation, const RigAdaptation& rig); /
 void adaptToRig(SgbmConfig& stereo, const RigAdaptation& rig);                 ///< guidance_bridge_rows
 void adaptToRig(DepthFusionConfig& fusion, const RigAdaptation& rig); ///< edge_window_rows (odd), parallax_max_rows
 void adaptToRig(TsdfIntegrator::Config& integrator, const RigAdaptation& rig); ///< max_depth_m
-
-/// -config of a tool that runs one stage: section `section` of the file at `path` into `stage`,
-/// section `rig` into `rig`, and any other key of the two refused (readConfigSection).
-template <typename Config>
-void readStageAndRig(const std::string& path, const std::string& section, Config& stage, RigAdaptationConfig& rig) {
-  const ConfigFile file(path);
-  stage.read(file.section(section));
-  rig.read(file.section("rig"));
-  file.rejectUnknownKeys();
-}
 
 /// The configuration the stages run with on `rig`: the keys in rows between LiDAR rings
 /// (the interpolation's gaps, the fusion's edge and parallax windows, the guidance's bridge)

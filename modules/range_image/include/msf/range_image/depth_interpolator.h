@@ -1,11 +1,11 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-#include <iosfwd>
+#include <msf/common/config_keys.h>
+#include <msf/common/limits.h>
 #include <msf/common/parallel.h>
 #include <msf/range_image/slice_interpolation.h>
 
 #include <opencv2/core/mat.hpp>
-#include <opencv2/core/persistence.hpp>
 
 #include <memory>
 #include <string>
@@ -13,40 +13,56 @@
 
 namespace msf {
 
-/// How the row and the column estimate of a pixel are merged when both exist. Measured
-/// under protocol 2 (odometry 04, frames 0-9, D1 with missing = bad): shorter_gap 4.26 %,
-/// nearest 4.40 %, gap_weighted 4.44 %, average 4.64 %. The shorter gap wins because its
-/// ends are nearer the pixel: between two scan lines that is the column, along one the row.
+/// How the row and the column estimate of a pixel are merged when both exist. The shorter gap
+/// wins on KITTI (docs/results.md) because its ends are nearer the pixel: between two scan
+/// lines that is the column, along one the row.
 enum class CombineRule {
   Average,     ///< mean of the two
   ShorterGap,  ///< the estimate bridged over the shorter gap (the more local one); mean on a tie
   GapWeighted, ///< weights 1 / (gap + 1)
   Nearest      ///< the smaller depth: foreground wins
 };
-/// "average", "shorter_gap", "gap_weighted", "nearest"; throws ConfigError otherwise.
-CombineRule parseCombineRule(const std::string& name);
+inline constexpr Choice<CombineRule> kCombineRules[] = {{"shorter_gap", CombineRule::ShorterGap},
+                                                       {"average", CombineRule::Average},
+                                                       {"gap_weighted", CombineRule::GapWeighted},
+                                                       {"nearest", CombineRule::Nearest}};
 const char* toString(CombineRule rule);
 
-/// Section `interpolation` of the YAML config (paper step 2, compound interpolation).
+/// Section `interpolation` of a config file (paper step 2, compound interpolation).
 struct InterpolationConfig {
-  SliceParams slice;                        ///< keys method, short_gap_px, max_gap_px, edge_test, jump_abs_m,
-                                            ///< jump_rel, jump_inv_per_m, cubic_alpha, cubic_beta,
-                                            ///< inverse_depth
+  static constexpr const char* kSection = "interpolation";
+  static constexpr const char* kAbout =
+      "CompoundInterpolation (paper step 2): rows and columns of the sparse LiDAR depth bridged, then one "
+      "Gaussian pass over the holes";
+  SliceParams slice;
   CombineRule combine = CombineRule::ShorterGap;
   /// Row estimates bridged over at most this many pixels join the samples that column
   /// slices see (0: columns see samples only). A scan line is dense along a row but its
   /// samples share azimuths, so without this, whole columns have no sample at all.
   int column_seed_gap_px = 3;
-  bool gaussian = true;                     ///< fill the holes left by the slices
-  int gaussian_size_px = 9;                 ///< odd kernel width
+  bool gaussian = true;
+  int gaussian_size_px = 9;
   float gaussian_sigma_px = 2.0f;
-  float gaussian_min_weight = 0.1f;         ///< share of the kernel's mass that must hold estimates
-  bool gaussian_smooth_valid = false;       ///< also smooth interpolated pixels (real returns never)
-  int threads = 0;                          ///< at most this many threads of OpenCV's pool, 0 = all of them
+  float gaussian_min_weight = 0.1f;
+  bool gaussian_smooth_valid = false;
+  int threads = 0;
 
-  /// The section as YAML, every key (configValue).
-  void print(std::ostream& out) const;
-  void read(const cv::FileNode& node);
+  template <class Keys>
+  void keys(Keys& k) {
+    slice.keys(k);
+    k("column_seed_gap_px", column_seed_gap_px, atLeast(0),
+      "row estimates over gaps of at most this many pixels seed the column slices (0: samples only), px");
+    k("combine", combine, kCombineRules,
+      "a pixel with a row and a column estimate takes: the one over the shorter gap, their average, their "
+      "mean weighted by 1 / (gap + 1), or the nearer");
+    k("gaussian", gaussian, "fill the holes left by the slices with a normalized Gaussian");
+    k("gaussian_size_px", gaussian_size_px, between(1, 31), "the Gaussian's width, px (odd)");
+    k("gaussian_sigma_px", gaussian_sigma_px, above(0), "the Gaussian's sigma, px");
+    k("gaussian_min_weight", gaussian_min_weight, Range{0, 1, true, false},
+      "share of the kernel's mass that must hold estimates for a hole to be filled");
+    k("gaussian_smooth_valid", gaussian_smooth_valid, "also smooth the interpolated pixels (never the real returns)");
+    k("threads", threads, between(0, limits::kMaxThreads), "at most this many threads of OpenCV's pool (0: all)");
+  }
   /// Throws ConfigError naming the first key out of range.
   void validate() const;
 };

@@ -1,8 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-#include <iosfwd>
+#include <msf/common/config_keys.h>
+
 #include <opencv2/core/mat.hpp>
-#include <opencv2/core/persistence.hpp>
 
 #include <string>
 
@@ -13,6 +13,10 @@ namespace msf {
 /// morphology step for step as the authors' fill_in_fast and fill_in_multiscale.
 enum class IpBasicVariant { Fast, Multiscale };
 enum class IpBasicBlur { None, Gaussian, Bilateral };
+inline constexpr Choice<IpBasicVariant> kIpBasicVariants[] = {{"fast", IpBasicVariant::Fast},
+                                                              {"multiscale", IpBasicVariant::Multiscale}};
+inline constexpr Choice<IpBasicBlur> kIpBasicBlurs[] = {
+    {"none", IpBasicBlur::None}, {"gaussian", IpBasicBlur::Gaussian}, {"bilateral", IpBasicBlur::Bilateral}};
 
 /// "fast" / "multiscale"; "none" / "gaussian" / "bilateral"; ConfigError otherwise.
 IpBasicVariant parseIpBasicVariant(const std::string& name);
@@ -20,16 +24,23 @@ IpBasicBlur parseIpBasicBlur(const std::string& name);
 const char* toString(IpBasicVariant variant);
 const char* toString(IpBasicBlur blur);
 
-/// Section `ip_basic` of the YAML config; defaults are the authors' recommended settings.
+/// Section `ip_basic` of a config file; the defaults are the authors' recommended settings.
 struct IpBasicConfig {
+  static constexpr const char* kSection = "ip_basic";
+  static constexpr const char* kAbout =
+      "IP-Basic (Ku et al. 2018), the classical baseline: msf_interpolate -method ipbasic and msf_holdout";
   IpBasicVariant variant = IpBasicVariant::Multiscale;
-  float max_depth_m = 100.f;   ///< inversion offset: depth d is processed as max_depth - d
-  bool extrapolate = false;    ///< extend the top pixel of each column to the image top
+  float max_depth_m = 100.f;
+  bool extrapolate = false;
   IpBasicBlur blur = IpBasicBlur::Bilateral;
 
-  /// The section as YAML, every key (configValue).
-  void print(std::ostream& out) const;
-  void read(const cv::FileNode& node);
+  template <class Keys>
+  void keys(Keys& k) {
+    k("variant", variant, kIpBasicVariants, "the authors' fill_in_fast or fill_in_multiscale");
+    k("max_depth_m", max_depth_m, above(1), "inversion offset: depth d is processed as max_depth_m - d, m");
+    k("extrapolate", extrapolate, "extend the top pixel of each column to the image's top");
+    k("blur", blur, kIpBasicBlurs, "the blur after the fill");
+  }
   void validate() const;
 };
 

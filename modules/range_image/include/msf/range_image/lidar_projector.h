@@ -1,12 +1,11 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-#include <iosfwd>
+#include <msf/common/config_keys.h>
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
 
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
-#include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -15,21 +14,26 @@
 
 namespace msf {
 
-/// Section `projection` of the YAML config.
+/// The settings of LidarProjector: section `projection` of a config file.
 struct ProjectionConfig {
-  int camera = 0;             ///< rectified camera (KITTI 0..3) whose image the scan fills; the pipeline needs 0
-  float min_range_m = 0.f;    ///< returns closer to the LiDAR than this are dropped
-  float max_range_m = 120.f;  ///< returns farther than this are dropped (HDL-64E: 120 m)
-  /// Border of the canvas (projectToCanvas): returns up to this many pixels outside the
-  /// image are kept there, so that interpolation bridges the gaps that cross the image's
-  /// edges (the lowest ring of the image has its neighbour below the image) instead of
-  /// leaving them open; results are cropped back to the image.
+  static constexpr const char* kSection = "projection";
+  static constexpr const char* kAbout =
+      "LidarProjector (paper step 1): the Velodyne scan into a camera's image, nearest return per pixel";
+  int camera = 0;
+  float min_range_m = 0.f;
+  float max_range_m = 120.f;
+  /// The canvas (projectToCanvas) keeps returns up to margin_px outside the image, so that
+  /// interpolation bridges the gaps that cross the image's edges (the lowest ring of the image
+  /// has its neighbour below the image) instead of leaving them open; results are cropped back.
   int margin_px = 16;
 
-  /// The section as YAML, every key (configValue).
-  void print(std::ostream& out) const;
-  /// Overrides the keys present; throws ConfigError naming a key with a bad value.
-  void read(const cv::FileNode& node);
+  template <class Keys>
+  void keys(Keys& k) {
+    k("camera", camera, between(0, 3), "rectified camera whose image the scan fills (KITTI's 0..3; the pipeline needs 0)");
+    k("min_range_m", min_range_m, atLeast(0), "returns nearer to the LiDAR are dropped, m");
+    k("max_range_m", max_range_m, above(0), "returns farther from the LiDAR are dropped, m (HDL-64E: 120)");
+    k("margin_px", margin_px, between(0, 256), "border of the canvas around the image whose returns are kept, px");
+  }
   /// Throws ConfigError naming the first key out of range.
   void validate() const;
 };

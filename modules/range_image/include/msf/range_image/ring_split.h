@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-#include <iosfwd>
-#include <opencv2/core/persistence.hpp>
+#include <msf/common/config_keys.h>
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -9,15 +9,20 @@
 
 namespace msf {
 
-/// Section `rings` of the YAML config: which rings of a scan are held out as ground truth
+/// Section `rings` of a config file: which rings of a scan are held out as ground truth
 /// (evaluation protocol 2, docs/design.md).
 struct RingSplitConfig {
-  int modulo = 4;            ///< rings with id % modulo == heldout_remainder are held out
+  static constexpr const char* kSection = "rings";
+  static constexpr const char* kAbout =
+      "the ring hold-out of evaluation protocols 2 and 4 (msf_holdout, msf_reconstruct -holdout)";
+  int modulo = 4;
   int heldout_remainder = 2;
 
-  /// The section as YAML, every key (configValue).
-  void print(std::ostream& out) const;
-  void read(const cv::FileNode& node);
+  template <class Keys>
+  void keys(Keys& k) {
+    k("modulo", modulo, atLeast(2), "rings with id % modulo == heldout_remainder are held out as ground truth");
+    k("heldout_remainder", heldout_remainder, atLeast(0), "the remainder of the held-out rings' ids (below modulo)");
+  }
   /// Throws ConfigError naming the key out of range.
   void validate() const;
   bool isHeldOut(int ring) const { return ring % modulo == heldout_remainder; }

@@ -1,5 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -13,26 +15,45 @@ enum class SliceInterpolant {
   Cubic     ///< zero-slope cubic (paper eq. 3-5) up to max_gap_px
 };
 
+inline constexpr Choice<SliceInterpolant> kSliceInterpolants[] = {
+    {"compound", SliceInterpolant::Compound}, {"linear", SliceInterpolant::Linear}, {"cubic", SliceInterpolant::Cubic}};
+
 /// "compound", "linear", "cubic"; throws ConfigError naming the text otherwise.
 SliceInterpolant parseSliceInterpolant(const std::string& name);
 const char* toString(SliceInterpolant interpolant);
 
-/// Parameters of one slice pass (a row or a column of a depth image).
+/// Parameters of one slice pass (a row or a column of a depth image): the first keys of
+/// section `interpolation`.
 struct SliceParams {
   SliceInterpolant interpolant = SliceInterpolant::Compound;
-  int short_gap_px = 4;        ///< gaps of at most this many empty pixels take the cubic
-  int max_gap_px = 64;         ///< longer gaps stay empty
-  /// Leave a gap open across an object edge (below); false bridges every gap up to
+  int short_gap_px = 4;
+  int max_gap_px = 64;
+  /// Leave a gap open across an object edge (isDepthJump); false bridges every gap up to
   /// max_gap_px, as the paper does.
   bool edge_test = true;
-  /// A gap is an object edge when its ends z0, z1 differ by more than all three of:
-  float jump_abs_m = 0.5f;     ///< an absolute jump |z1 - z0| in metres,
-  float jump_rel = 0.f;        ///< a share of the nearer depth,
-  float jump_inv_per_m = 0.03f;///< and a jump in inverse depth |1/z0 - 1/z1| (disparity / (f B))
-  float cubic_alpha = 2.f;     ///< cubic weight beta t^2 - alpha t^3 (paper: 2, 3)
+  /// A gap is an object edge when its ends z0, z1 differ by more than all three jumps.
+  float jump_abs_m = 0.5f;
+  float jump_rel = 0.f;
+  float jump_inv_per_m = 0.03f;
+  float cubic_alpha = 2.f;
   float cubic_beta = 3.f;
-  bool inverse_depth = true;   ///< interpolate 1/z, which is affine in the image along a plane
-                               ///< (false: plain depth, the paper's eq. 2-5 on z)
+  /// Interpolate 1/z, which is affine in the image along a plane (false: the paper's eq. 2-5 on z).
+  bool inverse_depth = true;
+
+  template <class Keys>
+  void keys(Keys& k) {
+    k("method", interpolant, kSliceInterpolants,
+      "how a gap is bridged: compound (cubic up to short_gap_px, linear up to max_gap_px), linear or cubic");
+    k("short_gap_px", short_gap_px, atLeast(0), "gaps of at most this many empty pixels take the cubic, px");
+    k("max_gap_px", max_gap_px, atLeast(0), "longer gaps stay empty, px");
+    k("edge_test", edge_test, "leave gaps across an object edge open (false: bridge every gap, as the paper)");
+    k("jump_abs_m", jump_abs_m, atLeast(0), "an edge's ends differ by more than this, m,");
+    k("jump_rel", jump_rel, atLeast(0), "and by more than this share of the nearer depth (0: off),");
+    k("jump_inv_per_m", jump_inv_per_m, atLeast(0), "and by more than this in inverse depth |1/z0 - 1/z1|, 1/m");
+    k("cubic_alpha", cubic_alpha, anyNumber(), "the cubic's weight beta t^2 - alpha t^3 (the paper: alpha 2, beta 3)");
+    k("cubic_beta", cubic_beta, anyNumber(), "the cubic's beta");
+    k("inverse_depth", inverse_depth, "interpolate 1/z, affine along a plane in the image (false: z, as the paper)");
+  }
 };
 
 /// True when the ends z0, z1 of a gap are on two sides of an object edge (never without edge_test).

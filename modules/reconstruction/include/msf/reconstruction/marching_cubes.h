@@ -3,7 +3,6 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Core>
-#include <opencv2/core/persistence.hpp>
 #include <pcl/PolygonMesh.h>
 
 #include <array>
@@ -40,41 +39,47 @@ public:
   using Ptr = std::shared_ptr<MarchingCubes>;
   using ConstPtr = std::shared_ptr<const MarchingCubes>;
 
+  /// Section `marching_cubes` of a config file.
   struct Config {
-    /// Voxels with weight <= this do not make triangles. Weights are inverse variances (m^-2,
-    /// TsdfIntegrator::Weighting): 4 meshes what is known to sigma 0.5 m on its own, a LiDAR-backed
-    /// surface after one frame, a stereo-only one at 20 m after one or two; smoothing_lambda pools
-    /// the neighbours' evidence in, and the floating pieces such a bar lets through (matches in
-    /// the sky) are removed below (docs/reconstruction.md).
+    static constexpr const char* kSection = "marching_cubes";
+    static constexpr const char* kAbout = "MarchingCubes (msf_mesh): the mesh of the map's surface";
+    /// Weights are inverse variances (m^-2, TsdfIntegrator::Weighting): 4 meshes what is known
+    /// to sigma 0.5 m on its own, a LiDAR-backed surface after one frame, a stereo-only one at
+    /// 20 m after one or two; smoothing_lambda pools the neighbours' evidence in, and the
+    /// floating pieces such a bar lets through (matches in the sky) are removed below.
     float min_weight = 4.f;
-    /// A cube with up to this many corners that no frame reached (weight 0), its other corners
-    /// above min_weight and on both sides of the surface, is meshed with those corners a voxel
-    /// behind the surface: the band a frame writes behind a surface seen at a grazing
-    /// angle, or at the end of its smooth run, stops short of the far corners of the cubes the
-    /// surface crosses, which left holes there (KITTI's cars and roads). 0: off.
+    /// The band a frame writes behind a surface seen at a grazing angle, or at the end of its
+    /// smooth run, stops short of the far corners of the cubes the surface crosses, which left
+    /// holes there (KITTI's cars and roads); such corners are meshed a voxel behind the surface.
     int max_unseen_corners = 1;
-    /// Eq. 7 at meshing (m^-2; 0: off): each grid point within half a truncation of its surface
-    /// is meshed at (W y + lambda sum_j y_j) / (W + lambda n) over its observed 6-neighbours j,
-    /// one Jacobi step on the volume's weighted means y with weights W. A LiDAR-backed voxel
-    /// (W ~ 1000) keeps its value; a far stereo-only one (W ~ 10) takes much of its neighbours'.
-    /// The volume is not changed, so meshing again gives the same mesh.
+    /// Each grid point within half a truncation of its surface is meshed at
+    /// (W y + lambda sum_j y_j) / (W + lambda n) over its observed 6-neighbours j, one Jacobi
+    /// step on the volume's weighted means y with weights W. A LiDAR-backed voxel (W ~ 1000)
+    /// keeps its value; a far stereo-only one (W ~ 10) takes much of its neighbours'. The
+    /// volume is not changed, so meshing again gives the same mesh.
     float smoothing_lambda = 10.f;
-    /// Connected pieces of fewer triangles are removed from the mesh (removeSmallComponents) unless
-    /// precise depth holds them (component_keep_weight); 0 keeps all. 2000 triangles are about
-    /// 10 m^2 at 0.1 m voxels: a piece smaller than that which no LiDAR return holds floats, as
-    /// stereo's matches in the sky do, while a canopy hangs on its trunk and an upper façade on
-    /// the lower one the LiDAR saw. Not applied to a streamed map, whose tiles are meshed apart.
+    /// 2000 triangles are about 10 m^2 at 0.1 m voxels: a piece smaller than that which no
+    /// LiDAR return holds floats, as stereo's matches in the sky do, while a canopy hangs on its
+    /// trunk and an upper façade on the lower one the LiDAR saw (removeSmallComponents). Not
+    /// applied to a streamed map, whose tiles are meshed apart.
     int min_component_triangles = 2000;
-    /// A piece with a vertex of at least this weight (m^-2; 300: sigma 6 cm, a LiDAR return or
-    /// near stereo) is kept whatever its size. 0: no piece is kept for its weight.
     float component_keep_weight = 300.f;
 
-    /// Overrides the keys present in a YAML section (`marching_cubes`): min_weight,
-    /// max_unseen_corners, smoothing_lambda, min_component_triangles, component_keep_weight.
-    void read(const cv::FileNode& node);
+    template <class Keys>
+    void keys(Keys& k) {
+      k("min_weight", min_weight, atLeast(0), "voxels of this weight or less make no triangles, m^-2");
+      k("max_unseen_corners", max_unseen_corners, between(0, 4),
+        "a cube with up to this many corners no frame reached, its others on both sides of the surface, is "
+        "meshed with them behind it (0: off)");
+      k("smoothing_lambda", smoothing_lambda, atLeast(0),
+        "eq. 7 at meshing, each voxel's own mean weighed by its weight, m^-2 (0: off; the volume is not changed)");
+      k("min_component_triangles", min_component_triangles, atLeast(0),
+        "connected pieces of fewer triangles that no precise depth holds are removed (0: keep all)");
+      k("component_keep_weight", component_keep_weight, atLeast(0),
+        "a piece with a vertex of at least this weight is kept whatever its size, m^-2 (300: sigma 6 cm)");
+    }
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
-    void print(std::ostream& out) const;
   };
 
   struct Stats {

@@ -1,19 +1,29 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
 #include <msf/io/pinhole_camera.h>
 
 #include <opencv2/core/mat.hpp>
 
 namespace msf {
 
-/// Settings of planeDistanceScale.
+/// Settings of planeDistanceScale: the `plane_` keys of section `tsdf_integrator`.
 struct PlaneDistanceConfig {
-  int step_px = 2;           ///< neighbours at +-step_px give the local plane (a wider base averages stereo noise)
-  float max_curvature = 0.05f; ///< |second difference of 1/z| over 1/z above which the pixel is on an edge
-  /// The scale never drops below this, which bounds the band along the ray. The road is at
-  /// s = h / z (camera height h): 0.05 keeps one voxel below it to ~33 m on KITTI, where 0.1
-  /// stopped at ~16 m (odometry 04 protocol 4 coverage 0.949 -> 0.967).
+  int step_px = 2;
+  float max_curvature = 0.05f;
+  /// The road is at s = h / z (camera height h): 0.05 keeps one voxel below it to ~33 m on
+  /// KITTI, where 0.1 stops at ~16 m.
   float min_scale = 0.05f;
+
+  template <class Keys>
+  void keys(Keys& k) {
+    k("plane_step_px", step_px, between(1, 64),
+      "neighbours at +-this give the local plane of a pixel (a wider base averages stereo noise), px");
+    k("plane_max_curvature", max_curvature, atLeast(0),
+      "a pixel is on an edge where the second difference of 1/z over 1/z exceeds this");
+    k("plane_min_scale", min_scale, Range{0, 1, true, false},
+      "floor of the plane distance's scale, which bounds the band along a ray to truncation_m / this");
+  }
 };
 
 /// Per pixel of a depth image, the factor s that turns the projective distance d - z of a

@@ -5,7 +5,6 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Core>
-#include <opencv2/core/persistence.hpp>
 
 #include <cstdint>
 #include <iosfwd>
@@ -37,20 +36,29 @@ namespace msf {
 class StreamingMap {
 public:
   /// The YAML section `streaming`.
+  /// Section `streaming` of a config file (docs/streaming.md).
   struct Config {
-    /// Metres around the sensor that stay in memory; 0 keeps the whole map in memory.
+    static constexpr const char* kSection = "streaming";
+    static constexpr const char* kAbout =
+        "StreamingMap (docs/streaming.md): the map in bounded memory; tiles farther than active_radius_m from the "
+        "camera are meshed into OUT/tiles, their TSDF written to OUT/tsdf and freed";
+    /// At least the integrator's reach plus a tile (msf_reconstruct says so when it is less).
     double active_radius_m = 0.0;
-    /// Edge of a tile in blocks (of 8 voxels): the unit of streaming, of a tile file and of
-    /// a mesh tile. 8 at 0.1 m voxels: 6.4 m.
     int tile_blocks = 8;
+
+    template <class Keys>
+    void keys(Keys& k) {
+      k("active_radius_m", active_radius_m, atLeast(0),
+        "metres around the sensor that stay in memory (0: the whole map in memory)");
+      k("tile_blocks", tile_blocks, between(1, 64),
+        "edge of a tile in blocks of 8 voxels: the unit of streaming, of a tile file and of a mesh tile");
+    }
     bool enabled() const { return active_radius_m > 0.0; }
-    void read(const cv::FileNode& node);
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
     /// Throws ConfigError when the active radius is below `reach_m` (TsdfIntegrator::reach)
     /// plus a tile of `voxel_size_m` voxels: a tile would be freed and read back at once.
     void requireRadius(double reach_m, double voxel_size_m) const;
-    void print(std::ostream& out) const;
   };
 
   struct Stats {

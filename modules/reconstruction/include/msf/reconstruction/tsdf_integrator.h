@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
 #include <msf/common/parallel.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/plane_distance.h>
@@ -7,12 +8,10 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Geometry>
-#include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
 #include <cstdint>
-#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,47 +62,56 @@ public:
     InverseSquare, ///< sigma = depth_sigma_m * z / (1 m), for depth whose noise grows with range
     PerPixel       ///< the frame's weight image, 1 / sigma^2 per pixel (DepthFusion's); as Constant without one
   };
+  static constexpr Choice<Weighting> kWeightings[] = {
+      {"per_pixel", Weighting::PerPixel}, {"constant", Weighting::Constant}, {"inverse_square", Weighting::InverseSquare}};
 
   /// What a voxel's signed distance measures.
   enum class SignedDistance {
     Projective, ///< depth difference along the optical axis (KinectFusion, the paper)
     Plane       ///< distance to the observed surface's tangent plane (planeDistanceScale)
   };
+  static constexpr Choice<SignedDistance> kSignedDistances[] = {{"plane", SignedDistance::Plane},
+                                                                {"projective", SignedDistance::Projective}};
 
   /// How much each voxel's own mean counts against lambda's pull towards its neighbours.
   enum class LambdaData {
     Uniform,        ///< eq. 7 as the paper writes it: every mean counts once
     InverseVariance ///< by the voxel's weight (1 / sigma^2): what is uncertain is smoothed
   };
+  static constexpr Choice<LambdaData> kLambdaData[] = {{"uniform", LambdaData::Uniform},
+                                                       {"inverse_variance", LambdaData::InverseVariance}};
 
   /// How eq. 7 is solved each frame.
   enum class Solve {
     Sweeps, ///< `sweeps` Gauss-Seidel sweeps, warm-started: refined over frames (the project's)
     Argmin  ///< sweeps until no voxel moves more than argmin_tolerance_m: the minimizer itself
   };
+  static constexpr Choice<Solve> kSolves[] = {{"sweeps", Solve::Sweeps}, {"argmin", Solve::Argmin}};
 
+  /// Section `tsdf_integrator` of a config file.
   struct Config {
+    static constexpr const char* kSection = "tsdf_integrator";
+    static constexpr const char* kAbout =
+        "TsdfIntegrator (paper step 5): each voxel's weighted mean, then the regularized update of eq. 7; a "
+        "voxel's weight is the inverse variance of its distance (m^-2)";
     Weighting weighting = Weighting::PerPixel;
-    double depth_sigma_m = 0.05;    ///< sigma of a depth without its own weight (see Weighting)
-    float max_weight = 1e4f;        ///< a voxel's weight saturates here (sigma 1 cm), so it can still change
-    /// Pixels of a smaller weight are not integrated: depth too uncertain to place a surface
-    /// (far stereo, matches in the sky). 0.25 m^-2 = sigma 2 m.
+    double depth_sigma_m = 0.05;
+    /// Saturates a voxel's weight (sigma 1 cm), so that it can still change.
+    float max_weight = 1e4f;
+    /// Depth too uncertain to place a surface (far stereo, matches in the sky) is not integrated.
     float min_pixel_weight = 0.25f;
     /// The band along a pixel's ray is at least this many of its sigmas, so that noisy depth is
-    /// averaged over frames instead of clipped at the truncation. 0 = the truncation alone.
+    /// averaged over frames instead of clipped at the truncation.
     double truncation_sigmas = 2.0;
-    bool space_carving = true;      ///< also update voxels seen in front of the band (sdf = +truncation)
-    /// A free-space update weighs this times the observation's weight: what a ray passed
-    /// through is weaker evidence than the surface it hit, so a surface seen from many frames
-    /// outlasts a few wrong rays while one seen once (a car that drove on) is cleared.
+    bool space_carving = true;
+    /// What a ray passed through is weaker evidence than the surface it hit, so a surface seen
+    /// from many frames outlasts a few wrong rays while one seen once (a car that drove on) is cleared.
     double carving_weight = 1.0;
-    /// Also carve with the LiDAR's whole scan outside the camera's view (carveWithScan), up to
-    /// this distance from the LiDAR (0 = off): an oncoming car that passed the camera is never
-    /// seen by it again, and stayed a ghost. Farther, a bin of the scan (0.4 degrees, 14 cm at
-    /// 20 m) grows wider than a voxel and the conservative test carves less and less.
+    /// carveWithScan: an oncoming car that passed the camera is never seen by it again, and
+    /// stayed a ghost. Farther, a bin of the scan (0.4 degrees, 14 cm at 20 m) grows wider than a
+    /// voxel and the conservative test carves less and less.
     double scan_carving_m = 20.0;
-    /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
-    /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
+    /// Voxblox's drop-off: behind the surface the observation only guesses the thickness.
     bool weight_dropoff = true;
     /// The band behind a pixel reaches no deeper than its object is seen to be wide
     /// (silhouetteThickness), and at least two truncations. A pole that far stereo sees with a
@@ -113,8 +121,8 @@ public:
     /// truncation_sigmas widens for noisy depth.
     bool silhouette_band = true;
     SignedDistance signed_distance = SignedDistance::Plane;
-    PlaneDistanceConfig plane;      ///< keys plane_step_px, plane_max_curvature, plane_min_scale
-    double lambda = 0.0;            ///< eq. 7; 0 = plain weighted mean, 5 = the paper's KITTI value
+    PlaneDistanceConfig plane;
+    double lambda = 0.0;
     /// Beyond it eq. 7 no longer regularizes but erases: a voxel's own mean counts less than a
     /// millionth against its neighbours' (a hundredth at max_weight with inverse_variance), and
     /// the surface is flattened to nothing; the float sums near their range long before 1e300.
@@ -124,52 +132,71 @@ public:
     /// (W ~ 1000) barely moves, a far stereo-only one (W ~ 10) takes its neighbours' mean, so
     /// that noisy façades are smoothed and the edges the LiDAR saw are not.
     LambdaData lambda_data = LambdaData::Uniform;
-    /// Gauss-Seidel sweeps per frame over the changed voxels. 1: the solution is warm-started
-    /// from the last frame, so it is refined over frames; solving each frame to convergence
-    /// compounds the smoothing frame after frame (measured: more sweeps, larger error).
+    /// 1: the solution is warm-started from the last frame, so it is refined over frames;
+    /// solving each frame to convergence compounds the smoothing frame after frame.
     int sweeps = 1;
     static constexpr int kMaxSweeps = 100;
     Solve solve = Solve::Sweeps;
-    /// Solve::Argmin stops after the sweep in which no voxel's sdf changed by more (metres).
-    /// Gauss-Seidel on eq. 7 contracts by about (6 lambda / (1 + 6 lambda))^2 a sweep (0.94
-    /// at lambda 5), so the remaining error is about 16 times this.
+    /// Gauss-Seidel on eq. 7 contracts by about (6 lambda / (1 + 6 lambda))^2 a sweep (0.94 at
+    /// lambda 5), so the remaining error is about 16 times argmin_tolerance_m.
     double argmin_tolerance_m = 1e-5;
-    /// ... or after this many sweeps (Stats::regularize_converged tells which).
-    int argmin_max_sweeps = 1000;
+    int argmin_max_sweeps = 1000; ///< (Stats::regularize_converged tells which stopped it)
     static constexpr int kMaxArgminSweeps = 100000;
     static constexpr double kMaxDepthM = 1000.0; ///< max_depth_m's bound (the volume's reach)
-    double min_depth_m = 0.1;       ///< depth outside [min, max] is ignored
+    double min_depth_m = 0.1;
     double max_depth_m = 40.0;
-    /// Depth known to within the truncation by its own weight (per-pixel weighting, weight >=
-    /// 1 / truncation^2: a LiDAR return or LiDAR-backed fused depth; stereo beyond ~17 m on KITTI
-    /// is not) is integrated up to this depth, the rest up to max_depth_m; 0 (or below
-    /// max_depth_m): max_depth_m for all, as for depth without weights. What the
-    /// camera sees 35-40 m ahead at its last frame was seen from beyond 40 m by the frames before,
-    /// and a map cut at 40 m held it from one or two frames only (docs/reconstruction.md).
+    /// What the camera sees 35-40 m ahead at its last frame was seen from beyond 40 m by the
+    /// frames before, and a map cut at 40 m held it from one or two frames only.
     double precise_max_depth_m = 60.0;
     /// The largest depth a pixel is integrated at: max(max_depth_m, precise_max_depth_m) with
     /// per-pixel weights, else max_depth_m.
     double farthestDepth() const;
-    bool interpolate_depth = true;  ///< bilinear depth between 4 valid pixels that agree, else nearest
-    /// Blocks and sub-blocks are found along the rays of every n-th pixel in each direction
-    /// (rows staggered): rays 3 px apart are 0.17 m apart at 40 m on KITTI, under the 0.4 m of
-    /// a sub-block. The bands along a grazing ray are long, and 3 took a third less time than
-    /// 2 to allocate with the same protocol-4 figures on KITTI and the street (4: D1 +0.05
-    /// points); use 1 for sparse depth.
+    bool interpolate_depth = true;
+    /// Rows are staggered: rays 3 px apart are 0.17 m apart at 40 m on KITTI, under the 0.4 m of
+    /// a sub-block. The bands along a grazing ray are long, so fewer rays allocate faster.
     int allocation_stride = 3;
 
-    /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
-    /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
-    /// space_carving, carving_weight, scan_carving_m,
-    /// weight_dropoff, silhouette_band, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
-    /// plane_min_scale, lambda, lambda_data (uniform | inverse_variance), sweeps, solve (sweeps |
-    /// argmin), argmin_tolerance_m,
-    /// argmin_max_sweeps, min_depth_m, max_depth_m, precise_max_depth_m, interpolate_depth,
-    /// allocation_stride. Throws ConfigError naming a bad key.
-    void read(const cv::FileNode& node);
+    template <class Keys>
+    void keys(Keys& k) {
+      k("weighting", weighting, kWeightings,
+        "a depth's weight: per_pixel (the fusion's 1 / sigma_z^2; depth_sigma_m without a weight image), constant "
+        "(sigma = depth_sigma_m) or inverse_square (sigma = depth_sigma_m * z / 1 m)");
+      k("max_weight", max_weight, above(0), "a voxel's weight saturates here, m^-2");
+      k("depth_sigma_m", depth_sigma_m, above(0), "sigma of a depth without a weight of its own, m");
+      k("min_pixel_weight", min_pixel_weight, atLeast(0), "pixels of a smaller weight are not integrated, m^-2");
+      k("truncation_sigmas", truncation_sigmas, atLeast(0),
+        "the band along a pixel's ray is at least this many of its sigmas (0: the truncation alone)");
+      k("space_carving", space_carving, "voxels seen in front of the band become free space (sdf = +truncation)");
+      k("carving_weight", carving_weight, atLeast(0), "a free-space update weighs this times the observation");
+      k("scan_carving_m", scan_carving_m, between(0, kMaxDepthM),
+        "also carve with the LiDAR's scan outside the camera's view, this far from the LiDAR, m (0: off)");
+      k("weight_dropoff", weight_dropoff, "behind the surface the weight falls to 0 at the band's end");
+      k("silhouette_band", silhouette_band,
+        "the band behind a pixel reaches no deeper than its object is seen to be wide (at least two truncations)");
+      k("signed_distance", signed_distance, kSignedDistances,
+        "plane: distance to the observed surface's tangent plane | projective: along the optical axis (the paper)");
+      plane.keys(k);
+      k("lambda", lambda, between(0, kMaxLambda),
+        "eq. 7's regularization weight (0: the plain weighted mean; the paper: 5; beyond 1e6 it flattens the "
+        "surface)");
+      k("lambda_data", lambda_data, kLambdaData,
+        "uniform: eq. 7 as written | inverse_variance: each mean counts by its weight, lambda in m^-2");
+      k("sweeps", sweeps, between(0, kMaxSweeps), "Gauss-Seidel sweeps per frame over the voxels it changed");
+      k("solve", solve, kSolves,
+        "sweeps: that many per frame | argmin: until no voxel moves more than argmin_tolerance_m");
+      k("argmin_tolerance_m", argmin_tolerance_m, above(0), "argmin stops after a sweep that moved no voxel more, m");
+      k("argmin_max_sweeps", argmin_max_sweeps, between(1, kMaxArgminSweeps), "... or after this many sweeps");
+      k("min_depth_m", min_depth_m, atLeast(0), "depth nearer than this is ignored, m");
+      k("max_depth_m", max_depth_m, Range{0, kMaxDepthM, true, false}, "depth farther than this is ignored, m");
+      k("precise_max_depth_m", precise_max_depth_m, between(0, kMaxDepthM),
+        "depth known to within the truncation by its weight (LiDAR-backed) is integrated up to here, m (0: "
+        "max_depth_m for all)");
+      k("interpolate_depth", interpolate_depth, "bilinear depth between 4 pixels that agree, else the nearest");
+      k("allocation_stride", allocation_stride, atLeast(1),
+        "blocks are allocated along the rays of every n-th pixel in each direction (1 for sparse depth)");
+    }
     /// Throws ConfigError naming the first value out of range.
     void validate() const;
-    void print(std::ostream& out) const;
   };
 
   /// What the last call did, with its time split (milliseconds).

@@ -1,15 +1,14 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
 #include <msf/reconstruction/point_types.h>
 #include <msf/reconstruction/tsdf_block.h>
 
-#include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,19 +27,27 @@ public:
   using Ptr = std::shared_ptr<TsdfVolume>;
   using ConstPtr = std::shared_ptr<const TsdfVolume>;
 
-  /// The YAML section `tsdf_volume`.
+  /// Section `tsdf_volume` of a config file.
   struct Config {
-    double voxel_size_m = 0.1;  ///< edge of a voxel
-    double truncation_m = 0.3;  ///< |sdf| is clamped here; observations update voxels within it
-    /// The memory budget (MiB); 0 = three quarters of the machine's RAM. The volume's blocks
-    /// and map may not exceed it: a growth that would stops with an error before allocating.
-    /// msf_reconstruct also refuses, before it starts, a run whose predicted peak (the whole
-    /// process: Reconstructor::predictMemory) exceeds a budget given here or with -max_memory.
+    static constexpr const char* kSection = "tsdf_volume";
+    static constexpr const char* kAbout = "TsdfVolume (paper step 5): the map, sparse hashed blocks of 8^3 voxels";
+    double voxel_size_m = 0.1;
+    double truncation_m = 0.3;
+    /// The volume's blocks and map may not exceed the budget: a growth that would stops with an
+    /// error before allocating. msf_reconstruct also refuses, before it starts, a run whose
+    /// predicted peak (the whole process: Reconstructor::predictMemory) exceeds a budget given
+    /// here or with -max_memory.
     double max_memory_mb = 0.0;
-    /// Overrides the keys present (voxel_size_m, truncation_m, max_memory_mb); throws
-    /// ConfigError naming a bad one (see validate).
-    void read(const cv::FileNode& node);
-    void print(std::ostream& out) const;
+
+    template <class Keys>
+    void keys(Keys& k) {
+      k("voxel_size_m", voxel_size_m, between(kMinVoxelSizeM, kMaxVoxelSizeM), "edge of a voxel, m");
+      k("truncation_m", truncation_m, above(0),
+        "|sdf| is clamped here and observations update voxels within it, m (at most 64 voxels)");
+      k("max_memory_mb", max_memory_mb, atLeast(0), "the map's memory budget, MiB (0: three quarters of the RAM)");
+    }
+    /// Throws ConfigError naming the key of a value out of range (see TsdfVolume::validate).
+    void validate() const;
   };
 
   /// Voxels from 1 mm to 10 m; a truncation of at most kMaxTruncationVoxels voxels (and > 0).

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
 #include <msf/io/poses.h>
 #include <msf/io/frame_source.h>
 #include <msf/registration/adaptive_threshold.h>
@@ -11,10 +12,8 @@
 #include <msf/registration/voxel_downsample.h>
 
 #include <Eigen/Geometry>
-#include <opencv2/core/persistence.hpp>
 #include <pcl/point_cloud.h>
 
-#include <iosfwd>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,35 +35,27 @@ public:
   using Ptr = std::shared_ptr<LidarOdometry>;
   using ConstPtr = std::shared_ptr<const LidarOdometry>;
 
-  /// Section `odometry`.
+  /// Section `odometry` of a config file.
   struct Config {
-    /// Voxel of the local map; scans are kept at half of it for the map and registered at
-    /// 1.5 times it (a few thousand points: the ICP's cost).
+    static constexpr const char* kSection = "odometry";
+    static constexpr const char* kAbout =
+        "LidarOdometry (msf_odometry; msf_reconstruct -poses estimate): each scan registered to a local map of "
+        "the scans before it";
     double voxel_size_m = 1.0;
-    /// Returns nearer than this (the car itself) or farther are dropped; the map keeps the
-    /// voxels within max_range_m of the sensor.
     double min_range_m = 3.0;
     double max_range_m = 100.0;
     /// 10: the planes come from every return (PointMoments), so the points only need to be a
     /// nearest neighbour; fewer make the search faster (KISS-ICP keeps 20).
     int max_points_per_voxel = 10;
-    /// Distances to the map's planes where its voxels are planar (ScanToMap ICP), else to points.
     bool point_to_plane = true;
-    /// How scans are motion-compensated: sweep (deskewSweep with the constant-velocity motion:
-    /// a spinning LiDAR, KITTI's HDL-64E), none (snapshots: msf_synth's LiDAR), or auto,
-    /// which resolveDeskew makes none for a synthetic sequence and sweep otherwise (and
-    /// LidarOdometry takes as sweep).
+    /// auto: resolveDeskew makes it none for a synthetic sequence and sweep otherwise (and
+    /// LidarOdometry takes it as sweep).
     std::string deskew = "auto";
-    /// Correspondence distance until a frame has moved (AdaptiveThreshold).
     double initial_threshold_m = 2.0;
-    /// Corrections of the prediction that move points less than this are no samples of its
-    /// error (AdaptiveThreshold): the threshold stays above 3 times this.
     double min_correction_m = 0.1;
     int max_iterations = 100;
     double convergence = 1e-4;
-    /// Smallest eigenvalue of a scan's normalised plane information (ScanConstraints) that
-    /// counts as constrained: KITTI 04 and raw 0009 have 0.016 or more, the synthetic street
-    /// 0.003 or more, a single plane 0.
+    /// KITTI's scans have 0.016 or more, the synthetic street 0.003 or more, a single plane 0.
     double min_constraint = 1e-3;
     /// A measured motion's accuracy per scan (registerPoints with a prior: a GPS/INS's poses),
     /// one standard deviation: the weight of its soft constraint, where each scan pair counts
@@ -73,10 +64,31 @@ public:
     double prior_translation_sigma_m = 0.1;
     double prior_rotation_sigma_deg = 0.1;
 
-    /// Overrides the keys present in a YAML section; throws ConfigError naming a bad key.
-    void read(const cv::FileNode& node);
+    template <class Keys>
+    void keys(Keys& k) {
+      k("voxel_size_m", voxel_size_m, above(0),
+        "voxel of the local map, m; scans are kept at half of it and registered at 1.5 times it");
+      k("min_range_m", min_range_m, atLeast(0), "returns nearer (the car itself) are dropped, m");
+      k("max_range_m", max_range_m, above(0), "returns farther are dropped, and the map keeps this around the sensor, m");
+      k("max_points_per_voxel", max_points_per_voxel, atLeast(1), "points the map keeps per voxel");
+      k("point_to_plane", point_to_plane, "distances to the map's planes where its voxels are planar, else to points");
+      k("deskew", deskew, {"auto", "sweep", "none"},
+        "motion compensation: sweep (a spinning LiDAR), none (snapshots), auto (none on a synthetic sequence)");
+      k("initial_threshold_m", initial_threshold_m, above(0), "correspondence distance until a frame has moved, m");
+      k("min_correction_m", min_correction_m, atLeast(0),
+        "corrections of the prediction smaller than this are no samples of its error, m");
+      k("max_iterations", max_iterations, atLeast(1), "ICP iterations per scan at most");
+      k("convergence", convergence, above(0), "ICP stops when a step moves the pose less than this");
+      k("min_constraint", min_constraint, Range{0, 1, false, true},
+        "a scan whose planes pin a degree of freedom down less than this (smallest eigenvalue) is an error");
+      k("prior_translation_sigma_m", prior_translation_sigma_m, above(0),
+        "a measured motion's (a GPS/INS's poses: -poses refine) accuracy per scan, one standard deviation: the "
+        "weight of its soft constraint on the registration, m");
+      k("prior_rotation_sigma_deg", prior_rotation_sigma_deg, above(0),
+        "the same for the measured motion's rotation, degrees");
+    }
+    /// Throws ConfigError naming the key of a value out of range.
     void validate() const;
-    void print(std::ostream& out) const;
   };
 
   /// What the last registerScan did.

@@ -1,22 +1,33 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/config_keys.h>
+
 #include <opencv2/core/mat.hpp>
-#include <opencv2/core/persistence.hpp>
 
 namespace msf {
 
-/// Parameters of the per-pixel confidence of an SGBM disparity image.
-/// On KITTI (odometry 04, LiDAR as ground truth) the share of disparities off by more than
-/// 3 px is 25 % within 7 px of a hole of the disparity image (speckle-filtered or rejected
-/// pixels: matching failed nearby, or an occlusion edge), under 0.5 % beyond 30 px; and it is
-/// 14 % where the disparity varies by more than 2 px within 5x5 pixels (a depth edge or a
-/// mismatch), 1-3 % elsewhere. Image texture, the usual cue, predicts little there.
+/// Parameters of the per-pixel confidence of an SGBM disparity image: the `confidence_` keys of
+/// section `stereo`. Wrong matches cluster near the holes of the disparity image (speckle-
+/// filtered or rejected pixels: matching failed nearby, or an occlusion edge) and where the
+/// disparity varies within a few pixels (a depth edge or a mismatch); image texture, the usual
+/// cue, predicts little on KITTI.
 struct StereoConfidenceConfig {
-  float hole_distance_px = 15.f; ///< confidence 1 - exp(-distance to the nearest hole / this)
-  int range_window_px = 5;       ///< odd window of the local disparity range
-  float range_free_px = 1.f;     ///< a local range up to this costs nothing
-  float range_scale_px = 1.f;    ///< beyond it, confidence falls as exp(-excess / this)
+  static constexpr const char* kSection = "stereo";
+  float hole_distance_px = 15.f;
+  int range_window_px = 5;
+  float range_free_px = 1.f;
+  float range_scale_px = 1.f;
 
+  template <class Keys>
+  void keys(Keys& k) {
+    k("confidence_hole_distance_px", hole_distance_px, above(0),
+      "confidence 1 - exp(-distance to the nearest hole / this), px");
+    k("confidence_range_window_px", range_window_px, atLeast(1),
+      "window of the local disparity range (max - min of the disparities), px (odd)");
+    k("confidence_range_free_px", range_free_px, atLeast(0), "a local range up to this costs no confidence, px");
+    k("confidence_range_scale_px", range_scale_px, above(0),
+      "beyond it, confidence falls as exp(-excess / this), px");
+  }
   /// Throws ConfigError naming the key of a value out of range.
   void validate() const;
 };
