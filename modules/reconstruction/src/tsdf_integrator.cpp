@@ -1,7 +1,9 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/config.h>
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/grid_key.h>
 #include <msf/common/limits.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/silhouette_thickness.h>
@@ -38,9 +40,6 @@ constexpr float kSilhouetteFloor = 2.f;
 float planeBand(float truncation, float voxel_size) { return std::min(truncation, 1.5f * voxel_size); }
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 using detail::PixelBand;
 using detail::updateVoxel;
@@ -48,20 +47,9 @@ using detail::updateVoxel;
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
 
-// 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
-std::uint64_t packKey(const Eigen::Vector3i& b) {
-  constexpr std::int64_t kBias = 1 << 19;
-  constexpr std::uint64_t kMask = (1u << 20) - 1;
-  return ((static_cast<std::uint64_t>(b.x() + kBias) & kMask) << 40) |
-         ((static_cast<std::uint64_t>(b.y() + kBias) & kMask) << 20) | (static_cast<std::uint64_t>(b.z() + kBias) & kMask);
-}
-GridIndex unpackKey(std::uint64_t k) {
-  constexpr std::int64_t kBias = 1 << 19;
-  constexpr std::uint64_t kMask = (1u << 20) - 1;
-  return {static_cast<int>(static_cast<std::int64_t>((k >> 40) & kMask) - kBias),
-          static_cast<int>(static_cast<std::int64_t>((k >> 20) & kMask) - kBias),
-          static_cast<int>(static_cast<std::int64_t>(k & kMask) - kBias)};
-}
+// A block's key: 20 bits an axis (+-2^19 blocks, +-419 km at 0.1 m voxels, see checkReach);
+// 60 bits leave 3 for a sub-block.
+using BlockKey = GridKey<20>;
 
 /// floor(x) as an int, inline: without SSE4.1 (not in x86-64's baseline) std::floor is a call.
 inline int floorToInt(float x) {
@@ -297,7 +285,7 @@ void TsdfIntegrator::setLambda(double lambda) {
 }
 
 void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
-  // Block keys hold 20 bits an axis (packKey), and voxel coordinates are ints: a camera
+  // Block keys hold 20 bits an axis (BlockKey), and voxel coordinates are ints: a camera
   // whose band reaches beyond that would alias blocks, or overflow a float -> int cast.
   const double reach_m = 0.99 * double(1 << 19) * TsdfBlock::kSide * volume_.voxelSize();
   const double far_m =
@@ -417,7 +405,7 @@ inline void widenTileRanges(const float* depth, const PixelBand* bands, const Fr
 
 /// The sub-blocks (4^3 voxels) that the band along a pixel's ray crosses. Sub-block coordinates
 /// s = (p / vs + 1/2) / 4, so that floor(s) holds p's nearest voxel. A key is the block's
-/// (packKey) and the sub-block's 3 bits.
+/// (BlockKey) and the sub-block's 3 bits.
 struct SubBlockWalk {
   const FrameView& view;
   Eigen::Matrix3f R_wc;
@@ -442,7 +430,7 @@ struct SubBlockWalk {
       traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
         const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
         const std::uint64_t k =
-            (packKey(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
+            (BlockKey::pack(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
         std::uint64_t& slot = recent[(k ^ (k >> 17) ^ (k >> 31)) & (recent.size() - 1)];
         if (slot == k)
           return;
@@ -498,6 +486,107 @@ struct SubBlockCull {
     return !carving && dmin - band > c.z() + radius; // every band is beyond: the voxels are free space
   }
 };
+
+/// The projective update of one block (updateBlocks' work for each): a row of voxels at a time
+/// of its listed sub-blocks tested in SIMD lanes against their nearest pixels, and those that
+/// pass updated after the whole block is tested. The voxels that pass are gathered first so
+/// that their voxels and colours are prefetched while the rest of the block is tested (a map
+/// of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
+struct BlockProjection {
+  const FrameView& view;
+  Eigen::Isometry3d T_cam_world;
+  Eigen::Vector3f ex, ey, ez; ///< the grid's axes in the camera frame, a voxel long
+  SubBlockCull cull;
+  detail::SubBlockTest test_sub_block;
+  detail::VoxelTestFrame test_frame;
+  detail::BlockUpdate update_block;
+  detail::VoxelUpdateFrame update_frame;
+  const cv::Mat& color;
+
+  /// Adds the voxels tested to `projected`; lists the changed ones in listed_index and
+  /// listed_sdf when they are given (see detail::BlockUpdate).
+  detail::VoxelUpdateResult operator()(TsdfBlock& block, std::uint8_t mask, detail::VoxelCandidates& candidates,
+                                       std::size_t& projected, std::uint16_t* listed_index, float* listed_sdf) const {
+    const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * view.vs)).cast<float>();
+    const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
+                                            {ey.x(), ey.y(), ey.z()}, {ez.x(), ez.y(), ez.z()}, block.voxels.data()};
+    int n_candidates = 0;
+    for (int sub = 0; sub < 8; ++sub) {
+      if (!(mask & (1u << sub)))
+        continue; // no sampled ray's band crosses this sub-block
+      const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
+      if (cull.skips(base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f))))
+        continue;
+      projected += 64;
+      n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
+    }
+    if (!color.empty()) // the voxels were prefetched by the test
+      for (int c = 0; c < n_candidates; ++c)
+        __builtin_prefetch(color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
+    return update_block(update_frame, candidates, n_candidates, block.voxels.data(), listed_index, listed_sdf);
+  }
+};
+
+/// Lists the voxels of `touched` flagged kUpdated (clearing the flags) whose |sdf| is below
+/// `band`: their local indices and sdf, block after block, offsets[i] where touched[i]'s begin.
+void listFlaggedVoxels(const std::vector<TsdfBlock*>& touched, float band, std::vector<std::uint16_t>& index,
+                       std::vector<float>& sdf, std::vector<std::size_t>& offsets) {
+  offsets.assign(1, 0);
+  index.clear();
+  sdf.clear();
+  for (TsdfBlock* block : touched) {
+    for (int j = 0; j < TsdfBlock::kVoxels; ++j)
+      if (block->voxels[j].flags & kUpdated) {
+        block->voxels[j].flags = 0;
+        if (!(std::abs(block->voxels[j].sdf) < band))
+          continue;
+        index.push_back(static_cast<std::uint16_t>(j));
+        sdf.push_back(block->voxels[j].sdf);
+      }
+    offsets.push_back(index.size());
+  }
+}
+
+/// One Gauss-Seidel step of eq. 7 over `n` changed voxels of `block` (local indices `index`,
+/// their means `mean`), its face neighbours `nb` (-x, +x, -y, +y, -z, +z; null where absent)
+/// held fixed: x_i = (W_i y_i + lambda * sum_j x_j) / (W_i + lambda * n_i) over the observed
+/// 6-neighbours j, W_i the voxel's weight by_weight, else 1. Records the signs in the block when
+/// `record_signs`. Returns the largest change of an sdf.
+float relaxBlock(TsdfBlock& block, const std::array<TsdfBlock*, 6>& nb, const std::uint16_t* index, const float* mean,
+                 std::size_t n, float lambda, bool by_weight, bool record_signs) {
+  std::uint8_t signs = 0, negative = 0;
+  float change = 0.f;
+  for (std::size_t k = 0; k < n; ++k) {
+    const int j = index[k];
+    const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
+    float sum = 0.f, count = 0.f;
+    // Without branches: whether a neighbour was observed is unpredictable.
+    auto add = [&](const TsdfVoxel& q) {
+      const bool observed = q.weight > 0.f;
+      sum += observed ? q.sdf : 0.f;
+      count += observed ? 1.f : 0.f;
+    };
+    if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
+    if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
+    if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
+    if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
+    if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
+    if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
+    float& sdf = block.voxels[j].sdf;
+    const float before = sdf;
+    const float data = by_weight ? block.voxels[j].weight : 1.f;
+    if (count > 0.f)
+      sdf = (data * mean[k] + lambda * sum) / (data + lambda * count);
+    change = std::max(change, std::abs(sdf - before));
+    signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+    negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
+  }
+  if (record_signs) {
+    block.signs |= signs;
+    block.negative_subblocks |= negative;
+  }
+  return change;
+}
 
 /// The order in which updateBlocks visits `blocks`: the image's (their centres' 32x32-pixel
 /// tiles along a Z-order curve) rather than the keys', so that neighbouring blocks' tests read
@@ -697,7 +786,7 @@ detail::BlockList TsdfIntegrator::allocateSubBlocks(const std::vector<std::uint6
   detail::BlockList list;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (i == 0 || (keys[i] >> 3) != (keys[i - 1] >> 3)) {
-      block_indices.push_back(unpackKey(keys[i] >> 3));
+      block_indices.push_back(BlockKey::unpack(keys[i] >> 3));
       list.masks.push_back(0);
     }
     list.masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
@@ -740,71 +829,51 @@ void TsdfIntegrator::addBlocksToCarve(const FrameView& view, const Eigen::Isomet
 
 detail::BlockChanges TsdfIntegrator::updateBlocks(const DepthFrame& frame, const FrameView& view,
                                                   const Eigen::Isometry3d& T_world_cam, const detail::BlockList& list) {
-  // Projective update of every voxel of the listed sub-blocks, in parallel over blocks: a row
-  // of voxels at a time tested in SIMD lanes against its nearest pixels, and the voxels that
-  // pass updated after the whole block is tested.
   const std::vector<TsdfBlock*>& blocks = list.blocks;
   detail::BlockChanges changes;
   changes.stamp = volume_.beginGeneration();
-  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
-  const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
-  const float vs = view.vs;
-  const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
+  changes.updated.assign(blocks.size(), 0);
+  changes.listed.assign(blocks.size(), 0);
   const bool regularized = regularizes();
   // Changed voxels of each block (local indices), for the regularization.
   if (regularized) {
     changed_index_.resize(blocks.size() * detail::kListStride);
     data_term_.resize(changed_index_.size());
   }
-  changes.updated.assign(blocks.size(), 0);
-  changes.listed.assign(blocks.size(), 0);
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
+  const float vs = view.vs;
   const bool carving = config_.space_carving;
   const bool has_color = !frame.color.empty();
   const float* depth_data = view.depth.ptr<float>(0);
-  const detail::SubBlockTest test_sub_block = detail::subBlockTest();
-  const detail::VoxelTestFrame test_frame{view.fx,    view.fy,    view.cx, view.cy, view.width, view.height,
-                                          view.min_d, view.max_d, carving, depth_data, pixels_.data()};
   // The wide kernels read a colour as 4 bytes, one before the pixel's (or after, at pixel 0).
   const bool color_wide = has_color && frame.color.cols >= 2;
-  const detail::BlockUpdate update_block =
-      !has_color || color_wide ? detail::blockUpdate() : detail::blockUpdatePortable;
-  const detail::VoxelUpdateFrame update_frame{
-      view.width, view.height, depth_data, pixels_.data(), has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
-      has_color ? static_cast<int>(frame.color.step[0]) : 0, config_.interpolate_depth, carving,
-      config_.weight_dropoff, regularized, view.trunc, vs, 1.5f * vs, config_.max_weight, smoothingBand()};
-  const SubBlockCull cull{view, carving, 0.5f * std::sqrt(3.f) * 3.f * vs, tile_min_.data(), tile_max_.data(),
-                          tile_band_.data()};
+  const BlockProjection project{
+      view, T_cam_world, R.col(0) * vs, R.col(1) * vs, R.col(2) * vs,
+      SubBlockCull{view, carving, 0.5f * std::sqrt(3.f) * 3.f * vs, tile_min_.data(), tile_max_.data(),
+                   tile_band_.data()},
+      detail::subBlockTest(),
+      detail::VoxelTestFrame{view.fx, view.fy, view.cx, view.cy, view.width, view.height, view.min_d, view.max_d,
+                             carving, depth_data, pixels_.data()},
+      !has_color || color_wide ? detail::blockUpdate() : detail::blockUpdatePortable,
+      detail::VoxelUpdateFrame{view.width, view.height, depth_data, pixels_.data(),
+                               has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
+                               has_color ? static_cast<int>(frame.color.step[0]) : 0, config_.interpolate_depth,
+                               carving, config_.weight_dropoff, regularized, view.trunc, vs, 1.5f * vs,
+                               config_.max_weight, smoothingBand()},
+      frame.color};
   const std::vector<std::uint64_t> order = visitOrder(blocks, T_cam_world, view);
   std::atomic<std::size_t> projected_total{0};
   parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
-    // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
-    // so that their voxels and colours are prefetched while the rest of the block is tested
-    // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
     detail::VoxelCandidates candidates;
     std::size_t projected = 0;
     for (int n = range.start; n < range.end; ++n) {
       const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(n)] & 0xffffffffu);
       TsdfBlock& block = *blocks[i];
-      const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
-      const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
-                                              {ey.x(), ey.y(), ey.z()}, {ez.x(), ez.y(), ez.z()}, block.voxels.data()};
-      int n_candidates = 0;
-      for (int sub = 0; sub < 8; ++sub) {
-        if (!(list.masks[i] & (1u << sub)))
-          continue; // no sampled ray's band crosses this sub-block
-        const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
-        if (cull.skips(base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f))))
-          continue;
-        projected += 64;
-        n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
-      }
-      if (has_color) // the voxels were prefetched by the test
-        for (int c = 0; c < n_candidates; ++c)
-          __builtin_prefetch(frame.color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
       const detail::VoxelUpdateResult r =
-          update_block(update_frame, candidates, n_candidates, block.voxels.data(),
-                       regularized ? &changed_index_[i * detail::kListStride] : nullptr,
-                       regularized ? &data_term_[i * detail::kListStride] : nullptr);
+          project(block, list.masks[i], candidates, projected,
+                  regularized ? &changed_index_[i * detail::kListStride] : nullptr,
+                  regularized ? &data_term_[i * detail::kListStride] : nullptr);
       changes.updated[i] = static_cast<std::uint16_t>(r.updated);
       changes.listed[i] = static_cast<std::uint16_t>(r.listed);
       if (r.updated) {
@@ -994,21 +1063,8 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
   stats_.update_ms = msSince(t_start);
   const auto t_reg = Clock::now();
   if (regularized) {
-    const float smooth_band = smoothingBand();
-    std::vector<std::size_t> offsets{0};
-    changed_index_.clear();
-    data_term_.clear();
-    for (TsdfBlock* block : touched) {
-      for (int j = 0; j < TsdfBlock::kVoxels; ++j)
-        if (block->voxels[j].flags & kUpdated) {
-          block->voxels[j].flags = 0;
-          if (!(std::abs(block->voxels[j].sdf) < smooth_band))
-            continue;
-          changed_index_.push_back(static_cast<std::uint16_t>(j));
-          data_term_.push_back(block->voxels[j].sdf);
-        }
-      offsets.push_back(changed_index_.size());
-    }
+    std::vector<std::size_t> offsets;
+    listFlaggedVoxels(touched, smoothingBand(), changed_index_, data_term_, offsets);
     regularize(touched, offsets);
   }
   stats_.regularize_ms = msSince(t_reg);
@@ -1037,10 +1093,8 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         neighbours[i][k] = volume_.findBlock(touched[i]->index + steps[k]);
   }, 16);
 
-  // x_i = (W_i y_i + lambda * sum_j x_j) / (W_i + lambda * n_i) over observed 6-neighbours j
-  // (W_i = 1 for LambdaData::Uniform): the
-  // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
-  // fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
+  // The stationarity condition of eq. 7 (relaxBlock), over the voxels this frame changed (the
+  // others are held fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
   // share no face (face neighbours differ by one in one coordinate), so each colour's blocks
   // run in parallel without races.
   std::array<std::vector<std::size_t>, 2> colour;
@@ -1067,39 +1121,9 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           for (std::size_t k = offsets[next]; k < offsets[next + 1]; ++k)
             __builtin_prefetch(&touched[next]->voxels[changed_index_[k]]);
         }
-        TsdfBlock& block = *touched[i];
-        const auto& nb = neighbours[i];
-        std::uint8_t signs = 0, negative = 0;
-        float change = 0.f;
-        for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-          const int j = changed_index_[k];
-          const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
-          float sum = 0.f, count = 0.f;
-          // Without branches: whether a neighbour was observed is unpredictable.
-          auto add = [&](const TsdfVoxel& q) {
-            const bool observed = q.weight > 0.f;
-            sum += observed ? q.sdf : 0.f;
-            count += observed ? 1.f : 0.f;
-          };
-          if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
-          if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
-          if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
-          if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
-          if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
-          if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
-          float& sdf = block.voxels[j].sdf;
-          const float before = sdf;
-          const float data = by_weight ? block.voxels[j].weight : 1.f;
-          if (count > 0.f)
-            sdf = (data * data_term_[k] + lambda * sum) / (data + lambda * count);
-          change = std::max(change, std::abs(sdf - before));
-          signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-          negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
-        }
-        if (last) {
-          block.signs |= signs;
-          block.negative_subblocks |= negative;
-        }
+        const float change = relaxBlock(*touched[i], neighbours[i], changed_index_.data() + offsets[i],
+                                        data_term_.data() + offsets[i], offsets[i + 1] - offsets[i], lambda, by_weight,
+                                        last);
         for (float seen = largest_change.load(); change > seen && !largest_change.compare_exchange_weak(seen, change);)
           ;
       }
