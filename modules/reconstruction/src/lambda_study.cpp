@@ -2,6 +2,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
 #include <msf/common/config.h>
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/common/line_plot.h>
@@ -145,7 +146,7 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
       }
     const auto t0 = std::chrono::steady_clock::now();
     integrator.integrate(frame, pose);
-    integrate_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    integrate_ms += msSince(t0);
     sweeps += integrator.lastStats().regularize_sweeps;
   }
   TriangleMesh mesh;
