@@ -663,18 +663,8 @@ private:
   std::map<std::string, pcl::PolygonMesh> polygons_;
 };
 
-} // namespace
-
-int main(int argc, char** argv) {
-  Request request;
-  msf::PipelineConfig config;
-  msf::tool::CommandLine cli(
-      "msf_reconstruct", "[DATASET_DIR] [options]",
-      "Reconstructs a dataset (a folder of the generic layout with a rig file, a KITTI odometry sequence or raw drive, "
-      "a synthetic sequence of msf_synth, a ROS 1 bag in kitti2bag's layout or with the topics named below: "
-      "docs/ros.md) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
-      "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
-      "(20 frames) in a temporary folder and reconstructs it.");
+/// The options, which write into `request` and `config`.
+void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::PipelineConfig& config) {
   cli.value("-o", "DIR", request.out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
             "depth_NNNNNN.png, sky_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
@@ -743,56 +733,85 @@ int main(int argc, char** argv) {
       .note("Ctrl-C (or SIGTERM) stops after the frames under way and still writes the mesh and the summary (exit "
             "code 130); a second one also skips the mesh's scores and renderings (summary.json lists them under "
             "\"skipped\"); later ones are ignored until the mesh and the summary are written.");
+}
+
+/// The DATASET_DIR argument ("" for the default street); refuses more than one.
+std::string datasetArgument(const msf::tool::Arguments& positional, const msf::tool::CommandLine& cli) {
+  if (positional.size() > 1) {
+    std::string extra, flags;
+    for (std::size_t k = 1; k < positional.size(); ++k)
+      extra += (k > 1 ? "', '" : "") + positional[k];
+    for (const std::string& flag : cli.flags())
+      flags += (flags.empty() ? "" : ", ") + flag;
+    throw msf::InvalidInputError("expected at most one DATASET_DIR, got '" + positional.front() + "' and '" + extra +
+                                 "' too (" + flags + " take no value; see -h)");
+  }
+  return positional.empty() ? "" : positional.front();
+}
+
+/// Refuses what the options cannot do together, before any folder is made.
+void checkRequest(const Request& request, const msf::PipelineConfig& config) {
+  config.validate();
+  if (request.panels < 0 || request.panels > kMaxPanels)
+    throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " +
+                                 std::to_string(request.panels));
+  const bool streaming = config.streaming.enabled();
+  if (streaming && config.mesher.min_component_triangles > 0)
+    std::printf("Note: a streamed map keeps its small pieces (marching_cubes.min_component_triangles is not "
+                "applied): its tiles are meshed apart, and a piece may cross them\n");
+  if (streaming && (request.holdout || request.compare_sources || request.compare_paper))
+    throw msf::InvalidInputError(std::string(request.holdout           ? "-holdout"
+                                             : request.compare_sources ? "-compare_sources"
+                                                                       : "-compare_paper") +
+                                 " needs the whole map in memory: not with a streamed map (-stream, " +
+                                 "streaming.active_radius_m)");
+  msf::FrameRange::parse(request.frames); // a malformed range
+}
+
+/// The run, into the output folder it commits at the end; the exit code (130: stopped).
+int reconstruct(const Request& request, const msf::PipelineConfig& config) {
+  // OUT is replaced as a whole: an input inside it is refused.
+  const bool poses_file = !request.poses.empty() && request.poses != "dataset" && request.poses != "estimate" &&
+                          request.poses != "refine";
+  installStopHandler();
+  msf::OutputFolder output(request.out, "msf_reconstruct",
+                           {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});
+  // The default street is generated inside the staging folder (a killed run's goes with it
+  // at the next run) and removed before the commit.
+  const fs::path street = fs::path(output.dir()) / ".street";
+  const std::unique_ptr<msf::FrameSource> source = msf::openDataset(
+      request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, request.reader);
+  for (const std::string& note : source->notes())
+    print_warn("%s: %s\n", source->description().c_str(), note.c_str());
+  if (request.save_depth)
+    fs::create_directories(fs::path(output.dir()) / "depth");
+
+  Run run(request, config, *source, output.dir());
+  const bool interrupted = run.reconstruct();
+  run.finish(interrupted);
+  std::error_code ec;
+  fs::remove_all(street, ec);
+  output.commit();
+  printSummary(run.report(), request.out);
+  return interrupted ? 130 : 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Request request;
+  msf::PipelineConfig config;
+  msf::tool::CommandLine cli(
+      "msf_reconstruct", "[DATASET_DIR] [options]",
+      "Reconstructs a dataset (a folder of the generic layout with a rig file, a KITTI odometry sequence or raw drive, "
+      "a synthetic sequence of msf_synth, a ROS 1 bag in kitti2bag's layout or with the topics named below: "
+      "docs/ros.md) into a coloured mesh: LiDAR projection + compound interpolation and SGBM stereo, fused per pixel, integrated into a "
+      "regularized TSDF, meshed by marching cubes. Without DATASET_DIR it generates the default synthetic street "
+      "(20 frames) in a temporary folder and reconstructs it.");
+  declareOptions(cli, request, config);
   return cli.run(argc, argv, 0, [&](const msf::tool::Arguments& positional) {
-    if (positional.size() > 1) {
-      std::string extra, flags;
-      for (std::size_t k = 1; k < positional.size(); ++k)
-        extra += (k > 1 ? "', '" : "") + positional[k];
-      for (const std::string& flag : cli.flags())
-        flags += (flags.empty() ? "" : ", ") + flag;
-      throw msf::InvalidInputError("expected at most one DATASET_DIR, got '" + positional.front() + "' and '" + extra +
-                                   "' too (" + flags + " take no value; see -h)");
-    }
-    request.dataset = positional.empty() ? "" : positional.front();
-    config.validate();
-    if (request.panels < 0 || request.panels > kMaxPanels)
-      throw msf::InvalidInputError("-panels must be 0.." + std::to_string(kMaxPanels) + ", not " +
-                                   std::to_string(request.panels));
-    const bool streaming = config.streaming.enabled();
-    if (streaming && config.mesher.min_component_triangles > 0)
-      std::printf("Note: a streamed map keeps its small pieces (marching_cubes.min_component_triangles is not "
-                  "applied): its tiles are meshed apart, and a piece may cross them\n");
-    if (streaming && (request.holdout || request.compare_sources || request.compare_paper))
-      throw msf::InvalidInputError(std::string(request.holdout           ? "-holdout"
-                                               : request.compare_sources ? "-compare_sources"
-                                                                         : "-compare_paper") +
-                                   " needs the whole map in memory: not with a streamed map (-stream, " +
-                                   "streaming.active_radius_m)");
-    msf::FrameRange::parse(request.frames); // a malformed range before any folder is made
-
-    // OUT is replaced as a whole: an input inside it is refused.
-    const bool poses_file = !request.poses.empty() && request.poses != "dataset" && request.poses != "estimate" &&
-                            request.poses != "refine";
-    installStopHandler();
-    msf::OutputFolder output(request.out, "msf_reconstruct",
-                             {request.dataset, request.config_path, poses_file ? request.poses : "", request.reader.rig});
-    // The default street is generated inside the staging folder (a killed run's goes with it
-    // at the next run) and removed before the commit.
-    const fs::path street = fs::path(output.dir()) / ".street";
-    const std::unique_ptr<msf::FrameSource> source = msf::openDataset(
-        request.dataset.empty() ? generateDefaultStreet(street.string()) : request.dataset, request.reader);
-    for (const std::string& note : source->notes())
-      print_warn("%s: %s\n", source->description().c_str(), note.c_str());
-    if (request.save_depth)
-      fs::create_directories(fs::path(output.dir()) / "depth");
-
-    Run run(request, config, *source, output.dir());
-    const bool interrupted = run.reconstruct();
-    run.finish(interrupted);
-    std::error_code ec;
-    fs::remove_all(street, ec);
-    output.commit();
-    printSummary(run.report(), request.out);
-    return interrupted ? 130 : 0;
+    request.dataset = datasetArgument(positional, cli);
+    checkRequest(request, config);
+    return reconstruct(request, config);
   });
 }

@@ -382,13 +382,7 @@ std::vector<float> nearestViewDistance(const std::vector<Eigen::Vector3f>& point
                             std::to_string(points.size()) + " points");
   if (!(cell_m > 0.f))
     throw InvalidInputError("nearest view distance: the cell must be > 0 m, not " + std::to_string(cell_m));
-  struct Hash {
-    std::size_t operator()(const Eigen::Vector3i& c) const {
-      return static_cast<std::size_t>(c.x()) * 73856093u ^ static_cast<std::size_t>(c.y()) * 19349663u ^
-             static_cast<std::size_t>(c.z()) * 83492791u;
-    }
-  };
-  std::unordered_map<Eigen::Vector3i, float, Hash> nearest;
+  std::unordered_map<Eigen::Vector3i, float, CellHash> nearest;
   nearest.reserve(points.size() / 4);
   const auto cell = [cell_m](const Eigen::Vector3f& p) { return (p / cell_m).array().floor().cast<int>().matrix().eval(); };
   for (std::size_t i = 0; i < points.size(); ++i) {

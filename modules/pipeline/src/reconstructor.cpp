@@ -1,4 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/parallel.h>
 #include <msf/fusion/depth_image_fusion.h>
@@ -51,9 +52,6 @@ constexpr double kOtherMapShare = 1.6;
 constexpr double kBlockMargin = 1.15;
 // Frames integrated to measure the share of the fused depth's blocks in the scans' bands.
 constexpr int kCalibrationFrames = 3;
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 } // namespace
 
 /// The stage objects of steps 1-4, configured once; they keep their work buffers.

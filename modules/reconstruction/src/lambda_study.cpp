@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/common/line_plot.h>
@@ -93,7 +94,7 @@ LambdaStudy::Cell LambdaStudy::run(double noise_mm, double lambda) const {
       }
     const auto t0 = std::chrono::steady_clock::now();
     integrator.integrate(frame, pose);
-    integrate_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    integrate_ms += msSince(t0);
     sweeps += integrator.lastStats().regularize_sweeps;
   }
   TriangleMesh mesh;

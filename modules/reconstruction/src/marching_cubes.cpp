@@ -1,4 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/elapsed.h>
+#include <msf/common/grid_key.h>
 #include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -20,9 +22,6 @@ namespace msf {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 constexpr int kSide = TsdfBlock::kSide;
 constexpr int kPad = kSide + 1; // a block's cubes read one voxel layer of its +x, +y, +z neighbours
@@ -43,11 +42,7 @@ std::uint64_t vertexKey(int x, int y, int z, int code) {
          (static_cast<std::uint64_t>(z + kKeyBias) << 2) | static_cast<std::uint64_t>(code);
 }
 
-std::uint64_t blockKey(const GridIndex& b) {
-  constexpr std::int64_t kBias = 1 << 20;
-  return (static_cast<std::uint64_t>(b.x() + kBias) << 42) | (static_cast<std::uint64_t>(b.y() + kBias) << 21) |
-         static_cast<std::uint64_t>(b.z() + kBias);
-}
+std::uint64_t blockKey(const GridIndex& b) { return GridKey<21>::pack(b); }
 
 bool lessIndex(const GridIndex& a, const GridIndex& b) {
   if (a.x() != b.x()) return a.x() < b.x();

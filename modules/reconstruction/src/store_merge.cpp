@@ -1,5 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/grid_key.h>
 #include <msf/reconstruction/store_merge.h>
 
 #include <algorithm>
@@ -81,11 +83,7 @@ struct MergedBlock {
   }
 };
 
-std::uint64_t blockKey(const GridIndex& b) {
-  constexpr std::int64_t kBias = 1 << 20;
-  return (static_cast<std::uint64_t>(b.x() + kBias) << 42) | (static_cast<std::uint64_t>(b.y() + kBias) << 21) |
-         static_cast<std::uint64_t>(b.z() + kBias);
-}
+std::uint64_t blockKey(const GridIndex& b) { return GridKey<21>::pack(b); }
 
 } // namespace
 
@@ -182,7 +180,7 @@ StoreMerge::Stats StoreMerge::merge(const std::vector<GridIndex>& tiles, const T
       pointers.push_back(&b);
     out.writeTile(tile, pointers);
   }
-  stats.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  stats.ms = msSince(start);
   return stats;
 }
 

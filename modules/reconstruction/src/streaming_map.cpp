@@ -1,8 +1,11 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/checked_write.h>
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/grid_key.h>
 #include <msf/common/output_folder.h>
+#include <msf/common/spatial_hash.h>
 #include <msf/reconstruction/streaming_map.h>
 
 #include <algorithm>
@@ -25,10 +28,8 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr int kSide = TsdfBlock::kSide;
-constexpr std::int64_t kTileBias = 1 << 20;
 
 std::string number(double v) {
   std::ostringstream ss;
@@ -148,8 +149,7 @@ private:
   };
   struct Hash {
     std::size_t operator()(const Key& k) const {
-      return (static_cast<std::size_t>(k.bits[0]) * 73856093u) ^ (static_cast<std::size_t>(k.bits[1]) * 19349663u) ^
-             (static_cast<std::size_t>(k.bits[2]) * 83492791u);
+      return spatialHash(k.bits[0], k.bits[1], k.bits[2]);
     }
   };
   float vs_;
@@ -253,10 +253,7 @@ public:
   }
 
 private:
-  static std::uint64_t key(const GridIndex& b) {
-    return (static_cast<std::uint64_t>(b.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(b.y() + kTileBias) << 21) |
-           static_cast<std::uint64_t>(b.z() + kTileBias);
-  }
+  static std::uint64_t key(const GridIndex& b) { return GridKey<21>::pack(b); }
   const TsdfStore& store_;
   std::unordered_map<std::string,
                      std::unordered_map<std::uint64_t, std::unique_ptr<TsdfBlock>>>
@@ -348,14 +345,10 @@ double StreamingMap::minimumRadius() const { return reach_m_ + config_.tile_bloc
 
 StreamingMap::TileKey StreamingMap::tileOf(const GridIndex& block) const {
   const GridIndex t = TsdfStore::tileOf(block, config_.tile_blocks);
-  return (static_cast<std::uint64_t>(t.x() + kTileBias) << 42) | (static_cast<std::uint64_t>(t.y() + kTileBias) << 21) |
-         static_cast<std::uint64_t>(t.z() + kTileBias);
+  return GridKey<21>::pack(t);
 }
 
-GridIndex StreamingMap::tileIndex(TileKey key) const {
-  const auto part = [&](int shift) { return static_cast<int>(static_cast<std::int64_t>((key >> shift) & 0x1fffff) - kTileBias); };
-  return {part(42), part(21), part(0)};
-}
+GridIndex StreamingMap::tileIndex(TileKey key) const { return GridKey<21>::unpack(key); }
 
 double StreamingMap::distanceToTile(TileKey key, const Eigen::Vector3d& p, int grow_blocks) const {
   const int voxels = config_.tile_blocks * kSide;
@@ -644,8 +637,7 @@ void StreamingMap::weldByPosition(TriangleMesh& mesh) {
   };
   struct Hash {
     std::size_t operator()(const Key& k) const {
-      return (static_cast<std::size_t>(k.x) * 73856093u) ^ (static_cast<std::size_t>(k.y) * 19349663u) ^
-             (static_cast<std::size_t>(k.z) * 83492791u);
+      return spatialHash(k.x, k.y, k.z);
     }
   };
   std::unordered_map<Key, std::uint32_t, Hash> seen;

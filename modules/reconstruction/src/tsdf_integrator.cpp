@@ -1,6 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
+#include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/grid_key.h>
 #include <msf/common/limits.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/silhouette_thickness.h>
@@ -33,13 +35,10 @@ constexpr float kSilhouetteSigmas = 1.f;
 constexpr float kSilhouetteFloor = 2.f;
 
 /// How far from a surface's plane its band reaches along a grazing ray, either side: a voxel
-/// and a half (see integrate's step 0), never more than the truncation.
+/// and a half (see computePixelBands), never more than the truncation.
 float planeBand(float truncation, float voxel_size) { return std::min(truncation, 1.5f * voxel_size); }
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 using detail::PixelBand;
 using detail::updateVoxel;
@@ -47,20 +46,9 @@ using detail::updateVoxel;
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
 constexpr int kSide = TsdfBlock::kSide;
 
-// 20 bits per axis: +-524288 blocks, +-419 km at 0.1 m voxels; 60 bits leave 3 for a sub-block.
-std::uint64_t packKey(const Eigen::Vector3i& b) {
-  constexpr std::int64_t kBias = 1 << 19;
-  constexpr std::uint64_t kMask = (1u << 20) - 1;
-  return ((static_cast<std::uint64_t>(b.x() + kBias) & kMask) << 40) |
-         ((static_cast<std::uint64_t>(b.y() + kBias) & kMask) << 20) | (static_cast<std::uint64_t>(b.z() + kBias) & kMask);
-}
-GridIndex unpackKey(std::uint64_t k) {
-  constexpr std::int64_t kBias = 1 << 19;
-  constexpr std::uint64_t kMask = (1u << 20) - 1;
-  return {static_cast<int>(static_cast<std::int64_t>((k >> 40) & kMask) - kBias),
-          static_cast<int>(static_cast<std::int64_t>((k >> 20) & kMask) - kBias),
-          static_cast<int>(static_cast<std::int64_t>(k & kMask) - kBias)};
-}
+// A block's key: 20 bits an axis (+-2^19 blocks, +-419 km at 0.1 m voxels, see checkReach);
+// 60 bits leave 3 for a sub-block.
+using BlockKey = GridKey<20>;
 
 /// floor(x) as an int, inline: without SSE4.1 (not in x86-64's baseline) std::floor is a call.
 inline int floorToInt(float x) {
@@ -184,7 +172,7 @@ void TsdfIntegrator::setLambda(double lambda) {
 }
 
 void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
-  // Block keys hold 20 bits an axis (packKey), and voxel coordinates are ints: a camera
+  // Block keys hold 20 bits an axis (BlockKey), and voxel coordinates are ints: a camera
   // whose band reaches beyond that would alias blocks, or overflow a float -> int cast.
   const double reach_m = 0.99 * double(1 << 19) * TsdfBlock::kSide * volume_.voxelSize();
   const double far_m =
@@ -197,7 +185,7 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
 }
 
 double TsdfIntegrator::widestBandBehind() const {
-  // The band behind a surface (see integrate's step 0): at most max(truncation, planeBand over
+  // The band behind a surface (see computePixelBands): at most max(truncation, planeBand over
   // the least plane scale, the depth's sigmas), the sigma from the least weight a pixel can
   // have and still be integrated.
   const double trunc = volume_.truncation(), vs = volume_.voxelSize();
@@ -239,15 +227,311 @@ double TsdfIntegrator::reach(const PinholeCamera& camera) const {
   return std::max((far + behind) * corner, config_.max_depth_m + trunc);
 }
 
+namespace detail {
+
+/// A frame as integrate's phases read it.
+struct FrameView {
+  /// The depth the voxels are tested against, without the pixels that weigh too little: rows of
+  /// `width` floats like the pixel records (pixels_), so that one index finds a pixel in both.
+  const cv::Mat& depth;
+  const PinholeCamera& cam;
+  bool own_weights; ///< per-pixel weighting with the frame's own weight image
+  int width, height;
+  float fx, fy, cx, cy;
+  float vs, trunc;
+  float min_d, max_d; ///< the depth integrated
+};
+
+/// The blocks a frame updates, each with the sub-blocks to project (bit x | y << 1 | z << 2).
+struct BlockList {
+  std::vector<TsdfBlock*> blocks;
+  std::vector<std::uint8_t> masks;
+};
+
+/// What updateBlocks did to each block of a BlockList.
+struct BlockChanges {
+  std::uint64_t stamp = 0;            ///< the volume's generation for this frame
+  std::vector<std::uint16_t> updated; ///< voxels updated, per block (0: the block is untouched)
+  std::vector<std::uint16_t> listed;  ///< of them, those listed for the regularization
+  std::size_t projected = 0;          ///< voxels of the sub-blocks tested
+};
+
+} // namespace detail
+
+namespace {
+
+using detail::FrameView;
+
+/// Marks the blocks of a frame's BlockList while space carving adds others, until collectChanged.
+constexpr std::uint64_t kListedMark = std::numeric_limits<std::uint64_t>::max();
+
+/// The depth range of a frame is summarized per tile of 8x8 pixels.
+constexpr int kTile = 8;
+
+/// Widens the depth range and the widest front band of each 8x8-pixel tile of one image row
+/// by its pixels in [min_d, max_d].
+inline void widenTileRanges(const float* depth, const PixelBand* bands, const FrameView& view, float* t_min,
+                            float* t_max, float* t_band) {
+  const int width = view.width, tiles_x = (width + kTile - 1) / kTile;
+  const float min_d = view.min_d, max_d = view.max_d;
+  for (int tx = 0; tx < tiles_x; ++tx) {
+    const float* tile = depth + tx * kTile;
+    const PixelBand* tile_band = bands + tx * kTile;
+    float lo = t_min[tx], hi = t_max[tx], band = t_band[tx];
+    for (int k = 0, n = std::min(kTile, width - tx * kTile); k < n; ++k) {
+      const bool valid = tile[k] >= min_d && tile[k] <= max_d; // without branches: holes are unpredictable
+      lo = std::min(lo, valid ? tile[k] : std::numeric_limits<float>::infinity());
+      hi = std::max(hi, valid ? tile[k] : -std::numeric_limits<float>::infinity());
+      band = std::max(band, valid ? tile_band[k].front : 0.f);
+    }
+    t_min[tx] = lo;
+    t_max[tx] = hi;
+    t_band[tx] = band;
+  }
+}
+
+/// The sub-blocks (4^3 voxels) that the band along a pixel's ray crosses. Sub-block coordinates
+/// s = (p / vs + 1/2) / 4, so that floor(s) holds p's nearest voxel. A key is the block's
+/// (BlockKey) and the sub-block's 3 bits.
+struct SubBlockWalk {
+  const FrameView& view;
+  Eigen::Matrix3f R_wc;
+  Eigen::Vector3f t_s; ///< the camera's centre in sub-block coordinates
+  float to_sub;        ///< metres to sub-block coordinates
+  int stride;          ///< Config::allocation_stride
+
+  /// Appends the keys along the rays of row v's sampled pixels (every stride-th, rows staggered).
+  /// Neighbouring pixels cross the same sub-blocks (a grazing band crosses a dozen): keys seen
+  /// lately, in a small direct-mapped table, are skipped.
+  void row(int v, const float* depth, const PixelBand* bands, std::vector<std::uint64_t>& keys,
+           std::array<std::uint64_t, 256>& recent) const {
+    const float min_d = view.min_d, max_d = view.max_d;
+    for (int u = (v / stride) % stride; u < view.width; u += stride) {
+      const float d = depth[u];
+      if (!(d >= min_d && d <= max_d))
+        continue;
+      const Eigen::Vector3f dir_s =
+          R_wc * Eigen::Vector3f((u - view.cx) / view.fx, (v - view.cy) / view.fy, 1.f) * to_sub;
+      // The band along the ray: `front` nearer than the surface, `behind` beyond it.
+      const float z0 = std::max(d - bands[u].front, min_d), z1 = d + bands[u].behind;
+      traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
+        const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
+        const std::uint64_t k =
+            (BlockKey::pack(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
+        std::uint64_t& slot = recent[(k ^ (k >> 17) ^ (k >> 31)) & (recent.size() - 1)];
+        if (slot == k)
+          return;
+        slot = k;
+        keys.push_back(k);
+      });
+    }
+  }
+};
+
+/// Which sub-blocks (4^3 voxels) a frame cannot change, by the depth range and widest band of
+/// the 8x8-pixel tiles their footprint covers: a sub-block whose footprint sees only bands far
+/// in front of or behind it is skipped without projecting its voxels.
+struct SubBlockCull {
+  const FrameView& view;
+  bool carving;
+  float radius; ///< of a sub-block's voxel centres
+  const float *tile_min, *tile_max, *tile_band;
+
+  /// Whether the sub-block centred at c (camera frame) lies in front of the nearest depth,
+  /// outside the image, hidden behind every band, or (without carving) beyond every band.
+  bool skips(const Eigen::Vector3f& c) const {
+    const float min_d = view.min_d, fx = view.fx, fy = view.fy;
+    if (c.z() + radius < min_d)
+      return true;
+    if (!(c.z() - radius > 0.5f * min_d + 1e-3f))
+      return false;
+    // Pixel footprint of the bounding sphere: |u(p) - u(c)| <= fx r (1 + |x/z|) / (z - r),
+    // +1 px for rounding and bilinear lookups.
+    const float inv = radius / (c.z() - radius);
+    const float ru = fx * inv * (1.f + std::abs(c.x() / c.z())) + 1.f;
+    const float rv = fy * inv * (1.f + std::abs(c.y() / c.z())) + 1.f;
+    const float uc = fx * c.x() / c.z() + view.cx, vc = fy * c.y() / c.z() + view.cy;
+    const int u0 = std::max(0, floorToInt(uc - ru)), u1 = std::min(view.width - 1, static_cast<int>(uc + ru));
+    const int v0 = std::max(0, floorToInt(vc - rv)), v1 = std::min(view.height - 1, static_cast<int>(vc + rv));
+    if (u0 > u1 || v0 > v1)
+      return true; // outside the image
+    const int tx0 = u0 / kTile, tx1 = u1 / kTile, ty0 = v0 / kTile, ty1 = v1 / kTile;
+    if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) > 64)
+      return false;
+    const int tiles_x = (view.width + kTile - 1) / kTile;
+    float dmin = std::numeric_limits<float>::infinity(), dmax = -dmin, band = 0.f;
+    for (int ty = ty0; ty <= ty1; ++ty)
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
+        dmin = std::min(dmin, tile_min[t]);
+        dmax = std::max(dmax, tile_max[t]);
+        band = std::max(band, tile_band[t]);
+      }
+    // A bilinear depth lies between its pixels' depths: within [dmin, dmax].
+    if (dmax + band < c.z() - radius)
+      return true; // every band is in front: the voxels are hidden behind the surface
+    return !carving && dmin - band > c.z() + radius; // every band is beyond: the voxels are free space
+  }
+};
+
+/// The projective update of one block (updateBlocks' work for each): a row of voxels at a time
+/// of its listed sub-blocks tested in SIMD lanes against their nearest pixels, and those that
+/// pass updated after the whole block is tested. The voxels that pass are gathered first so
+/// that their voxels and colours are prefetched while the rest of the block is tested (a map
+/// of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
+struct BlockProjection {
+  const FrameView& view;
+  Eigen::Isometry3d T_cam_world;
+  Eigen::Vector3f ex, ey, ez; ///< the grid's axes in the camera frame, a voxel long
+  SubBlockCull cull;
+  detail::SubBlockTest test_sub_block;
+  detail::VoxelTestFrame test_frame;
+  detail::BlockUpdate update_block;
+  detail::VoxelUpdateFrame update_frame;
+  const cv::Mat& color;
+
+  /// Adds the voxels tested to `projected`; lists the changed ones in listed_index and
+  /// listed_sdf when they are given (see detail::BlockUpdate).
+  detail::VoxelUpdateResult operator()(TsdfBlock& block, std::uint8_t mask, detail::VoxelCandidates& candidates,
+                                       std::size_t& projected, std::uint16_t* listed_index, float* listed_sdf) const {
+    const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * view.vs)).cast<float>();
+    const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
+                                            {ey.x(), ey.y(), ey.z()}, {ez.x(), ez.y(), ez.z()}, block.voxels.data()};
+    int n_candidates = 0;
+    for (int sub = 0; sub < 8; ++sub) {
+      if (!(mask & (1u << sub)))
+        continue; // no sampled ray's band crosses this sub-block
+      const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
+      if (cull.skips(base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f))))
+        continue;
+      projected += 64;
+      n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
+    }
+    if (!color.empty()) // the voxels were prefetched by the test
+      for (int c = 0; c < n_candidates; ++c)
+        __builtin_prefetch(color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
+    return update_block(update_frame, candidates, n_candidates, block.voxels.data(), listed_index, listed_sdf);
+  }
+};
+
+/// Lists the voxels of `touched` flagged kUpdated (clearing the flags) whose |sdf| is below
+/// `band`: their local indices and sdf, block after block, offsets[i] where touched[i]'s begin.
+void listFlaggedVoxels(const std::vector<TsdfBlock*>& touched, float band, std::vector<std::uint16_t>& index,
+                       std::vector<float>& sdf, std::vector<std::size_t>& offsets) {
+  offsets.assign(1, 0);
+  index.clear();
+  sdf.clear();
+  for (TsdfBlock* block : touched) {
+    for (int j = 0; j < TsdfBlock::kVoxels; ++j)
+      if (block->voxels[j].flags & kUpdated) {
+        block->voxels[j].flags = 0;
+        if (!(std::abs(block->voxels[j].sdf) < band))
+          continue;
+        index.push_back(static_cast<std::uint16_t>(j));
+        sdf.push_back(block->voxels[j].sdf);
+      }
+    offsets.push_back(index.size());
+  }
+}
+
+/// One Gauss-Seidel step of eq. 7 over `n` changed voxels of `block` (local indices `index`,
+/// their means `mean`), its face neighbours `nb` (-x, +x, -y, +y, -z, +z; null where absent)
+/// held fixed: x_i = (W_i y_i + lambda * sum_j x_j) / (W_i + lambda * n_i) over the observed
+/// 6-neighbours j, W_i the voxel's weight by_weight, else 1. Records the signs in the block when
+/// `record_signs`. Returns the largest change of an sdf.
+float relaxBlock(TsdfBlock& block, const std::array<TsdfBlock*, 6>& nb, const std::uint16_t* index, const float* mean,
+                 std::size_t n, float lambda, bool by_weight, bool record_signs) {
+  std::uint8_t signs = 0, negative = 0;
+  float change = 0.f;
+  for (std::size_t k = 0; k < n; ++k) {
+    const int j = index[k];
+    const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
+    float sum = 0.f, count = 0.f;
+    // Without branches: whether a neighbour was observed is unpredictable.
+    auto add = [&](const TsdfVoxel& q) {
+      const bool observed = q.weight > 0.f;
+      sum += observed ? q.sdf : 0.f;
+      count += observed ? 1.f : 0.f;
+    };
+    if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
+    if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
+    if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
+    if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
+    if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
+    if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
+    float& sdf = block.voxels[j].sdf;
+    const float before = sdf;
+    const float data = by_weight ? block.voxels[j].weight : 1.f;
+    if (count > 0.f)
+      sdf = (data * mean[k] + lambda * sum) / (data + lambda * count);
+    change = std::max(change, std::abs(sdf - before));
+    signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
+    negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
+  }
+  if (record_signs) {
+    block.signs |= signs;
+    block.negative_subblocks |= negative;
+  }
+  return change;
+}
+
+/// The order in which updateBlocks visits `blocks`: the image's (their centres' 32x32-pixel
+/// tiles along a Z-order curve) rather than the keys', so that neighbouring blocks' tests read
+/// the same depth and pixel records from the cache. Each block's work is its own: the order
+/// changes no result. An entry is the tile (high 32 bits) and the block's index.
+std::vector<std::uint64_t> visitOrder(const std::vector<TsdfBlock*>& blocks, const Eigen::Isometry3d& T_cam_world,
+                                      const FrameView& view) {
+  std::vector<std::uint64_t> order(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const Eigen::Vector3d centre = (blocks[i]->origin().cast<double>() + Eigen::Vector3d::Constant(3.5)) * view.vs;
+    const Eigen::Vector3f c = (T_cam_world * centre).cast<float>();
+    std::uint64_t tile = 0xffffffffu; // behind the camera: last
+    if (c.z() > view.min_d) {
+      const auto tu =
+          static_cast<std::uint32_t>(std::clamp(view.fx * c.x() / c.z() + view.cx, 0.f, view.width - 1.f)) >> 5;
+      const auto tv =
+          static_cast<std::uint32_t>(std::clamp(view.fy * c.y() / c.z() + view.cy, 0.f, view.height - 1.f)) >> 5;
+      tile = 0;
+      for (int b = 0; b < 16; ++b)
+        tile |= static_cast<std::uint64_t>(((tu >> b) & 1u) | (((tv >> b) & 1u) << 1)) << (2 * b);
+    }
+    order[i] = tile << 32 | i;
+  }
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+} // namespace
+
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
   checkReach(T_world_cam);
   stats_ = Stats();
   const auto t_start = Clock::now();
+  const FrameView view = prepareDepth(frame);
+  computePixelBands(frame, view);
+  detail::BlockList list = allocateSubBlocks(findBandSubBlocks(view, T_world_cam));
+  if (config_.space_carving)
+    addBlocksToCarve(view, T_world_cam, list);
+  stats_.allocate_ms = msSince(t_start);
 
+  const auto t_update = Clock::now();
+  const detail::BlockChanges changes = updateBlocks(frame, view, T_world_cam, list);
+  std::vector<TsdfBlock*> touched;
+  std::vector<std::size_t> offsets;
+  collectChanged(list, changes, touched, offsets);
+  stats_.update_ms = msSince(t_update);
+
+  const auto t_reg = Clock::now();
+  if (regularizes())
+    regularize(touched, offsets);
+  stats_.regularize_ms = msSince(t_reg);
+}
+
+FrameView TsdfIntegrator::prepareDepth(const DepthFrame& frame) {
   // Each pixel's weight, the inverse variance of its depth (m^-2); pixels weighing less than
-  // min_pixel_weight are no depth, for every step below.
+  // min_pixel_weight are no depth, for every phase.
   pixelWeights(frame, weight_);
   const float trunc = static_cast<float>(volume_.truncation());
   // Beyond max_depth_m only depth known to within the truncation is integrated, by its own
@@ -255,9 +539,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   const bool own_weights = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
   const bool precise_only = own_weights && config_.precise_max_depth_m > config_.max_depth_m;
   const bool masked = config_.min_pixel_weight > 0.f || precise_only;
-  // The depth the voxels are tested against is continuous, rows of `width` floats like the pixel
-  // records below, so that one index finds a pixel in both (a frame's depth may be a view into a
-  // wider image: then a copy).
+  // A frame's depth may be a view into a wider image: then a copy (see FrameView::depth).
   const bool copied = masked || !frame.depth.isContinuous();
   if (copied)
     frame.depth.copyTo(masked_depth_);
@@ -265,52 +547,61 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     masked_depth_.setTo(0.f, weight_ < config_.min_pixel_weight);
   if (precise_only)
     masked_depth_.setTo(0.f, (masked_depth_ > config_.max_depth_m) & (weight_ < 1.f / (trunc * trunc)));
-  const cv::Mat& depth_image = copied ? masked_depth_ : frame.depth;
-
   const PinholeCamera& cam = frame.camera;
-  const int width = cam.width, height = cam.height;
-  const float vs = static_cast<float>(volume_.voxelSize());
-  const float min_d = static_cast<float>(config_.min_depth_m);
-  const float max_d = static_cast<float>(precise_only ? config_.precise_max_depth_m : config_.max_depth_m);
-  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  return {copied ? masked_depth_ : frame.depth,
+          cam,
+          own_weights,
+          cam.width,
+          cam.height,
+          static_cast<float>(cam.fx),
+          static_cast<float>(cam.fy),
+          static_cast<float>(cam.cx),
+          static_cast<float>(cam.cy),
+          static_cast<float>(volume_.voxelSize()),
+          trunc,
+          static_cast<float>(config_.min_depth_m),
+          static_cast<float>(precise_only ? config_.precise_max_depth_m : config_.max_depth_m)};
+}
 
-  // 0. Per pixel p of depth d_p, the scale s_p from the projective distance to the distance to
-  //    the surface's plane (a voxel at depth z on p's ray has sdf (d_p - z) s_p), and the bands
-  //    along the ray within which voxels are updated, widened to truncation_sigmas standard
-  //    deviations so that noisy depth is averaged over frames rather than clipped:
-  //    - in front, the truncation along the ray, or a voxel and a half above the plane;
-  //    - behind, the truncation along the ray, or a voxel and a half below the plane (marching
-  //      cubes needs all 8 corners of a cube the surface crosses, which lie up to
-  //      |n_x| + |n_y| + |n_z| voxels from a plane of normal n: a road's camber or a street at
-  //      an angle to the grid puts some of them more than one voxel below it) but not the
-  //      plane's full length: beyond the surface's edge the plane is free space, and a box seen
-  //      edge-on would grow a skirt behind it.
+void TsdfIntegrator::computePixelBands(const DepthFrame& frame, const FrameView& view) {
+  // Per pixel p of depth d_p, the scale s_p from the projective distance to the distance to the
+  // surface's plane (a voxel at depth z on p's ray has sdf (d_p - z) s_p), and the bands along
+  // the ray within which voxels are updated, widened to truncation_sigmas standard deviations
+  // so that noisy depth is averaged over frames rather than clipped:
+  // - in front, the truncation along the ray, or a voxel and a half above the plane;
+  // - behind, the truncation along the ray, or a voxel and a half below the plane (marching
+  //   cubes needs all 8 corners of a cube the surface crosses, which lie up to
+  //   |n_x| + |n_y| + |n_z| voxels from a plane of normal n: a road's camber or a street at an
+  //   angle to the grid puts some of them more than one voxel below it) but not the plane's
+  //   full length: beyond the surface's edge the plane is free space, and a box seen edge-on
+  //   would grow a skirt behind it.
   if (config_.signed_distance == SignedDistance::Plane) {
-    planeDistanceScale(depth_image, cam, config_.plane, scale_);
-    smoothSurfaceExtent(depth_image, config_.plane.max_curvature, extent_);
+    planeDistanceScale(view.depth, view.cam, config_.plane, scale_);
+    smoothSurfaceExtent(view.depth, config_.plane.max_curvature, extent_);
   } else {
-    scale_ = cv::Mat(depth_image.size(), CV_32FC1, cv::Scalar(1.f));
-    extent_ = cv::Mat(depth_image.size(), CV_32FC1, cv::Scalar(0.f));
+    scale_ = cv::Mat(view.depth.size(), CV_32FC1, cv::Scalar(1.f));
+    extent_ = cv::Mat(view.depth.size(), CV_32FC1, cv::Scalar(0.f));
   }
   // One record per pixel, so that a voxel's update reads them from one cache line.
-  pixels_.resize(static_cast<std::size_t>(width) * height);
+  const int width = view.width;
+  pixels_.resize(static_cast<std::size_t>(width) * view.height);
+  const float trunc = view.trunc;
   const float sigmas = static_cast<float>(config_.truncation_sigmas);
   // How far from a plane its band reaches along a grazing ray: a voxel and a half either side
   // (above it, free space holds the voxels beyond at +truncation: the full truncation cost 12 %
   // more time for the same maps; below it, one voxel left holes wherever a cube's far corner
   // lay a little deeper: protocol 4 coverage 0.957 against 0.967 on raw 0009).
-  const float plane_band = planeBand(trunc, vs);
+  const float plane_band = planeBand(trunc, view.vs);
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
-  const cv::Mat& free_weight = own_weights ? frame.free_space_weight : cv::Mat();
+  const cv::Mat& free_weight = view.own_weights ? frame.free_space_weight : cv::Mat();
   const float carving_weight = static_cast<float>(config_.carving_weight);
   // The band behind a thin object's pixels reaches no deeper than the object is wide, and at
   // least kSilhouetteFloor truncations (see Config::silhouette_band).
   const bool silhouette = config_.silhouette_band && sigmas > 0.f;
   if (silhouette)
-    silhouetteThickness(depth_image, weight_, cam, kSilhouetteRelativeJump, kSilhouetteSigmas, thickness_);
+    silhouetteThickness(view.depth, weight_, view.cam, kSilhouetteRelativeJump, kSilhouetteSigmas, thickness_);
   const float silhouette_floor = kSilhouetteFloor * trunc;
-  parallelFor(cv::Range(0, height), [&](const cv::Range& rows) {
+  parallelFor(cv::Range(0, view.height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
@@ -329,28 +620,24 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
       }
     }
   });
-  const PixelBand* pixel_data = pixels_.data();
+}
 
-  // 1. Sub-blocks (4^3 voxels) that the truncation band of each pixel's ray crosses, found in
-  //    parallel: only those are projected below, which on KITTI's grazing road is a fraction
-  //    of their blocks. Sub-block coordinates s = (p / vs + 1/2) / 4, so that floor(s) holds
-  //    p's nearest voxel. A key is the block (20 bits per axis) and the sub-block's 3 bits.
-  const Eigen::Matrix3f R_wc = T_world_cam.linear().cast<float>();
+std::vector<std::uint64_t> TsdfIntegrator::findBandSubBlocks(const FrameView& view,
+                                                             const Eigen::Isometry3d& T_world_cam) {
+  // Only the sub-blocks that the band of a sampled pixel's ray crosses are projected: on
+  // KITTI's grazing road a fraction of their blocks. The rows' pass also sums up the tiles'
+  // depth ranges for SubBlockCull.
   constexpr int kSub = kSide / 2;
-  const float to_sub = 1.f / (vs * kSub);
-  const Eigen::Vector3f t_s = (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSub;
-  std::vector<std::uint64_t> keys;
-  std::mutex keys_mutex;
-  const int stride = config_.allocation_stride;
-  // Also the depth range of the bands of 8x8-pixel tiles (the least depth less the widest
-  // band, the largest depth plus the widest band), in the same pass over the rows: a sub-block
-  // of 4^3 voxels whose footprint sees only bands far in front of or behind it is skipped
-  // below without projecting its voxels.
-  constexpr int kTile = 8;
-  const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
+  const float vs = view.vs;
+  const SubBlockWalk walk{view, T_world_cam.linear().cast<float>(),
+                          (T_world_cam.translation().cast<float>() / vs + Eigen::Vector3f::Constant(0.5f)) / kSub,
+                          1.f / (vs * kSub), config_.allocation_stride};
+  const int tiles_x = (view.width + kTile - 1) / kTile, tiles_y = (view.height + kTile - 1) / kTile;
   tile_min_.assign(static_cast<std::size_t>(tiles_x) * tiles_y, std::numeric_limits<float>::infinity());
   tile_max_.assign(tile_min_.size(), -std::numeric_limits<float>::infinity());
   tile_band_.assign(tile_min_.size(), 0.f);
+  std::vector<std::uint64_t> keys;
+  std::mutex keys_mutex;
   // cv::parallel_for_, as the other stages. OpenCV runs a call made while another thread's
   // runs serially (one flag per process): in the pipeline, integration and SGBM then take a
   // core each. An OpenMP team of its own was measured too: no faster on KITTI, and 0.85x on
@@ -361,49 +648,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
     std::array<std::uint64_t, 256> recent;
     recent.fill(~0ull);
     for (int ty = range.start; ty < range.end; ++ty)
-    for (int v = ty * kTile; v < std::min(height, (ty + 1) * kTile); ++v) {
-      const float* depth = depth_image.ptr<float>(v);
-      const PixelBand* band_row = &pixels_[static_cast<std::size_t>(v) * width];
-      float* t_min = &tile_min_[static_cast<std::size_t>(ty) * tiles_x];
-      float* t_max = &tile_max_[static_cast<std::size_t>(ty) * tiles_x];
-      float* t_band = &tile_band_[static_cast<std::size_t>(ty) * tiles_x];
-      for (int tx = 0; tx < tiles_x; ++tx) {
-        const float* tile = depth + tx * kTile;
-        const PixelBand* tile_band = band_row + tx * kTile;
-        float lo = t_min[tx], hi = t_max[tx], band = t_band[tx];
-        for (int k = 0, n = std::min(kTile, width - tx * kTile); k < n; ++k) {
-          const bool valid = tile[k] >= min_d && tile[k] <= max_d; // without branches: holes are unpredictable
-          lo = std::min(lo, valid ? tile[k] : std::numeric_limits<float>::infinity());
-          hi = std::max(hi, valid ? tile[k] : -std::numeric_limits<float>::infinity());
-          band = std::max(band, valid ? tile_band[k].front : 0.f);
-        }
-        t_min[tx] = lo;
-        t_max[tx] = hi;
-        t_band[tx] = band;
+      for (int v = ty * kTile; v < std::min(view.height, (ty + 1) * kTile); ++v) {
+        const float* depth = view.depth.ptr<float>(v);
+        const PixelBand* bands = &pixels_[static_cast<std::size_t>(v) * view.width];
+        const std::size_t t = static_cast<std::size_t>(ty) * tiles_x;
+        widenTileRanges(depth, bands, view, &tile_min_[t], &tile_max_[t], &tile_band_[t]);
+        if (v % walk.stride == 0)
+          walk.row(v, depth, bands, local, recent);
       }
-      if (v % stride)
-        continue;
-      for (int u = (v / stride) % stride; u < width; u += stride) {
-        const float d = depth[u];
-        if (!(d >= min_d && d <= max_d))
-          continue;
-        const Eigen::Vector3f dir_s = R_wc * Eigen::Vector3f((u - cx) / fx, (v - cy) / fy, 1.f) * to_sub;
-        // The band along the ray: `front` nearer than the surface, `behind` beyond it.
-        const float z0 = std::max(d - band_row[u].front, min_d), z1 = d + band_row[u].behind;
-        traverseCells(t_s + dir_s * z0, t_s + dir_s * z1, [&](const Eigen::Vector3i& c) {
-          const GridIndex b(c.x() >> 1, c.y() >> 1, c.z() >> 1); // floor(c / 2), also below 0
-          const std::uint64_t k =
-              (packKey(b) << 3) | static_cast<std::uint64_t>((c.x() & 1) | ((c.y() & 1) << 1) | ((c.z() & 1) << 2));
-          // Neighbouring pixels cross the same sub-blocks (a grazing band crosses a dozen):
-          // skip keys seen lately, in a small direct-mapped table.
-          std::uint64_t& slot = recent[(k ^ (k >> 17) ^ (k >> 31)) & (recent.size() - 1)];
-          if (slot == k)
-            return;
-          slot = k;
-          local.push_back(k);
-        });
-      }
-    }
     // Sorted here, in parallel, so that the merged list is shorter and partly in order.
     std::sort(local.begin(), local.end());
     local.erase(std::unique(local.begin(), local.end()), local.end());
@@ -412,204 +664,139 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   });
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
+
+detail::BlockList TsdfIntegrator::allocateSubBlocks(const std::vector<std::uint64_t>& keys) {
   const std::size_t blocks_before = volume_.numBlocks();
   std::vector<GridIndex> block_indices;
-  std::vector<std::uint8_t> masks; // sub-blocks to project, bit x | y << 1 | z << 2
+  detail::BlockList list;
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (i == 0 || (keys[i] >> 3) != (keys[i - 1] >> 3)) {
-      block_indices.push_back(unpackKey(keys[i] >> 3));
-      masks.push_back(0);
+      block_indices.push_back(BlockKey::unpack(keys[i] >> 3));
+      list.masks.push_back(0);
     }
-    masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
+    list.masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
   }
-  std::vector<TsdfBlock*> blocks;
-  volume_.allocateBlocks(block_indices, blocks);
+  volume_.allocateBlocks(block_indices, list.blocks);
   stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
+  return list;
+}
 
-  if (config_.space_carving) {
-    // Existing blocks in the view in front of the observed surface: their voxels become free space.
-    const Eigen::Isometry3f T_cw = T_world_cam.inverse().cast<float>();
-    const std::uint64_t mark = std::numeric_limits<std::uint64_t>::max();
-    for (TsdfBlock* b : blocks)
-      b->stamp = mark; // temporary marker, reset below
-    // Only sub-blocks that hold a surface (a negative voxel): free space has nothing to carve.
-    // Also in the blocks the bands cross: a car that moved on by less than a block left its
-    // old rear in the sub-blocks beside its new one.
-    std::fill(masks.begin(), masks.end(), std::uint8_t{0xff});
-    // A block may be partly in view when its centre is not: test its bounding sphere.
-    const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
-    for (const auto& block : volume_.blocks()) {
-      if (block->stamp == mark || !block->negative_subblocks)
-        continue;
-      const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
-      if (!sphereInView(c, radius, cam, min_d))
-        continue;
-      const float z = std::max(c.z(), min_d);
-      const float u = fx * c.x() / z + cx, v = fy * c.y() / z + cy;
-      const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, width - 1);
-      const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, height - 1);
-      const float d = depth_image.at<float>(vi, ui);
-      if (!(d > 0.f) || c.z() - radius < d) {
-        blocks.push_back(block);
-        masks.push_back(block->negative_subblocks);
-      }
+void TsdfIntegrator::addBlocksToCarve(const FrameView& view, const Eigen::Isometry3d& T_world_cam,
+                                      detail::BlockList& list) {
+  // Existing blocks in the view in front of the observed surface: their voxels become free space.
+  const Eigen::Isometry3f T_cw = T_world_cam.inverse().cast<float>();
+  for (TsdfBlock* b : list.blocks)
+    b->stamp = kListedMark; // reset by collectChanged
+  // Only sub-blocks that hold a surface (a negative voxel): free space has nothing to carve.
+  // Also in the blocks the bands cross: a car that moved on by less than a block left its
+  // old rear in the sub-blocks beside its new one.
+  std::fill(list.masks.begin(), list.masks.end(), std::uint8_t{0xff});
+  // A block may be partly in view when its centre is not: test its bounding sphere.
+  const float vs = view.vs, min_d = view.min_d;
+  const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
+  for (const auto& block : volume_.blocks()) {
+    if (block->stamp == kListedMark || !block->negative_subblocks)
+      continue;
+    const Eigen::Vector3f c = T_cw * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
+    if (!sphereInView(c, radius, view.cam, min_d))
+      continue;
+    const float z = std::max(c.z(), min_d);
+    const float u = view.fx * c.x() / z + view.cx, v = view.fy * c.y() / z + view.cy;
+    const int ui = std::clamp(static_cast<int>(std::lround(u)), 0, view.width - 1);
+    const int vi = std::clamp(static_cast<int>(std::lround(v)), 0, view.height - 1);
+    const float d = view.depth.at<float>(vi, ui);
+    if (!(d > 0.f) || c.z() - radius < d) {
+      list.blocks.push_back(block);
+      list.masks.push_back(block->negative_subblocks);
     }
   }
-  stats_.allocate_ms = msSince(t_start);
+}
 
-  // 2. Projective update of every voxel of those blocks, in parallel over blocks.
-  const auto t_update = Clock::now();
-  const std::uint64_t stamp = volume_.beginGeneration();
-  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
-  const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
-  const Eigen::Vector3f ex = R.col(0) * vs, ey = R.col(1) * vs, ez = R.col(2) * vs;
+detail::BlockChanges TsdfIntegrator::updateBlocks(const DepthFrame& frame, const FrameView& view,
+                                                  const Eigen::Isometry3d& T_world_cam, const detail::BlockList& list) {
+  const std::vector<TsdfBlock*>& blocks = list.blocks;
+  detail::BlockChanges changes;
+  changes.stamp = volume_.beginGeneration();
+  changes.updated.assign(blocks.size(), 0);
+  changes.listed.assign(blocks.size(), 0);
   const bool regularized = regularizes();
   // Changed voxels of each block (local indices), for the regularization.
   if (regularized) {
     changed_index_.resize(blocks.size() * detail::kListStride);
     data_term_.resize(changed_index_.size());
   }
-  std::vector<std::uint16_t> changed_count(blocks.size(), 0), listed_count(blocks.size(), 0);
-  const float smooth_band = smoothingBand();
-  const bool bilinear = config_.interpolate_depth;
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const Eigen::Matrix3f R = T_cam_world.linear().cast<float>();
+  const float vs = view.vs;
   const bool carving = config_.space_carving;
-  const bool dropoff = config_.weight_dropoff;
-  const float colour_band = 1.5f * vs;
-  const float max_weight = config_.max_weight;
   const bool has_color = !frame.color.empty();
-  std::vector<char> changed(blocks.size(), 0);
-
-  const float sub_radius = 0.5f * std::sqrt(3.f) * 3.f * vs; // voxel centres of a 4^3 sub-block
-
-  std::atomic<std::size_t> projected_total{0};
-  const float* depth_data = depth_image.ptr<float>(0);
-  const detail::SubBlockTest test_sub_block = detail::subBlockTest();
-  const detail::VoxelTestFrame test_frame{fx, fy, cx, cy, width, height, min_d, max_d, carving, depth_data, pixel_data};
+  const float* depth_data = view.depth.ptr<float>(0);
   // The wide kernels read a colour as 4 bytes, one before the pixel's (or after, at pixel 0).
   const bool color_wide = has_color && frame.color.cols >= 2;
-  const detail::BlockUpdate update_block =
-      !has_color || color_wide ? detail::blockUpdate() : detail::blockUpdatePortable;
-  const detail::VoxelUpdateFrame update_frame{
-      width, height, depth_data, pixel_data, has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
-      has_color ? static_cast<int>(frame.color.step[0]) : 0, bilinear, carving, dropoff, regularized, trunc, vs,
-      colour_band, max_weight, smooth_band};
-  // Blocks visited in the image's order (their centres' 32x32-pixel tiles along a Z-order curve)
-  // rather than the keys', so that neighbouring blocks' tests read the same depth and pixel
-  // records from the cache. Each block's work is its own: the order changes no result.
-  std::vector<std::uint64_t> order(blocks.size());
-  for (std::size_t i = 0; i < blocks.size(); ++i) {
-    const Eigen::Vector3d centre = (blocks[i]->origin().cast<double>() + Eigen::Vector3d::Constant(3.5)) * vs;
-    const Eigen::Vector3f c = (T_cam_world * centre).cast<float>();
-    std::uint64_t tile = 0xffffffffu; // behind the camera: last
-    if (c.z() > min_d) {
-      const auto tu = static_cast<std::uint32_t>(std::clamp(fx * c.x() / c.z() + cx, 0.f, width - 1.f)) >> 5;
-      const auto tv = static_cast<std::uint32_t>(std::clamp(fy * c.y() / c.z() + cy, 0.f, height - 1.f)) >> 5;
-      tile = 0;
-      for (int b = 0; b < 16; ++b)
-        tile |= static_cast<std::uint64_t>(((tu >> b) & 1u) | (((tv >> b) & 1u) << 1)) << (2 * b);
-    }
-    order[i] = tile << 32 | i;
-  }
-  std::sort(order.begin(), order.end());
+  const BlockProjection project{
+      view, T_cam_world, R.col(0) * vs, R.col(1) * vs, R.col(2) * vs,
+      SubBlockCull{view, carving, 0.5f * std::sqrt(3.f) * 3.f * vs, tile_min_.data(), tile_max_.data(),
+                   tile_band_.data()},
+      detail::subBlockTest(),
+      detail::VoxelTestFrame{view.fx, view.fy, view.cx, view.cy, view.width, view.height, view.min_d, view.max_d,
+                             carving, depth_data, pixels_.data()},
+      !has_color || color_wide ? detail::blockUpdate() : detail::blockUpdatePortable,
+      detail::VoxelUpdateFrame{view.width, view.height, depth_data, pixels_.data(),
+                               has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
+                               has_color ? static_cast<int>(frame.color.step[0]) : 0, config_.interpolate_depth,
+                               carving, config_.weight_dropoff, regularized, view.trunc, vs, 1.5f * vs,
+                               config_.max_weight, smoothingBand()},
+      frame.color};
+  const std::vector<std::uint64_t> order = visitOrder(blocks, T_cam_world, view);
+  std::atomic<std::size_t> projected_total{0};
   parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
-  // Voxels of one block that passed the nearest-pixel test, gathered before any is updated
-  // so that their voxels and colours are prefetched while the rest of the block is tested
-  // (a map of 10 frames is ~75 MB: the voxels are read from memory, not from a cache).
-  detail::VoxelCandidates candidates;
-  std::size_t projected = 0;
-  for (int n = range.start; n < range.end; ++n) {
-    const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(n)] & 0xffffffffu);
-    TsdfBlock& block = *blocks[i];
-    const Eigen::Vector3f base = (T_cam_world * (block.origin().cast<double>() * vs)).cast<float>();
-    const detail::VoxelTestBlock test_block{{base.x(), base.y(), base.z()}, {ex.x(), ex.y(), ex.z()},
-                                            {ey.x(), ey.y(), ey.z()}, {ez.x(), ez.y(), ez.z()}, block.voxels.data()};
-    int n_candidates = 0;
-    for (int sub = 0; sub < 8; ++sub) {
-      if (!(masks[i] & (1u << sub)))
-        continue; // no sampled ray's band crosses this sub-block
-      const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = (sub & 4);
-      {
-        const Eigen::Vector3f c = base + (ex * (sx + 1.5f) + ey * (sy + 1.5f) + ez * (sz + 1.5f));
-        if (c.z() + sub_radius < min_d)
-          continue;
-        if (c.z() - sub_radius > 0.5f * min_d + 1e-3f) {
-          // Pixel footprint of the bounding sphere: |u(p) - u(c)| <= fx r (1 + |x/z|) / (z - r),
-          // +1 px for rounding and bilinear lookups.
-          const float inv = sub_radius / (c.z() - sub_radius);
-          const float ru = fx * inv * (1.f + std::abs(c.x() / c.z())) + 1.f;
-          const float rv = fy * inv * (1.f + std::abs(c.y() / c.z())) + 1.f;
-          const float uc = fx * c.x() / c.z() + cx, vc = fy * c.y() / c.z() + cy;
-          const int u0 = std::max(0, floorToInt(uc - ru)), u1 = std::min(width - 1, static_cast<int>(uc + ru));
-          const int v0 = std::max(0, floorToInt(vc - rv)), v1 = std::min(height - 1, static_cast<int>(vc + rv));
-          if (u0 > u1 || v0 > v1)
-            continue; // outside the image
-          const int tx0 = u0 / kTile, tx1 = u1 / kTile, ty0 = v0 / kTile, ty1 = v1 / kTile;
-          if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= 64) {
-            float dmin = std::numeric_limits<float>::infinity(), dmax = -dmin, band = 0.f;
-            for (int ty = ty0; ty <= ty1; ++ty)
-              for (int tx = tx0; tx <= tx1; ++tx) {
-                const std::size_t t = static_cast<std::size_t>(ty) * tiles_x + tx;
-                dmin = std::min(dmin, tile_min_[t]);
-                dmax = std::max(dmax, tile_max_[t]);
-                band = std::max(band, tile_band_[t]);
-              }
-            // A bilinear depth lies between its pixels' depths: within [dmin, dmax].
-            if (dmax + band < c.z() - sub_radius)
-              continue; // every band is in front: the voxels are hidden behind the surface
-            if (!carving && dmin - band > c.z() + sub_radius)
-              continue; // every band is beyond: the voxels are free space
-          }
-        }
+    detail::VoxelCandidates candidates;
+    std::size_t projected = 0;
+    for (int n = range.start; n < range.end; ++n) {
+      const auto i = static_cast<std::size_t>(order[static_cast<std::size_t>(n)] & 0xffffffffu);
+      TsdfBlock& block = *blocks[i];
+      const detail::VoxelUpdateResult r =
+          project(block, list.masks[i], candidates, projected,
+                  regularized ? &changed_index_[i * detail::kListStride] : nullptr,
+                  regularized ? &data_term_[i * detail::kListStride] : nullptr);
+      changes.updated[i] = static_cast<std::uint16_t>(r.updated);
+      changes.listed[i] = static_cast<std::uint16_t>(r.listed);
+      if (r.updated) {
+        block.stamp = changes.stamp;
+        // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
+        block.signs |= r.signs;
+        block.negative_subblocks |= r.negative;
       }
-      projected += 64;
-      n_candidates = test_sub_block(test_frame, test_block, sx, sy, sz, candidates, n_candidates);
     }
-    if (has_color) // the voxels were prefetched by the test
-      for (int c = 0; c < n_candidates; ++c)
-        __builtin_prefetch(frame.color.ptr<std::uint8_t>(candidates.vi[c]) + 3 * candidates.ui[c]);
-
-    const detail::VoxelUpdateResult r =
-        update_block(update_frame, candidates, n_candidates, block.voxels.data(),
-                     regularized ? &changed_index_[i * detail::kListStride] : nullptr,
-                     regularized ? &data_term_[i * detail::kListStride] : nullptr);
-    const int updated = r.updated, listed = r.listed;
-    changed_count[i] = static_cast<std::uint16_t>(updated);
-    listed_count[i] = static_cast<std::uint16_t>(listed);
-    if (updated) {
-      block.stamp = stamp;
-      // Only ever set here: a stale bit only costs the mesher a look (see TsdfBlock::signs).
-      block.signs |= r.signs;
-      block.negative_subblocks |= r.negative;
-      changed[i] = 1;
-    }
-  }
-  projected_total += projected;
+    projected_total += projected;
   }, std::max(1.0, static_cast<double>(blocks.size()) / 8));
-  std::vector<TsdfBlock*> touched;
-  touched.reserve(blocks.size());
-  std::vector<std::size_t> offsets{0};
+  changes.projected = projected_total;
+  return changes;
+}
+
+void TsdfIntegrator::collectChanged(const detail::BlockList& list, const detail::BlockChanges& changes,
+                                    std::vector<TsdfBlock*>& touched, std::vector<std::size_t>& offsets) {
+  const bool regularized = regularizes();
+  touched.reserve(list.blocks.size());
+  offsets.assign(1, 0);
   std::size_t updated_total = 0;
-  for (std::size_t i = 0; i < blocks.size(); ++i)
-    if (changed[i]) {
-      touched.push_back(blocks[i]);
-      updated_total += changed_count[i];
+  for (std::size_t i = 0; i < list.blocks.size(); ++i)
+    if (changes.updated[i]) {
+      touched.push_back(list.blocks[i]);
+      updated_total += changes.updated[i];
       if (regularized) {
         // Compact the lists in place: the source is at or after the destination.
-        std::copy_n(&changed_index_[i * detail::kListStride], listed_count[i], &changed_index_[offsets.back()]);
-        std::copy_n(&data_term_[i * detail::kListStride], listed_count[i], &data_term_[offsets.back()]);
-        offsets.push_back(offsets.back() + listed_count[i]);
+        std::copy_n(&changed_index_[i * detail::kListStride], changes.listed[i], &changed_index_[offsets.back()]);
+        std::copy_n(&data_term_[i * detail::kListStride], changes.listed[i], &data_term_[offsets.back()]);
+        offsets.push_back(offsets.back() + changes.listed[i]);
       }
-    } else if (blocks[i]->stamp == std::numeric_limits<std::uint64_t>::max())
-      blocks[i]->stamp = stamp;
+    } else if (list.blocks[i]->stamp == kListedMark)
+      list.blocks[i]->stamp = changes.stamp;
   stats_.blocks_touched = touched.size();
   stats_.voxels_updated = updated_total;
-  stats_.voxels_projected = projected_total;
-  stats_.update_ms = msSince(t_update);
-
-  const auto t_reg = Clock::now();
-  if (regularized)
-    regularize(touched, offsets);
-  stats_.regularize_ms = msSince(t_reg);
+  stats_.voxels_projected = changes.projected;
 }
 
 void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
@@ -763,21 +950,8 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
   stats_.update_ms = msSince(t_start);
   const auto t_reg = Clock::now();
   if (regularized) {
-    const float smooth_band = smoothingBand();
-    std::vector<std::size_t> offsets{0};
-    changed_index_.clear();
-    data_term_.clear();
-    for (TsdfBlock* block : touched) {
-      for (int j = 0; j < TsdfBlock::kVoxels; ++j)
-        if (block->voxels[j].flags & kUpdated) {
-          block->voxels[j].flags = 0;
-          if (!(std::abs(block->voxels[j].sdf) < smooth_band))
-            continue;
-          changed_index_.push_back(static_cast<std::uint16_t>(j));
-          data_term_.push_back(block->voxels[j].sdf);
-        }
-      offsets.push_back(changed_index_.size());
-    }
+    std::vector<std::size_t> offsets;
+    listFlaggedVoxels(touched, smoothingBand(), changed_index_, data_term_, offsets);
     regularize(touched, offsets);
   }
   stats_.regularize_ms = msSince(t_reg);
@@ -806,10 +980,8 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
         neighbours[i][k] = volume_.findBlock(touched[i]->index + steps[k]);
   }, 16);
 
-  // x_i = (W_i y_i + lambda * sum_j x_j) / (W_i + lambda * n_i) over observed 6-neighbours j
-  // (W_i = 1 for LambdaData::Uniform): the
-  // stationarity condition of eq. 7, over the voxels this frame changed (the others are held
-  // fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
+  // The stationarity condition of eq. 7 (relaxBlock), over the voxels this frame changed (the
+  // others are held fixed). Gauss-Seidel in place, block by block; blocks of one colour of a 3D checkerboard
   // share no face (face neighbours differ by one in one coordinate), so each colour's blocks
   // run in parallel without races.
   std::array<std::vector<std::size_t>, 2> colour;
@@ -836,39 +1008,9 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
           for (std::size_t k = offsets[next]; k < offsets[next + 1]; ++k)
             __builtin_prefetch(&touched[next]->voxels[changed_index_[k]]);
         }
-        TsdfBlock& block = *touched[i];
-        const auto& nb = neighbours[i];
-        std::uint8_t signs = 0, negative = 0;
-        float change = 0.f;
-        for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-          const int j = changed_index_[k];
-          const int x = j & 7, yy = (j >> 3) & 7, z = j >> 6;
-          float sum = 0.f, count = 0.f;
-          // Without branches: whether a neighbour was observed is unpredictable.
-          auto add = [&](const TsdfVoxel& q) {
-            const bool observed = q.weight > 0.f;
-            sum += observed ? q.sdf : 0.f;
-            count += observed ? 1.f : 0.f;
-          };
-          if (x > 0) add(block.voxels[j - 1]); else if (nb[0]) add(nb[0]->at(kSide - 1, yy, z));
-          if (x < kSide - 1) add(block.voxels[j + 1]); else if (nb[1]) add(nb[1]->at(0, yy, z));
-          if (yy > 0) add(block.voxels[j - kSide]); else if (nb[2]) add(nb[2]->at(x, kSide - 1, z));
-          if (yy < kSide - 1) add(block.voxels[j + kSide]); else if (nb[3]) add(nb[3]->at(x, 0, z));
-          if (z > 0) add(block.voxels[j - kSide * kSide]); else if (nb[4]) add(nb[4]->at(x, yy, kSide - 1));
-          if (z < kSide - 1) add(block.voxels[j + kSide * kSide]); else if (nb[5]) add(nb[5]->at(x, yy, 0));
-          float& sdf = block.voxels[j].sdf;
-          const float before = sdf;
-          const float data = by_weight ? block.voxels[j].weight : 1.f;
-          if (count > 0.f)
-            sdf = (data * data_term_[k] + lambda * sum) / (data + lambda * count);
-          change = std::max(change, std::abs(sdf - before));
-          signs |= sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
-          negative |= sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(j)) : 0;
-        }
-        if (last) {
-          block.signs |= signs;
-          block.negative_subblocks |= negative;
-        }
+        const float change = relaxBlock(*touched[i], neighbours[i], changed_index_.data() + offsets[i],
+                                        data_term_.data() + offsets[i], offsets[i + 1] - offsets[i], lambda, by_weight,
+                                        last);
         for (float seen = largest_change.load(); change > seen && !largest_change.compare_exchange_weak(seen, change);)
           ;
       }

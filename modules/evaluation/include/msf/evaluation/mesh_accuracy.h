@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/spatial_hash.h>
 #include <msf/io/surface_classes.h>
 
 #include <Eigen/Core>
@@ -37,12 +38,6 @@ public:
 
 private:
   using Cell = Eigen::Vector3i;
-  struct CellHash {
-    std::size_t operator()(const Cell& c) const {
-      return static_cast<std::size_t>(c.x()) * 73856093u ^ static_cast<std::size_t>(c.y()) * 19349663u ^
-             static_cast<std::size_t>(c.z()) * 83492791u;
-    }
-  };
   struct CellEqual {
     bool operator()(const Cell& a, const Cell& b) const { return a == b; }
   };

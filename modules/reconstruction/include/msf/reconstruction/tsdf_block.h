@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/spatial_hash.h>
 #include <msf/reconstruction/tsdf_voxel.h>
 
 #include <Eigen/Core>
@@ -14,13 +15,9 @@ namespace msf {
 /// Integer coordinates of a block (or of a voxel) on the volume's grid.
 using GridIndex = Eigen::Vector3i;
 
-/// Hash of a GridIndex for the volume's block map (the usual three large primes).
+/// Hash of a GridIndex for sets and maps of blocks (the mesher's cache, ScanBandBlocks).
 struct GridIndexHash {
-  std::size_t operator()(const GridIndex& i) const noexcept {
-    return static_cast<std::size_t>(static_cast<std::uint32_t>(i.x()) * 73856093u ^
-                                    static_cast<std::uint32_t>(i.y()) * 19349663u ^
-                                    static_cast<std::uint32_t>(i.z()) * 83492791u);
-  }
+  std::size_t operator()(const GridIndex& i) const noexcept { return spatialHash32(i.x(), i.y(), i.z()); }
 };
 
 /// A dense cube of kSide^3 voxels, the unit of allocation, of parallel work and of

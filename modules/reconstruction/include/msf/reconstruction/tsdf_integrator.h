@@ -25,6 +25,10 @@ struct PixelBand {
   float scale, front, behind, weight;
   float free; ///< the weight of a free-space update, carving_weight included
 };
+/// The state that TsdfIntegrator::integrate's phases pass on (tsdf_integrator.cpp).
+struct FrameView;
+struct BlockList;
+struct BlockChanges;
 } // namespace detail
 
 /// Integrates depth into a TsdfVolume (paper §III-C): a projective weighted running mean
@@ -295,6 +299,24 @@ private:
   }
   /// |sdf| below which a changed voxel is regularized (infinite: all of them).
   float smoothingBand() const;
+  // integrate's phases, in order.
+  /// The frame's pixel weights (weight_) and the depth to integrate.
+  detail::FrameView prepareDepth(const DepthFrame& frame);
+  /// Per pixel, its plane scale, bands and weights (pixels_).
+  void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
+  /// The sorted keys of the sub-blocks that the pixels' bands cross; also the depth ranges of
+  /// the image's tiles (tile_min_, tile_max_, tile_band_).
+  std::vector<std::uint64_t> findBandSubBlocks(const detail::FrameView& view, const Eigen::Isometry3d& T_world_cam);
+  /// Allocates the blocks of those sub-blocks.
+  detail::BlockList allocateSubBlocks(const std::vector<std::uint64_t>& keys);
+  /// Space carving: adds the blocks with a surface in the view in front of the frame's depth.
+  void addBlocksToCarve(const detail::FrameView& view, const Eigen::Isometry3d& T_world_cam, detail::BlockList& list);
+  /// Updates the voxels of the listed sub-blocks that the frame sees.
+  detail::BlockChanges updateBlocks(const DepthFrame& frame, const detail::FrameView& view,
+                                    const Eigen::Isometry3d& T_world_cam, const detail::BlockList& list);
+  /// The blocks changed and, for the regularization, their changed voxels' lists compacted.
+  void collectChanged(const detail::BlockList& list, const detail::BlockChanges& changes,
+                      std::vector<TsdfBlock*>& touched, std::vector<std::size_t>& offsets);
   /// Eq. 7 over the voxels changed_index_[offsets[i] .. offsets[i + 1]) of touched[i].
   void regularize(const std::vector<TsdfBlock*>& touched, const std::vector<std::size_t>& offsets);
 
