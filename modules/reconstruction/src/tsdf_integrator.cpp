@@ -178,6 +178,7 @@ void TsdfIntegrator::Config::read(const cv::FileNode& node) {
   readKey(node, "space_carving", space_carving);
   readKey(node, "carving_weight", carving_weight);
   readKey(node, "scan_carving_m", scan_carving_m);
+  readKey(node, "sky_carving", sky_carving);
   readKey(node, "weight_dropoff", weight_dropoff);
   readKey(node, "silhouette_band", silhouette_band);
   std::string distance = toString(signed_distance);
@@ -262,6 +263,7 @@ void TsdfIntegrator::Config::print(std::ostream& out) const {
       << "  space_carving: " << configValue(space_carving) << "\n"
       << "  carving_weight: " << configValue(carving_weight) << "\n"
       << "  scan_carving_m: " << configValue(scan_carving_m) << "\n"
+      << "  sky_carving: " << configValue(sky_carving) << "\n"
       << "  weight_dropoff: " << configValue(weight_dropoff) << "\n"
       << "  silhouette_band: " << configValue(silhouette_band) << "\n"
       << "  signed_distance: " << toString(signed_distance) << "\n"

@@ -102,6 +102,10 @@ public:
     /// seen by it again, and stayed a ghost. Farther, a bin of the scan (0.4 degrees, 14 cm at
     /// 20 m) grows wider than a voxel and the conservative test carves less and less.
     double scan_carving_m = 20.0;
+    /// Also carve along the rays of the frame's open sky (carveSky): they passed every surface,
+    /// but the sky gives no depth, so a surface left in front of it (a car that drove on, depth
+    /// carried over the sky) is cleared by nothing else.
+    bool sky_carving = true;
     /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
     /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
     bool weight_dropoff = true;
@@ -160,7 +164,7 @@ public:
 
     /// Overrides the keys present in a YAML section (`tsdf_integrator`): weighting
     /// (constant | inverse_square | per_pixel), max_weight, min_pixel_weight, truncation_sigmas,
-    /// space_carving, carving_weight, scan_carving_m,
+    /// space_carving, carving_weight, scan_carving_m, sky_carving,
     /// weight_dropoff, silhouette_band, signed_distance (projective | plane), plane_step_px, plane_max_curvature,
     /// plane_min_scale, lambda, lambda_data (uniform | inverse_variance), sweeps, solve (sweeps |
     /// argmin), argmin_tolerance_m,
@@ -209,6 +213,14 @@ public:
   /// whose returns lie around it, is left alone.
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam);
+
+  /// Free space that the open sky shows (Config::sky_carving, with space_carving): a ray through a
+  /// pixel of `sky` (CV_8UC1 of `camera`'s size, non-zero = open sky, as SkyMask finds it) passed
+  /// every surface, so each voxel behind a surface (sdf < 0) whose centre projects into such a
+  /// pixel, from min_depth_m to farthestDepth(), takes a free-space update of `weight` (m^-2)
+  /// times carving_weight. Throws InvalidInputError for a mask of another type or size, a weight
+  /// that is not positive and finite, or a pose that is not rigid.
+  void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are
