@@ -50,7 +50,7 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
   if (rect.empty() || !(w > 0.f))
     return;
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
-  const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(farthestDepth());
+  const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.farthestDepth());
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
   std::vector<TsdfBlock*> blocks;

@@ -104,8 +104,9 @@ public:
     double scan_carving_m = 20.0;
     /// Also carve along the rays of the frame's open sky (carveSky): they passed every surface,
     /// but the sky gives no depth, so a surface left in front of it (a car that drove on, depth
-    /// carried over the sky) is cleared by nothing else.
-    bool sky_carving = true;
+    /// carried over the sky) is cleared by nothing else. Off: a sky mask found in the image takes
+    /// a blank façade above the LiDAR's top ring for sky, and carving erases it.
+    bool sky_carving = false;
     /// Behind the surface the weight falls linearly from 1 at one voxel to 0 at the
     /// truncation (Voxblox's drop-off): there the observation only guesses the thickness.
     bool weight_dropoff = true;
