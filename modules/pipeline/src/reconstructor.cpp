@@ -2,6 +2,7 @@
 #include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/parallel.h>
+#include <msf/evaluation/sky_mask.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/bounded_queue.h>
@@ -61,6 +62,7 @@ struct Reconstructor::Stages {
   LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
   SgbmStereo stereo;
   DepthImageFusion fusion;
+  SkyMask sky;
 };
 
 Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config)
@@ -141,6 +143,16 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
   result.times.fusion_ms = msSince(start);
 }
 
+void Reconstructor::computeSky(const Frame& frame, FrameResult& result) {
+  if (!config_.integrator.sky_carving || !config_.integrator.space_carving)
+    return;
+  // The colour camera sees the far sky at camera 0's pixels (rectified, one image plane), and
+  // colour tells a blue or grey-white sky from a white wall.
+  const bool colour = !frame.color.empty() && frame.color.size() == frame.left.size();
+  result.sky = stages_->sky.compute(colour ? frame.color : frame.left,
+                                    realReturns(result.lidar_depth, result.lidar_distance));
+}
+
 bool Reconstructor::lidarBeforeStereo() const {
   return config_.scheduling.stereo_prior || config_.stereo.lidarGuidance();
 }
@@ -165,6 +177,7 @@ FrameResult Reconstructor::computeDepth(const Frame& frame) {
   }
   result.times.depth_ms = msSince(depth_start);
   computeFusion(frame, result);
+  computeSky(frame, result);
   return result;
 }
 
@@ -175,6 +188,14 @@ void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const 
   const double sigma = fusion.lidar_range_sigma_m;
   integrator.carveWithScan(result.scan_free_space, result.T_world_cam0 * calibration.T_cam0_velo,
                            static_cast<float>(1.0 / (sigma * sigma)), camera, result.T_world_cam0);
+}
+
+void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
+              const DepthFusionConfig& fusion) {
+  if (result.sky.empty())
+    return;
+  const double sigma = fusion.lidar_range_sigma_m;
+  integrator.carveSky(result.sky, camera, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)));
 }
 
 void Reconstructor::integrate(FrameResult& result) {
@@ -190,6 +211,7 @@ void Reconstructor::integrate(FrameResult& result) {
   const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
   integrator_->integrate(frame, result.T_world_cam0);
   carveWithScan(*integrator_, result, frame.camera, config_.fusion, calibration_);
+  carveSky(*integrator_, result, camera_, config_.fusion);
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
     streaming_->afterIntegration(result.T_world_cam0.translation());
@@ -386,6 +408,7 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
           computeStereo(item->frame, result);
           result.times.depth_ms = msSince(start) + result.times.lidar_ms;
           computeFusion(item->frame, result);
+          computeSky(item->frame, result);
         } else {
           result = computeDepth(item->frame);
         }

@@ -22,6 +22,7 @@ void SourceMaps::integrate(const FrameResult& result) {
     map->integrator.integrate(frame, result.T_world_cam0);
     if (map->source == DepthSource::Lidar)
       carveWithScan(map->integrator, result, frame.camera, config_.fusion, calibration_);
+    carveSky(map->integrator, result, result.fused.camera, config_.fusion);
   }
 }
 

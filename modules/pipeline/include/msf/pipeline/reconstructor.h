@@ -83,6 +83,9 @@ struct FrameResult {
   /// The scan's free space all around (tsdf_integrator.scan_carving_m): what the map clears
   /// outside the camera's view (TsdfIntegrator::carveWithScan).
   ScanFreeSpace scan_free_space;
+  /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky) when the map carves
+  /// along it (tsdf_integrator.sky_carving): what the map clears in front of the sky (carveSky).
+  cv::Mat sky;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
@@ -97,6 +100,13 @@ struct FrameResult {
 /// (fusion.lidar_range_sigma_m). `camera` is the integrated frame's.
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration);
+
+/// Free space along the frame's open sky (FrameResult::sky; see TsdfIntegrator::carveSky; nothing
+/// without a sky or when tsdf_integrator.sky_carving or space_carving is off): a sky pixel weighs
+/// as a LiDAR return does (fusion.lidar_range_sigma_m), since its ray is as surely free. `camera`
+/// is camera 0's, the sky's.
+void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
+              const DepthFusionConfig& fusion);
 
 /// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
@@ -255,6 +265,8 @@ private:
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
+  /// The frame's open sky (FrameResult::sky), when the map carves along it.
+  void computeSky(const Frame& frame, FrameResult& result);
   /// Whether frames from `first` on are tracked by the odometry (PoseMode).
   bool tracks(const Frame& first) const;
   /// The odometry's pose of the frame's scan; frames in order.

@@ -115,6 +115,11 @@ public:
     /// stayed a ghost. Farther, a bin of the scan (0.4 degrees, 14 cm at 20 m) grows wider than a
     /// voxel and the conservative test carves less and less.
     double scan_carving_m = 20.0;
+    /// Also carve along the rays of the frame's open sky (carveSky): they passed every surface,
+    /// but the sky gives no depth, so a surface left in front of it (a car that drove on, depth
+    /// carried over the sky) is cleared by nothing else. Off: a sky mask found in the image takes
+    /// a blank façade above the LiDAR's top ring for sky, and carving erases it.
+    bool sky_carving = false;
     /// Voxblox's drop-off: behind the surface the observation only guesses the thickness.
     bool weight_dropoff = true;
     /// The band behind a pixel reaches no deeper than its object is seen to be wide
@@ -174,6 +179,7 @@ public:
       k("carving_weight", carving_weight, atLeast(0), "a free-space update weighs this times the observation");
       k("scan_carving_m", scan_carving_m, between(0, kMaxDepthM),
         "also carve with the LiDAR's scan outside the camera's view, this far from the LiDAR, m (0: off)");
+      k("sky_carving", sky_carving, "also carve along the rays of the frame's open sky (SkyMask)");
       k("weight_dropoff", weight_dropoff, "behind the surface the weight falls to 0 at the band's end");
       k("silhouette_band", silhouette_band,
         "the band behind a pixel reaches no deeper than its object is seen to be wide (at least two truncations)");
@@ -240,6 +246,14 @@ public:
   /// whose returns lie around it, is left alone.
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam);
+
+  /// Free space that the open sky shows (Config::sky_carving, with space_carving): a ray through a
+  /// pixel of `sky` (CV_8UC1 of `camera`'s size, non-zero = open sky, as SkyMask finds it) passed
+  /// every surface, so each voxel behind a surface (sdf < 0) whose centre projects into such a
+  /// pixel, from min_depth_m to farthestDepth(), takes a free-space update of `weight` (m^-2)
+  /// times carving_weight. Throws InvalidInputError for a mask of another type or size, a weight
+  /// that is not positive and finite, or a pose that is not rigid.
+  void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are

@@ -1,0 +1,197 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include "scenes.h"
+#include "test_support.h"
+
+#include <msf/common/config.h>
+#include <msf/common/config_keys.h>
+#include <msf/common/exceptions.h>
+#include <msf/reconstruction/marching_cubes.h>
+#include <msf/reconstruction/mesh_rasterizer.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+namespace msf {
+namespace {
+
+/// KITTI's camera 0.
+PinholeCamera kittiCamera() {
+  PinholeCamera c;
+  c.width = 1241;
+  c.height = 376;
+  c.fx = c.fy = 718.856f;
+  c.cx = 607.19f;
+  c.cy = 185.22f;
+  return c;
+}
+
+/// The camera drives along +z (y down), 1 m per frame.
+Eigen::Isometry3d drivePose(int i) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().z() = i;
+  return T;
+}
+
+/// A road 1.65 m below the camera and a wall 4 m to its right, 6 m high; with `van`, a van
+/// 2.4 m high (0.75 m above the camera) stopped in the lane with its rear 12 m on.
+AnalyticScene road(bool van) {
+  AnalyticScene s;
+  s.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.65);
+  s.addBox(Eigen::Vector3d(4.2, -1.35, 20), Eigen::Vector3d(0.2, 3, 30));
+  if (van)
+    s.addBox(Eigen::Vector3d(0, 1.65 - 1.2, 14.5), Eigen::Vector3d(0.9, 1.2, 2.5));
+  return s;
+}
+
+/// The open sky of a frame of an analytic scene: the pixels above the horizon whose ray meets
+/// nothing within 80 m.
+cv::Mat openSky(const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose) {
+  const cv::Mat far = scene.renderDepth(camera, pose, 80.0);
+  cv::Mat sky = far == 0.f;
+  sky.rowRange(static_cast<int>(camera.cy), sky.rows).setTo(0);
+  return sky;
+}
+
+/// The share of a frame's open sky that the mesh covers (evaluation protocol 6).
+double skyCovered(const TriangleMesh& mesh, const cv::Mat& sky, const PinholeCamera& camera,
+                  const Eigen::Isometry3d& pose) {
+  cv::Mat rendered;
+  MeshRasterizer().render(mesh, camera, pose, rendered);
+  return cv::countNonZero(sky & (rendered > 0.f)) / static_cast<double>(std::max(1, cv::countNonZero(sky)));
+}
+
+struct DriveResult {
+  double sky_covered = 0;   ///< at the last frame
+  std::size_t van_top = 0;  ///< vertices of the van's ghost above the camera
+  std::size_t wall = 0;     ///< vertices of the wall
+};
+
+/// Frames 0-2 see the van; it drives off, and frames 3-8 see the road behind. What the rays
+/// through its upper part meet is the sky, which has no depth.
+DriveResult driveAfterTheVan(bool sky_carving) {
+  const PinholeCamera camera = kittiCamera();
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator::Config config;
+  config.sky_carving = sky_carving;
+  TsdfIntegrator integrator(volume, config);
+  for (int i = 0; i <= 8; ++i) {
+    const AnalyticScene scene = road(i <= 2);
+    const DepthFrame frame = test::renderFrame(scene, camera, drivePose(i), 0.0);
+    integrator.integrate(frame, drivePose(i));
+    integrator.carveSky(openSky(scene, camera, drivePose(i)), camera, drivePose(i), 1111.f);
+  }
+  DriveResult r;
+  TriangleMesh mesh;
+  MarchingCubes().extract(volume, mesh);
+  r.sky_covered = skyCovered(mesh, openSky(road(false), camera, drivePose(8)), camera, drivePose(8));
+  for (const auto& v : mesh.vertices) {
+    r.van_top += std::abs(v.x()) < 1.2f && v.y() < 0.f && v.z() > 11.f && v.z() < 18.f;
+    r.wall += v.x() > 3.8f && v.x() < 4.2f && v.z() > 10.f && v.z() < 25.f;
+  }
+  std::printf("  sky carving %d: sky covered %.4f, van top %zu vertices, wall %zu\n", sky_carving, r.sky_covered,
+              r.van_top, r.wall);
+  return r;
+}
+
+TEST(SkyCarving, ClearsTheGhostThatOnlyTheSkyLooksThrough) {
+  const DriveResult without = driveAfterTheVan(false), with = driveAfterTheVan(true);
+  // Without: the van's upper part stays, a sheet over the sky 4 m ahead of the last frame.
+  EXPECT_GT(without.van_top, 80u); // its rear, 1.8 m x 0.75 m: one vertex per 0.1 m voxel
+  EXPECT_GT(without.sky_covered, 0.05);
+  // With: gone, and the wall the sky runs along is whole.
+  // (a row at the horizon may stay: the voxels below it are not under the sky)
+  EXPECT_LT(with.van_top, without.van_top / 4);
+  EXPECT_LT(with.sky_covered, 0.01);
+  EXPECT_GE(with.wall, without.wall * 99 / 100);
+}
+
+TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
+  // A wall seen from the street; a mask that holds every pixel but the wall's leaves it whole,
+  // one that holds it too clears it.
+  const PinholeCamera camera = kittiCamera();
+  const AnalyticScene scene = road(false);
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator::Config config;
+  config.sky_carving = true;
+  TsdfIntegrator integrator(volume, config);
+  integrator.integrate(test::renderFrame(scene, camera, drivePose(0), 0.0), drivePose(0));
+  auto wallVertices = [&] {
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    std::size_t n = 0;
+    for (const auto& v : mesh.vertices)
+      n += v.x() > 3.8f && v.x() < 4.2f && v.y() < 0.f;
+    return n;
+  };
+  const std::size_t before = wallVertices();
+  const cv::Mat depth = scene.renderDepth(camera, drivePose(0), 20.0);
+  cv::Mat wall_pixels(depth.size(), CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < depth.rows; ++v)
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      wall_pixels.at<std::uint8_t>(v, u) = z > 0.f && (u - camera.cx) / camera.fx * z > 3.9 ? 255 : 0;
+    }
+  integrator.carveSky(~wall_pixels, camera, drivePose(0), 1111.f);
+  EXPECT_GE(wallVertices(), before * 99 / 100); // a voxel at its top edge may round into the sky
+  EXPECT_GT(before, 1000u);
+  integrator.carveSky(cv::Mat(depth.size(), CV_8UC1, cv::Scalar(255)), camera, drivePose(0), 1111.f);
+  EXPECT_LT(wallVertices(), before / 20);
+}
+
+TEST(SkyCarving, OffEmptyOrRefused) {
+  const PinholeCamera camera = kittiCamera();
+  const AnalyticScene scene = road(true);
+  const DepthFrame frame = test::renderFrame(scene, camera, drivePose(0), 0.0);
+  const cv::Mat everything(camera.height, camera.width, CV_8UC1, cv::Scalar(255));
+  auto vertices = [](const TsdfVolume& volume) {
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    return mesh.vertices.size();
+  };
+  for (const bool space_carving : {false, true}) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator::Config config;
+    config.space_carving = space_carving;
+    config.sky_carving = !space_carving; // sky carving needs both
+    TsdfIntegrator integrator(volume, config);
+    integrator.integrate(frame, drivePose(0));
+    const std::size_t before = vertices(volume);
+    integrator.carveSky(everything, camera, drivePose(0), 1111.f);
+    EXPECT_EQ(vertices(volume), before);
+  }
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator::Config config;
+  config.sky_carving = true;
+  TsdfIntegrator integrator(volume, config);
+  integrator.integrate(frame, drivePose(0));
+  const std::size_t before = vertices(volume);
+  integrator.carveSky(cv::Mat(), camera, drivePose(0), 1111.f); // no sky: nothing
+  integrator.carveSky(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(0)), camera, drivePose(0), 1111.f);
+  EXPECT_EQ(vertices(volume), before);
+  EXPECT_EQ(test::errorOf([&] {
+              integrator.carveSky(cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)), camera, drivePose(0), 1111.f);
+            }),
+            "carveSky: the sky mask must be CV_8UC1 of the camera's 1241x376, not 10x10 of type 0");
+  EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), 0.f), InvalidInputError);
+  EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), std::nanf("")), InvalidInputError);
+  EXPECT_EQ(vertices(volume), before);
+}
+
+TEST(SkyCarving, IsAConfigKey) {
+  TsdfIntegrator::Config config;
+  EXPECT_FALSE(config.sky_carving); // the mask takes blank façades for sky (docs/results.md)
+  ConfigFile::fromText("tsdf_integrator:\n  sky_carving: true\n", "c.yaml").read(config);
+  EXPECT_TRUE(config.sky_carving);
+  std::ostringstream printed;
+  printConfig(printed, config);
+  EXPECT_NE(printed.str().find("  sky_carving: true\n"), std::string::npos) << printed.str();
+}
+
+} // namespace
+} // namespace msf
