@@ -38,10 +38,12 @@ TEST(VolumeLimits, VoxelAndTruncationRanges) {
 TEST(VolumeLimits, SweepsAndDepthRange) {
   msf::TsdfIntegrator::Config c;
   c.sweeps = 1000000;
-  EXPECT_NE(errorOf([&] { c.validate(); }).find("sweeps (-sweeps) must be 0..100"), std::string::npos);
+  EXPECT_NE(errorOf([&] { c.validate(); }).find("tsdf_integrator.sweeps must be in 0..100, not 1000000"), std::string::npos);
   c.sweeps = 1;
   c.max_depth_m = 1e30;
-  EXPECT_NE(errorOf([&] { c.validate(); }).find("max_depth_m must be at most 1000"), std::string::npos);
+  const std::string depth_error = errorOf([&] { c.validate(); });
+  EXPECT_NE(depth_error.find("tsdf_integrator.max_depth_m must be in"), std::string::npos) << depth_error;
+  EXPECT_NE(depth_error.find("1000]"), std::string::npos) << depth_error;
 }
 
 TEST(VolumeLimits, MemoryBudgetStopsTheRunBeforeItAllocates) {
