@@ -4,6 +4,7 @@
 #include <msf/common/parallel.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
+#include "surface_voxel_walk.h"
 #include "voxel_update.h"
 
 #include <opencv2/imgproc.hpp>
@@ -66,38 +67,19 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
   const std::uint64_t stamp = volume_.beginGeneration();
   const float max_weight = config_.max_weight;
   parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
-    for (int n = range.start; n < range.end; ++n) {
-      TsdfBlock& block = *blocks[static_cast<std::size_t>(n)];
-      const Eigen::Vector3f origin = T_cam_world * (block.origin().cast<float>() * vs);
-      const Eigen::Matrix3f axes = T_cam_world.linear() * vs;
-      bool changed = false;
-      for (int sub = 0; sub < 8; ++sub) {
-        if (!(block.negative_subblocks & (1u << sub)))
-          continue;
-        const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = sub & 4;
-        for (int z = sz; z < sz + 4; ++z)
-          for (int y = sy; y < sy + 4; ++y)
-            for (int x = sx; x < sx + 4; ++x) {
-              TsdfVoxel& voxel = block.at(x, y, z);
-              if (!(voxel.sdf < 0.f && voxel.weight > 0.f))
-                continue;
-              const Eigen::Vector3f p =
-                  origin + axes * Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-              if (p.z() < min_d || p.z() > max_d)
-                continue;
-              const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
-              const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
-              if (u < 0 || v < 0 || u >= camera.width || v >= camera.height || !sky.at<std::uint8_t>(v, u))
-                continue;
-              detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
-              changed = true;
-            }
-      }
-      if (changed) {
-        block.updateSigns();
-        block.stamp = stamp;
-      }
-    }
+    for (int n = range.start; n < range.end; ++n)
+      detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_cam_world, vs, stamp,
+                                 [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
+                                   if (p.z() < min_d || p.z() > max_d)
+                                     return false;
+                                   const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
+                                   const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
+                                   if (u < 0 || v < 0 || u >= camera.width || v >= camera.height ||
+                                       !sky.at<std::uint8_t>(v, u))
+                                     return false;
+                                   detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                                   return true;
+                                 });
   });
 }
 

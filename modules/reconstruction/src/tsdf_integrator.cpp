@@ -8,6 +8,7 @@
 #include <msf/reconstruction/silhouette_thickness.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
+#include "surface_voxel_walk.h"
 #include "voxel_update.h"
 
 #include <opencv2/core/utility.hpp>
@@ -831,35 +832,15 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
   const std::uint64_t stamp = volume_.beginGeneration();
   const float max_weight = config_.max_weight;
   parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
-    for (int n = range.start; n < range.end; ++n) {
-      TsdfBlock& block = *blocks[static_cast<std::size_t>(n)];
-      const Eigen::Vector3f origin = T_lidar_world * (block.origin().cast<float>() * vs);
-      const Eigen::Matrix3f axes = T_lidar_world.linear() * vs;
-      bool changed = false;
-      for (int sub = 0; sub < 8; ++sub) {
-        if (!(block.negative_subblocks & (1u << sub)))
-          continue;
-        const int sx = 4 * (sub & 1), sy = 2 * (sub & 2), sz = sub & 4;
-        for (int z = sz; z < sz + 4; ++z)
-          for (int y = sy; y < sy + 4; ++y)
-            for (int x = sx; x < sx + 4; ++x) {
-              TsdfVoxel& voxel = block.at(x, y, z);
-              if (!(voxel.sdf < 0.f && voxel.weight > 0.f))
-                continue;
-              const Eigen::Vector3f p = origin + axes * Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
-                                                                        static_cast<float>(z));
-              const float nearest = free_space.nearestAround(p);
-              if (nearest > 0.f && p.norm() < nearest - margin) {
-                updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
-                changed = true;
-              }
-            }
-      }
-      if (changed) {
-        block.updateSigns();
-        block.stamp = stamp;
-      }
-    }
+    for (int n = range.start; n < range.end; ++n)
+      detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_lidar_world, vs, stamp,
+                                 [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
+                                   const float nearest = free_space.nearestAround(p);
+                                   if (!(nearest > 0.f && p.norm() < nearest - margin))
+                                     return false;
+                                   updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                                   return true;
+                                 });
   });
 }
 
