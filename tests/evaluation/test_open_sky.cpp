@@ -103,6 +103,33 @@ TEST(SkyMask, AWallWithoutReturnsIsSkyButAColouredOneIsNot) {
   EXPECT_FALSE(sky(mask, 160, 40));
 }
 
+TEST(SkyMask, GivesEachColumnTheDepthOfItsHighestReturn) {
+  // The crown's returns (8 m) reach row 26 over columns 20-59, the fence's (9 m) columns 80-119,
+  // the wall's (12 m) columns 140-179; the road's (10 m) start at row 62. A column takes the
+  // highest return within 8 columns of it.
+  const std::vector<float> depth = SkyMask().topReturnDepth(drawnReturns());
+  ASSERT_EQ(depth.size(), static_cast<std::size_t>(kWidth));
+  EXPECT_EQ(depth[40], 8.f);
+  EXPECT_EQ(depth[65], 8.f);  // within the window of the crown's last column
+  EXPECT_EQ(depth[70], 10.f); // the road's only
+  EXPECT_EQ(depth[100], 9.f);
+  EXPECT_EQ(depth[160], 12.f);
+  EXPECT_EQ(depth[185], 12.f);
+  EXPECT_EQ(depth[195], 10.f);
+  const cv::Mat none(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  EXPECT_EQ(SkyMask().topReturnDepth(none), std::vector<float>(kWidth, 0.f));
+  // One ring passes a far wall (30 m, row 10) and a near one (12 m, a row lower): a column
+  // between them takes the near wall's depth, not a lower ring's nearer return (5 m, row 20).
+  cv::Mat ring = none.clone();
+  ring(cv::Rect(100, 10, 5, 1)).setTo(30.f);
+  ring(cv::Rect(106, 11, 5, 1)).setTo(12.f);
+  ring(cv::Rect(100, 20, 11, 1)).setTo(5.f);
+  const std::vector<float> ring_depth = SkyMask().topReturnDepth(ring);
+  EXPECT_EQ(ring_depth[105], 12.f);
+  EXPECT_EQ(ring_depth[92], 30.f); // only the far wall within its window
+  EXPECT_THROW(SkyMask().topReturnDepth(cv::Mat(kHeight, kWidth, CV_8UC1)), InvalidInputError);
+}
+
 TEST(SkyMask, RefusesImagesOfAnotherTypeOrSize) {
   const cv::Mat returns = drawnReturns();
   EXPECT_THROW(SkyMask().compute(cv::Mat(kHeight, kWidth, CV_32FC3), returns), InvalidInputError);

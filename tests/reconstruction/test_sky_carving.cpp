@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace msf {
 namespace {
@@ -111,6 +112,74 @@ TEST(SkyCarving, ClearsTheGhostThatOnlyTheSkyLooksThrough) {
   EXPECT_GE(with.wall, without.wall * 99 / 100);
 }
 
+/// A mask that errs as SkyMask does on a blank façade: every pixel above the horizon.
+cv::Mat everythingAboveTheHorizon(const PinholeCamera& camera) {
+  cv::Mat sky(camera.height, camera.width, CV_8UC1, cv::Scalar(0));
+  sky.rowRange(0, static_cast<int>(camera.cy)).setTo(255);
+  return sky;
+}
+
+/// Per column, the depth of the highest return a LiDAR whose top ring looks 2 degrees up gets
+/// from `scene` (0: none), as SkyMask::topReturnDepth gives it.
+std::vector<float> topReturnDepth(const AnalyticScene& scene, const PinholeCamera& camera,
+                                  const Eigen::Isometry3d& pose) {
+  const cv::Mat depth = scene.renderDepth(camera, pose, 80.0);
+  const int top_ring_row = static_cast<int>(camera.cy - camera.fy * std::tan(2.0 * M_PI / 180.0));
+  std::vector<float> top(static_cast<std::size_t>(camera.width), 0.f);
+  for (int u = 0; u < camera.width; ++u)
+    for (int v = top_ring_row; v < depth.rows && top[static_cast<std::size_t>(u)] == 0.f; ++v)
+      top[static_cast<std::size_t>(u)] = depth.at<float>(v, u);
+  return top;
+}
+
+TEST(SkyCarving, KeepsAWallTheMaskTakesForSkyInFrontOfItsReturns) {
+  // The van's frames, then the road behind it, as in the drive above; but the mask also takes the
+  // wall above the LiDAR's top ring for sky. Bounded by each column's highest return, the sky's
+  // rays stop in front of the wall (a vertical plane keeps one depth down a column) and still
+  // pass through the van's ghost, which hangs in front of the returns beyond it.
+  const PinholeCamera camera = kittiCamera();
+  auto drive = [&](bool bounded) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator::Config config;
+    config.sky_carving = true;
+    TsdfIntegrator integrator(volume, config);
+    for (int i = 0; i <= 8; ++i) {
+      const AnalyticScene scene = road(i <= 2);
+      integrator.integrate(test::renderFrame(scene, camera, drivePose(i), 0.0), drivePose(i));
+      integrator.carveSky(everythingAboveTheHorizon(camera), camera, drivePose(i), 1111.f,
+                          bounded ? topReturnDepth(scene, camera, drivePose(i)) : std::vector<float>());
+    }
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    DriveResult r;
+    r.sky_covered = skyCovered(mesh, openSky(road(false), camera, drivePose(8)), camera, drivePose(8));
+    for (const auto& v : mesh.vertices) {
+      r.van_top += std::abs(v.x()) < 1.2f && v.y() < 0.f && v.z() > 11.f && v.z() < 18.f;
+      r.wall += v.x() > 3.8f && v.x() < 4.2f && v.y() < -0.5f && v.z() > 10.f && v.z() < 25.f;
+    }
+    std::printf("  bounded %d: sky covered %.4f, van top %zu vertices, wall above the ring %zu\n", bounded,
+                r.sky_covered, r.van_top, r.wall);
+    return r;
+  };
+  const DriveResult truth = driveAfterTheVan(false), unbounded = drive(false), bounded = drive(true);
+  std::size_t wall_above_the_ring = 0;
+  {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator integrator(volume, TsdfIntegrator::Config());
+    for (int i = 0; i <= 8; ++i)
+      integrator.integrate(test::renderFrame(road(false), camera, drivePose(i), 0.0), drivePose(i));
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    for (const auto& v : mesh.vertices)
+      wall_above_the_ring += v.x() > 3.8f && v.x() < 4.2f && v.y() < -0.5f && v.z() > 10.f && v.z() < 25.f;
+  }
+  ASSERT_GT(wall_above_the_ring, 500u);
+  EXPECT_LT(unbounded.wall, wall_above_the_ring / 10); // the mask's error erases the wall
+  EXPECT_GE(bounded.wall, wall_above_the_ring * 98 / 100);
+  EXPECT_LT(bounded.sky_covered, truth.sky_covered / 10); // and the ghost still goes
+  EXPECT_LT(bounded.van_top, truth.van_top * 2 / 3);
+}
+
 TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
   // A wall seen from the street; a mask that holds every pixel but the wall's leaves it whole,
   // one that holds it too clears it.
@@ -178,6 +247,10 @@ TEST(SkyCarving, OffEmptyOrRefused) {
               integrator.carveSky(cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)), camera, drivePose(0), 1111.f);
             }),
             "carveSky: the sky mask must be CV_8UC1 of the camera's 1241x376, not 10x10 of type 0");
+  EXPECT_EQ(test::errorOf([&] {
+              integrator.carveSky(everything, camera, drivePose(0), 1111.f, std::vector<float>(10, 5.f));
+            }),
+            "carveSky: the column depths must be one per image column (1241), not 10");
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), 0.f), InvalidInputError);
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), std::nanf("")), InvalidInputError);
   EXPECT_EQ(vertices(volume), before);
@@ -185,12 +258,12 @@ TEST(SkyCarving, OffEmptyOrRefused) {
 
 TEST(SkyCarving, IsAConfigKey) {
   TsdfIntegrator::Config config;
-  EXPECT_FALSE(config.sky_carving); // the mask takes blank façades for sky (docs/results.md)
-  ConfigFile::fromText("tsdf_integrator:\n  sky_carving: true\n", "c.yaml").read(config);
   EXPECT_TRUE(config.sky_carving);
+  ConfigFile::fromText("tsdf_integrator:\n  sky_carving: false\n", "c.yaml").read(config);
+  EXPECT_FALSE(config.sky_carving);
   std::ostringstream printed;
   printConfig(printed, config);
-  EXPECT_NE(printed.str().find("  sky_carving: true\n"), std::string::npos) << printed.str();
+  EXPECT_NE(printed.str().find("  sky_carving: false\n"), std::string::npos) << printed.str();
 }
 
 } // namespace

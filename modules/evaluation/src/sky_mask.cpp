@@ -15,6 +15,8 @@ namespace {
 constexpr double kBlueHueMin = 85.0, kBlueHueMax = 135.0;
 /// Side of the window of the texture's standard deviation.
 constexpr int kTextureWindow = 5;
+/// Rows within which returns lie on one ring (KITTI's rings lie 5-6 pixels apart up there).
+constexpr int kOneRingRows = 3;
 
 std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
 
@@ -43,21 +45,38 @@ cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
   return sky;
 }
 
-std::vector<int> SkyMask::lidarTop(const cv::Mat& returns) const {
-  std::vector<int> highest(static_cast<std::size_t>(returns.cols), returns.rows);
+std::vector<SkyMask::TopReturn> SkyMask::topReturns(const cv::Mat& returns) const {
+  std::vector<TopReturn> highest(static_cast<std::size_t>(returns.cols), TopReturn{returns.rows, 0.f});
   for (int v = returns.rows - 1; v >= 0; --v) {
     const float* z = returns.ptr<float>(v);
     for (int u = 0; u < returns.cols; ++u)
       if (z[u] > 0.f)
-        highest[static_cast<std::size_t>(u)] = v;
+        highest[static_cast<std::size_t>(u)] = TopReturn{v, z[u]};
   }
-  std::vector<int> top(highest.size());
+  const auto higher = [](const TopReturn& a, const TopReturn& b) { return a.row < b.row; };
+  std::vector<TopReturn> top(highest.size());
   for (int u = 0; u < returns.cols; ++u) {
     const auto first = highest.begin() + std::max(0, u - column_window_);
     const auto last = highest.begin() + std::min(returns.cols, u + column_window_ + 1);
-    top[static_cast<std::size_t>(u)] = *std::min_element(first, last);
+    TopReturn t = *std::min_element(first, last, higher);
+    // The nearest of the returns on the same ring: a pixel's row decides the highest among
+    // returns at one elevation, and a far one must not stand for a near wall beside it.
+    for (auto it = first; it != last; ++it)
+      if (it->row <= t.row + kOneRingRows && it->depth > 0.f)
+        t.depth = std::min(t.depth, it->depth);
+    top[static_cast<std::size_t>(u)] = t;
   }
   return top;
+}
+
+std::vector<float> SkyMask::topReturnDepth(const cv::Mat& returns) const {
+  if (returns.type() != CV_32FC1)
+    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1, not of type " +
+                            std::to_string(returns.type()));
+  const std::vector<TopReturn> top = topReturns(returns);
+  std::vector<float> depth(top.size());
+  std::transform(top.begin(), top.end(), depth.begin(), [](const TopReturn& t) { return t.depth; });
+  return depth;
 }
 
 cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
@@ -70,11 +89,11 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
     throw ConfigError("sky mask: the column window and the border must be >= 0, not " +
                       std::to_string(column_window_) + " and " + std::to_string(border_));
   cv::Mat sky = skyLike(image);
-  const std::vector<int> top = lidarTop(returns);
+  const std::vector<TopReturn> top = topReturns(returns);
   for (int v = 0; v < sky.rows; ++v) {
     std::uint8_t* s = sky.ptr<std::uint8_t>(v);
     for (int u = 0; u < sky.cols; ++u)
-      if (v >= top[static_cast<std::size_t>(u)])
+      if (v >= top[static_cast<std::size_t>(u)].row)
         s[u] = 0;
   }
   // Step 3: the components that touch the top row.

@@ -46,6 +46,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.truncation_sigmas = 0.0;
   c.integrator.min_pixel_weight = 0.f;
   c.integrator.space_carving = false;
+  c.integrator.sky_carving = false;
   c.integrator.weight_dropoff = false;
   c.integrator.silhouette_band = false;
   c.integrator.interpolate_depth = false;

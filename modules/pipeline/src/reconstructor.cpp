@@ -149,8 +149,9 @@ void Reconstructor::computeSky(const Frame& frame, FrameResult& result) {
   // The colour camera sees the far sky at camera 0's pixels (rectified, one image plane), and
   // colour tells a blue or grey-white sky from a white wall.
   const bool colour = !frame.color.empty() && frame.color.size() == frame.left.size();
-  result.sky = stages_->sky.compute(colour ? frame.color : frame.left,
-                                    realReturns(result.lidar_depth, result.lidar_distance));
+  const cv::Mat returns = realReturns(result.lidar_depth, result.lidar_distance);
+  result.sky = stages_->sky.compute(colour ? frame.color : frame.left, returns);
+  result.sky_column_depth = stages_->sky.topReturnDepth(returns);
 }
 
 bool Reconstructor::lidarBeforeStereo() const {
@@ -195,7 +196,8 @@ void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const Pinho
   if (result.sky.empty())
     return;
   const double sigma = fusion.lidar_range_sigma_m;
-  integrator.carveSky(result.sky, camera, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)));
+  integrator.carveSky(result.sky, camera, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)),
+                      result.sky_column_depth);
 }
 
 void Reconstructor::integrate(FrameResult& result) {

@@ -36,13 +36,16 @@ bool sphereMeetsRect(const Eigen::Vector3f& c, float r, const PinholeCamera& cam
 } // namespace
 
 void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-                              float weight) {
+                              float weight, const std::vector<float>& column_depth) {
   if (!config_.sky_carving || !config_.space_carving || sky.empty())
     return;
   if (sky.type() != CV_8UC1 || sky.cols != camera.width || sky.rows != camera.height)
     throw InvalidInputError("carveSky: the sky mask must be CV_8UC1 of the camera's " + std::to_string(camera.width) +
                             "x" + std::to_string(camera.height) + ", not " + std::to_string(sky.cols) + "x" +
                             std::to_string(sky.rows) + " of type " + std::to_string(sky.type()));
+  if (!column_depth.empty() && column_depth.size() != static_cast<std::size_t>(camera.width))
+    throw InvalidInputError("carveSky: the column depths must be one per image column (" +
+                            std::to_string(camera.width) + "), not " + std::to_string(column_depth.size()));
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveSky: the weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
@@ -52,6 +55,11 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
     return;
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_d = static_cast<float>(config_.farthestDepth());
+  const float wall_margin = trunc + vs;
+  const auto nearerThanWall = [&](int u, float z) {
+    return column_depth.empty() || !(column_depth[static_cast<std::size_t>(u)] > 0.f) ||
+           z < column_depth[static_cast<std::size_t>(u)] - wall_margin;
+  };
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
   std::vector<TsdfBlock*> blocks;
@@ -75,7 +83,7 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
                                    const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
                                    const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
                                    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height ||
-                                       !sky.at<std::uint8_t>(v, u))
+                                       !sky.at<std::uint8_t>(v, u) || !nearerThanWall(u, p.z()))
                                      return false;
                                    detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
                                    return true;

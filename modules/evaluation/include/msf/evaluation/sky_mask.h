@@ -48,11 +48,23 @@ public:
   /// ConfigError for a setting out of range (a negative window or border).
   cv::Mat compute(const cv::Mat& image, const cv::Mat& returns) const;
 
+  /// Per image column, the depth of the nearest return on the highest ring within its column
+  /// window (the returns within 3 rows of the highest, the one that bounds step 2), 0 where the
+  /// window has none. A blank wall that the mask takes for sky continues above its highest
+  /// returns at their depth (a vertical plane keeps one depth down an image column), so what
+  /// lies nearer than this depth is in front of any such wall.
+  /// Throws InvalidInputError for `returns` not CV_32FC1.
+  std::vector<float> topReturnDepth(const cv::Mat& returns) const;
+
 private:
+  /// The highest return within each column's window: its row (the image's height: none) and depth.
+  struct TopReturn {
+    int row;
+    float depth;
+  };
+  std::vector<TopReturn> topReturns(const cv::Mat& returns) const;
   /// Step 1: bright, blank and sky-coloured pixels (255).
   cv::Mat skyLike(const cv::Mat& image) const;
-  /// Step 2: per column, the first row below the highest return in its window (0: none above).
-  std::vector<int> lidarTop(const cv::Mat& returns) const;
 
   double min_brightness_ = 110.0;
   double max_texture_ = 6.0;

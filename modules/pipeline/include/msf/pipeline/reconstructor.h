@@ -86,6 +86,9 @@ struct FrameResult {
   /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky) when the map carves
   /// along it (tsdf_integrator.sky_carving): what the map clears in front of the sky (carveSky).
   cv::Mat sky;
+  /// Per image column, the depth of the LiDAR's highest return near it (SkyMask::topReturnDepth):
+  /// how far the sky's rays are carved there.
+  std::vector<float> sky_column_depth;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what

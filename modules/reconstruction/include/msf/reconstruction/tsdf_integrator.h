@@ -117,9 +117,8 @@ public:
     double scan_carving_m = 20.0;
     /// Also carve along the rays of the frame's open sky (carveSky): they passed every surface,
     /// but the sky gives no depth, so a surface left in front of it (a car that drove on, depth
-    /// carried over the sky) is cleared by nothing else. Off: a sky mask found in the image takes
-    /// a blank façade above the LiDAR's top ring for sky, and carving erases it.
-    bool sky_carving = false;
+    /// carried over the sky) is cleared by nothing else.
+    bool sky_carving = true;
     /// Voxblox's drop-off: behind the surface the observation only guesses the thickness.
     bool weight_dropoff = true;
     /// The band behind a pixel reaches no deeper than its object is seen to be wide
@@ -179,7 +178,8 @@ public:
       k("carving_weight", carving_weight, atLeast(0), "a free-space update weighs this times the observation");
       k("scan_carving_m", scan_carving_m, between(0, kMaxDepthM),
         "also carve with the LiDAR's scan outside the camera's view, this far from the LiDAR, m (0: off)");
-      k("sky_carving", sky_carving, "also carve along the rays of the frame's open sky (SkyMask)");
+      k("sky_carving", sky_carving,
+        "also carve along the rays of the frame's open sky (SkyMask), in front of the LiDAR's highest returns");
       k("weight_dropoff", weight_dropoff, "behind the surface the weight falls to 0 at the band's end");
       k("silhouette_band", silhouette_band,
         "the band behind a pixel reaches no deeper than its object is seen to be wide (at least two truncations)");
@@ -251,9 +251,14 @@ public:
   /// pixel of `sky` (CV_8UC1 of `camera`'s size, non-zero = open sky, as SkyMask finds it) passed
   /// every surface, so each voxel behind a surface (sdf < 0) whose centre projects into such a
   /// pixel, from min_depth_m to farthestDepth(), takes a free-space update of `weight` (m^-2)
-  /// times carving_weight. Throws InvalidInputError for a mask of another type or size, a weight
+  /// times carving_weight. `column_depth` (one per image column, or empty: no bound) bounds each
+  /// column's rays: where it is positive (the depth of the LiDAR's highest return there,
+  /// SkyMask::topReturnDepth), only voxels nearer by more than the truncation and a voxel are
+  /// carved, so that a blank wall above the returns that the mask takes for sky is kept. Throws
+  /// InvalidInputError for a mask of another type or size, a bound of another length, a weight
   /// that is not positive and finite, or a pose that is not rigid.
-  void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight);
+  void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight,
+                const std::vector<float>& column_depth = {});
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are
