@@ -157,6 +157,37 @@ TEST(CompoundInterpolation, ACameraOfAnotherSizeIsAnError) {
   EXPECT_THROW(filter.filter(out), msf::InvalidInputError);
 }
 
+TEST(CompoundInterpolation, SetIndicesChoosesTheReturnsCompletedFrom) {
+  // The left half's points as indices complete as the cloud whose right half has no returns;
+  // the output is still the whole organized cloud.
+  const Cloud::Ptr sparse = sparseCloud();
+  const int W = static_cast<int>(sparse->width);
+  pcl::IndicesPtr left(new pcl::Indices);
+  Cloud::Ptr left_only(new Cloud(*sparse));
+  for (std::size_t i = 0; i < sparse->size(); ++i) {
+    if (static_cast<int>(i) % W < W / 2)
+      left->push_back(static_cast<pcl::index_t>(i));
+    else
+      (*left_only)[i].z = std::numeric_limits<float>::quiet_NaN();
+  }
+  msf::CompoundInterpolation<msf::PointXYZID> filter;
+  filter.setCamera(msf::test::smallCamera());
+  filter.setInputCloud(left_only);
+  Cloud expected;
+  filter.filter(expected);
+  const cv::Mat expected_depth = filter.denseDepth().clone();
+  filter.setInputCloud(sparse);
+  filter.setIndices(left);
+  Cloud out;
+  filter.filter(out);
+  ASSERT_EQ(out.width, sparse->width);
+  ASSERT_EQ(out.height, sparse->height);
+  EXPECT_EQ(cv::norm(filter.denseDepth(), expected_depth, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::countNonZero(expected_depth.colRange(W / 2, W)), 0); // completed over the right half too
+  left->push_back(static_cast<pcl::index_t>(sparse->size()));
+  EXPECT_THROW(filter.filter(out), msf::InvalidInputError);
+}
+
 TEST(CompoundInterpolation, ACloudOffItsRaysCannotRecoverACamera) {
   Cloud::Ptr cloud = sparseCloud();
   cv::RNG rng(1);

@@ -13,7 +13,9 @@ namespace msf {
 /// keep their depth keep their exact point; a new point takes the other fields (intensity,
 /// colour) of the nearest real return. When PointT has a `distance` field (PointXYZID) it
 /// receives the exact distance in pixels to the nearest real return, also where there is
-/// no estimate (+inf when the input has no return at all).
+/// no estimate (+inf when the input has no return at all). With setIndices (PCL's
+/// convention), only the indexed points are returns to complete from; the output is still the
+/// whole organized cloud, and the other points are treated as pixels without a return.
 template <typename PointT>
 class DepthCompletionFilter : public pcl::Filter<PointT> {
 public:
@@ -38,8 +40,13 @@ protected:
   virtual void completeDepth(const cv::Mat& sparse, cv::Mat& dense) = 0;
   /// At most this many threads of OpenCV's pool (0: all of them).
   virtual int threads() const { return 0; }
+  /// Clears the depth of the points that setIndices left out (none without it). Throws
+  /// InvalidInputError for an index outside the cloud.
+  void keepIndexedReturns(cv::Mat& sparse) const;
 
   using pcl::Filter<PointT>::input_;
+  using pcl::Filter<PointT>::indices_;
+  using pcl::Filter<PointT>::fake_indices_;
   using pcl::Filter<PointT>::filter_name_;
 
   PinholeCamera camera_;

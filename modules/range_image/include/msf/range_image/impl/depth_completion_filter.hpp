@@ -24,6 +24,20 @@ struct HasDistance<PointT, std::void_t<decltype(std::declval<PointT&>().distance
 } // namespace detail
 
 template <typename PointT>
+void DepthCompletionFilter<PointT>::keepIndexedReturns(cv::Mat& sparse) const {
+  if (fake_indices_ || !indices_)
+    return; // no setIndices: every point
+  cv::Mat kept(sparse.size(), CV_32FC1, cv::Scalar(0));
+  for (const auto i : *indices_) {
+    if (i < 0 || static_cast<std::size_t>(i) >= sparse.total())
+      throw InvalidInputError(filter_name_ + ": index " + std::to_string(i) + " is outside the cloud's " +
+                              std::to_string(sparse.total()) + " points");
+    kept.at<float>(static_cast<int>(i)) = sparse.at<float>(static_cast<int>(i));
+  }
+  sparse = kept;
+}
+
+template <typename PointT>
 void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
   const PointCloud& in = *input_;
   if (!in.isOrganized() || in.empty())
@@ -47,6 +61,7 @@ void DepthCompletionFilter<PointT>::applyFilter(PointCloud& output) {
         d[u] = (std::isfinite(p[u].z) && p[u].z > 0.f) ? p[u].z : 0.f;
     }
   }, stripes);
+  keepIndexedReturns(sparse_);
   completeDepth(sparse_, dense_);
   if (dense_.size() != sparse_.size() || dense_.type() != CV_32FC1)
     throw InvalidInputError(filter_name_ + ": completion returned an image of another size or type");
