@@ -60,19 +60,20 @@ sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag&
     modifier.setPointCloud2Fields(4, "x", 1, F::FLOAT32, "y", 1, F::FLOAT32, "z", 1, F::FLOAT32, b.intensity.c_str(),
                                   1, F::FLOAT32);
   modifier.resize(4);
-  sensor_msgs::PointCloud2Iterator<float> x(m, "x"), y(m, "y"), z(m, "z"), i(m, b.intensity);
-  for (int k = 0; k < 4; ++k, ++x, ++y, ++z, ++i) {
-    *x = 10.f + static_cast<float>(k); // the LiDAR's x forward
-    *y = static_cast<float>(frame);
-    *z = k == 3 ? std::nanf("") : 0.f; // a point without a return: dropped
-    *i = 0.25f * static_cast<float>(k);
-  }
-  if (b.ring_and_time) {
-    sensor_msgs::PointCloud2Iterator<std::uint16_t> ring(m, "ring");
-    sensor_msgs::PointCloud2Iterator<float> time(m, "time");
-    for (int k = 0; k < 4; ++k, ++ring, ++time) {
-      *ring = static_cast<std::uint16_t>(5 + k);
-      *time = -0.1f + 0.02f * static_cast<float>(k); // a driver that stamps the sweep's end
+  // The ring and time layout is packed (22 bytes a point): its fields are copied, not referenced.
+  const auto put = [&m](const std::string& name, int k, auto value) {
+    for (const auto& field : m.fields)
+      if (field.name == name)
+        std::memcpy(&m.data[static_cast<std::size_t>(k) * m.point_step + field.offset], &value, sizeof value);
+  };
+  for (int k = 0; k < 4; ++k) {
+    put("x", k, 10.f + static_cast<float>(k)); // the LiDAR's x forward
+    put("y", k, static_cast<float>(frame));
+    put("z", k, k == 3 ? std::nanf("") : 0.f); // a point without a return: dropped
+    put(b.intensity, k, 0.25f * static_cast<float>(k));
+    if (b.ring_and_time) {
+      put("ring", k, static_cast<std::uint16_t>(5 + k));
+      put("time", k, -0.1f + 0.02f * static_cast<float>(k)); // a driver that stamps the sweep's end
     }
   }
   return m;

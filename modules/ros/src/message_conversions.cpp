@@ -41,6 +41,14 @@ double fieldValue(const sensor_msgs::PointCloud2& message, const sensor_msgs::Po
   }
 }
 
+/// Writes `value` into point i's field. A packed layout (x, y, z, intensity, a uint16 ring, then
+/// a float time: 22 bytes a point) leaves fields unaligned, so neither side goes through a typed
+/// reference.
+template <typename T>
+void putField(sensor_msgs::PointCloud2& message, const sensor_msgs::PointField& field, std::size_t i, T value) {
+  std::memcpy(&message.data[i * message.point_step + field.offset], &value, sizeof value);
+}
+
 void requireLayout(const sensor_msgs::PointCloud2& message, const std::string& what) {
   for (const char* name : {"x", "y", "z"}) {
     const auto* field = findField(message, name);
@@ -97,12 +105,13 @@ void scanFromMessage(const sensor_msgs::PointCloud2& message, Frame& frame, cons
   frame.scan->reserve(points);
   frame.point_ring.clear();
   frame.point_time_s.clear();
-  sensor_msgs::PointCloud2ConstIterator<float> x(message, "x"), y(message, "y"), z(message, "z");
-  for (std::size_t i = 0; i < points; ++i, ++x, ++y, ++z) {
+  const sensor_msgs::PointField &x = *findField(message, "x"), &y = *findField(message, "y"),
+                                 &z = *findField(message, "z");
+  for (std::size_t i = 0; i < points; ++i) {
     pcl::PointXYZI p;
-    p.x = *x;
-    p.y = *y;
-    p.z = *z;
+    p.x = static_cast<float>(fieldValue(message, x, i));
+    p.y = static_cast<float>(fieldValue(message, y, i));
+    p.z = static_cast<float>(fieldValue(message, z, i));
     p.intensity = intensity ? static_cast<float>(fieldValue(message, *intensity, i)) : 0.f;
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.intensity))
       continue;
@@ -143,27 +152,20 @@ sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Heade
                                   F::FLOAT32);
   modifier.resize(frame.scan->size());
   message.is_dense = true;
-  std::optional<sensor_msgs::PointCloud2Iterator<std::uint16_t>> ring;
-  std::optional<sensor_msgs::PointCloud2Iterator<float>> time;
-  if (with_ring)
-    ring.emplace(message, "ring");
-  if (with_time)
-    time.emplace(message, "time");
-  sensor_msgs::PointCloud2Iterator<float> x(message, "x"), y(message, "y"), z(message, "z"), i(message, "intensity");
-  for (std::size_t k = 0; k < frame.scan->size(); ++k, ++x, ++y, ++z, ++i) {
+  const sensor_msgs::PointField &x = *findField(message, "x"), &y = *findField(message, "y"),
+                                 &z = *findField(message, "z"), &intensity = *findField(message, "intensity");
+  const sensor_msgs::PointField* ring = findField(message, "ring");
+  const sensor_msgs::PointField* time = findField(message, "time");
+  for (std::size_t k = 0; k < frame.scan->size(); ++k) {
     const auto& p = (*frame.scan)[k];
-    *x = p.x;
-    *y = p.y;
-    *z = p.z;
-    *i = p.intensity;
-    if (ring) {
-      **ring = frame.point_ring[k];
-      ++*ring;
-    }
-    if (time) {
-      **time = frame.point_time_s[k];
-      ++*time;
-    }
+    putField(message, x, k, p.x);
+    putField(message, y, k, p.y);
+    putField(message, z, k, p.z);
+    putField(message, intensity, k, p.intensity);
+    if (ring)
+      putField(message, *ring, k, frame.point_ring[k]);
+    if (time)
+      putField(message, *time, k, frame.point_time_s[k]);
   }
   return message;
 }
