@@ -33,6 +33,12 @@ BIN=$(cd "${1:?usage: bad_inputs.sh BIN_DIR KITTI_DIR}" && pwd)
 KITTI=${2:-}
 MAX_SECONDS=5
 MAX_KB=$((500 * 1024))
+# Under AddressSanitizer (make test-sanitize sets ASAN_OPTIONS) a tool runs about twice as long
+# and its shadow memory and quarantine take about three times its memory.
+if [ -n "${ASAN_OPTIONS:-}" ]; then
+  MAX_SECONDS=$((MAX_SECONDS * 3))
+  MAX_KB=$((MAX_KB * 3))
+fi
 T=$(mktemp -d /tmp/msf_bad_inputs_XXXXXX)
 trap 'rm -rf "$T"' EXIT
 
