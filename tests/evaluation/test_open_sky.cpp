@@ -3,7 +3,7 @@
 // KITTI frame, and the share of it a mesh covers.
 #include <msf/common/exceptions.h>
 #include <msf/evaluation/open_sky_coverage.h>
-#include <msf/evaluation/sky_mask.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/lidar_projector.h>
 
@@ -128,6 +128,34 @@ TEST(SkyMask, GivesEachColumnTheDepthOfItsHighestReturn) {
   EXPECT_EQ(ring_depth[105], 12.f);
   EXPECT_EQ(ring_depth[92], 30.f); // only the far wall within its window
   EXPECT_THROW(SkyMask().topReturnDepth(cv::Mat(kHeight, kWidth, CV_8UC1)), InvalidInputError);
+}
+
+TEST(SkyMask, ItsClearSkyIsClippedOrBlueNotGreyWhite) {
+  // No return anywhere. The blue sky is clear; a grey-white wall as bright as it (grey 175) is
+  // sky but not clear (a blank wall may look so); a clipped white patch at the top edge is.
+  const cv::Mat none(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  cv::Mat image = drawnScene();
+  image(cv::Rect(140, 30, 40, 30)).setTo(cv::Scalar(175, 175, 175));
+  image(cv::Rect(140, 0, 40, 20)).setTo(cv::Scalar(252, 252, 252));
+  const SkyMask masker;
+  const cv::Mat mask = masker.compute(image, none);
+  const cv::Mat clear = masker.clearSky(image, mask);
+  ASSERT_EQ(clear.type(), CV_8UC1);
+  ASSERT_TRUE(sky(mask, 160, 45));
+  EXPECT_FALSE(sky(clear, 160, 45)); // grey-white
+  EXPECT_TRUE(sky(clear, 100, 5));   // blue
+  EXPECT_TRUE(sky(clear, 160, 8));   // clipped
+  EXPECT_EQ(cv::countNonZero(clear & ~mask), 0);
+  // Grey only: the clipped patch alone is clear.
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat grey_clear = masker.clearSky(grey, masker.compute(grey, none));
+  EXPECT_TRUE(sky(grey_clear, 160, 8));
+  EXPECT_FALSE(sky(grey_clear, 100, 5));
+  // Nothing of a mask that is empty; a mask of another size is refused.
+  EXPECT_EQ(cv::countNonZero(masker.clearSky(image, cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(0)))), 0);
+  EXPECT_THROW(masker.clearSky(image, cv::Mat(kHeight - 1, kWidth, CV_8UC1, cv::Scalar(0))), InvalidInputError);
+  EXPECT_THROW(masker.clearSky(cv::Mat(kHeight, kWidth, CV_32FC1), mask), InvalidInputError);
 }
 
 TEST(SkyMask, RefusesImagesOfAnotherTypeOrSize) {

@@ -8,6 +8,7 @@
 
 #include "test_support.h"
 
+#include <opencv2/core.hpp>
 #include <pcl/point_types.h>
 
 #include <cmath>
@@ -498,6 +499,60 @@ TEST(DepthImageFusion, SameResultAsTheCloudClass) {
         EXPECT_NEAR(cloud.at(u, v).weight, weight.at<float>(v, u), 1e-6f);
       }
   }
+}
+
+TEST(DepthImageFusion, NoDepthInTheClearSkyTheCloudClassNeither) {
+  // A blue sky over rows 0-19 (its blank part, eroded by the mask's border, rows 0-14) where
+  // stereo matched 20 m everywhere, the LiDAR's returns (10 m) from row 24 down: the sky's depth
+  // is withheld in both classes, given the colour image; with clear_sky off, or no image, it is
+  // kept. A sky image of another size is refused.
+  const int w = 60, h = 40;
+  Inputs in(w, h);
+  cv::Mat zl(h, w, CV_32FC1, cv::Scalar(0)), zs(h, w, CV_32FC1, cv::Scalar(20.f));
+  cv::Mat colour(h, w, CV_8UC3, cv::Scalar(100, 100, 100));
+  colour.rowRange(0, 20).setTo(cv::Scalar(230, 170, 120));
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      if (v >= 24 && v % 2 == 0)
+        zl.at<float>(v, u) = 10.f, in.setLidar(u, v, 10.f, 0.f);
+      in.setStereo(u, v, 20.f, 1.f);
+    }
+  const auto sky = [&](const cv::Mat& depth) { return cv::countNonZero(depth.rowRange(0, 12) > 0.f); };
+  msf::DepthImageFusion fusion;
+  fusion.setCalibration(calibration(w, h));
+  cv::Mat fused, weight;
+  fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused, &weight);
+  EXPECT_EQ(sky(fused), 12 * w);
+  EXPECT_TRUE(fusion.getOpenSky().empty());
+  fusion.setSkyImage(colour);
+  fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused, &weight);
+  EXPECT_EQ(sky(fused), 0);
+  EXPECT_EQ(cv::countNonZero(weight.rowRange(0, 12)), 0);
+  EXPECT_EQ(cv::countNonZero(fused.rowRange(24, h) > 0.f), (h - 24) * w); // below the sky: kept
+  EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(5, 30), 255);
+
+  Fusion cloud_fusion;
+  cloud_fusion.setCalibration(calibration(w, h));
+  cloud_fusion.setInputLidar(in.lidar);
+  cloud_fusion.setInputStereo(in.stereo);
+  cloud_fusion.setInputColor(colour);
+  FusedCloud cloud;
+  cloud_fusion.fuse(cloud);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const float z = cloud.at(u, v).z;
+      ASSERT_EQ(std::isfinite(z) ? z : 0.f, fused.at<float>(v, u)) << u << "," << v;
+    }
+
+  msf::DepthFusionConfig off;
+  off.clear_sky = false;
+  fusion.setConfig(off);
+  fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused, &weight);
+  EXPECT_EQ(sky(fused), 12 * w);
+  fusion.setConfig(msf::DepthFusionConfig());
+  fusion.setSkyImage(colour.rowRange(0, h - 1));
+  EXPECT_NE(msf::test::errorOf([&] { fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused); }).find("the sky image"),
+            std::string::npos);
 }
 
 TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {

@@ -60,7 +60,7 @@ cv::Mat fusedByTheTools(const msf::Sequence& sequence, std::size_t i, const std:
       {"msf_stereo", sequence.imagePath(0, i) + " " + sequence.imagePath(1, i) + " " + out.file("stereo.pcd") +
                          with_rig + " -color " + sequence.imagePath(2, i) + " -prior " + out.file("lidar.pcd")},
       {"msf_fuse", out.file("lidar.pcd") + " " + out.file("stereo.pcd") + " " + out.file("fused.pcd") + with_rig +
-                       " -left " + sequence.imagePath(0, i)},
+                       " -left " + sequence.imagePath(0, i) + " -color " + sequence.imagePath(2, i)},
   };
   for (const auto& step : steps) {
     const auto r = msf::test::runTool(step[0], step[1]);

@@ -1,6 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Evaluation protocol 6 on real frames: the sky mask of a hand-checked KITTI frame, and the
-// sheets over the road in front of the open sky that sky carving clears.
+// sheets over the road in front of the open sky that sky carving clears, and the clear sky that
+// gives no depth.
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/sky_scoring.h>
@@ -75,4 +77,33 @@ TEST(OpenSky, SkyCarvingClearsTheSheetsOverTheRoadInFrontOfTheSky) {
   // The whole drive (41 frames, msf_reconstruct): 11.47 -> 0.22 %, worst 36.45 -> 3.18 %.
   EXPECT_LT(with.share, without.share / 10);
   EXPECT_LT(with.worst_share, without.worst_share / 5);
+}
+
+TEST(OpenSky, AClearSkyGivesNoDepth) {
+  // Frame 2 of raw drive 0009: SGBM smears the crowns' disparity over the overexposed sky
+  // between them, thousands of pixels of depth 15-25 m, which hung in the map as sheets. With
+  // fusion.clear_sky the fused frame has no depth in the clear sky, and is the same everywhere
+  // else; the open sky sky carving takes is the one the fusion found.
+  MSF_REQUIRE_KITTI();
+  const msf::Sequence sequence(msf::test::kittiDir() + "/raw/2011_09_26/2011_09_26_drive_0009_sync");
+  const msf::Frame frame = sequence.load(2);
+  ASSERT_FALSE(frame.color.empty());
+  msf::PipelineConfig config;
+  config.fusion.clear_sky = false;
+  const msf::FrameResult without = msf::Reconstructor(sequence.calibration(), config).computeDepth(frame);
+  config.fusion.clear_sky = true;
+  const msf::FrameResult with = msf::Reconstructor(sequence.calibration(), config).computeDepth(frame);
+  ASSERT_FALSE(with.sky.empty());
+  EXPECT_EQ(cv::norm(with.sky, without.sky, cv::NORM_INF), 0.0);
+  const cv::Mat clear = msf::SkyMask().clearSky(frame.color, with.sky);
+  const cv::Mat had = without.fused.depth > 0.f, has = with.fused.depth > 0.f;
+  EXPECT_GT(cv::countNonZero(clear), 15000);
+  EXPECT_GT(cv::countNonZero(had & clear), 3000);
+  EXPECT_EQ(cv::countNonZero(has & clear), 0);
+  EXPECT_GT(cv::countNonZero((with.stereo_depth > 0.f) & clear), 3000); // the stages' own images are kept
+  cv::Mat differs;
+  cv::compare(without.fused.depth, with.fused.depth, differs, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(differs & ~clear), 0);
+  cv::compare(without.fused.weight, with.fused.weight, differs, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(differs & ~clear), 0);
 }

@@ -1,8 +1,10 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
+#include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/facade_extension.h>
+#include <msf/range_image/real_returns.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -86,6 +88,14 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
     supportAtDepthEdges(lidar, distance, fB, config_, fused_depth, edge_buffers_);
   if (config_.facade_extension && !left_.empty())
     extendFacades(left_, calibration_, config_, fused_depth, weight, free_weight);
+  open_sky_.release();
+  if (config_.clear_sky && !sky_image_.empty()) {
+    if (sky_image_.size() != size)
+      throw InvalidInputError("depth fusion: the sky image is " + std::to_string(sky_image_.cols) + "x" +
+                              std::to_string(sky_image_.rows) + ", the depth images " + std::to_string(size.width) +
+                              "x" + std::to_string(size.height));
+    open_sky_ = withholdClearSky(sky_, sky_image_, realReturns(lidar, distance), fused_depth, weight, free_weight);
+  }
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

@@ -39,6 +39,7 @@ PipelineConfig PipelineConfig::paper() {
   c.fusion.paper_weights = PaperWeights::AsWritten;
   c.fusion.edge_support = false;
   c.fusion.facade_extension = false;
+  c.fusion.clear_sky = false;
   // Step 5 (§III-C): a projective TSDF, every depth weighing the same, updated within the
   // truncation only, then eq. 7 solved to its minimizer with lambda 5 (the paper's KITTI value).
   c.integrator.weighting = TsdfIntegrator::Weighting::Constant;

@@ -68,11 +68,14 @@ public:
   const PointCloudStereoConstPtr& getInputStereo() const { return stereo_; }
 
   /// Optional image of the colour camera (BGR) to colour every fused point by projection,
-  /// also where only the LiDAR has depth. Empty: colour from the stereo points.
+  /// also where only the LiDAR has depth. Empty: colour from the stereo points. Of the clouds'
+  /// size, it is also where fusion.clear_sky finds the open sky (else in setInputImage's).
   void setInputColor(const cv::Mat& image) { color_ = image; }
   /// Optional grey image of camera 0 (CV_8UC1, the clouds' width x height): with it and
   /// fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank pixels above
-  /// it (extendFacades), as in the pipeline. Empty: nothing after the fusion but edge support.
+  /// it (extendFacades), as in the pipeline; and with fusion.clear_sky no depth in its clear
+  /// sky (withholdClearSky) when no colour image of its size is set. Empty: nothing after the
+  /// fusion but edge support.
   void setInputImage(const cv::Mat& left) { left_ = left; }
   void setColorCamera(int camera) { color_camera_ = camera; }
   int getColorCamera() const { return color_camera_; }

@@ -3,6 +3,7 @@
 #include <msf/fusion/edge_support.h>
 #include <msf/fusion/fusion_config.h>
 #include <msf/fusion/fusion_model.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 
 #include <opencv2/core/mat.hpp>
@@ -35,12 +36,21 @@ public:
   /// with it and fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank
   /// pixels above it (extendFacades). Empty: nothing after the fusion but edge support.
   void setInputImage(const cv::Mat& left) { left_ = left; }
+  /// Optional image of camera 0's view to find the open sky in (CV_8UC3 BGR, the colour
+  /// camera's at camera 0's pixels, which tells a blue sky from a white wall; or CV_8UC1 grey),
+  /// for the next fuse(): with it and fusion.clear_sky, no depth in the clear sky
+  /// (withholdClearSky). Empty: none withheld.
+  void setSkyImage(const cv::Mat& image) { sky_image_ = image; }
+  /// The open sky (SkyMask, CV_8UC1, 255 = sky) the last fuse() found; empty when it had no sky
+  /// image or clear_sky is off.
+  const cv::Mat& getOpenSky() const { return open_sky_; }
 
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]
   /// (empty: all 1); all of one size. Writes fused_depth (CV_32FC1, 0 = none) and, when
   /// given, fused_weight and free_space_weight (CV_32FC1, FusionResult). Throws
-  /// InvalidInputError naming the image whose type or size is wrong (setInputImage's too),
+  /// InvalidInputError naming the image whose type or size is wrong (setInputImage's and
+  /// setSkyImage's too),
   /// CalibrationError when no calibration was set.
   void fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,
             const cv::Mat& stereo_confidence, cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr,
@@ -52,6 +62,8 @@ private:
   Calibration calibration_;
   LidarParallax parallax_;
   cv::Mat left_;                        ///< setInputImage's
+  cv::Mat sky_image_, open_sky_;        ///< setSkyImage's, and the last fuse's open sky
+  SkyMask sky_;
   cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames
   cv::Mat weight_, free_weight_;        ///< weights when the caller wants none
   cv::Mat zeros_, ones_;                ///< distances and confidences when the caller gives none

@@ -78,6 +78,9 @@ struct DepthFusionConfig {
   // depth; stereo that agrees on the way is averaged with it, stereo that disagrees replaced,
   // unless it sees a surface behind the wall (three pixels beyond 6 sigmas stop the column).
   bool facade_extension = true;
+  // last: no depth in the open sky's clear pixels, clipped or blue (clear_sky.h), found in the
+  // sky image (DepthImageFusion::setSkyImage; msf_fuse's -color, or -left).
+  bool clear_sky = true;
   float facade_anchor_sigma_m = 0.2f;
   float facade_grey_tolerance = 8.f;
   float facade_max_texture = 4.f;
@@ -120,6 +123,7 @@ struct DepthFusionConfig {
     k("edge_tolerance_px", edge_tolerance_px, atLeast(0), "a fused disparity this near a return is on its surface, px");
     k("facade_extension", facade_extension,
       "a LiDAR-backed wall goes on upward above the top ring where the image stays blank");
+    k("clear_sky", clear_sky, "no depth in the open sky's clipped or blue pixels (SkyMask), where stereo smears crowns");
     k("facade_anchor_sigma_m", facade_anchor_sigma_m, above(0), "anchors: fused pixels known to within this, m");
     k("facade_grey_tolerance", facade_grey_tolerance, atLeast(0),
       "grey levels from the anchors' mean (5x5 box-filtered image)");

@@ -83,8 +83,9 @@ struct FrameResult {
   /// The scan's free space all around (tsdf_integrator.scan_carving_m): what the map clears
   /// outside the camera's view (TsdfIntegrator::carveWithScan).
   ScanFreeSpace scan_free_space;
-  /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky) when the map carves
-  /// along it (tsdf_integrator.sky_carving): what the map clears in front of the sky (carveSky).
+  /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky; the fusion's when it
+  /// found one, fusion.clear_sky) when the map carves along it (tsdf_integrator.sky_carving):
+  /// what the map clears in front of the sky (carveSky).
   cv::Mat sky;
   /// Per image column, the depth of the LiDAR's highest return near it (SkyMask::topReturnDepth):
   /// how far the sky's rays are carved there.

@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/evaluation/open_sky_coverage.h>
-#include <msf/evaluation/sky_mask.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 #include <msf/io/frame_source.h>
 #include <msf/range_image/lidar_projector.h>

@@ -5,7 +5,9 @@
 #include <msf/common/limits.h>
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/fusion_model.h>
+#include <msf/fusion/clear_sky.h>
 #include <msf/fusion/facade_extension.h>
+#include <msf/range_image/real_returns.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
 
@@ -124,6 +126,16 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   if (config.facade_extension && !left_.empty()) {
     cv::Mat no_free_space;
     extendFacades(left_, calibration_, config, fused_depth_, fused_weight_, no_free_space);
+  }
+  // The open sky in the colour image where it is camera 0's size (colour tells a blue sky from a
+  // white wall), else in the grey one.
+  const bool colour_sky = color_.type() == CV_8UC3 && color_.cols == cols && color_.rows == rows;
+  const cv::Mat& sky_image = colour_sky ? color_ : left_;
+  if (config.clear_sky && !sky_image.empty()) {
+    cv::Mat no_free_space;
+    withholdClearSky(SkyMask(), sky_image,
+                     lidar_distance_.empty() ? lidar_depth_ : realReturns(lidar_depth_, lidar_distance_), fused_depth_,
+                     fused_weight_, no_free_space);
   }
   // Where neither input has a point (a wall the extension continued), the pixel's own ray.
   const float fx = static_cast<float>(calibration_.fx()), fy = static_cast<float>(calibration_.fy());

@@ -1,6 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
-#include <msf/evaluation/sky_mask.h>
+#include <msf/fusion/sky_mask.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -43,6 +43,35 @@ cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
     sky &= grey_white | blue;
   }
   return sky;
+}
+
+cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
+  if (sky.type() != CV_8UC1 || sky.size() != image.size())
+    throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
+                            sizeText(sky) + " of type " + std::to_string(sky.type()));
+  cv::Mat clear(sky.size(), CV_8UC1, cv::Scalar(0));
+  const cv::Rect area = cv::boundingRect(sky);
+  if (area.empty())
+    return clear;
+  const cv::Mat pixels = image(area);
+  cv::Mat brightest = pixels;
+  if (pixels.channels() == 3) {
+    cv::Mat channel[3];
+    cv::split(pixels, channel);
+    brightest = cv::max(cv::max(channel[0], channel[1]), channel[2]);
+  }
+  cv::Mat out = brightest >= clipped_level_;
+  if (pixels.channels() == 3) {
+    cv::Mat hsv, blue;
+    cv::cvtColor(pixels, hsv, cv::COLOR_BGR2HSV);
+    cv::inRange(hsv, cv::Scalar(kBlueHueMin, max_saturation_ + 1, 0), cv::Scalar(kBlueHueMax, 255, 255), blue);
+    out |= blue;
+  }
+  cv::Mat clear_area = clear(area);
+  cv::bitwise_and(out, sky(area), clear_area);
+  return clear;
 }
 
 std::vector<SkyMask::TopReturn> SkyMask::topReturns(const cv::Mat& returns) const {

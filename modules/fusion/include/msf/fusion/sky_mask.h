@@ -22,6 +22,8 @@ namespace msf {
 ///  4. eroded by the border, so that a surface's outline blurred by the image or by the voxels
 ///     of a map does not count as covering the sky.
 /// The steps are OpenCV's (cvtColor, boxFilter, inRange, connectedComponents, erode).
+/// Within the mask, clearSky() picks what only the sky looks like: a blank wall may be as
+/// grey-white as an overcast sky, but it is rarely clipped or blue.
 class SkyMask {
 public:
   using Ptr = std::shared_ptr<SkyMask>;
@@ -38,6 +40,9 @@ public:
   /// Columns on each side whose highest LiDAR return also bounds a pixel's column.
   void setColumnWindow(int columns) { column_window_ = columns; }
   int getColumnWindow() const { return column_window_; }
+  /// Level (0-255) at which a channel counts as clipped (clearSky): overexposed.
+  void setClippedLevel(double level) { clipped_level_ = level; }
+  double getClippedLevel() const { return clipped_level_; }
   /// Pixels taken off the mask's outline.
   void setBorder(int pixels) { border_ = pixels; }
   int getBorder() const { return border_; }
@@ -47,6 +52,12 @@ public:
   /// > 0 where a return lands). Throws InvalidInputError for another type or size, or
   /// ConfigError for a setting out of range (a negative window or border).
   cv::Mat compute(const cv::Mat& image, const cv::Mat& returns) const;
+
+  /// The pixels of `sky` (compute's mask of `image`, CV_8UC1) whose colour only the sky has: a
+  /// channel clipped (at least the clipped level) or, in colour, blue with more saturation
+  /// than a grey-white pixel (the maximum saturation) has. CV_8UC1, 255 = clear sky. Throws
+  /// InvalidInputError for an image or mask of another type or size.
+  cv::Mat clearSky(const cv::Mat& image, const cv::Mat& sky) const;
 
   /// Per image column, the depth of the nearest return on the highest ring within its column
   /// window (the returns within 3 rows of the highest, the one that bounds step 2), 0 where the
@@ -69,6 +80,7 @@ private:
   double min_brightness_ = 110.0;
   double max_texture_ = 6.0;
   double max_saturation_ = 70.0;
+  double clipped_level_ = 250.0;
   int column_window_ = 8;
   int border_ = 3;
 };
