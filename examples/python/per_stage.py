@@ -23,7 +23,8 @@ for frame in itertools.islice(sequence, int(sys.argv[3]) if len(sys.argv) > 3 el
         frame.left, frame.right,                                       # (H, W) uint8
         prior=lidar_depth,                                             # narrows the disparity search
         guidance=msfusion.real_returns(lidar_depth, distance))         # the real returns guide the matching
-    depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left)
+    depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence,
+                                left=frame.left, sky=frame.color)  # no depth in the clear sky
     color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
     volume.integrate(depth, frame.pose, calibration, weight=weight, color=color)  # 4x4 T_world_cam0
     print(f"frame {frame.name}: {(depth > 0).mean():.0%} of the pixels have depth, {volume.num_blocks} blocks")

@@ -12,6 +12,7 @@
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
+#include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
 
 #include <mutex>
@@ -83,18 +84,25 @@ struct FusionStage {
 
 py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::handle& lidar_distance,
                const py::handle& stereo_depth, const py::handle& stereo_confidence, const py::handle& left,
-               bool free_space) {
+               bool free_space, const py::handle& sky) {
   const cv::Mat ld = imageView(lidar_depth, "lidar_depth", CV_32FC1);
   const cv::Size size = ld.size();
   const cv::Mat dist = optionalImageView(lidar_distance, "lidar_distance", CV_32FC1, size);
   const cv::Mat sd = imageView(stereo_depth, "stereo_depth", CV_32FC1, size);
   const cv::Mat conf = optionalImageView(stereo_confidence, "stereo_confidence", CV_32FC1, size);
   const cv::Mat grey = optionalImageView(left, "left", CV_8UC1, size);
+  // The sky's image: RGB (the library's order is BGR) or grey.
+  const bool colour_sky = py::isinstance<py::array>(sky) && py::reinterpret_borrow<py::array>(sky).ndim() == 3;
+  cv::Mat sky_image = optionalImageView(sky, "sky", colour_sky ? CV_8UC3 : CV_8UC1, size);
+  if (colour_sky)
+    cv::cvtColor(sky_image, sky_image, cv::COLOR_RGB2BGR);
   cv::Mat depth, weight, free_weight;
   withoutGil(stage.mutex, [&] {
     stage.fusion.setInputImage(grey);
+    stage.fusion.setSkyImage(sky_image);
     stage.fusion.fuse(ld, dist, sd, conf, depth, &weight, &free_weight);
     stage.fusion.setInputImage(cv::Mat());
+    stage.fusion.setSkyImage(cv::Mat());
   });
   if (free_space)
     return py::make_tuple(toArray(depth), toArray(weight), toArray(free_weight));
@@ -151,10 +159,13 @@ void bindStages(py::module_& m) {
       .def(py::init<const Calibration&, const PipelineConfig&>(), py::arg("calibration"), py::arg("config") = defaults)
       .def("fuse", &fuse, py::arg("lidar_depth"), py::arg("lidar_distance"), py::arg("stereo_depth"),
            py::arg("stereo_confidence"), py::arg("left") = py::none(), py::arg("free_space") = false,
+           py::arg("sky") = py::none(),
            "(H, W) float32 images: the LiDAR's depth and its distance to the nearest real return (None: all "
            "real), the stereo depth and its confidence (None: all 1). left: camera 0's grey image, for the "
-           "facade extension (as the pipeline does). Returns (depth, weight), the weight the inverse variance "
-           "in m^-2; with free_space=True also the weight of the free space in front of each depth.");
+           "facade extension (as the pipeline does). sky: the image to find the open sky in, the colour "
+           "camera's (H, W, 3) uint8 RGB or the (H, W) grey one: with fusion.clear_sky no depth in its clear "
+           "(clipped or blue) sky, as the pipeline does. Returns (depth, weight), the weight the inverse "
+           "variance in m^-2; with free_space=True also the weight of the free space in front of each depth.");
 
   m.def("real_returns", [](const py::handle& depth, const py::handle& distance) {
     const cv::Mat d = imageView(depth, "depth", CV_32FC1);

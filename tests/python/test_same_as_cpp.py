@@ -64,7 +64,8 @@ def per_stage(sequence):
         lidar_depth, distance = lidar.compute_depth(frame.scan)
         stereo_depth, confidence = stereo.compute_depth(frame.left, frame.right, prior=lidar_depth,
                                                         guidance=msfusion.real_returns(lidar_depth, distance))
-        depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left)
+        depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left,
+                                    sky=frame.color)
         color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
         results.append(dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color))
     return results
