@@ -34,13 +34,12 @@ void integrateSphere(TsdfVolume& volume, int first, int count, MarchingCubes* me
 
 } // namespace
 
-TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
-  // sdf = 0.25 - z on a 0.1 m grid: vertices at z = 0.25 exactly, triangles facing -z
-  // (towards positive sdf, the side the camera would see).
+/// sdf = 0.25 - z on a 0.1 m grid over 2 x 2 blocks, the first at `corner`.
+TsdfVolume planeOnTheGrid(const GridIndex& corner = GridIndex(-1, -1, 0)) {
   TsdfVolume volume(0.1, 0.5);
-  for (int bx = -1; bx <= 0; ++bx)
-    for (int by = -1; by <= 0; ++by) {
-      TsdfBlock& block = volume.allocateBlock(GridIndex(bx, by, 0));
+  for (int bx = 0; bx <= 1; ++bx)
+    for (int by = 0; by <= 1; ++by) {
+      TsdfBlock& block = volume.allocateBlock(corner + GridIndex(bx, by, 0));
       for (int z = 0; z < 8; ++z)
         for (int y = 0; y < 8; ++y)
           for (int x = 0; x < 8; ++x) {
@@ -51,10 +50,21 @@ TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
       block.stamp = volume.beginGeneration();
       block.updateSigns();
     }
+  return volume;
+}
+
+TriangleMesh wholeMeshOf(const TsdfVolume& volume) {
   TriangleMesh mesh;
   MarchingCubes::Config whole; // the plane is a small piece no precise vertex holds: not filtered here
   whole.min_component_triangles = 0;
   MarchingCubes(whole).extract(volume, mesh);
+  return mesh;
+}
+
+TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
+  // sdf = 0.25 - z on a 0.1 m grid: vertices at z = 0.25 exactly, triangles facing -z
+  // (towards positive sdf, the side the camera would see).
+  const TriangleMesh mesh = wholeMeshOf(planeOnTheGrid());
   // 16 x 16 voxel columns -> 15 x 15 cubes -> 225 squares -> 450 triangles, 256 vertices.
   EXPECT_EQ(mesh.triangles.size(), 450u);
   EXPECT_EQ(mesh.vertices.size(), 256u);
@@ -63,6 +73,16 @@ TEST(MarchingCubes, PlaneOnTheGridGivesExactVertices) {
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3f n = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
     EXPECT_LT(n.z(), 0.f);
+  }
+}
+
+TEST(MarchingCubes, APlaneFarFromTheOriginIsWeldedAsNearIt) {
+  // The same plane 64 km from the origin along -y and 60 km along +x (within the volume's reach):
+  // its vertices are welded as at the origin, none merged with another.
+  for (const GridIndex& corner : {GridIndex(0, -80000, 0), GridIndex(75000, 0, 0), GridIndex(-80000, 80000, 3)}) {
+    const TriangleMesh mesh = wholeMeshOf(planeOnTheGrid(corner));
+    EXPECT_EQ(mesh.triangles.size(), 450u) << corner.transpose();
+    EXPECT_EQ(mesh.vertices.size(), 256u) << corner.transpose();
   }
 }
 

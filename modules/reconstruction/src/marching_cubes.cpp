@@ -35,11 +35,13 @@ constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6
 
 
 /// A vertex is keyed by the grid element it lies on: the lower voxel of a grid edge and the
-/// edge's axis (0..2), or a voxel itself (3) when its sdf is exactly 0. 20 bits per axis.
-constexpr std::int64_t kKeyBias = 1 << 19;
+/// edge's axis (0..2), or a voxel itself (3) when its sdf is exactly 0. Each axis keeps its low
+/// 20 bits, so keys differ within any 2^20 voxels an axis (105 km at 0.1 m: more than a mesh
+/// holds), wherever in the volume's reach the map lies.
+constexpr std::uint64_t kKeyAxisMask = (std::uint64_t(1) << 20) - 1;
 std::uint64_t vertexKey(int x, int y, int z, int code) {
-  return (static_cast<std::uint64_t>(x + kKeyBias) << 42) | (static_cast<std::uint64_t>(y + kKeyBias) << 22) |
-         (static_cast<std::uint64_t>(z + kKeyBias) << 2) | static_cast<std::uint64_t>(code);
+  const auto axis = [](int c) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(c)) & kKeyAxisMask; };
+  return axis(x) << 42 | axis(y) << 22 | axis(z) << 2 | static_cast<std::uint64_t>(code);
 }
 
 std::uint64_t blockKey(const GridIndex& b) { return GridKey<21>::pack(b); }
