@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/fusion_model.h>
@@ -553,6 +554,10 @@ TEST(DepthImageFusion, NoDepthInTheClearSkyTheCloudClassNeither) {
   fusion.setSkyImage(colour.rowRange(0, h - 1));
   EXPECT_NE(msf::test::errorOf([&] { fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused); }).find("the sky image"),
             std::string::npos);
+  // A weight of another size is refused before the depth is touched.
+  cv::Mat depth = zs.clone(), small(h - 1, w, CV_32FC1, cv::Scalar(1.f)), none;
+  EXPECT_THROW(msf::withholdClearSky(msf::SkyMask(), colour, zl, depth, small, none), msf::InvalidInputError);
+  EXPECT_EQ(cv::countNonZero(depth != 20.f), 0);
 }
 
 TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {

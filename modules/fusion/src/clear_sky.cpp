@@ -2,22 +2,27 @@
 #include <msf/common/exceptions.h>
 #include <msf/fusion/clear_sky.h>
 
+#include <initializer_list>
 #include <string>
 
 namespace msf {
 
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& returns, cv::Mat& depth,
                          cv::Mat& weight, cv::Mat& free_weight) {
+  const std::initializer_list<cv::Mat*> images = {&depth, &weight, &free_weight};
+  for (const cv::Mat* values : images) // all checked before any is changed
+    if (!values->empty() && (values->type() != CV_32FC1 || values->size() != image.size()))
+      throw InvalidInputError("withholdClearSky: the depth and weights must be CV_32FC1 of the sky image's size");
   const cv::Mat open = sky.compute(image, returns);
   const cv::Mat clear = sky.clearSky(image, open);
-  for (cv::Mat* values : {&depth, &weight, &free_weight}) {
-    if (values->empty())
-      continue;
-    if (values->type() != CV_32FC1 || values->size() != image.size())
-      throw InvalidInputError("withholdClearSky: the depth and weights must be CV_32FC1 of the sky image's size");
-    values->setTo(0.f, clear);
-  }
+  for (cv::Mat* values : images)
+    if (!values->empty())
+      values->setTo(0.f, clear);
   return open;
+}
+
+const cv::Mat& skyImage(const cv::Mat& colour, const cv::Mat& grey, const cv::Size& size) {
+  return colour.type() == CV_8UC3 && colour.size() == size ? colour : grey;
 }
 
 } // namespace msf

@@ -2,6 +2,7 @@
 #include <msf/common/elapsed.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/parallel.h>
+#include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/sky_mask.h>
 #include <msf/io/pinhole_camera.h>
@@ -128,21 +129,11 @@ void Reconstructor::computeStereo(const Frame& frame, FrameResult& result) {
 
 
 
-namespace {
-
-/// The image a frame's open sky is found in: the colour camera sees the far sky at camera 0's
-/// pixels (rectified, one image plane), and colour tells a blue or grey-white sky from a white wall.
-const cv::Mat& skyImage(const Frame& frame) {
-  return !frame.color.empty() && frame.color.size() == frame.left.size() ? frame.color : frame.left;
-}
-
-} // namespace
-
 void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
   DepthFrame& fused = result.fused;
   stages_->fusion.setInputImage(frame.left); // for the facade extension
-  stages_->fusion.setSkyImage(skyImage(frame));
+  stages_->fusion.setSkyImage(skyImage(frame.color, frame.left, frame.left.size()));
   stages_->fusion.fuse(result.lidar_depth, result.lidar_distance, result.stereo_depth, result.stereo_confidence,
                        fused.depth, &fused.weight, &fused.free_space_weight);
   // Colour from the colour camera at the fused point, also where only the LiDAR has depth.
@@ -160,7 +151,7 @@ void Reconstructor::computeSky(const Frame& frame, FrameResult& result) {
   const cv::Mat returns = realReturns(result.lidar_depth, result.lidar_distance);
   result.sky = stages_->fusion.getOpenSky(); // found by the fusion (fusion.clear_sky), else here
   if (result.sky.empty())
-    result.sky = stages_->sky.compute(skyImage(frame), returns);
+    result.sky = stages_->sky.compute(skyImage(frame.color, frame.left, frame.left.size()), returns);
   result.sky_column_depth = stages_->sky.topReturnDepth(returns);
 }
 

@@ -11,8 +11,14 @@ namespace msf {
 /// them as sheets. Finds the open sky of `image` (SkyMask::compute, CV_8UC1 grey or CV_8UC3 BGR
 /// of camera 0's view) above the LiDAR's real returns `returns` (CV_32FC1, > 0 at a return),
 /// and empties `depth`, `weight` and `free_weight` (those not empty, CV_32FC1 of the image's
-/// size) at its clear pixels (SkyMask::clearSky). Returns the open sky's mask.
+/// size) at its clear pixels (SkyMask::clearSky). Returns the open sky's mask. Throws
+/// InvalidInputError, changing nothing, for a depth or weight image of another type or size.
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& returns, cv::Mat& depth,
                          cv::Mat& weight, cv::Mat& free_weight);
+
+/// The image to find camera 0's open sky in: the colour camera's (BGR) when it has camera 0's
+/// `size` (rectified, one image plane: it sees the far sky at camera 0's pixels, and colour tells
+/// a blue sky from a white wall), else camera 0's grey one.
+const cv::Mat& skyImage(const cv::Mat& colour, const cv::Mat& grey, const cv::Size& size);
 
 } // namespace msf

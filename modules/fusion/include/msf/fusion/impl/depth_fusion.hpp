@@ -127,10 +127,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
     cv::Mat no_free_space;
     extendFacades(left_, calibration_, config, fused_depth_, fused_weight_, no_free_space);
   }
-  // The open sky in the colour image where it is camera 0's size (colour tells a blue sky from a
-  // white wall), else in the grey one.
-  const bool colour_sky = color_.type() == CV_8UC3 && color_.cols == cols && color_.rows == rows;
-  const cv::Mat& sky_image = colour_sky ? color_ : left_;
+  const cv::Mat& sky_image = skyImage(color_, left_, cv::Size(cols, rows));
   if (config.clear_sky && !sky_image.empty()) {
     cv::Mat no_free_space;
     withholdClearSky(SkyMask(), sky_image,
