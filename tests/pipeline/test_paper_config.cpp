@@ -50,12 +50,13 @@ TEST(PaperConfig, EveryAdditionIsOff) {
   EXPECT_EQ(c.integrator.signed_distance, msf::TsdfIntegrator::SignedDistance::Projective);
   EXPECT_FALSE(c.integrator.space_carving);
   EXPECT_FALSE(c.integrator.sky_carving);
+  EXPECT_FALSE(c.integrator.far_carving);
   EXPECT_FALSE(c.integrator.silhouette_band);
   // The project's own defaults keep every addition.
   const msf::PipelineConfig ours;
   EXPECT_TRUE(ours.interpolation.slice.inverse_depth && ours.interpolation.slice.edge_test &&
               ours.fusion.edge_support && ours.stereo.lidarGuidance() && ours.integrator.silhouette_band &&
-              ours.integrator.sky_carving);
+              ours.integrator.sky_carving && ours.integrator.far_carving);
   EXPECT_EQ(ours.stereo.mode, "sgbm");
   EXPECT_EQ(ours.fusion.paper_weights, msf::PaperWeights::Relative);
   EXPECT_EQ(ours.integrator.solve, msf::TsdfIntegrator::Solve::Sweeps);

@@ -88,6 +88,17 @@ inline AnalyticScene corridor(double length, double wall = 4.0) {
   return scene;
 }
 
+/// KITTI's camera 0 (odometry sequence 04).
+inline PinholeCamera kittiCamera() {
+  PinholeCamera c;
+  c.width = 1241;
+  c.height = 376;
+  c.fx = c.fy = 718.856f;
+  c.cx = 607.19f;
+  c.cy = 185.22f;
+  return c;
+}
+
 /// Depth frame of `scene` from `pose`, with Gaussian depth noise of `sigma` metres.
 inline DepthFrame renderFrame(const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose,
                               double sigma = 0.0, unsigned seed = 1) {

@@ -22,17 +22,6 @@
 namespace msf {
 namespace {
 
-/// KITTI's camera 0.
-PinholeCamera kittiCamera() {
-  PinholeCamera c;
-  c.width = 1241;
-  c.height = 376;
-  c.fx = c.fy = 718.856f;
-  c.cx = 607.19f;
-  c.cy = 185.22f;
-  return c;
-}
-
 /// The camera drives along +z (y down), 1 m per frame.
 Eigen::Isometry3d drivePose(int i) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -90,7 +79,7 @@ FrameSky trueSky(const AnalyticScene& scene, const PinholeCamera& camera, const 
 /// Frames 0-2 see the van; it drives off, and frames 3-8 see the road behind. What the rays
 /// through its upper part meet is the sky, which has no depth.
 DriveResult driveAfterTheVan(bool sky_carving, const SkyOfFrame& sky_of = trueSky) {
-  const PinholeCamera camera = kittiCamera();
+  const PinholeCamera camera = test::kittiCamera();
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator::Config config;
   config.sky_carving = sky_carving;
@@ -172,7 +161,7 @@ TEST(SkyCarving, KeepsAWallTheMaskTakesForSkyInFrontOfItsReturns) {
 TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
   // A wall seen from the street; a mask that holds every pixel but the wall's leaves it whole,
   // one that holds it too clears it.
-  const PinholeCamera camera = kittiCamera();
+  const PinholeCamera camera = test::kittiCamera();
   const AnalyticScene scene = road(false);
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator::Config config;
@@ -203,7 +192,7 @@ TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
 }
 
 TEST(SkyCarving, OffEmptyOrRefused) {
-  const PinholeCamera camera = kittiCamera();
+  const PinholeCamera camera = test::kittiCamera();
   const AnalyticScene scene = road(true);
   const DepthFrame frame = test::renderFrame(scene, camera, drivePose(0), 0.0);
   const cv::Mat everything(camera.height, camera.width, CV_8UC1, cv::Scalar(255));

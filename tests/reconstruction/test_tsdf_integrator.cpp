@@ -456,16 +456,6 @@ Eigen::Isometry3d streetPose(int i) {
   return T;
 }
 
-PinholeCamera streetCamera() {
-  PinholeCamera c; // KITTI's camera 0
-  c.width = 1241;
-  c.height = 376;
-  c.fx = c.fy = 718.856f;
-  c.cx = 607.19f;
-  c.cy = 185.22f;
-  return c;
-}
-
 /// Share of `points` within `distance` of a mesh vertex.
 double coveredShare(const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& points, double distance) {
   if (mesh.vertices.empty() || points.empty())
@@ -549,7 +539,7 @@ TEST(TsdfIntegrator, GrazingGroundIsMeshedWithThePlaneDistance) {
   // is 3-5 cm high, so the projective distance leaves most of the road without a sign change
   // between two observed voxels; the distance to the road's plane keeps one voxel each side.
   const AnalyticScene scene = street(0, -1);
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   double covered[2];
   for (int plane = 0; plane < 2; ++plane) {
     TsdfVolume volume(0.1, 0.3);
@@ -598,7 +588,7 @@ TEST(TsdfIntegrator, AStreetAtAnAngleToTheGridIsMeshedWithoutHoles) {
   AnalyticScene scene;
   scene.addHalfSpace(up, up.dot(Eigen::Vector3d(0, 1.65, 0)));
   scene.addBox(turn * Eigen::Vector3d(4.2, 0, 20), Eigen::Vector3d(0.2, 3, 30), turn.linear());
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator integrator(volume, TsdfIntegrator::Config{});
   const int frames = 3;
@@ -628,7 +618,7 @@ TEST(TsdfIntegrator, CarvingRemovesTheGhostOfACarAheadAndKeepsTheStreet) {
   // A car drives ahead at the camera's speed (the KITTI van): each frame sees its rear 8 m
   // ahead. The next frames look through where it was, onto its new place: free space clears
   // the old rears, while the road and the wall, seen by every frame, stay.
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   const int frames = 8;
   std::size_t ghosts[2] = {0, 0};
   for (const bool carving : {false, true}) {
@@ -667,7 +657,7 @@ TEST(TsdfIntegrator, ARoofSeenAtAGrazingAngleIsMeshedWithoutASkirt) {
   AnalyticScene scene;
   scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.65);
   scene.addBox(Eigen::Vector3d(0, 1.65 - 0.6, 10), Eigen::Vector3d(0.9, 0.6, 2));
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator integrator(volume);
   for (int i = 0; i < 3; ++i) {
@@ -941,7 +931,7 @@ TEST(TsdfIntegrator, ScanCarvingClearsWhatDroveAwayOutOfViewAndKeepsTheStreet) {
   // An oncoming car 8 m ahead in the other lane at frame 0; it has passed by frame 1, when the
   // camera is 12 m on and never sees its place again. The camera's own free space cannot clear
   // it; the LiDAR's scans, all around, see the road behind through it.
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   AnalyticScene with_car = street(0, -1);
   with_car.addBox(Eigen::Vector3d(-2.5, 1.65 - 0.75, 8.0), Eigen::Vector3d(0.9, 0.75, 2.2));
   const AnalyticScene static_street = street(0, -1);
@@ -991,7 +981,7 @@ TEST(TsdfIntegrator, ScanCarvingKeepsAThinBoardSeenFromBehindByASkewedSweep) {
   // where the LiDAR sees its back. The sweep is not motion-compensated: its returns lie half a
   // metre beyond the board. The board's front surface, a few centimetres behind its back from
   // the LiDAR, must stay.
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   AnalyticScene scene = street(0, -1);
   scene.addBox(Eigen::Vector3d(-1.5, 0.5, 6.0), Eigen::Vector3d(1.0, 1.0, 0.05));
   TsdfVolume volume(0.1, 0.3);
@@ -1022,7 +1012,7 @@ TEST(TsdfIntegrator, ScanCarvingKeepsAThinBoardSeenFromBehindByASkewedSweep) {
 TEST(TsdfIntegrator, ScanCarvingLeavesWhatTheCameraSeesToTheCamera) {
   // The car stays in view; a scan that sees through it (it is not in the scan's world) must
   // not carve it: in view, the frame's own depth decides.
-  const PinholeCamera camera = streetCamera();
+  const PinholeCamera camera = test::kittiCamera();
   AnalyticScene with_car = street(0, -1);
   with_car.addBox(Eigen::Vector3d(0, 1.65 - 0.75, 10.0), Eigen::Vector3d(0.9, 0.75, 2.2));
   TsdfVolume volume(0.1, 0.3);

@@ -48,6 +48,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.min_pixel_weight = 0.f;
   c.integrator.space_carving = false;
   c.integrator.sky_carving = false;
+  c.integrator.far_carving = false;
   c.integrator.weight_dropoff = false;
   c.integrator.silhouette_band = false;
   c.integrator.interpolate_depth = false;

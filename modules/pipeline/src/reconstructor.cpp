@@ -201,6 +201,12 @@ void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const Pinho
                       result.sky_column_depth);
 }
 
+void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const FrameResult& result,
+                      const DepthFusionConfig& fusion) {
+  const double sigma = fusion.lidar_range_sigma_m;
+  integrator.carveBeyondRange(frame, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)));
+}
+
 void Reconstructor::integrate(FrameResult& result) {
   if (!result.has_pose)
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
@@ -215,6 +221,7 @@ void Reconstructor::integrate(FrameResult& result) {
   integrator_->integrate(frame, result.T_world_cam0);
   carveWithScan(*integrator_, result, frame.camera, config_.fusion, calibration_);
   carveSky(*integrator_, result, camera_, config_.fusion);
+  carveBeyondRange(*integrator_, frame, result, config_.fusion);
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
     streaming_->afterIntegration(result.T_world_cam0.translation());

@@ -23,6 +23,7 @@ void SourceMaps::integrate(const FrameResult& result) {
     if (map->source == DepthSource::Lidar)
       carveWithScan(map->integrator, result, frame.camera, config_.fusion, calibration_);
     carveSky(map->integrator, result, result.fused.camera, config_.fusion);
+    carveBeyondRange(map->integrator, frame, result, config_.fusion);
   }
 }
 

@@ -112,6 +112,12 @@ void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const 
 void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
               const DepthFusionConfig& fusion);
 
+/// Free space along the integrated frame's rays that reach beyond the range (see
+/// TsdfIntegrator::carveBeyondRange; nothing when tsdf_integrator.far_carving or space_carving is
+/// off): such a ray weighs as a LiDAR return does, as a sky ray.
+void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const FrameResult& result,
+                      const DepthFusionConfig& fusion);
+
 /// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
 /// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected

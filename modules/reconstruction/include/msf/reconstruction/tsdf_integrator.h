@@ -119,6 +119,10 @@ public:
     /// but the sky gives no depth, so a surface left in front of it (a car that drove on, depth
     /// carried over the sky) is cleared by nothing else.
     bool sky_carving = true;
+    /// Also carve along the rays whose depth lies beyond max_depth_m (carveBeyondRange): they are
+    /// not integrated, yet they passed every surface nearer than that, such as the edge of a car
+    /// seen a moment ago where the background far behind it shows now.
+    bool far_carving = true;
     /// Voxblox's drop-off: behind the surface the observation only guesses the thickness.
     bool weight_dropoff = true;
     /// The band behind a pixel reaches no deeper than its object is seen to be wide
@@ -180,6 +184,7 @@ public:
         "also carve with the LiDAR's scan outside the camera's view, this far from the LiDAR, m (0: off)");
       k("sky_carving", sky_carving,
         "also carve along the rays of the frame's open sky (SkyMask), in front of the LiDAR's highest returns");
+      k("far_carving", far_carving, "also carve along the rays whose depth lies beyond max_depth_m, up to it");
       k("weight_dropoff", weight_dropoff, "behind the surface the weight falls to 0 at the band's end");
       k("silhouette_band", silhouette_band,
         "the band behind a pixel reaches no deeper than its object is seen to be wide (at least two truncations)");
@@ -259,6 +264,16 @@ public:
   /// that is not positive and finite, or a pose that is not rigid.
   void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight,
                 const std::vector<float>& column_depth = {});
+
+  /// Free space that the rays beyond the range show (Config::far_carving, with space_carving): a
+  /// pixel of `frame` whose depth lies beyond max_depth_m by more than truncation_sigmas of its
+  /// sigma (its weight's; any depth without weights) passed every surface nearer than that; each
+  /// voxel behind a surface (sdf < 0) nearer than max_depth_m by more than the truncation and a
+  /// voxel, whose footprint in the image lies wholly within such pixels, takes a free-space update
+  /// of `weight` (m^-2) times carving_weight. The footprint keeps the silhouettes of thin objects
+  /// (a pole against a far façade), whose voxels straddle the pixels beside them. Throws
+  /// InvalidInputError for a weight that is not positive and finite, or a pose that is not rigid.
+  void carveBeyondRange(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, float weight);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are
@@ -351,6 +366,7 @@ private:
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
   cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_
   cv::Mat computed_weight_;
+  cv::Mat far_rays_, far_distance_; // carveBeyondRange: the pixels whose rays reach beyond the range
 };
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.

@@ -1,0 +1,154 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
+#include <msf/common/parallel.h>
+#include <msf/reconstruction/tsdf_integrator.h>
+
+#include "surface_voxel_walk.h"
+#include "voxel_update.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace msf {
+
+namespace {
+
+constexpr int kSide = TsdfBlock::kSide;
+/// How far (pixels) a depth image's silhouettes may lie from the true ones: interpolation and
+/// stereo matching both widen or narrow an object by a pixel or two.
+constexpr float kSilhouetteSlackPx = 3.f;
+
+/// Whether a block's bounding sphere (centre `c` in the camera frame, radius `r`) lies within
+/// [min_d, max_d] of depth and its projection, grown by its radius in pixels, meets `rect`.
+bool sphereMeetsRect(const Eigen::Vector3f& c, float r, const PinholeCamera& cam, float min_d, float max_d,
+                     const cv::Rect& rect) {
+  if (c.z() + r < min_d || c.z() - r > max_d)
+    return false;
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float z = std::max(c.z() - r, min_d); // the sphere's nearest depth: its widest footprint
+  const float r_px = std::max(fx, fy) * r / z;
+  const float zc = std::max(c.z(), min_d);
+  const float u = fx * c.x() / zc + static_cast<float>(cam.cx), v = fy * c.y() / zc + static_cast<float>(cam.cy);
+  return u + r_px >= rect.x && u - r_px <= rect.x + rect.width && v + r_px >= rect.y && v - r_px <= rect.y + rect.height;
+}
+
+/// Carves the voxels behind a surface (sdf < 0) whose centres project into a non-zero pixel of
+/// `rays` (CV_8UC1 of `camera`'s size) within `rect` of it, from min_d to max_d of depth: a
+/// free-space update of weight freeWeight(u, v, z) each (none where it is 0).
+template <class FreeWeight>
+void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rect, const PinholeCamera& camera,
+                    const Eigen::Isometry3d& T_world_cam, float min_d, float max_d, float max_weight,
+                    FreeWeight&& freeWeight) {
+  const float vs = static_cast<float>(volume.voxelSize()), trunc = static_cast<float>(volume.truncation());
+  const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
+  const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
+  std::vector<TsdfBlock*> blocks;
+  for (const auto& block : volume.blocks()) {
+    if (!block->negative_subblocks)
+      continue; // nothing behind a surface: nothing to carve
+    const Eigen::Vector3f centre = (block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs;
+    if (sphereMeetsRect(T_cam_world * centre, radius, camera, min_d, max_d, rect))
+      blocks.push_back(block);
+  }
+  const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const std::uint64_t stamp = volume.beginGeneration();
+  parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
+    for (int n = range.start; n < range.end; ++n)
+      detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_cam_world, vs, stamp,
+                                 [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
+                                   if (p.z() < min_d || p.z() > max_d)
+                                     return false;
+                                   const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx));
+                                   const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy));
+                                   if (u < 0 || v < 0 || u >= camera.width || v >= camera.height ||
+                                       !rays.at<std::uint8_t>(v, u))
+                                     return false;
+                                   const float w = freeWeight(u, v, p.z());
+                                   if (!(w > 0.f))
+                                     return false;
+                                   detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                                   return true;
+                                 });
+  });
+}
+
+/// The pixels whose depth lies beyond `range` by more than `sigmas` of its sigma (1/sqrt of its
+/// weight; `weight` may be empty: every depth is precise enough).
+void raysBeyondRange(const cv::Mat& depth, const cv::Mat& weight, float range, float sigmas, cv::Mat& rays) {
+  rays.create(depth.size(), CV_8UC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* d = depth.ptr<float>(v);
+    const float* w = weight.empty() ? nullptr : weight.ptr<float>(v);
+    std::uint8_t* out = rays.ptr<std::uint8_t>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      const float sigma = w ? (w[u] > 0.f ? 1.f / std::sqrt(w[u]) : std::numeric_limits<float>::infinity()) : 0.f;
+      out[u] = d[u] - sigmas * sigma > range ? 255 : 0;
+    }
+  }
+}
+
+} // namespace
+
+void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
+                              float weight, const std::vector<float>& column_depth) {
+  if (!config_.sky_carving || !config_.space_carving || sky.empty())
+    return;
+  if (sky.type() != CV_8UC1 || sky.cols != camera.width || sky.rows != camera.height)
+    throw InvalidInputError("carveSky: the sky mask must be CV_8UC1 of the camera's " + std::to_string(camera.width) +
+                            "x" + std::to_string(camera.height) + ", not " + std::to_string(sky.cols) + "x" +
+                            std::to_string(sky.rows) + " of type " + std::to_string(sky.type()));
+  if (!column_depth.empty() && column_depth.size() != static_cast<std::size_t>(camera.width))
+    throw InvalidInputError("carveSky: the column depths must be one per image column (" +
+                            std::to_string(camera.width) + "), not " + std::to_string(column_depth.size()));
+  if (!(weight > 0.f) || !std::isfinite(weight))
+    throw InvalidInputError("carveSky: the weight must be positive and finite, got " + std::to_string(weight));
+  limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
+  const cv::Rect rect = cv::boundingRect(sky);
+  const float w = weight * static_cast<float>(config_.carving_weight);
+  if (rect.empty() || !(w > 0.f))
+    return;
+  const float wall_margin = static_cast<float>(volume_.truncation() + volume_.voxelSize());
+  const auto inFrontOfWall = [&](int u, int, float z) {
+    const bool free = column_depth.empty() || !(column_depth[static_cast<std::size_t>(u)] > 0.f) ||
+                      z < column_depth[static_cast<std::size_t>(u)] - wall_margin;
+    return free ? w : 0.f;
+  };
+  carveAlongRays(volume_, sky, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),
+                 static_cast<float>(config_.farthestDepth()), config_.max_weight, inFrontOfWall);
+}
+
+void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, float weight) {
+  if (!config_.far_carving || !config_.space_carving)
+    return;
+  frame.validate();
+  if (!(weight > 0.f) || !std::isfinite(weight))
+    throw InvalidInputError("carveBeyondRange: the weight must be positive and finite, got " + std::to_string(weight));
+  limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
+  const float w = weight * static_cast<float>(config_.carving_weight);
+  const float range = static_cast<float>(config_.max_depth_m);
+  const bool own_weights = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
+  raysBeyondRange(frame.depth, own_weights ? frame.weight : cv::Mat(), range,
+                  static_cast<float>(config_.truncation_sigmas), far_rays_);
+  const cv::Rect rect = cv::boundingRect(far_rays_);
+  if (rect.empty() || !(w > 0.f))
+    return;
+  // Each far pixel's distance to the nearest pixel that is not: a voxel is carved only where its
+  // footprint (half its diagonal, in pixels at its depth) lies wholly within the far rays.
+  cv::distanceTransform(far_rays_, far_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  const float reach_px = 0.5f * std::sqrt(3.f) * static_cast<float>(volume_.voxelSize()) *
+                         static_cast<float>(std::max(frame.camera.fx, frame.camera.fy));
+  const auto withinFarRays = [&](int u, int v, float z) {
+    return far_distance_.at<float>(v, u) > reach_px / z + kSilhouetteSlackPx ? w : 0.f;
+  };
+  const float bound = range - static_cast<float>(volume_.truncation() + volume_.voxelSize());
+  carveAlongRays(volume_, far_rays_, rect, frame.camera, T_world_cam, static_cast<float>(config_.min_depth_m), bound,
+                 config_.max_weight, withinFarRays);
+}
+
+} // namespace msf
