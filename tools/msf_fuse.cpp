@@ -65,87 +65,122 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
     p.confidence = 1.f;
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
+/// What the command line sets.
+struct Settings {
   std::string calib_path, image_size_text, color_path, left_path;
   bool print_config = false;
   msf::DepthFusionConfig config;
   msf::RigAdaptationConfig rig;
+};
+
+/// What the fusion reads: the two clouds, and the colour and grey images when given.
+struct Inputs {
+  pcl::PointCloud<msf::PointXYZID>::Ptr lidar{new pcl::PointCloud<msf::PointXYZID>};
+  pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr stereo{new pcl::PointCloud<msf::PointXYZRGBConfidence>};
+  cv::Mat color, left;
+};
+
+/// The calibration, after the arguments are checked; the fusion config adapted to its rig.
+msf::Calibration configure(const msf::tool::Arguments& files, Settings& settings) {
+  if (files.size() != 3)
+    throw msf::InvalidInputError("expected <lidar.pcd> <stereo.pcd> <out.pcd> (see -h)");
+  const std::string ext = msf::fileExtension(files[2]);
+  if (ext != ".pcd" && ext != ".ply")
+    throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
+  const cv::Size image_size = msf::parseImageSize(settings.image_size_text);
+  if (settings.calib_path.empty())
+    throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
+  msf::Calibration calibration = msf::loadCalibration(settings.calib_path, image_size);
+  msf::adaptToRig(settings.config, msf::rigAdaptation(settings.rig, calibration));
+  if (settings.print_config)
+    msf::printConfig(std::cout, settings.config);
+  return calibration;
+}
+
+Inputs loadInputs(const std::string& lidar_path, const std::string& stereo_path, const Settings& settings) {
+  TicToc tt;
+  tt.tic();
+  print_highlight("Loading ");
+  print_value("%s %s ", lidar_path.c_str(), stereo_path.c_str());
+  Inputs inputs;
+  loadLidar(lidar_path, *inputs.lidar);
+  loadStereo(stereo_path, *inputs.stereo);
+  if (!settings.color_path.empty())
+    inputs.color = msf::readImage(settings.color_path, cv::IMREAD_COLOR);
+  if (!settings.left_path.empty()) {
+    const std::string& left_path = settings.left_path;
+    const pcl::PointCloud<msf::PointXYZRGBConfidence>& stereo = *inputs.stereo;
+    inputs.left = msf::readImage(left_path, cv::IMREAD_GRAYSCALE);
+    if (inputs.left.cols != static_cast<int>(stereo.width) || inputs.left.rows != static_cast<int>(stereo.height))
+      throw msf::InvalidInputError("-left image '" + left_path + "' is " + std::to_string(inputs.left.cols) + "x" +
+                                   std::to_string(inputs.left.rows) + ", the clouds are " +
+                                   std::to_string(stereo.width) + "x" + std::to_string(stereo.height));
+  }
+  msf::tool::printDone(tt.toc(), inputs.lidar->size() + inputs.stereo->size());
+  return inputs;
+}
+
+/// Fuses the clouds into `fused`, with a done line.
+void fuse(const Inputs& inputs, const msf::Calibration& calibration, const msf::DepthFusionConfig& config,
+          pcl::PointCloud<msf::PointXYZRGBWeight>& fused) {
+  TicToc tt;
+  tt.tic();
+  print_highlight("Fusing ");
+  print_value("(%s) ", msf::toString(config.method));
+  msf::DepthFusion<> fusion(config);
+  fusion.setCalibration(calibration);
+  fusion.setInputLidar(inputs.lidar);
+  fusion.setInputStereo(inputs.stereo);
+  fusion.setInputColor(inputs.color);
+  fusion.setInputImage(inputs.left);
+  fusion.fuse(fused);
+  std::size_t valid = 0;
+  for (const auto& p : fused)
+    valid += std::isfinite(p.z);
+  msf::tool::printDone(tt.toc(), valid);
+}
+
+int run(const msf::tool::Arguments& files, Settings& settings) {
+  const msf::Calibration calibration = configure(files, settings);
+  const Inputs inputs = loadInputs(files[0], files[1], settings);
+  pcl::PointCloud<msf::PointXYZRGBWeight> fused;
+  fuse(inputs, calibration, settings.config, fused);
+
+  TicToc tt;
+  tt.tic();
+  print_highlight("Saving ");
+  print_value("%s ", files[2].c_str());
+  msf::saveCloud(files[2], fused);
+  msf::tool::printDone(tt.toc(), fused.size());
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Settings settings;
+  msf::DepthFusionConfig& config = settings.config;
   msf::tool::CommandLine cli(
       "msf_fuse", "<lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]",
       "Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one organized cloud with "
       "fields x y z rgb weight (NaN where neither has depth). lidar.pcd: interpolated LiDAR, ideally with the field "
       "'distance' (pixels to the nearest real return; without it every point counts as a real return). stereo.pcd: "
       "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
-  cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
-      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
-      .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
+  cli.value("-calib", "PATH", settings.calib_path,
+            "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
+      .value("-rig", "FILE", settings.calib_path,
+             "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
+      .value("-image_size", "WxH", settings.image_size_text, "image size where no image lies beside the calibration")
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, settings.rig); },
              "YAML config, sections fusion and rig (the windows in rows between LiDAR rings follow the rig's "
              "beams, as in msf_reconstruct)")
       .value("-method", "NAME", [&](const std::string& name) { config.method = msf::parseFusionMethod(name); },
              "paper (eq. 6, dynamic weights) | uncertainty (inverse variance, default)")
-      .value("-color", "PATH", color_path, "colour camera image (image_2) to colour every fused point by projection")
-      .value("-left", "PATH", left_path,
+      .value("-color", "PATH", settings.color_path,
+             "colour camera image (image_2) to colour every fused point by projection")
+      .value("-left", "PATH", settings.left_path,
              "camera 0's grey image (image_0): a LiDAR-backed wall goes on upward over the blank pixels above it "
              "(fusion.facade_extension), as in msf_reconstruct")
-      .flag("-print_config", print_config, "print the fusion settings in use");
-  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
-    if (files.size() != 3)
-      throw msf::InvalidInputError("expected <lidar.pcd> <stereo.pcd> <out.pcd> (see -h)");
-    const std::string ext = msf::fileExtension(files[2]);
-    if (ext != ".pcd" && ext != ".ply")
-      throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
-    const cv::Size image_size = msf::parseImageSize(image_size_text);
-    if (calib_path.empty())
-      throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
-    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
-    msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
-    if (print_config)
-      msf::printConfig(std::cout, config);
-
-    TicToc tt;
-    tt.tic();
-    print_highlight("Loading ");
-    print_value("%s %s ", files[0].c_str(), files[1].c_str());
-    pcl::PointCloud<msf::PointXYZID>::Ptr lidar(new pcl::PointCloud<msf::PointXYZID>);
-    pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr stereo(new pcl::PointCloud<msf::PointXYZRGBConfidence>);
-    loadLidar(files[0], *lidar);
-    loadStereo(files[1], *stereo);
-    cv::Mat color, left;
-    if (!color_path.empty())
-      color = msf::readImage(color_path, cv::IMREAD_COLOR);
-    if (!left_path.empty()) {
-      left = msf::readImage(left_path, cv::IMREAD_GRAYSCALE);
-      if (left.cols != static_cast<int>(stereo->width) || left.rows != static_cast<int>(stereo->height))
-        throw msf::InvalidInputError("-left image '" + left_path + "' is " + std::to_string(left.cols) + "x" +
-                                     std::to_string(left.rows) + ", the clouds are " + std::to_string(stereo->width) +
-                                     "x" + std::to_string(stereo->height));
-    }
-    msf::tool::printDone(tt.toc(), lidar->size() + stereo->size());
-
-    tt.tic();
-    print_highlight("Fusing ");
-    print_value("(%s) ", msf::toString(config.method));
-    msf::DepthFusion<> fusion(config);
-    fusion.setCalibration(calibration);
-    fusion.setInputLidar(lidar);
-    fusion.setInputStereo(stereo);
-    fusion.setInputColor(color);
-    fusion.setInputImage(left);
-    pcl::PointCloud<msf::PointXYZRGBWeight> fused;
-    fusion.fuse(fused);
-    std::size_t valid = 0;
-    for (const auto& p : fused)
-      valid += std::isfinite(p.z);
-    msf::tool::printDone(tt.toc(), valid);
-
-    tt.tic();
-    print_highlight("Saving ");
-    print_value("%s ", files[2].c_str());
-    msf::saveCloud(files[2], fused);
-    msf::tool::printDone(tt.toc(), fused.size());
-    return 0;
-  });
+      .flag("-print_config", settings.print_config, "print the fusion settings in use");
+  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) { return run(files, settings); });
 }

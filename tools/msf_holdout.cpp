@@ -277,18 +277,135 @@ void writeRegionCsv(const std::string& path, const std::vector<RegionResults>& r
   });
 }
 
-} // namespace
+using NamedMethods = std::vector<std::pair<std::string, msf::HoldoutMethod>>;
 
-int main(int argc, char** argv) {
+/// What the command line sets.
+struct Settings {
   std::string frames_text = "0:", methods_text, config_path, csv_path, bounds_text;
   bool gt_switch = false, holdout_switch = false, breakdown = false;
-  std::string methods_help =
-      std::string("methods, in this order (default: all; with gt/: ") + kGroundTruthMethods + "):";
+};
+
+/// The help of -methods: the table's methods, a line each.
+std::string methodsHelp() {
+  std::string help = std::string("methods, in this order (default: all; with gt/: ") + kGroundTruthMethods + "):";
   for (const auto& m : methodTable()) {
     char line[256];
     std::snprintf(line, sizeof line, "\n  %-19s %s", m.name, m.description);
-    methods_help += line;
+    help += line;
   }
+  return help;
+}
+
+/// Whether `sequence` is evaluated in full-image mode (it has gt/ and -holdout is not given),
+/// after the options are checked against the mode; -methods defaults to the mode's methods.
+bool chooseFullImageMode(const msf::tool::CommandLine& cli, const std::string& sequence_dir,
+                         const msf::Sequence& sequence, Settings& settings) {
+  if (settings.gt_switch && sequence.groundTruthDir().empty())
+    throw msf::InvalidInputError("-gt: '" + sequence_dir +
+                                 "' has no synthetic ground truth (no gt/depth_0 beside its sequences/, as msf_synth "
+                                 "writes); without -gt it is evaluated by ring hold-out");
+  const bool gt_mode = !settings.holdout_switch && !sequence.groundTruthDir().empty();
+  if (settings.breakdown && gt_mode)
+    throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
+                                 "regions (add -holdout to evaluate '" + sequence_dir + "' by ring hold-out)");
+  if (!cli.given("-methods"))
+    settings.methods_text = gt_mode ? kGroundTruthMethods : methodNames();
+  if (!settings.bounds_text.empty() && gt_mode)
+    throw msf::InvalidInputError("-bounds is a ring hold-out option (add -holdout to evaluate '" + sequence_dir +
+                                 "' by ring hold-out)");
+  if (!settings.csv_path.empty() && msf::fileExtension(settings.csv_path) != ".csv")
+    throw msf::InvalidInputError("-csv '" + settings.csv_path + "' must end in .csv");
+  return gt_mode;
+}
+
+/// The methods -methods names, each also added to `evaluation`, and the bounds of -bounds.
+NamedMethods addMethods(const Settings& settings, const msf::ConfigFile& config_file,
+                        msf::HoldoutEvaluation& evaluation) {
+  NamedMethods methods;
+  const auto names = split(settings.methods_text);
+  if (names.empty())
+    throw msf::InvalidInputError("-methods is empty; known methods: " + methodNames());
+  for (const auto& name : names) {
+    const MethodEntry* entry = nullptr;
+    for (const auto& m : methodTable())
+      if (name == m.name)
+        entry = &m;
+    if (!entry)
+      throw msf::InvalidInputError("unknown method '" + name + "'; known methods: " + methodNames());
+    methods.emplace_back(name, entry->make(config_file));
+    evaluation.addMethod(name, methods.back().second);
+  }
+  if (!settings.bounds_text.empty()) {
+    const auto pair = split(settings.bounds_text);
+    if (pair.size() != 2)
+      throw msf::InvalidInputError("-bounds needs two methods separated by a comma, got '" + settings.bounds_text +
+                                   "'");
+    evaluation.addFusionBounds(pair[0], pair[1]);
+  }
+  return methods;
+}
+
+/// Full-image mode: the rows of all, background and foreground pixels of each method.
+void reportFullImage(const msf::Sequence& sequence, const std::vector<std::size_t>& frames,
+                     const NamedMethods& methods, const msf::D1Threshold& d1, const Settings& settings) {
+  pcl::StopWatch watch;
+  const auto results = runFullImage(sequence, frames, methods, d1);
+  const double ms = watch.getTime();
+  std::printf("%s", formatRegionTable(results).c_str());
+  std::fflush(stdout);
+  if (!settings.csv_path.empty())
+    writeRegionCsv(settings.csv_path, results);
+  msf::tool::printDone(ms, results.empty() ? 0 : results.front().region[0].metrics.gt_pixels);
+}
+
+/// Ring hold-out: a row per method, and with -breakdown its rows by visibility and depth.
+void reportHoldout(const msf::Sequence& sequence, const std::vector<std::size_t>& frames,
+                   msf::HoldoutEvaluation& evaluation, const Settings& settings) {
+  pcl::StopWatch watch;
+  const auto results = evaluation.run(sequence, frames);
+  const double ms = watch.getTime();
+  std::printf("%s", msf::formatHoldoutTable(results).c_str());
+  if (settings.breakdown)
+    std::printf("\n%s", msf::formatHoldoutBreakdown(results).c_str());
+  std::fflush(stdout);
+  if (!settings.csv_path.empty())
+    msf::writeHoldoutCsv(settings.csv_path, results);
+  msf::tool::printDone(ms, results.empty() ? 0 : results.front().metrics.gt_pixels);
+}
+
+int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& positional, Settings& settings) {
+  if (positional.size() != 1)
+    throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
+  if (settings.gt_switch && settings.holdout_switch)
+    throw msf::InvalidInputError("-gt and -holdout exclude each other");
+  const msf::Sequence sequence(positional[0]);
+  const bool gt_mode = chooseFullImageMode(cli, positional[0], sequence, settings);
+
+  const msf::ConfigFile config_file =
+      settings.config_path.empty() ? msf::ConfigFile() : msf::openConfigFile(settings.config_path);
+  msf::HoldoutConfig config;
+  config_file.read(config.rings);
+  config_file.read(config.projection);
+  msf::HoldoutEvaluation evaluation(config);
+  evaluation.setBreakdown(settings.breakdown);
+  const NamedMethods methods = addMethods(settings, config_file, evaluation);
+
+  const auto frames = sequence.indices(msf::FrameRange::parse(settings.frames_text));
+  print_highlight("Evaluating ");
+  print_value("%zu frames ", frames.size());
+  print_info("of %s, %zu methods%s\n", sequence.directory().c_str(), methods.size(),
+             gt_mode ? ", full image against synthetic ground truth" : ", ring hold-out");
+  if (gt_mode)
+    reportFullImage(sequence, frames, methods, config.d1, settings);
+  else
+    reportHoldout(sequence, frames, evaluation, settings);
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Settings settings;
   msf::tool::CommandLine cli(
       "msf_holdout", "<sequence_dir> [options]",
       "Ring hold-out (evaluation protocol 2): rings with id % 4 == 2 of each scan are ground truth in camera 0, the "
@@ -298,97 +415,23 @@ int main(int argc, char** argv) {
       "Full-image mode (protocol 3), automatic when the sequence has synthetic ground truth (gt/, as msf_synth "
       "writes): the whole scan is the LiDAR input, every pixel of gt/depth_0 is ground truth, and each method has "
       "rows for all, background and foreground pixels (gt/obj_map_0).");
-  cli.value("-frames", "a:b", frames_text, "frames to use (default: all)")
-      .flag("-gt", gt_switch, "full-image mode; an error when the sequence has no gt/")
-      .flag("-holdout", holdout_switch, "ring hold-out even when the sequence has gt/")
-      .value("-methods", "a,b,..", methods_text, methods_help)
-      .value("-config", "FILE", config_path,
+  cli.value("-frames", "a:b", settings.frames_text, "frames to use (default: all)")
+      .flag("-gt", settings.gt_switch, "full-image mode; an error when the sequence has no gt/")
+      .flag("-holdout", settings.holdout_switch, "ring hold-out even when the sequence has gt/")
+      .value("-methods", "a,b,..", settings.methods_text, methodsHelp())
+      .value("-config", "FILE", settings.config_path,
              "YAML config (sections projection, rings, interpolation, ip_basic, stereo, fusion)")
-      .value("-bounds", "A,B", bounds_text,
+      .value("-bounds", "A,B", settings.bounds_text,
              "ring hold-out: also the rows a per-pixel fusion of methods A and B cannot beat, found with the ground "
              "truth: bound_select (per pixel the input nearer the truth: the least MAE of choosing one) and "
              "bound_blend (the value between the two nearest the truth: the least error of a weighted mean); e.g. "
              "-bounds interpolated,sgbm_guided")
-      .value("-csv", "FILE", csv_path, "also write the rows as CSV")
-      .flag("-breakdown", breakdown,
+      .value("-csv", "FILE", settings.csv_path, "also write the rows as CSV")
+      .flag("-breakdown", settings.breakdown,
             "ring hold-out: also each method's rows for the ground truth that camera 0 sees (visible) and cannot see "
             "(hidden: an input return within 1 px in front of it), and for the depth bands < 20, 20-40, >= 40 m; "
             "'MAE part' adds up to the MAE; and the share of estimates off by >= 10 m (another surface) with their "
             "part of it");
-  return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
-    if (positional.size() != 1)
-      throw msf::InvalidInputError("expected one <sequence_dir> (see -h)");
-    if (gt_switch && holdout_switch)
-      throw msf::InvalidInputError("-gt and -holdout exclude each other");
-    const msf::Sequence sequence(positional[0]);
-    if (gt_switch && sequence.groundTruthDir().empty())
-      throw msf::InvalidInputError("-gt: '" + positional[0] +
-                                   "' has no synthetic ground truth (no gt/depth_0 beside its sequences/, as msf_synth "
-                                   "writes); without -gt it is evaluated by ring hold-out");
-    const bool gt_mode = !holdout_switch && !sequence.groundTruthDir().empty();
-    if (breakdown && gt_mode)
-      throw msf::InvalidInputError("-breakdown splits the ring hold-out's ground truth; full-image mode has its own "
-                                   "regions (add -holdout to evaluate '" + positional[0] + "' by ring hold-out)");
-    if (!cli.given("-methods"))
-      methods_text = gt_mode ? kGroundTruthMethods : methodNames();
-    if (!bounds_text.empty() && gt_mode)
-      throw msf::InvalidInputError("-bounds is a ring hold-out option (add -holdout to evaluate '" + positional[0] +
-                                   "' by ring hold-out)");
-    if (!csv_path.empty() && msf::fileExtension(csv_path) != ".csv")
-      throw msf::InvalidInputError("-csv '" + csv_path + "' must end in .csv");
-
-    const msf::ConfigFile config_file = config_path.empty() ? msf::ConfigFile() : msf::openConfigFile(config_path);
-    msf::HoldoutConfig config;
-    config_file.read(config.rings);
-    config_file.read(config.projection);
-    msf::HoldoutEvaluation evaluation(config);
-    evaluation.setBreakdown(breakdown);
-    std::vector<std::pair<std::string, msf::HoldoutMethod>> methods;
-    const auto names = split(methods_text);
-    if (names.empty())
-      throw msf::InvalidInputError("-methods is empty; known methods: " + methodNames());
-    for (const auto& name : names) {
-      const MethodEntry* entry = nullptr;
-      for (const auto& m : methodTable())
-        if (name == m.name)
-          entry = &m;
-      if (!entry)
-        throw msf::InvalidInputError("unknown method '" + name + "'; known methods: " + methodNames());
-      methods.emplace_back(name, entry->make(config_file));
-      evaluation.addMethod(name, methods.back().second);
-    }
-    if (!bounds_text.empty()) {
-      const auto pair = split(bounds_text);
-      if (pair.size() != 2)
-        throw msf::InvalidInputError("-bounds needs two methods separated by a comma, got '" + bounds_text + "'");
-      evaluation.addFusionBounds(pair[0], pair[1]);
-    }
-
-    const auto frames = sequence.indices(msf::FrameRange::parse(frames_text));
-    print_highlight("Evaluating ");
-    print_value("%zu frames ", frames.size());
-    print_info("of %s, %zu methods%s\n", sequence.directory().c_str(), names.size(),
-               gt_mode ? ", full image against synthetic ground truth" : ", ring hold-out");
-    pcl::StopWatch watch;
-    if (gt_mode) {
-      const auto results = runFullImage(sequence, frames, methods, config.d1);
-      const double ms = watch.getTime();
-      std::printf("%s", formatRegionTable(results).c_str());
-      std::fflush(stdout);
-      if (!csv_path.empty())
-        writeRegionCsv(csv_path, results);
-      msf::tool::printDone(ms, results.empty() ? 0 : results.front().region[0].metrics.gt_pixels);
-      return 0;
-    }
-    const auto results = evaluation.run(sequence, frames);
-    const double ms = watch.getTime();
-    std::printf("%s", msf::formatHoldoutTable(results).c_str());
-    if (breakdown)
-      std::printf("\n%s", msf::formatHoldoutBreakdown(results).c_str());
-    std::fflush(stdout);
-    if (!csv_path.empty())
-      msf::writeHoldoutCsv(csv_path, results);
-    msf::tool::printDone(ms, results.empty() ? 0 : results.front().metrics.gt_pixels);
-    return 0;
-  });
+  return cli.run(argc, argv, 1,
+                 [&](const msf::tool::Arguments& positional) { return run(cli, positional, settings); });
 }

@@ -41,41 +41,191 @@ pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
   return scan;
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
+/// What the command line sets.
+struct Settings {
   std::string poses_path, output, input_dir, frames, calib, scans_dir;
   msf::TsdfVolume::Config volume_config;
   msf::TsdfIntegrator::Config config;
   msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
   msf::RigAdaptationConfig rig;
   bool carving = false, no_carving = false, print_config = false;
+};
+
+/// What is integrated: the i-th depth cloud seen from the i-th pose, with the i-th scan when
+/// there are scans; `first_frame` is the line of the first pose in the poses file.
+struct Frames {
+  std::vector<std::string> clouds, scans;
+  msf::PoseList poses;
+  std::size_t first_frame = 0;
+};
+
+/// The clouds given and those of -input_dir, checked with the other file arguments.
+std::vector<std::string> listClouds(const msf::tool::CommandLine& cli, const msf::tool::Arguments& positional,
+                                    const Settings& settings, const char* program) {
+  std::vector<std::string> clouds = positional;
+  if (!settings.input_dir.empty()) {
+    const std::vector<std::string> found = msf::filesIn(settings.input_dir, {".pcd"}, "input folder");
+    clouds.insert(clouds.end(), found.begin(), found.end());
+  }
+  if (clouds.empty() || settings.poses_path.empty() || settings.output.empty()) {
+    cli.printHelp(program);
+    throw msf::InvalidInputError("need depth clouds, -poses and -o");
+  }
+  if (msf::fileExtension(settings.output) != ".pcd")
+    throw msf::InvalidInputError("output '" + settings.output + "' must be a .pcd file");
+  return clouds;
+}
+
+/// The poses of the lines -frames selects, one per cloud.
+void selectPoses(const msf::tool::CommandLine& cli, const Settings& settings, Frames& frames) {
+  const std::string& poses_path = settings.poses_path;
+  frames.poses = msf::loadOdometryPoses(poses_path);
+  if (cli.given("-frames")) {
+    const msf::FrameRange range = msf::FrameRange::parse(settings.frames);
+    const int count = static_cast<int>(frames.poses.size());
+    const int last = range.last < 0 ? count - 1 : range.last;
+    if (range.first >= count || last >= count)
+      throw msf::InvalidInputError("frames '" + settings.frames + "' is beyond the " + std::to_string(count) +
+                                   " poses of '" + poses_path + "'");
+    frames.poses = msf::PoseList(frames.poses.begin() + range.first, frames.poses.begin() + last + 1);
+    frames.first_frame = static_cast<std::size_t>(range.first);
+  }
+  if (frames.poses.size() != frames.clouds.size())
+    throw msf::InvalidInputError(std::to_string(frames.clouds.size()) + " depth clouds but " +
+                                 std::to_string(frames.poses.size()) + " poses in '" + poses_path +
+                                 "' (one pose per cloud; -frames a:b selects poses)");
+}
+
+/// The scans of -scans, one per cloud.
+void selectScans(const msf::tool::CommandLine& cli, const Settings& settings, const msf::Calibration& calibration,
+                 Frames& frames) {
+  if (!(cli.given("-calib") || cli.given("-rig")))
+    throw msf::InvalidInputError("-scans needs -calib: the LiDAR's pose is the camera's times its extrinsics");
+  calibration.requireVelodyne();
+  if (!settings.config.space_carving || !(settings.config.scan_carving_m > 0.0))
+    throw msf::InvalidInputError("-scans carves free space: it needs space carving and "
+                                 "tsdf_integrator.scan_carving_m > 0");
+  std::vector<std::string> scans = msf::filesIn(settings.scans_dir, {".bin", ".pcd"}, "scan folder");
+  const std::size_t first = frames.first_frame, count = frames.clouds.size();
+  // A whole sequence's folder (KITTI's velodyne/): -frames picks the scans as it picks the poses.
+  if (cli.given("-frames") && scans.size() >= first + count && scans.size() > count)
+    scans = std::vector<std::string>(scans.begin() + static_cast<std::ptrdiff_t>(first),
+                                     scans.begin() + static_cast<std::ptrdiff_t>(first + count));
+  if (scans.size() != count)
+    throw msf::InvalidInputError(std::to_string(count) + " depth clouds but " + std::to_string(scans.size()) +
+                                 " scans in '" + settings.scans_dir +
+                                 "' (one per cloud, or the whole sequence's with -frames a:b)");
+  frames.scans = scans;
+}
+
+/// Integrates every frame, a done line each; returns the integrator's time in ms summed over them.
+double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, const msf::Calibration& calibration,
+                       const msf::DepthFusionConfig& fusion, msf::TsdfIntegrator& integrator) {
+  const float scan_weight = 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m);
+  pcl::console::TicToc tt;
+  double integrate_ms = 0;
+  for (std::size_t i = 0; i < frames.clouds.size(); ++i) {
+    const std::string& cloud = frames.clouds[i];
+    print_highlight("Integrating ");
+    print_value("%s ", cloud.c_str());
+    tt.tic();
+    pcl::PCLPointCloud2 blob;
+    msf::loadCloudBlob(cloud, blob);
+    const msf::DepthFrame frame = msf::toDepthFrame(blob, camera.valid() ? &camera : nullptr, "cloud '" + cloud + "'");
+    integrator.integrate(frame, frames.poses[i]);
+    if (!frames.scans.empty())
+      integrator.carveWithScan(msf::ScanFreeSpace(loadScan(frames.scans[i])),
+                               frames.poses[i] * calibration.T_cam0_velo, scan_weight, frame.camera, frames.poses[i]);
+    const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
+    integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;
+    msf::tool::printDone(tt.toc(), stats.voxels_updated);
+  }
+  return integrate_ms;
+}
+
+void printVolume(const msf::TsdfVolume& volume, double integrate_ms_per_frame) {
+  print_info("Volume: ");
+  print_value("%zu", volume.numBlocks());
+  print_info(" blocks, ");
+  print_value("%zu", volume.numObservedVoxels());
+  print_info(" observed voxels, ");
+  print_value("%.1f", static_cast<double>(volume.memoryBytes()) / (1024.0 * 1024.0));
+  print_info(" MiB; integration ");
+  print_value("%.1f", integrate_ms_per_frame);
+  print_info(" ms per frame\n");
+}
+
+int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& positional, Settings& settings,
+        const char* program) {
+  Frames frames;
+  frames.clouds = listClouds(cli, positional, settings, program);
+  msf::TsdfIntegrator::Config& config = settings.config;
+  if (settings.carving && settings.no_carving)
+    throw msf::InvalidInputError("-carving and -no_carving together: choose one");
+  if (settings.carving || settings.no_carving)
+    config.space_carving = settings.carving;
+  msf::PinholeCamera camera;
+  msf::Calibration calibration;
+  if (cli.given("-calib") || cli.given("-rig")) {
+    calibration = msf::loadCalibration(settings.calib);
+    camera = msf::PinholeCamera::fromCalibration(calibration);
+    msf::adaptToRig(config, msf::rigAdaptation(settings.rig, calibration));
+  }
+  msf::TsdfVolume volume(settings.volume_config); // validates voxel size and truncation
+  msf::TsdfIntegrator integrator(volume, config);
+  if (settings.print_config) {
+    msf::printConfig(std::cout, settings.volume_config);
+    msf::printConfig(std::cout, config);
+  }
+  selectPoses(cli, settings, frames);
+  if (cli.given("-scans"))
+    selectScans(cli, settings, calibration, frames);
+
+  const double integrate_ms = integrateFrames(frames, camera, calibration, settings.fusion, integrator);
+  printVolume(volume, integrate_ms / static_cast<double>(frames.clouds.size()));
+
+  pcl::console::TicToc tt;
+  print_highlight("Saving ");
+  print_value("%s ", settings.output.c_str());
+  tt.tic();
+  volume.save(settings.output);
+  msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Settings settings;
+  msf::TsdfVolume::Config& volume_config = settings.volume_config;
+  msf::TsdfIntegrator::Config& config = settings.config;
   msf::tool::CommandLine cli(
       "msf_integrate", "<depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]",
       "Integrates organized depth clouds (rectified camera 0 frame, NaN where there is no depth) into a sparse TSDF "
       "volume, the i-th cloud seen from the i-th pose (T_world_cam, KITTI odometry format). A cloud's rgb colours "
       "the voxels; a 'weight' field (1/sigma^2 of the depth, msf_fuse's) is used with -weighting per_pixel.");
-  cli.value("-poses", "FILE", poses_path, "the poses, one line per cloud")
-      .value("-o", "FILE", output, "the volume (.pcd)")
-      .value("-input_dir", "DIR", input_dir, "also every .pcd of DIR, in name order")
-      .value("-frames", "a:b", frames, "the poses of these lines (0-based) only, when the file has more")
-      .value("-scans", "DIR", scans_dir,
+  cli.value("-poses", "FILE", settings.poses_path, "the poses, one line per cloud")
+      .value("-o", "FILE", settings.output, "the volume (.pcd)")
+      .value("-input_dir", "DIR", settings.input_dir, "also every .pcd of DIR, in name order")
+      .value("-frames", "a:b", settings.frames, "the poses of these lines (0-based) only, when the file has more")
+      .value("-scans", "DIR", settings.scans_dir,
              "every .bin (KITTI velodyne) or .pcd scan of DIR in name order, one per cloud (or the whole sequence's, "
              "picked by -frames as the poses are), in the LiDAR's frame: each "
              "clears what lies in front of its returns outside the camera's view, within "
              "tsdf_integrator.scan_carving_m of the LiDAR, as msf_reconstruct does (needs -calib with the LiDAR's "
              "extrinsics, and space carving)")
-      .value("-calib", "PATH", calib,
+      .value("-calib", "PATH", settings.calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
-      .value("-rig", "FILE", calib, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
+      .value("-rig", "FILE", settings.calib,
+             "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
       .value("-config", "FILE",
              [&](const std::string& path) {
                const msf::ConfigFile file = msf::openConfigFile(path);
                file.read(volume_config);
                file.read(config);
-               file.read(fusion);
-               file.read(rig);
+               file.read(settings.fusion);
+               file.read(settings.rig);
              },
              "YAML with sections tsdf_volume, tsdf_integrator, fusion (the LiDAR's range noise) and rig (with "
              "-calib, max_depth_m at most stereo's trusted depth, as in msf_reconstruct); the options below override "
@@ -94,109 +244,12 @@ int main(int argc, char** argv) {
       .value("-precise_max_depth", "M", config.precise_max_depth_m,
              "depth whose weight field says it is known to within the truncation is integrated up to M metres "
              "(default {default}; 0: -max_depth for all)")
-      .flag("-carving", carving,
+      .flag("-carving", settings.carving,
             std::string("space carving on: voxels seen in front of the surface become free (default ") +
                 (config.space_carving ? "on" : "off") + "; tsdf_integrator.space_carving)")
-      .flag("-no_carving", no_carving, "space carving off")
-      .flag("-print_config", print_config, "print the configuration in use");
+      .flag("-no_carving", settings.no_carving, "space carving off")
+      .flag("-print_config", settings.print_config, "print the configuration in use");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
-    std::vector<std::string> clouds = positional;
-    if (!input_dir.empty()) {
-      const std::vector<std::string> found = msf::filesIn(input_dir, {".pcd"}, "input folder");
-      clouds.insert(clouds.end(), found.begin(), found.end());
-    }
-    if (clouds.empty() || poses_path.empty() || output.empty()) {
-      cli.printHelp(argv[0]);
-      throw msf::InvalidInputError("need depth clouds, -poses and -o");
-    }
-    if (msf::fileExtension(output) != ".pcd")
-      throw msf::InvalidInputError("output '" + output + "' must be a .pcd file");
-    if (carving && no_carving)
-      throw msf::InvalidInputError("-carving and -no_carving together: choose one");
-    if (carving || no_carving)
-      config.space_carving = carving;
-    msf::PinholeCamera camera;
-    msf::Calibration calibration;
-    if (cli.given("-calib") || cli.given("-rig")) {
-      calibration = msf::loadCalibration(calib);
-      camera = msf::PinholeCamera::fromCalibration(calibration);
-      msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
-    }
-    msf::TsdfVolume volume(volume_config); // validates voxel size and truncation
-    msf::TsdfIntegrator integrator(volume, config);
-    if (print_config) {
-      msf::printConfig(std::cout, volume_config);
-      msf::printConfig(std::cout, config);
-    }
-
-    msf::PoseList poses = msf::loadOdometryPoses(poses_path);
-    std::size_t first_frame = 0;
-    if (cli.given("-frames")) {
-      const msf::FrameRange range = msf::FrameRange::parse(frames);
-      const int last = range.last < 0 ? static_cast<int>(poses.size()) - 1 : range.last;
-      if (range.first >= static_cast<int>(poses.size()) || last >= static_cast<int>(poses.size()))
-        throw msf::InvalidInputError("frames '" + frames + "' is beyond the " + std::to_string(poses.size()) +
-                                     " poses of '" + poses_path + "'");
-      poses = msf::PoseList(poses.begin() + range.first, poses.begin() + last + 1);
-      first_frame = static_cast<std::size_t>(range.first);
-    }
-    if (poses.size() != clouds.size())
-      throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " + std::to_string(poses.size()) +
-                                   " poses in '" + poses_path + "' (one pose per cloud; -frames a:b selects poses)");
-
-    std::vector<std::string> scans;
-    if (cli.given("-scans")) {
-      if (!(cli.given("-calib") || cli.given("-rig")))
-        throw msf::InvalidInputError("-scans needs -calib: the LiDAR's pose is the camera's times its extrinsics");
-      calibration.requireVelodyne();
-      if (!config.space_carving || !(config.scan_carving_m > 0.0))
-        throw msf::InvalidInputError("-scans carves free space: it needs space carving and "
-                                     "tsdf_integrator.scan_carving_m > 0");
-      scans = msf::filesIn(scans_dir, {".bin", ".pcd"}, "scan folder");
-      // A whole sequence's folder (KITTI's velodyne/): -frames picks the scans as it picks the poses.
-      if (cli.given("-frames") && scans.size() >= first_frame + clouds.size() && scans.size() > clouds.size())
-        scans = std::vector<std::string>(scans.begin() + static_cast<std::ptrdiff_t>(first_frame),
-                                         scans.begin() + static_cast<std::ptrdiff_t>(first_frame + clouds.size()));
-      if (scans.size() != clouds.size())
-        throw msf::InvalidInputError(std::to_string(clouds.size()) + " depth clouds but " +
-                                     std::to_string(scans.size()) + " scans in '" + scans_dir +
-                                     "' (one per cloud, or the whole sequence's with -frames a:b)");
-    }
-    const float scan_weight = 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m);
-
-    pcl::console::TicToc tt;
-    double integrate_ms = 0;
-    for (std::size_t i = 0; i < clouds.size(); ++i) {
-      print_highlight("Integrating ");
-      print_value("%s ", clouds[i].c_str());
-      tt.tic();
-      pcl::PCLPointCloud2 blob;
-      msf::loadCloudBlob(clouds[i], blob);
-      const msf::DepthFrame frame =
-          msf::toDepthFrame(blob, camera.valid() ? &camera : nullptr, "cloud '" + clouds[i] + "'");
-      integrator.integrate(frame, poses[i]);
-      if (!scans.empty())
-        integrator.carveWithScan(msf::ScanFreeSpace(loadScan(scans[i])), poses[i] * calibration.T_cam0_velo,
-                                 scan_weight, frame.camera, poses[i]);
-      integrate_ms += integrator.lastStats().allocate_ms + integrator.lastStats().update_ms +
-                      integrator.lastStats().regularize_ms;
-      msf::tool::printDone(tt.toc(), integrator.lastStats().voxels_updated);
-    }
-    print_info("Volume: ");
-    print_value("%zu", volume.numBlocks());
-    print_info(" blocks, ");
-    print_value("%zu", volume.numObservedVoxels());
-    print_info(" observed voxels, ");
-    print_value("%.1f", static_cast<double>(volume.memoryBytes()) / (1024.0 * 1024.0));
-    print_info(" MiB; integration ");
-    print_value("%.1f", integrate_ms / static_cast<double>(clouds.size()));
-    print_info(" ms per frame\n");
-
-    print_highlight("Saving ");
-    print_value("%s ", output.c_str());
-    tt.tic();
-    volume.save(output);
-    msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
-    return 0;
+    return run(cli, positional, settings, argv[0]);
   });
 }

@@ -61,29 +61,117 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
   guidance = msf::realReturns(prior, distance);
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
+/// What the command line sets.
+struct Settings {
   std::string calib_path, image_size_text, color_path, disparity_path, prior_path;
   bool print_config = false;
   msf::SgbmConfig config;
   msf::RigAdaptationConfig rig;
+};
+
+/// What the matcher reads: the grey pair, and the colour image and the prior when given.
+struct Inputs {
+  cv::Mat left, right, color, prior, guidance;
+};
+
+/// The calibration, after the arguments are checked; the stereo config adapted to its rig.
+msf::Calibration configure(const msf::tool::Arguments& files, Settings& settings) {
+  if (files.size() != 3)
+    throw msf::InvalidInputError("expected <left.png> <right.png> <out.pcd> (see -h)");
+  const std::string ext = msf::fileExtension(files[2]);
+  if (ext != ".pcd" && ext != ".ply")
+    throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
+  const cv::Size image_size = msf::parseImageSize(settings.image_size_text);
+  if (settings.calib_path.empty())
+    throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
+  if (!settings.disparity_path.empty() && msf::fileExtension(settings.disparity_path) != ".png")
+    throw msf::InvalidInputError("-disparity_png '" + settings.disparity_path + "' must end in .png");
+  settings.config.validate();
+  msf::Calibration calibration = msf::loadCalibration(settings.calib_path, image_size);
+  msf::adaptToRig(settings.config, msf::rigAdaptation(settings.rig, calibration));
+  if (settings.print_config)
+    msf::printConfig(std::cout, settings.config);
+  return calibration;
+}
+
+Inputs loadInputs(const std::string& left_path, const std::string& right_path, const Settings& settings) {
+  TicToc tt;
+  tt.tic();
+  print_highlight("Loading ");
+  print_value("%s %s ", left_path.c_str(), right_path.c_str());
+  Inputs inputs;
+  inputs.left = msf::readImage(left_path, cv::IMREAD_GRAYSCALE);
+  inputs.right = msf::readImage(right_path, cv::IMREAD_GRAYSCALE);
+  if (!settings.color_path.empty())
+    inputs.color = msf::readImage(settings.color_path, cv::IMREAD_COLOR);
+  if (!settings.prior_path.empty())
+    loadPrior(settings.prior_path, settings.config.lidarGuidance(), inputs.prior, inputs.guidance);
+  msf::tool::printDone(tt.toc(), static_cast<std::size_t>(inputs.left.total()));
+  return inputs;
+}
+
+/// Matches the pair into `cloud`, with a done line; nothing matched is a warning.
+void match(const Inputs& inputs, const msf::Calibration& calibration, msf::SgbmStereo& stereo,
+           pcl::PointCloud<msf::PointXYZRGBConfidence>& cloud) {
+  TicToc tt;
+  tt.tic();
+  print_highlight("Matching ");
+  stereo.setCalibration(calibration);
+  stereo.setInputImages(inputs.left, inputs.right);
+  stereo.setInputColor(inputs.color);
+  stereo.setDepthPrior(inputs.prior);
+  stereo.setGuidance(inputs.guidance);
+  stereo.compute(cloud);
+  std::size_t valid = 0;
+  for (const auto& p : cloud)
+    valid += std::isfinite(p.z);
+  print_value("(%d disparities) ", stereo.getSearchedDisparities());
+  msf::tool::printDone(tt.toc(), valid);
+  if (valid == 0)
+    print_warn("no pixel was matched: check the images (a rectified left/right pair?) and the disparity range\n");
+}
+
+int run(const msf::tool::Arguments& files, Settings& settings) {
+  const msf::Calibration calibration = configure(files, settings);
+  const Inputs inputs = loadInputs(files[0], files[1], settings);
+  msf::SgbmStereo stereo(settings.config);
+  pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
+  match(inputs, calibration, stereo, cloud);
+
+  TicToc tt;
+  tt.tic();
+  print_highlight("Saving ");
+  print_value("%s ", files[2].c_str());
+  if (!settings.disparity_path.empty())
+    msf::writeKittiDisparityPng(settings.disparity_path, stereo.getDisparity());
+  msf::saveCloud(files[2], cloud);
+  msf::tool::printDone(tt.toc(), cloud.size());
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  Settings settings;
+  msf::SgbmConfig& config = settings.config;
   msf::tool::CommandLine cli(
       "msf_stereo", "<left.png> <right.png> <out.pcd> -calib PATH [options]",
       "Matches a rectified pair (KITTI image_0, image_1) with SGBM (stereo.unguided_mode, or stereo.mode where -prior "
-      "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 (fields x y z rgb confidence; NaN where there "
-      "is no match).");
-  cli.value("-calib", "PATH", calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
-      .value("-rig", "FILE", calib_path, "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
-      .value("-image_size", "WxH", image_size_text, "image size where no image lies beside the calibration")
-      .value("-color", "PATH", color_path,
+      "guides it; stereo.engine: the native matcher or OpenCV's StereoSGBM) and writes the organized cloud of camera 0 "
+      "(fields x y z rgb confidence; NaN where there is no match).");
+  cli.value("-calib", "PATH", settings.calib_path, "KITTI odometry calib.txt, raw date folder, object calib or YAML")
+      .value("-rig", "FILE", settings.calib_path,
+             "the same as -calib: a rig file (docs/usage.md, \"Your own rig\") or any calibration above")
+      .value("-image_size", "WxH", settings.image_size_text, "image size where no image lies beside the calibration")
+      .value("-color", "PATH", settings.color_path,
              "colour camera image (image_2), projected for each point's colour; without it the colour is the left "
              "image's grey")
-      .value("-disparity_png", "PATH", disparity_path, "also write the disparity as a KITTI 16-bit PNG (pixels x 256)")
-      .value("-prior", "PATH", prior_path,
+      .value("-disparity_png", "PATH", settings.disparity_path,
+             "also write the disparity as a KITTI 16-bit PNG (pixels x 256)")
+      .value("-prior", "PATH", settings.prior_path,
              "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
              "real returns (distance 0) guide it")
-      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, rig); },
+      .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, settings.rig); },
              "YAML config, sections stereo (every SGBM parameter; the options below override it) and rig (the keys "
              "in rows between LiDAR rings follow the rig's beams, as in msf_reconstruct)")
       .value("-num_disparities", "N", config.num_disparities_px,
@@ -93,63 +181,6 @@ int main(int argc, char** argv) {
              "the paths, guided or not: ground_3way | sgbm (5 paths) | sgbm_3way | hh | hh4 (default: sgbm guided by "
              "-prior, ground_3way without)")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
-      .flag("-print_config", print_config, "print the stereo settings in use");
-  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) {
-    if (files.size() != 3)
-      throw msf::InvalidInputError("expected <left.png> <right.png> <out.pcd> (see -h)");
-    const std::string ext = msf::fileExtension(files[2]);
-    if (ext != ".pcd" && ext != ".ply")
-      throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
-    const cv::Size image_size = msf::parseImageSize(image_size_text);
-    if (calib_path.empty())
-      throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
-    if (!disparity_path.empty() && msf::fileExtension(disparity_path) != ".png")
-      throw msf::InvalidInputError("-disparity_png '" + disparity_path + "' must end in .png");
-    config.validate();
-    const msf::Calibration calibration = msf::loadCalibration(calib_path, image_size);
-    msf::adaptToRig(config, msf::rigAdaptation(rig, calibration));
-    if (print_config)
-      msf::printConfig(std::cout, config);
-
-    TicToc tt;
-    tt.tic();
-    print_highlight("Loading ");
-    print_value("%s %s ", files[0].c_str(), files[1].c_str());
-    const cv::Mat left = msf::readImage(files[0], cv::IMREAD_GRAYSCALE);
-    const cv::Mat right = msf::readImage(files[1], cv::IMREAD_GRAYSCALE);
-    cv::Mat color;
-    if (!color_path.empty())
-      color = msf::readImage(color_path, cv::IMREAD_COLOR);
-    cv::Mat prior, guidance;
-    if (!prior_path.empty())
-      loadPrior(prior_path, config.lidarGuidance(), prior, guidance);
-    msf::tool::printDone(tt.toc(), static_cast<std::size_t>(left.total()));
-
-    tt.tic();
-    print_highlight("Matching ");
-    msf::SgbmStereo stereo(config);
-    stereo.setCalibration(calibration);
-    stereo.setInputImages(left, right);
-    stereo.setInputColor(color);
-    stereo.setDepthPrior(prior);
-    stereo.setGuidance(guidance);
-    pcl::PointCloud<msf::PointXYZRGBConfidence> cloud;
-    stereo.compute(cloud);
-    std::size_t valid = 0;
-    for (const auto& p : cloud)
-      valid += std::isfinite(p.z);
-    print_value("(%d disparities) ", stereo.getSearchedDisparities());
-    msf::tool::printDone(tt.toc(), valid);
-    if (valid == 0)
-      print_warn("no pixel was matched: check the images (a rectified left/right pair?) and the disparity range\n");
-
-    tt.tic();
-    print_highlight("Saving ");
-    print_value("%s ", files[2].c_str());
-    if (!disparity_path.empty())
-      msf::writeKittiDisparityPng(disparity_path, stereo.getDisparity());
-    msf::saveCloud(files[2], cloud);
-    msf::tool::printDone(tt.toc(), cloud.size());
-    return 0;
-  });
+      .flag("-print_config", settings.print_config, "print the stereo settings in use");
+  return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) { return run(files, settings); });
 }

@@ -41,8 +41,50 @@ void requirePinholeFor(const msf::tool::CommandLine& cli, msf::synthetic::Synthe
   }
 }
 
+/// The "Building the street" done line: what the scene holds.
+void printStreet(const msf::synthetic::SyntheticGenerator& generator, double milliseconds) {
+  print_info("[done, ");
+  print_value("%g", milliseconds);
+  print_info(" ms : ");
+  print_value("%zu", generator.scene().primitives.size());
+  print_info(" solids, ");
+  print_value("%u", generator.scene().objectCount());
+  print_info(" foreground objects, ");
+  print_value("%zu", generator.scene().movers.size());
+  print_info(" of them moving]\n");
+}
+
+/// Writes the dataset into `output`, a done line a frame; a stop signal ends it at the next
+/// frame, leaving no staging folder and `output` as it was.
+void writeFrames(const msf::synthetic::SyntheticGenerator& generator, int frames, const std::string& output) {
+  std::vector<double> seconds;
+  TicToc tt;
+  tt.tic();
+  print_highlight("Writing ");
+  print_value("%d frames", frames);
+  print_info(" to ");
+  print_value("%s\n", output.c_str());
+  msf::tool::installStopSignals({"msf_synth: stopping after the frame under way; nothing is written"});
+  generator.writeDataset(output, [&](std::size_t frame, double s, std::size_t points) {
+    if (msf::tool::stopFlag())
+      throw msf::InvalidInputError("interrupted at frame " + std::to_string(frame) + ": nothing was written to '" +
+                                   output + "'");
+    seconds.push_back(s);
+    print_info("  frame %06zu ", frame);
+    msf::tool::printDone(1000.0 * s, points);
+  });
+  print_info("Wrote ");
+  print_value("%s", output.c_str());
+  print_info(": %d frames, median ", frames);
+  print_value("%.3f", msf::median(seconds));
+  print_info(" s per frame, total ");
+  print_value("%.1f", tt.toc() / 1000.0);
+  print_info(" s\n");
+}
+
 } // namespace
 
+// Longer than the other steps for its option table: one declaration an option.
 int main(int argc, char** argv) {
   msf::synthetic::SyntheticConfig config;
   std::string output;
@@ -119,39 +161,8 @@ int main(int argc, char** argv) {
     tt.tic();
     print_highlight("Building the street ");
     const msf::synthetic::SyntheticGenerator generator(config);
-    print_info("[done, ");
-    print_value("%g", tt.toc());
-    print_info(" ms : ");
-    print_value("%zu", generator.scene().primitives.size());
-    print_info(" solids, ");
-    print_value("%u", generator.scene().objectCount());
-    print_info(" foreground objects, ");
-    print_value("%zu", generator.scene().movers.size());
-    print_info(" of them moving]\n");
-
-    std::vector<double> seconds;
-    tt.tic();
-    print_highlight("Writing ");
-    print_value("%d frames", config.frames);
-    print_info(" to ");
-    print_value("%s\n", output.c_str());
-    // A stop signal ends the run at the next frame, leaving no staging folder and OUT as it was.
-    msf::tool::installStopSignals({"msf_synth: stopping after the frame under way; nothing is written"});
-    generator.writeDataset(output, [&](std::size_t frame, double s, std::size_t points) {
-      if (msf::tool::stopFlag())
-        throw msf::InvalidInputError("interrupted at frame " + std::to_string(frame) + ": nothing was written to '" +
-                                     output + "'");
-      seconds.push_back(s);
-      print_info("  frame %06zu ", frame);
-      msf::tool::printDone(1000.0 * s, points);
-    });
-    print_info("Wrote ");
-    print_value("%s", output.c_str());
-    print_info(": %d frames, median ", config.frames);
-    print_value("%.3f", msf::median(seconds));
-    print_info(" s per frame, total ");
-    print_value("%.1f", tt.toc() / 1000.0);
-    print_info(" s\n");
+    printStreet(generator, tt.toc());
+    writeFrames(generator, config.frames, output);
     return 0;
   });
 }

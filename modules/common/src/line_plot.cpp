@@ -59,24 +59,39 @@ void LinePlot::addSeries(const std::string& name, const std::vector<double>& x, 
   series_.push_back({name, x, y});
 }
 
-cv::Mat LinePlot::render(int width, int height) const {
-  auto ty = [&](double y) { return log_y_ ? std::log10(y) : y; };
-  auto usable = [&](double y) { return std::isfinite(y) && (!log_y_ || y > 0); };
+/// The data's range, y as drawn (log10 on a logarithmic axis), and the plot's area.
+struct LinePlot::Frame {
+  bool log_y = false;
+  double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
+  cv::Rect area;
+
+  double ty(double y) const { return log_y ? std::log10(y) : y; }
+  bool usable(double y) const { return std::isfinite(y) && (!log_y || y > 0); }
+  int px(double x) const { return area.x + static_cast<int>(std::lround((x - x_lo) / (x_hi - x_lo) * area.width)); }
+  int py(double y) const {
+    return area.y + area.height - static_cast<int>(std::lround((ty(y) - y_lo) / (y_hi - y_lo) * area.height));
+  }
+};
+
+/// The range of the finite points and the reference lines (or the y range set), padded.
+LinePlot::Frame LinePlot::fit(int width, int height) const {
+  Frame f;
+  f.log_y = log_y_;
   double x_lo = std::numeric_limits<double>::max(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
   for (const auto& s : series_)
     for (std::size_t i = 0; i < s.x.size(); ++i)
-      if (std::isfinite(s.x[i]) && usable(s.y[i])) {
+      if (std::isfinite(s.x[i]) && f.usable(s.y[i])) {
         x_lo = std::min(x_lo, s.x[i]), x_hi = std::max(x_hi, s.x[i]);
-        y_lo = std::min(y_lo, ty(s.y[i])), y_hi = std::max(y_hi, ty(s.y[i]));
+        y_lo = std::min(y_lo, f.ty(s.y[i])), y_hi = std::max(y_hi, f.ty(s.y[i]));
       }
   if (x_lo > x_hi)
     throw InvalidInputError("plot '" + title_ + "' has no finite point");
   for (const auto& r : references_)
-    if (usable(r.y))
-      y_lo = std::min(y_lo, ty(r.y)), y_hi = std::max(y_hi, ty(r.y));
+    if (f.usable(r.y))
+      y_lo = std::min(y_lo, f.ty(r.y)), y_hi = std::max(y_hi, f.ty(r.y));
   if (y_hi > y_lo || y_lo_ != y_hi_) {
     if (y_lo_ != y_hi_)
-      y_lo = ty(y_lo_), y_hi = ty(y_hi_);
+      y_lo = f.ty(y_lo_), y_hi = f.ty(y_hi_);
   }
   if (!log_y_ && y_lo_ == y_hi_ && y_lo > 0 && y_lo < 0.5 * y_hi)
     y_lo = 0; // start linear axes at zero when the data is not far from it
@@ -87,60 +102,67 @@ cv::Mat LinePlot::render(int width, int height) const {
   const double pad = 0.05 * (y_hi - y_lo);
   if (!(y_lo_ != y_hi_))
     y_hi += pad, y_lo = (y_lo == 0 && !log_y_) ? 0 : y_lo - pad;
-
-  cv::Mat image(height, width, CV_8UC3, cv::Scalar::all(255));
+  f.x_lo = x_lo, f.x_hi = x_hi, f.y_lo = y_lo, f.y_hi = y_hi;
   const int left = 80, right = 190, top = 44, bottom = 56;
-  const cv::Rect area(left, top, width - left - right, height - top - bottom);
-  auto px = [&](double x) { return area.x + static_cast<int>(std::lround((x - x_lo) / (x_hi - x_lo) * area.width)); };
-  auto py = [&](double y) {
-    return area.y + area.height - static_cast<int>(std::lround((ty(y) - y_lo) / (y_hi - y_lo) * area.height));
-  };
+  f.area = cv::Rect(left, top, width - left - right, height - top - bottom);
+  return f;
+}
 
-  put(image, title_, {width / 2, 28}, 0.6, 1);
-  put(image, x_label_, {area.x + area.width / 2, height - 14}, 0.5, 1);
+/// The title, the axes' labels, the grid at round ticks (decades on a logarithmic axis), the frame.
+void LinePlot::drawAxes(cv::Mat& image, const Frame& f) const {
+  const cv::Rect& area = f.area;
+  put(image, title_, {image.cols / 2, 28}, 0.6, 1);
+  put(image, x_label_, {area.x + area.width / 2, image.rows - 14}, 0.5, 1);
   cv::Mat ylabel(24, area.height, CV_8UC3, cv::Scalar::all(255));
   put(ylabel, y_label_, {area.height / 2, 17}, 0.5, 1);
   cv::rotate(ylabel, ylabel, cv::ROTATE_90_COUNTERCLOCKWISE);
   ylabel.copyTo(image(cv::Rect(4, area.y, 24, area.height)));
 
-  for (double t : niceTicks(x_lo, x_hi, 8)) {
-    cv::line(image, {px(t), area.y}, {px(t), area.y + area.height}, cv::Scalar::all(232));
-    put(image, label(t), {px(t), area.y + area.height + 18}, 0.42, 1);
+  for (double t : niceTicks(f.x_lo, f.x_hi, 8)) {
+    cv::line(image, {f.px(t), area.y}, {f.px(t), area.y + area.height}, cv::Scalar::all(232));
+    put(image, label(t), {f.px(t), area.y + area.height + 18}, 0.42, 1);
   }
+  std::vector<double> y_ticks;
   if (log_y_) {
-    for (int e = static_cast<int>(std::floor(y_lo)); e <= static_cast<int>(std::ceil(y_hi)); ++e) {
-      const double v = std::pow(10.0, e);
-      if (e < y_lo || e > y_hi)
-        continue;
-      cv::line(image, {area.x, py(v)}, {area.x + area.width, py(v)}, cv::Scalar::all(232));
-      put(image, label(v), {area.x - 6, py(v) + 5}, 0.42, 2);
-    }
+    for (int e = static_cast<int>(std::floor(f.y_lo)); e <= static_cast<int>(std::ceil(f.y_hi)); ++e)
+      if (e >= f.y_lo && e <= f.y_hi)
+        y_ticks.push_back(std::pow(10.0, e));
   } else {
-    for (double t : niceTicks(y_lo, y_hi, 6)) {
-      cv::line(image, {area.x, py(t)}, {area.x + area.width, py(t)}, cv::Scalar::all(232));
-      put(image, label(t), {area.x - 6, py(t) + 5}, 0.42, 2);
-    }
+    y_ticks = niceTicks(f.y_lo, f.y_hi, 6);
+  }
+  for (double t : y_ticks) {
+    cv::line(image, {area.x, f.py(t)}, {area.x + area.width, f.py(t)}, cv::Scalar::all(232));
+    put(image, label(t), {area.x - 6, f.py(t) + 5}, 0.42, 2);
   }
   cv::rectangle(image, area, cv::Scalar::all(80));
+}
 
+/// Each reference line within the range, dashed and labelled at its right end.
+void LinePlot::drawReferences(cv::Mat& image, const Frame& f) const {
+  const cv::Rect& area = f.area;
   for (const auto& r : references_) {
-    if (!usable(r.y) || ty(r.y) < y_lo || ty(r.y) > y_hi)
+    if (!f.usable(r.y) || f.ty(r.y) < f.y_lo || f.ty(r.y) > f.y_hi)
       continue;
     for (int x = area.x; x < area.x + area.width; x += 12)
-      cv::line(image, {x, py(r.y)}, {std::min(x + 6, area.x + area.width), py(r.y)}, cv::Scalar(60, 60, 200), 1);
-    put(image, r.label, {area.x + area.width - 4, py(r.y) - 5}, 0.42, 2);
+      cv::line(image, {x, f.py(r.y)}, {std::min(x + 6, area.x + area.width), f.py(r.y)}, cv::Scalar(60, 60, 200), 1);
+    put(image, r.label, {area.x + area.width - 4, f.py(r.y) - 5}, 0.42, 2);
   }
+}
 
+/// Each series as a polyline in its colour (markers when it has few points), broken where a
+/// point is not finite, and its line of the legend.
+void LinePlot::drawSeries(cv::Mat& image, const Frame& f) const {
+  const cv::Rect& area = f.area;
   for (std::size_t k = 0; k < series_.size(); ++k) {
     const auto& s = series_[k];
     const cv::Scalar colour = kColours[k % (sizeof kColours / sizeof kColours[0])];
     cv::Point last(-1, -1);
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (!std::isfinite(s.x[i]) || !usable(s.y[i])) {
+      if (!std::isfinite(s.x[i]) || !f.usable(s.y[i])) {
         last = {-1, -1};
         continue;
       }
-      const cv::Point p(px(s.x[i]), py(s.y[i]));
+      const cv::Point p(f.px(s.x[i]), f.py(s.y[i]));
       if (last.x >= 0)
         cv::line(image, last, p, colour, 2, cv::LINE_AA);
       if (s.x.size() <= 40)
@@ -151,6 +173,14 @@ cv::Mat LinePlot::render(int width, int height) const {
     cv::line(image, {area.x + area.width + 14, ly}, {area.x + area.width + 38, ly}, colour, 2, cv::LINE_AA);
     put(image, s.name, {area.x + area.width + 44, ly + 5}, 0.45);
   }
+}
+
+cv::Mat LinePlot::render(int width, int height) const {
+  const Frame frame = fit(width, height);
+  cv::Mat image(height, width, CV_8UC3, cv::Scalar::all(255));
+  drawAxes(image, frame);
+  drawReferences(image, frame);
+  drawSeries(image, frame);
   return image;
 }
 

@@ -219,6 +219,136 @@ WeightLevel WeightCurve::atCompleteness(double completeness) const {
   return atWeight(sample_levels_[k - 1]);
 }
 
+namespace {
+
+/// A class index for no true triangle (none within reach, or no classes).
+constexpr std::uint8_t kOff = 255;
+
+/// By weight: a triangle stays while its lightest vertex passes the bar, a vertex while its
+/// surest triangle does.
+void weightLevels(const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<float>& weights,
+                  std::vector<float>& triangle_levels, std::vector<float>& vertex_levels) {
+  vertex_levels.assign(weights.size(), -1.f);
+  triangle_levels.reserve(triangles.size());
+  for (const auto& t : triangles) {
+    const float level = std::min({weights[t[0]], weights[t[1]], weights[t[2]]});
+    triangle_levels.push_back(level);
+    for (std::uint32_t i : t)
+      vertex_levels[i] = std::max(vertex_levels[i], level);
+  }
+}
+
+/// The class of the true triangle `t`, kOff for none.
+std::uint8_t classOf(const std::vector<std::uint8_t>& triangle_class, std::uint32_t t) {
+  return t == SurfaceDistance::kNoTriangle ? kOff : triangle_class[t];
+}
+
+/// Each true triangle's class: its first vertex's. Throws when the classes do not fit `truth`.
+std::vector<std::uint8_t> trueTriangleClasses(const pcl::PolygonMesh& truth, const SurfaceDistance& to_truth,
+                                              const SurfaceClasses& classes) {
+  const std::size_t truth_vertices = truth.cloud.width * truth.cloud.height;
+  if (classes.vertex_class.size() != truth_vertices)
+    throw InvalidInputError("mesh evaluation: " + std::to_string(classes.vertex_class.size()) +
+                            " classes for the true surface's " + std::to_string(truth_vertices) + " vertices");
+  for (std::uint8_t c : classes.vertex_class)
+    if (c >= classes.names.size())
+      throw InvalidInputError("mesh evaluation: class " + std::to_string(c) + " of " +
+                              std::to_string(classes.names.size()) + " names");
+  std::vector<std::uint8_t> triangle_class(to_truth.numTriangles());
+  for (std::uint32_t t = 0; t < triangle_class.size(); ++t)
+    triangle_class[t] = classes.vertex_class[to_truth.triangle(t)[0]];
+  return triangle_class;
+}
+
+/// The class of each sample, the samples taken every `truth_step` of `seen_truth`. A sample
+/// lies on the truth, or within the tessellation's few centimetres of a curved solid's: its
+/// class is the nearest triangle's within `on_surface`.
+std::vector<std::uint8_t> sampleClasses(const SurfaceDistance& to_truth,
+                                        const std::vector<std::uint8_t>& triangle_class,
+                                        const std::vector<Eigen::Vector3f>& seen_truth, std::size_t truth_step,
+                                        std::size_t samples, float on_surface) {
+  std::vector<std::uint8_t> sample_class(samples);
+  parallelFor(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      std::uint32_t nearest = SurfaceDistance::kNoTriangle;
+      to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], on_surface, &nearest);
+      sample_class[i] = classOf(triangle_class, nearest);
+    }
+  });
+  return sample_class;
+}
+
+/// The mean and median of the vertices' distances to the truth, and the share within the threshold.
+void setAccuracy(const std::vector<double>& distances, double threshold_m, MeshAccuracy& result) {
+  result.vertices = distances.size();
+  double sum = 0;
+  std::size_t near = 0;
+  for (double d : distances) {
+    sum += d;
+    near += d <= threshold_m;
+  }
+  result.accuracy_mean_m = distances.empty() ? 0.0 : sum / static_cast<double>(distances.size());
+  result.accuracy_median_m = median(distances);
+  result.precision = distances.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(distances.size());
+}
+
+/// Accuracy and completeness per class of `names`, then kOffSurface's: the vertices' distances
+/// by their class, the samples' coverage by theirs.
+std::vector<ClassAccuracy> accuracyByClass(const std::vector<std::string>& names,
+                                           const std::vector<std::uint8_t>& vertex_class,
+                                           const std::vector<double>& distances,
+                                           const std::vector<std::uint8_t>& sample_class,
+                                           const std::vector<std::uint8_t>& is_covered) {
+  const std::size_t n = names.size();
+  std::vector<ClassAccuracy> split(n + 1), by_class;
+  std::vector<double> sums(n + 1, 0.0);
+  std::vector<std::size_t> hits(n + 1, 0);
+  for (std::size_t c = 0; c < n; ++c)
+    split[c].name = names[c];
+  split[n].name = ClassAccuracy::kOffSurface;
+  const auto slot = [n](std::uint8_t c) { return c == kOff ? n : static_cast<std::size_t>(c); };
+  for (std::size_t i = 0; i < distances.size(); ++i) {
+    ++split[slot(vertex_class[i])].vertices;
+    sums[slot(vertex_class[i])] += distances[i];
+  }
+  for (std::size_t i = 0; i < sample_class.size(); ++i) {
+    ++split[slot(sample_class[i])].truth_samples;
+    hits[slot(sample_class[i])] += is_covered[i];
+  }
+  for (std::size_t c = 0; c <= n; ++c) {
+    ClassAccuracy& a = split[c];
+    a.accuracy_mean_m = a.vertices ? sums[c] / static_cast<double>(a.vertices) : 0.0;
+    a.contribution_m = distances.empty() ? 0.0 : sums[c] / static_cast<double>(distances.size());
+    a.completeness = a.truth_samples ? static_cast<double>(hits[c]) / static_cast<double>(a.truth_samples) : 0.0;
+    if (a.vertices > 0 || a.truth_samples > 0 || c < n)
+      by_class.push_back(a);
+  }
+  return by_class;
+}
+
+/// Completeness in 10 m bands of the distance to the nearest view, of the samples taken every
+/// `truth_step` of `view_distance_m` (at least one sample).
+std::vector<CompletenessBand> completenessByViewDistance(const std::vector<float>& view_distance_m,
+                                                         std::size_t truth_step,
+                                                         const std::vector<std::uint8_t>& is_covered) {
+  constexpr double kBand = 10.0;
+  const float farthest = *std::max_element(view_distance_m.begin(), view_distance_m.end());
+  const int bands = std::max(1, static_cast<int>(std::ceil(farthest / kBand)));
+  std::vector<std::size_t> n(bands), hit(bands);
+  for (std::size_t i = 0; i < is_covered.size(); ++i) {
+    const int b = std::clamp(static_cast<int>(std::ceil(view_distance_m[i * truth_step] / kBand)) - 1, 0, bands - 1);
+    ++n[b];
+    hit[b] += is_covered[i];
+  }
+  std::vector<CompletenessBand> by_band;
+  for (int b = 0; b < bands; ++b)
+    by_band.push_back({kBand * b, kBand * (b + 1), n[b], n[b] ? static_cast<double>(hit[b]) / static_cast<double>(n[b])
+                                                               : 0.0});
+  return by_band;
+}
+
+} // namespace
+
 MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& truth,
                           const std::vector<Eigen::Vector3f>& seen_truth, double threshold_m, double cap_m,
                           std::size_t max_samples, const std::vector<float>* view_distance_m,
@@ -241,37 +371,13 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   if (vertex_weights && vertex_weights->size() != vertices.size())
     throw InvalidInputError("mesh evaluation: " + std::to_string(vertex_weights->size()) + " vertex weights for " +
                             std::to_string(vertices.size()) + " vertices");
-  // By weight: a triangle stays while its lightest vertex passes the bar, a vertex while its
-  // surest triangle does.
   std::vector<float> triangle_levels, vertex_levels;
-  if (vertex_weights) {
-    vertex_levels.assign(vertices.size(), -1.f);
-    triangle_levels.reserve(triangles.size());
-    for (const auto& t : triangles) {
-      const float level = std::min({(*vertex_weights)[t[0]], (*vertex_weights)[t[1]], (*vertex_weights)[t[2]]});
-      triangle_levels.push_back(level);
-      for (std::uint32_t i : t)
-        vertex_levels[i] = std::max(vertex_levels[i], level);
-    }
-  }
+  if (vertex_weights)
+    weightLevels(triangles, *vertex_weights, triangle_levels, vertex_levels);
   const SurfaceDistance to_truth(truth, std::max(cap, 0.25f));
-  // Each true triangle's class, kOff for none: vertices and samples take their nearest's.
-  constexpr std::uint8_t kOff = 255;
-  std::vector<std::uint8_t> triangle_class;
-  if (truth_classes) {
-    const std::size_t truth_vertices = truth.cloud.width * truth.cloud.height;
-    if (truth_classes->vertex_class.size() != truth_vertices)
-      throw InvalidInputError("mesh evaluation: " + std::to_string(truth_classes->vertex_class.size()) +
-                              " classes for the true surface's " + std::to_string(truth_vertices) + " vertices");
-    for (std::uint8_t c : truth_classes->vertex_class)
-      if (c >= truth_classes->names.size())
-        throw InvalidInputError("mesh evaluation: class " + std::to_string(c) + " of " +
-                                std::to_string(truth_classes->names.size()) + " names");
-    triangle_class.resize(to_truth.numTriangles());
-    for (std::uint32_t t = 0; t < triangle_class.size(); ++t)
-      triangle_class[t] = truth_classes->vertex_class[to_truth.triangle(t)[0]];
-  }
-  const auto classOf = [&](std::uint32_t t) { return t == SurfaceDistance::kNoTriangle ? kOff : triangle_class[t]; };
+  // Each true triangle's class: vertices and samples take their nearest's, kOff for none.
+  const std::vector<std::uint8_t> triangle_class =
+      truth_classes ? trueTriangleClasses(truth, to_truth, *truth_classes) : std::vector<std::uint8_t>();
   // A regular stride over large inputs: deterministic, and the statistics barely move.
   const std::size_t vertex_step = std::max<std::size_t>(1, (vertices.size() + max_samples - 1) / max_samples);
   std::vector<double> distances((vertices.size() + vertex_step - 1) / vertex_step);
@@ -282,19 +388,10 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
       distances[i] = to_truth.distance(vertices[static_cast<std::size_t>(i) * vertex_step], cap,
                                        truth_classes ? &nearest : nullptr);
       if (truth_classes)
-        vertex_class[i] = classOf(nearest);
+        vertex_class[i] = classOf(triangle_class, nearest);
     }
   });
-  result.vertices = distances.size();
-  double sum = 0;
-  std::size_t near = 0;
-  for (double d : distances) {
-    sum += d;
-    near += d <= threshold_m;
-  }
-  result.accuracy_mean_m = distances.empty() ? 0.0 : sum / static_cast<double>(distances.size());
-  result.accuracy_median_m = median(distances);
-  result.precision = distances.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(distances.size());
+  setAccuracy(distances, threshold_m, result);
 
   const SurfaceDistance to_mesh(std::move(vertices), std::move(triangles), std::max(threshold, 0.1f));
   const std::size_t truth_step = std::max<std::size_t>(1, (seen_truth.size() + max_samples - 1) / max_samples);
@@ -320,58 +417,14 @@ MeshAccuracy evaluateMesh(const pcl::PolygonMesh& mesh, const pcl::PolygonMesh& 
   }
   const std::size_t covered = static_cast<std::size_t>(std::count(is_covered.begin(), is_covered.end(), 1));
   if (truth_classes) {
-    // A sample lies on the truth, or within the tessellation's few centimetres of a curved
-    // solid's: its class is the nearest triangle's within the threshold.
-    const float on_surface = std::max(threshold, 0.05f);
-    std::vector<std::uint8_t> sample_class(samples);
-    parallelFor(cv::Range(0, static_cast<int>(samples)), [&](const cv::Range& range) {
-      for (int i = range.start; i < range.end; ++i) {
-        std::uint32_t nearest = SurfaceDistance::kNoTriangle;
-        to_truth.distance(seen_truth[static_cast<std::size_t>(i) * truth_step], on_surface, &nearest);
-        sample_class[i] = classOf(nearest);
-      }
-    });
-    const std::size_t n = truth_classes->names.size();
-    std::vector<ClassAccuracy> split(n + 1);
-    std::vector<double> sums(n + 1, 0.0);
-    std::vector<std::size_t> hits(n + 1, 0);
-    for (std::size_t c = 0; c < n; ++c)
-      split[c].name = truth_classes->names[c];
-    split[n].name = ClassAccuracy::kOffSurface;
-    const auto slot = [n](std::uint8_t c) { return c == kOff ? n : static_cast<std::size_t>(c); };
-    for (std::size_t i = 0; i < distances.size(); ++i) {
-      ++split[slot(vertex_class[i])].vertices;
-      sums[slot(vertex_class[i])] += distances[i];
-    }
-    for (std::size_t i = 0; i < samples; ++i) {
-      ++split[slot(sample_class[i])].truth_samples;
-      hits[slot(sample_class[i])] += is_covered[i];
-    }
-    for (std::size_t c = 0; c <= n; ++c) {
-      ClassAccuracy& a = split[c];
-      a.accuracy_mean_m = a.vertices ? sums[c] / static_cast<double>(a.vertices) : 0.0;
-      a.contribution_m = distances.empty() ? 0.0 : sums[c] / static_cast<double>(distances.size());
-      a.completeness = a.truth_samples ? static_cast<double>(hits[c]) / static_cast<double>(a.truth_samples) : 0.0;
-      if (a.vertices > 0 || a.truth_samples > 0 || c < n)
-        result.by_class.push_back(a);
-    }
+    const std::vector<std::uint8_t> sample_class =
+        sampleClasses(to_truth, triangle_class, seen_truth, truth_step, samples, std::max(threshold, 0.05f));
+    result.by_class = accuracyByClass(truth_classes->names, vertex_class, distances, sample_class, is_covered);
   }
   result.truth_samples = samples;
   result.completeness = samples == 0 ? 0.0 : static_cast<double>(covered) / static_cast<double>(samples);
-  if (view_distance_m && samples > 0) {
-    constexpr double kBand = 10.0;
-    const float farthest = *std::max_element(view_distance_m->begin(), view_distance_m->end());
-    const int bands = std::max(1, static_cast<int>(std::ceil(farthest / kBand)));
-    std::vector<std::size_t> n(bands), hit(bands);
-    for (std::size_t i = 0; i < samples; ++i) {
-      const int b = std::clamp(static_cast<int>(std::ceil((*view_distance_m)[i * truth_step] / kBand)) - 1, 0, bands - 1);
-      ++n[b];
-      hit[b] += is_covered[i];
-    }
-    for (int b = 0; b < bands; ++b)
-      result.by_view_distance.push_back({kBand * b, kBand * (b + 1), n[b],
-                                         n[b] ? static_cast<double>(hit[b]) / static_cast<double>(n[b]) : 0.0});
-  }
+  if (view_distance_m && samples > 0)
+    result.by_view_distance = completenessByViewDistance(*view_distance_m, truth_step, is_covered);
   return result;
 }
 

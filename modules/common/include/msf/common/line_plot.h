@@ -37,6 +37,13 @@ private:
     double y;
     std::string label;
   };
+  struct Frame; // the data's range and where it goes on the picture
+
+  Frame fit(int width, int height) const;
+  void drawAxes(cv::Mat& image, const Frame& frame) const;
+  void drawReferences(cv::Mat& image, const Frame& frame) const;
+  void drawSeries(cv::Mat& image, const Frame& frame) const;
+
   std::string title_, x_label_, y_label_;
   std::vector<Series> series_;
   std::vector<Reference> references_;
