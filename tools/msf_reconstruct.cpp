@@ -223,6 +223,8 @@ public:
         sky_->addFrame(frame); // from the whole scan
       if (request_.holdout)
         holdout_.split(frame);
+      if (truth_)
+        truth_->addScan(frame); // the scan the map is made of
       poses_.apply(frame);
     });
     Progress progress(frames_.size());
@@ -378,7 +380,8 @@ private:
 
   void makeEvaluations() {
     if (!source_.groundTruthDir().empty())
-      truth_ = std::make_unique<msf::SyntheticScoring>(source_.groundTruthDir(), !streaming());
+      truth_ = std::make_unique<msf::SyntheticScoring>(source_.groundTruthDir(), !streaming(),
+                                                       config_.volume.voxel_size_m);
     // Protocol 4 renders the whole mesh at every frame's pose: not for a streamed map, whose
     // mesh is on disk (its depth scores are bounded and kept).
     if (!streaming() && (request_.holdout || truth_))

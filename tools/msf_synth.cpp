@@ -126,6 +126,9 @@ int main(int argc, char** argv) {
       .value("-frames", "N", config.frames, "number of frames (default {default})")
       .value("-seed", "S", config.seed, "random seed, a whole number >= 0 (default {default})")
       .value("-scene", "NAME", config.scene, "scene to render: street (default)")
+      .value("-sky", "LOOK", config.sky,
+             "pale: a smooth pale blue (default) | kitti: KITTI's overexposed sky, clipped to a flat white near the "
+             "horizon and in soft clouds, where SGBM smears the crowns' disparity (synthetic.sky)")
       .flag("-loop", config.loop,
             "drive out, turn round across the road and drive back in the other lane to the start (synthetic.loop): "
             "the way back revisits the street")
@@ -150,6 +153,8 @@ int main(int argc, char** argv) {
     checkRange(cli, "-seed", config.seed, 0, 2147483647);
     if (config.scene != "street")
       throw msf::InvalidInputError("option -scene: unknown scene '" + config.scene + "' (known: street)");
+    if (cli.given("-sky") && config.sky != "pale" && config.sky != "kitti")
+      throw msf::InvalidInputError("option -sky: unknown sky '" + config.sky + "' (known: pale, kitti)");
     requirePinholeFor(cli, config);
     config.validate();
     if (output.empty())

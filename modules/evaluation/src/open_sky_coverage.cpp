@@ -61,7 +61,8 @@ void OpenSkyCoverage::setPose(std::size_t frame, const Eigen::Isometry3d& T_worl
   sky.has_pose = true;
 }
 
-SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh) {
+SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
+                                       const std::function<bool(const Eigen::Vector3f&)>& counts) {
   const std::lock_guard<std::mutex> lock(mutex_);
   SkyCoverage out;
   double share_sum = 0;
@@ -74,10 +75,18 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh) {
       continue;
     rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_);
     const float* depth = rendered_.ptr<float>(0);
+    const Eigen::Isometry3f T = sky.T_world_cam.cast<float>();
+    const auto counted = [&](std::uint32_t p) { // the surface point seen at pixel p, in the world
+      const auto u = static_cast<float>(p % static_cast<std::uint32_t>(camera_.width));
+      const auto v = static_cast<float>(p / static_cast<std::uint32_t>(camera_.width));
+      const float z = depth[p];
+      return !counts ||
+             counts(T * Eigen::Vector3f((u - camera_.cx) * z / camera_.fx, (v - camera_.cy) * z / camera_.fy, z));
+    };
     std::size_t covered = 0;
     for (std::size_t r = 0; r < sky.runs.size(); r += 2)
       for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
-        if (depth[p] > 0.f) {
+        if (depth[p] > 0.f && counted(p)) {
           ++covered;
           covered_depth.push_back(depth[p]);
         }

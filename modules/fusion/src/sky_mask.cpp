@@ -138,10 +138,14 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
     for (int u = 0; u < sky.cols; ++u)
       s[u] = open[static_cast<std::size_t>(l[u])] ? 255 : 0;
   }
-  if (border_ > 0)
-    cv::erode(sky, sky, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
-              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  takeBorder(sky);
   return sky;
+}
+
+void SkyMask::takeBorder(cv::Mat& mask) const {
+  if (border_ > 0)
+    cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
+              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
 }
 
 } // namespace msf

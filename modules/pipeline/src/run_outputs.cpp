@@ -78,6 +78,9 @@ void summarizeMapEvaluation(const ReconstructionEvaluation& evaluation,
           row.has_ghosts = it->second.has_ghosts;
           row.ghosts = it->second.ghosts;
           row.crumbs = it->second.crumbs;
+          row.true_sky = it->second.true_sky;
+          row.true_sky_sheets = it->second.true_sky_sheets;
+          row.off_surface = it->second.off_surface;
         }
         const auto seen = seen_through.find(source);
         if (seen != seen_through.end()) {

@@ -127,6 +127,39 @@ std::string accuracyJson(const MeshAccuracy& m) {
          (classes.empty() ? "" : ", \"by_class\": [" + classes + "]") + "}";
 }
 
+std::string skyJson(const SkyCoverage& c) {
+  std::ostringstream s;
+  s << "{\"frames\": " << c.frames << ", \"sky_pixels\": " << c.sky_pixels
+    << ", \"covered_pixels\": " << c.covered_pixels
+    << ", \"share\": " << num(c.share, 6) << ", \"mean_frame_share\": " << num(c.mean_frame_share, 6)
+    << ", \"worst_share\": " << num(c.worst_share, 6) << ", \"worst_frame\": " << c.worst_frame
+    << ", \"covered_depth_median_m\": " << num(c.covered_depth_median_m, 2) << "}";
+  return s.str();
+}
+
+/// A band's edge: null for the open ends.
+std::string edgeJson(double m) { return std::isfinite(m) ? num(m) : "null"; }
+
+std::string offSurfaceJson(const OffSurfaceSplit& o) {
+  std::string bands;
+  for (const auto& b : o.bands)
+    bands += std::string(bands.empty() ? "" : ", ") + "{\"lower_m\": " + edgeJson(b.lower_m) + ", \"upper_m\": " +
+             edgeJson(b.upper_m) + ", \"supported_m2\": " + num(b.supported_m2, 3) + ", \"unsupported_m2\": " +
+             num(b.unsupported_m2, 3) + ", \"supported_share\": " + num(o.shareOfOff(b.supported_m2), 4) +
+             ", \"unsupported_share\": " + num(o.shareOfOff(b.unsupported_m2), 4) + "}";
+  return "{\"distance_m\": " + num(o.distance_m) + ", \"area_m2\": " + num(o.area_m2, 2) + ", \"off_area_m2\": " +
+         num(o.off_area_m2, 3) + ", \"off_share\": " + num(o.offShare(), 6) + ", \"bands\": [" + bands + "]}";
+}
+
+/// A band's heights in words: "below 2 m", "2-5 m", "above 5 m".
+std::string bandText(const OffSurfaceSplit::Band& b) {
+  if (!std::isfinite(b.lower_m))
+    return "below " + num(b.upper_m) + " m";
+  if (!std::isfinite(b.upper_m))
+    return "above " + num(b.lower_m) + " m";
+  return num(b.lower_m) + "–" + num(b.upper_m) + " m";
+}
+
 /// What a second stop signal left out, as a sentence of report.md ("" when nothing was).
 std::string skippedSentence(const std::vector<std::string>& skipped) {
   if (skipped.empty())
@@ -316,6 +349,10 @@ void RunReport::writeSummaryJson(const std::string& path) const {
           << in << "\"crumbs\": {\"crumbs\": " << r.crumbs.crumbs << ", \"crumb_triangles\": " << r.crumbs.crumb_triangles
           << ", \"specks\": " << r.crumbs.specks << ", \"small_pieces\": " << r.crumbs.small_pieces
           << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles << "}";
+      if (r.has_accuracy)
+        s << ",\n" << in << "\"true_sky\": " << skyJson(r.true_sky) << ",\n"
+          << in << "\"true_sky_sheets\": " << skyJson(r.true_sky_sheets) << ",\n"
+          << in << "\"off_surface\": " << offSurfaceJson(r.off_surface);
       if (r.has_seen_through)
         s << ",\n" << in << "\"seen_through\": {\"pieces\": " << r.seen_through.seen_through << ", \"triangles\": "
           << r.seen_through.triangles << ", \"small_pieces\": " << r.seen_through.small_pieces
@@ -329,12 +366,7 @@ void RunReport::writeSummaryJson(const std::string& path) const {
   if (open_sky.empty())
     s << "null";
   for (auto it = open_sky.begin(); it != open_sky.end(); ++it) {
-    const SkyCoverage& c = it->second;
-    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": {\"frames\": " << c.frames
-      << ", \"sky_pixels\": " << c.sky_pixels << ", \"covered_pixels\": " << c.covered_pixels
-      << ", \"share\": " << num(c.share, 6) << ", \"mean_frame_share\": " << num(c.mean_frame_share, 6)
-      << ", \"worst_share\": " << num(c.worst_share, 6) << ", \"worst_frame\": " << c.worst_frame
-      << ", \"covered_depth_median_m\": " << num(c.covered_depth_median_m, 2) << "}"
+    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": " << skyJson(it->second)
       << (std::next(it) == open_sky.end() ? "\n  }" : "");
   }
   s << ",\n  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
@@ -451,6 +483,7 @@ void RunReport::writeMarkdown(const std::string& path) const {
     writeMapEvaluation(s);
   if (!open_sky.empty())
     writeOpenSky(s);
+  writeTruthOffSurface(s);
   if (!depth_panels.empty()) {
     s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
          " (and the fused depth's error where ground truth exists).\n\n";
@@ -519,6 +552,50 @@ void RunReport::writeOpenSky(std::ostream& s) const {
     s << "The sky in cyan, where the mesh covers it in red:\n\n";
   for (const auto& picture : sky_pictures)
     s << "![" << picture << "](" << picture << ")\n\n";
+}
+
+void RunReport::writeTruthOffSurface(std::ostream& s) const {
+  std::vector<const MapEvaluation::Row*> rows;
+  for (const auto& r : map_evaluation.rows)
+    if (r.has_accuracy)
+      rows.push_back(&r);
+  if (rows.empty())
+    return;
+  const double off_m = rows.front()->off_surface.distance_m;
+  const auto share = [](const SkyCoverage& c) {
+    return num(100 * c.share, 2) + " % | " + num(100 * c.mean_frame_share, 2) + " % | " + num(100 * c.worst_share, 2) +
+           " % (frame " + std::to_string(c.worst_frame) + ")";
+  };
+  s << "## The true sky and the surface off the truth (synthetic)\n\n"
+    << "The true sky (pixels of zero true depth, less protocol 6's 3-pixel border) that each mesh rendered at every "
+       "frame's pose covers; a sheet: the covering surface lies farther than "
+    << num(off_m) << " m from the static true surface (a blurred outline lies nearer):\n\n"
+    << "| mesh | sky pixels | covered | mean per frame | worst frame | by sheets | mean per frame | worst frame |\n"
+    << "|---|---|---|---|---|---|---|---|\n";
+  for (const auto* r : rows)
+    s << "| " << r->score.source << " | " << r->true_sky.sky_pixels << " | " << share(r->true_sky) << " | "
+      << share(r->true_sky_sheets) << " |\n";
+  s << "\nThe mesh's area farther than " << num(off_m)
+    << " m from the static true surface (gt/scene.ply; a moving car's ghost is off it too), by height above the road "
+       "and whether a LiDAR return of any frame lay within a cell (a voxel) of it, as shares of that area:\n\n"
+       "| mesh | area m² | off the surface |";
+  const auto& bands = rows.front()->off_surface.bands;
+  for (const auto& b : bands)
+    s << " " << bandText(b) << ", LiDAR | " << bandText(b) << ", none |";
+  s << "\n|---|---|---|";
+  for (std::size_t k = 0; k < bands.size(); ++k)
+    s << "---|---|";
+  s << "\n";
+  for (const auto* r : rows) {
+    const OffSurfaceSplit& o = r->off_surface;
+    s << "| " << r->score.source << " | " << num(o.area_m2, 1) << " | " << num(o.off_area_m2, 2) << " m² ("
+      << num(100 * o.offShare(), 2) << " %) |";
+    for (const auto& b : o.bands)
+      s << " " << num(100 * o.shareOfOff(b.supported_m2), 1) << " % | " << num(100 * o.shareOfOff(b.unsupported_m2), 1)
+        << " % |";
+    s << "\n";
+  }
+  s << "\n";
 }
 
 void RunReport::writeMapEvaluation(std::ostream& s) const {

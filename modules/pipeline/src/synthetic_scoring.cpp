@@ -1,6 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/cloud_io.h>
 #include <msf/pipeline/synthetic_scoring.h>
+#include <msf/synthetic/kitti_rig.h>
 
 #include <filesystem>
 
@@ -9,10 +11,17 @@ namespace msf {
 namespace {
 constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
 constexpr std::size_t kCrumbTriangles = 50; // a piece this small is a speck to the eye (a few voxels' faces)
+constexpr float kOffSurfaceM = static_cast<float>(kGhostDistanceM); // off the true surface: a sheet, not an outline
 } // namespace
 
-SyntheticScoring::SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes)
-    : truth_(std::make_unique<synthetic::GroundTruth>(ground_truth_dir)), score_meshes_(score_meshes) {
+const std::vector<double>& SyntheticScoring::offSurfaceBands() {
+  static const std::vector<double> edges = {2.0, 5.0};
+  return edges;
+}
+
+SyntheticScoring::SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes, double voxel_size_m)
+    : truth_(std::make_unique<synthetic::GroundTruth>(ground_truth_dir)), score_meshes_(score_meshes),
+      lidar_(voxel_size_m) {
   if (!score_meshes_)
     return;
   loadMesh(truth_->sceneMeshPath(), scene_);
@@ -32,6 +41,13 @@ void SyntheticScoring::addDepth(const std::string& method, const std::string& fr
   foreground_[method].add(true_depth, estimate, focal_baseline, truth_->foregroundMask(gt_index));
 }
 
+void SyntheticScoring::addScan(const Frame& frame) {
+  if (!score_meshes_ || !frame.scan)
+    return;
+  const std::lock_guard<std::mutex> lock(scans_mutex_);
+  scans_[frame.index] = frame.scan;
+}
+
 void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth, const Calibration& calibration,
                                 double max_depth_m) {
   const double fb = calibration.focalBaseline();
@@ -41,6 +57,24 @@ void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth,
     addDepth(name, r.name, true_depth, estimate, fb);
   if (!score_meshes_)
     return;
+  if (!true_sky_)
+    true_sky_ = std::make_unique<OpenSkyCoverage>(PinholeCamera::fromCalibration(calibration, 0));
+  // The exact sky (no surface along the pixel's ray), less the border protocol 6's mask leaves.
+  cv::Mat sky = true_depth == 0.f;
+  SkyMask().takeBorder(sky);
+  true_sky_->addMask(r.index, sky);
+  true_sky_->setPose(r.index, r.T_world_cam0);
+  pcl::PointCloud<pcl::PointXYZI>::ConstPtr scan;
+  {
+    const std::lock_guard<std::mutex> lock(scans_mutex_);
+    const auto it = scans_.find(r.index);
+    if (it != scans_.end()) {
+      scan = it->second;
+      scans_.erase(it);
+    }
+  }
+  if (scan)
+    lidar_.addScan(*scan, r.T_world_cam0 * calibration.T_cam0_velo);
   // Every 4th pixel of the true static surface in range, for the mesh's completeness against
   // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
   const cv::Mat moving = truth_->movingMask(truth_->indexOf(r.name));
@@ -73,9 +107,10 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
           return true;
       return false;
     };
-  std::unique_ptr<SurfaceDistance> static_surface;
-  if (was_moving)
-    static_surface = std::make_unique<SurfaceDistance>(scene_);
+  const SurfaceDistance static_surface(scene_);
+  // The street's road in its world (y down): the camera's height below the cameras' path.
+  const Eigen::Hyperplane<float, 3> road(Eigen::Vector3f(0.f, -1.f, 0.f),
+                                         static_cast<float>(synthetic::kCameraHeightM));
   // The nearest distance each piece of the seen surface was seen from (cells of a voxel):
   // what a frame far away cannot place within the completeness threshold.
   const std::vector<float> view_distance =
@@ -90,10 +125,17 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
                               weights.size() == m.mesh->vertices.size() ? &weights : nullptr,
                               classes_ ? &*classes_ : nullptr);
     if (was_moving) {
-      s.ghosts = measureGhosts(m.mesh->vertices, *static_surface, was_moving, kGhostDistanceM);
-      s.crumbs = measureCrumbs(*m.mesh, *static_surface, was_moving, kCrumbTriangles, kGhostDistanceM);
+      s.ghosts = measureGhosts(m.mesh->vertices, static_surface, was_moving, kGhostDistanceM);
+      s.crumbs = measureCrumbs(*m.mesh, static_surface, was_moving, kCrumbTriangles, kGhostDistanceM);
       s.has_ghosts = true;
     }
+    if (true_sky_) {
+      s.true_sky = true_sky_->scoreMesh(*m.mesh);
+      s.true_sky_sheets = true_sky_->scoreMesh(*m.mesh, [&](const Eigen::Vector3f& p) {
+        return static_surface.distance(p, 2.f * kOffSurfaceM) > kOffSurfaceM;
+      });
+    }
+    s.off_surface = splitOffSurface(*m.mesh, static_surface, road, lidar_, kGhostDistanceM, offSurfaceBands());
   }
   return scores;
 }

@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/counter_rng.h>
+#include <msf/synthetic/kitti_sky.h>
 
 #include <opencv2/core/utility.hpp>
 
@@ -68,6 +69,18 @@ Radiance sky(V3 dir) {
   return {0.82f - 0.42f * t, 0.86f - 0.30f * t, 0.92f - 0.12f * t};
 }
 
+/// The sky of synthetic.sky: the pale default, or KITTI's (kittiSky) with its clouds drawn from the seed.
+struct SkyLook {
+  bool kitti = false;
+  std::uint32_t seed = 0;
+  Radiance operator()(V3 dir) const {
+    if (!kitti)
+      return sky(dir);
+    const SkyRadiance r = kittiSky(dir, seed);
+    return {r.r, r.g, r.b};
+  }
+};
+
 /// What one ray sees: its radiance, which surface (a key that differs across geometric
 /// edges), and the exact depth and object id for the ground truth.
 struct Sample {
@@ -78,11 +91,11 @@ struct Sample {
 };
 
 /// Traces one ray; step_x / step_y are the ray's spread for one sample step in the image.
-Sample trace(const SceneSnapshot& scene, const Ray& ray, V3 step_x, V3 step_y) {
+Sample trace(const SceneSnapshot& scene, const Ray& ray, V3 step_x, V3 step_y, const SkyLook& look) {
   Sample out;
   Hit hit;
   if (!scene.intersect(ray, 0.f, kMaxDepthM, hit)) {
-    out.radiance = sky(ray.dir);
+    out.radiance = look(ray.dir);
     return out;
   }
   const V3 world = ray.origin + ray.dir * hit.t;
@@ -139,6 +152,13 @@ inline std::uint8_t toByte(const GammaTable& gamma, float linear, float noise) {
   return static_cast<std::uint8_t>(std::clamp(roundHalfAway(gamma(linear) + noise), 0L, 255L));
 }
 
+/// The same with the sensor's headroom: radiance past the white keeps rising before the noise, so
+/// an overexposed patch clips to a flat 255 as a real sensor's does (KITTI's sky).
+inline std::uint8_t toByteClipping(const GammaTable& gamma, float linear, float noise) {
+  const float level = linear * kExposure > 1.f ? 255.f * std::pow(linear * kExposure, 1.f / 2.2f) : gamma(linear);
+  return static_cast<std::uint8_t>(std::clamp(roundHalfAway(level + noise), 0L, 255L));
+}
+
 } // namespace
 
 CameraRenderer::CameraRenderer(const Calibration& calibration, const SyntheticConfig& config)
@@ -166,6 +186,11 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
   const HashPrefix image_key =
       HashPrefix(static_cast<std::uint64_t>(config_.seed)).then(noise_key).then(static_cast<std::uint64_t>(camera));
   static const GammaTable gamma;
+  const SkyLook look{config_.sky == "kitti",
+                     static_cast<std::uint32_t>(hashKey(static_cast<std::uint64_t>(config_.seed), 0x5c1e5ULL))};
+  const auto byte = [&](float linear, float noise) {
+    return look.kitti ? toByteClipping(gamma, linear, noise) : toByte(gamma, linear, noise);
+  };
 
   // Pass 1: the ray through each pixel centre, its texture filtered over the whole pixel.
   std::vector<Radiance> radiance(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
@@ -175,8 +200,8 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
       float* d = depth ? depth->ptr<float>(v) : nullptr;
       std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
       for (int u = 0; u < W; ++u) {
-        const Sample s =
-            trace(scene, {cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))}, pixel_x, pixel_y);
+        const Ray ray{cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))};
+        const Sample s = trace(scene, ray, pixel_x, pixel_y, look);
         const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
         radiance[i] = s.radiance;
         surface[i] = s.surface;
@@ -207,7 +232,7 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
               // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
               const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
               const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
-              const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y).radiance;
+              const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y, look).radiance;
               r.r += q.r;
               r.g += q.g;
               r.b += q.b;
@@ -221,11 +246,11 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
         };
         if (color) {
           // OpenCV's BGR order.
-          row[3 * u + 0] = toByte(gamma, r.b, noise(0));
-          row[3 * u + 1] = toByte(gamma, r.g, noise(1));
-          row[3 * u + 2] = toByte(gamma, r.r, noise(2));
+          row[3 * u + 0] = byte(r.b, noise(0));
+          row[3 * u + 1] = byte(r.g, noise(1));
+          row[3 * u + 2] = byte(r.r, noise(2));
         } else {
-          row[u] = toByte(gamma, 0.30f * r.r + 0.59f * r.g + 0.11f * r.b, noise(0));
+          row[u] = byte(0.30f * r.r + 0.59f * r.g + 0.11f * r.b, noise(0));
         }
       }
     }

@@ -15,6 +15,11 @@ namespace {
 
 constexpr float kPiF = 3.14159265f;
 constexpr float kPlateauOuterX = 48.f; // street offset where the back row of buildings ends
+// synthetic.sky kitti: lower buildings and wide, low-hanging crowns. SGBM smears a crown's disparity over
+// the clipped sky beside it, and the LiDAR's top ring returning the crown bounds sky carving there.
+constexpr float kKittiBuildingScale = 0.6f; // the buildings' height, of the default street's
+constexpr float kKittiTrunkDropM = 1.2f;    // the crown starts this much lower
+constexpr float kKittiCrownGrowM = 1.0f;    // and its radii are this much larger
 
 struct Rgb3 {
   float r, g, b;
@@ -61,6 +66,9 @@ private:
   float yAbove(float height) const { return layout().ground_y - height; }
   float yAboveSidewalk(float height) const { return layout().sidewalkY() - height; }
   float uniform(double lo, double hi) { return static_cast<float>(rng_.uniform(lo, hi)); }
+  /// A building's height: with synthetic.sky kitti lower, so that the sky over the street is wide
+  /// and the crowns stand against it, as on KITTI's drives.
+  float lower(float height) const { return config_.sky == "kitti" ? kKittiBuildingScale * height : height; }
 
   std::uint16_t material(MaterialType type, Rgb3 c, float reflectivity) {
     Material m;
@@ -140,19 +148,19 @@ private:
       if (roll < blank_share) {
         // Warehouse with blank walls, or a blank garden wall in front of a back building.
         if (rng_.chance(0.5)) {
-          addBuilding(side, building_line + uniform(0.0, 1.0), uniform(10.0, 16.0), z, z + lot, uniform(4.0, 9.0),
-                      true);
+          addBuilding(side, building_line + uniform(0.0, 1.0), uniform(10.0, 16.0), z, z + lot,
+                      lower(uniform(4.0, 9.0)), true);
         } else {
           addBuilding(side, building_line + 0.2f, 0.25f, z, z + lot - 2.5f, uniform(1.8, 2.6), true);
-          addBuilding(side, uniform(26.0, 30.0), uniform(8.0, 12.0), z, z + lot, uniform(8.0, 16.0), false);
+          addBuilding(side, uniform(26.0, 30.0), uniform(8.0, 12.0), z, z + lot, lower(uniform(8.0, 16.0)), false);
         }
       } else if (roll < blank_share + 0.15 * (1.0 - blank_share)) {
-        addBuilding(side, uniform(26.0, 30.0), uniform(8.0, 12.0), z, z + lot, uniform(8.0, 16.0), false);
+        addBuilding(side, uniform(26.0, 30.0), uniform(8.0, 12.0), z, z + lot, lower(uniform(8.0, 16.0)), false);
       } else {
         const float setback = rng_.chance(0.6) ? 0.f : uniform(0.5, 3.0);
         const int floors = 2 + rng_.index(5);
         addBuilding(side, building_line + setback, uniform(10.0, 16.0), z, z + lot,
-                    static_cast<float>(floors) * uniform(3.0, 3.5) + 1.f, false);
+                    lower(static_cast<float>(floors) * uniform(3.0, 3.5) + 1.f), false);
       }
       z += lot + (rng_.chance(0.5) ? 0.f : uniform(1.0, 4.0));
     }
@@ -162,7 +170,7 @@ private:
   void addBackRow(int side) {
     for (float z = layout().z_begin - 15.f; z < layout().z_end + 15.f;) {
       const float lot = uniform(15.0, 30.0);
-      addBuilding(side, kPlateauOuterX - 6.f, 6.f, z, z + lot, uniform(12.0, 24.0), false);
+      addBuilding(side, kPlateauOuterX - 6.f, 6.f, z, z + lot, lower(uniform(12.0, 24.0)), false);
       z += lot;
     }
   }
@@ -217,7 +225,12 @@ private:
         continue;
       const std::uint16_t leaves =
           material(MaterialType::Foliage, {uniform(0.07, 0.12), uniform(0.15, 0.22), uniform(0.04, 0.07)}, 0.45f);
-      const float trunk = uniform(2.6, 3.4), rh = uniform(1.7, 2.6), rv = uniform(2.0, 3.0);
+      float trunk = uniform(2.6, 3.4), rh = uniform(1.7, 2.6), rv = uniform(2.0, 3.0);
+      if (config_.sky == "kitti") { // wide crowns from the LiDAR's top ring to above the eaves, as KITTI's
+        trunk -= kKittiTrunkDropM;
+        rh += kKittiCrownGrowM;
+        rv += kKittiCrownGrowM;
+      }
       scene_.add(cylinderSolid({x, yAboveSidewalk(0.5f * trunk + 0.25f), z}, 1, uniform(0.12, 0.2),
                                0.5f * trunk + 0.25f, bark));
       scene_.add(ellipsoidSolid({x, yAboveSidewalk(trunk + 0.75f * rv), z}, {rh, rv, rh}, leaves));

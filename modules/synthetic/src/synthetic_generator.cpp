@@ -186,7 +186,10 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
     saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
   }
   std::ostringstream yaml; // plain YAML, which msf_synth -config reads back to the same dataset
-  printConfig(yaml, config_);
+  std::vector<KeyText> keys = listKeys(config_);
+  if (config_.sky == SyntheticConfig().sky) // the default sky unnamed: the file reads as before the key
+    keys.erase(std::find_if(keys.begin(), keys.end(), [](const KeyText& k) { return k.name == "sky"; }));
+  printSection(yaml, SyntheticConfig::kSection, keys);
   writeText(gt / "synthetic.yaml", yaml.str());
   std::string readme = kGroundTruthReadme;
   if (config_.placed()) // the world is the street's, where this drive does not start

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -49,8 +50,10 @@ public:
   /// not finite.
   void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam);
   /// Renders `mesh` (world frame) at the pose of every frame that has a mask and counts the sky
-  /// it covers. Frames without a pose (a run stopped early) are left out.
-  SkyCoverage scoreMesh(const TriangleMesh& mesh);
+  /// it covers; with `counts`, only the pixels whose covering surface point (world frame) it
+  /// accepts (e.g. those off a true surface: a sheet, not a blurred outline). Frames without a
+  /// pose (a run stopped early) are left out.
+  SkyCoverage scoreMesh(const TriangleMesh& mesh, const std::function<bool(const Eigen::Vector3f&)>& counts = {});
 
   /// A picture of one frame: `image` (CV_8UC1 or CV_8UC3 of the camera's size) with its open
   /// sky tinted cyan and the sky a mesh covers (`rendered`: depth, > 0 where a surface is) in

@@ -53,6 +53,10 @@ public:
   /// ConfigError for a setting out of range (a negative window or border).
   cv::Mat compute(const cv::Mat& image, const cv::Mat& returns) const;
 
+  /// Takes the border off `mask` (CV_8UC1, 255 = sky) in place, as compute's step 4 does: a
+  /// surface's outline blurred by the image or by a map's voxels is not counted as sky.
+  void takeBorder(cv::Mat& mask) const;
+
   /// The pixels of `sky` (compute's mask of `image`, CV_8UC1) whose colour only the sky has: a
   /// channel clipped (at least the clipped level) or, in colour, blue with more saturation
   /// than a grey-white pixel (the maximum saturation) has. CV_8UC1, 255 = clear sky. Throws

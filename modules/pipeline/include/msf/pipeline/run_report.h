@@ -5,6 +5,7 @@
 #include <msf/evaluation/ghost_metric.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/evaluation/odometry_metrics.h>
+#include <msf/evaluation/off_surface_split.h>
 #include <msf/evaluation/open_sky_coverage.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/pipeline/reconstructor.h>
@@ -49,6 +50,11 @@ public:
       CrumbMetrics crumbs;
       bool has_seen_through = false; ///< a mesh: its small pieces the ground truth sees through
       SeenThroughPieces seen_through;
+      /// A mesh against the true surface (synthetic): the true sky it covers, rendered at every
+      /// frame's pose (all of it, and by surface off the truth: sheets), and its area off the
+      /// surface by height and LiDAR support.
+      SkyCoverage true_sky, true_sky_sheets;
+      OffSurfaceSplit off_surface;
     };
     std::string truth;             ///< what the ground truth is, in words
     double range_m = 0;            ///< "within range": true depth <= this (tsdf_integrator.max_depth_m)
@@ -117,6 +123,8 @@ public:
 private:
   void writeMapEvaluation(std::ostream& out) const;
   void writeOpenSky(std::ostream& out) const;
+  /// The true sky each mesh covers and its surface off the truth (synthetic rows).
+  void writeTruthOffSurface(std::ostream& out) const;
   /// The meshes' accuracy and completeness by the class of the true surface (when known).
   void writeClassTable(std::ostream& out) const;
 };

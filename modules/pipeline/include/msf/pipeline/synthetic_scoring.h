@@ -3,8 +3,12 @@
 #include <msf/evaluation/crumb_metric.h>
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/ghost_metric.h>
+#include <msf/evaluation/lidar_support.h>
 #include <msf/evaluation/mesh_accuracy.h>
+#include <msf/evaluation/off_surface_split.h>
+#include <msf/evaluation/open_sky_coverage.h>
 #include <msf/io/calibration.h>
+#include <msf/io/frame_source.h>
 #include <msf/io/surface_classes.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/run_report.h>
@@ -14,6 +18,7 @@
 
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,22 +27,26 @@ namespace msf {
 
 /// A synthetic sequence's exact ground truth (its gt/ folder) scored over a run (protocol 3):
 /// each frame's depth images against the true depth (all, background, foreground), and after
-/// the run the meshes against the true surface (accuracy, completeness, by class of surface)
-/// and where moving objects were (ghosts).
+/// the run the meshes against the true surface (accuracy, completeness, by class of surface),
+/// where moving objects were (ghosts), over the true sky, and off the surface (OffSurfaceSplit).
 class SyntheticScoring {
 public:
   /// Reads gt/scene.ply and gt/scene_classes.txt now, so that a garbled file stops the run
   /// before its first frame. `score_meshes` false (a streamed map, whose mesh is on disk)
-  /// keeps the depth scores only and nothing per frame beyond them. Throws IOError naming a
-  /// garbled file.
-  SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes);
+  /// keeps the depth scores only and nothing per frame beyond them. `voxel_size_m`: the cell
+  /// of the LiDAR's support. Throws IOError naming a garbled file.
+  SyntheticScoring(const std::string& ground_truth_dir, bool score_meshes, double voxel_size_m);
 
   const synthetic::GroundTruth& truth() const { return *truth_; }
   /// The true depth of a frame, by its name ("000042").
   cv::Mat depth(const std::string& frame_name) const;
 
-  /// Scores the frame's SGBM, interpolated LiDAR and fused depth against `true_depth` and
-  /// keeps every 4th pixel of the true static surface within `max_depth_m` for completeness.
+  /// The scan the engine integrates for `frame` (after any hold-out), kept until addFrame places
+  /// it in the world at the frame's pose: the LiDAR's support of the meshes. Any thread.
+  void addScan(const Frame& frame);
+  /// Scores the frame's SGBM, interpolated LiDAR and fused depth against `true_depth`, keeps
+  /// every 4th pixel of the true static surface within `max_depth_m` for completeness, the
+  /// true sky (zero true depth) at the frame's pose and its scan (addScan) in the world.
   void addFrame(const FrameResult& result, const cv::Mat& true_depth, const Calibration& calibration,
                 double max_depth_m);
   /// Scores another method's depth of the frame (the paper's).
@@ -55,7 +64,14 @@ public:
     bool has_ghosts = false;  ///< ghosts and crumbs: the dataset has moving-object boxes
     GhostMetrics ghosts;
     CrumbMetrics crumbs;
+    SkyCoverage true_sky;          ///< the true sky the mesh rendered at every frame's pose covers
+    SkyCoverage true_sky_sheets;   ///< of it, the pixels whose covering surface is off the true surface
+    OffSurfaceSplit off_surface;   ///< by height above the road and the LiDAR's support
   };
+  /// The heights that split the surface off the truth (m above the road): below 2 m the road's
+  /// cars, people and their ghosts; 2-5 m trunks, signs and the lower crowns; above 5 m the
+  /// crowns' tops, lamps, upper floors and what SGBM hangs in the sky beside them.
+  static const std::vector<double>& offSurfaceBands();
   /// Each mesh against the true surface; `voxel_size_m` sets the completeness threshold (2
   /// voxels) and the margin around moving boxes (a voxel).
   std::map<std::string, MeshScores> scoreMeshes(const std::map<std::string, MeshToScore>& meshes,
@@ -73,6 +89,10 @@ private:
   pcl::PolygonMesh scene_;                     // gt/scene.ply
   std::optional<SurfaceClasses> classes_;      // gt/scene_classes.txt, when the dataset has it
   bool score_meshes_ = true;
+  std::unique_ptr<OpenSkyCoverage> true_sky_;  // made at the first frame, with its camera
+  LidarSupport lidar_;
+  std::mutex scans_mutex_;                     // addScan's thread and addFrame's
+  std::map<std::size_t, pcl::PointCloud<pcl::PointXYZI>::ConstPtr> scans_;
 };
 
 } // namespace msf

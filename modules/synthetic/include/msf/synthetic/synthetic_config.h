@@ -19,6 +19,7 @@ struct SyntheticConfig {
   double frame_rate_hz = 10.0;
   int supersampling = 2;
   double image_noise_sigma = 2.0;
+  std::string sky = "pale";
   double lidar_range_noise_m = 0.02;
   double lidar_dropout = 0.02;
   double lidar_max_range_m = 120.0;
@@ -66,6 +67,9 @@ struct SyntheticConfig {
     k("frame_rate_hz", frame_rate_hz, Range{0, 100, true, false}, "camera and LiDAR rate, Hz");
     k("supersampling", supersampling, between(1, 4), "samples per pixel along each image axis");
     k("image_noise_sigma", image_noise_sigma, between(0, 50), "Gaussian image noise per pixel and channel, grey levels");
+    k("sky", sky, {"pale", "kitti"},
+      "pale: a smooth pale blue that stereo matches | kitti: KITTI's overexposed sky, clipped to a flat white "
+      "near the horizon and in soft clouds, against which SGBM smears the crowns");
     k("lidar_range_noise_m", lidar_range_noise_m, between(0, 1), "Gaussian LiDAR noise along the beam, m");
     k("lidar_dropout", lidar_dropout, Range{0, 1, false, true}, "probability that a return is lost");
     k("lidar_max_range_m", lidar_max_range_m, Range{0, 250, true, false},
