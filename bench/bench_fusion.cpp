@@ -13,12 +13,14 @@
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/facade_extension.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
 #include <msf/range_image/compound_interpolation.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/distance_transform.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/range_image/real_returns.h>
 #include <msf/reconstruction/silhouette_thickness.h>
 #include <msf/stereo/sgbm_stereo.h>
 
@@ -34,7 +36,7 @@ struct Data {
   msf::Calibration calibration;
   std::vector<pcl::PointCloud<msf::PointXYZID>::Ptr> lidar;
   std::vector<pcl::PointCloud<msf::PointXYZRGBConfidence>::Ptr> stereo;
-  std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence, left;
+  std::vector<cv::Mat> lidar_depth, lidar_distance, stereo_depth, stereo_confidence, left, color;
   Data() {
     const msf::Sequence sequence = msf::bench::kittiSequence();
     calibration = sequence.calibration();
@@ -66,6 +68,7 @@ struct Data {
       stereo_depth.push_back(sgbm.getDepth());
       stereo_confidence.push_back(sgbm.getConfidence().clone());
       left.push_back(f.left);
+      color.push_back(f.color);
     }
   }
 };
@@ -165,6 +168,19 @@ void BM_SilhouetteThickness(benchmark::State& state) {
   state.counters["pixels_bounded"] = bounded / static_cast<double>(state.iterations());
 }
 
+/// The open sky of a frame (SkyMask::compute on the colour image and the real returns) and its
+/// clear sky (SkyMask::clearSky), as the fusion finds them with fusion.clear_sky.
+void BM_SkyMask(benchmark::State& state) {
+  const Data& d = data();
+  const msf::SkyMask sky;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    const cv::Mat open = sky.compute(d.color[f], msf::realReturns(d.lidar_depth[f], d.lidar_distance[f]));
+    benchmark::DoNotOptimize(sky.clearSky(d.color[f], open).data);
+  }
+}
+
 void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Paper); }
 void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
 void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
@@ -182,6 +198,7 @@ BENCHMARK(BM_FusionImagePaper)->Unit(benchmark::kMillisecond)->UseRealTime()->It
 BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FusionImageUncertaintyNoEdgeSupport)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FacadeExtension)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
+BENCHMARK(BM_SkyMask)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_SilhouetteThickness)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
 
 BENCHMARK_MAIN();

@@ -117,15 +117,28 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
   if (column_window_ < 0 || border_ < 0)
     throw ConfigError("sky mask: the column window and the border must be >= 0, not " +
                       std::to_string(column_window_) + " and " + std::to_string(border_));
-  cv::Mat sky = skyLike(image);
   const std::vector<TopReturn> top = topReturns(returns);
-  for (int v = 0; v < sky.rows; ++v) {
-    std::uint8_t* s = sky.ptr<std::uint8_t>(v);
-    for (int u = 0; u < sky.cols; ++u)
+  // Only the rows above the lowest column's highest return can be sky: the steps run on them,
+  // with the rows that the texture window and the border reach below.
+  int lowest = 0;
+  for (const TopReturn& t : top)
+    lowest = std::max(lowest, t.row);
+  const int band_rows = std::min(image.rows, lowest + std::max(kTextureWindow / 2, border_) + 1);
+  cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(0));
+  cv::Mat band = mask.rowRange(0, band_rows);
+  skyLike(image.rowRange(0, band_rows)).copyTo(band);
+  for (int v = 0; v < band.rows; ++v) {
+    std::uint8_t* s = band.ptr<std::uint8_t>(v);
+    for (int u = 0; u < band.cols; ++u)
       if (v >= top[static_cast<std::size_t>(u)].row)
         s[u] = 0;
   }
-  // Step 3: the components that touch the top row.
+  keepOpenToTheTop(band);
+  takeBorder(band);
+  return mask;
+}
+
+void SkyMask::keepOpenToTheTop(cv::Mat& sky) {
   cv::Mat labels;
   const int count = cv::connectedComponents(sky, labels, 8, CV_32S);
   std::vector<std::uint8_t> open(static_cast<std::size_t>(count), 0);
@@ -138,8 +151,6 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
     for (int u = 0; u < sky.cols; ++u)
       s[u] = open[static_cast<std::size_t>(l[u])] ? 255 : 0;
   }
-  takeBorder(sky);
-  return sky;
 }
 
 void SkyMask::takeBorder(cv::Mat& mask) const {

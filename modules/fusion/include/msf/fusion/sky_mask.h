@@ -80,6 +80,8 @@ private:
   std::vector<TopReturn> topReturns(const cv::Mat& returns) const;
   /// Step 1: bright, blank and sky-coloured pixels (255).
   cv::Mat skyLike(const cv::Mat& image) const;
+  /// Step 3: keeps the components of `sky` (CV_8UC1) that touch its top row.
+  static void keepOpenToTheTop(cv::Mat& sky);
 
   double min_brightness_ = 110.0;
   double max_texture_ = 6.0;
