@@ -23,18 +23,25 @@ constexpr int kSide = TsdfBlock::kSide;
 /// stereo matching both widen or narrow an object by a pixel or two.
 constexpr float kSilhouetteSlackPx = 3.f;
 
-/// Whether a block's bounding sphere (centre `c` in the camera frame, radius `r`) lies within
-/// [min_d, max_d] of depth and its projection, grown by its radius in pixels, meets `rect`.
-bool sphereMeetsRect(const Eigen::Vector3f& c, float r, const PinholeCamera& cam, float min_d, float max_d,
-                     const cv::Rect& rect) {
+/// The pixels that a block's bounding sphere (centre `c` in the camera frame, radius `r`) may
+/// project into, with a pixel to spare, within the image; empty where it lies outside
+/// [min_d, max_d] of depth.
+cv::Rect sphereFootprint(const Eigen::Vector3f& c, float r, const PinholeCamera& cam, float min_d, float max_d) {
   if (c.z() + r < min_d || c.z() - r > max_d)
-    return false;
+    return {};
   const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
   const float z = std::max(c.z() - r, min_d); // the sphere's nearest depth: its widest footprint
-  const float r_px = std::max(fx, fy) * r / z;
+  const float r_px = std::max(fx, fy) * r / z + 1.f;
   const float zc = std::max(c.z(), min_d);
   const float u = fx * c.x() / zc + static_cast<float>(cam.cx), v = fy * c.y() / zc + static_cast<float>(cam.cy);
-  return u + r_px >= rect.x && u - r_px <= rect.x + rect.width && v + r_px >= rect.y && v - r_px <= rect.y + rect.height;
+  const cv::Rect image(0, 0, cam.width, cam.height);
+  const float lo_u = std::max(u - r_px, -1.f), hi_u = std::min(u + r_px, static_cast<float>(cam.width));
+  const float lo_v = std::max(v - r_px, -1.f), hi_v = std::min(v + r_px, static_cast<float>(cam.height));
+  if (!(lo_u <= hi_u && lo_v <= hi_v))
+    return {};
+  const cv::Point first(static_cast<int>(std::floor(lo_u)), static_cast<int>(std::floor(lo_v)));
+  const cv::Point last(static_cast<int>(std::ceil(hi_u)) + 1, static_cast<int>(std::ceil(hi_v)) + 1);
+  return cv::Rect(first, last) & image;
 }
 
 /// Carves the voxels behind a surface (sdf < 0) whose centres project into a non-zero pixel of
@@ -47,12 +54,20 @@ void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rec
   const float vs = static_cast<float>(volume.voxelSize()), trunc = static_cast<float>(volume.truncation());
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
+  // Only the blocks whose footprint holds a pixel of `rays` (counted on its integral image).
+  cv::Mat count;
+  cv::integral(rays(rect) != 0, count, CV_32S);
   std::vector<TsdfBlock*> blocks;
   for (const auto& block : volume.blocks()) {
     if (!block->negative_subblocks)
       continue; // nothing behind a surface: nothing to carve
     const Eigen::Vector3f centre = (block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs;
-    if (sphereMeetsRect(T_cam_world * centre, radius, camera, min_d, max_d, rect))
+    const cv::Rect seen = (sphereFootprint(T_cam_world * centre, radius, camera, min_d, max_d) & rect) - rect.tl();
+    if (seen.empty())
+      continue;
+    const int bottom = seen.y + seen.height, right = seen.x + seen.width;
+    if (count.at<int>(bottom, right) - count.at<int>(seen.y, right) - count.at<int>(bottom, seen.x) +
+            count.at<int>(seen.y, seen.x) > 0)
       blocks.push_back(block);
   }
   const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
