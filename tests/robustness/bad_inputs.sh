@@ -351,6 +351,10 @@ check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg 
 check "synth -camera kitti -focal 500" 1 "option -focal sets a pinhole camera, but -camera is 'kitti'" -- \
   msf_synth -o out -frames 1 -camera kitti -focal 500
 check "synth -baseline 0" 1 "synthetic.baseline_m must be in \(0, 10\], not 0.0" -- msf_synth -o out -frames 1 -baseline 0
+check "synth -sky foo" 1 "option -sky: unknown sky 'foo' \(known: pale, kitti\)" -- msf_synth -o out -frames 1 -sky foo
+printf 'synthetic:\n  sky: cloudy\n' >"$F/sky_cloudy.yaml"
+check "synth -config: an unknown sky" 1 "sky_cloudy.yaml' line 2: synthetic.sky must be pale \| kitti, not 'cloudy'" -- \
+  msf_synth -o out -frames 1 -config "$F/sky_cloudy.yaml"
 
 # ---- configuration files ------------------------------------------------------------------
 check "mesh -config: a misspelt section" 1 "typo_section.yaml' line 1: 'tsdf_volumes' is not a section of the configuration" -- \
