@@ -207,6 +207,242 @@ std::string configJson(const std::string& yaml) {
   return out + "\n  }";
 }
 
+/// summary.json's depth scores: by method, all pixels and, when split, background and foreground.
+std::string depthJson(const std::map<std::string, RunReport::DepthScores>& depth) {
+  std::ostringstream s;
+  s << "{";
+  std::size_t k = 0;
+  for (const auto& [method, scores] : depth) {
+    s << (k++ ? "," : "") << "\n    " << jsonString(method)
+      << ": {\n      \"all\": " << metricsJson(scores.all, "      ");
+    if (scores.has_split)
+      s << ",\n      \"background\": " << metricsJson(scores.background, "      ")
+        << ",\n      \"foreground\": " << metricsJson(scores.foreground, "      ");
+    s << "\n    }";
+  }
+  s << (depth.empty() ? "" : "\n  ") << "}";
+  return s.str();
+}
+
+/// The fused mesh's surest surface that is as complete as each other mesh, as a JSON array.
+std::string atCompletenessJson(const RunReport::MapEvaluation& e, const RunReport::MapEvaluation::Row& fused) {
+  std::string matched;
+  for (const auto& other : e.rows)
+    if (&other != &fused && other.has_accuracy)
+      matched += std::string(matched.empty() ? "" : ", ") + "{\"mesh\": " + jsonString(other.score.source) +
+                 ", \"kept\": " + levelJson(fused.accuracy.by_weight.atCompleteness(other.accuracy.completeness)) +
+                 "}";
+  return "[" + matched + "]";
+}
+
+/// A row's ghosts and crumbs as two JSON members, each line indented by `in`.
+std::string ghostsJson(const RunReport::MapEvaluation::Row& r, const std::string& in) {
+  std::ostringstream s;
+  s << in << "\"ghosts\": {\"share\": " << num(r.ghosts.share, 6) << ", \"ghost_vertices\": "
+    << r.ghosts.ghost_vertices << ", \"vertices\": " << r.ghosts.vertices << ", \"distance_m\": "
+    << num(r.ghosts.distance_m) << "},\n"
+    << in << "\"crumbs\": {\"crumbs\": " << r.crumbs.crumbs << ", \"crumb_triangles\": " << r.crumbs.crumb_triangles
+    << ", \"specks\": " << r.crumbs.specks << ", \"small_pieces\": " << r.crumbs.small_pieces
+    << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles << "}";
+  return s.str();
+}
+
+/// The members of one source's row of reconstruction_evaluation: its depth scores, then what it
+/// has of accuracy, matched bars, ghosts, the true sky and pieces seen through.
+std::string evaluationRowJson(const RunReport::MapEvaluation& e, const RunReport::MapEvaluation::Row& r) {
+  const std::string in = "        ";
+  std::ostringstream s;
+  s << in << "\"within_range\": " << metricsJson(r.score.within_range, in) << ",\n"
+    << in << "\"all\": " << metricsJson(r.score.all, in);
+  if (e.moving_split)
+    s << ",\n" << in << "\"moving_within_range\": " << metricsJson(r.score.moving_within_range, in) << ",\n"
+      << in << "\"moving_all\": " << metricsJson(r.score.moving_all, in);
+  if (r.has_accuracy)
+    s << ",\n" << in << "\"accuracy\": " << accuracyJson(r.accuracy);
+  if (&r == e.fusedCurveRow())
+    s << ",\n" << in << "\"at_completeness_of\": " << atCompletenessJson(e, r);
+  if (r.has_ghosts)
+    s << ",\n" << ghostsJson(r, in);
+  if (r.has_accuracy)
+    s << ",\n" << in << "\"true_sky\": " << skyJson(r.true_sky) << ",\n"
+      << in << "\"true_sky_sheets\": " << skyJson(r.true_sky_sheets) << ",\n"
+      << in << "\"off_surface\": " << offSurfaceJson(r.off_surface);
+  if (r.has_seen_through)
+    s << ",\n" << in << "\"seen_through\": {\"pieces\": " << r.seen_through.seen_through << ", \"triangles\": "
+      << r.seen_through.triangles << ", \"small_pieces\": " << r.seen_through.small_pieces
+      << ", \"all_pieces\": " << r.seen_through.pieces << ", \"max_triangles\": " << r.seen_through.max_triangles
+      << "}";
+  return s.str();
+}
+
+/// summary.json's reconstruction_evaluation: the ground truth and a row per source ("null" without rows).
+std::string mapEvaluationJson(const RunReport::MapEvaluation& e) {
+  if (e.rows.empty())
+    return "null";
+  std::ostringstream s;
+  s << "{\n    \"truth\": " << jsonString(e.truth) << ", \"range_m\": " << num(e.range_m)
+    << ", \"frames\": " << e.frames << ", \"gt_pixels\": " << e.gt_pixels
+    << ", \"moving_split\": " << (e.moving_split ? "true" : "false")
+    << ",\n    \"no_ghosts\": " << (e.no_ghosts.empty() ? "null" : jsonString(e.no_ghosts)) << ",\n    \"rows\": {";
+  for (std::size_t row = 0; row < e.rows.size(); ++row)
+    s << (row ? "," : "") << "\n      " << jsonString(e.rows[row].score.source) << ": {\n"
+      << evaluationRowJson(e, e.rows[row]) << "\n      }";
+  s << "\n    }\n  }";
+  return s.str();
+}
+
+/// summary.json's open sky: each mesh's cover, a mesh a line ("null" when not measured).
+std::string openSkyJson(const std::map<std::string, SkyCoverage>& open_sky) {
+  if (open_sky.empty())
+    return "null";
+  std::ostringstream s;
+  for (auto it = open_sky.begin(); it != open_sky.end(); ++it)
+    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": " << skyJson(it->second);
+  s << "\n  }";
+  return s.str();
+}
+
+/// report.md's depth errors against ground truth, a row per method (and its split).
+void writeDepthTable(std::ostream& s, const std::map<std::string, RunReport::DepthScores>& depth) {
+  s << "## Depth against ground truth\n\n"
+    << "| method | pixels | coverage | D1 (missing = bad) | D1 on estimates | disparity MAE px | depth MAE m | "
+       "depth RMSE m |\n|---|---|---|---|---|---|---|---|\n";
+  auto row = [&](const std::string& name, const DepthMetrics& m) {
+    s << "| " << name << " | " << m.gt_pixels << " | " << num(m.coverage, 3) << " | " << num(100 * m.d1_all, 2)
+      << " % | " << num(100 * m.d1_estimated, 2) << " % | " << num(m.disparity_mae_px, 2) << " | "
+      << num(m.mae_m, 3) << " | " << num(m.rmse_m, 3) << " |\n";
+  };
+  for (const auto& [method, scores] : depth) {
+    row(method, scores.all);
+    if (scores.has_split) {
+      row(method + " (background)", scores.background);
+      row(method + " (foreground)", scores.foreground);
+    }
+  }
+  s << "\n";
+  if (depth.count("paper"))
+    s << kPaperRows << "\n\n";
+}
+
+/// report.md's mesh against the true surface: accuracy, completeness by view distance, the weight curve.
+void writeMeshAccuracy(std::ostream& s, const MeshAccuracy& m) {
+  s << "## Mesh against the true surface\n\n"
+    << "Accuracy (mean distance of " << m.vertices << " mesh vertices to the true surface, capped at "
+    << num(m.cap_m) << " m): " << num(m.accuracy_mean_m, 3) << " m (median " << num(m.accuracy_median_m, 3)
+    << " m); " << num(100 * m.precision, 1) << " % of vertices within " << num(m.threshold_m) << " m.\n"
+    << "Completeness (share of " << m.truth_samples << " samples of the seen true surface within "
+    << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n";
+  if (!m.by_view_distance.empty()) {
+    s << "By the nearest distance a frame saw the surface from:";
+    for (const auto& b : m.by_view_distance)
+      s << (&b == &m.by_view_distance.front() ? " " : ", ") << num(b.lower_m) << "–" << num(b.upper_m) << " m "
+        << num(100 * b.completeness, 1) << " % ("
+        << num(100.0 * b.samples / std::max<std::size_t>(1, m.truth_samples), 1) << " % of the samples)";
+    s << ".\n";
+  }
+  if (!m.by_weight.empty()) {
+    s << "\nKept at a bar on the vertices' weights (m^-2; the triangles whose three vertices weigh at least it):\n\n"
+         "| bar | vertices | accuracy m | completeness |\n|---|---|---|---|\n";
+    for (double bar : kWeightBars) {
+      const WeightLevel l = m.by_weight.atWeight(bar);
+      s << "| " << num(bar) << " | " << l.vertices << " | " << num(l.accuracy_mean_m, 3) << " | "
+        << num(100 * l.completeness, 1) << " % |\n";
+    }
+  }
+  s << "\n";
+}
+
+/// The optional columns of protocol 4's tables: those some row has a figure for.
+struct ScoreColumns {
+  bool accuracy = false, ghosts = false, seen = false;
+};
+
+ScoreColumns scoreColumns(const RunReport::MapEvaluation& e) {
+  ScoreColumns c;
+  for (const auto& r : e.rows)
+    c.accuracy |= r.has_accuracy, c.ghosts |= r.has_ghosts, c.seen |= r.has_seen_through;
+  return c;
+}
+
+/// Protocol 4's opening paragraph: what the ground truth is and how the meshes are scored.
+void writeEvaluationIntro(std::ostream& s, const RunReport::MapEvaluation& e) {
+  s << "## The map against ground truth it never saw (evaluation protocol 4)\n\n"
+    << "Ground truth: " << e.truth << ", " << e.gt_pixels << " pixels in " << e.frames
+    << " frames. Each mesh is rendered into camera 0 at every frame's pose (the first surface along each pixel's ray) "
+       "and scored at the ground-truth pixels beside the per-frame fused depth; a missing estimate counts as bad in "
+       "D1. Within range: true depth at most "
+    << num(e.range_m)
+    << " m (`tsdf_integrator.max_depth_m`, at most the depth of `rig.stereo_min_disparity_px`), the map holds nothing "
+       "farther."
+    << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
+    << "\n\n";
+}
+
+/// One table of protocol 4: a row per source, its pixels in range and all of them, and the optional columns.
+void writeScoreTable(std::ostream& s, const RunReport::MapEvaluation& e, const ScoreColumns& c, const char* what,
+                     DepthMetrics ReconstructionScore::*in_range, DepthMetrics ReconstructionScore::*all) {
+  s << "| " << what
+    << " | pixels in range | coverage | D1 | D1 on estimates | MAE m | pixels | coverage | D1 | MAE m |"
+    << (c.accuracy ? " accuracy m | completeness |" : "") << (c.ghosts ? " ghosts | crumbs | specks |" : "")
+    << (c.seen ? " pieces seen through |" : "") << "\n|---|---|---|---|---|---|---|---|---|---|"
+    << (c.accuracy ? "---|---|" : "") << (c.ghosts ? "---|---|---|" : "") << (c.seen ? "---|" : "") << "\n";
+  for (const auto& r : e.rows) {
+    const DepthMetrics &a = r.score.*in_range, &b = r.score.*all;
+    s << "| " << r.score.source << " | " << a.gt_pixels << " | " << num(a.coverage, 3) << " | "
+      << num(100 * a.d1_all, 2) << " % | " << num(100 * a.d1_estimated, 2) << " % | " << num(a.mae_m, 3) << " | "
+      << b.gt_pixels << " | " << num(b.coverage, 3) << " | " << num(100 * b.d1_all, 2) << " % | " << num(b.mae_m, 3)
+      << " |";
+    if (c.accuracy)
+      s << (r.has_accuracy ? " " + num(r.accuracy.accuracy_mean_m, 3) + " | " + num(100 * r.accuracy.completeness, 1) +
+                                 " % |"
+                           : " | |");
+    if (c.ghosts)
+      s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % | " + std::to_string(r.crumbs.crumbs) + " | " +
+                               std::to_string(r.crumbs.specks) + " |"
+                         : " | | |");
+    if (c.seen)
+      s << (r.has_seen_through ? " " + std::to_string(r.seen_through.seen_through) + " |" : " |");
+    s << "\n";
+  }
+  s << "\n";
+}
+
+/// The fused mesh kept at the weight bar that matches each other mesh's completeness (when it has a curve).
+void writeFusedAtCompleteness(std::ostream& s, const RunReport::MapEvaluation& e) {
+  const RunReport::MapEvaluation::Row* fused = e.fusedCurveRow();
+  if (!fused)
+    return;
+  std::string rows;
+  for (const auto& other : e.rows)
+    if (&other != fused && other.has_accuracy) {
+      const WeightLevel l = fused->accuracy.by_weight.atCompleteness(other.accuracy.completeness);
+      rows += "| " + other.score.source + " | " + num(100 * other.accuracy.completeness, 1) + " % | " +
+              num(other.accuracy.accuracy_mean_m, 3) + " | " + num(l.min_weight, 1) + " | " +
+              num(100 * l.completeness, 1) + " % | " + num(l.accuracy_mean_m, 3) + " |\n";
+    }
+  if (!rows.empty())
+    s << "\nThe fused mesh kept at a bar on its vertices' weights (its surest surface), at the completeness of each "
+         "other mesh:\n\n| other mesh | its completeness | its accuracy m | fused mesh's bar m^-2 | completeness | "
+         "accuracy m |\n|---|---|---|---|---|---|\n"
+      << rows << "\n";
+}
+
+/// What the ghost, crumb and seen-through columns count (or why there is no ghost figure).
+void writeGhostNotes(std::ostream& s, const RunReport::MapEvaluation& e, const ScoreColumns& c) {
+  if (!e.no_ghosts.empty())
+    s << "No ghost figure: " << e.no_ghosts << ".\n";
+  else if (c.ghosts)
+    s << "Ghosts: share of the mesh's vertices farther than " << num(e.rows.front().ghosts.distance_m)
+      << " m from the static true surface inside the space a moving object occupied; crumbs (specks): pieces of "
+         "fewer than "
+      << e.rows.front().crumbs.max_triangles
+      << " triangles mostly that far from it, inside that space (elsewhere).\n";
+  if (c.seen)
+    s << "Pieces seen through: pieces of fewer than " << e.rows.front().seen_through.max_triangles
+      << " triangles most of whose vertices lie in front of the true depth by more than D1's threshold at some "
+         "frame: the ground truth saw through them.\n";
+}
+
 } // namespace
 
 double peakMemoryMb() {
@@ -260,11 +496,21 @@ void RunReport::writeSummaryJson(const std::string& path) const {
     << "  \"msfusion\": {\"version\": " << jsonString(versionString()) << ", \"commit\": " << jsonString(gitCommit())
     << "},\n"
     << "  \"dataset\": " << jsonString(dataset) << ",\n"
-    << "  \"layout\": " << jsonString(layout) << ",\n"
-    << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);
+    << "  \"layout\": " << jsonString(layout) << ",\n";
+  writeTrajectoryJson(s);
+  writeSpeedJson(s);
+  writeMapJson(s);
+  s << "  \"reconstruction_evaluation\": " << mapEvaluationJson(map_evaluation) << ",\n"
+    << "  \"open_sky\": " << openSkyJson(open_sky) << ",\n"
+    << "  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
+  writeText(path, s.str());
+}
+
+void RunReport::writeTrajectoryJson(std::ostream& s) const {
+  s << "  \"trajectory\": {\"source\": " << jsonString(trajectory) << ", \"file\": " << jsonString(poses_file);
   if (!pose_ms.empty())
-    s << ", \"estimate_ms\": {\"median\": " << num(median(pose_ms), 3) << ", \"p95\": " << num(percentile(pose_ms, 95), 3)
-      << "}";
+    s << ", \"estimate_ms\": {\"median\": " << num(median(pose_ms), 3)
+      << ", \"p95\": " << num(percentile(pose_ms, 95), 3) << "}";
   if (has_trajectory_metrics) {
     const OdometryMetrics& m = trajectory_metrics;
     s << ", \"reference\": " << jsonString(trajectory_reference) << ", \"ate_rmse_m\": " << num(m.ate_rmse_m, 4)
@@ -272,8 +518,11 @@ void RunReport::writeSummaryJson(const std::string& path) const {
       << ", \"translation_error_pct\": " << num(m.translation_error_pct, 3)
       << ", \"rotation_error_deg_per_m\": " << num(m.rotation_error_deg_per_m, 5);
   }
-  s << "},\n"
-    << "  \"frames\": " << frames.size() << ",\n"
+  s << "},\n";
+}
+
+void RunReport::writeSpeedJson(std::ostream& s) const {
+  s << "  \"frames\": " << frames.size() << ",\n"
     << "  \"frames_requested\": " << frames_requested << ",\n"
     << "  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n"
     << "  \"skipped\": [";
@@ -296,81 +545,17 @@ void RunReport::writeSummaryJson(const std::string& path) const {
       << ", \"p95\": " << num(percentile(values, 95), 3) << "}" << (k + 1 < columns.size() ? "," : "") << "\n";
   }
   s << "  },\n"
-    << "  \"mesh_ms\": " << num(mesh_ms, 3) << ",\n"
-    << "  \"map\": {\"voxel_size_m\": " << num(voxel_size_m) << ", \"lambda\": " << num(lambda)
+    << "  \"mesh_ms\": " << num(mesh_ms, 3) << ",\n";
+}
+
+void RunReport::writeMapJson(std::ostream& s) const {
+  s << "  \"map\": {\"voxel_size_m\": " << num(voxel_size_m) << ", \"lambda\": " << num(lambda)
     << ", \"observed_voxels\": " << observed_voxels << ", \"blocks\": " << blocks
     << ", \"memory_mb\": " << num(volume_memory_mb, 1) << ", \"vertices\": " << vertices
     << ", \"triangles\": " << triangles << ", \"pieces_removed\": " << pieces_removed
-    << ", \"triangles_removed\": " << triangles_removed << "},\n";
-  s << "  \"depth\": {";
-  std::size_t k = 0;
-  for (const auto& [method, scores] : depth) {
-    s << (k++ ? "," : "") << "\n    " << jsonString(method) << ": {\n      \"all\": " << metricsJson(scores.all, "      ");
-    if (scores.has_split)
-      s << ",\n      \"background\": " << metricsJson(scores.background, "      ")
-        << ",\n      \"foreground\": " << metricsJson(scores.foreground, "      ");
-    s << "\n    }";
-  }
-  s << (depth.empty() ? "" : "\n  ") << "},\n";
-  s << "  \"mesh_accuracy\": " << (has_mesh_accuracy ? accuracyJson(mesh_accuracy) : "null") << ",\n";
-  s << "  \"reconstruction_evaluation\": ";
-  const MapEvaluation& e = map_evaluation;
-  if (e.rows.empty()) {
-    s << "null";
-  } else {
-    s << "{\n    \"truth\": " << jsonString(e.truth) << ", \"range_m\": " << num(e.range_m) << ", \"frames\": " << e.frames
-      << ", \"gt_pixels\": " << e.gt_pixels << ", \"moving_split\": " << (e.moving_split ? "true" : "false")
-      << ",\n    \"no_ghosts\": " << (e.no_ghosts.empty() ? "null" : jsonString(e.no_ghosts)) << ",\n    \"rows\": {";
-    const std::string in = "        ";
-    for (std::size_t row = 0; row < e.rows.size(); ++row) {
-      const MapEvaluation::Row& r = e.rows[row];
-      s << (row ? "," : "") << "\n      " << jsonString(r.score.source) << ": {\n"
-        << in << "\"within_range\": " << metricsJson(r.score.within_range, in) << ",\n"
-        << in << "\"all\": " << metricsJson(r.score.all, in);
-      if (e.moving_split)
-        s << ",\n" << in << "\"moving_within_range\": " << metricsJson(r.score.moving_within_range, in) << ",\n"
-          << in << "\"moving_all\": " << metricsJson(r.score.moving_all, in);
-      if (r.has_accuracy)
-        s << ",\n" << in << "\"accuracy\": " << accuracyJson(r.accuracy);
-      if (&r == e.fusedCurveRow()) {
-        // The fused mesh's surest surface that is as complete as each other mesh.
-        std::string matched;
-        for (const auto& other : e.rows)
-          if (&other != &r && other.has_accuracy)
-            matched += std::string(matched.empty() ? "" : ", ") + "{\"mesh\": " + jsonString(other.score.source) +
-                       ", \"kept\": " + levelJson(r.accuracy.by_weight.atCompleteness(other.accuracy.completeness)) +
-                       "}";
-        s << ",\n" << in << "\"at_completeness_of\": [" << matched << "]";
-      }
-      if (r.has_ghosts)
-        s << ",\n" << in << "\"ghosts\": {\"share\": " << num(r.ghosts.share, 6) << ", \"ghost_vertices\": "
-          << r.ghosts.ghost_vertices << ", \"vertices\": " << r.ghosts.vertices << ", \"distance_m\": "
-          << num(r.ghosts.distance_m) << "},\n"
-          << in << "\"crumbs\": {\"crumbs\": " << r.crumbs.crumbs << ", \"crumb_triangles\": " << r.crumbs.crumb_triangles
-          << ", \"specks\": " << r.crumbs.specks << ", \"small_pieces\": " << r.crumbs.small_pieces
-          << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles << "}";
-      if (r.has_accuracy)
-        s << ",\n" << in << "\"true_sky\": " << skyJson(r.true_sky) << ",\n"
-          << in << "\"true_sky_sheets\": " << skyJson(r.true_sky_sheets) << ",\n"
-          << in << "\"off_surface\": " << offSurfaceJson(r.off_surface);
-      if (r.has_seen_through)
-        s << ",\n" << in << "\"seen_through\": {\"pieces\": " << r.seen_through.seen_through << ", \"triangles\": "
-          << r.seen_through.triangles << ", \"small_pieces\": " << r.seen_through.small_pieces
-          << ", \"all_pieces\": " << r.seen_through.pieces << ", \"max_triangles\": " << r.seen_through.max_triangles
-          << "}";
-      s << "\n      }";
-    }
-    s << "\n    }\n  }";
-  }
-  s << ",\n  \"open_sky\": ";
-  if (open_sky.empty())
-    s << "null";
-  for (auto it = open_sky.begin(); it != open_sky.end(); ++it) {
-    s << (it == open_sky.begin() ? "{" : ",") << "\n    " << jsonString(it->first) << ": " << skyJson(it->second)
-      << (std::next(it) == open_sky.end() ? "\n  }" : "");
-  }
-  s << ",\n  \"config\": " << (config_yaml.empty() ? "null" : configJson(config_yaml)) << "\n}\n";
-  writeText(path, s.str());
+    << ", \"triangles_removed\": " << triangles_removed << "},\n"
+    << "  \"depth\": " << depthJson(depth) << ",\n"
+    << "  \"mesh_accuracy\": " << (has_mesh_accuracy ? accuracyJson(mesh_accuracy) : "null") << ",\n";
 }
 
 void RunReport::writeRuntimePlot(const std::string& path) const {
@@ -389,6 +574,23 @@ void RunReport::writeRuntimePlot(const std::string& path) const {
 
 void RunReport::writeMarkdown(const std::string& path) const {
   std::ostringstream s;
+  writeIntro(s);
+  writeSpeed(s);
+  writeMapSize(s);
+  if (!depth.empty())
+    writeDepthTable(s, depth);
+  if (has_mesh_accuracy)
+    writeMeshAccuracy(s, mesh_accuracy);
+  if (!map_evaluation.rows.empty())
+    writeMapEvaluation(s);
+  if (!open_sky.empty())
+    writeOpenSky(s);
+  writeTruthOffSurface(s);
+  writeDepthImagesAndLinks(s);
+  writeText(path, s.str());
+}
+
+void RunReport::writeIntro(std::ostream& s) const {
   s << "# msfusion reconstruction\n\n"
     << "Dataset `" << dataset << "` (" << layout << "), " << frames.size() << " of " << frames_requested
     << " frames" << (interrupted ? " (interrupted: the map holds the frames integrated before the stop)" : "")
@@ -408,8 +610,10 @@ void RunReport::writeMarkdown(const std::string& path) const {
   s << "\n\n";
   if (!trajectory_plot_file.empty())
     s << "![the trajectory from above](" << trajectory_plot_file << ")\n\n";
-  s
-    << "## Speed\n\n"
+}
+
+void RunReport::writeSpeed(std::ostream& s) const {
+  s << "## Speed\n\n"
     << num(framesPerSecond(), 2) << " frames per second end to end (" << num(wall_s, 2) << " s; "
     << num(framesPerSecondAfterFirst(), 2) << " after the first frame, done at " << num(first_frame_s, 2)
     << " s), peak memory " << num(std::max(peak_memory_mb, peakMemoryMb()), 0) << " MiB, mesh extraction "
@@ -421,8 +625,11 @@ void RunReport::writeMarkdown(const std::string& path) const {
   }
   s << "\nLiDAR and stereo run at the same time (`depth` is their wall time); loading, depth and "
        "integration of successive frames overlap, so frames per second exceed 1000 / latency.\n\n"
-    << "![run time per frame](runtime.png)\n\n"
-    << "## Map\n\n"
+    << "![run time per frame](runtime.png)\n\n";
+}
+
+void RunReport::writeMapSize(std::ostream& s) const {
+  s << "## Map\n\n"
     << observed_voxels << " observed voxels in " << blocks << " blocks (" << num(volume_memory_mb, 1) << " MiB); mesh "
     << vertices << " vertices, " << triangles << " triangles: [`" << mesh_file << "`](" << mesh_file << "), volume [`"
     << volume_file << "`](" << volume_file << ").";
@@ -432,58 +639,9 @@ void RunReport::writeMarkdown(const std::string& path) const {
   s << "\n\n";
   if (!preview_file.empty())
     s << "![mesh from above and from the first camera](" << preview_file << ")\n\n";
-  if (!depth.empty()) {
-    s << "## Depth against ground truth\n\n"
-      << "| method | pixels | coverage | D1 (missing = bad) | D1 on estimates | disparity MAE px | depth MAE m | "
-         "depth RMSE m |\n|---|---|---|---|---|---|---|---|\n";
-    auto row = [&](const std::string& name, const DepthMetrics& m) {
-      s << "| " << name << " | " << m.gt_pixels << " | " << num(m.coverage, 3) << " | " << num(100 * m.d1_all, 2)
-        << " % | " << num(100 * m.d1_estimated, 2) << " % | " << num(m.disparity_mae_px, 2) << " | "
-        << num(m.mae_m, 3) << " | " << num(m.rmse_m, 3) << " |\n";
-    };
-    for (const auto& [method, scores] : depth) {
-      row(method, scores.all);
-      if (scores.has_split) {
-        row(method + " (background)", scores.background);
-        row(method + " (foreground)", scores.foreground);
-      }
-    }
-    s << "\n";
-    if (depth.count("paper"))
-      s << kPaperRows << "\n\n";
-  }
-  if (has_mesh_accuracy) {
-    const auto& m = mesh_accuracy;
-    s << "## Mesh against the true surface\n\n"
-      << "Accuracy (mean distance of " << m.vertices << " mesh vertices to the true surface, capped at "
-      << num(m.cap_m) << " m): " << num(m.accuracy_mean_m, 3) << " m (median " << num(m.accuracy_median_m, 3)
-      << " m); " << num(100 * m.precision, 1) << " % of vertices within " << num(m.threshold_m) << " m.\n"
-      << "Completeness (share of " << m.truth_samples << " samples of the seen true surface within "
-      << num(m.threshold_m) << " m of the mesh): " << num(100 * m.completeness, 1) << " %.\n";
-    if (!m.by_view_distance.empty()) {
-      s << "By the nearest distance a frame saw the surface from:";
-      for (const auto& b : m.by_view_distance)
-        s << (&b == &m.by_view_distance.front() ? " " : ", ") << num(b.lower_m) << "–" << num(b.upper_m) << " m "
-          << num(100 * b.completeness, 1) << " % (" << num(100.0 * b.samples / std::max<std::size_t>(1, m.truth_samples), 1)
-          << " % of the samples)";
-      s << ".\n";
-    }
-    if (!m.by_weight.empty()) {
-      s << "\nKept at a bar on the vertices' weights (m^-2; the triangles whose three vertices weigh at least it):\n\n"
-           "| bar | vertices | accuracy m | completeness |\n|---|---|---|---|\n";
-      for (double bar : kWeightBars) {
-        const WeightLevel l = m.by_weight.atWeight(bar);
-        s << "| " << num(bar) << " | " << l.vertices << " | " << num(l.accuracy_mean_m, 3) << " | "
-          << num(100 * l.completeness, 1) << " % |\n";
-      }
-    }
-    s << "\n";
-  }
-  if (!map_evaluation.rows.empty())
-    writeMapEvaluation(s);
-  if (!open_sky.empty())
-    writeOpenSky(s);
-  writeTruthOffSurface(s);
+}
+
+void RunReport::writeDepthImagesAndLinks(std::ostream& s) const {
   if (!depth_panels.empty()) {
     s << "## Depth images\n\nRows: left image, projected LiDAR, interpolated LiDAR, SGBM, fused"
          " (and the fused depth's error where ground truth exists).\n\n";
@@ -494,7 +652,6 @@ void RunReport::writeMarkdown(const std::string& path) const {
   if (!config_file.empty())
     s << "; the configuration in full: [`" << config_file << "`](" << config_file << ")";
   s << ".\n";
-  writeText(path, s.str());
 }
 
 void RunReport::writeClassTable(std::ostream& s) const {
@@ -600,86 +757,24 @@ void RunReport::writeTruthOffSurface(std::ostream& s) const {
 
 void RunReport::writeMapEvaluation(std::ostream& s) const {
   const MapEvaluation& e = map_evaluation;
-  s << "## The map against ground truth it never saw (evaluation protocol 4)\n\n"
-    << "Ground truth: " << e.truth << ", " << e.gt_pixels << " pixels in " << e.frames
-    << " frames. Each mesh is rendered into camera 0 at every frame's pose (the first surface along each pixel's ray) "
-       "and scored at the ground-truth pixels beside the per-frame fused depth; a missing estimate counts as bad in "
-       "D1. Within range: true depth at most "
-    << num(e.range_m) << " m (`tsdf_integrator.max_depth_m`, at most the depth of `rig.stereo_min_disparity_px`), the map holds nothing "
-         "farther."
-    << (e.moving_split ? " Pixels on moving objects are scored apart: a moving object is not part of the map." : "")
-    << "\n\n";
-  bool accuracy = false, ghosts = false, seen = false;
-  for (const auto& r : e.rows)
-    accuracy |= r.has_accuracy, ghosts |= r.has_ghosts, seen |= r.has_seen_through;
-  auto table = [&](const char* what, auto in_range, auto all) {
-    s << "| " << what << " | pixels in range | coverage | D1 | D1 on estimates | MAE m | pixels | coverage | D1 | MAE m |"
-      << (accuracy ? " accuracy m | completeness |" : "") << (ghosts ? " ghosts | crumbs | specks |" : "") << (seen ? " pieces seen through |" : "")
-      << "\n|---|---|---|---|---|---|---|---|---|---|" << (accuracy ? "---|---|" : "") << (ghosts ? "---|---|---|" : "")
-      << (seen ? "---|" : "") << "\n";
-    for (const auto& r : e.rows) {
-      const DepthMetrics &a = in_range(r.score), &b = all(r.score);
-      s << "| " << r.score.source << " | " << a.gt_pixels << " | " << num(a.coverage, 3) << " | "
-        << num(100 * a.d1_all, 2) << " % | " << num(100 * a.d1_estimated, 2) << " % | " << num(a.mae_m, 3) << " | "
-        << b.gt_pixels << " | " << num(b.coverage, 3) << " | " << num(100 * b.d1_all, 2) << " % | " << num(b.mae_m, 3)
-        << " |";
-      if (accuracy)
-        s << (r.has_accuracy ? " " + num(r.accuracy.accuracy_mean_m, 3) + " | " + num(100 * r.accuracy.completeness, 1) +
-                                   " % |"
-                             : " | |");
-      if (ghosts)
-        s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % | " + std::to_string(r.crumbs.crumbs) + " | " +
-                                 std::to_string(r.crumbs.specks) + " |"
-                           : " | | |");
-      if (seen)
-        s << (r.has_seen_through ? " " + std::to_string(r.seen_through.seen_through) + " |" : " |");
-      s << "\n";
-    }
-    s << "\n";
-  };
-  table(e.moving_split ? "source (static pixels)" : "source",
-        [](const ReconstructionScore& r) -> const DepthMetrics& { return r.within_range; },
-        [](const ReconstructionScore& r) -> const DepthMetrics& { return r.all; });
+  writeEvaluationIntro(s, e);
+  const ScoreColumns columns = scoreColumns(e);
+  writeScoreTable(s, e, columns, e.moving_split ? "source (static pixels)" : "source",
+                  &ReconstructionScore::within_range, &ReconstructionScore::all);
   if (e.moving_split)
-    table("source (moving objects)",
-          [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_within_range; },
-          [](const ReconstructionScore& r) -> const DepthMetrics& { return r.moving_all; });
+    writeScoreTable(s, e, columns, "source (moving objects)", &ReconstructionScore::moving_within_range,
+                    &ReconstructionScore::moving_all);
   for (const auto& r : e.rows)
     if (r.score.source == "paper") {
       s << kPaperRows << "\n";
       break;
     }
-  if (accuracy)
+  if (columns.accuracy)
     s << "Accuracy: mean distance of the mesh's vertices to the true surface; completeness: share of the seen true "
          "surface within the threshold of the mesh (as above).\n";
-  if (const MapEvaluation::Row* fused = e.fusedCurveRow()) {
-    std::string rows;
-    for (const auto& other : e.rows)
-      if (&other != fused && other.has_accuracy) {
-        const WeightLevel l = fused->accuracy.by_weight.atCompleteness(other.accuracy.completeness);
-        rows += "| " + other.score.source + " | " + num(100 * other.accuracy.completeness, 1) + " % | " +
-                num(other.accuracy.accuracy_mean_m, 3) + " | " + num(l.min_weight, 1) + " | " +
-                num(100 * l.completeness, 1) + " % | " + num(l.accuracy_mean_m, 3) + " |\n";
-      }
-    if (!rows.empty())
-      s << "\nThe fused mesh kept at a bar on its vertices' weights (its surest surface), at the completeness of each "
-           "other mesh:\n\n| other mesh | its completeness | its accuracy m | fused mesh's bar m^-2 | completeness | "
-           "accuracy m |\n|---|---|---|---|---|---|\n"
-        << rows << "\n";
-  }
+  writeFusedAtCompleteness(s, e);
   writeClassTable(s);
-  if (!e.no_ghosts.empty())
-    s << "No ghost figure: " << e.no_ghosts << ".\n";
-  else if (ghosts)
-    s << "Ghosts: share of the mesh's vertices farther than " << num(e.rows.front().ghosts.distance_m)
-      << " m from the static true surface inside the space a moving object occupied; crumbs (specks): pieces of "
-         "fewer than "
-      << e.rows.front().crumbs.max_triangles
-      << " triangles mostly that far from it, inside that space (elsewhere).\n";
-  if (seen)
-    s << "Pieces seen through: pieces of fewer than " << e.rows.front().seen_through.max_triangles
-      << " triangles most of whose vertices lie in front of the true depth by more than D1's threshold at some "
-         "frame: the ground truth saw through them.\n";
+  writeGhostNotes(s, e, columns);
   s << "\n";
 }
 

@@ -121,12 +121,27 @@ public:
   void writeMarkdown(const std::string& path) const;
 
 private:
+  // summary.json's sections, in the order written.
+  void writeTrajectoryJson(std::ostream& out) const;
+  /// Frames, stop signals, rates, memory and the stages' times.
+  void writeSpeedJson(std::ostream& out) const;
+  /// The map's size, the depth errors and the mesh's accuracy.
+  void writeMapJson(std::ostream& out) const;
+
+  // report.md's sections, in the order written.
+  /// The title, the dataset, the trajectory and how it compares with the reference.
+  void writeIntro(std::ostream& out) const;
+  void writeSpeed(std::ostream& out) const;
+  /// The map's size, its files and the mesh preview.
+  void writeMapSize(std::ostream& out) const;
   void writeMapEvaluation(std::ostream& out) const;
   void writeOpenSky(std::ostream& out) const;
   /// The true sky each mesh covers and its surface off the truth (synthetic rows).
   void writeTruthOffSurface(std::ostream& out) const;
   /// The meshes' accuracy and completeness by the class of the true surface (when known).
   void writeClassTable(std::ostream& out) const;
+  /// The depth panels, then links to the other outputs.
+  void writeDepthImagesAndLinks(std::ostream& out) const;
 };
 
 /// Peak resident memory of this process so far, in MiB (getrusage).
