@@ -14,6 +14,7 @@
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
+#include <msf/range_image/scan_history.h>
 #include <msf/stereo/sgbm_stereo.h>
 #include <msf/synthetic/ground_truth.h>
 
@@ -88,27 +89,64 @@ msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
   };
 }
 
-/// Paper steps 1-4 with the stages' configurations: compound interpolation of the input
-/// rings, SGBM (narrowed by it with stereo.prior_search_range, guided by the projected input
-/// rings with stereo.guidance lidar), and the per-pixel fusion of the two, with the facade
-/// extension after it (fusion.facade_extension) as in the pipeline.
-msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf::InterpolationConfig& interpolation,
-                             const msf::SgbmConfig& stereo_config, const msf::DepthFusionConfig& fusion) {
+/// The input rings with the agreeing returns of the earlier frames' input rings (ScanHistory,
+/// section accumulation), placed by the sequence's poses; the input rings alone for a frame
+/// without a pose or with accumulation.scans 0. Frames come in order.
+std::function<const pcl::PointCloud<pcl::PointXYZI>&(const msf::HoldoutInput&)>
+withEarlierScans(const msf::ProjectionConfig& projection, const msf::ScanHistoryConfig& accumulation) {
+  std::shared_ptr<msf::ScanHistory> history;
+  auto dense = std::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
+  return [=](const msf::HoldoutInput& in) mutable -> const pcl::PointCloud<pcl::PointXYZI>& {
+    if (accumulation.scans == 0 || !in.has_pose)
+      return *in.scan;
+    if (!history)
+      history = std::make_shared<msf::ScanHistory>(*in.calibration, projection, accumulation);
+    history->densify(*in.scan, in.T_world_cam0 * in.calibration->T_cam0_velo, *dense);
+    return *dense;
+  };
+}
+
+/// Compound interpolation of the input rings with the earlier frames' (withEarlierScans).
+msf::HoldoutMethod accumulated(const msf::ConfigFile& file) {
+  const auto projection = file.get<msf::ProjectionConfig>();
+  const auto interpolation = file.get<msf::InterpolationConfig>();
+  auto scans = withEarlierScans(projection, file.get<msf::ScanHistoryConfig>());
   std::shared_ptr<msf::LidarCompletion> completion;
+  return [=](const msf::HoldoutInput& in) mutable {
+    if (!completion)
+      completion = std::make_shared<msf::LidarCompletion>(*in.calibration, msf::CompletionMethod::Compound,
+                                                          projection, interpolation);
+    cv::Mat depth;
+    completion->computeDepth(scans(in), depth);
+    return depth;
+  };
+}
+
+/// Paper steps 1-4 with the stages' configurations: compound interpolation of the input
+/// rings (with the earlier frames' agreeing returns, section accumulation), SGBM (narrowed by it
+/// with stereo.prior_search_range, guided by its real returns with stereo.guidance lidar), and the
+/// per-pixel fusion of the two, with the facade extension after it (fusion.facade_extension) as in
+/// the pipeline.
+msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf::InterpolationConfig& interpolation,
+                             const msf::ScanHistoryConfig& accumulation, const msf::SgbmConfig& stereo_config,
+                             const msf::DepthFusionConfig& fusion) {
+  std::shared_ptr<msf::LidarCompletion> completion;
+  auto scans = withEarlierScans(projection, accumulation);
   auto sgbm = std::make_shared<msf::SgbmStereo>(stereo_config);
   auto fuser = std::make_shared<msf::DepthImageFusion>(fusion);
   return [=](const msf::HoldoutInput& in) mutable {
     if (!completion)
       completion = std::make_shared<msf::LidarCompletion>(*in.calibration, msf::CompletionMethod::Compound,
                                                           projection, interpolation);
+    const pcl::PointCloud<pcl::PointXYZI>& scan = scans(in);
     cv::Mat lidar_depth, distance, depth;
-    completion->computeDepth(*in.scan, lidar_depth, &distance);
+    completion->computeDepth(scan, lidar_depth, &distance);
     sgbm->setCalibration(*in.calibration);
     sgbm->setInputImages(in.left, in.right);
     sgbm->setDepthPrior(lidar_depth);
     cv::Mat sparse;
     if (stereo_config.lidarGuidance())
-      completion->projector().projectToImage(*in.scan, sparse); // the input rings only
+      completion->projector().projectToImage(scan, sparse); // the input rings (and earlier scans') only
     sgbm->setGuidance(sparse);
     sgbm->computeDisparity();
     fuser->setCalibration(*in.calibration);
@@ -119,10 +157,13 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
 }
 
 /// The same with the sections of `file` (section fusion, its method forced to `method` when given).
-msf::HoldoutMethod fused(const msf::ConfigFile& file, std::optional<msf::FusionMethod> method) {
+msf::HoldoutMethod fused(const msf::ConfigFile& file, std::optional<msf::FusionMethod> method,
+                         std::optional<int> earlier_scans = std::nullopt) {
   auto fusion = file.get<msf::DepthFusionConfig>();
   fusion.method = method.value_or(fusion.method);
-  return fusedWith(file.get<msf::ProjectionConfig>(), file.get<msf::InterpolationConfig>(),
+  auto accumulation = file.get<msf::ScanHistoryConfig>();
+  accumulation.scans = earlier_scans.value_or(accumulation.scans);
+  return fusedWith(file.get<msf::ProjectionConfig>(), file.get<msf::InterpolationConfig>(), accumulation,
                    file.get<msf::SgbmConfig>(), fusion);
 }
 
@@ -130,7 +171,7 @@ msf::HoldoutMethod fused(const msf::ConfigFile& file, std::optional<msf::FusionM
 /// its steps 1-4 beside ours on the same pixels.
 msf::HoldoutMethod paper() {
   const msf::PipelineConfig c = msf::PipelineConfig::paper();
-  return fusedWith(c.projection, c.interpolation, c.stereo, c.fusion);
+  return fusedWith(c.projection, c.interpolation, c.accumulation, c.stereo, c.fusion);
 }
 
 /// Add a method here (name -> function of the frame input) to get its row in the table.
@@ -138,6 +179,8 @@ const std::vector<MethodEntry>& methodTable() {
   static const std::vector<MethodEntry> table{
       {"interpolated", "compound interpolation (section interpolation)",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::Compound); }},
+      {"accumulated", "the same with the earlier frames' scans (section accumulation; needs poses)",
+       [](const msf::ConfigFile& f) { return accumulated(f); }},
       {"linear", "the same slices, linear only",
        [](const msf::ConfigFile& f) { return lidar(f, msf::CompletionMethod::Linear); }},
       {"cubic", "the same slices, zero-slope cubic only",
@@ -154,6 +197,8 @@ const std::vector<MethodEntry>& methodTable() {
        [](const msf::ConfigFile& f) { return stereo(f, StereoInput::Guided); }},
       {"fused", "steps 1-4 as the config says (fusion.method too): scripts/paper_additions.sh",
        [](const msf::ConfigFile& f) { return fused(f, std::nullopt); }},
+      {"fused_single_scan", "the same from each frame's own scan alone (accumulation.scans 0)",
+       [](const msf::ConfigFile& f) { return fused(f, std::nullopt, 0); }},
       {"fused_paper", "interpolated + SGBM fused by eq. 6 (section fusion; sgbm_guided with stereo.guidance lidar)",
        [](const msf::ConfigFile& f) { return fused(f, msf::FusionMethod::Paper); }},
       {"fused_uncertainty", "the same fused by inverse variance",
@@ -212,6 +257,8 @@ std::vector<RegionResults> runFullImage(const msf::Sequence& sequence, const std
     input.scan = frame.scan;
     input.left = frame.left;
     input.right = frame.right;
+    input.has_pose = frame.has_pose;
+    input.T_world_cam0 = frame.T_world_cam0;
     for (std::size_t m = 0; m < methods.size(); ++m) {
       const auto start = std::chrono::steady_clock::now();
       const cv::Mat estimate = methods[m].second(input);

@@ -9,6 +9,7 @@
 #include "test_support.h"
 
 #include <filesystem>
+#include <fstream>
 
 namespace {
 
@@ -46,6 +47,26 @@ TEST_F(PipelineTest, TheEngineFedFrameByFrameGivesTheToolsMapByteForByte) {
   const auto [mesh, volume] = savedMap(engine, mine);
   EXPECT_TRUE(mesh == readFile(dir.file("out/mesh.ply"))) << "the mesh differs from msf_reconstruct's";
   EXPECT_TRUE(volume == readFile(dir.file("out/volume.pcd"))) << "the volume differs from msf_reconstruct's";
+}
+
+TEST_F(PipelineTest, WithEarlierScansTheEngineFedFrameByFrameGivesTheToolsMap) {
+  msf::test::TempDir dir;
+  const std::string config_path = dir.file("earlier.yaml");
+  std::ofstream(config_path) << "accumulation:\n  scans: 2\n";
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:2 -panels 0 -config " + config_path +
+                                                           " -o " + dir.file("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig::load(config_path));
+  feed(engine, sequence);
+  msf::test::TempDir mine;
+  const auto [mesh, volume] = savedMap(engine, mine);
+  EXPECT_TRUE(mesh == readFile(dir.file("out/mesh.ply"))) << "the mesh differs from msf_reconstruct's";
+  EXPECT_TRUE(volume == readFile(dir.file("out/volume.pcd"))) << "the volume differs from msf_reconstruct's";
+  msf::Reconstructor own_scans(sequence.calibration(), msf::PipelineConfig{});
+  feed(own_scans, sequence);
+  msf::test::TempDir other;
+  EXPECT_FALSE(savedMap(own_scans, other).second == volume) << "the earlier scans changed nothing";
 }
 
 TEST_F(PipelineTest, OneThreadGivesTheSameMapAsAllCores) {

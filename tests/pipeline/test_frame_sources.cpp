@@ -13,7 +13,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <map>
+#include <set>
 #include <mutex>
 #include <thread>
 
@@ -69,6 +71,61 @@ TEST_F(PipelineTest, TheFrameFilterChangesEachFrameBeforeAnyStageSeesIt) { check
 TEST(FrameFilter, NoHeldOutReturnOfARealKittiScanReachesThePipeline) {
   MSF_REQUIRE_KITTI();
   checkTheFilterComesFirst(msf::test::kittiDir() + "/odometry/sequences/04");
+}
+
+/// With earlier scans carried into the view, under a ring hold-out: every scan the history holds
+/// is a frame's input rings, none of its held-out returns, whichever way the poses come (the
+/// dataset's, or the odometry's, tracked before steps 1-2); and the earlier scans add returns.
+void checkNoHeldOutReturnIsCarried(msf::Reconstructor::PoseMode poses) {
+  const msf::Sequence sequence(msf::test::kittiDir() + "/odometry/sequences/04");
+  const auto frames = sequence.indices(msf::FrameRange::parse("0:3"));
+  msf::PipelineConfig config;
+  config.accumulation.scans = 2;
+  msf::Reconstructor::Options options;
+  options.poses = poses;
+  options.keep_sparse = true;
+  msf::Reconstructor pipeline(sequence.calibration(), config, options);
+  std::mutex mutex;
+  std::map<std::size_t, pcl::PointCloud<pcl::PointXYZI>> removed;
+  pipeline.setFrameFilter([&](msf::Frame& frame) {
+    pcl::PointCloud<pcl::PointXYZI> input, heldout;
+    msf::splitRings(*frame.scan, msf::RingSplitConfig{}, input, heldout);
+    *frame.scan = input;
+    const std::lock_guard<std::mutex> lock(mutex);
+    removed[frame.index] = heldout;
+  });
+  std::size_t denser = 0;
+  pipeline.run(sequence, frames, [&](msf::FrameResult& r) {
+    // The LiDAR depth has real returns (distance 0) beyond the frame's own projected ones.
+    const int own = cv::countNonZero(r.lidar_sparse > 0);
+    const int real = cv::countNonZero(r.lidar_distance == 0.f);
+    denser += r.index > 0 && real > own + 1000;
+  });
+  EXPECT_EQ(denser, frames.size() - 1);
+  const msf::ScanHistory& history = pipeline.scanHistory();
+  ASSERT_EQ(history.size(), 2u);
+  for (std::size_t age = 1; age <= history.size(); ++age) {
+    const std::size_t frame = frames.back() + 1 - age;
+    std::set<std::array<float, 3>> heldout;
+    for (const auto& p : removed[frame])
+      heldout.insert({p.x, p.y, p.z});
+    ASSERT_GT(heldout.size(), 1000u);
+    std::size_t carried = 0;
+    for (const auto& p : history.scan(age - 1))
+      carried += heldout.count({p.x, p.y, p.z});
+    EXPECT_EQ(carried, 0u) << "held-out returns of frame " << frame << " among the earlier scans";
+    EXPECT_GT(history.scan(age - 1).size(), 10000u);
+  }
+}
+
+TEST(EarlierScans, NoHeldOutRingIsCarriedWithTheDatasetsPoses) {
+  MSF_REQUIRE_KITTI();
+  checkNoHeldOutReturnIsCarried(msf::Reconstructor::PoseMode::Given);
+}
+
+TEST(EarlierScans, NoHeldOutRingIsCarriedWithTheOdometrysPoses) {
+  MSF_REQUIRE_KITTI();
+  checkNoHeldOutReturnIsCarried(msf::Reconstructor::PoseMode::Odometry);
 }
 
 /// A frame whose fused depth is `width` x `height` of `depth` weighing `weight`, its colour

@@ -355,6 +355,9 @@ check "synth -sky foo" 1 "option -sky: unknown sky 'foo' \(known: pale, kitti\)"
 printf 'synthetic:\n  sky: cloudy\n' >"$F/sky_cloudy.yaml"
 check "synth -config: an unknown sky" 1 "sky_cloudy.yaml' line 2: synthetic.sky must be pale \| kitti, not 'cloudy'" -- \
   msf_synth -o out -frames 1 -config "$F/sky_cloudy.yaml"
+printf 'accumulation:\n  scans: 40\n' >"$F/scans_40.yaml"
+check "interpolate -config: 40 earlier scans" 1 "scans_40.yaml' line 2: accumulation.scans must be a whole number in 0..16, not 40" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -config "$F/scans_40.yaml"
 
 # ---- configuration files ------------------------------------------------------------------
 check "mesh -config: a misspelt section" 1 "typo_section.yaml' line 1: 'tsdf_volumes' is not a section of the configuration" -- \

@@ -46,6 +46,8 @@ HoldoutFrame makeHoldoutFrame(const Frame& frame, const Calibration& calibration
   out.input.left = frame.left;
   out.input.right = frame.right;
   out.input.color = frame.color;
+  out.input.has_pose = frame.has_pose;
+  out.input.T_world_cam0 = frame.T_world_cam0;
   return out;
 }
 

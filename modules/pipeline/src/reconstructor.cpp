@@ -12,6 +12,7 @@
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
+#include <msf/range_image/scan_history.h>
 #include <msf/reconstruction/block_footprint.h>
 #include <msf/reconstruction/scan_band_blocks.h>
 #include <msf/stereo/color_sampler.h>
@@ -59,8 +60,11 @@ constexpr int kCalibrationFrames = 3;
 /// The stage objects of steps 1-4, configured once; they keep their work buffers.
 struct Reconstructor::Stages {
   explicit Stages(const Calibration& calibration, const PipelineConfig& config)
-      : lidar(calibration, CompletionMethod::Compound, config.projection, config.interpolation) {}
+      : lidar(calibration, CompletionMethod::Compound, config.projection, config.interpolation),
+        history(calibration, config.projection, config.accumulation) {}
   LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
+  ScanHistory history;    // the earlier scans that step 1 carries into the view
+  pcl::PointCloud<pcl::PointXYZI> dense_scan;  // the scan with them
   SgbmStereo stereo;
   DepthImageFusion fusion;
   SkyMask sky;
@@ -91,6 +95,8 @@ Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& confi
 
 Reconstructor::~Reconstructor() = default;
 
+const ScanHistory& Reconstructor::scanHistory() const { return stages_->history; }
+
 FrameResult Reconstructor::startFrame(const Frame& frame) const {
   FrameResult result;
   result.index = frame.index;
@@ -100,9 +106,20 @@ FrameResult Reconstructor::startFrame(const Frame& frame) const {
   return result;
 }
 
+const pcl::PointCloud<pcl::PointXYZI>& Reconstructor::withEarlierScans(const Frame& frame, const FrameResult& result) {
+  if (config_.accumulation.scans == 0)
+    return *frame.scan;
+  if (!result.has_pose) {
+    stages_->history.clear(); // earlier scans cannot be placed without the poses
+    return *frame.scan;
+  }
+  stages_->history.densify(*frame.scan, result.T_world_cam0 * calibration_.T_cam0_velo, stages_->dense_scan);
+  return stages_->dense_scan;
+}
+
 void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
-  stages_->lidar.computeDepth(*frame.scan, result.lidar_depth, &result.lidar_distance);
+  stages_->lidar.computeDepth(withEarlierScans(frame, result), result.lidar_depth, &result.lidar_distance);
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
@@ -162,6 +179,11 @@ bool Reconstructor::lidarBeforeStereo() const {
 FrameResult Reconstructor::computeDepth(const Frame& frame) {
   const ThreadBudget budget(options_.threads);
   FrameResult result = startFrame(frame);
+  computeDepth(frame, result);
+  return result;
+}
+
+void Reconstructor::computeDepth(const Frame& frame, FrameResult& result) {
   const auto depth_start = Clock::now();
   if (lidarBeforeStereo()) {
     computeLidar(frame, result);
@@ -180,7 +202,6 @@ FrameResult Reconstructor::computeDepth(const Frame& frame) {
   result.times.depth_ms = msSince(depth_start);
   computeFusion(frame, result);
   computeSky(frame, result);
-  return result;
 }
 
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
@@ -280,11 +301,12 @@ FrameResult Reconstructor::addFrame(const Frame& frame) {
   const ThreadBudget budget(options_.threads);
   if (frames_added_ == 0)
     add_tracks_ = tracks(frame);
-  FrameResult result = computeDepth(frame);
-  if (add_tracks_) {
+  FrameResult result = startFrame(frame);
+  if (add_tracks_) { // first: steps 1-2 place the earlier scans by the frame's pose
     result.T_world_cam0 = track(frame, "the scan of frame " + std::to_string(frame.index));
     result.has_pose = true;
   }
+  computeDepth(frame, result);
   integrate(result);
   ++frames_added_;
   if (config_.scheduling.mesh_every_n_frames > 0 &&
@@ -354,6 +376,7 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
     tracked.close();
   };
   std::atomic<bool> interrupted{false};
+  const bool accumulating = config_.accumulation.scans > 0;
 
   const auto run_start = Clock::now();
   std::thread loader([&] {
@@ -371,7 +394,14 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
         item.load_ms = msSince(start);
         if (i == frames.front())
           tracking = tracks(item.frame);
-        if (tracking) {
+        item.result = startFrame(item.frame);
+        if (tracking && accumulating) {
+          // Steps 1-2 place the earlier scans by this frame's pose: tracked here, before them.
+          item.result.T_world_cam0 = track(item.frame, source.scanName(item.frame.index));
+          item.result.has_pose = true;
+          if (!tracked.push(item.result.T_world_cam0))
+            break;
+        } else if (tracking) {
           Frame scan_only;
           scan_only.index = item.frame.index;
           scan_only.timestamp = item.frame.timestamp;
@@ -381,7 +411,6 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
           if (!to_track.push(std::move(scan_only)))
             break;
         }
-        item.result = startFrame(item.frame);
         // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior or guidance.
         if (lidarBeforeStereo())
           computeLidar(item.frame, item.result);
@@ -420,7 +449,8 @@ Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std:
           computeFusion(item->frame, result);
           computeSky(item->frame, result);
         } else {
-          result = computeDepth(item->frame);
+          result = std::move(item->result);
+          computeDepth(item->frame, result);
         }
         result.name = source.frameName(item->frame.index);
         result.times.load_ms = item->load_ms;
@@ -523,7 +553,9 @@ double Reconstructor::blocksPerBandBlock(const FrameSource& source, const std::v
     bands.addScan(*frame.scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
     // The depth from this engine's own stages, whose buffers the run then reuses; integrated
     // into a volume of its own (the scan's carving updates only blocks that exist).
+    stages_->history.clear(); // frames far apart: none is another's earlier scan
     FrameResult result = computeDepth(frame);
+    stages_->history.clear();
     TsdfVolume volume(config_.volume.voxel_size_m, config_.volume.truncation_m);
     volume.setMaxMemoryMb(config_.volume.max_memory_mb);
     TsdfIntegrator integrator(volume, config_.integrator);

@@ -8,6 +8,7 @@
 #include <msf/range_image/lidar_projector.h>
 #include <msf/range_image/ring_split.h>
 
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -36,6 +37,9 @@ struct HoldoutInput {
   pcl::PointCloud<pcl::PointXYZI>::ConstPtr scan;      ///< input rings only, velodyne frame, file order
   cv::Mat left, right;                                 ///< grey rectified pair (cameras 0, 1)
   cv::Mat color;                                       ///< camera 2 when loaded, else empty
+  /// The frame's pose from the sequence, when it has one: what places earlier frames' scans.
+  bool has_pose = false;
+  Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
 };
 
 /// One frame split for the protocol: the method input and the ground truth.

@@ -5,6 +5,7 @@
 #include <msf/range_image/lidar_projector.h>
 #include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/ring_split.h>
+#include <msf/range_image/scan_history.h>
 #include <msf/registration/lidar_odometry.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/streaming_map.h>
@@ -46,6 +47,7 @@ struct SchedulingConfig {
 struct PipelineConfig {
   ProjectionConfig projection;
   InterpolationConfig interpolation;
+  ScanHistoryConfig accumulation; ///< earlier scans in the current view, before step 2
   /// Not a stage's: the ring hold-out of msf_reconstruct -holdout (protocols 2 and 4).
   RingSplitConfig rings;
   SgbmConfig stereo;
@@ -64,6 +66,7 @@ struct PipelineConfig {
   static void forEachSection(Self& config, Visit&& visit) {
     visit(config.projection);
     visit(config.interpolation);
+    visit(config.accumulation);
     visit(config.rings);
     visit(config.stereo);
     visit(config.fusion);

@@ -2,6 +2,7 @@
 #pragma once
 #include <msf/io/frame_source.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/range_image/scan_history.h>
 #include <msf/reconstruction/block_footprint.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
@@ -121,7 +122,8 @@ void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const
 /// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
 /// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected
-/// onto the image grown by a margin, so gaps across the image's border are bridged) and SGBM
+/// onto the image grown by a margin, so gaps across the image's border are bridged; the last few
+/// scans, placed by the poses, add their returns between the current rings: ScanHistory) and SGBM
 /// stereo give two depth images, fused per pixel; the frame's pose (its own, or LiDAR
 /// odometry's) places the fused depth in the regularized TSDF volume; marching cubes gives the
 /// mesh, incrementally. The stages are the library's classes with the settings of one
@@ -188,7 +190,9 @@ public:
   /// that do not fit the rig, or a frame without a pose where one is needed.
   FrameResult addFrame(const Frame& frame);
 
-  /// Depth of one frame, synchronously: steps 1-4, nothing added to the map.
+  /// Depth of one frame, synchronously: steps 1-4, nothing added to the map. With
+  /// `accumulation.scans` > 0 and a frame with a pose, step 1 adds the earlier frames' scans
+  /// (ScanHistory) and the frame's scan joins them: call it with the frames in order.
   FrameResult computeDepth(const Frame& frame);
   /// Integrates the fused depth of `result` at its pose (step 5), grown by the interpolated
   /// LiDAR of the canvas's margin (fusedDepthFrame). Throws InvalidInputError when the frame
@@ -264,6 +268,8 @@ public:
   TsdfVolume& volume() { return *volume_; }
   const TsdfVolume& volume() const { return *volume_; }
   const TsdfIntegrator& integrator() const { return *integrator_; }
+  /// The earlier scans step 1 carries into the next frame's view (accumulation.scans).
+  const ScanHistory& scanHistory() const;
 
 private:
   struct Stages;  // the stage objects, which keep their buffers from frame to frame
@@ -272,6 +278,11 @@ private:
   /// Steps 1-2 before SGBM: its search range (stereo prior) or its guidance comes from them;
   /// otherwise they run beside it.
   bool lidarBeforeStereo() const;
+  /// Steps 1-4 into a started result, at its pose (the earlier scans are placed by it).
+  void computeDepth(const Frame& frame, FrameResult& result);
+  /// The frame's scan with the earlier scans' agreeing returns (ScanHistory), when the config
+  /// carries them and the result has a pose; the frame's scan otherwise.
+  const pcl::PointCloud<pcl::PointXYZI>& withEarlierScans(const Frame& frame, const FrameResult& result);
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
