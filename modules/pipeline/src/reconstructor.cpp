@@ -6,7 +6,6 @@
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/sky_mask.h>
 #include <msf/io/pinhole_camera.h>
-#include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/run_report.h>
 #include <msf/pipeline/source_depth_frame.h>
@@ -23,9 +22,7 @@
 #include <cstdio>
 #include <exception>
 #include <future>
-#include <mutex>
 #include <optional>
-#include <thread>
 
 namespace msf {
 
@@ -345,164 +342,6 @@ std::size_t Reconstructor::finishStreaming(const std::string& mesh_path) {
   const ThreadBudget budget(options_.threads);
   mesher_.reset();
   return streaming_->finish(mesh_path);
-}
-
-Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                           const FrameCallback& on_frame, const std::atomic<bool>* stop) {
-  options_.sweeping_scans = source.sweepingScans();
-  struct Loaded {
-    Frame frame;
-    FrameResult result;  // with the stereo prior or guidance, steps 1-2 are already done
-    double load_ms;
-  };
-  const auto capacity = static_cast<std::size_t>(config_.scheduling.queue_capacity);
-  BoundedQueue<Loaded> loaded(capacity);
-  BoundedQueue<FrameResult> depths(capacity);
-  BoundedQueue<Frame> to_track(capacity);            // scans for the odometry
-  BoundedQueue<Eigen::Isometry3d> tracked(capacity);  // its poses, in frame order
-  // Set by the loader from the first frame before any frame moves on: read after a queue's pop.
-  std::atomic<bool> tracking{false};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto fail = [&](std::exception_ptr e) {
-    {
-      std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure)
-        failure = e;
-    }
-    loaded.close();
-    depths.close();
-    to_track.close();
-    tracked.close();
-  };
-  std::atomic<bool> interrupted{false};
-  const bool accumulating = config_.accumulation.scans > 0;
-
-  const auto run_start = Clock::now();
-  std::thread loader([&] {
-    const ThreadBudget budget(options_.threads);
-    try {
-      for (std::size_t i : frames) {
-        if (stop && stop->load()) {
-          interrupted = true;
-          break;
-        }
-        const auto start = Clock::now();
-        Loaded item{source.load(i), FrameResult(), 0.0};
-        if (frame_filter_)
-          frame_filter_(item.frame);
-        item.load_ms = msSince(start);
-        if (i == frames.front())
-          tracking = tracks(item.frame);
-        item.result = startFrame(item.frame);
-        if (tracking && accumulating) {
-          // Steps 1-2 place the earlier scans by this frame's pose: tracked here, before them.
-          item.result.T_world_cam0 = track(item.frame, source.scanName(item.frame.index));
-          item.result.has_pose = true;
-          if (!tracked.push(item.result.T_world_cam0))
-            break;
-        } else if (tracking) {
-          Frame scan_only;
-          scan_only.index = item.frame.index;
-          scan_only.timestamp = item.frame.timestamp;
-          scan_only.scan = item.frame.scan; // shared, read only: no stage changes a scan after the filter
-          scan_only.has_pose = item.frame.has_pose; // the first frame's anchors the odometry's world
-          scan_only.T_world_cam0 = item.frame.T_world_cam0;
-          if (!to_track.push(std::move(scan_only)))
-            break;
-        }
-        // Steps 1-2 here, one frame ahead of SGBM, when SGBM waits for their prior or guidance.
-        if (lidarBeforeStereo())
-          computeLidar(item.frame, item.result);
-        if (!loaded.push(std::move(item)))
-          break;
-      }
-    } catch (...) {
-      fail(std::current_exception());
-    }
-    loaded.close();
-    to_track.close();
-  });
-  std::thread tracker([&] {
-    const ThreadBudget budget(options_.threads);
-    try {
-      while (auto frame = to_track.pop())
-        if (!tracked.push(track(*frame, source.scanName(frame->index))))
-          break;
-    } catch (...) {
-      fail(std::current_exception());
-    }
-    tracked.close();
-  });
-  std::thread depth([&] {
-    const ThreadBudget budget(options_.threads);
-    try {
-      while (auto item = loaded.pop()) {
-        if (stop && stop->load())
-          break; // a frame not started is dropped: a stop should be prompt
-        FrameResult result;
-        if (lidarBeforeStereo()) {
-          result = std::move(item->result);
-          const auto start = Clock::now();
-          computeStereo(item->frame, result);
-          result.times.depth_ms = msSince(start) + result.times.lidar_ms;
-          computeFusion(item->frame, result);
-          computeSky(item->frame, result);
-        } else {
-          result = std::move(item->result);
-          computeDepth(item->frame, result);
-        }
-        result.name = source.frameName(item->frame.index);
-        result.times.load_ms = item->load_ms;
-        if (!depths.push(std::move(result)))
-          break;
-      }
-    } catch (...) {
-      fail(std::current_exception());
-    }
-    depths.close();
-  });
-
-  RunStats stats;
-  const ThreadBudget budget(options_.threads);
-  try {
-    while (auto result = depths.pop()) {
-      if (tracking) {
-        auto pose = tracked.pop();
-        if (!pose)
-          break; // the estimator failed (its error is rethrown below) or the run stopped
-        result->T_world_cam0 = *pose;
-        result->has_pose = true;
-      }
-      integrate(*result);
-      if (config_.scheduling.mesh_every_n_frames > 0 &&
-          (stats.frames_done + 1) % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
-        mesh();
-      ++stats.frames_done;
-      if (on_frame)
-        on_frame(*result);
-      if (stats.frames_done == 1)
-        stats.first_frame_s = msSince(run_start) / 1000.0;
-      if (stop && stop->load()) {
-        interrupted = stats.frames_done < frames.size();
-        break;
-      }
-    }
-  } catch (...) {
-    fail(std::current_exception());
-  }
-  loaded.close(); // wakes the other stages when the loop ended early
-  depths.close();
-  to_track.close();
-  tracked.close();
-  loader.join();
-  depth.join();
-  tracker.join();
-  if (failure)
-    std::rethrow_exception(failure);
-  stats.wall_s = msSince(run_start) / 1000.0;
-  stats.interrupted = interrupted;
-  return stats;
 }
 
 std::string MemoryPrediction::describe() const {

@@ -273,6 +273,7 @@ public:
 
 private:
   struct Stages;  // the stage objects, which keep their buffers from frame to frame
+  struct Run;     // one run(): its queues and stage loops
 
   FrameResult startFrame(const Frame& frame) const;
   /// Steps 1-2 before SGBM: its search range (stereo prior) or its guidance comes from them;
