@@ -86,6 +86,15 @@ public:
   void fuse(PointCloudOut& output);
 
 private:
+  // The steps of fuse().
+  void checkInputs() const;
+  /// The LiDAR cloud's depth and distance to a real return as images (lidar_depth_, lidar_distance_).
+  void readLidarImages();
+  /// Paper step 4 on the images: fused_depth_ and fused_weight_, with the additions after it.
+  void fuseImages();
+  /// The fused points on the rays of the input points, coloured; the header of the stereo cloud's.
+  void writePoints(PointCloudOut& output) const;
+
   DepthFusionConfig config_;
   Calibration calibration_;
   bool has_calibration_{false};

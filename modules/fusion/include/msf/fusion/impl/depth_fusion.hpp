@@ -32,6 +32,14 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::setCalibration(const Cal
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
 void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& output) {
+  checkInputs();
+  readLidarImages();
+  fuseImages();
+  writePoints(output);
+}
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() const {
   const auto size = [](const auto& cloud) { return std::to_string(cloud.width) + "x" + std::to_string(cloud.height); };
   if (!lidar_ || lidar_->empty())
     throw InvalidInputError("DepthFusion: the LiDAR cloud is missing or empty (setInputLidar)");
@@ -58,9 +66,11 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
   };
   checkRange(*lidar_, "LiDAR");
   checkRange(*stereo_, "stereo");
+}
 
-  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
-  const float fB = static_cast<float>(calibration_.focalBaseline());
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::readLidarImages() {
+  const int rows = static_cast<int>(lidar_->height), cols = static_cast<int>(lidar_->width);
   lidar_depth_.create(rows, cols, CV_32FC1);
   if constexpr (detail::has_distance_v<PointLidarT>)
     lidar_distance_.create(rows, cols, CV_32FC1);
@@ -81,27 +91,18 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
       }
     }
   });
+}
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
+  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
+  const float fB = static_cast<float>(calibration_.focalBaseline());
   const bool uncertainty = config_.method == FusionMethod::Uncertainty;
   if (uncertainty)
     lidarEdgeCue(lidar_depth_, fB, config_, lidar_edge_);
-
-  const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   const DepthFusionConfig config = config_;
   const LidarParallax parallax = lidarParallax(calibration_, config);
-  output.resize(static_cast<std::size_t>(rows) * cols);
-  output.width = static_cast<std::uint32_t>(cols);
-  output.height = static_cast<std::uint32_t>(rows);
-  // The stereo cloud's header (camera 0); SGBM works on images that carry no stamp, so the
-  // LiDAR's, the scan's carried through projection, fills one the stereo cloud lacks.
-  output.header = stereo_->header;
-  if (output.header.stamp == 0)
-    output.header.stamp = lidar_->header.stamp;
-  if (output.header.frame_id.empty())
-    output.header.frame_id = lidar_->header.frame_id;
-  output.sensor_origin_ = stereo_->sensor_origin_;
-  output.sensor_orientation_ = stereo_->sensor_orientation_;
-  // 1. The fused depth and weight images, a row at a time in contiguous arrays for fuseRow.
+  // A row at a time in contiguous arrays for fuseRow.
   fused_depth_.create(rows, cols, CV_32FC1);
   fused_weight_.create(rows, cols, CV_32FC1);
   parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
@@ -134,11 +135,28 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& outp
                      lidar_distance_.empty() ? lidar_depth_ : realReturns(lidar_depth_, lidar_distance_), fused_depth_,
                      fused_weight_, no_free_space);
   }
+}
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOut& output) const {
+  const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
+  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
+  output.resize(static_cast<std::size_t>(rows) * cols);
+  output.width = static_cast<std::uint32_t>(cols);
+  output.height = static_cast<std::uint32_t>(rows);
+  // The stereo cloud's header (camera 0); SGBM works on images that carry no stamp, so the
+  // LiDAR's, the scan's carried through projection, fills one the stereo cloud lacks.
+  output.header = stereo_->header;
+  if (output.header.stamp == 0)
+    output.header.stamp = lidar_->header.stamp;
+  if (output.header.frame_id.empty())
+    output.header.frame_id = lidar_->header.frame_id;
+  output.sensor_origin_ = stereo_->sensor_origin_;
+  output.sensor_orientation_ = stereo_->sensor_orientation_;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   // Where neither input has a point (a wall the extension continued), the pixel's own ray.
   const float fx = static_cast<float>(calibration_.fx()), fy = static_cast<float>(calibration_.fy());
   const float cx = static_cast<float>(calibration_.cx()), cy = static_cast<float>(calibration_.cy());
-
-  // 2. The points, on the rays of the input points.
   std::atomic<bool> dense{true};
   parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     bool range_dense = true;
