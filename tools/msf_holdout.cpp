@@ -95,14 +95,11 @@ msf::HoldoutMethod stereo(const msf::ConfigFile& file, StereoInput input) {
 std::function<const pcl::PointCloud<pcl::PointXYZI>&(const msf::HoldoutInput&)>
 withEarlierScans(const msf::ProjectionConfig& projection, const msf::ScanHistoryConfig& accumulation) {
   std::shared_ptr<msf::ScanHistory> history;
-  auto dense = std::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
   return [=](const msf::HoldoutInput& in) mutable -> const pcl::PointCloud<pcl::PointXYZI>& {
-    if (accumulation.scans == 0 || !in.has_pose)
-      return *in.scan;
     if (!history)
       history = std::make_shared<msf::ScanHistory>(*in.calibration, projection, accumulation);
-    history->densify(*in.scan, in.T_world_cam0 * in.calibration->T_cam0_velo, *dense);
-    return *dense;
+    const Eigen::Isometry3d T_world_velo = in.T_world_cam0 * in.calibration->T_cam0_velo;
+    return history->withEarlierScans(*in.scan, in.has_pose ? &T_world_velo : nullptr);
   };
 }
 

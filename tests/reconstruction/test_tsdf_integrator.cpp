@@ -244,6 +244,41 @@ TEST(TsdfIntegrator, WeightingModesAndMaximumWeight) {
   }
 }
 
+/// A weighting of one's own: sigma 0.1 m within 2.5 m, 1 m beyond.
+class NearIsPrecise : public DepthWeighting {
+public:
+  float weight(float depth) const override { return depth < 2.5f ? 100.f : 1.f; }
+  double leastWeight(double) const override { return 1.0; }
+};
+
+TEST(TsdfIntegrator, AWeightingIsATypeThatTheConfigNamesOrTheUserGives) {
+  EXPECT_FLOAT_EQ(makeDepthWeighting(TsdfIntegrator::Weighting::Constant, 0.1)->weight(7.f), 100.f);
+  EXPECT_FLOAT_EQ(makeDepthWeighting(TsdfIntegrator::Weighting::InverseSquare, 0.1)->weight(2.f), 25.f);
+  EXPECT_DOUBLE_EQ(makeDepthWeighting(TsdfIntegrator::Weighting::InverseSquare, 0.1)->leastWeight(10.0), 1.0);
+  const auto per_pixel = makeDepthWeighting(TsdfIntegrator::Weighting::PerPixel, 0.5);
+  EXPECT_TRUE(per_pixel->takesFrameWeights());
+  EXPECT_FLOAT_EQ(per_pixel->weight(3.f), 4.f); // without a weight image: depth_sigma_m's
+  EXPECT_EQ(per_pixel->leastWeight(40.0), 0.0);
+
+  DepthFrame frame;
+  frame.camera = test::smallCamera();
+  frame.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.0f));
+  frame.depth.colRange(240, 320).setTo(3.0f);
+  TsdfVolume volume(0.05, 0.3);
+  TsdfIntegrator integrator(volume);
+  EXPECT_TRUE(integrator.weighting().takesFrameWeights()); // the default config's per_pixel
+  integrator.setWeighting(std::make_shared<NearIsPrecise>());
+  EXPECT_FALSE(integrator.weighting().takesFrameWeights());
+  integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  EXPECT_FLOAT_EQ(volume.findVoxel(GridIndex(0, 0, 40))->weight, 100.f); // on the near surface, 2 m ahead
+  const double x_far = 3.0 * (280 - frame.camera.cx) / frame.camera.fx; // a pixel of the far part
+  EXPECT_FLOAT_EQ(volume.findVoxel(GridIndex(static_cast<int>(std::lround(x_far / 0.05)), 0, 60))->weight, 1.f);
+  EXPECT_THROW(integrator.setWeighting(nullptr), InvalidInputError);
+  // A new config sets its own weighting again.
+  integrator.setConfig(TsdfIntegrator::Config());
+  EXPECT_TRUE(integrator.weighting().takesFrameWeights());
+}
+
 TEST(TsdfIntegrator, OrganizedCloudsOfAnyPointTypeWithRecoveredIntrinsics) {
   const AnalyticScene scene = test::makeScene(SceneKind::Sphere);
   const PinholeCamera camera = test::smallCamera();

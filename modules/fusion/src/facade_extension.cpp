@@ -32,10 +32,8 @@ struct ColumnFit {
 
   /// That many stereo pixels of a column in a row (no other depth between them), each more
   /// than kBehindSigmas of its sigmas behind the wall, see the surface above the wall's top
-  /// edge (a building behind a lower one of the same grey, street 20: 12 sigmas): the column
-  /// stops. SGBM's guesses on a blank wall come in runs too (its paths carry them), but
-  /// nearer: at 3 sigmas they stopped columns on streets 4, 5 and 12 (fused D1 +0.3 points a
-  /// frame), at 6 not.
+  /// edge (a building behind a lower one of the same grey): the column stops. SGBM's guesses on
+  /// a blank wall come in runs too (its paths carry them), but nearer, hence the wide margin.
   static constexpr int kBehindToStop = 3;
   static constexpr float kBehindSigmas = 6.f;
 
@@ -75,8 +73,8 @@ struct ColumnFit {
   }
 };
 
-/// An overexposed pixel (a bright sky, a glare; 30 % of raw 0009's top rows) shows no surface,
-/// however blank: a white wall's column stops there.
+/// An overexposed pixel (a bright sky, a glare) shows no surface, however blank: a white wall's
+/// column stops there.
 constexpr float kOverexposed = 250.f;
 
 /// A window's glass lies up to ~0.2 m behind its façade: the wall's sigma there has this added
@@ -110,6 +108,172 @@ void checkImage(const cv::Mat& image, int type, const cv::Size& size, const std:
                             std::to_string(size.height));
 }
 
+/// Walks the columns of a depth image bottom-up and carries each column's wall up over the blank
+/// pixels of the wall's grey (extendFacades).
+class FacadeWalk {
+public:
+  FacadeWalk(const cv::Mat& left, const PinholeCamera& camera, const DepthFusionConfig& config, cv::Mat& depth,
+             cv::Mat& weight, cv::Mat& free_space_weight)
+      : camera_(camera), config_(config), depth_(depth), weight_(weight), free_(free_space_weight),
+        anchor_weight_(1.f / (config.facade_anchor_sigma_m * config.facade_anchor_sigma_m)),
+        max_variance_(config.facade_max_texture * config.facade_max_texture) {
+    // The grey's mean and mean square over 5x5 pixels: a blank surface's variance is its noise's.
+    cv::boxFilter(left, mean_, CV_32F, cv::Size(5, 5));
+    cv::sqrBoxFilter(left, mean_square_, CV_32F, cv::Size(5, 5));
+  }
+
+  /// Columns [u0, u1), walked bottom-up together so that rows stay contiguous; the number of
+  /// pixels that took a wall's depth.
+  std::size_t walkStrip(int u0, int u1) const {
+    std::vector<ColumnFit> fits(static_cast<std::size_t>(u1 - u0));
+    std::size_t count = 0;
+    for (int v = depth_.rows - 1; v >= 0; --v)
+      for (int u = u0; u < u1; ++u)
+        count += visit(fits[static_cast<std::size_t>(u - u0)], u, v);
+    return count;
+  }
+
+private:
+  /// One pixel of a column: an anchor goes into the fit, a pixel of the wall's grey takes its
+  /// depth, another image on the wall (a window) is crossed.
+  std::size_t visit(ColumnFit& fit, int u, int v) const {
+    float& z = depth_.ptr<float>(v)[u];
+    float& w = weight_.ptr<float>(v)[u];
+    const bool has_depth = z > 0.f && std::isfinite(z);
+    const float grey = mean_.ptr<float>(v)[u];
+    if (has_depth && w >= anchor_weight_) {
+      fit.add(v, z, w, grey);
+      return 0;
+    }
+    fit.run_below = false;
+    if (fit.anchor_row < 0)
+      return 0;
+    const float variance = mean_square_.ptr<float>(v)[u] - grey * grey;
+    const bool same_surface = std::abs(grey - fit.grey) <= config_.facade_grey_tolerance &&
+                              variance <= max_variance_ && grey < kOverexposed;
+    float wall_depth;
+    if ((!same_surface && config_.facade_max_gap_m <= 0.f) || !wallDepth(fit, u, v, wall_depth)) {
+      fit.stop();
+      return 0;
+    }
+    const float sigma = sigmaAt(fit, v, wall_depth);
+    if (!same_surface) {
+      crossGap(fit, has_depth ? z : 0.f, w, wall_depth, sigma);
+      return 0;
+    }
+    std::size_t count = 0;
+    if (fit.gap > 0) {
+      if (!fit.gap_seen) {
+        fit.stop(); // nothing says the wall goes on behind what was crossed (the sky)
+        return 0;
+      }
+      count += fillWindow(fit, u, v, wall_depth);
+    }
+    return count + extendWall(fit, u, v, wall_depth, sigma);
+  }
+
+  /// The wall's depth at pixel (u, v), false when the column's fit says it is no wall. On a
+  /// plane n . X = d, 1/z = n . ray / d, so d(1/z)/dv = n_y / (fy d) and, with d <= |X| at the
+  /// anchor, |n_y| <= |b| fy |X_anchor|: the slope tells a wall from the road or a car's roof.
+  /// The wall itself goes on vertical (n_y = 0): 1/z stays the run's up the column, since its
+  /// slope, from a few rows of anchors, carried far up puts a façade off.
+  bool wallDepth(const ColumnFit& fit, int u, int v, float& wall_depth) const {
+    double b;
+    if (!fit.slope(b))
+      return false;
+    const double inverse = fit.si / fit.sw;
+    const float x = (static_cast<float>(u) - camera_.cx) / camera_.fx;
+    const float y = (static_cast<float>(v) - camera_.cy) / camera_.fy;
+    const double ray = std::sqrt(1.0 + x * x + y * y);
+    if (!(inverse > 0.0) || std::abs(b) * camera_.fy * ray > config_.facade_max_normal_y * fit.last_inverse)
+      return false;
+    wall_depth = static_cast<float>(1.0 / inverse);
+    return true;
+  }
+
+  /// The wall's sigma at `row`: the anchor's, growing with the height above it.
+  float sigmaAt(const ColumnFit& fit, int row, float wall_depth) const {
+    const float height = static_cast<float>(fit.anchor_row - row) * wall_depth / camera_.fy;
+    return 1.f / std::sqrt(fit.anchor_weight) + config_.facade_sigma_per_m * height;
+  }
+
+  /// Another image on the wall (a window) is crossed up to facade_max_gap_m, while the stereo
+  /// there (`z`, 0 for none) sees the wall and nothing else (a pole, a crown, the building
+  /// behind a roof's edge): written once the wall's grey comes back above it.
+  void crossGap(ColumnFit& fit, float z, float w, float wall_depth, float sigma) const {
+    if (++fit.gap * wall_depth > config_.facade_max_gap_m * camera_.fy) {
+      fit.stop();
+      return;
+    }
+    if (z > 0.f) {
+      const float own_sigma = w > 0.f ? 1.f / std::sqrt(w) : sigma;
+      if (std::abs(z - wall_depth) > 3.f * std::max(sigma, own_sigma)) {
+        fit.stop();
+        return;
+      }
+      fit.gap_seen = true;
+    }
+    fit.run_below = true;
+  }
+
+  /// The window is on the wall: its rows below (u, v) take the wall, its stereo agreed with it.
+  std::size_t fillWindow(ColumnFit& fit, int u, int v, float wall_depth) const {
+    std::size_t count = 0;
+    for (int r = v + 1; r <= v + fit.gap; ++r) {
+      const float s = sigmaAt(fit, r, wall_depth);
+      const float window_weight = 1.f / (s * s + kWindowRecessSigma * kWindowRecessSigma);
+      float& zr = depth_.ptr<float>(r)[u];
+      float* fr = free_.empty() ? nullptr : free_.ptr<float>(r) + u;
+      if (zr > 0.f && std::isfinite(zr)) {
+        averageWithWall(zr, weight_.ptr<float>(r)[u], fr, wall_depth, window_weight);
+      } else {
+        writeWall(zr, weight_.ptr<float>(r)[u], fr, wall_depth, window_weight);
+        ++count;
+      }
+    }
+    fit.gap = 0;
+    fit.gap_seen = false;
+    return count;
+  }
+
+  /// Pixel (u, v) of the wall's grey: its own depth that agrees is averaged with the wall, one
+  /// behind it (the surface above the wall's top edge, seen over several pixels) stops the
+  /// column, anything else takes the wall.
+  std::size_t extendWall(ColumnFit& fit, int u, int v, float wall_depth, float sigma) const {
+    float& z = depth_.ptr<float>(v)[u];
+    float& w = weight_.ptr<float>(v)[u];
+    float* f = free_.empty() ? nullptr : free_.ptr<float>(v) + u;
+    if (z > 0.f && std::isfinite(z)) {
+      const float own_sigma = w > 0.f ? 1.f / std::sqrt(w) : sigma;
+      if (std::abs(z - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {
+        averageWithWall(z, w, f, wall_depth, 1.f / (sigma * sigma));
+        fit.run_below = true;
+        fit.behind = 0;
+        return 0;
+      }
+      if (z - wall_depth > ColumnFit::kBehindSigmas * own_sigma) {
+        if (++fit.behind >= ColumnFit::kBehindToStop) {
+          fit.stop(); // the wall ended below: what stereo sees behind it stays
+          return 0;
+        }
+      } else {
+        fit.behind = 0;
+      }
+    }
+    writeWall(z, w, f, wall_depth, 1.f / (sigma * sigma));
+    fit.run_below = true;
+    return 1;
+  }
+
+  const PinholeCamera& camera_;
+  const DepthFusionConfig& config_;
+  cv::Mat& depth_;
+  cv::Mat& weight_;
+  cv::Mat& free_;
+  cv::Mat mean_, mean_square_;
+  float anchor_weight_, max_variance_;
+};
+
 } // namespace
 
 std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, const DepthFusionConfig& config,
@@ -125,124 +289,11 @@ std::size_t extendFacades(const cv::Mat& left, const PinholeCamera& camera, cons
                             std::to_string(camera.height) + ", fx " + std::to_string(camera.fx) +
                             ") does not fit the " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                             " depth");
-  // The grey's mean and mean square over 5x5 pixels: a blank surface's variance is its noise's.
-  cv::Mat mean, mean_square;
-  cv::boxFilter(left, mean, CV_32F, cv::Size(5, 5));
-  cv::sqrBoxFilter(left, mean_square, CV_32F, cv::Size(5, 5));
-  const float anchor_weight = 1.f / (config.facade_anchor_sigma_m * config.facade_anchor_sigma_m);
-  const float tolerance = config.facade_grey_tolerance;
-  const float max_variance = config.facade_max_texture * config.facade_max_texture;
+  const FacadeWalk walk(left, camera, config, depth, weight, free_space_weight);
   std::atomic<std::size_t> extended{0};
-  constexpr int kStrip = 128; // columns of one task, walked bottom-up together: rows stay contiguous
+  constexpr int kStrip = 128; // columns of one task
   parallelFor(cv::Range(0, (size.width + kStrip - 1) / kStrip), [&](const cv::Range& strips) {
-    const int u0 = strips.start * kStrip, u1 = std::min(size.width, strips.end * kStrip);
-    std::vector<ColumnFit> fits(static_cast<std::size_t>(u1 - u0));
-    std::size_t count = 0;
-    for (int v = size.height - 1; v >= 0; --v) {
-      float* z = depth.ptr<float>(v);
-      float* w = weight.ptr<float>(v);
-      float* f = free_space_weight.empty() ? nullptr : free_space_weight.ptr<float>(v);
-      const float* g = mean.ptr<float>(v);
-      const float* g2 = mean_square.ptr<float>(v);
-      const float y = (static_cast<float>(v) - camera.cy) / camera.fy;
-      for (int u = u0; u < u1; ++u) {
-        ColumnFit& fit = fits[static_cast<std::size_t>(u - u0)];
-        const bool has_depth = z[u] > 0.f && std::isfinite(z[u]);
-        const float grey_here = g[u];
-        if (has_depth && w[u] >= anchor_weight) {
-          fit.add(v, z[u], w[u], grey_here);
-          continue;
-        }
-        fit.run_below = false;
-        if (fit.anchor_row < 0)
-          continue;
-        const bool same_surface = std::abs(grey_here - fit.grey) <= tolerance &&
-                                  g2[u] - grey_here * grey_here <= max_variance && grey_here < kOverexposed;
-        double b;
-        if ((!same_surface && config.facade_max_gap_m <= 0.f) || !fit.slope(b)) {
-          fit.stop();
-          continue;
-        }
-        // On a plane n . X = d, 1/z = n . ray / d, so d(1/z)/dv = n_y / (fy d) and, with
-        // d <= |X| at the anchor, |n_y| <= |b| fy |X_anchor|: the slope tells a wall from the
-        // road or a car's roof. The wall itself goes on vertical (n_y = 0): 1/z stays the run's
-        // up the column. Its slope, from ~5 rows of anchors, carried 100 rows up put a façade
-        // 0.3-1 m off (street 20, 0.077 -> 0.075 m with this alone).
-        const double inverse = fit.si / fit.sw;
-        const float x = (static_cast<float>(u) - camera.cx) / camera.fx;
-        const double ray = std::sqrt(1.0 + x * x + y * y);
-        if (!(inverse > 0.0) || std::abs(b) * camera.fy * ray > config.facade_max_normal_y * fit.last_inverse) {
-          fit.stop();
-          continue;
-        }
-        const float wall_depth = static_cast<float>(1.0 / inverse);
-        auto sigmaAt = [&](int row) {
-          const float height = static_cast<float>(fit.anchor_row - row) * wall_depth / camera.fy;
-          return 1.f / std::sqrt(fit.anchor_weight) + config.facade_sigma_per_m * height;
-        };
-        const float sigma = sigmaAt(v);
-        if (!same_surface) {
-          // Another image on the wall (a window) is crossed up to facade_max_gap_m, while the
-          // stereo there sees the wall and nothing else (a pole, a crown, the building behind a
-          // roof's edge): written once the wall's grey comes back above it.
-          if (++fit.gap * wall_depth > config.facade_max_gap_m * camera.fy) {
-            fit.stop();
-            continue;
-          }
-          if (has_depth) {
-            const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
-            if (std::abs(z[u] - wall_depth) > 3.f * std::max(sigma, own_sigma)) {
-              fit.stop();
-              continue;
-            }
-            fit.gap_seen = true;
-          }
-          fit.run_below = true;
-          continue;
-        }
-        if (fit.gap > 0) {
-          if (!fit.gap_seen) {
-            fit.stop(); // nothing says the wall goes on behind what was crossed (the sky)
-            continue;
-          }
-          // The window is on the wall: its rows below take the wall, its stereo agreed with it.
-          for (int r = v + 1; r <= v + fit.gap; ++r) {
-            const float s = sigmaAt(r), window_weight = 1.f / (s * s + kWindowRecessSigma * kWindowRecessSigma);
-            float& zr = depth.ptr<float>(r)[u];
-            float* fr = f ? free_space_weight.ptr<float>(r) + u : nullptr;
-            if (zr > 0.f && std::isfinite(zr)) {
-              averageWithWall(zr, weight.ptr<float>(r)[u], fr, wall_depth, window_weight);
-            } else {
-              writeWall(zr, weight.ptr<float>(r)[u], fr, wall_depth, window_weight);
-              ++count;
-            }
-          }
-          fit.gap = 0;
-          fit.gap_seen = false;
-        }
-        if (has_depth) {
-          const float own_sigma = w[u] > 0.f ? 1.f / std::sqrt(w[u]) : sigma;
-          if (std::abs(z[u] - wall_depth) <= 3.f * std::max(sigma, own_sigma)) {
-            averageWithWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
-            fit.run_below = true;
-            fit.behind = 0;
-            continue;
-          }
-          if (z[u] - wall_depth > ColumnFit::kBehindSigmas * own_sigma) {
-            if (++fit.behind >= ColumnFit::kBehindToStop) {
-              fit.stop();
-              continue; // the wall ended below: what stereo sees behind it stays
-            }
-          } else {
-            fit.behind = 0;
-          }
-        }
-        writeWall(z[u], w[u], f ? f + u : nullptr, wall_depth, 1.f / (sigma * sigma));
-        fit.run_below = true;
-        ++count;
-      }
-    }
-    extended += count;
+    extended += walk.walkStrip(strips.start * kStrip, std::min(size.width, strips.end * kStrip));
   });
   return extended;
 }

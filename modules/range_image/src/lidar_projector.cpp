@@ -33,9 +33,9 @@ void LidarProjector::setCalibration(const Calibration& calibration) {
   // P_i = K_i [I | t_i] on the rectified frame of camera 0, so the point in camera i's
   // frame is X_0 + K_i^-1 P_i.col(3) (a translation only: the cameras share one plane).
   const Eigen::Vector3d t_i = calibration.K(config_.camera).inverse() * calibration.P[config_.camera].col(3);
-  Eigen::Isometry3d T = calibration.T_cam0_velo;
-  T.translation() += t_i;
-  T_cam_velo_ = T.matrix().topRows<3>().cast<float>();
+  T_camera_velo_ = calibration.T_cam0_velo;
+  T_camera_velo_.translation() += t_i;
+  T_cam_velo_ = T_camera_velo_.matrix().topRows<3>().cast<float>();
   skew_ = static_cast<float>(calibration.P[config_.camera](0, 1));
   calibration_ = calibration;
   calibrated_ = true;

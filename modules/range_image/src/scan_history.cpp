@@ -15,11 +15,19 @@ ScanHistory::ScanHistory(const Calibration& calibration, const ProjectionConfig&
                          const ScanHistoryConfig& config)
     : config_(config), projector_(calibration, projection) {
   config_.validate();
-  const Eigen::Vector3d t_camera =
-      calibration.K(projection.camera).inverse() * calibration.P[projection.camera].col(3);
-  Eigen::Isometry3d T_cam_velo = calibration.T_cam0_velo;
-  T_cam_velo.translation() += t_camera;
-  T_velo_cam_ = T_cam_velo.inverse();
+  T_velo_cam_ = projector_.cameraFromLidar().inverse();
+}
+
+const pcl::PointCloud<pcl::PointXYZI>& ScanHistory::withEarlierScans(const pcl::PointCloud<pcl::PointXYZI>& scan,
+                                                                      const Eigen::Isometry3d* T_world_velo) {
+  if (config_.scans == 0)
+    return scan;
+  if (!T_world_velo) {
+    clear(); // earlier scans cannot be placed without the poses
+    return scan;
+  }
+  densify(scan, *T_world_velo, dense_);
+  return dense_;
 }
 
 void ScanHistory::densify(const pcl::PointCloud<pcl::PointXYZI>& scan, const Eigen::Isometry3d& T_world_velo,

@@ -21,6 +21,74 @@ struct Plane {
   Eigen::Vector3d n;
   double d;
 };
+
+/// The view's frustum in the world, as six half-spaces: x / z between the left and right pixel
+/// edges, y / z between the top and bottom ones, z between near and far (camera frame).
+std::array<Plane, 6> frustumPlanes(const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, double near_m,
+                                   double far_m) {
+  const double left = (-0.5 - camera.cx) / camera.fx, right = (camera.width - 0.5 - camera.cx) / camera.fx;
+  const double top = (-0.5 - camera.cy) / camera.fy, bottom = (camera.height - 0.5 - camera.cy) / camera.fy;
+  const std::array<Plane, 6> in_camera{{{Eigen::Vector3d(-1, 0, left), 0.0},
+                                        {Eigen::Vector3d(1, 0, -right), 0.0},
+                                        {Eigen::Vector3d(0, -1, top), 0.0},
+                                        {Eigen::Vector3d(0, 1, -bottom), 0.0},
+                                        {Eigen::Vector3d(0, 0, -1), -near_m},
+                                        {Eigen::Vector3d(0, 0, 1), far_m}}};
+  const Eigen::Matrix3d R = T_world_cam.linear();
+  const Eigen::Vector3d t = T_world_cam.translation();
+  std::array<Plane, 6> planes;
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    planes[i].n = R * in_camera[i].n;
+    planes[i].d = in_camera[i].d + planes[i].n.dot(t);
+  }
+  return planes;
+}
+
+/// The world bounding box [lo, hi] of the view's frustum.
+void frustumBox(const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, double near_m, double far_m,
+                Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  const double left = (-0.5 - camera.cx) / camera.fx, right = (camera.width - 0.5 - camera.cx) / camera.fx;
+  const double top = (-0.5 - camera.cy) / camera.fy, bottom = (camera.height - 0.5 - camera.cy) / camera.fy;
+  lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (const double z : {near_m, far_m})
+    for (const double x : {left * z, right * z})
+      for (const double y : {top * z, bottom * z}) {
+        const Eigen::Vector3d p = T_world_cam * Eigen::Vector3d(x, y, z);
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+}
+
+/// The blocks of column (bi, bj) (axes i, j) along axis k, within [first, last], that meet every
+/// plane; first > last when none does. A block meets the frustum unless it lies wholly outside
+/// one plane: for a box of centre c and half side h, n . c - h |n|_1 > d. The half side is grown
+/// by a voxel: a ray's cells are found in single precision. Box of block b along an axis:
+/// [(kSide b - 1/2) vs, (kSide b + kSide - 1/2) vs], centre (kSide b + kSide / 2 - 1/2) vs.
+void clipColumn(const std::array<Plane, 6>& planes, double vs, int k, int i, int j, int bi, int bj, int& first,
+                int& last) {
+  const double half = 0.5 * kSide * vs + vs;
+  auto centre = [&](int b) { return (kSide * b + 0.5 * kSide - 0.5) * vs; };
+  for (const Plane& p : planes) {
+    // n_k c_k <= rhs, with c_k = (kSide bk + kSide / 2 - 1/2) vs.
+    const double rhs = p.d + half * p.n.lpNorm<1>() - p.n[i] * centre(bi) - p.n[j] * centre(bj);
+    const double nk = p.n[k];
+    if (std::abs(nk) < 1e-12) {
+      if (rhs < 0.0)
+        first = last + 1;
+      continue;
+    }
+    // Clamped both ways before the cast: a plane nearly parallel to the axis gives a bound of
+    // either sign far beyond an int.
+    const double bound = std::clamp((rhs / (nk * vs) - 0.5 * kSide + 0.5) / kSide, -1e9, 1e9);
+    if (nk > 0.0)
+      last = std::min(last, static_cast<int>(std::floor(bound)));
+    else
+      first = std::max(first, static_cast<int>(std::ceil(bound)));
+    if (first > last)
+      return;
+  }
+}
 } // namespace
 
 BlockFootprint::BlockFootprint(double voxel_size_m) : voxel_size_(voxel_size_m) {
@@ -40,33 +108,10 @@ void BlockFootprint::addView(const PinholeCamera& camera, const Eigen::Isometry3
   if (!(near_m >= 0.0 && far_m > near_m && std::isfinite(far_m)))
     throw InvalidInputError("BlockFootprint::addView: need 0 <= near < far, finite; got " + std::to_string(near_m) +
                             " and " + std::to_string(far_m));
-  const double vs = voxel_size_;
-  // The frustum in the camera frame, each plane n . p <= d: x / z between the left and right
-  // pixel edges, y / z between the top and bottom ones, z between near and far.
-  const double left = (-0.5 - camera.cx) / camera.fx, right = (camera.width - 0.5 - camera.cx) / camera.fx;
-  const double top = (-0.5 - camera.cy) / camera.fy, bottom = (camera.height - 0.5 - camera.cy) / camera.fy;
-  const std::array<Plane, 6> in_camera{{{Eigen::Vector3d(-1, 0, left), 0.0},
-                                        {Eigen::Vector3d(1, 0, -right), 0.0},
-                                        {Eigen::Vector3d(0, -1, top), 0.0},
-                                        {Eigen::Vector3d(0, 1, -bottom), 0.0},
-                                        {Eigen::Vector3d(0, 0, -1), -near_m},
-                                        {Eigen::Vector3d(0, 0, 1), far_m}}};
-  const Eigen::Matrix3d R = T_world_cam.linear();
-  const Eigen::Vector3d t = T_world_cam.translation();
-  std::array<Plane, 6> planes;
-  for (std::size_t i = 0; i < planes.size(); ++i) {
-    planes[i].n = R * in_camera[i].n;
-    planes[i].d = in_camera[i].d + planes[i].n.dot(t);
-  }
+  const std::array<Plane, 6> planes = frustumPlanes(camera, T_world_cam, near_m, far_m);
   // The blocks of the frustum's bounding box, a block wider each side.
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const double z : {near_m, far_m})
-    for (const double x : {left * z, right * z})
-      for (const double y : {top * z, bottom * z}) {
-        const Eigen::Vector3d p = T_world_cam * Eigen::Vector3d(x, y, z);
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
+  Eigen::Vector3d lo, hi;
+  frustumBox(camera, T_world_cam, near_m, far_m, lo, hi);
   if (axis_ < 0)
     (hi - lo).maxCoeff(&axis_); // runs along the longest extent: fewest columns
   const int k = axis_, i = (k + 1) % 3, j = (k + 2) % 3;
@@ -85,34 +130,10 @@ void BlockFootprint::addView(const PinholeCamera& camera, const Eigen::Isometry3
     unlisted_ += std::min(columns * (double(last[k]) - first[k] + 1), 1e15);
     return;
   }
-  // A block meets the frustum unless it lies wholly outside one plane: for a box of centre c
-  // and half side h, n . c - h |n|_1 > d. The half side is grown by a voxel: a ray's cells
-  // are found in single precision. Box of block b along an axis: [(kSide b - 1/2) vs,
-  // (kSide b + kSide - 1/2) vs], centre (kSide b + kSide / 2 - 1/2) vs.
-  const double half = 0.5 * kSide * vs + vs;
-  auto centre = [&](int b) { return (kSide * b + 0.5 * kSide - 0.5) * vs; };
   for (int bi = first[i]; bi <= last[i]; ++bi)
     for (int bj = first[j]; bj <= last[j]; ++bj) {
       int run_first = first[k], run_last = last[k];
-      for (const Plane& p : planes) {
-        // n_k c_k <= rhs, with c_k = (kSide bk + kSide / 2 - 1/2) vs.
-        const double rhs = p.d + half * p.n.lpNorm<1>() - p.n[i] * centre(bi) - p.n[j] * centre(bj);
-        const double nk = p.n[k];
-        if (std::abs(nk) < 1e-12) {
-          if (rhs < 0.0)
-            run_first = run_last + 1;
-          continue;
-        }
-        // Clamped both ways before the cast: a plane nearly parallel to the axis gives a bound
-        // of either sign far beyond an int (UBSan's float-cast-overflow found 2.6e11).
-        const double bound = std::clamp((rhs / (nk * vs) - 0.5 * kSide + 0.5) / kSide, -1e9, 1e9);
-        if (nk > 0.0)
-          run_last = std::min(run_last, static_cast<int>(std::floor(bound)));
-        else
-          run_first = std::max(run_first, static_cast<int>(std::ceil(bound)));
-        if (run_first > run_last)
-          break;
-      }
+      clipColumn(planes, voxel_size_, k, i, j, bi, bj, run_first, run_last);
       if (run_first <= run_last)
         addRun(columnKey(bi, bj), run_first, run_last);
     }

@@ -109,35 +109,29 @@ void smoothGridPoints(const TsdfBlock* const* around, float lambda, float band, 
       }
 }
 
-void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const MarchingCubes::Config& config,
-                   MarchingCubes::BlockMesh& out, Scratch& s) {
-  const float vs = static_cast<float>(volume.voxelSize());
-  const float min_weight = config.min_weight;
-  const int max_unseen = config.max_unseen_corners;
-  const bool smooth = config.smoothing_lambda > 0.f;
-
-  if (block.signs == 0)
-    return; // never observed: every cube has this block's unobserved corner
-  const TsdfBlock* nb[8];
+/// The blocks a block's cubes and (smoothed) grid points read: `corner` the 8 at offsets 0..1
+/// (x fastest), `around` the 27 at -1..1 when smoothing. False when no sign change lies within
+/// their reach, so the block has no surface.
+bool gatherNeighbours(const TsdfVolume& volume, const TsdfBlock& block, bool smooth, const TsdfBlock* corner[8],
+                      const TsdfBlock* around[27]) {
   std::uint8_t signs = 0;
   for (int i = 0; i < 8; ++i) {
-    nb[i] = i == 0 ? &block : volume.findBlock(block.index + GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-    signs |= nb[i] ? nb[i]->signs : 0;
+    corner[i] = i == 0 ? &block : volume.findBlock(block.index + GridIndex(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+    signs |= corner[i] ? corner[i]->signs : 0;
   }
   // Smoothed, a grid point also reads the -x, -y, -z layer around the block.
-  const TsdfBlock* around[27] = {};
-  if (smooth)
-    for (int i = 0; i < 27; ++i) {
-      const GridIndex d(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
-      around[i] = d.isZero() ? &block : volume.findBlock(block.index + d);
-      signs |= around[i] ? around[i]->signs : 0;
-    }
-  if (signs != (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative))
-    return; // no sign change within reach of this block's cubes
-  if (smooth)
-    smoothGridPoints(around, config.smoothing_lambda, 0.5f * static_cast<float>(volume.truncation()), s);
+  for (int i = 0; smooth && i < 27; ++i) {
+    const GridIndex d(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
+    around[i] = d.isZero() ? &block : volume.findBlock(block.index + d);
+    signs |= around[i] ? around[i]->signs : 0;
+  }
+  return signs == (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative);
+}
 
-  // Bit masks of the 9^3 grid points (a missing neighbour block's points are unobserved).
+/// Fills the scratch's rows of voxel pointers, the sdf of the grid points (unless smoothing
+/// wrote them) and the bit masks of valid, negative and unseen points; a missing neighbour
+/// block's points are unobserved. False when no valid point is negative or none positive.
+bool loadGridPoints(const TsdfBlock* const corner[8], float min_weight, bool smoothed, Scratch& s) {
   std::uint16_t any_negative = 0, any_positive = 0;
   for (int z = 0; z < kPad; ++z)
     for (int y = 0; y < kPad; ++y) {
@@ -145,14 +139,14 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
       const int sel = ((y >> 3) << 1) | ((z >> 3) << 2);
       std::uint16_t valid = 0, negative = 0, unseen = 0;
       for (int part = 0; part < 2; ++part) {
-        const TsdfBlock* b = nb[sel | part];
+        const TsdfBlock* b = corner[sel | part];
         s.row[r][part] = b ? &b->at(0, y & 7, z & 7) : nullptr;
         if (!b)
           continue;
         const TsdfVoxel* src = s.row[r][part];
         float* sdf = &s.sdf[static_cast<std::size_t>(kPad) * r];
         for (int x = part * kSide, n = part ? 1 : kSide, k = 0; k < n; ++k, ++x) {
-          if (!smooth)
+          if (!smoothed)
             sdf[x] = src[k].sdf;
           valid |= static_cast<std::uint16_t>((src[k].weight > min_weight) << x);
           unseen |= static_cast<std::uint16_t>((src[k].weight <= 0.f) << x);
@@ -166,121 +160,181 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
       any_negative |= negative;
       any_positive |= valid & ~negative;
     }
-  if (!any_negative || !any_positive)
-    return;
+  return any_negative && any_positive;
+}
 
-  const GridIndex o = block.origin();
-  auto vertexOf = [&](int px, int py, int pz, int code, float t, const TsdfVoxel& a, const TsdfVoxel& b) -> std::uint32_t {
+/// Makes a block's vertices, each once: a grid element's vertex is made by its first cube and
+/// found in the scratch's slots by the others.
+class BlockVertices {
+public:
+  BlockVertices(const GridIndex& origin, float voxel_size, MarchingCubes::BlockMesh& out, Scratch& s)
+      : origin_(origin), voxel_size_(voxel_size), out_(out), s_(s) {}
+  ~BlockVertices() {
+    for (const int u : s_.used)
+      s_.slot[u] = -1;
+    s_.used.clear();
+  }
+
+  /// The vertex on grid point (px, py, pz)'s edge along `code` (0..2) at t from it towards the
+  /// voxel `b`, or on the point itself (code 3).
+  std::uint32_t vertex(int px, int py, int pz, int code, float t, const TsdfVoxel& a, const TsdfVoxel& b) {
     const int local = px + kPad * (py + kPad * pz);
-    std::int32_t& slot = s.slot[local * 4 + code];
+    std::int32_t& slot = s_.slot[local * 4 + code];
     if (slot >= 0)
       return static_cast<std::uint32_t>(slot);
-    slot = static_cast<std::int32_t>(out.vertices.size());
-    s.used.push_back(local * 4 + code);
-    Eigen::Vector3f p(static_cast<float>(o.x() + px), static_cast<float>(o.y() + py), static_cast<float>(o.z() + pz));
+    slot = static_cast<std::int32_t>(out_.vertices.size());
+    s_.used.push_back(local * 4 + code);
+    Eigen::Vector3f p(static_cast<float>(origin_.x() + px), static_cast<float>(origin_.y() + py),
+                      static_cast<float>(origin_.z() + pz));
     if (code < 3)
       p[code] += t;
-    out.vertices.push_back(p * vs);
-    // An unseen voxel (a filled cube's corner) has no colour: its edge takes the other end's.
+    out_.vertices.push_back(p * voxel_size_);
+    out_.colors.push_back(colour(t, a, b));
+    out_.weights.push_back(std::min(a.weight, b.weight)); // 0 next to an unseen corner: no evidence
+    out_.keys.push_back(isInterior(px, py, pz, code)
+                            ? MarchingCubes::kInterior
+                            : vertexKey(origin_.x() + px, origin_.y() + py, origin_.z() + pz, code));
+    return static_cast<std::uint32_t>(slot);
+  }
+
+private:
+  /// An unseen voxel (a filled cube's corner) has no colour: its edge takes the other end's.
+  static std::array<std::uint8_t, 3> colour(float t, const TsdfVoxel& a, const TsdfVoxel& b) {
     const TsdfVoxel& colour_a = a.weight > 0.f ? a : b;
     const TsdfVoxel& colour_b = b.weight > 0.f ? b : a;
     const std::uint8_t ca[3] = {colour_a.r, colour_a.g, colour_a.b}, cb[3] = {colour_b.r, colour_b.g, colour_b.b};
     std::array<std::uint8_t, 3> c;
     for (int k = 0; k < 3; ++k)
       c[k] = static_cast<std::uint8_t>(ca[k] + t * (static_cast<float>(cb[k]) - ca[k]) + 0.5f);
-    out.colors.push_back(c);
-    out.weights.push_back(std::min(a.weight, b.weight)); // 0 next to an unseen corner: no evidence
-    // Interior: every cube around this edge (or voxel) belongs to this block, so no other
-    // block makes this vertex.
+    return c;
+  }
+  /// Every cube around this edge (or voxel) belongs to this block, so no other block makes it.
+  static bool isInterior(int px, int py, int pz, int code) {
     const int q[3] = {px, py, pz};
-    bool interior = true;
     for (int k = 0; k < 3; ++k)
       if (k != code && (q[k] < 1 || q[k] > kSide - 1))
-        interior = false;
-    out.keys.push_back(interior ? MarchingCubes::kInterior : vertexKey(o.x() + px, o.y() + py, o.z() + pz, code));
-    return static_cast<std::uint32_t>(slot);
-  };
+        return false;
+    return true;
+  }
 
+  GridIndex origin_;
+  float voxel_size_;
+  MarchingCubes::BlockMesh& out_;
+  Scratch& s_;
+};
+
+/// The masks of a row of 8 cubes (y, z), read from the 4 rows of grid points around them;
+/// cube x reads bits x and x + 1 of each.
+struct CubeRow {
+  unsigned n00, n10, n01, n11; ///< negative
+  unsigned u00, u10, u01, u11; ///< unseen
+  unsigned active;             ///< cubes whose 8 corners are observed and not all of one sign
+  unsigned filled = 0;         ///< cubes whose unseen corners lie behind the surface
+
+  CubeRow(const Scratch& s, int y, int z, int max_unseen) {
+    const int r00 = y + kPad * z, r10 = r00 + 1, r01 = r00 + kPad, r11 = r01 + 1;
+    const unsigned valid4 = s.valid[r00] & s.valid[r10] & s.valid[r01] & s.valid[r11];
+    n00 = s.negative[r00], n10 = s.negative[r10], n01 = s.negative[r01], n11 = s.negative[r11];
+    const unsigned all_negative = n00 & n10 & n01 & n11, any_neg = n00 | n10 | n01 | n11;
+    active = valid4 & (valid4 >> 1) & (any_neg | (any_neg >> 1)) & ~(all_negative & (all_negative >> 1)) & 0xffu;
+    u00 = s.unseen[r00], u10 = s.unseen[r10], u01 = s.unseen[r01], u11 = s.unseen[r11];
+    if (max_unseen <= 0)
+      return;
+    // Config::max_unseen_corners: every corner valid or unseen, a valid one on each side, and at
+    // most max_unseen unseen.
+    const unsigned known4 =
+        (s.valid[r00] | u00) & (s.valid[r10] | u10) & (s.valid[r01] | u01) & (s.valid[r11] | u11);
+    const unsigned any_pos =
+        (s.valid[r00] & ~n00) | (s.valid[r10] & ~n10) | (s.valid[r01] & ~n01) | (s.valid[r11] & ~n11);
+    const unsigned candidates =
+        known4 & (known4 >> 1) & (any_pos | (any_pos >> 1)) & (any_neg | (any_neg >> 1)) & ~active & 0xffu;
+    for (unsigned c = candidates; c; c &= c - 1) {
+      const int x = __builtin_ctz(c);
+      const unsigned corners = ((u00 >> x) & 3) | ((u10 >> x) & 3) << 2 | ((u01 >> x) & 3) << 4 | ((u11 >> x) & 3) << 6;
+      filled |= (__builtin_popcount(corners) <= max_unseen ? 1u : 0u) << x;
+    }
+  }
+
+  /// Cube x's case in Bourke's corners 0..7: (0,0,0) (1,0,0) (1,1,0) (0,1,0) (0,0,1) (1,0,1)
+  /// (1,1,1) (0,1,1). A filled cube counts its unseen corners inside.
+  int cubeCase(int x, bool fill) const {
+    const unsigned m00 = fill ? n00 | u00 : n00, m10 = fill ? n10 | u10 : n10;
+    const unsigned m01 = fill ? n01 | u01 : n01, m11 = fill ? n11 | u11 : n11;
+    return static_cast<int>(((m00 >> x) & 1) | ((m00 >> x) & 2) | ((m10 >> x) & 2) << 1 | ((m10 >> x) & 1) << 3 |
+                            ((m01 >> x) & 1) << 4 | ((m01 >> x) & 2) << 4 | ((m11 >> x) & 2) << 5 |
+                            ((m11 >> x) & 1) << 7);
+  }
+};
+
+/// The triangles of cube (x, y, z). An unseen corner of a filled cube is a voxel behind the
+/// surface: an edge from a seen corner at distance p to it is crossed p * voxel / (p + voxel)
+/// from that corner, about p for a small p.
+void meshCube(int x, int y, int z, int cube, bool fill, float voxel_size, const Scratch& s, BlockVertices& vertices,
+              MarchingCubes::BlockMesh& out) {
+  const unsigned int edges = detail::kEdgeTable[cube];
+  const TsdfVoxel* c[8];
+  float d[8];
+  for (int i = 0; i < 8; ++i) {
+    const int px = x + kCorner[i][0], py = y + kCorner[i][1], pz = z + kCorner[i][2];
+    c[i] = &s.voxel(px, py, pz);
+    d[i] = fill && c[i]->weight <= 0.f ? -voxel_size : s.sdf[px + kPad * (py + kPad * pz)];
+  }
+  std::uint32_t vert[12];
+  for (int e = 0; e < 12; ++e) {
+    if (!(edges & (1u << e)))
+      continue;
+    int ia = kEdge[e][0], ib = kEdge[e][1];
+    int axis = 0;
+    while (kCorner[ia][axis] == kCorner[ib][axis])
+      ++axis;
+    if (kCorner[ia][axis] > kCorner[ib][axis])
+      std::swap(ia, ib); // interpolate from the lower end, so every block computes the same vertex
+    const TsdfVoxel& a = *c[ia];
+    const TsdfVoxel& b = *c[ib];
+    const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
+    // A voxel at the crossing (sdf 0, or so near it that the vertex would round to the voxel's
+    // position) is the vertex of all its edges (no duplicate positions).
+    const float t = d[ia] / (d[ia] - d[ib]);
+    if (!(t > kOnVoxel))
+      vert[e] = vertices.vertex(px, py, pz, 3, 0.f, a, a);
+    else if (!(t < 1.f - kOnVoxel))
+      vert[e] = vertices.vertex(px + (axis == 0), py + (axis == 1), pz + (axis == 2), 3, 0.f, b, b);
+    else
+      vert[e] = vertices.vertex(px, py, pz, axis, t, a, b);
+  }
+  const int* tri = detail::kTriTable[cube];
+  for (int t = 0; tri[t] != -1; t += 3) {
+    // Bourke's order is clockwise seen from outside with "inside = sdf < 0": reversed here.
+    const std::array<std::uint32_t, 3> f = {vert[tri[t]], vert[tri[t + 2]], vert[tri[t + 1]]};
+    if (f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+      out.triangles.push_back(f);
+  }
+}
+
+void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const MarchingCubes::Config& config,
+                   MarchingCubes::BlockMesh& out, Scratch& s) {
+  if (block.signs == 0)
+    return; // never observed: every cube has this block's unobserved corner
+  const bool smooth = config.smoothing_lambda > 0.f;
+  const TsdfBlock* corner[8];
+  const TsdfBlock* around[27] = {};
+  if (!gatherNeighbours(volume, block, smooth, corner, around))
+    return;
+  if (smooth)
+    smoothGridPoints(around, config.smoothing_lambda, 0.5f * static_cast<float>(volume.truncation()), s);
+  if (!loadGridPoints(corner, config.min_weight, smooth, s))
+    return;
+  const float voxel_size = static_cast<float>(volume.voxelSize());
+  BlockVertices vertices(block.origin(), voxel_size, out, s);
   for (int z = 0; z < kSide; ++z)
     for (int y = 0; y < kSide; ++y) {
-      // The 8 cubes of a row at once: the 4 rows of grid points around them (y, z), (y + 1, z),
-      // (y, z + 1), (y + 1, z + 1); cube x reads bits x and x + 1 of each.
-      const int r00 = y + kPad * z, r10 = r00 + 1, r01 = r00 + kPad, r11 = r01 + 1;
-      const unsigned valid4 = s.valid[r00] & s.valid[r10] & s.valid[r01] & s.valid[r11];
-      const unsigned n00 = s.negative[r00], n10 = s.negative[r10], n01 = s.negative[r01], n11 = s.negative[r11];
-      const unsigned all_negative = n00 & n10 & n01 & n11, any_neg = n00 | n10 | n01 | n11;
-      // Cubes whose 8 corners are observed and not all of one sign.
-      unsigned active = valid4 & (valid4 >> 1) & (any_neg | (any_neg >> 1)) & ~(all_negative & (all_negative >> 1)) & 0xffu;
-      // Cubes whose unseen corners lie behind the surface (Config::max_unseen_corners): every
-      // corner valid or unseen, a valid one on each side, and at most max_unseen_corners unseen.
-      const unsigned u00 = s.unseen[r00], u10 = s.unseen[r10], u01 = s.unseen[r01], u11 = s.unseen[r11];
-      unsigned filled = 0;
-      if (max_unseen > 0) {
-        const unsigned known4 = (s.valid[r00] | u00) & (s.valid[r10] | u10) & (s.valid[r01] | u01) & (s.valid[r11] | u11);
-        const unsigned any_pos = (s.valid[r00] & ~n00) | (s.valid[r10] & ~n10) | (s.valid[r01] & ~n01) | (s.valid[r11] & ~n11);
-        for (unsigned c = known4 & (known4 >> 1) & (any_pos | (any_pos >> 1)) & (any_neg | (any_neg >> 1)) & ~active & 0xffu;
-             c; c &= c - 1) {
-          const int x = __builtin_ctz(c);
-          const unsigned corners = ((u00 >> x) & 3) | ((u10 >> x) & 3) << 2 | ((u01 >> x) & 3) << 4 | ((u11 >> x) & 3) << 6;
-          filled |= (__builtin_popcount(corners) <= max_unseen ? 1u : 0u) << x;
-        }
-      }
-      for (active |= filled; active; active &= active - 1) {
-        const int x = __builtin_ctz(active);
-        // An unseen corner of a filled cube is a voxel behind the surface: an edge from a seen
-        // corner at distance p to it is crossed p * voxel / (p + voxel) from that corner, about p
-        // for a small p.
-        const bool fill = (filled >> x) & 1;
-        const unsigned m00 = fill ? n00 | u00 : n00, m10 = fill ? n10 | u10 : n10;
-        const unsigned m01 = fill ? n01 | u01 : n01, m11 = fill ? n11 | u11 : n11;
-        // Bourke's corners 0..7: (0,0,0) (1,0,0) (1,1,0) (0,1,0) (0,0,1) (1,0,1) (1,1,1) (0,1,1).
-        const int cube = static_cast<int>(((m00 >> x) & 1) | ((m00 >> x) & 2) | ((m10 >> x) & 2) << 1 | ((m10 >> x) & 1) << 3 |
-                                          ((m01 >> x) & 1) << 4 | ((m01 >> x) & 2) << 4 | ((m11 >> x) & 2) << 5 |
-                                          ((m11 >> x) & 1) << 7);
-        const unsigned int edges = detail::kEdgeTable[cube];
-        const TsdfVoxel* c[8];
-        float d[8];
-        for (int i = 0; i < 8; ++i) {
-          const int px = x + kCorner[i][0], py = y + kCorner[i][1], pz = z + kCorner[i][2];
-          c[i] = &s.voxel(px, py, pz);
-          d[i] = fill && c[i]->weight <= 0.f ? -vs : s.sdf[px + kPad * (py + kPad * pz)];
-        }
-        std::uint32_t vert[12];
-        for (int e = 0; e < 12; ++e) {
-          if (!(edges & (1u << e)))
-            continue;
-          int ia = kEdge[e][0], ib = kEdge[e][1];
-          int axis = 0;
-          while (kCorner[ia][axis] == kCorner[ib][axis])
-            ++axis;
-          if (kCorner[ia][axis] > kCorner[ib][axis])
-            std::swap(ia, ib); // interpolate from the lower end, so every block computes the same vertex
-          const TsdfVoxel& a = *c[ia];
-          const TsdfVoxel& b = *c[ib];
-          const float da = d[ia], db = d[ib];
-          const int px = x + kCorner[ia][0], py = y + kCorner[ia][1], pz = z + kCorner[ia][2];
-          // A voxel at the crossing (sdf 0, or so near it that the vertex would round to the voxel's
-          // position) is the vertex of all its edges (no duplicate positions).
-          const float t = da / (da - db);
-          if (!(t > kOnVoxel))
-            vert[e] = vertexOf(px, py, pz, 3, 0.f, a, a);
-          else if (!(t < 1.f - kOnVoxel))
-            vert[e] = vertexOf(px + (axis == 0), py + (axis == 1), pz + (axis == 2), 3, 0.f, b, b);
-          else
-            vert[e] = vertexOf(px, py, pz, axis, t, a, b);
-        }
-        const int* tri = detail::kTriTable[cube];
-        for (int t = 0; tri[t] != -1; t += 3) {
-          // Bourke's order is clockwise seen from outside with "inside = sdf < 0": reversed here.
-          const std::array<std::uint32_t, 3> f = {vert[tri[t]], vert[tri[t + 2]], vert[tri[t + 1]]};
-          if (f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
-            out.triangles.push_back(f);
-        }
+      const CubeRow row(s, y, z, config.max_unseen_corners);
+      for (unsigned cubes = row.active | row.filled; cubes; cubes &= cubes - 1) {
+        const int x = __builtin_ctz(cubes);
+        const bool fill = (row.filled >> x) & 1;
+        meshCube(x, y, z, row.cubeCase(x, fill), fill, voxel_size, s, vertices, out);
       }
     }
-  for (const int u : s.used)
-    s.slot[u] = -1;
-  s.used.clear();
 }
 
 void meshBlock(const TsdfVolume& volume, const TsdfBlock& block, const MarchingCubes::Config& config,

@@ -107,34 +107,37 @@ void planeDistanceScale(const cv::Mat& depth, const PinholeCamera& camera, const
   });
 }
 
-void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& extent) {
-  if (depth.type() != CV_32FC1)
-    throw InvalidInputError("smoothSurfaceExtent: the depth image must be CV_32FC1");
-  const int width = depth.cols, height = depth.rows;
-  extent.create(depth.size(), CV_32FC1);
-  // A run is a stretch of pixels with depth along a row or a column; it ends where 1/z bends
-  // by more than max_curvature of itself between three consecutive pixels (a kink: such a
-  // pixel is alone). With a border of one zero, the image's first and last pixels are no kink.
-  // Each line is walked forwards keeping the largest depth of the run so far (stored negated
-  // where the pixel joins the run before it), then backwards handing every pixel its run's
-  // largest, that of the run's last pixel. Without branches, in SIMD lanes where the lines are
-  // columns: noisy stereo's runs end at random.
-  const cv::Mat inverse = paddedInverse(depth, 1);
-  // 1 where the middle of three 1/z samples is a kink, else 0 (T: float, or Float4 lanes).
-  auto kink = [max_curvature](auto a, auto b, auto c) {
-    const auto bend = a + c - 2.f * b, limit = max_curvature * b;
-    return (a > 0.f) & (b > 0.f) & (c > 0.f) & ((bend > limit) | (-bend > limit)) ? decltype(bend){} + 1.f : decltype(bend){};
-  };
-  // One step forwards: a pixel of depth z after one of depth `before` joins its run when both
-  // have depth and neither is a kink; `run` becomes the run's largest so far.
-  auto forward = [](auto before, auto z, auto kink_before, auto kink_here, auto& run) {
-    const auto join = (before > 0.f) & (z > 0.f) & (kink_before == 0.f) & (kink_here == 0.f);
-    const auto larger = run > z ? run : z;
-    run = join ? larger : (z > 0.f ? z : decltype(z){});
-    return join ? -run : run;
-  };
-  // Along rows, into `extent`.
-  parallelFor(cv::Range(0, height), [&](const cv::Range& rows) {
+namespace {
+
+// A run is a stretch of pixels with depth along a row or a column; it ends where 1/z bends by
+// more than max_curvature of itself between three consecutive pixels (a kink: such a pixel is
+// alone). With a border of one zero, the image's first and last pixels are no kink. Each line
+// is walked forwards keeping the largest depth of the run so far (stored negated where the
+// pixel joins the run before it), then backwards handing every pixel its run's largest, that
+// of the run's last pixel. Without branches, in SIMD lanes where the lines are columns: noisy
+// stereo's runs end at random. T is float or Float4.
+
+/// 1 where the middle of three 1/z samples is a kink, else 0.
+template <typename T>
+T kink(float max_curvature, T a, T b, T c) {
+  const T bend = a + c - 2.f * b, limit = max_curvature * b;
+  return (a > 0.f) & (b > 0.f) & (c > 0.f) & ((bend > limit) | (-bend > limit)) ? T{} + 1.f : T{};
+}
+
+/// One step forwards: a pixel of depth z after one of depth `before` joins its run when both
+/// have depth and neither is a kink; `run` becomes the run's largest so far.
+template <typename T>
+T forward(T before, T z, T kink_before, T kink_here, T& run) {
+  const auto join = (before > 0.f) & (z > 0.f) & (kink_before == 0.f) & (kink_here == 0.f);
+  const T larger = run > z ? run : z;
+  run = join ? larger : (z > 0.f ? z : T{});
+  return join ? -run : run;
+}
+
+/// Each pixel's run's largest depth along its row, into `extent`.
+void rowRunLargest(const cv::Mat& depth, const cv::Mat& inverse, float max_curvature, cv::Mat& extent) {
+  const int width = depth.cols;
+  parallelFor(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
     std::vector<float> kinks(static_cast<std::size_t>(width));
     for (int v = rows.start; v < rows.end; ++v) {
       const float* d = depth.ptr<float>(v);
@@ -142,9 +145,10 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
       float* e = extent.ptr<float>(v);
       const int whole = width - width % 4;
       for (int u = 0; u < whole; u += 4)
-        store(&kinks[static_cast<std::size_t>(u)], kink(load<Float4>(i + u - 1), load<Float4>(i + u), load<Float4>(i + u + 1)));
+        store(&kinks[static_cast<std::size_t>(u)],
+              kink(max_curvature, load<Float4>(i + u - 1), load<Float4>(i + u), load<Float4>(i + u + 1)));
       for (int u = whole; u < width; ++u)
-        kinks[static_cast<std::size_t>(u)] = kink(i[u - 1], i[u], i[u + 1]);
+        kinks[static_cast<std::size_t>(u)] = kink(max_curvature, i[u - 1], i[u], i[u + 1]);
       float run = 0.f;
       e[0] = forward(0.f, d[0], 0.f, kinks[0], run);
       for (int u = 1; u < width; ++u)
@@ -157,8 +161,13 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
       e[0] = run;
     }
   });
-  // Along columns, a strip of columns at a time, row after row (contiguous reads), and the
-  // larger of the two into the extent.
+}
+
+/// Each pixel's run's largest depth along its column, the larger of it and the row's (in
+/// `extent`) less the pixel's depth into `extent`. A strip of columns at a time, row after row
+/// (contiguous reads).
+void columnRunLargest(const cv::Mat& depth, const cv::Mat& inverse, float max_curvature, cv::Mat& extent) {
+  const int width = depth.cols, height = depth.rows;
   cv::Mat down(depth.size(), CV_32FC1);
   constexpr int kStrip = 64;
   const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(inverse.step1());
@@ -170,7 +179,7 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
     auto walk_down = [&](auto lanes, int v, int k) {
       using T = decltype(lanes);
       const float* i = inverse.ptr<float>(v + 1) + 1 + u0 + k;
-      const T here = kink(load<T>(i - row), load<T>(i), load<T>(i + row));
+      const T here = kink(max_curvature, load<T>(i - row), load<T>(i), load<T>(i + row));
       T r = load<T>(&run[k]);
       const float* above = v > 0 ? depth.ptr<float>(v - 1) + u0 + k : &none[k];
       store(down.ptr<float>(v) + u0 + k,
@@ -203,6 +212,17 @@ void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& ext
         walk_up(0.f, v, k);
     }
   });
+}
+
+} // namespace
+
+void smoothSurfaceExtent(const cv::Mat& depth, float max_curvature, cv::Mat& extent) {
+  if (depth.type() != CV_32FC1)
+    throw InvalidInputError("smoothSurfaceExtent: the depth image must be CV_32FC1");
+  extent.create(depth.size(), CV_32FC1);
+  const cv::Mat inverse = paddedInverse(depth, 1);
+  rowRunLargest(depth, inverse, max_curvature, extent);
+  columnRunLargest(depth, inverse, max_curvature, extent);
 }
 
 } // namespace msf

@@ -147,7 +147,7 @@ void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isom
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
   const float w = weight * static_cast<float>(config_.carving_weight);
   const float range = static_cast<float>(config_.max_depth_m);
-  const bool own_weights = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
+  const bool own_weights = takesWeightsOf(frame);
   raysBeyondRange(frame.depth, own_weights ? frame.weight : cv::Mat(), range,
                   static_cast<float>(config_.truncation_sigmas), far_rays_);
   const cv::Rect rect = cv::boundingRect(far_rays_);

@@ -124,6 +124,18 @@ TsdfIntegrator::Weighting parseWeighting(const std::string& text) {
   return parseWord(TsdfIntegrator::kWeightings, text, "weighting");
 }
 
+DepthWeighting::ConstPtr makeDepthWeighting(TsdfIntegrator::Weighting weighting, double depth_sigma_m) {
+  switch (weighting) {
+  case TsdfIntegrator::Weighting::Constant:
+    return std::make_shared<ConstantWeighting>(depth_sigma_m);
+  case TsdfIntegrator::Weighting::InverseSquare:
+    return std::make_shared<InverseSquareWeighting>(depth_sigma_m);
+  case TsdfIntegrator::Weighting::PerPixel:
+    break;
+  }
+  return std::make_shared<PerPixelWeighting>(depth_sigma_m);
+}
+
 const char* toString(TsdfIntegrator::SignedDistance distance) {
   return wordOf(TsdfIntegrator::kSignedDistances, distance);
 }
@@ -157,19 +169,31 @@ double TsdfIntegrator::Config::farthestDepth() const {
   return weighting == Weighting::PerPixel ? std::max(max_depth_m, precise_max_depth_m) : max_depth_m;
 }
 
-TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : volume_(volume) {}
+TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : TsdfIntegrator(volume, Config()) {}
 
 TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume, const Config& config) : volume_(volume) { setConfig(config); }
 
 void TsdfIntegrator::setConfig(const Config& config) {
   config.validate();
   config_ = config;
+  weighting_ = makeDepthWeighting(config.weighting, config.depth_sigma_m);
+}
+
+void TsdfIntegrator::setWeighting(DepthWeighting::ConstPtr weighting) {
+  if (!weighting)
+    throw InvalidInputError("TsdfIntegrator::setWeighting: no weighting given");
+  weighting_ = std::move(weighting);
+}
+
+bool TsdfIntegrator::takesWeightsOf(const DepthFrame& frame) const {
+  return weighting_->takesFrameWeights() && !frame.weight.empty();
 }
 
 void TsdfIntegrator::setLambda(double lambda) {
   Config c = config_;
   c.lambda = lambda;
-  setConfig(c);
+  c.validate();
+  config_ = c; // the weighting stays
 }
 
 void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
@@ -194,12 +218,8 @@ double TsdfIntegrator::widestBandBehind() const {
                            ? planeBand(static_cast<float>(trunc), static_cast<float>(vs)) /
                                  static_cast<double>(config_.plane.min_scale)
                            : 0.0;
-  double least_weight = static_cast<double>(config_.min_pixel_weight); // the mask
-  const double sigma = config_.depth_sigma_m;
-  if (config_.weighting == Weighting::Constant)
-    least_weight = std::max(least_weight, 1.0 / (sigma * sigma));
-  else if (config_.weighting == Weighting::InverseSquare)
-    least_weight = std::max(least_weight, 1.0 / (sigma * sigma * config_.max_depth_m * config_.max_depth_m));
+  const double least_weight = std::max(static_cast<double>(config_.min_pixel_weight), // the mask
+                                       weighting_->leastWeight(config_.max_depth_m));
   double noise = 0.0;
   if (config_.truncation_sigmas > 0.0)
     noise = least_weight > 0.0 ? config_.truncation_sigmas / std::sqrt(least_weight)
@@ -537,7 +557,7 @@ FrameView TsdfIntegrator::prepareDepth(const DepthFrame& frame) {
   const float trunc = static_cast<float>(volume_.truncation());
   // Beyond max_depth_m only depth known to within the truncation is integrated, by its own
   // weight: a depth without one is max_depth_m's (depth_sigma_m is no measure of it).
-  const bool own_weights = config_.weighting == Weighting::PerPixel && !frame.weight.empty();
+  const bool own_weights = takesWeightsOf(frame);
   const bool precise_only = own_weights && config_.precise_max_depth_m > config_.max_depth_m;
   const bool masked = config_.min_pixel_weight > 0.f || precise_only;
   // A frame's depth may be a view into a wider image: then a copy (see FrameView::depth).
@@ -589,9 +609,8 @@ void TsdfIntegrator::computePixelBands(const DepthFrame& frame, const FrameView&
   const float trunc = view.trunc;
   const float sigmas = static_cast<float>(config_.truncation_sigmas);
   // How far from a plane its band reaches along a grazing ray: a voxel and a half either side
-  // (above it, free space holds the voxels beyond at +truncation: the full truncation cost 12 %
-  // more time for the same maps; below it, one voxel left holes wherever a cube's far corner
-  // lay a little deeper: protocol 4 coverage 0.957 against 0.967 on raw 0009).
+  // (free space holds the voxels beyond at +truncation, so the full truncation only costs
+  // time; one voxel leaves holes wherever a cube's far corner lies a little deeper).
   const float plane_band = planeBand(trunc, view.vs);
   // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
   const cv::Mat& free_weight = view.own_weights ? frame.free_space_weight : cv::Mat();
@@ -844,13 +863,8 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
   });
 }
 
-float TsdfIntegrator::depthWeight(float depth) const {
-  const float sigma = static_cast<float>(config_.depth_sigma_m);
-  return config_.weighting == Weighting::InverseSquare ? 1.f / (sigma * sigma * depth * depth) : 1.f / (sigma * sigma);
-}
-
 void TsdfIntegrator::pixelWeights(const DepthFrame& frame, cv::Mat& weight) {
-  if (config_.weighting == Weighting::PerPixel && !frame.weight.empty()) {
+  if (takesWeightsOf(frame)) {
     weight = frame.weight;
     return;
   }
@@ -860,7 +874,7 @@ void TsdfIntegrator::pixelWeights(const DepthFrame& frame, cv::Mat& weight) {
     const float* d = frame.depth.ptr<float>(v);
     float* w = weight.ptr<float>(v);
     for (int u = 0; u < frame.depth.cols; ++u)
-      w[u] = d[u] > 0.f ? depthWeight(d[u]) : 0.f;
+      w[u] = d[u] > 0.f ? weighting_->weight(d[u]) : 0.f;
   }
 }
 
@@ -898,7 +912,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
     if (!(dist >= min_d && dist <= max_d))
       continue;
     dir /= dist;
-    const float w = depthWeight(dist);
+    const float w = weighting_->weight(dist);
     const float t0 = config_.space_carving ? 0.f : dist - trunc;
     const Eigen::Vector3f a = (o + dir * t0) / vs + Eigen::Vector3f::Constant(0.5f);
     const Eigen::Vector3f b = (o + dir * (dist + trunc)) / vs + Eigen::Vector3f::Constant(0.5f);
@@ -941,8 +955,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
 float TsdfIntegrator::smoothingBand() const {
   // LambdaData::InverseVariance smooths the voxels within half a truncation of their surface,
   // where the zero crossing is; those farther out (free space, the far side of the band) are
-  // about half of the changed voxels and hardly move a vertex (KITTI and street maps within
-  // 0.002 m and 0.1 points of smoothing them all, in 45 % less time).
+  // about half of the changed voxels and hardly move a vertex.
   return config_.lambda_data == LambdaData::InverseVariance ? 0.5f * static_cast<float>(volume_.truncation())
                                                             : std::numeric_limits<float>::infinity();
 }

@@ -14,6 +14,65 @@ MSF_SIMD_INLINE typename V::F stdClamp(typename V::F x, typename V::F lo, typena
   return V::select(V::lt(x, lo), lo, V::select(V::lt(hi, x), hi, x));
 }
 
+/// The frame's depth where candidates project to (u, v): the bilinear blend of the 4 pixels
+/// around, where all lie in the image, have depth and agree within `behind` (when f.bilinear),
+/// else the nearest pixel's. `quad_min` is the least of the 4 (`nearest` outside the image).
+template <class V>
+MSF_SIMD_INLINE typename V::F sampleDepth(const VoxelUpdateFrame& f, typename V::M valid, typename V::F u,
+                                          typename V::F v, typename V::F nearest, typename V::F behind,
+                                          typename V::F& quad_min) {
+  using F = typename V::F;
+  using I = typename V::I;
+  using M = typename V::M;
+  const F zero = V::set1(0.f), one = V::set1(1.f);
+  const I width = V::set1i(f.width), height = V::set1i(f.height), one_i = V::set1i(1);
+  const I u0 = V::cvtt(u), v0 = V::cvtt(v);
+  const M quad = V::and_(V::and_(valid, V::and_(V::ge(u, zero), V::ge(v, zero))),
+                         V::and_(V::lti(V::addi(u0, one_i), width), V::lti(V::addi(v0, one_i), height)));
+  const I at = V::addi(V::mullo(v0, width), u0);
+  const F d00 = V::gatherm(f.depth, at, quad), d10 = V::gatherm(f.depth + 1, at, quad);
+  const F d01 = V::gatherm(f.depth + f.width, at, quad), d11 = V::gatherm(f.depth + f.width + 1, at, quad);
+  const F lo = stdMin<V>(stdMin<V>(d00, d10), stdMin<V>(d01, d11));
+  const F hi = stdMax<V>(stdMax<V>(d00, d10), stdMax<V>(d01, d11));
+  quad_min = V::select(quad, lo, nearest);
+  if (!f.bilinear)
+    return nearest;
+  const M blend = V::and_(quad, V::and_(V::gt(lo, zero), V::lt(V::sub(hi, lo), behind)));
+  const F a = V::sub(u, V::cvtf(u0)), b = V::sub(v, V::cvtf(v0));
+  const F one_a = V::sub(one, a), one_b = V::sub(one, b);
+  const F blended = V::add(V::mul(V::add(V::mul(d00, one_a), V::mul(d10, a)), one_b),
+                           V::mul(V::add(V::mul(d01, one_a), V::mul(d11, a)), b));
+  return V::select(blend, blended, nearest);
+}
+
+/// The `coloured` voxels' colours (words of r, g, b and flags at `voxel_colour` + at_voxel)
+/// take the weighted mean with their pixels' (candidates k..): old_weight theirs, w the pixel's,
+/// inv 1 / (old_weight + w).
+template <class V>
+MSF_SIMD_INLINE void blendColours(const VoxelUpdateFrame& f, const VoxelCandidates& c, int k, typename V::I at_voxel,
+                                  typename V::M coloured, typename V::F old_weight, typename V::F w,
+                                  typename V::F inv, std::int32_t* voxel_colour) {
+  using F = typename V::F;
+  using I = typename V::I;
+  using M = typename V::M;
+  const F half = V::set1(0.5f);
+  const I byte = V::set1i(0xff), zero_i = V::set1i(0), one_i = V::set1i(1);
+  // A pixel's 3 bytes as the top of the 4 from the byte before (the low 3 at pixel 0).
+  const I offset = V::addi(V::mullo(V::loadi(c.vi + k), V::set1i(f.color_step)), V::times3(V::loadi(c.ui + k)));
+  const M first = V::eqi(offset, zero_i);
+  const I word = V::gatheri1(f.color, V::selecti(first, offset, V::subi(offset, one_i)), coloured);
+  const I bgr = V::srlv(word, V::selecti(first, zero_i, V::set1i(8)));
+  const I rgbf = V::gatheri4(voxel_colour, at_voxel, coloured);
+  I mixed = V::andi(rgbf, V::set1i(static_cast<std::int32_t>(0xff000000u))); // the flags
+  for (int ch = 0; ch < 3; ++ch) { // r, g, b: the voxel's bytes 0, 1, 2; the image's 2, 1, 0
+    const F mine = V::cvtf(V::andi(V::srli(rgbf, 8 * ch), byte));
+    const F seen = V::cvtf(V::andi(V::srli(bgr, 8 * (2 - ch)), byte));
+    const I mean = V::cvtt(V::add(V::mul(V::add(V::mul(mine, old_weight), V::mul(seen, w)), inv), half));
+    mixed = V::ori(mixed, V::slli(V::andi(mean, byte), 8 * ch));
+  }
+  V::scatteri(voxel_colour, at_voxel, coloured, mixed);
+}
+
 /// The update of a block's candidates, V's lanes a time: blockUpdatePortable's float operations
 /// lane for lane, its branches as masks. A block's candidates are distinct voxels, so the
 /// scatters of one vector never collide.
@@ -29,13 +88,12 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
   float* voxel_weight = &voxels->weight;
   // r, g, b and flags as one word (from the array, not from r: GCC checks a store's object).
   auto* voxel_colour = reinterpret_cast<std::int32_t*>(reinterpret_cast<char*>(voxels) + offsetof(TsdfVoxel, r));
-  const F zero = V::set1(0.f), one = V::set1(1.f), half = V::set1(0.5f);
+  const F zero = V::set1(0.f), one = V::set1(1.f);
   const F trunc = V::set1(f.trunc), minus_trunc = V::set1(-f.trunc);
   const F vs = V::set1(f.voxel_size), minus_vs = V::set1(-f.voxel_size);
   const F colour_band = V::set1(f.colour_band), max_weight = V::set1(f.max_weight);
   const F smooth_band = V::set1(f.smooth_band), sign = V::set1(-0.f);
-  const I width = V::set1i(f.width), height = V::set1i(f.height), one_i = V::set1i(1), zero_i = V::set1i(0);
-  const I byte = V::set1i(0xff), colour_step = V::set1i(f.color_step);
+  const I one_i = V::set1i(1), zero_i = V::set1i(0);
   VoxelUpdateResult out;
   I negative = zero_i;
   unsigned signs_neg = 0, signs_pos = 0;
@@ -46,25 +104,8 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
     F scale, band, behind, pixel_weight;
     V::records4(pixel_base, pixel, valid, scale, band, behind, pixel_weight);
     const F pixel_free = V::gatherm(pixel_base + 4, V::times5(pixel), valid);
-    // The 4 pixels around the projection, where all lie in the image.
-    const I u0 = V::cvtt(u), v0 = V::cvtt(v);
-    const M quad = V::and_(V::and_(valid, V::and_(V::ge(u, zero), V::ge(v, zero))),
-                           V::and_(V::lti(V::addi(u0, one_i), width), V::lti(V::addi(v0, one_i), height)));
-    const I at = V::addi(V::mullo(v0, width), u0);
-    const F d00 = V::gatherm(f.depth, at, quad), d10 = V::gatherm(f.depth + 1, at, quad);
-    const F d01 = V::gatherm(f.depth + f.width, at, quad), d11 = V::gatherm(f.depth + f.width + 1, at, quad);
-    const F lo = stdMin<V>(stdMin<V>(d00, d10), stdMin<V>(d01, d11));
-    const F hi = stdMax<V>(stdMax<V>(d00, d10), stdMax<V>(d01, d11));
-    const F quad_min = V::select(quad, lo, nearest);
-    F d = nearest;
-    if (f.bilinear) {
-      const M blend = V::and_(quad, V::and_(V::gt(lo, zero), V::lt(V::sub(hi, lo), behind)));
-      const F a = V::sub(u, V::cvtf(u0)), b = V::sub(v, V::cvtf(v0));
-      const F one_a = V::sub(one, a), one_b = V::sub(one, b);
-      const F blended = V::add(V::mul(V::add(V::mul(d00, one_a), V::mul(d10, a)), one_b),
-                               V::mul(V::add(V::mul(d01, one_a), V::mul(d11, a)), b));
-      d = V::select(blend, blended, nearest);
-    }
+    F quad_min;
+    const F d = sampleDepth<V>(f, valid, u, v, nearest, behind, quad_min);
     const F diff = V::sub(d, z);
     const M in_band = V::le(diff, band);
     M keep = V::andnot(valid, V::lt(diff, V::xor_(behind, sign)));
@@ -91,22 +132,8 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
     const F new_sdf = stdClamp<V>(V::mul(V::add(V::mul(old_sdf, old_weight), V::mul(sdf, w)), inv), minus_trunc, trunc);
     if (f.color) {
       const M coloured = V::and_(V::and_(keep, in_band), V::lt(V::andnot(sdf, sign), colour_band));
-      if (V::bits(coloured)) {
-        // A pixel's 3 bytes as the top of the 4 from the byte before (the low 3 at pixel 0).
-        const I offset = V::addi(V::mullo(V::loadi(c.vi + k), colour_step), V::times3(V::loadi(c.ui + k)));
-        const M first = V::eqi(offset, zero_i);
-        const I word = V::gatheri1(f.color, V::selecti(first, offset, V::subi(offset, one_i)), coloured);
-        const I bgr = V::srlv(word, V::selecti(first, zero_i, V::set1i(8)));
-        const I rgbf = V::gatheri4(voxel_colour, at_voxel, coloured);
-        I mixed = V::andi(rgbf, V::set1i(static_cast<std::int32_t>(0xff000000u))); // the flags
-        for (int ch = 0; ch < 3; ++ch) { // r, g, b: the voxel's bytes 0, 1, 2; the image's 2, 1, 0
-          const F mine = V::cvtf(V::andi(V::srli(rgbf, 8 * ch), byte));
-          const F seen = V::cvtf(V::andi(V::srli(bgr, 8 * (2 - ch)), byte));
-          const I mean = V::cvtt(V::add(V::mul(V::add(V::mul(mine, old_weight), V::mul(seen, w)), inv), half));
-          mixed = V::ori(mixed, V::slli(V::andi(mean, byte), 8 * ch));
-        }
-        V::scatteri(voxel_colour, at_voxel, coloured, mixed);
-      }
+      if (V::bits(coloured))
+        blendColours<V>(f, c, k, at_voxel, coloured, old_weight, w, inv, voxel_colour);
     }
     V::scatter(voxel_sdf, at_voxel, keep, new_sdf);
     V::scatter(voxel_weight, at_voxel, keep, V::min(max_weight, total)); // std::min(total, max_weight)

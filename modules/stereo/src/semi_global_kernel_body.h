@@ -419,6 +419,61 @@ MSF_SIMD_UNROLL(8)
   }
 }
 
+/// OpenCV's uniqueness check: a pixel is ambiguous when another disparity, not next to the
+/// best, costs at most min_cost * 100 / (100 - ratio) (OpenCV's vectorised check); the quotient
+/// by a reciprocal, corrected to the exact integer one.
+class UniquenessCheck {
+public:
+  UniquenessCheck(int ratio, int searched)
+      : ratio_(ratio), searched_(searched), reciprocal_(ratio < 100 ? 100.0 / (100 - ratio) : 0.0) {}
+
+  /// Whether the totals of K vectors at `total` leave the best disparity ambiguous.
+  MSF_SIMD_INLINE bool ambiguous(const std::int16_t* total, int best, int min_cost, int K) const {
+    if (ratio_ <= 0)
+      return false;
+    // Totals within the threshold, less the best and its neighbours.
+    const int limit = threshold(min_cost);
+    const Reg limit_vector = V::set16(limit);
+    int within = 0;
+    for (int k = 0; k < K; ++k)
+      within += __builtin_popcountll(V::atMostMask(V::load(total + kLanes * k), limit_vector));
+    within /= V::kMaskBitsPerLane;
+    for (int d = best - 1; d <= best + 1; ++d)
+      within -= d >= 0 && d < searched_ && total[d] <= limit;
+    return within > 0;
+  }
+
+private:
+  int threshold(int min_cost) const {
+    if (ratio_ >= 100)
+      return 0x7FFF;
+    int t = static_cast<int>(min_cost * reciprocal_);
+    while ((t + 1) * (100 - ratio_) <= 100 * min_cost)
+      ++t;
+    while (t * (100 - ratio_) > 100 * min_cost)
+      --t;
+    return t > 0x7FFF ? 0x7FFF : t;
+  }
+
+  int ratio_, searched_;
+  double reciprocal_;
+};
+
+/// The best disparity in 1/16 px, refined by the parabola through it and its neighbours.
+MSF_SIMD_INLINE int subpixelDisparity(const std::int16_t* total, int best, int searched) {
+  constexpr int scale = 16;
+  int d = best * scale;
+  if (best > 0 && best < searched - 1) {
+    const int below = total[best - 1], above = total[best + 1];
+    const int curvature = below + above - 2 * total[best];
+    const int denominator = curvature > 1 ? curvature : 1;
+    // Exactly C's truncating division: |numerator| < 2^21, so the double quotient never rounds
+    // across an integer.
+    d += static_cast<int>(static_cast<double>((below - above) * scale + denominator) / (denominator * 2));
+  }
+  return d;
+}
+
 /// Right-to-left path, the total over the paths, and the disparity of each pixel.
 MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, const Guide& guide, const int K) {
   const SgmStrip& s = strip.s;
@@ -433,21 +488,8 @@ MSF_SIMD_INLINE void backwardPassFor(const Strip& strip, std::int16_t* out, cons
   std::int16_t* disp2 = strip.at<std::int16_t>(layout.disp2);
   std::int16_t* disp2_cost = strip.at<std::int16_t>(layout.disp2_cost);
   const Reg p1 = V::set16(s.p1);
-  const int min_d = s.min_disparity, scale = 16, ratio = s.uniqueness_ratio;
-  // Ambiguous when another disparity, not next to the best, costs at most
-  // min_cost * 100 / (100 - ratio) (OpenCV's vectorised check); the quotient by a
-  // reciprocal, corrected to the exact integer one.
-  const double reciprocal = ratio < 100 ? 100.0 / (100 - ratio) : 0.0;
-  const auto threshold = [&](int min_cost) {
-    if (ratio >= 100)
-      return 0x7FFF;
-    int t = static_cast<int>(min_cost * reciprocal);
-    while ((t + 1) * (100 - ratio) <= 100 * min_cost)
-      ++t;
-    while (t * (100 - ratio) > 100 * min_cost)
-      --t;
-    return t > 0x7FFF ? 0x7FFF : t;
-  };
+  const int min_d = s.min_disparity, scale = 16;
+  const UniquenessCheck uniqueness(s.uniqueness_ratio, searched);
   startBox(strip, last, -1);
   std::memset(right, 0, sizeof(std::int16_t) * static_cast<std::size_t>(D));
   int right_min = 0;
@@ -474,34 +516,15 @@ MSF_SIMD_UNROLL(8)
     // the vector width (and OpenCV's scalar rule).
     const Reg disparity = V::add16(V::mullo16(best_k, V::set16(kLanes)), V::laneIndex());
     const int best = V::horizontalMin(V::whereEqual(best_cost, V::set16(min_cost), disparity, V::set16(0x7FFF)));
-    if (ratio > 0) {
-      // Totals within the threshold, less the best and its neighbours.
-      const int limit = threshold(min_cost);
-      const Reg limit_vector = V::set16(limit);
-      int within = 0;
-      for (int k = 0; k < K; ++k)
-        within += __builtin_popcountll(V::atMostMask(V::load(total + kLanes * k), limit_vector));
-      within /= V::kMaskBitsPerLane;
-      for (int d = best - 1; d <= best + 1; ++d)
-        within -= d >= 0 && d < searched && total[d] <= limit;
-      if (within > 0)
-        continue;
-    }
+    if (uniqueness.ambiguous(total, best, min_cost, K))
+      continue;
     const int x = xi + layout.min_x;
     const int x_right = x - best - min_d;
     if (x_right >= 0 && x_right < s.width && disp2_cost[x_right] > min_cost) {
       disp2_cost[x_right] = static_cast<std::int16_t>(min_cost);
       disp2[x_right] = static_cast<std::int16_t>(best + min_d);
     }
-    int d = best * scale;
-    if (best > 0 && best < searched - 1) { // parabola through the best and its neighbours
-      const int below = total[best - 1], above = total[best + 1];
-      const int curvature = below + above - 2 * total[best];
-      const int denominator = curvature > 1 ? curvature : 1;
-      // Exactly C's truncating division: |numerator| < 2^21, so the double quotient
-      // never rounds across an integer.
-      d += static_cast<int>(static_cast<double>((below - above) * scale + denominator) / (denominator * 2));
-    }
+    const int d = subpixelDisparity(total, best, searched);
     out[x] = static_cast<std::int16_t>(d + min_d * scale);
   }
 }

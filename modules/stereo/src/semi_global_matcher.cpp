@@ -20,7 +20,7 @@ namespace msf {
 
 namespace {
 // Fixed, like OpenCV's, so that results do not depend on the number of threads; 4 strips
-// balance 2 threads on a shared machine and cost ~6 % in warm-up rows.
+// balance 2 threads on a shared machine for a few warm-up rows each.
 constexpr int kStrips = 4;
 
 std::atomic<bool> avx2_enabled{true};

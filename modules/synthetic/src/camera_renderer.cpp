@@ -159,6 +159,76 @@ inline std::uint8_t toByteClipping(const GammaTable& gamma, float linear, float 
   return static_cast<std::uint8_t>(std::clamp(roundHalfAway(level + noise), 0L, 255L));
 }
 
+/// The rays of a camera's image: each pixel centre's, and ss x ss over the pixels on an edge.
+struct PixelRays {
+  const SceneSnapshot& scene;
+  const CameraModel& cam;
+  const SkyLook& look;
+  int ss; ///< samples per pixel side on an edge
+  V3 pixel_x, pixel_y; ///< a pixel's step in the world
+  std::vector<Radiance> radiance; ///< of the pixel centres' rays, row-major
+  std::vector<std::int32_t> surface; ///< the surface each centre's ray hit
+
+  /// The ray through each pixel centre, its texture filtered over the whole pixel; its depth and
+  /// object into the images given.
+  void traceCentres(cv::Mat* depth, cv::Mat* objects) {
+    const int W = cam.width;
+    radiance.resize(static_cast<std::size_t>(W) * static_cast<std::size_t>(cam.height));
+    surface.resize(radiance.size());
+    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& range) {
+      for (int v = range.start; v < range.end; ++v) {
+        float* d = depth ? depth->ptr<float>(v) : nullptr;
+        std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
+        for (int u = 0; u < W; ++u) {
+          const Ray ray{cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))};
+          const Sample s = trace(scene, ray, pixel_x, pixel_y, look);
+          const std::size_t i = index(u, v);
+          radiance[i] = s.radiance;
+          surface[i] = s.surface;
+          if (d)
+            d[u] = s.depth;
+          if (o)
+            o[u] = s.object;
+        }
+      }
+    });
+  }
+
+  /// The pixel's radiance: its centre's, or on a geometric edge (a neighbour sees another
+  /// surface) the mean of ss x ss samples.
+  Radiance at(int u, int v) const {
+    const std::size_t i = index(u, v);
+    const std::int32_t k = surface[i];
+    const auto W = static_cast<std::size_t>(cam.width);
+    const bool edge = (u > 0 && surface[i - 1] != k) || (u + 1 < cam.width && surface[i + 1] != k) ||
+                      (v > 0 && surface[i - W] != k) || (v + 1 < cam.height && surface[i + W] != k);
+    return edge && ss > 1 ? supersample(u, v) : radiance[i];
+  }
+
+private:
+  std::size_t index(int u, int v) const {
+    return static_cast<std::size_t>(v) * static_cast<std::size_t>(cam.width) + static_cast<std::size_t>(u);
+  }
+
+  Radiance supersample(int u, int v) const {
+    const float inv_ss = 1.f / static_cast<float>(ss);
+    const V3 sub_x = pixel_x * inv_ss, sub_y = pixel_y * inv_ss;
+    Radiance r;
+    for (int sy = 0; sy < ss; ++sy)
+      for (int sx = 0; sx < ss; ++sx) {
+        // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
+        const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
+        const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
+        const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y, look).radiance;
+        r.r += q.r;
+        r.g += q.g;
+        r.b += q.b;
+      }
+    const float w = inv_ss * inv_ss;
+    return {r.r * w, r.g * w, r.b * w};
+  }
+};
+
 } // namespace
 
 CameraRenderer::CameraRenderer(const Calibration& calibration, const SyntheticConfig& config)
@@ -177,10 +247,6 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
     depth->create(H, W, CV_32FC1);
   if (objects)
     objects->create(H, W, CV_32SC1);
-  const V3 pixel_x = cam.rotate(1.f / cam.fx, 0.f, 0.f), pixel_y = cam.rotate(0.f, 1.f / cam.fy, 0.f);
-  const int ss = config_.supersampling;
-  const float inv_ss = 1.f / static_cast<float>(ss);
-  const V3 sub_x = pixel_x * inv_ss, sub_y = pixel_y * inv_ss;
   const float sigma = static_cast<float>(config_.image_noise_sigma);
   // The noise of pixel i, channel c: hashKey(seed, noise_key, camera, i, c).
   const HashPrefix image_key =
@@ -191,55 +257,16 @@ cv::Mat CameraRenderer::render(const SceneSnapshot& scene, int camera, const Eig
   const auto byte = [&](float linear, float noise) {
     return look.kitti ? toByteClipping(gamma, linear, noise) : toByte(gamma, linear, noise);
   };
-
-  // Pass 1: the ray through each pixel centre, its texture filtered over the whole pixel.
-  std::vector<Radiance> radiance(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
-  std::vector<std::int32_t> surface(radiance.size());
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
-    for (int v = range.start; v < range.end; ++v) {
-      float* d = depth ? depth->ptr<float>(v) : nullptr;
-      std::int32_t* o = objects ? objects->ptr<std::int32_t>(v) : nullptr;
-      for (int u = 0; u < W; ++u) {
-        const Ray ray{cam.center, cam.direction(static_cast<float>(u), static_cast<float>(v))};
-        const Sample s = trace(scene, ray, pixel_x, pixel_y, look);
-        const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
-        radiance[i] = s.radiance;
-        surface[i] = s.surface;
-        if (d)
-          d[u] = s.depth;
-        if (o)
-          o[u] = s.object;
-      }
-    }
-  });
-
-  // Pass 2: pixels on a geometric edge (a neighbour sees another surface) get ss x ss
-  // samples; then gamma, noise and quantization.
+  PixelRays rays{scene, cam, look, config_.supersampling, cam.rotate(1.f / cam.fx, 0.f, 0.f),
+                 cam.rotate(0.f, 1.f / cam.fy, 0.f), {}, {}};
+  rays.traceCentres(depth, objects);
+  // Then gamma, noise and quantization.
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       std::uint8_t* row = image.ptr<std::uint8_t>(v);
       for (int u = 0; u < W; ++u) {
+        const Radiance r = rays.at(u, v);
         const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(W) + static_cast<std::size_t>(u);
-        Radiance r = radiance[i];
-        const std::int32_t k = surface[i];
-        const bool edge = (u > 0 && surface[i - 1] != k) || (u + 1 < W && surface[i + 1] != k) ||
-                          (v > 0 && surface[i - static_cast<std::size_t>(W)] != k) ||
-                          (v + 1 < H && surface[i + static_cast<std::size_t>(W)] != k);
-        if (edge && ss > 1) {
-          r = Radiance();
-          for (int sy = 0; sy < ss; ++sy)
-            for (int sx = 0; sx < ss; ++sx) {
-              // Centres of an ss x ss grid over the pixel (pixel centre at integer u, v).
-              const float pu = static_cast<float>(u) - 0.5f + (static_cast<float>(sx) + 0.5f) * inv_ss;
-              const float pv = static_cast<float>(v) - 0.5f + (static_cast<float>(sy) + 0.5f) * inv_ss;
-              const Radiance q = trace(scene, {cam.center, cam.direction(pu, pv)}, sub_x, sub_y, look).radiance;
-              r.r += q.r;
-              r.g += q.g;
-              r.b += q.b;
-            }
-          const float w = inv_ss * inv_ss;
-          r = {r.r * w, r.g * w, r.b * w};
-        }
         const HashPrefix pixel_key = image_key.then(static_cast<std::uint64_t>(i));
         auto noise = [&](std::uint64_t channel) {
           return sigma > 0.f ? sigma * gaussianFast(pixel_key.then(channel).value()) : 0.f;

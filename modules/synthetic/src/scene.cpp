@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <tuple>
+#include <utility>
 
 namespace msf::synthetic {
 
@@ -45,36 +47,19 @@ float surfaceArea(V3 lo, V3 hi) {
   const V3 e = hi - lo;
   return 2.f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
-} // namespace
 
-std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vector<V3>& lo, const std::vector<V3>& hi,
-                          const std::vector<V3>& centroid) {
-  const auto id = static_cast<std::int32_t>(nodes_.size());
-  nodes_.emplace_back();
-  V3 box_lo = lo[order_[begin]], box_hi = hi[order_[begin]];
-  V3 c_lo = centroid[order_[begin]], c_hi = c_lo;
-  for (std::int32_t i = begin; i < end; ++i) {
-    box_lo = minV(box_lo, lo[order_[i]]);
-    box_hi = maxV(box_hi, hi[order_[i]]);
-    c_lo = minV(c_lo, centroid[order_[i]]);
-    c_hi = maxV(c_hi, centroid[order_[i]]);
-  }
-  nodes_[id].lo = box_lo;
-  nodes_[id].hi = box_hi;
-  const std::int32_t count = end - begin;
-  auto makeLeaf = [&] {
-    nodes_[id].index = begin;
-    nodes_[id].count = static_cast<std::uint16_t>(count);
-    return id;
-  };
-  if (count <= 2)
-    return makeLeaf();
+constexpr int kSplitBins = 16;
 
-  // Binned surface area heuristic: the split that minimizes the expected number of
-  // primitive tests for a random ray, (area_left n_left + area_right n_right) / area.
-  constexpr int kBins = 16;
+/// The axis and bin (the split lies before it) of the binned surface area heuristic over
+/// primitives order[begin, end): the split that minimizes the expected number of primitive
+/// tests for a random ray, (area_left n_left + area_right n_right) / area, if one costs less
+/// than `leaf_cost`; else axis -1.
+std::pair<int, int> bestSplit(const std::vector<std::int32_t>& order, std::int32_t begin, std::int32_t end,
+                              const std::vector<V3>& lo, const std::vector<V3>& hi, const std::vector<V3>& centroid,
+                              V3 c_lo, V3 c_hi, float leaf_cost) {
+  constexpr int kBins = kSplitBins;
   int best_axis = -1, best_bin = 0;
-  float best_cost = static_cast<float>(count) * surfaceArea(box_lo, box_hi);
+  float best_cost = leaf_cost;
   for (int axis = 0; axis < 3; ++axis) {
     const float extent = c_hi[axis] - c_lo[axis];
     if (extent <= 1e-6f)
@@ -86,7 +71,7 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
       bin_hi[b] = {-1e30f, -1e30f, -1e30f};
     }
     for (std::int32_t i = begin; i < end; ++i) {
-      const std::int32_t p = order_[i];
+      const std::int32_t p = order[i];
       const int b = std::min(kBins - 1, static_cast<int>(kBins * (centroid[p][axis] - c_lo[axis]) / extent));
       ++bin_count[b];
       bin_lo[b] = minV(bin_lo[b], lo[p]);
@@ -123,6 +108,36 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
       }
     }
   }
+  return {best_axis, best_bin};
+}
+} // namespace
+
+std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vector<V3>& lo, const std::vector<V3>& hi,
+                          const std::vector<V3>& centroid) {
+  const auto id = static_cast<std::int32_t>(nodes_.size());
+  nodes_.emplace_back();
+  V3 box_lo = lo[order_[begin]], box_hi = hi[order_[begin]];
+  V3 c_lo = centroid[order_[begin]], c_hi = c_lo;
+  for (std::int32_t i = begin; i < end; ++i) {
+    box_lo = minV(box_lo, lo[order_[i]]);
+    box_hi = maxV(box_hi, hi[order_[i]]);
+    c_lo = minV(c_lo, centroid[order_[i]]);
+    c_hi = maxV(c_hi, centroid[order_[i]]);
+  }
+  nodes_[id].lo = box_lo;
+  nodes_[id].hi = box_hi;
+  const std::int32_t count = end - begin;
+  auto makeLeaf = [&] {
+    nodes_[id].index = begin;
+    nodes_[id].count = static_cast<std::uint16_t>(count);
+    return id;
+  };
+  if (count <= 2)
+    return makeLeaf();
+
+  int best_axis, best_bin;
+  const float leaf_cost = static_cast<float>(count) * surfaceArea(box_lo, box_hi);
+  std::tie(best_axis, best_bin) = bestSplit(order_, begin, end, lo, hi, centroid, c_lo, c_hi, leaf_cost);
   if (best_axis < 0) {
     if (count <= kMaxLeafSize)
       return makeLeaf();
@@ -134,7 +149,8 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
   if (best_bin >= 0) {
     const float extent = c_hi[best_axis] - c_lo[best_axis];
     const auto it = std::stable_partition(order_.begin() + begin, order_.begin() + end, [&](std::int32_t p) {
-      return std::min(kBins - 1, static_cast<int>(kBins * (centroid[p][best_axis] - c_lo[best_axis]) / extent)) < best_bin;
+      const float offset = centroid[p][best_axis] - c_lo[best_axis];
+      return std::min(kSplitBins - 1, static_cast<int>(kSplitBins * offset / extent)) < best_bin;
     });
     mid = static_cast<std::int32_t>(it - order_.begin());
   }
@@ -145,21 +161,50 @@ std::int32_t Scene::build(std::int32_t begin, std::int32_t end, const std::vecto
   return id;
 }
 
+namespace {
+/// The ray's hit of the road plane y = ground_y, if nearer than hit.t.
+bool intersectGround(const Ray& ray, float ground_y, float tmin, Hit& hit) {
+  if (!(ray.dir.y > 0.f))
+    return false;
+  const float t = (ground_y - ray.origin.y) / ray.dir.y;
+  if (!(t > tmin && t < hit.t))
+    return false;
+  hit.t = t;
+  hit.primitive = Hit::kGround;
+  hit.face = 3;
+  hit.local = ray.origin + ray.dir * t;
+  hit.normal = {0.f, -1.f, 0.f};
+  return true;
+}
+} // namespace
+
+void Scene::enterChildren(const ChildBoxes& c, const Ray& ray, const V3& inv, float tmin, float tmax, float entry[2],
+                          bool enters[2]) {
+  // rayEntersBox for both children in SIMD lanes, the same operations in the same order per
+  // lane (so the same results): lanes 0 and 1 are the children's slab distances.
+  Float4 t0 = {tmin, tmin, tmin, tmin}, t1 = {tmax, tmax, tmax, tmax};
+  auto slab = [&](const float* bounds, float o, float i) {
+    Float4 v;
+    std::memcpy(&v, bounds, sizeof v);
+    const Float4 a = (v - o) * i;
+    const Float4 b = __builtin_shufflevector(a, a, 2, 3, 0, 1); // each lane's hi with its lo
+    const Float4 near = a < b ? a : b, far = a < b ? b : a;
+    t0 = near > t0 ? near : t0;
+    t1 = far < t1 ? far : t1;
+  };
+  slab(c.x, ray.origin.x, inv.x);
+  slab(c.y, ray.origin.y, inv.y);
+  slab(c.z, ray.origin.z, inv.z);
+  for (int k = 0; k < 2; ++k) {
+    entry[k] = t0[k];
+    enters[k] = t0[k] <= t1[k];
+  }
+}
+
 bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
   hit = Hit();
   hit.t = tmax;
-  bool found = false;
-  if (ray.dir.y > 0.f) {
-    const float t = (layout.ground_y - ray.origin.y) / ray.dir.y;
-    if (t > tmin && t < hit.t) {
-      hit.t = t;
-      hit.primitive = Hit::kGround;
-      hit.face = 3;
-      hit.local = ray.origin + ray.dir * t;
-      hit.normal = {0.f, -1.f, 0.f};
-      found = true;
-    }
-  }
+  bool found = intersectGround(ray, layout.ground_y, tmin, hit);
   float entry = 0.f;
   if (nodes_.empty() || !rayEntersBox(nodes_[0].lo, nodes_[0].hi, ray.origin,
                                       {1.f / ray.dir.x, 1.f / ray.dir.y, 1.f / ray.dir.z}, tmin, hit.t, entry))
@@ -194,24 +239,11 @@ bool Scene::intersect(const Ray& ray, float tmin, float tmax, Hit& hit) const {
       continue;
     }
     const std::int32_t left = current + 1, right = node.index;
-    // rayEntersBox for both children in SIMD lanes, the same operations in the same order
-    // per lane (so the same results): lanes 0 and 1 are the children's slab distances.
-    const ChildBoxes& c = children_[static_cast<std::size_t>(current)];
-    Float4 t0 = {tmin, tmin, tmin, tmin}, t1 = {hit.t, hit.t, hit.t, hit.t};
-    auto slab = [&](const float* bounds, float o, float i) {
-      Float4 v;
-      std::memcpy(&v, bounds, sizeof v);
-      const Float4 a = (v - o) * i;
-      const Float4 b = __builtin_shufflevector(a, a, 2, 3, 0, 1); // each lane's hi with its lo
-      const Float4 near = a < b ? a : b, far = a < b ? b : a;
-      t0 = near > t0 ? near : t0;
-      t1 = far < t1 ? far : t1;
-    };
-    slab(c.x, ray.origin.x, inv.x);
-    slab(c.y, ray.origin.y, inv.y);
-    slab(c.z, ray.origin.z, inv.z);
-    const float t_left = t0[0], t_right = t0[1];
-    const bool hit_left = t0[0] <= t1[0], hit_right = t0[1] <= t1[1];
+    float entry_of[2];
+    bool enters[2];
+    enterChildren(children_[static_cast<std::size_t>(current)], ray, inv, tmin, hit.t, entry_of, enters);
+    const float t_left = entry_of[0], t_right = entry_of[1];
+    const bool hit_left = enters[0], hit_right = enters[1];
     if (hit_left && hit_right) {
       if (t_left <= t_right) {
         push(right, t_right);

@@ -169,7 +169,13 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
                               staging / "poses", gt / "depth_0", gt / "disp_0", gt / "obj_map_0", gt / "moving_0"})
     if (!fs::create_directories(dir, ec) || ec)
       throw IOError("cannot create folder '" + dir.string() + "'" + (ec ? ": " + ec.message() : ""));
+  writeSequenceFiles(seq, staging / "poses", gt);
+  writeGroundTruthFiles(gt);
+  writeFrames(seq, gt, progress);
+  output.commit();
+}
 
+void SyntheticGenerator::writeSequenceFiles(const fs::path& seq, const fs::path& poses, const fs::path& gt) const {
   saveOdometryCalibration(calibration_, (seq / "calib.txt").string());
   saveRigFile(calibration_, (seq / "rig.yaml").string());
   std::ostringstream times;
@@ -180,11 +186,14 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   }
   writeText(seq / "times.txt", times.str());
   if (config_.ins_poses) {
-    saveOdometryPoses((staging / "poses" / "00.txt").string(), insPoses(poses_, config_));
+    saveOdometryPoses((poses / "00.txt").string(), insPoses(poses_, config_));
     saveOdometryPoses((gt / "poses.txt").string(), poses_);
   } else {
-    saveOdometryPoses((staging / "poses" / "00.txt").string(), poses_);
+    saveOdometryPoses((poses / "00.txt").string(), poses_);
   }
+}
+
+void SyntheticGenerator::writeGroundTruthFiles(const fs::path& gt) const {
   std::ostringstream yaml; // plain YAML, which msf_synth -config reads back to the same dataset
   std::vector<KeyText> keys = listKeys(config_);
   if (config_.sky == SyntheticConfig().sky) // the default sky unnamed: the file reads as before the key
@@ -199,7 +208,9 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   saveMesh((gt / "scene.ply").string(), mesh(&classes));
   writeText(gt / "scene_classes.txt", formatSurfaceClasses(classes));
   writeText(gt / "moving_objects.txt", formatMovingBoxes(movingBoxes()));
+}
 
+void SyntheticGenerator::writeFrames(const fs::path& seq, const fs::path& gt, const Progress& progress) const {
   // Frame i's files are written (PNG compression, a tenth of a frame's time) on a thread of
   // their own while frame i + 1 renders: they fill the renderer's idle moments instead of
   // following them. A frame's writes end before the next frame's begin.
@@ -241,8 +252,6 @@ void SyntheticGenerator::writeDataset(const std::string& root_arg, const Progres
   }
   if (pending)
     finishPending(Clock::now());
-
-  output.commit();
 }
 
 } // namespace msf::synthetic

@@ -35,8 +35,8 @@ const char* toString(FusionMethod method);
 const char* toString(PaperWeights weights);
 const char* toString(LidarEdgeCue cue);
 
-/// Every parameter of DepthFusion: section `fusion` of a config file. The defaults were
-/// measured on KITTI odometry 04 frames 0-9 under protocol 2 (msf_holdout; docs/results.md).
+/// Every parameter of DepthFusion: section `fusion` of a config file. The defaults are chosen
+/// under protocol 2 (msf_holdout; docs/results.md).
 struct DepthFusionConfig {
   static constexpr const char* kSection = "fusion";
   static constexpr const char* kAbout =

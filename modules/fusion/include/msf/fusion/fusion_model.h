@@ -135,9 +135,8 @@ inline FusionResult fuseUncertainty(const FusionInputs& in, const DepthFusionCon
   const bool take_stereo = stereo & (no_lidar | (disagree & stereo_more_certain));
   // The LiDAR's weight counts its error growing away from a return, not lidarSigmaPx's term of
   // the local disparity range: on the road that is a plane's slope (a third of a pixel a row
-  // on KITTI), and as a weight it left the road beyond 20 m unmeshed (odometry 04, protocol 4:
-  // coverage 0.871 against 0.949). At edges the fusion itself decides (parallax check, edge
-  // support).
+  // on KITTI), and as a weight it left the far road unmeshed. At edges the fusion itself
+  // decides (parallax check, edge support).
   const float w_L = lidarDepthWeight(in.z_lidar, c.lidar_sigma_per_distance * in.lidar_distance, focal_baseline, c);
   const float w_S = depthWeight(in.z_stereo, 1.f / v_S, focal_baseline);
   // An average's variance is its samples' spread about it as well as theirs: where the two

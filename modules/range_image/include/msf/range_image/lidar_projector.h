@@ -61,6 +61,8 @@ public:
 
   /// Intrinsics and size of the target camera's image.
   const PinholeCamera& camera() const { return camera_; }
+  /// The rigid transform from the LiDAR's frame to the projecting camera's.
+  const Eigen::Isometry3d& cameraFromLidar() const { return T_camera_velo_; }
   /// The canvas: the image grown by margin_px on every side (principal point shifted).
   PinholeCamera canvasCamera() const;
   /// Where the image lies in the canvas.
@@ -98,7 +100,8 @@ private:
   ProjectionConfig config_;
   Calibration calibration_;
   PinholeCamera camera_;
-  Eigen::Matrix<float, 3, 4> T_cam_velo_ = Eigen::Matrix<float, 3, 4>::Zero(); ///< velodyne -> this camera
+  Eigen::Isometry3d T_camera_velo_ = Eigen::Isometry3d::Identity(); ///< velodyne -> this camera
+  Eigen::Matrix<float, 3, 4> T_cam_velo_ = Eigen::Matrix<float, 3, 4>::Zero(); ///< the same, as projected
   float skew_ = 0.f;
   bool calibrated_ = false;
   mutable std::vector<int> pixel_;    ///< per scan point: pixel index or -1

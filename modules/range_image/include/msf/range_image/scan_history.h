@@ -94,6 +94,11 @@ public:
   void densify(const pcl::PointCloud<pcl::PointXYZI>& scan, const Eigen::Isometry3d& T_world_velo,
                pcl::PointCloud<pcl::PointXYZI>& out);
 
+  /// What step 1 interpolates: `scan` with the earlier scans' agreeing returns (densify) when
+  /// `scans` > 0 and the frame has its pose T_world_velo; else `scan` itself, and a frame without
+  /// a pose clears the history (earlier scans cannot be placed). Valid until the next call.
+  const pcl::PointCloud<pcl::PointXYZI>& withEarlierScans(const pcl::PointCloud<pcl::PointXYZI>& scan,
+                                                          const Eigen::Isometry3d* T_world_velo);
   /// Forgets every earlier scan (a jump in the poses, a new sequence).
   void clear() { scans_.clear(); }
   /// The earlier scans held, newest first, each in its own LiDAR frame.
@@ -125,6 +130,7 @@ private:
   cv::Mat added_;                                // canvas depth of the earlier returns added
   pcl::PointCloud<pcl::PointXYZI> moved_;        // an earlier scan in the current frame
   pcl::PointCloud<pcl::PointXYZI> organized_;    // its nearest return per canvas pixel, camera frame
+  pcl::PointCloud<pcl::PointXYZI> dense_;        // withEarlierScans' result
   Stats stats_;
 };
 

@@ -3,6 +3,7 @@
 #include <msf/common/config_keys.h>
 #include <msf/common/parallel.h>
 #include <msf/reconstruction/depth_frame.h>
+#include <msf/reconstruction/depth_weighting.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_volume.h>
@@ -60,7 +61,8 @@ public:
 
   /// A voxel's weight is the inverse variance of its signed distance, in m^-2: observations
   /// add 1 / sigma^2, so that a voxel seen often or closely is both more precise and harder to
-  /// overwrite, and a threshold on it (MarchingCubes min_weight) is a precision.
+  /// overwrite, and a threshold on it (MarchingCubes min_weight) is a precision. The config's
+  /// word for a DepthWeighting (makeDepthWeighting).
   enum class Weighting {
     Constant,      ///< every depth has sigma = depth_sigma_m
     InverseSquare, ///< sigma = depth_sigma_m * z / (1 m), for depth whose noise grows with range
@@ -230,7 +232,11 @@ public:
   TsdfIntegrator(TsdfVolume& volume, const Config& config);
 
   const Config& getConfig() const { return config_; }
+  /// Also sets the weighting that the config names (makeDepthWeighting).
   void setConfig(const Config& config);
+  /// Weighs depth by `weighting` instead of the config's (not null).
+  void setWeighting(DepthWeighting::ConstPtr weighting);
+  const DepthWeighting& weighting() const { return *weighting_; }
   double getLambda() const { return config_.lambda; }
   void setLambda(double lambda);
   TsdfVolume& volume() { return volume_; }
@@ -323,9 +329,9 @@ private:
   double widestBandBehind() const;
   /// Throws InvalidInputError when the frame's band would reach beyond the volume's index range.
   void checkReach(const Eigen::Isometry3d& T_world_cam) const;
-  /// The weight of a depth without its own (Constant, InverseSquare), in m^-2.
-  float depthWeight(float depth) const;
-  /// Per pixel, the weight of the frame's depth (see Weighting); 0 where there is no depth.
+  /// Whether the frame's own weight image weighs its depth (DepthWeighting::takesFrameWeights).
+  bool takesWeightsOf(const DepthFrame& frame) const;
+  /// Per pixel, the weight of the frame's depth (see DepthWeighting); 0 where there is no depth.
   void pixelWeights(const DepthFrame& frame, cv::Mat& weight);
   /// Whether eq. 7 changes anything: lambda > 0 and at least one sweep.
   bool regularizes() const {
@@ -364,6 +370,7 @@ private:
   cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
+  DepthWeighting::ConstPtr weighting_;
   cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_
   cv::Mat computed_weight_;
   cv::Mat far_rays_, far_distance_; // carveBeyondRange: the pixels whose rays reach beyond the range
@@ -371,6 +378,8 @@ private:
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.
 const char* toString(TsdfIntegrator::Weighting weighting);
+/// The weighting a config's word names, its sigma `depth_sigma_m`.
+DepthWeighting::ConstPtr makeDepthWeighting(TsdfIntegrator::Weighting weighting, double depth_sigma_m);
 TsdfIntegrator::Weighting parseWeighting(const std::string& text);
 /// "sweeps", "argmin"; parse throws ConfigError naming the key and the text.
 const char* toString(TsdfIntegrator::LambdaData data);

@@ -117,7 +117,7 @@ private:
 /// so that a few tens of kilobytes stay in the cache. A clear bit says the voxel is absent
 /// without a look-up in the table (most of a search's 27 voxels are empty space, and a
 /// look-up that finds nothing misses the cache as one that finds a voxel does); a set one, that
-/// the table must tell (for ~6 % of the absent voxels).
+/// the table must tell (for the few absent voxels that share a bit with a present one).
 class VoxelBits {
 public:
   /// No voxel, room for `voxels` at 16 bits each.

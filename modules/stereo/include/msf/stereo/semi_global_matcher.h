@@ -82,7 +82,7 @@ public:
   /// machine with AVX2.
   static void setAvx2Enabled(bool enabled);
   /// True when compute() runs the AVX-512BW kernel (32 disparities per instruction, the
-  /// same result as the AVX2 one, ~12 % faster at 128 disparities) for a number of
+  /// same result as the AVX2 one, faster) for a number of
   /// disparities that is a multiple of 32: the CPU has it and it is not disabled.
   static bool usesAvx512();
   /// Disables (false) or re-enables the AVX-512 kernel process-wide (AVX2 runs instead).

@@ -81,6 +81,9 @@ private:
   struct alignas(64) ChildBoxes {
     float x[4], y[4], z[4];
   };
+  /// Where the ray enters each of an inner node's two children within [tmin, tmax], if it does.
+  static void enterChildren(const ChildBoxes& c, const Ray& ray, const V3& inv, float tmin, float tmax, float entry[2],
+                            bool enters[2]);
 
   static constexpr std::int32_t kMaxLeafSize = 8;
   std::vector<Node> nodes_;

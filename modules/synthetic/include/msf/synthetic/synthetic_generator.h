@@ -16,6 +16,7 @@
 #include <pcl/point_types.h>
 
 #include <cstddef>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -75,6 +76,14 @@ public:
   void writeDataset(const std::string& root, const Progress& progress = {}) const;
 
 private:
+  /// The sequence's calibration, rig file, times and poses (the INS-like ones with the truth in gt).
+  void writeSequenceFiles(const std::filesystem::path& seq, const std::filesystem::path& poses,
+                          const std::filesystem::path& gt) const;
+  /// The ground truth beside the frames: the config, a README, the scene's mesh and classes, the moving boxes.
+  void writeGroundTruthFiles(const std::filesystem::path& gt) const;
+  /// Each frame's images, scan and ground-truth images.
+  void writeFrames(const std::filesystem::path& seq, const std::filesystem::path& gt, const Progress& progress) const;
+
   SyntheticConfig config_;
   Calibration calibration_;
   PoseList poses_;
