@@ -104,3 +104,27 @@ TEST_F(PipelineTest, AStreamedEngineWritesItsTilesWhereItIsTold) {
                 .find("streaming.active_radius_m is 0"),
             std::string::npos);
 }
+
+TEST_F(PipelineTest, TheMapAsAPriorFillsTheFusedDepthsHolesAndLeavesTheMapAsItWas) {
+  const msf::Sequence sequence(dataset());
+  msf::PipelineConfig with_prior;
+  with_prior.map_prior.enabled = true;
+  msf::Reconstructor plain(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor prior(sequence.calibration(), with_prior);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const msf::FrameResult a = plain.addFrame(sequence.load(i));
+    const msf::FrameResult b = prior.addFrame(sequence.load(i));
+    const cv::Mat had_depth = a.fused.depth > 0.f;
+    // What the frame saw stays; only its holes change.
+    EXPECT_EQ(cv::countNonZero((a.fused.depth != b.fused.depth) & had_depth), 0) << "frame " << i;
+    const int holes_before = cv::countNonZero(~had_depth), holes_after = cv::countNonZero(~(b.fused.depth > 0.f));
+    if (i == 0)
+      EXPECT_EQ(holes_after, holes_before) << "the first frame has no map to take depth from";
+    else
+      EXPECT_LT(holes_after, holes_before) << "frame " << i << ": the map filled no hole";
+    const cv::Mat filled = (b.fused.depth > 0.f) & ~had_depth;
+    EXPECT_EQ(cv::countNonZero(filled & (b.fused.weight <= 0.f)), 0) << "a filled pixel without its weight";
+  }
+  msf::test::TempDir a, b;
+  EXPECT_TRUE(savedMap(plain, a) == savedMap(prior, b)) << "the map's depth went back into the map";
+}

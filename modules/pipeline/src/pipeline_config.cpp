@@ -54,6 +54,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.interpolate_depth = false;
   c.integrator.lambda = 5.0;
   c.integrator.solve = TsdfIntegrator::Solve::Argmin;
+  c.map_prior.enabled = false;
   c.mesher.min_weight = 0.f;
   c.mesher.max_unseen_corners = 0;
   c.mesher.smoothing_lambda = 0.f;

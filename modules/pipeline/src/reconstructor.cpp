@@ -61,7 +61,6 @@ struct Reconstructor::Stages {
         history(calibration, config.projection, config.accumulation) {}
   LidarCompletion lidar;  // projection onto the canvas with its margin, then interpolation
   ScanHistory history;    // the earlier scans that step 1 carries into the view
-  pcl::PointCloud<pcl::PointXYZI> dense_scan;  // the scan with them
   SgbmStereo stereo;
   DepthImageFusion fusion;
   SkyMask sky;
@@ -103,20 +102,11 @@ FrameResult Reconstructor::startFrame(const Frame& frame) const {
   return result;
 }
 
-const pcl::PointCloud<pcl::PointXYZI>& Reconstructor::withEarlierScans(const Frame& frame, const FrameResult& result) {
-  if (config_.accumulation.scans == 0)
-    return *frame.scan;
-  if (!result.has_pose) {
-    stages_->history.clear(); // earlier scans cannot be placed without the poses
-    return *frame.scan;
-  }
-  stages_->history.densify(*frame.scan, result.T_world_cam0 * calibration_.T_cam0_velo, stages_->dense_scan);
-  return stages_->dense_scan;
-}
-
 void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   const auto start = Clock::now();
-  stages_->lidar.computeDepth(withEarlierScans(frame, result), result.lidar_depth, &result.lidar_distance);
+  const Eigen::Isometry3d T_world_velo = result.T_world_cam0 * calibration_.T_cam0_velo;
+  const auto& scan = stages_->history.withEarlierScans(*frame.scan, result.has_pose ? &T_world_velo : nullptr);
+  stages_->lidar.computeDepth(scan, result.lidar_depth, &result.lidar_distance);
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
@@ -236,6 +226,7 @@ void Reconstructor::integrate(FrameResult& result) {
   if (streaming_)
     streaming_->beforeIntegration(result.T_world_cam0.translation());
   const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
+  fillFromMap(result);
   integrator_->integrate(frame, result.T_world_cam0);
   carveWithScan(*integrator_, result, frame.camera, config_.fusion, calibration_);
   carveSky(*integrator_, result, camera_, config_.fusion);
@@ -247,6 +238,27 @@ void Reconstructor::integrate(FrameResult& result) {
       mesher_.reset(); // its cache holds the freed blocks' meshes
   }
   result.times.integrate_ms = msSince(start);
+}
+
+void Reconstructor::fillFromMap(FrameResult& result) const {
+  DepthFrame& fused = result.fused;
+  if (!config_.map_prior.enabled || volume_->numBlocks() == 0 || fused.weight.empty())
+    return;
+  cv::Mat holes = ~(fused.depth > 0.f); // no depth (0 or NaN)
+  if (!result.sky.empty())
+    holes.setTo(0, result.sky);
+  cv::Mat depth, weight;
+  MapRaycaster(*volume_, config_.map_prior).render(fused.camera, result.T_world_cam0, holes, depth, weight);
+  const cv::Mat found = depth > 0.f;
+  // New images: the frame being integrated may share the fused ones.
+  fused.depth = fused.depth.clone();
+  depth.copyTo(fused.depth, found);
+  fused.weight = fused.weight.clone();
+  weight.copyTo(fused.weight, found);
+  if (!fused.free_space_weight.empty()) {
+    fused.free_space_weight = fused.free_space_weight.clone();
+    fused.free_space_weight.setTo(0.f, found);
+  }
 }
 
 bool Reconstructor::tracks(const Frame& first) const {

@@ -7,6 +7,7 @@
 #include <msf/range_image/ring_split.h>
 #include <msf/range_image/scan_history.h>
 #include <msf/registration/lidar_odometry.h>
+#include <msf/reconstruction/map_raycaster.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -54,6 +55,7 @@ struct PipelineConfig {
   DepthFusionConfig fusion;
   VolumeConfig volume;
   TsdfIntegrator::Config integrator;
+  MapPriorConfig map_prior; ///< the map rendered into the view where the fused depth has none
   MarchingCubes::Config mesher;
   SchedulingConfig scheduling;
   StreamingMap::Config streaming; ///< the map in bounded memory (off by default)
@@ -72,6 +74,7 @@ struct PipelineConfig {
     visit(config.fusion);
     visit(config.volume);
     visit(config.integrator);
+    visit(config.map_prior);
     visit(config.mesher);
     visit(config.scheduling);
     visit(config.streaming);

@@ -94,7 +94,8 @@ struct FrameResult {
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
-  /// the integrator (step 5) consumes.
+  /// the integrator (step 5) consumes. Once integrated, with map_prior.enabled, its holes hold the
+  /// map's depth where earlier frames saw a surface (those pixels were not integrated).
   DepthFrame fused;
   StageTimes times;
 };
@@ -281,9 +282,10 @@ private:
   bool lidarBeforeStereo() const;
   /// Steps 1-4 into a started result, at its pose (the earlier scans are placed by it).
   void computeDepth(const Frame& frame, FrameResult& result);
-  /// The frame's scan with the earlier scans' agreeing returns (ScanHistory), when the config
-  /// carries them and the result has a pose; the frame's scan otherwise.
-  const pcl::PointCloud<pcl::PointXYZI>& withEarlierScans(const Frame& frame, const FrameResult& result);
+  /// The fused depth's holes (no depth; not open sky) filled with
+  /// the map's surface seen from the frame's pose (MapRaycaster, section map_prior), before the
+  /// frame is integrated: what earlier frames saw where this one sees nothing.
+  void fillFromMap(FrameResult& result) const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4

@@ -12,8 +12,8 @@ namespace msf {
 /// interpolated LiDAR fills the margin around the image (weighed as the fusion weighs the
 /// LiDAR, lidarDepthWeight; the image's border colours repeated). So the edge of what the frame
 /// adds to the map (marching cubes needs voxels seen on both sides of a surface) lies outside
-/// the camera's view rather than a voxel inside it: protocol 4 on KITTI, odometry 04 coverage
-/// 0.970 -> 0.974, raw 0009 0.953 -> 0.959. The fused frame itself when the frame has no canvas.
+/// the camera's view rather than a voxel inside it. The fused frame itself when the frame has no
+/// canvas.
 DepthFrame fusedDepthFrame(const FrameResult& result, const DepthFusionConfig& fusion, double focal_baseline);
 
 /// One input of the fusion, integrated alone into a volume of its own (msf_reconstruct
