@@ -92,6 +92,15 @@ TEST(MapRaycaster, RefusesABadMaskAndConfig) {
   } catch (const InvalidInputError& e) {
     EXPECT_NE(std::string(e.what()).find("320x240"), std::string::npos) << e.what();
   }
+  Eigen::Isometry3d sheared = Eigen::Isometry3d::Identity();
+  sheared.linear()(0, 1) = 0.5;
+  const cv::Mat all(240, 320, CV_8UC1, cv::Scalar(1));
+  try {
+    raycaster.render(test::smallCamera(), sheared, all, depth, weight);
+    FAIL() << "a pose that is not rigid was taken";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("T_world_cam"), std::string::npos) << e.what();
+  }
   MapPriorConfig inverted;
   inverted.min_depth_m = 50.0;
   try {

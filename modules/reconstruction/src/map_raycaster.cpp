@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/config.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/common/parallel.h>
 #include <msf/reconstruction/map_raycaster.h>
 #include <msf/reconstruction/tsdf_block.h>
@@ -19,14 +20,19 @@ void MapPriorConfig::validate() const {
                       std::to_string(min_depth_m) + ")");
 }
 
+MapRaycaster::MapRaycaster(const TsdfVolume& volume, const MapPriorConfig& config)
+    : volume_(volume), config_(config) {
+  config_.validate();
+}
+
 namespace {
+
 /// The ray parameter at which the ray o + d t (in voxels) leaves the block of voxel v.
 float blockExit(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const GridIndex& v) {
-  constexpr int side = TsdfBlock::kSide;
+  const GridIndex block = blockOf(v);
   float exit = std::numeric_limits<float>::infinity();
   for (int a = 0; a < 3; ++a) {
-    const int cell = v[a] >= 0 ? v[a] / side : (v[a] + 1) / side - 1; // floor(v / side)
-    const float lo = static_cast<float>(cell * side) - 0.5f, hi = lo + static_cast<float>(side);
+    const float lo = static_cast<float>(block[a] * TsdfBlock::kSide) - 0.5f, hi = lo + TsdfBlock::kSide;
     if (d[a] > 0.f)
       exit = std::min(exit, (hi - o[a]) / d[a]);
     else if (d[a] < 0.f)
@@ -34,15 +40,6 @@ float blockExit(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const GridIn
   }
   return exit;
 }
-
-} // namespace
-
-MapRaycaster::MapRaycaster(const TsdfVolume& volume, const MapPriorConfig& config)
-    : volume_(volume), config_(config) {
-  config_.validate();
-}
-
-namespace {
 
 /// Voxel look-ups along one ray: most fall in the block of the one before.
 class RayVoxels {
@@ -160,6 +157,7 @@ void MapRaycaster::render(const PinholeCamera& camera, const Eigen::Isometry3d& 
                           cv::Mat& depth, cv::Mat& weight) const {
   if (!camera.valid())
     throw InvalidInputError("MapRaycaster::render: the camera is not valid (fx, fy > 0, a size)");
+  limits::checkRigid(T_world_cam, "MapRaycaster::render: T_world_cam (the view's pose)");
   if (mask.type() != CV_8UC1 || mask.cols != camera.width || mask.rows != camera.height)
     throw InvalidInputError("MapRaycaster::render: the mask must be CV_8UC1 of the camera's " +
                             std::to_string(camera.width) + "x" + std::to_string(camera.height) + " pixels");

@@ -53,7 +53,8 @@ public:
   /// At each pixel where `mask` (CV_8UC1 of the camera's size) is non-zero: the depth along the
   /// optical axis of the map's first surface and its weight (the smaller of the voxel weights
   /// around the crossing, m^-2), 0 and 0 where the ray meets none; elsewhere 0. Throws
-  /// InvalidInputError for a mask of another size or type or an invalid camera.
+  /// InvalidInputError for a mask of another size or type, an invalid camera or a pose that is
+  /// not rigid.
   void render(const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, const cv::Mat& mask, cv::Mat& depth,
               cv::Mat& weight) const;
 
