@@ -913,6 +913,85 @@ TEST(TsdfIntegrator, ArgminSolveReachesTheMinimizerOfEquation7) {
   EXPECT_EQ(stats.regularize_sweeps, 2);
 }
 
+/// A schedule of one's own: three sweeps, reported as converged once a sweep moved less than 1 m.
+class ThreeSweeps : public SweepSchedule {
+public:
+  int maxSweeps() const override { return 3; }
+  bool converged(float largest_change) const override { return largest_change < 1.f; }
+  bool runsEverySweep() const override { return false; }
+};
+
+TEST(TsdfIntegrator, TheSolveIsASweepScheduleThatTheConfigNamesOrTheUserGives) {
+  TsdfIntegrator::Config config;
+  config.solve = TsdfIntegrator::Solve::Argmin;
+  config.argmin_tolerance_m = 1e-3;
+  config.argmin_max_sweeps = 50;
+  const auto argmin = makeSweepSchedule(config);
+  EXPECT_EQ(argmin->maxSweeps(), 50);
+  EXPECT_TRUE(argmin->converged(1e-3f));
+  EXPECT_FALSE(argmin->converged(2e-3f));
+  config.solve = TsdfIntegrator::Solve::Sweeps;
+  config.sweeps = 4;
+  const auto sweeps = makeSweepSchedule(config);
+  EXPECT_EQ(sweeps->maxSweeps(), 4);
+  EXPECT_TRUE(sweeps->runsEverySweep());
+  EXPECT_FALSE(sweeps->converged(0.f)); // a fixed count: never stops early
+
+  // The schedule given decides: the first sweep moves less than a metre, so one sweep runs,
+  // and the volume is the one a single fixed sweep gives.
+  TsdfVolume volume(kVoxel, kTrunc);
+  TsdfIntegrator::Config one;
+  one.lambda = 5.0;
+  one.weighting = TsdfIntegrator::Weighting::Constant;
+  TsdfIntegrator integrator(volume, one);
+  integrator.setSweepSchedule(std::make_shared<ThreeSweeps>());
+  const AnalyticScene scene = test::makeScene(SceneKind::Sphere);
+  const auto pose = test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 15, 1).front();
+  integrator.integrate(test::renderFrame(scene, test::smallCamera(), pose, 0.02, 11), pose);
+  EXPECT_EQ(integrator.lastStats().regularize_sweeps, 1);
+  EXPECT_TRUE(integrator.lastStats().regularize_converged);
+  EXPECT_EQ(largestDifference(volume, regularizedOnce(TsdfIntegrator::Config())), 0.0);
+  EXPECT_THROW(integrator.setSweepSchedule(nullptr), InvalidInputError);
+  integrator.setConfig(one); // a new config sets its own schedule again
+  EXPECT_EQ(integrator.sweepSchedule().maxSweeps(), 1);
+}
+
+TEST(TsdfIntegrator, TheSignedDistanceIsAModelThatTheConfigNamesOrTheUserGives) {
+  // A ground plane seen at a grazing angle: the plane distance shrinks the scale below 1, the
+  // projective distance keeps 1 and sees no surface behind the pixel.
+  const PinholeCamera camera = test::smallCamera();
+  AnalyticScene scene;
+  scene.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.5); // a floor 1.5 m below the camera (y down)
+  const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  const cv::Mat depth = scene.renderDepth(camera, pose, 20.0);
+  cv::Mat scale, extent;
+  makeSignedDistance(TsdfIntegrator::SignedDistance::Projective, {})->pixelScales(depth, camera, scale, extent);
+  EXPECT_EQ(cv::norm(scale - 1.f, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(extent), 0);
+  const PlaneDistanceConfig plane;
+  makeSignedDistance(TsdfIntegrator::SignedDistance::Plane, plane)->pixelScales(depth, camera, scale, extent);
+  cv::Mat expected;
+  planeDistanceScale(depth, camera, plane, expected);
+  EXPECT_EQ(cv::norm(scale, expected, cv::NORM_INF), 0.0);
+  const int v = camera.height - 10, u = camera.width / 2; // the road a few metres ahead
+  ASSERT_GT(depth.at<float>(v, u), 0.f);
+  EXPECT_LT(scale.at<float>(v, u), 0.5f);
+  EXPECT_GT(extent.at<float>(v, u), depth.at<float>(v, u));
+
+  // Given to the integrator, the model decides, as the config's word would.
+  const DepthFrame frame = test::renderFrame(scene, camera, pose, 0.0, 1);
+  TsdfVolume by_word(kVoxel, kTrunc), by_model(kVoxel, kTrunc);
+  TsdfIntegrator::Config projective;
+  projective.signed_distance = TsdfIntegrator::SignedDistance::Projective;
+  TsdfIntegrator(by_word, projective).integrate(frame, pose);
+  TsdfIntegrator integrator(by_model); // the default config's plane distance
+  integrator.setSignedDistance(std::make_shared<ProjectiveDistance>());
+  integrator.integrate(frame, pose);
+  ASSERT_EQ(by_word.numObservedVoxels(), by_model.numObservedVoxels());
+  EXPECT_EQ(largestDifference(by_word, by_model), 0.0);
+  EXPECT_THROW(integrator.setSignedDistance(nullptr), InvalidInputError);
+}
+
 TEST(TsdfIntegrator, SolveKeysAreNamedWhenWrong) {
   for (const std::string key :
        {"solve: exact", "argmin_tolerance_m: 0", "argmin_max_sweeps: 0", "lambda_data: weighted"}) {

@@ -19,8 +19,8 @@ namespace msf {
 
 namespace {
 /// Width and height from a PNG's IHDR chunk, or {0, 0} when the file is not a PNG: the size
-/// is checked before the decoder allocates it (a 30000x20000 PNG took 1.8 GB, then the
-/// matcher crashed on it).
+/// is checked before the decoder allocates it: a huge PNG would take gigabytes before the
+/// matcher refused it.
 cv::Size pngSize(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char h[24] = {};

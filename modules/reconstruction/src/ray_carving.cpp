@@ -135,7 +135,7 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
     return free ? w : 0.f;
   };
   carveAlongRays(volume_, sky, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),
-                 static_cast<float>(config_.farthestDepth()), config_.max_weight, inFrontOfWall);
+                 static_cast<float>(farthestDepth()), config_.max_weight, inFrontOfWall);
 }
 
 void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, float weight) {

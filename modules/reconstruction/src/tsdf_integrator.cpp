@@ -29,8 +29,7 @@ namespace {
 /// silhouette_band: neighbours lie on one object unless their depths differ by more than a tenth
 /// of the nearer, or by more than the larger of their sigmas (far stereo's noise does not cut a
 /// wall into slivers); the band behind stays at least two truncations deep, which keeps the
-/// weights of the drop-off around a surface as they were (one truncation took 0.01-0.15 points
-/// of the streets' completeness; two took 0.00-0.06).
+/// weights of the drop-off around a surface as they were (one truncation cost completeness).
 constexpr float kSilhouetteRelativeJump = 0.1f;
 constexpr float kSilhouetteSigmas = 1.f;
 constexpr float kSilhouetteFloor = 2.f;
@@ -136,6 +135,19 @@ DepthWeighting::ConstPtr makeDepthWeighting(TsdfIntegrator::Weighting weighting,
   return std::make_shared<PerPixelWeighting>(depth_sigma_m);
 }
 
+SignedDistanceModel::ConstPtr makeSignedDistance(TsdfIntegrator::SignedDistance distance,
+                                                 const PlaneDistanceConfig& plane) {
+  if (distance == TsdfIntegrator::SignedDistance::Projective)
+    return std::make_shared<ProjectiveDistance>();
+  return std::make_shared<PlaneDistance>(plane);
+}
+
+SweepSchedule::ConstPtr makeSweepSchedule(const TsdfIntegrator::Config& config) {
+  if (config.solve == TsdfIntegrator::Solve::Argmin)
+    return std::make_shared<SweepsToArgmin>(config.argmin_tolerance_m, config.argmin_max_sweeps);
+  return std::make_shared<FixedSweeps>(config.sweeps);
+}
+
 const char* toString(TsdfIntegrator::SignedDistance distance) {
   return wordOf(TsdfIntegrator::kSignedDistances, distance);
 }
@@ -165,8 +177,9 @@ void TsdfIntegrator::Config::validate() const {
                       configValue(max_depth_m));
 }
 
-double TsdfIntegrator::Config::farthestDepth() const {
-  return weighting == Weighting::PerPixel ? std::max(max_depth_m, precise_max_depth_m) : max_depth_m;
+double TsdfIntegrator::farthestDepth() const {
+  return weighting_->takesFrameWeights() ? std::max(config_.max_depth_m, config_.precise_max_depth_m)
+                                         : config_.max_depth_m;
 }
 
 TsdfIntegrator::TsdfIntegrator(TsdfVolume& volume) : TsdfIntegrator(volume, Config()) {}
@@ -177,12 +190,26 @@ void TsdfIntegrator::setConfig(const Config& config) {
   config.validate();
   config_ = config;
   weighting_ = makeDepthWeighting(config.weighting, config.depth_sigma_m);
+  signed_distance_ = makeSignedDistance(config.signed_distance, config.plane);
+  sweep_schedule_ = makeSweepSchedule(config);
 }
 
 void TsdfIntegrator::setWeighting(DepthWeighting::ConstPtr weighting) {
   if (!weighting)
     throw InvalidInputError("TsdfIntegrator::setWeighting: no weighting given");
   weighting_ = std::move(weighting);
+}
+
+void TsdfIntegrator::setSignedDistance(SignedDistanceModel::ConstPtr model) {
+  if (!model)
+    throw InvalidInputError("TsdfIntegrator::setSignedDistance: no signed distance given");
+  signed_distance_ = std::move(model);
+}
+
+void TsdfIntegrator::setSweepSchedule(SweepSchedule::ConstPtr schedule) {
+  if (!schedule)
+    throw InvalidInputError("TsdfIntegrator::setSweepSchedule: no sweep schedule given");
+  sweep_schedule_ = std::move(schedule);
 }
 
 bool TsdfIntegrator::takesWeightsOf(const DepthFrame& frame) const {
@@ -201,7 +228,7 @@ void TsdfIntegrator::checkReach(const Eigen::Isometry3d& T_world_cam) const {
   // whose band reaches beyond that would alias blocks, or overflow a float -> int cast.
   const double reach_m = 0.99 * double(1 << 19) * TsdfBlock::kSide * volume_.voxelSize();
   const double far_m =
-      T_world_cam.translation().cwiseAbs().maxCoeff() + config_.farthestDepth() + volume_.truncation();
+      T_world_cam.translation().cwiseAbs().maxCoeff() + farthestDepth() + volume_.truncation();
   if (!(far_m < reach_m))
     throw InvalidInputError("the frame's pose (translation " + std::to_string(T_world_cam.translation().norm()) +
                             " m) with its farthest depth (max_depth_m, precise_max_depth_m) reaches " +
@@ -214,10 +241,7 @@ double TsdfIntegrator::widestBandBehind() const {
   // the least plane scale, the depth's sigmas), the sigma from the least weight a pixel can
   // have and still be integrated.
   const double trunc = volume_.truncation(), vs = volume_.voxelSize();
-  const double below = config_.signed_distance == SignedDistance::Plane
-                           ? planeBand(static_cast<float>(trunc), static_cast<float>(vs)) /
-                                 static_cast<double>(config_.plane.min_scale)
-                           : 0.0;
+  const double below = signed_distance_->widestBandBelow(planeBand(static_cast<float>(trunc), static_cast<float>(vs)));
   const double least_weight = std::max(static_cast<double>(config_.min_pixel_weight), // the mask
                                        weighting_->leastWeight(config_.max_depth_m));
   double noise = 0.0;
@@ -230,7 +254,7 @@ double TsdfIntegrator::widestBandBehind() const {
 double TsdfIntegrator::allocationDepth() const {
   // A ray's band is allocated from the depth less its front band to the depth plus its band
   // behind (at most the widest), along the optical axis, for depths up to farthestDepth().
-  return config_.farthestDepth() + widestBandBehind();
+  return farthestDepth() + widestBandBehind();
 }
 
 double TsdfIntegrator::reach(const PinholeCamera& camera) const {
@@ -239,7 +263,7 @@ double TsdfIntegrator::reach(const PinholeCamera& camera) const {
   // bilinear one of 4 pixels that agree within that band: up to twice the band behind the
   // nearest pixel's depth, itself at most farthestDepth().
   const double behind = 2.0 * widestBandBehind();
-  const double far = config_.farthestDepth();
+  const double far = farthestDepth();
   // The longest ray per metre of depth: through a corner of the image (pixel edges at -0.5
   // and size - 0.5, as the projection's inside test).
   const double du = std::max(std::abs(-0.5 - camera.cx), std::abs(camera.width - 0.5 - camera.cx)) / camera.fx;
@@ -596,13 +620,7 @@ void TsdfIntegrator::computePixelBands(const DepthFrame& frame, const FrameView&
   //   angle to the grid puts some of them more than one voxel below it) but not the plane's
   //   full length: beyond the surface's edge the plane is free space, and a box seen edge-on
   //   would grow a skirt behind it.
-  if (config_.signed_distance == SignedDistance::Plane) {
-    planeDistanceScale(view.depth, view.cam, config_.plane, scale_);
-    smoothSurfaceExtent(view.depth, config_.plane.max_curvature, extent_);
-  } else {
-    scale_ = cv::Mat(view.depth.size(), CV_32FC1, cv::Scalar(1.f));
-    extent_ = cv::Mat(view.depth.size(), CV_32FC1, cv::Scalar(0.f));
-  }
+  signed_distance_->pixelScales(view.depth, view.cam, scale_, extent_);
   // One record per pixel, so that a voxel's update reads them from one cache line.
   const int width = view.width;
   pixels_.resize(static_cast<std::size_t>(width) * view.height);
@@ -983,13 +1001,12 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
     const GridIndex& b = touched[i]->index;
     colour[(b.x() + b.y() + b.z()) & 1].push_back(i);
   }
-  const bool argmin = config_.solve == Solve::Argmin;
-  const int max_sweeps = argmin ? config_.argmin_max_sweeps : config_.sweeps;
-  const auto tolerance = static_cast<float>(config_.argmin_tolerance_m);
+  const SweepSchedule& schedule = *sweep_schedule_;
+  const int max_sweeps = schedule.maxSweeps();
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
     // The sweeps move values towards their neighbours' and can change signs: the last one
     // records them (every one when the last is not known in advance; the flags only add).
-    const bool last = argmin || sweep + 1 == max_sweeps;
+    const bool last = !schedule.runsEverySweep() || sweep + 1 == max_sweeps;
     std::atomic<float> largest_change{0.f};
     for (const auto& group : colour) {
       const auto m = static_cast<std::ptrdiff_t>(group.size());
@@ -1011,7 +1028,7 @@ void TsdfIntegrator::regularize(const std::vector<TsdfBlock*>& touched, const st
       }, std::max(1.0, static_cast<double>(m) / 16));
     }
     stats_.regularize_sweeps = sweep + 1;
-    if (argmin && largest_change.load() <= tolerance) {
+    if (schedule.converged(largest_change.load())) {
       stats_.regularize_converged = true;
       break;
     }

@@ -21,8 +21,7 @@ namespace msf {
 /// is tight for a few frames and grows with the volume swept rather than the surface seen.
 ///
 /// Stored as runs of blocks along one axis per column of the other two (the axis of the first
-/// view's largest extent), so that a view costs a few thousand columns, not its blocks: 1000
-/// KITTI frames take ~0.1 s.
+/// view's largest extent), so that a view costs a few thousand columns, not its blocks.
 class BlockFootprint {
 public:
   /// `voxel_size_m`: the volume's voxel (> 0).

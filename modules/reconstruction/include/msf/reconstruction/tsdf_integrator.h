@@ -6,6 +6,8 @@
 #include <msf/reconstruction/depth_weighting.h>
 #include <msf/reconstruction/plane_distance.h>
 #include <msf/reconstruction/scan_free_space.h>
+#include <msf/reconstruction/signed_distance.h>
+#include <msf/reconstruction/sweep_schedule.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <Eigen/Geometry>
@@ -71,7 +73,8 @@ public:
   static constexpr Choice<Weighting> kWeightings[] = {
       {"per_pixel", Weighting::PerPixel}, {"constant", Weighting::Constant}, {"inverse_square", Weighting::InverseSquare}};
 
-  /// What a voxel's signed distance measures.
+  /// What a voxel's signed distance measures: the config's word for a SignedDistanceModel
+  /// (makeSignedDistance).
   enum class SignedDistance {
     Projective, ///< depth difference along the optical axis (KinectFusion, the paper)
     Plane       ///< distance to the observed surface's tangent plane (planeDistanceScale)
@@ -87,7 +90,7 @@ public:
   static constexpr Choice<LambdaData> kLambdaData[] = {{"uniform", LambdaData::Uniform},
                                                        {"inverse_variance", LambdaData::InverseVariance}};
 
-  /// How eq. 7 is solved each frame.
+  /// How eq. 7 is solved each frame: the config's word for a SweepSchedule (makeSweepSchedule).
   enum class Solve {
     Sweeps, ///< `sweeps` Gauss-Seidel sweeps, warm-started: refined over frames (the project's)
     Argmin  ///< sweeps until no voxel moves more than argmin_tolerance_m: the minimizer itself
@@ -162,9 +165,6 @@ public:
     /// What the camera sees 35-40 m ahead at its last frame was seen from beyond 40 m by the
     /// frames before, and a map cut at 40 m held it from one or two frames only.
     double precise_max_depth_m = 60.0;
-    /// The largest depth a pixel is integrated at: max(max_depth_m, precise_max_depth_m) with
-    /// per-pixel weights, else max_depth_m.
-    double farthestDepth() const;
     bool interpolate_depth = true;
     /// Rows are staggered: rays 3 px apart are 0.17 m apart at 40 m on KITTI, under the 0.4 m of
     /// a sub-block. The bands along a grazing ray are long, so fewer rays allocate faster.
@@ -232,11 +232,22 @@ public:
   TsdfIntegrator(TsdfVolume& volume, const Config& config);
 
   const Config& getConfig() const { return config_; }
-  /// Also sets the weighting that the config names (makeDepthWeighting).
+  /// Also sets the weighting, the signed distance and the sweep schedule that the config names
+  /// (makeDepthWeighting, makeSignedDistance, makeSweepSchedule).
   void setConfig(const Config& config);
   /// Weighs depth by `weighting` instead of the config's (not null).
   void setWeighting(DepthWeighting::ConstPtr weighting);
   const DepthWeighting& weighting() const { return *weighting_; }
+  /// Measures the signed distance by `model` instead of the config's (not null).
+  void setSignedDistance(SignedDistanceModel::ConstPtr model);
+  const SignedDistanceModel& signedDistance() const { return *signed_distance_; }
+  /// Solves eq. 7 by `schedule` instead of the config's (not null).
+  void setSweepSchedule(SweepSchedule::ConstPtr schedule);
+  const SweepSchedule& sweepSchedule() const { return *sweep_schedule_; }
+  /// The largest depth a pixel is integrated at: max(max_depth_m, precise_max_depth_m) when the
+  /// frame's own weights say which depth is precise (DepthWeighting::takesFrameWeights), else
+  /// max_depth_m.
+  double farthestDepth() const;
   double getLambda() const { return config_.lambda; }
   void setLambda(double lambda);
   TsdfVolume& volume() { return volume_; }
@@ -334,9 +345,7 @@ private:
   /// Per pixel, the weight of the frame's depth (see DepthWeighting); 0 where there is no depth.
   void pixelWeights(const DepthFrame& frame, cv::Mat& weight);
   /// Whether eq. 7 changes anything: lambda > 0 and at least one sweep.
-  bool regularizes() const {
-    return config_.lambda > 0.0 && (config_.solve == Solve::Argmin || config_.sweeps > 0);
-  }
+  bool regularizes() const { return config_.lambda > 0.0 && sweep_schedule_->maxSweeps() > 0; }
   /// |sdf| below which a changed voxel is regularized (infinite: all of them).
   float smoothingBand() const;
   // integrate's phases, in order.
@@ -371,6 +380,8 @@ private:
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
   DepthWeighting::ConstPtr weighting_;
+  SignedDistanceModel::ConstPtr signed_distance_;
+  SweepSchedule::ConstPtr sweep_schedule_;
   cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_
   cv::Mat computed_weight_;
   cv::Mat far_rays_, far_distance_; // carveBeyondRange: the pixels whose rays reach beyond the range
@@ -386,9 +397,14 @@ const char* toString(TsdfIntegrator::LambdaData data);
 TsdfIntegrator::LambdaData parseLambdaData(const std::string& text);
 const char* toString(TsdfIntegrator::Solve solve);
 TsdfIntegrator::Solve parseSolve(const std::string& text);
+/// The sweep schedule a config names: its solve, sweeps, argmin_tolerance_m and argmin_max_sweeps.
+SweepSchedule::ConstPtr makeSweepSchedule(const TsdfIntegrator::Config& config);
 /// "projective", "plane"; parse throws ConfigError naming the text.
 const char* toString(TsdfIntegrator::SignedDistance distance);
 TsdfIntegrator::SignedDistance parseSignedDistance(const std::string& text);
+/// The signed distance a config's word names, a plane's by `plane`.
+SignedDistanceModel::ConstPtr makeSignedDistance(TsdfIntegrator::SignedDistance distance,
+                                                 const PlaneDistanceConfig& plane);
 
 } // namespace msf
 

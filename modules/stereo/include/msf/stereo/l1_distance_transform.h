@@ -15,8 +15,8 @@ constexpr int kL1DistanceCap = 8192;
 /// nearest zero pixel of it, capped at kL1DistanceCap: the values of
 /// cv::distanceTransform(mask, distance, cv::DIST_L1, 3, CV_32F), computed in two separable
 /// passes on cv::parallel_for_ (the distance along each row, then forward and backward
-/// column scans vectorised across columns) instead of its serial chamfer sweep: on a KITTI
-/// disparity mask 0.8 ms of CPU against its 4 ms. `type` is CV_32F (as OpenCV) or CV_16U.
+/// column scans vectorised across columns) instead of its serial chamfer sweep, which is
+/// several times slower. `type` is CV_32F (as OpenCV) or CV_16U.
 /// Throws InvalidInputError for a mask that is empty or not CV_8UC1, or another type.
 void l1DistanceTransform(const cv::Mat& mask, cv::Mat& distance, int type = CV_32F);
 

@@ -10,8 +10,8 @@ namespace msf {
 /// pixels connected through 4-neighbours whose values differ by at most `max_diff` (pixels
 /// equal to `new_value` belong to none). Each band cuts its rows into runs of connected
 /// pixels and labels them with union-find; the labels of regions crossing a band border
-/// are then joined, and a last parallel pass clears the small regions' runs (on a KITTI
-/// frame 0.9 ms of CPU against OpenCV's flood fill's 3.5 ms). `buffer` is scratch memory
+/// are then joined, and a last parallel pass clears the small regions' runs (a few times less
+/// CPU than OpenCV's flood fill). `buffer` is scratch memory
 /// kept between calls (five ints a pixel, mostly untouched). Throws InvalidInputError for an
 /// empty image or another type.
 void filterSpecklesParallel(cv::Mat& disparity, int new_value, int max_speckle_size, int max_diff, cv::Mat& buffer);
