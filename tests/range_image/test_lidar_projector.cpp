@@ -14,6 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include <cmath>
+#include <thread>
+#include <vector>
 
 namespace {
 
@@ -134,6 +136,45 @@ TEST(LidarProjector, BadConfigsAndMissingCalibration) {
   EXPECT_THROW(msf::LidarProjector{no_size}, msf::CalibrationError);
   cv::Mat depth;
   EXPECT_THROW(msf::LidarProjector().projectToImage(pcl::PointCloud<pcl::PointXYZI>(), depth), msf::InvalidInputError);
+}
+
+TEST(LidarProjector, OneProjectorServesSeveralThreadsAtOnce) {
+  // Two threads project two different KITTI scans through one const projector, many times
+  // over: each gets exactly what a projection alone gives.
+  MSF_REQUIRE_KITTI();
+  const msf::Sequence sequence(msf::test::kittiDir() + "/odometry/sequences/04");
+  pcl::PointCloud<pcl::PointXYZI> scans[2];
+  msf::loadVelodyneBin(sequence.scanPath(0), scans[0]);
+  msf::loadVelodyneBin(sequence.scanPath(5), scans[1]);
+  const msf::LidarProjector projector(sequence.calibration());
+  cv::Mat expected_depth[2], expected_intensity[2];
+  pcl::PointCloud<msf::PointXYZID> expected_cloud[2];
+  for (int k = 0; k < 2; ++k) {
+    projector.projectToCanvas(scans[k], expected_depth[k], &expected_intensity[k]);
+    projector.project(scans[k], expected_cloud[k]);
+  }
+  ASSERT_GT(cv::norm(expected_depth[0], expected_depth[1], cv::NORM_INF), 0.0); // the scans differ
+  std::vector<int> mismatches(2, 0);
+  auto work = [&](int k) {
+    for (int round = 0; round < 20; ++round) {
+      cv::Mat depth, intensity;
+      pcl::PointCloud<msf::PointXYZID> cloud;
+      projector.projectToCanvas(scans[k], depth, &intensity);
+      projector.project(scans[k], cloud);
+      bool same = cv::norm(depth, expected_depth[k], cv::NORM_INF) == 0.0 &&
+                  cv::norm(intensity, expected_intensity[k], cv::NORM_INF) == 0.0 &&
+                  cloud.size() == expected_cloud[k].size();
+      for (std::size_t i = 0; same && i < cloud.size(); ++i)
+        same = std::isfinite(cloud[i].z) ? cloud[i].z == expected_cloud[k][i].z
+                                         : !std::isfinite(expected_cloud[k][i].z);
+      mismatches[k] += !same;
+    }
+  };
+  std::thread other(work, 1);
+  work(0);
+  other.join();
+  EXPECT_EQ(mismatches[0], 0);
+  EXPECT_EQ(mismatches[1], 0);
 }
 
 TEST(LidarProjector, RealKittiScan) {

@@ -11,8 +11,24 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace msf {
+
+namespace {
+/// A projection's buffers, one set per calling thread: the projector's const methods may run on
+/// several threads at once, and each thread reuses its buffers from scan to scan.
+struct ProjectionScratch {
+  std::vector<int> pixel;   ///< per scan point: pixel index or -1
+  std::vector<float> depth; ///< per scan point: depth in the camera
+  cv::Mat winner;           ///< per pixel: the index of the winning return, -1 none
+};
+
+ProjectionScratch& projectionScratch() {
+  thread_local ProjectionScratch scratch;
+  return scratch;
+}
+} // namespace
 
 void ProjectionConfig::validate() const {
   checkKeyRanges(*this);
@@ -69,8 +85,11 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
     throw InvalidInputError("LidarProjector: no calibration set");
   const int W = camera_.width + 2 * margin, H = camera_.height + 2 * margin;
   const int n = static_cast<int>(scan.size());
-  pixel_.resize(scan.size());
-  depth_.resize(scan.size());
+  // This thread's buffers, bound here: the workers below write into them, not their own.
+  std::vector<int>& pixel = projectionScratch().pixel;
+  std::vector<float>& point_depth = projectionScratch().depth;
+  pixel.resize(scan.size());
+  point_depth.resize(scan.size());
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
   const float fx = camera_.fx, fy = camera_.fy, skew = skew_;
   const float cx = camera_.cx + static_cast<float>(margin), cy = camera_.cy + static_cast<float>(margin);
@@ -82,7 +101,7 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
   parallelFor(cv::Range(0, n), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const pcl::PointXYZI& p = scan[static_cast<std::size_t>(i)];
-      pixel_[i] = -1;
+      pixel[i] = -1;
       const float z = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2) * p.z + T(2, 3);
       if (!(z > 0.f))
         continue; // behind the camera (or NaN)
@@ -97,8 +116,8 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
       if (!(u > -0.5f && u < umax && v > -0.5f && v < vmax))
         continue;
       // Pixel centres are integers (as in depthImageToCloud): round to nearest, u + 0.5 > 0.
-      pixel_[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
-      depth_[i] = z;
+      pixel[i] = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
+      point_depth[i] = z;
     }
   });
 
@@ -112,11 +131,11 @@ void LidarProjector::scatter(const pcl::PointCloud<pcl::PointXYZI>& scan, int ma
     w = winner->ptr<int>();
   }
   for (int i = 0; i < n; ++i) {
-    const int k = pixel_[i];
+    const int k = pixel[i];
     if (k < 0)
       continue;
-    if (d[k] == 0.f || depth_[i] < d[k]) {
-      d[k] = depth_[i];
+    if (d[k] == 0.f || point_depth[i] < d[k]) {
+      d[k] = point_depth[i];
       if (w)
         w[k] = i;
     }
@@ -129,9 +148,10 @@ void LidarProjector::projectDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, i
     scatter(scan, margin, depth, nullptr);
     return;
   }
-  scatter(scan, margin, depth, &winner_);
+  cv::Mat& winner = projectionScratch().winner;
+  scatter(scan, margin, depth, &winner);
   intensity->create(depth.size(), CV_32FC1);
-  const int* w = winner_.ptr<int>();
+  const int* w = winner.ptr<int>();
   float* out = intensity->ptr<float>();
   const int total = static_cast<int>(depth.total());
   parallelFor(cv::Range(0, total), [&](const cv::Range& range) {
@@ -167,7 +187,8 @@ template <typename PointT>
 void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, int margin,
                                   pcl::PointCloud<PointT>& cloud) const {
   cv::Mat depth;
-  scatter(scan, margin, depth, &winner_);
+  cv::Mat& winner = projectionScratch().winner;
+  scatter(scan, margin, depth, &winner);
   const int W = depth.cols, H = depth.rows;
   cloud.resize(static_cast<std::size_t>(W) * H);
   cloud.width = static_cast<std::uint32_t>(W);
@@ -176,7 +197,7 @@ void LidarProjector::projectCloud(const pcl::PointCloud<pcl::PointXYZI>& scan, i
   cloud.header.frame_id = cameraFrameId(config_.camera);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const Eigen::Matrix<float, 3, 4> T = T_cam_velo_;
-  const int* w = winner_.ptr<int>();
+  const int* w = winner.ptr<int>();
   std::atomic<bool> dense{true};
   parallelFor(cv::Range(0, W * H), [&](const cv::Range& range) {
     bool all = true;

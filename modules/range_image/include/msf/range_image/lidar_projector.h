@@ -43,7 +43,8 @@ struct ProjectionConfig {
 /// (a precomputed 3x4 matrix in float, one pass); points behind the camera, outside the
 /// image or outside [min_range, max_range] (distance from the LiDAR) are dropped, and
 /// where several land on one pixel the nearest wins. Pixel centres are integers.
-/// Not thread-safe: an object keeps per-point work buffers between scans.
+/// The const methods may be called from several threads at once: the work buffers are per
+/// thread, reused from scan to scan.
 class LidarProjector {
 public:
   using Ptr = std::shared_ptr<LidarProjector>;
@@ -104,9 +105,6 @@ private:
   Eigen::Matrix<float, 3, 4> T_cam_velo_ = Eigen::Matrix<float, 3, 4>::Zero(); ///< the same, as projected
   float skew_ = 0.f;
   bool calibrated_ = false;
-  mutable std::vector<int> pixel_;    ///< per scan point: pixel index or -1
-  mutable std::vector<float> depth_;  ///< per scan point: depth in the camera
-  mutable cv::Mat winner_;
 };
 
 } // namespace msf
