@@ -14,9 +14,11 @@ DEMO_OUT ?= out/demo
 PYTHON_PACKAGES := pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-yaml
 # The ros module (bag reader, msf_kitti2bag, msf_ros_node) and its tests: Debian's ROS 1
 # (roscore, rosbag, roslaunch, rostopic in ros-core; the C++ libraries and messages), and
-# procps (pgrep, ps) with which the node's test makes sure nothing it started is left.
+# procps (pgrep, ps) with which the node's test makes sure nothing it started is left;
+# python3-sensor-msgs, with which rostopic counts the depth images the node publishes.
 ROS_PACKAGES := ros-core libroscpp-dev librosbag-dev libtf2-ros-dev libtf2-msgs-dev libmessage-filters-dev \
-                libsensor-msgs-dev libvisualization-msgs-dev libcv-bridge-dev libpcl-conversions-dev procps
+                libsensor-msgs-dev libvisualization-msgs-dev libcv-bridge-dev libpcl-conversions-dev procps \
+                python3-sensor-msgs
 # Every Debian package the project needs to build, test and view its results (pcl_viewer);
 # time: GNU time, which the bad-input matrix measures each case's memory with; python3-yaml:
 # PyYAML, which a test reads and writes the configuration files with.

@@ -66,6 +66,8 @@ for ((k = 0; ; ++k)); do
   ((k < 600)) || fail "the node published $(grep -c '^---' "$work/depth_seen.log") depth images of $frames in 60 s"
   sleep 0.1
 done
+seen=$(grep -c '^---' "$work/depth_seen.log" || true)
+((seen >= frames)) || fail "rostopic counted $seen of $frames depth images: $(tr '\n' ' ' < "$work/depth_seen.log")"
 stop_group "$launcher" 30 # the node publishes the last mesh marker, saves the mesh, gives its account
 stop_group "$recorder" 10
 node_lines "$work/launch.log"
