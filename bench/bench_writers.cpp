@@ -1,8 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The cost of writing checked to the end (msf/common/checked_write.h) beside PCL's own writers,
 // in the same run, into /dev/shm (the CPU's cost, not a disk's): an organized KITTI-sized
-// cloud as a binary compressed .pcd (PCL's file writer maps the file; saveCloud goes through
-// PCL's stream writer into a checked stream) and a mesh as a binary .ply (PCL's writer alone;
+// cloud as a binary compressed .pcd (PCL's file writer maps the file; saveCloud writes the same
+// bytes by writeCompressedPcd into a checked stream) and a mesh as a binary .ply (PCL's writer alone;
 // saveMesh, the same writer through the checked pipe). 10 repetitions of 5 writes; median and
 // minimum over the repetitions.
 //

@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/checked_write.h>
 #include <msf/io/impl/cloud_io.hpp>
+#include <msf/io/compressed_pcd.h>
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
@@ -654,10 +655,18 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
 
 void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
                    const Eigen::Quaternionf& orientation) {
+  detail::saveCloudData(path, blob, blob.data.data(), blob.data.size(), origin, orientation);
+}
+
+void detail::saveCloudData(const std::string& path, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
+                           std::size_t bytes, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation) {
   const std::string ext = fileExtension(path);
   if (ext != ".pcd" && ext != ".ply")
     throw IOError("cannot write '" + path + "': a cloud is written as .pcd or .ply");
   if (ext == ".ply") {
+    pcl::PCLPointCloud2 blob = layout;
+    if (blob.data.data() != data)
+      blob.data.assign(data, data + bytes);
     writeThroughPipeAtomically(path, [&](const std::string& sink) {
       if (pcl::PLYWriter().write(sink, blob, origin, orientation, true, false) != 0)
         throw IOError("cannot write cloud '" + path + "'");
@@ -667,10 +676,10 @@ void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob, con
   // The compressed format keeps its sizes in 32 bits, and PCL's writer needs room for half as
   // much again (it refuses, or its template version crashes, beyond).
   std::uint64_t point_bytes = 0;
-  for (const auto& f : blob.fields)
+  for (const auto& f : layout.fields)
     if (f.name != "_")
       point_bytes += static_cast<std::uint64_t>(f.count) * pcl::getFieldSize(f.datatype);
-  const std::uint64_t points = static_cast<std::uint64_t>(blob.width) * blob.height;
+  const std::uint64_t points = static_cast<std::uint64_t>(layout.width) * layout.height;
   constexpr std::uint64_t kMaxCompressedData = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
   if (points * point_bytes > kMaxCompressedData)
     throw IOError("cannot write '" + path + "': its " + std::to_string(points) + " points of " +
@@ -678,8 +687,7 @@ void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob, con
                   " bytes, more than a binary_compressed .pcd holds (" + std::to_string(kMaxCompressedData) +
                   ": its sizes are 32-bit)");
   writeStreamAtomically(path, [&](std::ostream& out) {
-    if (pcl::PCDWriter().writeBinaryCompressed(out, blob, origin, orientation) != 0)
-      throw IOError("cannot write cloud '" + path + "'");
+    writeCompressedPcd(out, layout, data, bytes, origin, orientation);
   });
 }
 

@@ -4,6 +4,7 @@
 #include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/cloud_io.hpp>
+#include <msf/io/compressed_pcd.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <opencv2/core/utility.hpp>
@@ -361,23 +362,12 @@ void TsdfVolume::save(const std::string& path) const {
   toCloud(cloud);
   if (cloud.empty())
     throw InvalidInputError("cannot write volume '" + path + "': it has no observed voxel");
-  // PCL formats the file; the parameters go into a comment line after its first line, which
-  // PCD readers (pcl_viewer included) skip.
-  pcl::PCLPointCloud2 blob;
-  pcl::toPCLPointCloud2(cloud, blob);
-  std::ostringstream formatted;
-  if (pcl::PCDWriter().writeBinaryCompressed(formatted, blob) != 0)
-    throw IOError("cannot write volume '" + path + "'");
-  const std::string bytes = formatted.str();
-  const auto eol = bytes.find('\n');
-  if (eol == std::string::npos)
-    throw IOError("cannot write volume '" + path + "': PCL wrote no header");
+  // The parameters go into a comment line after the file's first line, which PCD readers
+  // (pcl_viewer included) skip.
   const std::string comment = std::string(kHeaderTag) + " voxel_size_m " + number(voxel_size_) + " truncation_m " +
                               number(truncation_) + "\n";
   writeStreamAtomically(path, [&](std::ostream& out) {
-    out.write(bytes.data(), static_cast<std::streamsize>(eol + 1));
-    out.write(comment.data(), static_cast<std::streamsize>(comment.size()));
-    out.write(bytes.data() + eol + 1, static_cast<std::streamsize>(bytes.size() - eol - 1));
+    writeCompressedPcd(out, cloud, comment);
   });
 }
 

@@ -3,6 +3,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/cloud_io.h>
+#include <msf/io/compressed_pcd.h>
 #include <msf/io/field_conversion.h>
 
 #include <pcl/PCLPointCloud2.h>
@@ -43,13 +44,19 @@ void fromCloudBlob(pcl::PCLPointCloud2 blob, pcl::PointCloud<PointT>& cloud, con
   pcl::fromPCLPointCloud2(blob, cloud);
 }
 
+namespace detail {
+/// saveCloudBlob with the points in `data` (`bytes` of them), laid out as `layout` says.
+void saveCloudData(const std::string& path, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
+                   std::size_t bytes, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation);
+} // namespace detail
+
 template <typename PointT>
 void saveCloud(const std::string& path, const pcl::PointCloud<PointT>& cloud) {
   if (cloud.empty())
     throw InvalidInputError("cannot write '" + path + "': the cloud is empty");
-  pcl::PCLPointCloud2 blob;
-  pcl::toPCLPointCloud2(cloud, blob);
-  saveCloudBlob(path, blob, cloud.sensor_origin_, cloud.sensor_orientation_);
+  // The points are read where they lie, not copied into a PCLPointCloud2.
+  detail::saveCloudData(path, pointLayout(cloud), reinterpret_cast<const std::uint8_t*>(cloud.data()),
+                        cloud.size() * sizeof(PointT), cloud.sensor_origin_, cloud.sensor_orientation_);
 }
 
 } // namespace msf

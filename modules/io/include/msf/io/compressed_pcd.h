@@ -1,0 +1,52 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/conversions.h>
+#include <pcl/point_cloud.h>
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+namespace msf {
+
+/// Writes `blob` to `out` as a binary_compressed .pcd: byte for byte what PCL's
+/// PCDWriter::writeBinaryCompressed writes (its header, each field's values side by side,
+/// compressed by pcl::lzfCompress), with `comment` (whole "# ..." lines, each ending in a
+/// newline) after the first line, where PCD readers skip it. PCL's stream writer hands the
+/// compressed body to the stream a character at a time, which dominates the writing of a
+/// large cloud; here it is one write. Throws IOError when the points are more than the
+/// format's 32-bit sizes hold or do not compress.
+void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
+                        const Eigen::Quaternionf& orientation, const std::string& comment = "");
+
+/// The same with the points in `data` (`bytes` of them), laid out as `layout` says; its own
+/// data is not read.
+void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
+                        std::size_t bytes, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+                        const std::string& comment = "");
+
+/// What a PCLPointCloud2 of `cloud` holds but its points: the fields and the size.
+template <typename PointT>
+pcl::PCLPointCloud2 pointLayout(const pcl::PointCloud<PointT>& cloud) {
+  pcl::PCLPointCloud2 layout;
+  pcl::toPCLPointCloud2(pcl::PointCloud<PointT>(), layout); // the fields
+  layout.width = cloud.width;
+  layout.height = cloud.height;
+  layout.point_step = sizeof(PointT);
+  layout.row_step = layout.point_step * cloud.width;
+  layout.is_dense = cloud.is_dense;
+  return layout;
+}
+
+/// The same for a cloud, read where it lies (no copy into a PCLPointCloud2).
+template <typename PointT>
+void writeCompressedPcd(std::ostream& out, const pcl::PointCloud<PointT>& cloud, const std::string& comment = "") {
+  writeCompressedPcd(out, pointLayout(cloud), reinterpret_cast<const std::uint8_t*>(cloud.data()),
+                     cloud.size() * sizeof(PointT), cloud.sensor_origin_, cloud.sensor_orientation_, comment);
+}
+
+} // namespace msf

@@ -1,0 +1,109 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// writeCompressedPcd against PCL's own binary_compressed writer, byte for byte.
+#include <msf/common/exceptions.h>
+#include <msf/io/cloud_io.h>
+#include <msf/io/compressed_pcd.h>
+#include <msf/io/impl/cloud_io.hpp>
+
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <random>
+#include <sstream>
+
+namespace {
+
+/// `n` points of PointXYZRGBNormal (fields with padding between them), values of a noisy surface.
+pcl::PCLPointCloud2 surfaceBlob(std::size_t n) {
+  pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.f, 0.01f);
+  for (std::size_t i = 0; i < n; ++i) {
+    pcl::PointXYZRGBNormal p;
+    p.x = 0.1f * static_cast<float>(i % 100);
+    p.y = 0.1f * static_cast<float>(i / 100);
+    p.z = 2.f + noise(rng);
+    p.r = static_cast<std::uint8_t>(i % 256);
+    p.g = 100;
+    p.b = 7;
+    p.normal_x = noise(rng);
+    p.normal_y = 0.f;
+    p.normal_z = 1.f;
+    p.curvature = noise(rng);
+    cloud.push_back(p);
+  }
+  cloud.sensor_origin_ = Eigen::Vector4f(1, 2, 3, 0);
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(cloud, blob);
+  return blob;
+}
+
+std::string pclWrites(const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin) {
+  std::ostringstream out;
+  EXPECT_EQ(pcl::PCDWriter().writeBinaryCompressed(out, blob, origin, Eigen::Quaternionf::Identity()), 0);
+  return out.str();
+}
+
+std::string weWrite(const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin, const std::string& comment = "") {
+  std::ostringstream out;
+  msf::writeCompressedPcd(out, blob, origin, Eigen::Quaternionf::Identity(), comment);
+  return out.str();
+}
+
+TEST(CompressedPcd, TheBytesArePclsOwn) {
+  const Eigen::Vector4f origin(1, 2, 3, 0);
+  for (std::size_t n : {0u, 1u, 5000u}) {
+    const pcl::PCLPointCloud2 blob = surfaceBlob(n);
+    const std::string expected = pclWrites(blob, origin), written = weWrite(blob, origin);
+    EXPECT_GT(written.size(), 100u);
+    EXPECT_TRUE(written == expected) << n << " points: " << written.size() << " bytes against PCL's "
+                                     << expected.size();
+    // The cloud itself, read where it lies, gives the same bytes.
+    pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
+    pcl::fromPCLPointCloud2(blob, cloud);
+    cloud.sensor_origin_ = origin;
+    std::ostringstream from_cloud;
+    msf::writeCompressedPcd(from_cloud, cloud);
+    EXPECT_TRUE(from_cloud.str() == expected) << n << " points, from the cloud";
+  }
+}
+
+TEST(CompressedPcd, ACommentFollowsTheFirstLineAndPclReadsThePointsBack) {
+  const pcl::PCLPointCloud2 blob = surfaceBlob(3000);
+  const std::string comment = "# made by a test\n";
+  const std::string written = weWrite(blob, Eigen::Vector4f::Zero(), comment);
+  std::string expected = pclWrites(blob, Eigen::Vector4f::Zero());
+  expected.insert(expected.find('\n') + 1, comment);
+  EXPECT_TRUE(written == expected);
+
+  msf::test::TempDir dir;
+  msf::saveCloudBlob(dir.file("c.pcd"), blob);
+  pcl::PointCloud<pcl::PointXYZRGBNormal> back, original;
+  pcl::fromPCLPointCloud2(blob, original);
+  msf::loadCloud(dir.file("c.pcd"), back);
+  ASSERT_EQ(back.size(), original.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].z, original[i].z);
+    EXPECT_EQ(back[i].rgba, original[i].rgba);
+    EXPECT_EQ(back[i].curvature, original[i].curvature);
+  }
+}
+
+TEST(CompressedPcd, DataShorterThanItsPointsIsRefused) {
+  pcl::PCLPointCloud2 blob = surfaceBlob(100);
+  blob.data.resize(blob.data.size() / 2);
+  std::ostringstream out;
+  try {
+    msf::writeCompressedPcd(out, blob, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
+    ADD_FAILURE() << "a cloud with half its data was written";
+  } catch (const msf::IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("not its 100 points"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(out.str().empty());
+}
+
+} // namespace
