@@ -18,7 +18,7 @@
 namespace {
 
 /// `n` points of PointXYZRGBNormal (fields with padding between them), values of a noisy surface.
-pcl::PCLPointCloud2 surfaceBlob(std::size_t n) {
+pcl::PointCloud<pcl::PointXYZRGBNormal> surfaceCloud(std::size_t n) {
   pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
   std::mt19937 rng(3);
   std::normal_distribution<float> noise(0.f, 0.01f);
@@ -37,8 +37,12 @@ pcl::PCLPointCloud2 surfaceBlob(std::size_t n) {
     cloud.push_back(p);
   }
   cloud.sensor_origin_ = Eigen::Vector4f(1, 2, 3, 0);
+  return cloud;
+}
+
+pcl::PCLPointCloud2 surfaceBlob(std::size_t n) {
   pcl::PCLPointCloud2 blob;
-  pcl::toPCLPointCloud2(cloud, blob);
+  pcl::toPCLPointCloud2(surfaceCloud(n), blob);
   return blob;
 }
 
@@ -63,9 +67,7 @@ TEST(CompressedPcd, TheBytesArePclsOwn) {
     EXPECT_TRUE(written == expected) << n << " points: " << written.size() << " bytes against PCL's "
                                      << expected.size();
     // The cloud itself, read where it lies, gives the same bytes.
-    pcl::PointCloud<pcl::PointXYZRGBNormal> cloud;
-    pcl::fromPCLPointCloud2(blob, cloud);
-    cloud.sensor_origin_ = origin;
+    const pcl::PointCloud<pcl::PointXYZRGBNormal> cloud = surfaceCloud(n);
     std::ostringstream from_cloud;
     msf::writeCompressedPcd(from_cloud, cloud);
     EXPECT_TRUE(from_cloud.str() == expected) << n << " points, from the cloud";

@@ -34,10 +34,11 @@ template <typename PointT>
 pcl::PCLPointCloud2 pointLayout(const pcl::PointCloud<PointT>& cloud) {
   pcl::PCLPointCloud2 layout;
   pcl::toPCLPointCloud2(pcl::PointCloud<PointT>(), layout); // the fields
-  layout.width = cloud.width;
-  layout.height = cloud.height;
+  const bool unsized = cloud.width == 0 && cloud.height == 0; // as pcl::toPCLPointCloud2 takes it
+  layout.width = unsized ? static_cast<std::uint32_t>(cloud.size()) : cloud.width;
+  layout.height = unsized ? 1 : cloud.height;
   layout.point_step = sizeof(PointT);
-  layout.row_step = layout.point_step * cloud.width;
+  layout.row_step = layout.point_step * layout.width;
   layout.is_dense = cloud.is_dense;
   return layout;
 }
