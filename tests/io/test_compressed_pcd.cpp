@@ -109,3 +109,23 @@ TEST(CompressedPcd, DataShorterThanItsPointsIsRefused) {
 }
 
 } // namespace
+
+namespace {
+
+TEST(CompressedPcd, MorePointsThanTheFormatHoldsAreRefusedByNameWithNoFile) {
+  pcl::PCLPointCloud2 blob = surfaceBlob(1);
+  blob.width = 1000000000; // a header's claim: 1e9 points, no data behind it
+  msf::test::TempDir dir;
+  try {
+    msf::saveCloudBlob(dir.file("huge.pcd"), blob);
+    ADD_FAILURE() << "a cloud beyond the format's 32-bit sizes was written";
+  } catch (const msf::IOError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cannot write '" + dir.file("huge.pcd") + "': its 1000000000 points of"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("its sizes are 32-bit"), std::string::npos) << what;
+  }
+  EXPECT_EQ(msf::test::countEntries(dir.path()), 0u) << "a file or temporary was left";
+}
+
+} // namespace

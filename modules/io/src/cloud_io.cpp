@@ -664,30 +664,25 @@ void detail::saveCloudData(const std::string& path, const pcl::PCLPointCloud2& l
   if (ext != ".pcd" && ext != ".ply")
     throw IOError("cannot write '" + path + "': a cloud is written as .pcd or .ply");
   if (ext == ".ply") {
-    pcl::PCLPointCloud2 blob = layout;
-    if (blob.data.data() != data)
-      blob.data.assign(data, data + bytes);
+    // PCL's PLY writer takes a PCLPointCloud2: the points are copied in unless they are its own.
+    pcl::PCLPointCloud2 copy;
+    if (layout.data.data() != data) {
+      copy = layout;
+      copy.data.assign(data, data + bytes);
+    }
+    const pcl::PCLPointCloud2& blob = layout.data.data() == data ? layout : copy;
     writeThroughPipeAtomically(path, [&](const std::string& sink) {
       if (pcl::PLYWriter().write(sink, blob, origin, orientation, true, false) != 0)
         throw IOError("cannot write cloud '" + path + "'");
     });
     return;
   }
-  // The compressed format keeps its sizes in 32 bits, and PCL's writer needs room for half as
-  // much again (it refuses, or its template version crashes, beyond).
-  std::uint64_t point_bytes = 0;
-  for (const auto& f : layout.fields)
-    if (f.name != "_")
-      point_bytes += static_cast<std::uint64_t>(f.count) * pcl::getFieldSize(f.datatype);
-  const std::uint64_t points = static_cast<std::uint64_t>(layout.width) * layout.height;
-  constexpr std::uint64_t kMaxCompressedData = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
-  if (points * point_bytes > kMaxCompressedData)
-    throw IOError("cannot write '" + path + "': its " + std::to_string(points) + " points of " +
-                  std::to_string(point_bytes) + " bytes make " + std::to_string(points * point_bytes) +
-                  " bytes, more than a binary_compressed .pcd holds (" + std::to_string(kMaxCompressedData) +
-                  ": its sizes are 32-bit)");
   writeStreamAtomically(path, [&](std::ostream& out) {
-    writeCompressedPcd(out, layout, data, bytes, origin, orientation);
+    try {
+      writeCompressedPcd(out, layout, data, bytes, origin, orientation);
+    } catch (const IOError& e) { // checked before a byte is written; the atomic write leaves no file
+      throw IOError("cannot write '" + path + "': " + e.what());
+    }
   });
 }
 

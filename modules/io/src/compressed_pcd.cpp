@@ -79,11 +79,15 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
   std::size_t point_bytes = 0;
   for (const FieldPlane& f : fields)
     point_bytes += f.bytes;
+  // The format keeps its sizes in 32 bits, and the compressed body may need half as much again.
   const std::size_t bytes = points * point_bytes, room = bytes * 3 / 2;
-  if (room > std::numeric_limits<std::uint32_t>::max())
-    throw IOError("a cloud of " + std::to_string(bytes) + " bytes is more than a binary_compressed .pcd holds");
+  constexpr std::size_t kMaxBytes = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
+  if (bytes > kMaxBytes)
+    throw IOError("its " + std::to_string(points) + " points of " + std::to_string(point_bytes) + " bytes make " +
+                  std::to_string(bytes) + " bytes, more than a binary_compressed .pcd holds (" +
+                  std::to_string(kMaxBytes) + ": its sizes are 32-bit)");
   if (data_bytes < points * layout.point_step)
-    throw IOError("a cloud's data holds " + std::to_string(data_bytes) + " bytes, not its " +
+    throw IOError("its data holds " + std::to_string(data_bytes) + " bytes, not its " +
                   std::to_string(points) + " points of " + std::to_string(layout.point_step));
   std::uint32_t sizes[2] = {0, 0}; // compressed, uncompressed
   std::unique_ptr<char[]> compressed;
@@ -94,7 +98,7 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
                                 static_cast<unsigned int>(room));
     sizes[1] = static_cast<std::uint32_t>(bytes);
     if (sizes[0] == 0)
-      throw IOError("a cloud of " + std::to_string(bytes) + " bytes does not compress");
+      throw IOError("its " + std::to_string(bytes) + " bytes do not compress");
   }
   const std::string text = header(layout, origin, orientation, comment);
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
