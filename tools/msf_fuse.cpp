@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // Paper step 4: fuses an interpolated LiDAR cloud and a stereo cloud of one camera (both
-// organized, same size) into one organized cloud, per pixel (eq. 6 or inverse variance).
+// organized, the LiDAR's of the image or its canvas) into one organized cloud, per pixel
+// (eq. 6 or inverse variance).
 #include <msf/common/atomic_file.h>
 #include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
@@ -163,9 +164,11 @@ int main(int argc, char** argv) {
   msf::tool::CommandLine cli(
       "msf_fuse", "<lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]",
       "Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one organized cloud with "
-      "fields x y z rgb weight (NaN where neither has depth). lidar.pcd: interpolated LiDAR, ideally with the field "
-      "'distance' (pixels to the nearest real return; without it every point counts as a real return). stereo.pcd: "
-      "msf_stereo's output, ideally with 'confidence' (without it every match counts as confident) and 'rgb'.");
+      "fields x y z rgb weight free_space_weight sky_depth (NaN where neither has depth; sky_depth NaN but in the "
+      "open sky). lidar.pcd: interpolated LiDAR, ideally with the field 'distance' (pixels to the nearest real "
+      "return; without it every point counts as a real return); msf_interpolate -canvas's canvas makes the output "
+      "the canvas, the frame msf_reconstruct integrates. stereo.pcd: msf_stereo's output, ideally with "
+      "'confidence' (without it every match counts as confident) and 'rgb'.");
   cli.value("-calib", "PATH", settings.calib_path,
             "KITTI odometry calib.txt, raw date folder, object calib or YAML (f B)")
       .value("-rig", "FILE", settings.calib_path,

@@ -1,7 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // msf_integrate: fuses organized depth clouds (camera frame, NaN = no depth) seen from known
-// poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud; with
-// -scans, each frame's LiDAR scan also clears what it saw through outside the camera's view.
+// poses into a sparse TSDF volume (paper §III-C, eq. 7), saved as a .pcd voxel cloud. The free
+// space each frame saw is carved as msf_reconstruct carves it: in front of its depth, along its
+// open sky (msf_fuse's sky_depth), beyond the range, and with -scans along its LiDAR scan.
 #include <msf/common/atomic_file.h>
 #include <msf/pipeline/config_catalog.h>
 #include <msf/common/exceptions.h>
@@ -19,10 +20,14 @@
 
 #include <pcl/console/time.h>
 #include <pcl/console/print.h>
+#include <pcl/common/io.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +44,38 @@ pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
   else
     msf::loadCloud(path, scan);
   return scan;
+}
+
+/// The open sky a fused cloud carries (field sky_depth, msf_fuse's), in the part of the cloud
+/// that is the camera's image (`image`; empty: the whole cloud): the mask and, per column, the
+/// depth of the LiDAR's highest return (0 where there is none), as TsdfIntegrator::carveSky
+/// takes them. Empty when the cloud has no such field.
+struct CloudSky {
+  cv::Mat mask;
+  std::vector<float> column_depth;
+};
+
+CloudSky readSky(const pcl::PCLPointCloud2& blob, cv::Rect image) {
+  CloudSky sky;
+  const int field = pcl::getFieldIndex(blob, "sky_depth");
+  if (field < 0 || blob.fields[field].datatype != pcl::PCLPointField::FLOAT32)
+    return sky;
+  if (image.empty())
+    image = cv::Rect(0, 0, static_cast<int>(blob.width), static_cast<int>(blob.height));
+  sky.mask = cv::Mat::zeros(image.size(), CV_8UC1);
+  sky.column_depth.assign(static_cast<std::size_t>(image.width), 0.f);
+  const std::uint32_t offset = blob.fields[field].offset;
+  for (int v = 0; v < image.height; ++v)
+    for (int u = 0; u < image.width; ++u) {
+      const std::size_t point = static_cast<std::size_t>(v + image.y) * blob.width + static_cast<std::size_t>(u + image.x);
+      float depth;
+      std::memcpy(&depth, blob.data.data() + point * blob.point_step + offset, sizeof depth);
+      if (std::isnan(depth))
+        continue;
+      sky.mask.at<std::uint8_t>(v, u) = 255;
+      sky.column_depth[static_cast<std::size_t>(u)] = std::isfinite(depth) ? depth : 0.f;
+    }
+  return sky;
 }
 
 /// What the command line sets.
@@ -118,24 +155,46 @@ void selectScans(const msf::tool::CommandLine& cli, const Settings& settings, co
   frames.scans = scans;
 }
 
-/// Integrates every frame, a done line each; returns the integrator's time in ms summed over them.
+/// The camera of a cloud: -calib's, on its canvas when the cloud is the image with a margin
+/// (msf_fuse of msf_interpolate -canvas); nullptr without -calib (recovered from the points).
+std::optional<msf::PinholeCamera> cloudCamera(const pcl::PCLPointCloud2& blob, const msf::PinholeCamera& camera,
+                                              const std::string& what, cv::Rect& image_in_cloud) {
+  image_in_cloud = cv::Rect();
+  if (!camera.valid())
+    return std::nullopt;
+  const cv::Size size(static_cast<int>(blob.width), static_cast<int>(blob.height));
+  image_in_cloud = msf::imageInCanvas(size, {camera.width, camera.height}, what);
+  return image_in_cloud.empty() ? camera : camera.onCanvas(image_in_cloud, size);
+}
+
+/// Integrates every frame, a done line each, and carves the free space it saw as
+/// msf_reconstruct does: the scan's, the open sky's, the rays beyond the range; returns the
+/// integrator's time in ms summed over them.
 double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, const msf::Calibration& calibration,
                        const msf::DepthFusionConfig& fusion, msf::TsdfIntegrator& integrator) {
-  const float scan_weight = 1.f / (fusion.lidar_range_sigma_m * fusion.lidar_range_sigma_m);
+  const float lidar_weight = fusion.lidarRangeWeight();
   pcl::console::TicToc tt;
   double integrate_ms = 0;
   for (std::size_t i = 0; i < frames.clouds.size(); ++i) {
     const std::string& cloud = frames.clouds[i];
+    const Eigen::Isometry3d& T_world_cam = frames.poses[i];
     print_highlight("Integrating ");
     print_value("%s ", cloud.c_str());
     tt.tic();
     pcl::PCLPointCloud2 blob;
     msf::loadCloudBlob(cloud, blob);
-    const msf::DepthFrame frame = msf::toDepthFrame(blob, camera.valid() ? &camera : nullptr, "cloud '" + cloud + "'");
-    integrator.integrate(frame, frames.poses[i]);
+    const std::string what = "cloud '" + cloud + "'";
+    cv::Rect image;
+    const std::optional<msf::PinholeCamera> cloud_camera = cloudCamera(blob, camera, what, image);
+    const msf::DepthFrame frame = msf::toDepthFrame(blob, cloud_camera ? &*cloud_camera : nullptr, what);
+    integrator.integrate(frame, T_world_cam);
     if (!frames.scans.empty())
       integrator.carveWithScan(msf::ScanFreeSpace(loadScan(frames.scans[i])),
-                               frames.poses[i] * calibration.T_cam0_velo, scan_weight, frame.camera, frames.poses[i]);
+                               T_world_cam * calibration.T_cam0_velo, lidar_weight, frame.camera, T_world_cam);
+    const CloudSky sky = readSky(blob, image);
+    integrator.carveSky(sky.mask, image.empty() ? frame.camera : camera, T_world_cam, lidar_weight,
+                        sky.column_depth);
+    integrator.carveBeyondRange(frame, T_world_cam, lidar_weight);
     const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
     integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;
     msf::tool::printDone(tt.toc(), stats.voxels_updated);
@@ -203,7 +262,10 @@ int main(int argc, char** argv) {
       "msf_integrate", "<depth_cloud.pcd>... -poses poses.txt -o volume.pcd [options]",
       "Integrates organized depth clouds (rectified camera 0 frame, NaN where there is no depth) into a sparse TSDF "
       "volume, the i-th cloud seen from the i-th pose (T_world_cam, KITTI odometry format). A cloud's rgb colours "
-      "the voxels; a 'weight' field (1/sigma^2 of the depth, msf_fuse's) is used with -weighting per_pixel.");
+      "the voxels; a 'weight' field (1/sigma^2 of the depth, msf_fuse's) is used with -weighting per_pixel, and "
+      "msf_fuse's 'free_space_weight' and 'sky_depth' weigh and carve the free space. msf_fuse's clouds of the "
+      "LiDAR's canvas (msf_interpolate -canvas) with -calib, the scans (-scans) and msf_reconstruct's -config give "
+      "msf_reconstruct's map.");
   cli.value("-poses", "FILE", settings.poses_path, "the poses, one line per cloud")
       .value("-o", "FILE", settings.output, "the volume (.pcd)")
       .value("-input_dir", "DIR", settings.input_dir, "also every .pcd of DIR, in name order")

@@ -42,7 +42,7 @@ struct Settings {
   msf::InterpolationConfig interpolation;
   msf::IpBasicConfig ip_basic;
   msf::RigAdaptationConfig rig;
-  bool no_gaussian = false;
+  bool no_gaussian = false, canvas = false;
 };
 
 /// The method and the calibration, if any; configure() sets the stages' configs for them.
@@ -140,8 +140,13 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
                                    "or project it first with msf_project");
     msf::LidarCompletion lidar_completion(*completion.calibration, completion.method, settings.projection,
                                           settings.interpolation, settings.ip_basic);
-    lidar_completion.compute(*input, dense);
+    if (settings.canvas)
+      lidar_completion.computeCanvas(*input, dense);
+    else
+      lidar_completion.compute(*input, dense);
   } else {
+    if (settings.canvas)
+      throw msf::InvalidInputError("-canvas needs a scan: '" + in + "' is an organized cloud, which has no margin");
     completeOrganized(*input, completion, settings, dense);
   }
   const std::size_t valid = countValid(dense);
@@ -198,6 +203,9 @@ int main(int argc, char** argv) {
              "scaled to the beams of -calib's rig as the config's are)")
       .value("-max_gap", "N", interpolation.slice.max_gap_px,
              "longer gaps stay empty (interpolation.max_gap_px; scaled as -short_gap)")
+      .flag("-canvas", settings.canvas,
+            "write the whole canvas, the image with its margin of projection.margin_px on every side: what the map "
+            "takes around the fused image (msf_fuse then writes the frame msf_reconstruct integrates)")
       .flag("-no_gaussian", settings.no_gaussian,
             "no Gaussian hole filling after the slices (interpolation.gaussian: false)")
       .value("-threads", "N", interpolation.threads, "at most N threads of OpenCV's pool (0: all)");

@@ -424,7 +424,7 @@ private:
     if (source_maps_)
       source_maps_->integrate(r);
     if (request_.save_depth)
-      msf::saveCloud(path("depth/" + r.name + ".pcd"), msf::fusedCloud(r.fused, source_.calibration()));
+      msf::saveCloud(path("depth/" + r.name + ".pcd"), msf::fusedCloud(r, source_.calibration()));
     if (panel_frames_.count(r.index)) {
       const std::string name = "depth_" + r.name + ".png";
       msf::writeImage(path(name), msf::framePanel(r, request_.holdout, true_depth));

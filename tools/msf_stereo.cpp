@@ -7,6 +7,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/organized_conversion.h>
@@ -104,8 +105,17 @@ Inputs loadInputs(const std::string& left_path, const std::string& right_path, c
   inputs.right = msf::readImage(right_path, cv::IMREAD_GRAYSCALE);
   if (!settings.color_path.empty())
     inputs.color = msf::readImage(settings.color_path, cv::IMREAD_COLOR);
-  if (!settings.prior_path.empty())
+  if (!settings.prior_path.empty()) {
     loadPrior(settings.prior_path, settings.config.lidarGuidance(), inputs.prior, inputs.guidance);
+    // The LiDAR's canvas (msf_interpolate -canvas): the image's part of it.
+    const cv::Rect image = msf::imageInCanvas(inputs.prior.size(), inputs.left.size(),
+                                              "-prior '" + settings.prior_path + "'");
+    if (!image.empty()) {
+      inputs.prior = inputs.prior(image).clone();
+      if (!inputs.guidance.empty())
+        inputs.guidance = inputs.guidance(image).clone();
+    }
+  }
   msf::tool::printDone(tt.toc(), static_cast<std::size_t>(inputs.left.total()));
   return inputs;
 }
@@ -169,8 +179,8 @@ int main(int argc, char** argv) {
       .value("-disparity_png", "PATH", settings.disparity_path,
              "also write the disparity as a KITTI 16-bit PNG (pixels x 256)")
       .value("-prior", "PATH", settings.prior_path,
-             "organized depth cloud (the interpolated LiDAR) that narrows the search; with stereo.guidance lidar its "
-             "real returns (distance 0) guide it")
+             "organized depth cloud (the interpolated LiDAR, of the image or its canvas) that narrows the search; "
+             "with stereo.guidance lidar its real returns (distance 0) guide it")
       .value("-config", "FILE", [&](const std::string& path) { msf::readStageAndRig(path, config, settings.rig); },
              "YAML config, sections stereo (every SGBM parameter; the options below override it) and rig (the keys "
              "in rows between LiDAR rings follow the rig's beams, as in msf_reconstruct)")

@@ -70,6 +70,46 @@ TEST_F(PipelineTest, FusedDepthEqualsTheChainOfTools) {
   EXPECT_GT(cv::norm(a, plain.computeDepth(frame).fused.depth, cv::NORM_INF), 0.0);
 }
 
+TEST_F(PipelineTest, TheChainOfToolsGivesTheEnginesMapByteForByte) {
+  // msf_interpolate -canvas, msf_stereo, msf_fuse, then msf_integrate with the scans: the fusion
+  // grows the frame onto the LiDAR's canvas and carries its free-space weight and open sky, so the
+  // map is the one msf_reconstruct integrates.
+  const msf::Sequence sequence(dataset());
+  msf::test::TempDir out;
+  const std::string calib = " -calib " + sequence.directory() + "/calib.txt";
+  std::string fused;
+  for (std::size_t i = 0; i < sequence.size(); ++i) {
+    const std::string lidar = out.file("lidar_" + std::to_string(i) + ".pcd");
+    const std::string stereo = out.file("stereo_" + std::to_string(i) + ".pcd");
+    fused += " " + out.file("fused_" + std::to_string(i) + ".pcd");
+    const std::string colour = " -color " + sequence.imagePath(2, i);
+    const std::string steps[][2] = {
+        {"msf_interpolate", sequence.scanPath(i) + " " + lidar + calib + " -canvas"},
+        {"msf_stereo", sequence.imagePath(0, i) + " " + sequence.imagePath(1, i) + " " + stereo + calib + colour +
+                           " -prior " + lidar},
+        {"msf_fuse", lidar + " " + stereo + " " + out.file("fused_" + std::to_string(i) + ".pcd") + calib + colour +
+                         " -left " + sequence.imagePath(0, i)},
+    };
+    for (const auto& step : steps) {
+      const auto r = msf::test::runTool(step[0], step[1]);
+      ASSERT_EQ(r.exit_code, 0) << step[0] << ": " << r.err;
+    }
+  }
+  auto r = msf::test::runTool("msf_integrate", fused + " -poses " + dataset() + "/poses/00.txt" + calib + " -scans " +
+                                                   sequence.directory() + "/velodyne -o " + out.file("volume.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = msf::test::runTool("msf_reconstruct", dataset() + " -panels 0 -o " + out.file("run"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string chained = readFile(out.file("volume.pcd")), engine = readFile(out.file("run/volume.pcd"));
+  EXPECT_GT(engine.size(), 100000u);
+  EXPECT_TRUE(chained == engine) << "the volume of the tools differs from msf_reconstruct's";
+  // The fused clouds are the canvas, and carry the open sky the map is carved along.
+  pcl::PointCloud<msf::PointXYZRGBWeight> first;
+  msf::loadCloud(out.file("fused_0.pcd"), first);
+  EXPECT_GT(first.width, static_cast<std::uint32_t>(sequence.calibration().image_size.width));
+  EXPECT_GT(std::count_if(first.begin(), first.end(), [](const auto& p) { return !std::isnan(p.sky_depth); }), 1000);
+}
+
 TEST_F(PipelineTest, RunIntegratesEveryFrameInOrderAndStopsCleanly) {
   const msf::Sequence sequence(dataset());
   const auto frames = sequence.indices(msf::FrameRange::parse("0:"));

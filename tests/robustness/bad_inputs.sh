@@ -318,6 +318,8 @@ fi
 check "interpolate -threads 100000" 1 "interpolation.threads must be in 0..256, not 100000" -- \
   msf_interpolate "$F/sparse.pcd" o.pcd -threads 100000
 check "interpolate -threads -1" 1 "threads.*not -1" -- msf_interpolate "$F/sparse.pcd" o.pcd -threads -1
+check "interpolate -canvas of an organized cloud" 1 "-canvas needs a scan: '.*sparse.pcd' is an organized cloud" -- \
+  msf_interpolate "$F/sparse.pcd" o.pcd -canvas
 check "info: POINTS 1e9 in a 1.4 KB .pcd" 1 "declares 1000000000 points" -- msf_info "$F/bomb.pcd"
 check "interpolate: POINTS 1e9 in a 1.4 KB .pcd" 1 "bomb.pcd' declares 1000000000 points" -- \
   msf_interpolate "$F/bomb.pcd" o.pcd
@@ -518,6 +520,8 @@ if [ $have_kitti = 1 ]; then
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -num_disparities 1232
   check "stereo -prior without x y z" 1 "-prior '.*wrong_fields.pcd' has no field 'x'" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
+  check "stereo -prior neither the image's size nor its canvas" 1 "-prior '.*sparse.pcd' is [0-9]+x[0-9]+: neither the image's [0-9]+x[0-9]+ nor that image with a margin" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/sparse.pcd"
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
   printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"

@@ -89,13 +89,26 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   if (config_.facade_extension && !left_.empty())
     extendFacades(left_, calibration_, config_, fused_depth, weight, free_weight);
   open_sky_.release();
-  if (config_.clear_sky && !sky_image_.empty()) {
-    if (sky_image_.size() != size)
-      throw InvalidInputError("depth fusion: the sky image is " + std::to_string(sky_image_.cols) + "x" +
-                              std::to_string(sky_image_.rows) + ", the depth images " + std::to_string(size.width) +
-                              "x" + std::to_string(size.height));
-    open_sky_ = withholdClearSky(sky_, sky_image_, realReturns(lidar, distance), fused_depth, weight, free_weight);
+  returns_.release();
+  if (sky_image_.empty())
+    return;
+  if (sky_image_.size() != size)
+    throw InvalidInputError("depth fusion: the sky image is " + std::to_string(sky_image_.cols) + "x" +
+                            std::to_string(sky_image_.rows) + ", the depth images " + std::to_string(size.width) +
+                            "x" + std::to_string(size.height));
+  returns_ = realReturns(lidar, distance);
+  if (config_.clear_sky)
+    open_sky_ = withholdClearSky(sky_, sky_image_, returns_, fused_depth, weight, free_weight);
+}
+
+void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const {
+  if (returns_.empty()) {
+    sky.release();
+    column_depth.clear();
+    return;
   }
+  sky = open_sky_.empty() ? sky_.compute(sky_image_, returns_) : open_sky_;
+  column_depth = sky_.topReturnDepth(returns_);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

@@ -30,6 +30,27 @@ PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int
   return c;
 }
 
+PinholeCamera PinholeCamera::onCanvas(const cv::Rect& image_in_canvas, const cv::Size& canvas) const {
+  PinholeCamera c = *this;
+  c.cx += static_cast<float>(image_in_canvas.x);
+  c.cy += static_cast<float>(image_in_canvas.y);
+  c.width = canvas.width;
+  c.height = canvas.height;
+  return c;
+}
+
+cv::Rect imageInCanvas(const cv::Size& canvas, const cv::Size& image, const std::string& what) {
+  if (canvas == image)
+    return {};
+  const int margin_x = (canvas.width - image.width) / 2, margin_y = (canvas.height - image.height) / 2;
+  if (margin_x <= 0 || margin_y <= 0 || canvas.width != image.width + 2 * margin_x ||
+      canvas.height != image.height + 2 * margin_y)
+    throw InvalidInputError(what + " is " + std::to_string(canvas.width) + "x" + std::to_string(canvas.height) +
+                            ": neither the image's " + std::to_string(image.width) + "x" +
+                            std::to_string(image.height) + " nor that image with a margin on every side");
+  return {margin_x, margin_y, image.width, image.height};
+}
+
 void PinholeFit::add(double u, double v, double x, double y, double z) {
   const double a = x / z, b = y / z;
   n_ += 1;

@@ -1,10 +1,15 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/impl/organized_conversion.hpp> // depthImageToCloud for the fused point type
+#include <msf/fusion/sky_mask.h>
 #include <msf/pipeline/fused_cloud.h>
+
 
 namespace msf {
 
-pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const DepthFrame& fused, const Calibration& calibration) {
+pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const Calibration& calibration) {
+  const DepthFrame& fused = result.fused;
+  const cv::Mat& free_weight = fused.free_space_weight.empty() ? fused.weight : fused.free_space_weight;
+  const bool has_sky = !result.sky.empty() && result.sky.size() == fused.depth.size();
   pcl::PointCloud<PointXYZRGBWeight> cloud;
   depthImageToCloud(fused.depth, calibration, 0, cloud);
   for (int v = 0; v < fused.depth.rows; ++v)
@@ -16,6 +21,11 @@ pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const DepthFrame& fused, const Cal
       p.r = bgr[2];
       p.a = 255;
       p.weight = fused.weight.at<float>(v, u);
+      p.free_space_weight = free_weight.at<float>(v, u);
+      const bool sky = has_sky && result.sky.at<std::uint8_t>(v, u) != 0;
+      p.sky_depth = skyDepth(sky, sky && static_cast<std::size_t>(u) < result.sky_column_depth.size()
+                                      ? result.sky_column_depth[static_cast<std::size_t>(u)]
+                                      : 0.f);
     }
   return cloud;
 }

@@ -4,7 +4,6 @@
 #include <msf/common/parallel.h>
 #include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
-#include <msf/fusion/sky_mask.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/run_report.h>
@@ -63,7 +62,6 @@ struct Reconstructor::Stages {
   ScanHistory history;    // the earlier scans that step 1 carries into the view
   SgbmStereo stereo;
   DepthImageFusion fusion;
-  SkyMask sky;
 };
 
 Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config)
@@ -149,14 +147,10 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
   result.times.fusion_ms = msSince(start);
 }
 
-void Reconstructor::computeSky(const Frame& frame, FrameResult& result) {
+void Reconstructor::computeSky(FrameResult& result) {
   if (!config_.integrator.sky_carving || !config_.integrator.space_carving)
     return;
-  const cv::Mat returns = realReturns(result.lidar_depth, result.lidar_distance);
-  result.sky = stages_->fusion.getOpenSky(); // found by the fusion (fusion.clear_sky), else here
-  if (result.sky.empty())
-    result.sky = stages_->sky.compute(skyImage(frame.color, frame.left, frame.left.size()), returns);
-  result.sky_column_depth = stages_->sky.topReturnDepth(returns);
+  stages_->fusion.findOpenSky(result.sky, result.sky_column_depth);
 }
 
 bool Reconstructor::lidarBeforeStereo() const {
@@ -188,31 +182,27 @@ void Reconstructor::computeDepth(const Frame& frame, FrameResult& result) {
   }
   result.times.depth_ms = msSince(depth_start);
   computeFusion(frame, result);
-  computeSky(frame, result);
+  computeSky(result);
 }
 
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration) {
   if (!integrator.getConfig().space_carving || result.scan_free_space.empty())
     return;
-  const double sigma = fusion.lidar_range_sigma_m;
   integrator.carveWithScan(result.scan_free_space, result.T_world_cam0 * calibration.T_cam0_velo,
-                           static_cast<float>(1.0 / (sigma * sigma)), camera, result.T_world_cam0);
+                           fusion.lidarRangeWeight(), camera, result.T_world_cam0);
 }
 
 void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
               const DepthFusionConfig& fusion) {
   if (result.sky.empty())
     return;
-  const double sigma = fusion.lidar_range_sigma_m;
-  integrator.carveSky(result.sky, camera, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)),
-                      result.sky_column_depth);
+  integrator.carveSky(result.sky, camera, result.T_world_cam0, fusion.lidarRangeWeight(), result.sky_column_depth);
 }
 
 void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const FrameResult& result,
                       const DepthFusionConfig& fusion) {
-  const double sigma = fusion.lidar_range_sigma_m;
-  integrator.carveBeyondRange(frame, result.T_world_cam0, static_cast<float>(1.0 / (sigma * sigma)));
+  integrator.carveBeyondRange(frame, result.T_world_cam0, fusion.lidarRangeWeight());
 }
 
 void Reconstructor::integrate(FrameResult& result) {

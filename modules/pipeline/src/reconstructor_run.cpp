@@ -125,7 +125,7 @@ struct Reconstructor::Run {
         engine.computeStereo(item->frame, result);
         result.times.depth_ms = msSince(start) + result.times.lidar_ms;
         engine.computeFusion(item->frame, result);
-        engine.computeSky(item->frame, result);
+        engine.computeSky(result);
       } else {
         engine.computeDepth(item->frame, result);
       }

@@ -1,6 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/fusion/fused_canvas.h>
 #include <msf/fusion/fusion_model.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/source_depth_frame.h>
 
 #include <opencv2/core.hpp>
@@ -19,43 +21,15 @@ std::string frameName(const FrameResult& result) {
 /// frame has no canvas around its image.
 cv::Rect imageInCanvas(const FrameResult& result, const cv::Size& image) {
   const cv::Mat& canvas = result.lidar_canvas_depth;
-  if (canvas.empty() || canvas.size() == image)
+  if (canvas.empty())
     return {};
-  const int margin_x = (canvas.cols - image.width) / 2, margin_y = (canvas.rows - image.height) / 2;
-  if (canvas.type() != CV_32FC1 || result.lidar_canvas_distance.size() != canvas.size() || margin_x <= 0 ||
-      margin_y <= 0 || result.lidar_canvas_camera.width != canvas.cols ||
-      result.lidar_canvas_camera.height != canvas.rows)
-    throw InvalidInputError("frame " + frameName(result) + "'s LiDAR canvas (" + std::to_string(canvas.cols) + "x" +
-                            std::to_string(canvas.rows) + ") does not hold its " + std::to_string(image.width) +
-                            "x" + std::to_string(image.height) + " image with its distance image and camera");
-  return {margin_x, margin_y, image.width, image.height};
-}
-
-/// The LiDAR's inverse variances of `depth` (lidarDepthWeight): its interpolation error from the
-/// distance to the nearest real return and, when `range` is given, the local disparity range.
-cv::Mat lidarWeights(const cv::Mat& depth, const cv::Mat& distance, const cv::Mat& range,
-                     const DepthFusionConfig& fusion, float focal_baseline) {
-  cv::Mat weight(depth.size(), CV_32FC1);
-  for (int v = 0; v < depth.rows; ++v) {
-    const float* z = depth.ptr<float>(v);
-    const float* d = distance.empty() ? nullptr : distance.ptr<float>(v);
-    const float* r = range.empty() ? nullptr : range.ptr<float>(v);
-    float* w = weight.ptr<float>(v);
-    for (int u = 0; u < depth.cols; ++u) {
-      const float error_px =
-          fusion.lidar_sigma_per_distance * (d ? d[u] : 0.f) + fusion.lidar_sigma_per_range * (r ? r[u] : 0.f);
-      w[u] = std::isfinite(z[u]) && z[u] > 0.f ? lidarDepthWeight(z[u], error_px, focal_baseline, fusion) : 0.f;
-    }
-  }
-  return weight;
-}
-
-/// The image's colours in the canvas, the border pixels repeated over the margin.
-cv::Mat canvasColour(const cv::Mat& colour, const cv::Rect& image, const cv::Size& canvas) {
-  cv::Mat out;
-  cv::copyMakeBorder(colour, out, image.y, canvas.height - image.br().y, image.x, canvas.width - image.br().x,
-                     cv::BORDER_REPLICATE);
-  return out;
+  const std::string what = "frame " + frameName(result) + "'s LiDAR canvas";
+  const cv::Rect in_canvas = msf::imageInCanvas(canvas.size(), image, what);
+  if (!in_canvas.empty() && (canvas.type() != CV_32FC1 || result.lidar_canvas_distance.size() != canvas.size() ||
+                             result.lidar_canvas_camera.width != canvas.cols ||
+                             result.lidar_canvas_camera.height != canvas.rows))
+    throw InvalidInputError(what + " has no distance image or camera of its size");
+  return in_canvas;
 }
 
 void requireBaseline(double focal_baseline) {
@@ -67,22 +41,12 @@ void requireBaseline(double focal_baseline) {
 
 DepthFrame fusedDepthFrame(const FrameResult& result, const DepthFusionConfig& fusion, double focal_baseline) {
   requireBaseline(focal_baseline);
-  const cv::Rect image = imageInCanvas(result, result.fused.depth.size());
-  if (image.empty())
+  if (imageInCanvas(result, result.fused.depth.size()).empty())
     return result.fused;
-  DepthFrame frame;
+  DepthFrame frame = result.fused;
   frame.camera = result.lidar_canvas_camera;
-  result.lidar_canvas_depth.copyTo(frame.depth);
-  frame.weight = lidarWeights(frame.depth, result.lidar_canvas_distance, cv::Mat(), fusion,
-                              static_cast<float>(focal_baseline));
-  result.fused.depth.copyTo(frame.depth(image));
-  result.fused.weight.copyTo(frame.weight(image));
-  if (!result.fused.free_space_weight.empty()) { // around the image, the LiDAR's own weight
-    frame.free_space_weight = frame.weight.clone();
-    result.fused.free_space_weight.copyTo(frame.free_space_weight(image));
-  }
-  if (!result.fused.color.empty())
-    frame.color = canvasColour(result.fused.color, image, frame.depth.size());
+  growOntoCanvas(result.lidar_canvas_depth, result.lidar_canvas_distance, fusion, static_cast<float>(focal_baseline),
+                 frame.depth, frame.weight, frame.free_space_weight, &frame.color);
   return frame;
 }
 
@@ -114,9 +78,12 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
     cv::Mat range;
     lidarEdgeCue(canvas, focal_baseline, fusion, range);
     out.depth = canvas;
-    out.weight = lidarWeights(canvas, distance, range, fusion, fb);
+    out.weight = lidarWeightImage(canvas, distance, range, fusion, fb);
     out.camera = image.empty() ? result.fused.camera : result.lidar_canvas_camera;
-    out.color = image.empty() ? result.fused.color : canvasColour(result.fused.color, image, canvas.size());
+    out.color = result.fused.color;
+    if (!image.empty())
+      cv::copyMakeBorder(out.color, out.color, image.y, canvas.rows - image.br().y, image.x,
+                         canvas.cols - image.br().x, cv::BORDER_REPLICATE);
   } else {
     out.depth = depth;
     out.color = result.fused.color;

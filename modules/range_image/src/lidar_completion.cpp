@@ -105,12 +105,16 @@ void LidarCompletion::computeDepth(const pcl::PointCloud<pcl::PointXYZI>& scan, 
 }
 
 void LidarCompletion::compute(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointXYZID>& cloud) {
+  computeCanvas(scan, canvas_out_);
+  cropOrganized(canvas_out_, projector_.imageInCanvas(), cloud);
+}
+
+void LidarCompletion::computeCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointXYZID>& cloud) {
   projector_.projectCanvas(scan, *canvas_);
   if (isIpBasic(method_))
-    ip_basic_filter_.filter(canvas_out_);
+    ip_basic_filter_.filter(cloud);
   else
-    compound_filter_.filter(canvas_out_);
-  cropOrganized(canvas_out_, projector_.imageInCanvas(), cloud);
+    compound_filter_.filter(cloud);
 }
 
 } // namespace msf

@@ -66,13 +66,8 @@ void LidarProjector::setConfig(const ProjectionConfig& config) {
 }
 
 PinholeCamera LidarProjector::canvasCamera() const {
-  PinholeCamera c = camera_;
   const int m = config_.margin_px;
-  c.cx += static_cast<float>(m);
-  c.cy += static_cast<float>(m);
-  c.width += 2 * m;
-  c.height += 2 * m;
-  return c;
+  return camera_.onCanvas(imageInCanvas(), {camera_.width + 2 * m, camera_.height + 2 * m});
 }
 
 cv::Rect LidarProjector::imageInCanvas() const {

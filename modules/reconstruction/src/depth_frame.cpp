@@ -47,6 +47,15 @@ const pcl::PCLPointField* findField(const pcl::PCLPointCloud2& cloud, const char
   return nullptr;
 }
 
+/// A field of one float32 that the cloud may have (nullptr when it has none).
+const pcl::PCLPointField* optionalFloatField(const pcl::PCLPointCloud2& cloud, const char* name,
+                                             const std::string& what) {
+  const pcl::PCLPointField* field = findField(cloud, name);
+  if (field && (field->datatype != pcl::PCLPointField::FLOAT32 || field->count != 1))
+    throw InvalidInputError(what + ": field '" + name + "' must be one float32");
+  return field;
+}
+
 float readFloat(const std::uint8_t* p) {
   float f;
   std::memcpy(&f, p, sizeof f);
@@ -65,9 +74,8 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
   const pcl::PCLPointField* frgb = findField(cloud, "rgb");
   if (!frgb)
     frgb = findField(cloud, "rgba");
-  const pcl::PCLPointField* fw = findField(cloud, "weight");
-  if (fw && (fw->datatype != pcl::PCLPointField::FLOAT32 || fw->count != 1))
-    throw InvalidInputError(what + ": field 'weight' must be one float32");
+  const pcl::PCLPointField* fw = optionalFloatField(cloud, "weight", what);
+  const pcl::PCLPointField* ffree = optionalFloatField(cloud, "free_space_weight", what);
 
   const int rows = static_cast<int>(cloud.height), cols = static_cast<int>(cloud.width);
   if (cloud.data.size() < static_cast<std::size_t>(rows) * cols * cloud.point_step)
@@ -78,6 +86,8 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
     frame.color.create(rows, cols, CV_8UC3);
   if (fw)
     frame.weight.create(rows, cols, CV_32FC1);
+  if (ffree)
+    frame.free_space_weight.create(rows, cols, CV_32FC1);
   PinholeFit fit;
   for (int v = 0; v < rows; ++v) {
     float* depth = frame.depth.ptr<float>(v);
@@ -99,6 +109,10 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
       if (fw) {
         const float w = readFloat(p + fw->offset);
         frame.weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
+      }
+      if (ffree) {
+        const float w = readFloat(p + ffree->offset);
+        frame.free_space_weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
       }
     }
   }

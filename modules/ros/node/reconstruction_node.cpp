@@ -288,7 +288,7 @@ void ReconstructionNode::publish(const FrameResult& result, const std_msgs::Head
     weight_pub_.publish(imageToMessage(result.fused.weight, camera_header));
   if (points_pub_.getNumSubscribers() > 0) {
     Cloud points;
-    pcl::toROSMsg(fusedCloud(result.fused, engine_->calibration()), points);
+    pcl::toROSMsg(fusedCloud(result, engine_->calibration()), points);
     points.header = camera_header;
     points_pub_.publish(points);
   }

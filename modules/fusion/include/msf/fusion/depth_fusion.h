@@ -1,6 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-#include <msf/fusion/edge_support.h>
+#include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/fusion_config.h>
 #include <msf/fusion/point_types.h>
 #include <msf/io/calibration.h>
@@ -11,6 +11,7 @@
 #include <pcl/point_cloud.h>
 
 #include <memory>
+#include <vector>
 
 namespace msf {
 
@@ -25,14 +26,20 @@ namespace msf {
 ///   pcl::PointCloud<msf::PointXYZRGBWeight> fused;
 ///   fusion.fuse(fused);
 ///
-/// Each pixel is fused by fuseRow (fusion_model.h: eq. 6 or inverse-variance). The LiDAR
-/// type's `distance` field (pixels to the nearest real return) and the stereo type's
-/// `confidence` feed the weights; a type without them counts as real returns (distance 0)
-/// and as fully confident matches. A fused point lies on the ray of its input point
-/// (stereo's where it has one), so no intrinsics are needed; colour comes from the stereo
-/// point, or from the colour image by projection when setInputColor was given; `weight`
-/// is the fused weight. Pixels without depth in both inputs are NaN, and then the cloud is
-/// not dense. The header (frame id, stamp) is the stereo cloud's.
+/// The clouds' depths are fused by DepthImageFusion, the model the pipeline applies
+/// (fusion_model.h: eq. 6 or inverse-variance). The LiDAR type's `distance` field (pixels to
+/// the nearest real return) and the stereo type's `confidence` feed the weights; a type
+/// without them counts as real returns (distance 0) and as fully confident matches. A fused
+/// point lies on the ray of its input point (stereo's where it has one, else its pixel's);
+/// colour comes from the stereo point, or, when setInputColor was given, from the colour image
+/// by projection (colorizeDepth, with the grey image where the colour camera does not see).
+/// An output type with the fields writes the fused `weight`, `free_space_weight` and
+/// `sky_depth` (PointXYZRGBWeight). Pixels without depth are NaN, and then the cloud is not
+/// dense. The header (frame id, stamp) is the stereo cloud's.
+///
+/// A LiDAR cloud of the LiDAR's canvas (LidarCompletion::computeCanvas: the image with a margin
+/// on every side) gives an output of the canvas's size: the image's pixels fused, the margin the
+/// LiDAR's, as the map integrates a frame (growOntoCanvas).
 template <typename PointLidarT = PointXYZID, typename PointStereoT = PointXYZRGBConfidence,
           typename PointOutT = PointXYZRGBWeight>
 class DepthFusion {
@@ -80,19 +87,21 @@ public:
   void setColorCamera(int camera) { color_camera_ = camera; }
   int getColorCamera() const { return color_camera_; }
 
-  /// Fuses the inputs into `output` (resized to their width x height).
+  /// Fuses the inputs into `output` (resized to the LiDAR cloud's width x height).
   /// Throws InvalidInputError naming the input that is missing, not organized, or of
-  /// another size than the other; CalibrationError when no calibration was set.
+  /// another size than the other (or its canvas); CalibrationError when no calibration was set.
   void fuse(PointCloudOut& output);
 
 private:
   // The steps of fuse().
-  void checkInputs() const;
-  /// The LiDAR cloud's depth and distance to a real return as images (lidar_depth_, lidar_distance_).
-  void readLidarImages();
-  /// Paper step 4 on the images: fused_depth_ and fused_weight_, with the additions after it.
+  void checkInputs();
+  /// The clouds' depths, the LiDAR's distance to a real return and the stereo's confidence as
+  /// images (the LiDAR's over its whole cloud, the canvas when it is one).
+  void readImages();
+  /// Paper step 4 on the images (DepthImageFusion), the colours and the open sky, grown onto the
+  /// LiDAR's canvas when it is one.
   void fuseImages();
-  /// The fused points on the rays of the input points, coloured; the header of the stereo cloud's.
+  /// The fused points on the rays of the input points; the header of the stereo cloud's.
   void writePoints(PointCloudOut& output) const;
 
   DepthFusionConfig config_;
@@ -102,9 +111,12 @@ private:
   PointCloudStereoConstPtr stereo_;
   cv::Mat color_, left_;
   int color_camera_{2};
-  cv::Mat lidar_depth_, lidar_distance_, lidar_edge_; ///< work buffers, kept between frames
-  cv::Mat fused_depth_, fused_weight_;
-  EdgeSupportBuffers edge_buffers_;
+  cv::Rect image_in_canvas_; ///< where the stereo's image lies in the LiDAR cloud; empty: the same size
+  DepthImageFusion image_fusion_;
+  // Work buffers, kept between frames.
+  cv::Mat lidar_depth_, lidar_distance_, stereo_depth_, stereo_confidence_;
+  cv::Mat fused_depth_, fused_weight_, fused_free_weight_, fused_color_, sky_;
+  std::vector<float> sky_column_depth_;
 };
 
 } // namespace msf

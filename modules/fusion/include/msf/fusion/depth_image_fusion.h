@@ -9,6 +9,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <memory>
+#include <vector>
 
 namespace msf {
 
@@ -44,6 +45,11 @@ public:
   /// The open sky (SkyMask, CV_8UC1, 255 = sky) the last fuse() found; empty when it had no sky
   /// image or clear_sky is off.
   const cv::Mat& getOpenSky() const { return open_sky_; }
+  /// The open sky in the last fuse()'s sky image (CV_8UC1, 255 = sky): getOpenSky()'s when
+  /// clear_sky found it, else found now (SkyMask); and per image column the depth of the
+  /// LiDAR's highest return (SkyMask::topReturnDepth, 0 where there is none), which bounds
+  /// the carving along the sky's rays (TsdfIntegrator::carveSky). Both empty without a sky image.
+  void findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const;
 
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]
@@ -63,6 +69,7 @@ private:
   LidarParallax parallax_;
   cv::Mat left_;                        ///< setInputImage's
   cv::Mat sky_image_, open_sky_;        ///< setSkyImage's, and the last fuse's open sky
+  cv::Mat returns_;                     ///< the last fuse's real LiDAR returns, with a sky image
   SkyMask sky_;
   cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames
   cv::Mat weight_, free_weight_;        ///< weights when the caller wants none

@@ -60,6 +60,12 @@ struct DepthFusionConfig {
   LidarEdgeCue lidar_edge_cue = LidarEdgeCue::Bend;
   /// The HDL-64E's range noise is under 2 cm; 3 cm leaves room for calibration and timing.
   float lidar_range_sigma_m = 0.03f;
+  /// The inverse variance (m^-2) of a return's range, 1 / lidar_range_sigma_m^2: the weight of
+  /// the free space that a LiDAR ray (or the open sky, or a ray beyond the range) shows.
+  float lidarRangeWeight() const {
+    const double sigma = lidar_range_sigma_m;
+    return static_cast<float>(1.0 / (sigma * sigma));
+  }
   float disagreement_k_sigma = 3.f;
   int lidar_range_window_px = 5;
   bool parallax_check = true;

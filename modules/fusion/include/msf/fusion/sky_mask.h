@@ -2,6 +2,7 @@
 #pragma once
 #include <opencv2/core/mat.hpp>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -90,5 +91,14 @@ private:
   int column_window_ = 8;
   int border_ = 3;
 };
+
+/// A pixel's sky_depth as the fused cloud carries it (PointXYZRGBWeight): NaN where the pixel is
+/// not open sky, else the depth of its column's highest LiDAR return (topReturnDepth), +inf
+/// where that column has none.
+inline float skyDepth(bool open_sky, float column_depth) {
+  if (!open_sky)
+    return std::numeric_limits<float>::quiet_NaN();
+  return column_depth > 0.f ? column_depth : std::numeric_limits<float>::infinity();
+}
 
 } // namespace msf

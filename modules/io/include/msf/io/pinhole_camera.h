@@ -2,6 +2,7 @@
 #pragma once
 #include <msf/io/calibration.h>
 
+#include <opencv2/core/types.hpp>
 #include <pcl/point_cloud.h>
 
 #include <string>
@@ -18,7 +19,16 @@ struct PinholeCamera {
   /// Camera `camera` (0..3) of a calibration; throws CalibrationError when the calibration
   /// has no image size, InvalidInputError for a camera index out of range.
   static PinholeCamera fromCalibration(const Calibration& calibration, int camera = 0);
+  /// The camera of a canvas that holds this camera's image at `image_in_canvas` (imageInCanvas):
+  /// the principal point moved by the margins, the canvas's size.
+  PinholeCamera onCanvas(const cv::Rect& image_in_canvas, const cv::Size& canvas) const;
 };
+
+/// Where an image lies in a canvas grown from it by one margin on the left and right and one on
+/// the top and bottom (the LiDAR's canvas, projection.margin_px): the image's pixels, or an empty
+/// rectangle when the two sizes are equal. Throws InvalidInputError naming `what` when the canvas
+/// is not such a growth of the image.
+cv::Rect imageInCanvas(const cv::Size& canvas, const cv::Size& image, const std::string& what);
 
 /// Least-squares fit of u = fx x/z + cx and v = fy y/z + cy over points and their pixels,
 /// so that a tool can work on an organized .pcd alone, without its calibration.

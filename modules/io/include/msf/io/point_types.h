@@ -7,6 +7,7 @@
 #include <pcl/register_point_struct.h>
 
 #include <cstdint>
+#include <limits>
 
 namespace msf {
 
@@ -57,18 +58,24 @@ struct EIGEN_ALIGN16 PointXYZRGBConfidence {
 };
 
 /// A point of a fused depth image: position in the rectified frame of camera 0, colour, and
-/// `weight` in [0, 1], the confidence of its depth (DepthFusion documents it per method),
-/// which a TSDF integrator can use as the per-pixel weight; 0 where there is no depth.
+/// `weight`, the confidence of its depth (DepthFusion documents it per method), which a TSDF
+/// integrator can use as the per-pixel weight; 0 where there is no depth. What the map takes
+/// beside the depth: `free_space_weight`, the weight of the free space in front of it (the
+/// fusion's differs from `weight` where it averaged two samples that disagree), and
+/// `sky_depth`, NaN where the pixel is not open sky, else the depth up to which its ray passed
+/// every surface (the LiDAR's highest return in its column, +inf where the column has none).
 /// Registered, so .pcd files keep the field names and pcl_viewer still colours by `rgb`.
 struct EIGEN_ALIGN16 PointXYZRGBWeight {
   PCL_ADD_POINT4D;
   PCL_ADD_RGB;
   float weight;
+  float free_space_weight;
+  float sky_depth;
 
   inline PointXYZRGBWeight() : PointXYZRGBWeight(0.f, 0.f, 0.f) {}
   inline PointXYZRGBWeight(float x_, float y_, float z_, std::uint8_t r_ = 0, std::uint8_t g_ = 0,
                            std::uint8_t b_ = 0, float weight_ = 0.f)
-      : weight(weight_) {
+      : weight(weight_), free_space_weight(weight_), sky_depth(std::numeric_limits<float>::quiet_NaN()) {
     x = x_;
     y = y_;
     z = z_;
@@ -90,4 +97,5 @@ POINT_CLOUD_REGISTER_POINT_STRUCT(msf::PointXYZRGBConfidence,
                                   (float, x, x)(float, y, y)(float, z, z)(float, rgb, rgb)(float, confidence, confidence))
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(msf::PointXYZRGBWeight,
-                                  (float, x, x)(float, y, y)(float, z, z)(float, rgb, rgb)(float, weight, weight))
+                                  (float, x, x)(float, y, y)(float, z, z)(float, rgb, rgb)(float, weight, weight)(
+                                      float, free_space_weight, free_space_weight)(float, sky_depth, sky_depth))

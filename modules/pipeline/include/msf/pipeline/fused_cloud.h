@@ -2,14 +2,15 @@
 #pragma once
 #include <msf/fusion/point_types.h>
 #include <msf/io/calibration.h>
-#include <msf/reconstruction/depth_frame.h>
+#include <msf/pipeline/reconstructor.h>
 
 #include <pcl/point_cloud.h>
 
 namespace msf {
 
-/// A fused depth frame as msf_fuse writes it: an organized cloud of camera 0 with the frame's
-/// colour and per-pixel weight (NaN where there is no depth).
-pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const DepthFrame& fused, const Calibration& calibration);
+/// A frame's fused depth as msf_fuse writes it: an organized cloud of camera 0 (NaN where there
+/// is no depth) with the fused colour, weight and free-space weight, and the open sky where the
+/// frame found it (FrameResult::sky, with sky carving).
+pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const Calibration& calibration);
 
 } // namespace msf

@@ -290,7 +290,7 @@ private:
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
   /// The frame's open sky (FrameResult::sky), when the map carves along it.
-  void computeSky(const Frame& frame, FrameResult& result);
+  void computeSky(FrameResult& result);
   /// Whether frames from `first` on are tracked by the odometry (PoseMode).
   bool tracks(const Frame& first) const;
   /// The odometry's pose of the frame's scan; frames in order.

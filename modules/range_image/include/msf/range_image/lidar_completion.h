@@ -63,6 +63,9 @@ public:
   /// lie on their pixels' rays with the reflectance of the nearest return; `distance` as
   /// above (0 on real returns).
   void compute(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointXYZID>& cloud);
+  /// The same over the whole canvas (the image and its margin, projector().canvasCamera()): the
+  /// LiDAR depth that the map integrates around the fused image (growOntoCanvas).
+  void computeCanvas(const pcl::PointCloud<pcl::PointXYZI>& scan, pcl::PointCloud<PointXYZID>& cloud);
 
   CompletionMethod method() const { return method_; }
   const LidarProjector& projector() const { return projector_; }

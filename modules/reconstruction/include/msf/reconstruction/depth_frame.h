@@ -30,8 +30,9 @@ struct DepthFrame {
 };
 
 /// Organized cloud (NaN where there is no depth) to a DepthFrame: depth = z; colour from the
-/// rgb field when PointT has one; weight from a float field named `weight` when PointT has
-/// one (pcl::traits::has_field), as the fusion stage's point type does. `camera` = nullptr
+/// rgb field when PointT has one; weight and free-space weight from float fields named
+/// `weight` and `free_space_weight` when PointT has them (pcl::traits::has_field), as the
+/// fusion stage's point type does. `camera` = nullptr
 /// recovers the intrinsics from the cloud (estimatePinholeCamera). Instantiated for PCL's
 /// PointXYZ, PointXYZI, PointXYZRGB, PointXYZRGBA and the stages' PointXYZID,
 /// PointXYZRGBConfidence and PointXYZRGBWeight (MSF_NO_PRECOMPILE for other types).
@@ -40,7 +41,7 @@ template <typename PointT>
 DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamera* camera = nullptr);
 
 /// Same from a cloud of any point type as read from a file (fields x y z, optional rgb or
-/// rgba, optional weight), so tools accept every organized cloud the other stages write.
+/// rgba, optional weight and free_space_weight), so tools accept every organized cloud the other stages write.
 /// `what` names the cloud in messages.
 DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* camera = nullptr,
                         const std::string& what = "cloud");

@@ -36,6 +36,20 @@ template <typename T>
 inline constexpr bool has_weight_v = has_weight<T>::value;
 
 template <typename T, typename = void>
+struct has_free_space_weight : std::false_type {};
+template <typename T>
+struct has_free_space_weight<T, std::void_t<decltype(std::declval<T&>().free_space_weight)>> : std::true_type {};
+template <typename T>
+inline constexpr bool has_free_space_weight_v = has_free_space_weight<T>::value;
+
+template <typename T, typename = void>
+struct has_sky_depth : std::false_type {};
+template <typename T>
+struct has_sky_depth<T, std::void_t<decltype(std::declval<T&>().sky_depth)>> : std::true_type {};
+template <typename T>
+inline constexpr bool has_sky_depth_v = has_sky_depth<T>::value;
+
+template <typename T, typename = void>
 struct has_intensity : std::false_type {};
 template <typename T>
 struct has_intensity<T, std::void_t<decltype(std::declval<T&>().intensity)>> : std::true_type {};

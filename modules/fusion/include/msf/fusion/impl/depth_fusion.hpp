@@ -6,8 +6,9 @@
 #include <msf/fusion/depth_fusion.h>
 #include <msf/fusion/fusion_model.h>
 #include <msf/fusion/clear_sky.h>
-#include <msf/fusion/facade_extension.h>
-#include <msf/range_image/real_returns.h>
+#include <msf/fusion/fused_canvas.h>
+#include <msf/fusion/sky_mask.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
 
@@ -23,9 +24,7 @@ namespace msf {
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
 void DepthFusion<PointLidarT, PointStereoT, PointOutT>::setCalibration(const Calibration& calibration) {
-  if (!(calibration.focalBaseline() > 0.0))
-    throw CalibrationError("calibration '" + calibration.source +
-                           "': the grey pair has no baseline (P1 must hold -f B in its last column)");
+  image_fusion_.setCalibration(calibration); // throws CalibrationError without a baseline
   calibration_ = calibration;
   has_calibration_ = true;
 }
@@ -33,13 +32,13 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::setCalibration(const Cal
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
 void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuse(PointCloudOut& output) {
   checkInputs();
-  readLidarImages();
+  readImages();
   fuseImages();
   writePoints(output);
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
-void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() const {
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() {
   const auto size = [](const auto& cloud) { return std::to_string(cloud.width) + "x" + std::to_string(cloud.height); };
   if (!lidar_ || lidar_->empty())
     throw InvalidInputError("DepthFusion: the LiDAR cloud is missing or empty (setInputLidar)");
@@ -49,9 +48,15 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() const {
     throw InvalidInputError("DepthFusion: the LiDAR cloud is not organized (" + size(*lidar_) + ")");
   if (!stereo_->isOrganized())
     throw InvalidInputError("DepthFusion: the stereo cloud is not organized (" + size(*stereo_) + ")");
-  if (lidar_->width != stereo_->width || lidar_->height != stereo_->height)
+  const cv::Size lidar_size(static_cast<int>(lidar_->width), static_cast<int>(lidar_->height));
+  const cv::Size image_size(static_cast<int>(stereo_->width), static_cast<int>(stereo_->height));
+  try {
+    image_in_canvas_ = imageInCanvas(lidar_size, image_size, "the LiDAR cloud");
+  } catch (const InvalidInputError&) {
     throw InvalidInputError("DepthFusion: the LiDAR cloud is " + size(*lidar_) + " but the stereo cloud is " +
-                            size(*stereo_));
+                            size(*stereo_) + " (the LiDAR's must be the stereo's size, or its canvas: that size "
+                            "with a margin on every side)");
+  }
   if (!has_calibration_)
     throw CalibrationError("DepthFusion: no calibration set (setCalibration)");
   // A finite depth beyond any sensor's range (1e30 m) is a broken input: it would pass
@@ -69,25 +74,42 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() const {
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
-void DepthFusion<PointLidarT, PointStereoT, PointOutT>::readLidarImages() {
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::readImages() {
   const int rows = static_cast<int>(lidar_->height), cols = static_cast<int>(lidar_->width);
   lidar_depth_.create(rows, cols, CV_32FC1);
-  if constexpr (detail::has_distance_v<PointLidarT>)
-    lidar_distance_.create(rows, cols, CV_32FC1);
+  lidar_distance_.create(rows, cols, CV_32FC1); // 0 (a real return) for a type without distances
+  const int image_rows = static_cast<int>(stereo_->height), image_cols = static_cast<int>(stereo_->width);
+  stereo_depth_.create(image_rows, image_cols, CV_32FC1);
+  if constexpr (detail::has_confidence_v<PointStereoT>)
+    stereo_confidence_.create(image_rows, image_cols, CV_32FC1);
   else
-    lidar_distance_.release(); // every LiDAR depth counts as a real return
+    stereo_confidence_.release(); // every match counts as confident
   // cv::parallel_for_ rather than OpenMP: its work stealing keeps both cores busy when the
   // machine is shared, where a static OpenMP split waits for the slower thread.
   parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const PointLidarT* in = &(*lidar_)[static_cast<std::size_t>(v) * cols];
       float* z = lidar_depth_.ptr<float>(v);
-      for (int u = 0; u < cols; ++u)
+      float* distance = lidar_distance_.ptr<float>(v);
+      for (int u = 0; u < cols; ++u) {
         z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
-      if constexpr (detail::has_distance_v<PointLidarT>) {
-        float* distance = lidar_distance_.ptr<float>(v);
-        for (int u = 0; u < cols; ++u)
+        if constexpr (detail::has_distance_v<PointLidarT>)
           distance[u] = in[u].distance;
+        else
+          distance[u] = 0.f;
+      }
+    }
+  });
+  parallelFor(cv::Range(0, image_rows), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      const PointStereoT* in = &(*stereo_)[static_cast<std::size_t>(v) * image_cols];
+      float* z = stereo_depth_.ptr<float>(v);
+      for (int u = 0; u < image_cols; ++u)
+        z[u] = detail::validDepth(in[u].z) ? in[u].z : 0.f;
+      if constexpr (detail::has_confidence_v<PointStereoT>) {
+        float* confidence = stereo_confidence_.ptr<float>(v);
+        for (int u = 0; u < image_cols; ++u)
+          confidence[u] = in[u].confidence;
       }
     }
   });
@@ -95,52 +117,47 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::readLidarImages() {
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
 void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
-  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
-  const float fB = static_cast<float>(calibration_.focalBaseline());
-  const bool uncertainty = config_.method == FusionMethod::Uncertainty;
-  if (uncertainty)
-    lidarEdgeCue(lidar_depth_, fB, config_, lidar_edge_);
-  const DepthFusionConfig config = config_;
-  const LidarParallax parallax = lidarParallax(calibration_, config);
-  // A row at a time in contiguous arrays for fuseRow.
-  fused_depth_.create(rows, cols, CV_32FC1);
-  fused_weight_.create(rows, cols, CV_32FC1);
-  parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
-    std::vector<float> zeros(static_cast<std::size_t>(cols), 0.f), z_stereo(zeros), confidence(zeros), free(zeros);
-    for (int v = range.start; v < range.end; ++v) {
-      const std::size_t row = static_cast<std::size_t>(v) * cols;
-      for (int u = 0; u < cols; ++u) {
-        const PointStereoT& s = (*stereo_)[row + u];
-        z_stereo[u] = detail::validDepth(s.z) ? s.z : 0.f;
-        if constexpr (detail::has_confidence_v<PointStereoT>)
-          confidence[u] = s.confidence;
-        else
-          confidence[u] = 1.f;
+  const cv::Size size = stereo_depth_.size();
+  const bool on_canvas = !image_in_canvas_.empty();
+  const cv::Mat lidar = on_canvas ? lidar_depth_(image_in_canvas_).clone() : lidar_depth_;
+  const cv::Mat distance = on_canvas ? lidar_distance_(image_in_canvas_).clone() : lidar_distance_;
+  image_fusion_.setConfig(config_);
+  image_fusion_.setInputImage(left_);
+  image_fusion_.setSkyImage(skyImage(color_, left_, size));
+  image_fusion_.fuse(lidar, distance, stereo_depth_, stereo_confidence_, fused_depth_, &fused_weight_,
+                     &fused_free_weight_);
+  if constexpr (detail::has_sky_depth_v<PointOutT>)
+    image_fusion_.findOpenSky(sky_, sky_column_depth_);
+  // The stereo points' colours, or the colour camera's at the fused points as the pipeline
+  // colours them (the grey image, else the stereo's, where that camera does not see).
+  fused_color_.create(size, CV_8UC3);
+  for (int v = 0; v < size.height; ++v)
+    for (int u = 0; u < size.width; ++u) {
+      cv::Vec3b& bgr = fused_color_.at<cv::Vec3b>(v, u);
+      if constexpr (detail::has_rgb_v<PointStereoT>) {
+        const PointStereoT& s = stereo_->at(u, v);
+        bgr = cv::Vec3b(s.b, s.g, s.r);
+      } else {
+        bgr = cv::Vec3b(0, 0, 0);
       }
-      fuseRow(config, fB, parallax, lidar_depth_, v, lidar_distance_.empty() ? zeros.data() : lidar_distance_.ptr<float>(v),
-              uncertainty ? lidar_edge_.ptr<float>(v) : zeros.data(), z_stereo.data(), confidence.data(),
-              fused_depth_.ptr<float>(v), fused_weight_.ptr<float>(v), free.data());
     }
-  });
-  if (config.edge_support)
-    supportAtDepthEdges(lidar_depth_, lidar_distance_, fB, config, fused_depth_, edge_buffers_);
-  if (config.facade_extension && !left_.empty()) {
-    cv::Mat no_free_space;
-    extendFacades(left_, calibration_, config, fused_depth_, fused_weight_, no_free_space);
+  if (!color_.empty()) {
+    PinholeCamera camera;
+    camera.fx = static_cast<float>(calibration_.fx()), camera.fy = static_cast<float>(calibration_.fy());
+    camera.cx = static_cast<float>(calibration_.cx()), camera.cy = static_cast<float>(calibration_.cy());
+    camera.width = size.width, camera.height = size.height;
+    const cv::Mat fallback = left_.empty() ? fused_color_.clone() : left_;
+    colorizeDepth(fused_depth_, camera, ColorSampler(color_, calibration_, color_camera_), fallback, fused_color_);
   }
-  const cv::Mat& sky_image = skyImage(color_, left_, cv::Size(cols, rows));
-  if (config.clear_sky && !sky_image.empty()) {
-    cv::Mat no_free_space;
-    withholdClearSky(SkyMask(), sky_image,
-                     lidar_distance_.empty() ? lidar_depth_ : realReturns(lidar_depth_, lidar_distance_), fused_depth_,
-                     fused_weight_, no_free_space);
-  }
+  if (on_canvas)
+    growOntoCanvas(lidar_depth_, lidar_distance_, config_, static_cast<float>(calibration_.focalBaseline()),
+                   fused_depth_, fused_weight_, fused_free_weight_, &fused_color_);
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
 void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOut& output) const {
-  const ColorSampler sampler = color_.empty() ? ColorSampler() : ColorSampler(color_, calibration_, color_camera_);
-  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
+  const int rows = fused_depth_.rows, cols = fused_depth_.cols;
+  const cv::Rect image = image_in_canvas_.empty() ? cv::Rect(0, 0, cols, rows) : image_in_canvas_;
   output.resize(static_cast<std::size_t>(rows) * cols);
   output.width = static_cast<std::uint32_t>(cols);
   output.height = static_cast<std::uint32_t>(rows);
@@ -156,27 +173,27 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOu
   const float nan = std::numeric_limits<float>::quiet_NaN();
   // Where neither input has a point (a wall the extension continued), the pixel's own ray.
   const float fx = static_cast<float>(calibration_.fx()), fy = static_cast<float>(calibration_.fy());
-  const float cx = static_cast<float>(calibration_.cx()), cy = static_cast<float>(calibration_.cy());
+  const float cx = static_cast<float>(calibration_.cx()) + static_cast<float>(image.x);
+  const float cy = static_cast<float>(calibration_.cy()) + static_cast<float>(image.y);
   std::atomic<bool> dense{true};
   parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     bool range_dense = true;
     for (int v = range.start; v < range.end; ++v) {
-      const std::size_t row = static_cast<std::size_t>(v) * cols;
       const float* fused_z = fused_depth_.ptr<float>(v);
-      const float* fused_weight = fused_weight_.ptr<float>(v);
       for (int u = 0; u < cols; ++u) {
-        const PointStereoT& s = (*stereo_)[row + u];
-        PointOutT& p = output[row + u];
+        PointOutT& p = output[static_cast<std::size_t>(v) * cols + u];
+        const bool in_image = image.contains(cv::Point(u, v));
+        const PointStereoT* s = in_image ? &stereo_->at(u - image.x, v - image.y) : nullptr;
         const float z = fused_z[u];
         if (z > 0.f) {
           // On the ray of the input point: stereo's lies on the pixel's ray, the LiDAR's
           // within half a pixel of it.
-          const bool from_stereo = detail::validDepth(s.z);
-          const PointLidarT& l = (*lidar_)[row + u];
+          const bool from_stereo = s && detail::validDepth(s->z);
+          const PointLidarT& l = lidar_->at(u, v);
           if (from_stereo || detail::validDepth(l.z)) {
-            const float scale = z / (from_stereo ? s.z : l.z);
-            p.x = (from_stereo ? s.x : l.x) * scale;
-            p.y = (from_stereo ? s.y : l.y) * scale;
+            const float scale = z / (from_stereo ? s->z : l.z);
+            p.x = (from_stereo ? s->x : l.x) * scale;
+            p.y = (from_stereo ? s->y : l.y) * scale;
           } else {
             p.x = (static_cast<float>(u) - cx) * z / fx;
             p.y = (static_cast<float>(v) - cy) * z / fy;
@@ -187,19 +204,20 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOu
           range_dense = false;
         }
         if constexpr (detail::has_rgb_v<PointOutT>) {
-          if constexpr (detail::has_rgb_v<PointStereoT>) {
-            p.r = s.r;
-            p.g = s.g;
-            p.b = s.b;
-          } else {
-            p.r = p.g = p.b = 0;
-          }
+          const cv::Vec3b& bgr = fused_color_.at<cv::Vec3b>(v, u);
+          p.b = bgr[0];
+          p.g = bgr[1];
+          p.r = bgr[2];
           p.a = 255;
-          if (z > 0.f)
-            sampler.sample(p.x, p.y, p.z, p.r, p.g, p.b);
         }
         if constexpr (detail::has_weight_v<PointOutT>)
-          p.weight = fused_weight[u];
+          p.weight = fused_weight_.at<float>(v, u);
+        if constexpr (detail::has_free_space_weight_v<PointOutT>)
+          p.free_space_weight = fused_free_weight_.at<float>(v, u);
+        if constexpr (detail::has_sky_depth_v<PointOutT>) {
+          const bool sky = in_image && !sky_.empty() && sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
+          p.sky_depth = skyDepth(sky, sky ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
+        }
       }
     }
     if (!range_dense)

@@ -3,6 +3,7 @@
 #include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/impl/pinhole_camera.hpp>
+#include <msf/io/point_types.h> // the fields of the fused point type
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/point_types.h>
 
@@ -31,10 +32,13 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
   constexpr bool kHasRgb = pcl::traits::has_field<PointT, pcl::fields::rgb>::value ||
                            pcl::traits::has_field<PointT, pcl::fields::rgba>::value;
   constexpr bool kHasWeight = pcl::traits::has_field<PointT, pcl::fields::weight>::value;
+  constexpr bool kHasFreeSpaceWeight = pcl::traits::has_field<PointT, pcl::fields::free_space_weight>::value;
   if constexpr (kHasRgb)
     frame.color.create(rows, cols, CV_8UC3);
   if constexpr (kHasWeight)
     frame.weight.create(rows, cols, CV_32FC1);
+  if constexpr (kHasFreeSpaceWeight)
+    frame.free_space_weight.create(rows, cols, CV_32FC1);
   parallelFor(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const PointT* in = &cloud[static_cast<std::size_t>(v) * cols];
@@ -53,6 +57,10 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
           const float w = static_cast<float>(*reinterpret_cast<const WeightT*>(
               reinterpret_cast<const std::uint8_t*>(&p) + pcl::traits::offset<PointT, pcl::fields::weight>::value));
           frame.weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
+        }
+        if constexpr (kHasFreeSpaceWeight) {
+          const float w = p.free_space_weight;
+          frame.free_space_weight.ptr<float>(v)[u] = std::isfinite(w) && w > 0.f ? w : 0.f;
         }
       }
     }
