@@ -108,7 +108,7 @@ void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
-  if (config_.integrator.scan_carving_m > 0.0 && config_.integrator.space_carving)
+  if (integrator_->carvesWithScans()) // built here, beside SGBM, rather than on the map's thread
     result.scan_free_space = ScanFreeSpace(*frame.scan);
   result.times.lidar_ms = msSince(start);
   if (options_.keep_sparse)
@@ -187,7 +187,7 @@ void Reconstructor::computeDepth(const Frame& frame, FrameResult& result) {
 
 void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
                    const DepthFusionConfig& fusion, const Calibration& calibration) {
-  if (!integrator.getConfig().space_carving || result.scan_free_space.empty())
+  if (!integrator.carvesWithScans() || result.scan_free_space.empty())
     return;
   integrator.carveWithScan(result.scan_free_space, result.T_world_cam0 * calibration.T_cam0_velo,
                            fusion.lidarRangeWeight(), camera, result.T_world_cam0);

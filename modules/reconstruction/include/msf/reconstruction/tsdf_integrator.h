@@ -266,6 +266,9 @@ public:
   /// variance) times carving_weight. Conservative: only where the scan has returns, and only
   /// voxels behind a surface (the ones that make it), so that a road seen at a grazing angle,
   /// whose returns lie around it, is left alone.
+  /// Whether carveWithScan clears anything (space carving with scan_carving_m > 0): whether a
+  /// frame's scan is worth turning into a ScanFreeSpace.
+  bool carvesWithScans() const { return config_.space_carving && config_.scan_carving_m > 0.0; }
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam);
 
