@@ -55,11 +55,13 @@ struct CloudSky {
   std::vector<float> column_depth;
 };
 
-CloudSky readSky(const pcl::PCLPointCloud2& blob, cv::Rect image) {
+CloudSky readSky(const pcl::PCLPointCloud2& blob, cv::Rect image, const std::string& what) {
   CloudSky sky;
   const int field = pcl::getFieldIndex(blob, "sky_depth");
-  if (field < 0 || blob.fields[field].datatype != pcl::PCLPointField::FLOAT32)
+  if (field < 0)
     return sky;
+  if (blob.fields[field].datatype != pcl::PCLPointField::FLOAT32 || blob.fields[field].count != 1)
+    throw msf::InvalidInputError(what + ": field 'sky_depth' must be one float32");
   if (image.empty())
     image = cv::Rect(0, 0, static_cast<int>(blob.width), static_cast<int>(blob.height));
   sky.mask = cv::Mat::zeros(image.size(), CV_8UC1);
@@ -191,7 +193,7 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     if (!frames.scans.empty())
       integrator.carveWithScan(msf::ScanFreeSpace(loadScan(frames.scans[i])),
                                T_world_cam * calibration.T_cam0_velo, lidar_weight, frame.camera, T_world_cam);
-    const CloudSky sky = readSky(blob, image);
+    const CloudSky sky = readSky(blob, image, what);
     integrator.carveSky(sky.mask, image.empty() ? frame.camera : camera, T_world_cam, lidar_weight,
                         sky.column_depth);
     integrator.carveBeyondRange(frame, T_world_cam, lidar_weight);

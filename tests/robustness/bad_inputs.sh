@@ -522,6 +522,9 @@ if [ $have_kitti = 1 ]; then
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/wrong_fields.pcd"
   check "stereo -prior neither the image's size nor its canvas" 1 "-prior '.*sparse.pcd' is [0-9]+x[0-9]+: neither the image's [0-9]+x[0-9]+ nor that image with a margin" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -prior "$F/sparse.pcd"
+  head -n 1 "$KITTI/odometry/poses/04.txt" >"$F/one_pose.txt"
+  check "integrate -calib: a cloud neither the image's size nor its canvas" 1 "cloud '.*sparse.pcd' is [0-9]+x[0-9]+: neither the image's [0-9]+x[0-9]+ nor that image with a margin" -- \
+    msf_integrate "$F/sparse.pcd" -poses "$F/one_pose.txt" -calib "$SEQ/calib.txt" -o o.pcd
   check "stereo -color of the wrong size" 1 "colour image is 8x6 but calibration" -- \
     msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -color "$K/small.png"
   printf '%%YAML:1.0\nrig:\n  stereo_min_disparity_px: -1.0\n' >"$F/rig_negative.yaml"

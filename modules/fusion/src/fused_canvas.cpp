@@ -27,6 +27,13 @@ cv::Mat lidarWeightImage(const cv::Mat& depth, const cv::Mat& distance, const cv
   return weight;
 }
 
+cv::Mat repeatBorderOntoCanvas(const cv::Mat& image, const cv::Rect& image_in_canvas, const cv::Size& canvas) {
+  cv::Mat grown;
+  cv::copyMakeBorder(image, grown, image_in_canvas.y, canvas.height - image_in_canvas.br().y, image_in_canvas.x,
+                     canvas.width - image_in_canvas.br().x, cv::BORDER_REPLICATE);
+  return grown;
+}
+
 void growOntoCanvas(const cv::Mat& canvas_depth, const cv::Mat& canvas_distance, const DepthFusionConfig& fusion,
                     float focal_baseline, cv::Mat& depth, cv::Mat& weight, cv::Mat& free_space_weight,
                     cv::Mat* color) {
@@ -46,12 +53,8 @@ void growOntoCanvas(const cv::Mat& canvas_depth, const cv::Mat& canvas_distance,
   weight.copyTo(grown_weight(image));
   depth = grown_depth;
   weight = grown_weight;
-  if (color && !color->empty()) {
-    cv::Mat grown_color;
-    cv::copyMakeBorder(*color, grown_color, image.y, canvas_depth.rows - image.br().y, image.x,
-                       canvas_depth.cols - image.br().x, cv::BORDER_REPLICATE);
-    *color = grown_color;
-  }
+  if (color && !color->empty())
+    *color = repeatBorderOntoCanvas(*color, image, canvas_depth.size());
 }
 
 } // namespace msf

@@ -80,10 +80,7 @@ DepthFrame sourceDepthFrame(const FrameResult& result, DepthSource source, const
     out.depth = canvas;
     out.weight = lidarWeightImage(canvas, distance, range, fusion, fb);
     out.camera = image.empty() ? result.fused.camera : result.lidar_canvas_camera;
-    out.color = result.fused.color;
-    if (!image.empty())
-      cv::copyMakeBorder(out.color, out.color, image.y, canvas.rows - image.br().y, image.x,
-                         canvas.cols - image.br().x, cv::BORDER_REPLICATE);
+    out.color = image.empty() ? result.fused.color : repeatBorderOntoCanvas(result.fused.color, image, canvas.size());
   } else {
     out.depth = depth;
     out.color = result.fused.color;

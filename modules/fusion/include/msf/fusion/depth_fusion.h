@@ -101,6 +101,8 @@ private:
   /// Paper step 4 on the images (DepthImageFusion), the colours and the open sky, grown onto the
   /// LiDAR's canvas when it is one.
   void fuseImages();
+  /// The stereo points' colours as a BGR image (black for a type without colour).
+  void readStereoColours(cv::Mat& bgr) const;
   /// The fused points on the rays of the input points; the header of the stereo cloud's.
   void writePoints(PointCloudOut& output) const;
 

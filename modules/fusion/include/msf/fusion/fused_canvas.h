@@ -13,6 +13,10 @@ namespace msf {
 cv::Mat lidarWeightImage(const cv::Mat& depth, const cv::Mat& distance, const cv::Mat& range,
                          const DepthFusionConfig& fusion, float focal_baseline);
 
+/// An image of the camera's size (any type) grown onto the canvas that holds it at
+/// `image_in_canvas`, its border pixels repeated over the margin: the colours around a frame.
+cv::Mat repeatBorderOntoCanvas(const cv::Mat& image, const cv::Rect& image_in_canvas, const cv::Size& canvas);
+
 /// The fused images grown onto the LiDAR's canvas (the image with the margin it was projected
 /// with, projection.margin_px): the interpolated LiDAR fills the margin, weighed by
 /// lidarWeightImage, its free space by the same weight. So the edge of what a frame adds to the

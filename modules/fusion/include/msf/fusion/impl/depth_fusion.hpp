@@ -128,19 +128,10 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
                      &fused_free_weight_);
   if constexpr (detail::has_sky_depth_v<PointOutT>)
     image_fusion_.findOpenSky(sky_, sky_column_depth_);
-  // The stereo points' colours, or the colour camera's at the fused points as the pipeline
-  // colours them (the grey image, else the stereo's, where that camera does not see).
-  fused_color_.create(size, CV_8UC3);
-  for (int v = 0; v < size.height; ++v)
-    for (int u = 0; u < size.width; ++u) {
-      cv::Vec3b& bgr = fused_color_.at<cv::Vec3b>(v, u);
-      if constexpr (detail::has_rgb_v<PointStereoT>) {
-        const PointStereoT& s = stereo_->at(u, v);
-        bgr = cv::Vec3b(s.b, s.g, s.r);
-      } else {
-        bgr = cv::Vec3b(0, 0, 0);
-      }
-    }
+  // The colour camera's at the fused points, as the pipeline colours them (camera 0's grey where
+  // that camera does not see); without it, or where neither has a colour, the stereo points'.
+  if (color_.empty() || left_.empty())
+    readStereoColours(fused_color_);
   if (!color_.empty()) {
     PinholeCamera camera;
     camera.fx = static_cast<float>(calibration_.fx()), camera.fy = static_cast<float>(calibration_.fy());
@@ -152,6 +143,22 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
   if (on_canvas)
     growOntoCanvas(lidar_depth_, lidar_distance_, config_, static_cast<float>(calibration_.focalBaseline()),
                    fused_depth_, fused_weight_, fused_free_weight_, &fused_color_);
+}
+
+template <typename PointLidarT, typename PointStereoT, typename PointOutT>
+void DepthFusion<PointLidarT, PointStereoT, PointOutT>::readStereoColours(cv::Mat& bgr) const {
+  const int rows = static_cast<int>(stereo_->height), cols = static_cast<int>(stereo_->width);
+  bgr.create(rows, cols, CV_8UC3);
+  if constexpr (!detail::has_rgb_v<PointStereoT>) {
+    bgr.setTo(cv::Scalar::all(0));
+  } else {
+    for (int v = 0; v < rows; ++v) {
+      const PointStereoT* in = &(*stereo_)[static_cast<std::size_t>(v) * cols];
+      cv::Vec3b* out = bgr.ptr<cv::Vec3b>(v);
+      for (int u = 0; u < cols; ++u)
+        out[u] = cv::Vec3b(in[u].b, in[u].g, in[u].r);
+    }
+  }
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
