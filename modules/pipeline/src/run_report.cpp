@@ -433,8 +433,8 @@ void writeGhostNotes(std::ostream& s, const RunReport::MapEvaluation& e, const S
     s << "No ghost figure: " << e.no_ghosts << ".\n";
   else if (c.ghosts)
     s << "Ghosts: share of the mesh's vertices farther than " << num(e.rows.front().ghosts.distance_m)
-      << " m from the static true surface inside the space a moving object occupied; crumbs (specks): pieces of "
-         "fewer than "
+      << " m from the static true surface inside the space a moving object occupied and had left by the last "
+         "frame; crumbs (specks): pieces of fewer than "
       << e.rows.front().crumbs.max_triangles
       << " triangles mostly that far from it, inside that space (elsewhere).\n";
   if (c.seen)

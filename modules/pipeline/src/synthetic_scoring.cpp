@@ -4,6 +4,7 @@
 #include <msf/pipeline/synthetic_scoring.h>
 #include <msf/synthetic/kitti_rig.h>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace msf {
@@ -12,6 +13,26 @@ namespace {
 constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
 constexpr std::size_t kCrumbTriangles = 50; // a piece this small is a speck to the eye (a few voxels' faces)
 constexpr float kOffSurfaceM = static_cast<float>(kGhostDistanceM); // off the true surface: a sheet, not an outline
+
+/// Where moving objects were and no longer are: inside a box of a frame up to `last_frame`
+/// (gt/moving_objects.txt), and in none of `last_frame`'s, each grown by `margin_m` (a car's
+/// surface is meshed up to a voxel off its box). Where a car stands when the run ends is what
+/// the last frame saw, a true surface; frames the run never reached are not its past.
+MovingSpace spaceLeftBehind(std::vector<synthetic::MovingBox> boxes, std::size_t last_frame, double margin_m) {
+  boxes.erase(std::remove_if(boxes.begin(), boxes.end(), [&](const auto& box) { return box.frame > last_frame; }),
+              boxes.end());
+  return [boxes = std::move(boxes), last_frame, margin_m](const Eigen::Vector3f& p) {
+    const Eigen::Vector3d q = p.cast<double>();
+    bool was_inside = false;
+    for (const auto& box : boxes)
+      if (box.contains(q, margin_m)) {
+        if (box.frame == last_frame)
+          return false;
+        was_inside = true;
+      }
+    return was_inside;
+  };
+}
 } // namespace
 
 const std::vector<double>& SyntheticScoring::offSurfaceBands() {
@@ -57,6 +78,8 @@ void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth,
     addDepth(name, r.name, true_depth, estimate, fb);
   if (!score_meshes_)
     return;
+  const std::size_t gt_index = truth_->indexOf(r.name);
+  last_frame_ = std::max(last_frame_.value_or(gt_index), gt_index);
   if (!true_sky_)
     true_sky_ = std::make_unique<OpenSkyCoverage>(PinholeCamera::fromCalibration(calibration, 0));
   // The exact sky (no surface along the pixel's ray), less the border protocol 6's mask leaves.
@@ -77,7 +100,7 @@ void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth,
     lidar_.addScan(*scan, r.T_world_cam0 * calibration.T_cam0_velo);
   // Every 4th pixel of the true static surface in range, for the mesh's completeness against
   // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
-  const cv::Mat moving = truth_->movingMask(truth_->indexOf(r.name));
+  const cv::Mat moving = truth_->movingMask(gt_index);
   const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
   const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
   const Eigen::Isometry3f T = r.T_world_cam0.cast<float>();
@@ -96,17 +119,9 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
   std::map<std::string, MeshScores> scores;
   if (!score_meshes_ || meshes.empty())
     return scores;
-  // Where moving objects were: inside a box of gt/moving_objects.txt at any frame, grown by a
-  // voxel (a car's surface is meshed up to a voxel off its box).
   MovingSpace was_moving;
-  if (std::filesystem::exists(truth_->movingBoxesPath()))
-    was_moving = [boxes = truth_->movingBoxes(), margin = voxel_size_m](const Eigen::Vector3f& p) {
-      const Eigen::Vector3d q = p.cast<double>();
-      for (const auto& box : boxes)
-        if (box.contains(q, margin))
-          return true;
-      return false;
-    };
+  if (std::filesystem::exists(truth_->movingBoxesPath()) && last_frame_)
+    was_moving = spaceLeftBehind(truth_->movingBoxes(), *last_frame_, voxel_size_m);
   const SurfaceDistance static_surface(scene_);
   // The street's road in its world (y down): the camera's height below the cameras' path.
   const Eigen::Hyperplane<float, 3> road(Eigen::Vector3f(0.f, -1.f, 0.f),

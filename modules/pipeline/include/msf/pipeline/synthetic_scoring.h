@@ -28,7 +28,8 @@ namespace msf {
 /// A synthetic sequence's exact ground truth (its gt/ folder) scored over a run (protocol 3):
 /// each frame's depth images against the true depth (all, background, foreground), and after
 /// the run the meshes against the true surface (accuracy, completeness, by class of surface),
-/// where moving objects were (ghosts), over the true sky, and off the surface (OffSurfaceSplit).
+/// where moving objects were before the last frame (ghosts), over the true sky, and off the
+/// surface (OffSurfaceSplit).
 class SyntheticScoring {
 public:
   /// Reads gt/scene.ply and gt/scene_classes.txt now, so that a garbled file stops the run
@@ -73,7 +74,8 @@ public:
   /// crowns' tops, lamps, upper floors and what SGBM hangs in the sky beside them.
   static const std::vector<double>& offSurfaceBands();
   /// Each mesh against the true surface; `voxel_size_m` sets the completeness threshold (2
-  /// voxels) and the margin around moving boxes (a voxel).
+  /// voxels) and the margin around moving boxes (a voxel). Ghosts and crumbs lie where a moving
+  /// object was at a frame scored and is not at the last one (where it stands then is real).
   std::map<std::string, MeshScores> scoreMeshes(const std::map<std::string, MeshToScore>& meshes,
                                                 double voxel_size_m) const;
   /// The depth scores by method into the report.
@@ -89,6 +91,7 @@ private:
   pcl::PolygonMesh scene_;                     // gt/scene.ply
   std::optional<SurfaceClasses> classes_;      // gt/scene_classes.txt, when the dataset has it
   bool score_meshes_ = true;
+  std::optional<std::size_t> last_frame_;      // the latest ground-truth frame scored: where cars stand at the end
   std::unique_ptr<OpenSkyCoverage> true_sky_;  // made at the first frame, with its camera
   LidarSupport lidar_;
   std::mutex scans_mutex_;                     // addScan's thread and addFrame's
