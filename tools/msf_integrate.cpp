@@ -8,23 +8,22 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/fusion_config.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/poses.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
 #include <msf/pipeline/rig_adaptation.h>
+#include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/scan_free_space.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <pcl/console/time.h>
 #include <pcl/console/print.h>
-#include <pcl/common/io.h>
 
 #include <algorithm>
-#include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -47,37 +46,13 @@ pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
 }
 
 /// The open sky a fused cloud carries (field sky_depth, msf_fuse's), in the part of the cloud
-/// that is the camera's image (`image`; empty: the whole cloud): the mask and, per column, the
-/// depth of the LiDAR's highest return (0 where there is none), as TsdfIntegrator::carveSky
-/// takes them. Empty when the cloud has no such field.
-struct CloudSky {
-  cv::Mat mask;
-  std::vector<float> column_depth;
-};
-
-CloudSky readSky(const pcl::PCLPointCloud2& blob, cv::Rect image, const std::string& what) {
-  CloudSky sky;
-  const int field = pcl::getFieldIndex(blob, "sky_depth");
-  if (field < 0)
-    return sky;
-  if (blob.fields[field].datatype != pcl::PCLPointField::FLOAT32 || blob.fields[field].count != 1)
-    throw msf::InvalidInputError(what + ": field 'sky_depth' must be one float32");
-  if (image.empty())
-    image = cv::Rect(0, 0, static_cast<int>(blob.width), static_cast<int>(blob.height));
-  sky.mask = cv::Mat::zeros(image.size(), CV_8UC1);
-  sky.column_depth.assign(static_cast<std::size_t>(image.width), 0.f);
-  const std::uint32_t offset = blob.fields[field].offset;
-  for (int v = 0; v < image.height; ++v)
-    for (int u = 0; u < image.width; ++u) {
-      const std::size_t point = static_cast<std::size_t>(v + image.y) * blob.width + static_cast<std::size_t>(u + image.x);
-      float depth;
-      std::memcpy(&depth, blob.data.data() + point * blob.point_step + offset, sizeof depth);
-      if (std::isnan(depth))
-        continue;
-      sky.mask.at<std::uint8_t>(v, u) = 255;
-      sky.column_depth[static_cast<std::size_t>(u)] = std::isfinite(depth) ? depth : 0.f;
-    }
-  return sky;
+/// that is the camera's image (`image`; empty: the whole cloud). Empty when the cloud has no
+/// such field.
+msf::OpenSky readSky(const pcl::PCLPointCloud2& blob, const cv::Rect& image, const std::string& what) {
+  const cv::Mat sky_depth = msf::readSkyDepth(blob, what);
+  if (sky_depth.empty())
+    return {};
+  return msf::openSkyOf(image.empty() ? sky_depth : sky_depth(image));
 }
 
 /// What the command line sets.
@@ -193,7 +168,7 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     if (!frames.scans.empty())
       integrator.carveWithScan(msf::ScanFreeSpace(loadScan(frames.scans[i])),
                                T_world_cam * calibration.T_cam0_velo, lidar_weight, frame.camera, T_world_cam);
-    const CloudSky sky = readSky(blob, image, what);
+    const msf::OpenSky sky = readSky(blob, image, what);
     integrator.carveSky(sky.mask, image.empty() ? frame.camera : camera, T_world_cam, lidar_weight,
                         sky.column_depth);
     integrator.carveBeyondRange(frame, T_world_cam, lidar_weight);

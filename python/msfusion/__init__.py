@@ -41,10 +41,10 @@ from ._core import (  # noqa: F401  (the package's API)
     get_num_threads,
     load_calibration,
     open_dataset,
-    read_depth_cloud,
     read_mesh,
     real_returns,
     set_num_threads,
 )
 from .config import load_config  # noqa: F401
+from .depth_cloud import DepthCloud, read_depth_cloud  # noqa: F401
 from .geometry import depth_to_points  # noqa: F401

@@ -20,25 +20,27 @@ namespace {
 
 py::tuple readDepthCloud(const std::string& path, const std::optional<PinholeCamera>& camera) {
   DepthFrame frame;
+  cv::Mat sky_depth;
   {
     py::gil_scoped_release release;
     pcl::PCLPointCloud2 cloud;
     loadCloudBlob(path, cloud);
-    frame = toDepthFrame(cloud, camera ? &*camera : nullptr, "cloud '" + path + "'");
+    const std::string what = "cloud '" + path + "'";
+    frame = toDepthFrame(cloud, camera ? &*camera : nullptr, what);
+    sky_depth = readSkyDepth(cloud, what);
     if (!frame.color.empty())
       cv::cvtColor(frame.color, frame.color, cv::COLOR_BGR2RGB);
   }
-  return py::make_tuple(toArray(frame.depth), toArray(frame.weight), toArray(frame.color));
+  return py::make_tuple(toArray(frame.depth), toArray(frame.weight), toArray(frame.color),
+                        toArray(frame.free_space_weight), toArray(sky_depth));
 }
 
 } // namespace
 
 void bindDepthClouds(py::module_& m) {
-  m.def("read_depth_cloud", &readDepthCloud, py::arg("path"), py::arg("camera") = py::none(),
-        "An organized .pcd of camera 0 (msf_interpolate's, msf_stereo's, msf_fuse's) as (depth, weight, color): "
-        "(H, W) float32 z in metres (0 where NaN), (H, W) float32 from the field weight or None, (H, W, 3) uint8 RGB "
-        "or None. `camera` (a PinholeCamera) skips fitting the intrinsics to the points. Raises IOError naming the "
-        "file, InvalidInputError for a cloud that is not organized.");
+  m.def("_read_depth_cloud", &readDepthCloud, py::arg("path"), py::arg("camera") = py::none(),
+        "(depth, weight, color, free_space_weight, sky_depth) of an organized .pcd: msfusion.read_depth_cloud's "
+        "arrays, each None where the cloud has no such field.");
 }
 
 } // namespace msf::python

@@ -5,6 +5,7 @@
 #include "bindings.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/reconstruction/depth_frame.h>
@@ -26,12 +27,14 @@ namespace {
 
 struct Tsdf {
   Tsdf(const PipelineConfig& config, double voxel_size_m, double truncation_m)
-      : volume(voxel_size_m, truncation_m), integrator(volume, config.integrator), mesher(config.mesher) {
+      : volume(voxel_size_m, truncation_m), integrator(volume, config.integrator), mesher(config.mesher),
+        free_space_weight(config.fusion.lidarRangeWeight()) {
     volume.setMaxMemoryMb(config.volume.max_memory_mb);
   }
   TsdfVolume volume;
   TsdfIntegrator integrator;  // writes `volume`
   MarchingCubes mesher;       // remembers each block's mesh: extract_mesh meshes only what changed
+  float free_space_weight;    // of the open sky's and the far rays' carving: the LiDAR's, as the engine's
   std::mutex mutex;
 };
 
@@ -52,7 +55,8 @@ PinholeCamera cameraFrom(const py::handle& camera) {
 }
 
 void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose, const py::handle& camera,
-                    const py::handle& weight, const py::handle& color, const py::handle& free_space_weight) {
+                    const py::handle& weight, const py::handle& color, const py::handle& free_space_weight,
+                    const py::handle& sky_depth) {
   DepthFrame frame;
   frame.camera = cameraFrom(camera);
   const cv::Size size(frame.camera.width, frame.camera.height);
@@ -60,11 +64,20 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
   frame.weight = optionalImageView(weight, "weight", CV_32FC1, size);
   frame.free_space_weight = optionalImageView(free_space_weight, "free_space_weight", CV_32FC1, size);
   const cv::Mat rgb = optionalImageView(color, "color", CV_8UC3, size);
+  const cv::Mat sky = optionalImageView(sky_depth, "sky_depth", CV_32FC1, size);
   const Eigen::Isometry3d T_world_cam = poseFrom(pose, "pose");
   withoutGil(tsdf.mutex, [&] {
     if (!rgb.empty())
       cv::cvtColor(rgb, frame.color, cv::COLOR_RGB2BGR); // the volume keeps OpenCV's order
+    // What msf_integrate does with a fused cloud: the depth, then the free space of its open
+    // sky and of its rays beyond the range (each as the configuration's carving allows).
     tsdf.integrator.integrate(frame, T_world_cam);
+    if (!sky.empty()) {
+      const OpenSky open_sky = openSkyOf(sky);
+      tsdf.integrator.carveSky(open_sky.mask, frame.camera, T_world_cam, tsdf.free_space_weight,
+                               open_sky.column_depth);
+    }
+    tsdf.integrator.carveBeyondRange(frame, T_world_cam, tsdf.free_space_weight);
   });
 }
 
@@ -110,9 +123,13 @@ void bindTsdf(py::module_& m) {
            py::arg("truncation") = py::none())
       .def("integrate", &integrateDepth, py::arg("depth"), py::arg("pose"), py::arg("camera"),
            py::arg("weight") = py::none(), py::arg("color") = py::none(), py::arg("free_space_weight") = py::none(),
+           py::arg("sky_depth") = py::none(),
            "A depth image seen from `pose` (4x4 T_world_cam): depth (H, W) float32 metres (0 = none), camera a "
            "PinholeCamera (or a Calibration: its camera 0) of that size; optional (H, W) float32 weight (inverse "
-           "variance, m^-2: DepthFusion's) and free_space_weight, (H, W, 3) uint8 RGB color.")
+           "variance, m^-2: DepthFusion's) and free_space_weight, (H, W, 3) uint8 RGB color, (H, W) float32 "
+           "sky_depth (NaN where not open sky: a DepthCloud's). As msf_integrate does, the rays of the open sky "
+           "and those beyond tsdf_integrator.max_depth_m then carve the free space they passed (sky_carving, "
+           "far_carving, with space_carving).")
       .def("integrate_points", &integratePoints, py::arg("points"), py::arg("pose"), py::arg("colors") = py::none(),
            "Points (N, 3) or (N, 4) float32 in the sensor's frame, the sensor at `pose` (4x4 T_world_sensor): each "
            "point's ray from the sensor updates the voxels around it (VDBFusion's integrate(points, origin)). "

@@ -2,14 +2,18 @@
 // Evaluation protocol 6 on real frames: the sky mask of a hand-checked KITTI frame, and the
 // sheets over the road in front of the open sky that sky carving clears, and the clear sky that
 // gives no depth.
+#include <msf/common/exceptions.h>
 #include <msf/fusion/sky_mask.h>
 #include <msf/io/sequence.h>
+#include <msf/pipeline/fused_cloud.h>
 #include <msf/pipeline/reconstructor.h>
+#include <msf/reconstruction/depth_frame.h>
 #include <msf/pipeline/sky_scoring.h>
 
 #include <test_support.h>
 
 #include <gtest/gtest.h>
+#include <pcl/conversions.h>
 
 #include <cstdio>
 #include <map>
@@ -107,4 +111,45 @@ TEST(OpenSky, AClearSkyGivesNoDepth) {
   EXPECT_EQ(cv::countNonZero(differs & ~clear), 0);
   cv::compare(without.fused.weight, with.fused.weight, differs, cv::CMP_NE);
   EXPECT_EQ(cv::countNonZero(differs & ~clear), 0);
+}
+
+TEST(OpenSky, AFusedCloudCarriesTheFramesOpenSky) {
+  // What msf_fuse writes (field sky_depth) and msf_integrate and msfusion read back: the
+  // frame's open sky and each column's depth of its highest LiDAR return, as sky carving takes them.
+  MSF_REQUIRE_KITTI();
+  const msf::Sequence sequence(drive());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig());
+  const msf::FrameResult r = engine.computeDepth(sequence.load(20));
+  ASSERT_GT(cv::countNonZero(r.sky), 20000);
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(msf::fusedCloud(r, sequence.calibration()), blob);
+  const msf::OpenSky sky = msf::openSkyOf(msf::readSkyDepth(blob, "fused"));
+  EXPECT_EQ(cv::norm(sky.mask, r.sky, cv::NORM_INF), 0.0);
+  std::size_t bounded = 0;
+  for (int u = 0; u < r.sky.cols; ++u) {
+    if (cv::countNonZero(r.sky.col(u)) == 0)
+      continue;
+    const auto column = static_cast<std::size_t>(u);
+    EXPECT_EQ(sky.column_depth[column], r.sky_column_depth[column]) << u;
+    bounded += r.sky_column_depth[column] > 0.f;
+  }
+  EXPECT_GT(bounded, 100u); // most of the sky's columns have a return below it
+  // A cloud without the field carries no sky; a field of another type is refused, named.
+  pcl::toPCLPointCloud2(pcl::PointCloud<pcl::PointXYZ>(4, 3), blob);
+  EXPECT_TRUE(msf::readSkyDepth(blob, "plain").empty());
+  blob.fields.push_back(pcl::PCLPointField());
+  blob.fields.back().name = "sky_depth";
+  blob.fields.back().datatype = pcl::PCLPointField::FLOAT64;
+  blob.fields.back().count = 1;
+  EXPECT_THROW(
+      {
+        try {
+          msf::readSkyDepth(blob, "cloud 'x.pcd'");
+        } catch (const msf::InvalidInputError& e) {
+          EXPECT_STREQ(e.what(), "cloud 'x.pcd': field 'sky_depth' must be one float32");
+          throw;
+        }
+      },
+      msf::InvalidInputError);
+  EXPECT_THROW(msf::openSkyOf(cv::Mat(3, 4, CV_64FC1)), msf::InvalidInputError);
 }

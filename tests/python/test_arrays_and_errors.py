@@ -137,6 +137,10 @@ def test_wrong_arrays_are_errors_naming_the_argument(calibration, frame):
         (lambda: msfusion.LidarCompletion(calibration).compute_depth(frame.scan[:, :2].copy()),
          r"scan must have shape \(N, 3\) or \(N, 4\), got \(\d+, 2\)"),
         (lambda: msfusion.LidarCompletion(calibration, method="bilinear"), "bilinear"),
+        (lambda: msfusion.TsdfVolume().integrate(depth, np.eye(4), calibration, sky_depth=depth.astype(np.float64)),
+         "sky_depth must be float32, got float64"),
+        (lambda: msfusion.TsdfVolume().integrate(depth, np.eye(4), calibration, sky_depth=depth[:100].copy()),
+         r"sky_depth is 1226x100 .W x H., expected 1226x370"),
     ]
     for call, message in cases:
         with pytest.raises(msfusion.InvalidInputError, match=message):

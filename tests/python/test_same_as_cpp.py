@@ -33,10 +33,7 @@ def tool_chain(odometry04, run_tool, tmp_path_factory):
         run_tool("msf_stereo", image(0), image(1), stereo, "-calib", calib, "-color", image(2), "-prior", lidar)
         run_tool("msf_fuse", lidar, stereo, fused[-1], "-calib", calib, "-color", image(2), "-left", image(0))
     poses = os.path.join(odometry04, "..", "..", "poses", "04.txt")
-    # Without carving: msf_integrate carves the free space the fused clouds carry (their free-space
-    # weight and open sky), which TsdfVolume.integrate is not given here.
-    run_tool("msf_integrate", *fused, "-poses", poses, "-frames", "0:2", "-calib", calib, "-no_carving",
-             "-o", out / "volume.pcd")
+    run_tool("msf_integrate", *fused, "-poses", poses, "-frames", "0:2", "-calib", calib, "-o", out / "volume.pcd")
     run_tool("msf_mesh", out / "volume.pcd", out / "mesh.ply")
     return out
 
@@ -112,12 +109,19 @@ def test_each_stage_gives_the_tools_output(sequence, tool_chain, per_stage, pipe
 
 
 def test_the_volume_meshes_as_msf_integrate_and_msf_mesh(sequence, tool_chain):
-    """msf_fuse's clouds, integrated here and by msf_integrate, then meshed here and by msf_mesh."""
-    volume = msfusion.TsdfVolume(msfusion.load_config(overrides={"tsdf_integrator.space_carving": False}))
+    """msf_fuse's clouds, integrated here and by msf_integrate (the free space their rays, open sky
+    included, passed carved by both), then meshed here and by msf_mesh."""
+    volume = msfusion.TsdfVolume()
     camera = sequence.calibration.camera(0)
+    open_sky = 0
     for i in range(3):
-        depth, weight, color = msfusion.read_depth_cloud(str(tool_chain / f"fused_{i:06d}.pcd"), camera)
-        volume.integrate(depth, sequence.poses[i], camera, weight=weight, color=color)
+        cloud = msfusion.read_depth_cloud(tool_chain / f"fused_{i:06d}.pcd", camera)
+        depth, weight, color = cloud
+        assert cloud.free_space_weight.shape == depth.shape and cloud.sky_depth.shape == depth.shape
+        open_sky += np.count_nonzero(~np.isnan(cloud.sky_depth))
+        volume.integrate(depth, sequence.poses[i], camera, weight=weight, color=color,
+                         free_space_weight=cloud.free_space_weight, sky_depth=cloud.sky_depth)
+    assert open_sky > 1000, "frames 0-2 of odometry 04 show no open sky"
     mesh = volume.extract_mesh()
     assert len(mesh.triangles) > 10000
     assert_same_mesh(mesh, msfusion.read_mesh(str(tool_chain / "mesh.ply")))

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace msf {
@@ -157,6 +158,24 @@ void SkyMask::takeBorder(cv::Mat& mask) const {
   if (border_ > 0)
     cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
               cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+}
+
+OpenSky openSkyOf(const cv::Mat& sky_depth) {
+  if (sky_depth.type() != CV_32FC1)
+    throw InvalidInputError("sky_depth must be one float32 per pixel (CV_32FC1)");
+  OpenSky sky;
+  sky.mask = cv::Mat::zeros(sky_depth.size(), CV_8UC1);
+  sky.column_depth.assign(static_cast<std::size_t>(sky_depth.cols), 0.f);
+  for (int v = 0; v < sky_depth.rows; ++v) {
+    const float* depth = sky_depth.ptr<float>(v);
+    for (int u = 0; u < sky_depth.cols; ++u) {
+      if (std::isnan(depth[u]))
+        continue;
+      sky.mask.ptr<std::uint8_t>(v)[u] = 255;
+      sky.column_depth[static_cast<std::size_t>(u)] = std::isfinite(depth[u]) ? depth[u] : 0.f;
+    }
+  }
+  return sky;
 }
 
 } // namespace msf

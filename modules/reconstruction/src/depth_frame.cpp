@@ -121,6 +121,22 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
   return frame;
 }
 
+cv::Mat readSkyDepth(const pcl::PCLPointCloud2& cloud, const std::string& what) {
+  const pcl::PCLPointField* field = optionalFloatField(cloud, "sky_depth", what);
+  if (!field)
+    return cv::Mat();
+  detail::requireOrganized(cloud.width, cloud.height, what);
+  const int rows = static_cast<int>(cloud.height), cols = static_cast<int>(cloud.width);
+  if (cloud.data.size() < static_cast<std::size_t>(rows) * cols * cloud.point_step)
+    throw InvalidInputError(what + " has fewer data bytes than width x height points");
+  cv::Mat sky_depth(rows, cols, CV_32FC1);
+  for (int v = 0; v < rows; ++v)
+    for (int u = 0; u < cols; ++u)
+      sky_depth.ptr<float>(v)[u] =
+          readFloat(cloud.data.data() + (static_cast<std::size_t>(v) * cols + u) * cloud.point_step + field->offset);
+  return sky_depth;
+}
+
 #define MSF_INSTANTIATE_DEPTH_FRAME(T)                                                        \
   template DepthFrame toDepthFrame<T>(const pcl::PointCloud<T>&, const PinholeCamera*);
 MSF_INSTANTIATE_DEPTH_FRAME(pcl::PointXYZ)

@@ -101,4 +101,15 @@ inline float skyDepth(bool open_sky, float column_depth) {
   return column_depth > 0.f ? column_depth : std::numeric_limits<float>::infinity();
 }
 
+/// The open sky that a sky_depth image carries (as skyDepth writes it), as
+/// TsdfIntegrator::carveSky takes it: the mask (255 where the pixel is open sky) and each
+/// column's depth of its highest LiDAR return (0 where the column has none or no open sky).
+struct OpenSky {
+  cv::Mat mask;                    ///< CV_8UC1
+  std::vector<float> column_depth; ///< one per column
+};
+
+/// Throws InvalidInputError when `sky_depth` is not CV_32FC1.
+OpenSky openSkyOf(const cv::Mat& sky_depth);
+
 } // namespace msf

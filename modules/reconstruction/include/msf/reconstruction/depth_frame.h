@@ -46,6 +46,12 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
 DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* camera = nullptr,
                         const std::string& what = "cloud");
 
+/// The field `sky_depth` of an organized cloud (the fused cloud's: NaN where the pixel is not
+/// open sky, else the depth its ray passed every surface to) as a CV_32FC1 image of the cloud's
+/// size; empty when the cloud has no such field. Throws InvalidInputError naming `what` when
+/// the field is not one float32 or the cloud is not organized.
+cv::Mat readSkyDepth(const pcl::PCLPointCloud2& cloud, const std::string& what = "cloud");
+
 } // namespace msf
 
 #ifdef MSF_NO_PRECOMPILE
