@@ -435,6 +435,73 @@ TEST(TsdfIntegrator, SpaceCarvingRemovesASurfaceSeenThrough) {
   }
 }
 
+TEST(TsdfIntegrator, TheFramesThatPassedASurfaceSinceItWasSeenAreCounted) {
+  // A wall at 2 m seen by twenty frames, then (it moved away) at 3 m: the old wall keeps most of
+  // its weight, so the mesh keeps a surface there, but the rays of each later frame pass the
+  // voxels behind it. From component_release_passes such frames on, the mesh gives its
+  // vertices no weight (no LiDAR hold); the new wall's voxels are never passed. When the wall
+  // comes back, the count starts again.
+  ASSERT_EQ(MarchingCubes::Config{}.component_release_passes, 2);
+  TsdfVolume volume(0.05, 0.15);
+  TsdfIntegrator::Config c;
+  c.lambda = 0.0; // the plain mean
+  TsdfIntegrator integrator(volume, c);
+  DepthFrame frame;
+  frame.camera = test::smallCamera();
+  frame.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(2.0f));
+  for (int i = 0; i < 20; ++i)
+    integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  auto voxelAt = [&](double z) { return volume.findVoxel(volume.voxelIndexOf(Eigen::Vector3d(0.0, 0.0, z))); };
+  const double behind_old[] = {2.0, 2.05, 2.1}; // the voxels in front share no sub-block with a surface
+  for (const double z : behind_old)
+    ASSERT_EQ(voxelAt(z)->passes(), 0) << z;
+
+  // Mesh vertices of the old wall and of the new one, and of each those that keep a weight.
+  struct Held {
+    std::size_t old_wall = 0, old_held = 0, new_wall = 0, new_held = 0;
+  };
+  auto held = [&](int release_passes) {
+    MarchingCubes::Config whole;
+    whole.min_component_triangles = 0;
+    whole.component_release_passes = release_passes;
+    TriangleMesh mesh;
+    MarchingCubes(whole).extract(volume, mesh);
+    Held h;
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const bool old = mesh.vertices[i].z() < 2.5f;
+      (old ? h.old_wall : h.new_wall) += 1;
+      (old ? h.old_held : h.new_held) += mesh.weights[i] > 0.f;
+    }
+    return h;
+  };
+  frame.depth.setTo(3.0f);
+  for (int passes = 1; passes <= TsdfVoxel::kMaxPasses + 1; ++passes) {
+    integrator.integrate(frame, Eigen::Isometry3d::Identity());
+    for (const double z : behind_old) {
+      EXPECT_EQ(voxelAt(z)->passes(), std::min(passes, TsdfVoxel::kMaxPasses)) << z;
+      EXPECT_LT(voxelAt(z)->sdf, 0.15f) << z << ": the old wall is still a surface in the mean";
+    }
+    for (const double z : {2.95, 3.0, 3.05})
+      EXPECT_EQ(voxelAt(z)->passes(), 0) << z;
+    if (passes > 2)
+      continue; // then the mean is carved past the surface: no old wall to mesh
+    const Held by_default = held(2);
+    ASSERT_GT(by_default.old_wall, 100u);
+    ASSERT_GT(by_default.new_wall, 100u);
+    EXPECT_EQ(by_default.new_held, by_default.new_wall);
+    if (passes < 2)
+      EXPECT_EQ(by_default.old_held, by_default.old_wall) << passes << " frames passed";
+    else
+      EXPECT_EQ(by_default.old_held, 0u) << passes << " frames passed";
+    EXPECT_EQ(held(1).old_held, 0u);
+    EXPECT_EQ(held(0).old_held, held(0).old_wall) << "0: passes release nothing";
+  }
+  frame.depth.setTo(2.0f);
+  integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  for (const double z : behind_old)
+    EXPECT_EQ(voxelAt(z)->passes(), 0) << z << ": seen again";
+}
+
 TEST(TsdfIntegrator, FreeSpaceWeighsTheFramesFreeSpaceWeight) {
   // The wall at 2 m, then a wall at 3 m whose depth is uncertain (weight 25, sigma 0.2 m: the
   // fusion's average of two samples that disagree) but whose free space in front is not (the frame's

@@ -114,7 +114,7 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
   EXPECT_DOUBLE_EQ(loaded.voxelSize(), 0.04);
   EXPECT_DOUBLE_EQ(loaded.truncation(), 0.12);
   EXPECT_EQ(loaded.numObservedVoxels(), volume.numObservedVoxels());
-  std::size_t compared = 0;
+  std::size_t compared = 0, passed = 0;
   for (const auto& block : volume.blocks())
     for (int z = 0; z < 8; ++z)
       for (int y = 0; y < 8; ++y)
@@ -129,9 +129,12 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
           EXPECT_EQ(a.r, b->r);
           EXPECT_EQ(a.g, b->g);
           EXPECT_EQ(a.b, b->b);
+          EXPECT_EQ(a.passes(), b->passes());
+          passed += a.passes() > 0;
           ++compared;
         }
   EXPECT_EQ(compared, volume.numObservedVoxels());
+  EXPECT_GT(passed, 100u); // the free space in front of the sphere
   const TsdfVoxel* some = nullptr;
   for (const auto& block : loaded.blocks())
     for (const auto& v : block->voxels)
@@ -153,6 +156,27 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
   pcl::PointCloud<PointTsdf> cloud;
   ASSERT_EQ(pcl::io::loadPCDFile(dir.file("volume.pcd"), cloud), 0);
   EXPECT_EQ(cloud.size(), volume.numObservedVoxels());
+}
+
+TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {
+  // Volumes saved before the passes field: their voxels load, none passed.
+  test::TempDir dir;
+  std::ofstream(dir.file("older.pcd")) << "# .PCD v0.7 - Point Cloud Data file format\n"
+                                          "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
+                                          "VERSION 0.7\nFIELDS x y z sdf weight rgb\nSIZE 4 4 4 4 4 4\n"
+                                          "TYPE F F F F F U\nCOUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+                                          "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
+                                          "0 0 0 -0.05 10 4278190335\n0.1 0 0 0.05 12 4278190335\n";
+  const TsdfVolume older = TsdfVolume::load(dir.file("older.pcd"));
+  ASSERT_EQ(older.numObservedVoxels(), 2u);
+  const TsdfVoxel* a = older.findVoxel(GridIndex(0, 0, 0));
+  const TsdfVoxel* b = older.findVoxel(GridIndex(1, 0, 0));
+  ASSERT_TRUE(a && b);
+  EXPECT_FLOAT_EQ(a->sdf, -0.05f);
+  EXPECT_FLOAT_EQ(b->weight, 12.f);
+  EXPECT_EQ(a->b, 255);
+  EXPECT_EQ(a->passes(), 0);
+  EXPECT_EQ(b->passes(), 0);
 }
 
 TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
@@ -177,6 +201,7 @@ TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
   p.sdf = 0.f;
   p.weight = 1.f;
   p.rgba = 0;
+  p.passes = 0;
   cloud.push_back(p);
   pcl::io::savePCDFileBinary(dir.file("plain.pcd"), cloud);
   try {

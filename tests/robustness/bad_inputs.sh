@@ -389,6 +389,8 @@ check "synth -config: a key twice" 1 "twice.yaml' line 3: 'stereo.p1' appears tw
   msf_synth -o out -config "$F/twice.yaml"
 check "mesh -config: a number of a million digits" 1 "long_number.yaml' line 2: stereo.p1 must be a whole number in 0..2147483647, not 7777.*\(1000000 characters\)" -- \
   msf_mesh "$F/dense.pcd" o.ply -config "$F/long_number.yaml"
+check "mesh: passes beyond what a voxel counts" 1 "marching_cubes.component_release_passes must be in 0..3, not 4" -- \
+  msf_mesh "$F/dense.pcd" o.ply -component_release_passes 4
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \

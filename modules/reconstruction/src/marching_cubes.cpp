@@ -167,8 +167,9 @@ bool loadGridPoints(const TsdfBlock* const corner[8], float min_weight, bool smo
 /// found in the scratch's slots by the others.
 class BlockVertices {
 public:
-  BlockVertices(const GridIndex& origin, float voxel_size, MarchingCubes::BlockMesh& out, Scratch& s)
-      : origin_(origin), voxel_size_(voxel_size), out_(out), s_(s) {}
+  BlockVertices(const GridIndex& origin, float voxel_size, int release_passes, MarchingCubes::BlockMesh& out,
+                Scratch& s)
+      : origin_(origin), voxel_size_(voxel_size), release_passes_(release_passes), out_(out), s_(s) {}
   ~BlockVertices() {
     for (const int u : s_.used)
       s_.slot[u] = -1;
@@ -190,7 +191,11 @@ public:
       p[code] += t;
     out_.vertices.push_back(p * voxel_size_);
     out_.colors.push_back(colour(t, a, b));
-    out_.weights.push_back(std::min(a.weight, b.weight)); // 0 next to an unseen corner: no evidence
+    // 0 next to an unseen corner (no evidence) and where rays passed the corner behind the
+    // surface release_passes times in a row since it last saw one: the surface was seen to go.
+    const TsdfVoxel& behind = a.sdf < b.sdf ? a : b;
+    const bool released = release_passes_ > 0 && behind.passes() >= release_passes_;
+    out_.weights.push_back(released ? 0.f : std::min(a.weight, b.weight));
     out_.keys.push_back(isInterior(px, py, pz, code)
                             ? MarchingCubes::kInterior
                             : vertexKey(origin_.x() + px, origin_.y() + py, origin_.z() + pz, code));
@@ -219,6 +224,7 @@ private:
 
   GridIndex origin_;
   float voxel_size_;
+  int release_passes_;
   MarchingCubes::BlockMesh& out_;
   Scratch& s_;
 };
@@ -325,7 +331,7 @@ void meshBlockInto(const TsdfVolume& volume, const TsdfBlock& block, const March
   if (!loadGridPoints(corner, config.min_weight, smooth, s))
     return;
   const float voxel_size = static_cast<float>(volume.voxelSize());
-  BlockVertices vertices(block.origin(), voxel_size, out, s);
+  BlockVertices vertices(block.origin(), voxel_size, config.component_release_passes, out, s);
   for (int z = 0; z < kSide; ++z)
     for (int y = 0; y < kSide; ++y) {
       const CubeRow row(s, y, z, config.max_unseen_corners);
@@ -477,7 +483,8 @@ MarchingCubes::MarchingCubes(const Config& config) { setConfig(config); }
 void MarchingCubes::setConfig(const Config& config) {
   config.validate();
   if (config.min_weight != config_.min_weight || config.smoothing_lambda != config_.smoothing_lambda ||
-      config.max_unseen_corners != config_.max_unseen_corners)
+      config.max_unseen_corners != config_.max_unseen_corners ||
+      config.component_release_passes != config_.component_release_passes)
     reset();
   config_ = config;
 }

@@ -88,6 +88,7 @@ void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rec
                                    if (!(w > 0.f))
                                      return false;
                                    detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                                   detail::countPass(voxel, true);
                                    return true;
                                  });
   });

@@ -23,7 +23,7 @@ using Clock = std::chrono::steady_clock;
 struct MergedBlock {
   struct Sums {
     double sdf_w = 0, w = 0, r_w = 0, g_w = 0, b_w = 0;
-    int observers = 0;
+    int observers = 0, passes = TsdfVoxel::kMaxPasses;
   };
   TsdfBlock block;
   std::unique_ptr<std::array<Sums, TsdfBlock::kVoxels>> sums;
@@ -57,6 +57,7 @@ struct MergedBlock {
       s.g_w += v.g * w;
       s.b_w += v.b * w;
       ++s.observers;
+      s.passes = std::min(s.passes, v.passes());
     }
   }
 
@@ -78,6 +79,8 @@ struct MergedBlock {
       v.r = static_cast<std::uint8_t>(s.r_w / s.w + 0.5);
       v.g = static_cast<std::uint8_t>(s.g_w / s.w + 0.5);
       v.b = static_cast<std::uint8_t>(s.b_w / s.w + 0.5);
+      // Drives have no order: the passes every drive's latest rays made.
+      v.flags = static_cast<std::uint8_t>(s.passes << TsdfVoxel::kPassesShift);
     }
     sums.reset();
   }

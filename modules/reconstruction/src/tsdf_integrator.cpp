@@ -41,6 +41,7 @@ float planeBand(float truncation, float voxel_size) { return std::min(truncation
 using Clock = std::chrono::steady_clock;
 
 using detail::PixelBand;
+using detail::countPass;
 using detail::updateVoxel;
 
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
@@ -459,7 +460,7 @@ struct BlockProjection {
   }
 };
 
-/// Lists the voxels of `touched` flagged kUpdated (clearing the flags) whose |sdf| is below
+/// Lists the voxels of `touched` flagged kUpdated (clearing the flag) whose |sdf| is below
 /// `band`: their local indices and sdf, block after block, offsets[i] where touched[i]'s begin.
 void listFlaggedVoxels(const std::vector<TsdfBlock*>& touched, float band, std::vector<std::uint16_t>& index,
                        std::vector<float>& sdf, std::vector<std::size_t>& offsets) {
@@ -469,7 +470,7 @@ void listFlaggedVoxels(const std::vector<TsdfBlock*>& touched, float band, std::
   for (TsdfBlock* block : touched) {
     for (int j = 0; j < TsdfBlock::kVoxels; ++j)
       if (block->voxels[j].flags & kUpdated) {
-        block->voxels[j].flags = 0;
+        block->voxels[j].flags &= static_cast<std::uint8_t>(~kUpdated);
         if (!(std::abs(block->voxels[j].sdf) < band))
           continue;
         index.push_back(static_cast<std::uint16_t>(j));
@@ -785,7 +786,8 @@ detail::BlockChanges TsdfIntegrator::updateBlocks(const DepthFrame& frame, const
                                has_color ? frame.color.ptr<std::uint8_t>(0) : nullptr,
                                has_color ? static_cast<int>(frame.color.step[0]) : 0, config_.interpolate_depth,
                                carving, config_.weight_dropoff, regularized, view.trunc, vs, 1.5f * vs,
-                               config_.max_weight, smoothingBand()},
+                               config_.max_weight, smoothingBand(),
+                               static_cast<float>(config_.truncation_sigmas * config_.truncation_sigmas)},
       frame.color};
   const std::vector<std::uint64_t> order = visitOrder(blocks, T_cam_world, view);
   std::atomic<std::size_t> projected_total{0};
@@ -876,6 +878,7 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
                                    if (!(nearest > 0.f && p.norm() < nearest - margin))
                                      return false;
                                    updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
+                                   countPass(voxel, true);
                                    return true;
                                  });
   });
@@ -951,6 +954,7 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
       const GridIndex l = v - bi * kSide;
       TsdfVoxel& voxel = last->at(l.x(), l.y(), l.z());
       updateVoxel(voxel, in_band ? sdf_raw : trunc, w, in_band ? bgr : nullptr, config_.max_weight, trunc);
+      countPass(voxel, sdf_raw > trunc); // a ray of precise depth: passed beyond the truncation
       voxel.flags |= flag;
       ++updated;
     });

@@ -93,7 +93,7 @@ std::string TsdfStore::blockPath(const GridIndex& tile) const {
 
 /// Block file: magic, voxel size and truncation (float64), block side and block count
 /// (int32), then per block its index (3 x int32), its sign bits (2 bytes and 2 of padding)
-/// and its 512 voxels as in memory (12 bytes each, the integrator's flags zeroed; they are
+/// and its 512 voxels as in memory (12 bytes each, the integrator's own flags zeroed; they are
 /// zero between frames anyway), little-endian as the host.
 void TsdfStore::writeTile(const GridIndex& tile, const std::vector<const TsdfBlock*>& blocks) const {
   const std::string path = blockPath(tile);
@@ -113,7 +113,7 @@ void TsdfStore::writeTile(const GridIndex& tile, const std::vector<const TsdfBlo
       out.write(reinterpret_cast<const char*>(bits), sizeof(bits));
       voxels = block->voxels;
       for (TsdfVoxel& v : voxels)
-        v.flags = 0;
+        v.flags &= TsdfVoxel::kPassesMask;
       out.write(reinterpret_cast<const char*>(voxels.data()), sizeof(voxels));
     }
   });

@@ -8,6 +8,7 @@
 #include <msf/reconstruction/tsdf_volume.h>
 
 #include <opencv2/core/utility.hpp>
+#include <pcl/common/io.h>
 #include <pcl/io/pcd_io.h>
 
 #if __has_include(<sys/mman.h>)
@@ -44,6 +45,25 @@ std::string number(double v) {
 }
 
 constexpr const char* kHeaderTag = "# msfusion tsdf";
+
+/// Adds a uint8 field of zeros named `name` to every point of `blob`.
+void addZeroField(pcl::PCLPointCloud2& blob, const std::string& name) {
+  pcl::PCLPointCloud2 zeros;
+  zeros.width = blob.width;
+  zeros.height = blob.height;
+  pcl::PCLPointField field;
+  field.name = name;
+  field.offset = 0;
+  field.datatype = pcl::PCLPointField::UINT8;
+  field.count = 1;
+  zeros.fields.push_back(field);
+  zeros.point_step = 1;
+  zeros.row_step = blob.width;
+  zeros.data.assign(static_cast<std::size_t>(blob.width) * blob.height, 0);
+  pcl::PCLPointCloud2 joined;
+  pcl::concatenateFields(blob, zeros, joined);
+  blob = std::move(joined);
+}
 
 // TsdfBlock is trivially destructible: a chunk is freed without destroying its blocks.
 static_assert(std::is_trivially_destructible_v<TsdfBlock>);
@@ -316,6 +336,7 @@ void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) co
           p.g = voxel.g;
           p.b = voxel.b;
           p.a = 255;
+          p.passes = static_cast<std::uint8_t>(voxel.passes());
           cloud.push_back(p);
         }
   }
@@ -346,7 +367,7 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     voxel.r = p.r;
     voxel.g = p.g;
     voxel.b = p.b;
-    voxel.flags = 0;
+    voxel.flags = static_cast<std::uint8_t>(std::min<int>(p.passes, TsdfVoxel::kMaxPasses) << TsdfVoxel::kPassesShift);
   }
   const std::uint64_t stamp = beginGeneration();
   for (auto& block : blocks_) {
@@ -405,8 +426,12 @@ TsdfVolume TsdfVolume::load(const std::string& path, double voxel_size_m, double
                     "truncation it was made with (msf_mesh -voxel V -trunc T)");
   }
   TsdfVolume volume(voxel_size, truncation);
+  pcl::PCLPointCloud2 blob;
+  loadCloudBlob(path, blob);
+  if (pcl::getFieldIndex(blob, "passes") < 0)
+    addZeroField(blob, "passes"); // written before the field: no voxel known to be passed
   pcl::PointCloud<PointTsdf> cloud;
-  loadCloud(path, cloud);
+  fromCloudBlob(std::move(blob), cloud, path);
   try {
     volume.fromCloud(cloud);
   } catch (const InvalidInputError& e) {

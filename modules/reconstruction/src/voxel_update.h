@@ -26,6 +26,12 @@ inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t
   voxel.weight = std::min(total, max_weight);
 }
 
+/// Counts an update of the voxel whose ray passed through it, or resets the count (TsdfVoxel::passes).
+inline void countPass(TsdfVoxel& voxel, bool passed) {
+  const int passes = passed ? std::min(voxel.passes() + 1, TsdfVoxel::kMaxPasses) : 0;
+  voxel.flags = static_cast<std::uint8_t>((voxel.flags & ~TsdfVoxel::kPassesMask) | passes << TsdfVoxel::kPassesShift);
+}
+
 /// What the update reads of a frame and of the integrator's settings.
 struct VoxelUpdateFrame {
   int width, height;
@@ -35,7 +41,19 @@ struct VoxelUpdateFrame {
   int color_step;
   bool bilinear, carving, dropoff, regularized;
   float trunc, voxel_size, colour_band, max_weight, smooth_band;
+  /// Squared sigmas of a pixel's depth that a voxel must lie in front of it (and more than the
+  /// truncation) for its ray to have passed through the voxel (TsdfVoxel::passes).
+  float through_sigmas2;
 };
+
+/// Whether the rays passed a voxel that lies `ahead` in front of the least depth of the 4 pixels
+/// around its projection (along the ray; the pixel's weight `w`, its inverse variance): by more
+/// than the truncation and than the depth's noise. All 4, as for free space: beside a depth edge
+/// the nearest pixel may see the background past a foreground voxel. Along the ray, not the
+/// plane distance: a voxel above a grazing road is near its plane.
+inline bool passedThrough(const VoxelUpdateFrame& f, float ahead, float w) {
+  return ahead > f.trunc && ahead * ahead * w > f.through_sigmas2;
+}
 
 /// The block's updated voxels, and (when regularized) those within smooth_band of a surface.
 struct VoxelUpdateResult {

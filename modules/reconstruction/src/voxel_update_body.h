@@ -45,13 +45,13 @@ MSF_SIMD_INLINE typename V::F sampleDepth(const VoxelUpdateFrame& f, typename V:
   return V::select(blend, blended, nearest);
 }
 
-/// The `coloured` voxels' colours (words of r, g, b and flags at `voxel_colour` + at_voxel)
-/// take the weighted mean with their pixels' (candidates k..): old_weight theirs, w the pixel's,
+/// The voxels' words of r, g, b and flags (`rgbf`) with the `coloured` ones' colours the
+/// weighted mean with their pixels' (candidates k..): old_weight theirs, w the pixel's,
 /// inv 1 / (old_weight + w).
 template <class V>
-MSF_SIMD_INLINE void blendColours(const VoxelUpdateFrame& f, const VoxelCandidates& c, int k, typename V::I at_voxel,
-                                  typename V::M coloured, typename V::F old_weight, typename V::F w,
-                                  typename V::F inv, std::int32_t* voxel_colour) {
+MSF_SIMD_INLINE typename V::I blendColours(const VoxelUpdateFrame& f, const VoxelCandidates& c, int k,
+                                           typename V::I rgbf, typename V::M coloured, typename V::F old_weight,
+                                           typename V::F w, typename V::F inv) {
   using F = typename V::F;
   using I = typename V::I;
   using M = typename V::M;
@@ -62,7 +62,6 @@ MSF_SIMD_INLINE void blendColours(const VoxelUpdateFrame& f, const VoxelCandidat
   const M first = V::eqi(offset, zero_i);
   const I word = V::gatheri1(f.color, V::selecti(first, offset, V::subi(offset, one_i)), coloured);
   const I bgr = V::srlv(word, V::selecti(first, zero_i, V::set1i(8)));
-  const I rgbf = V::gatheri4(voxel_colour, at_voxel, coloured);
   I mixed = V::andi(rgbf, V::set1i(static_cast<std::int32_t>(0xff000000u))); // the flags
   for (int ch = 0; ch < 3; ++ch) { // r, g, b: the voxel's bytes 0, 1, 2; the image's 2, 1, 0
     const F mine = V::cvtf(V::andi(V::srli(rgbf, 8 * ch), byte));
@@ -70,7 +69,7 @@ MSF_SIMD_INLINE void blendColours(const VoxelUpdateFrame& f, const VoxelCandidat
     const I mean = V::cvtt(V::add(V::mul(V::add(V::mul(mine, old_weight), V::mul(seen, w)), inv), half));
     mixed = V::ori(mixed, V::slli(V::andi(mean, byte), 8 * ch));
   }
-  V::scatteri(voxel_colour, at_voxel, coloured, mixed);
+  return V::selecti(coloured, mixed, rgbf);
 }
 
 /// The update of a block's candidates, V's lanes a time: blockUpdatePortable's float operations
@@ -93,6 +92,9 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
   const F vs = V::set1(f.voxel_size), minus_vs = V::set1(-f.voxel_size);
   const F colour_band = V::set1(f.colour_band), max_weight = V::set1(f.max_weight);
   const F smooth_band = V::set1(f.smooth_band), sign = V::set1(-0.f);
+  const F through_sigmas2 = V::set1(f.through_sigmas2);
+  const I max_passes = V::set1i(TsdfVoxel::kMaxPasses);
+  const I passes_cleared = V::set1i(~(std::int32_t{TsdfVoxel::kPassesMask} << 24));
   const I one_i = V::set1i(1), zero_i = V::set1i(0);
   VoxelUpdateResult out;
   I negative = zero_i;
@@ -130,11 +132,20 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
     const F total = V::add(old_weight, w);
     const F inv = V::div(one, total);
     const F new_sdf = stdClamp<V>(V::mul(V::add(V::mul(old_sdf, old_weight), V::mul(sdf, w)), inv), minus_trunc, trunc);
+    I rgbf = V::gatheri4(voxel_colour, at_voxel, keep);
     if (f.color) {
       const M coloured = V::and_(V::and_(keep, in_band), V::lt(V::andnot(sdf, sign), colour_band));
       if (V::bits(coloured))
-        blendColours<V>(f, c, k, at_voxel, coloured, old_weight, w, inv, voxel_colour);
+        rgbf = blendColours<V>(f, c, k, rgbf, coloured, old_weight, w, inv);
     }
+    // countPass(passedThrough(quad_min - z)): the flags are the word's top byte.
+    const F ahead = V::sub(quad_min, z);
+    const M passed = V::and_(V::gt(ahead, trunc), V::gt(V::mul(V::mul(ahead, ahead), pixel_weight), through_sigmas2));
+    const I passes = V::andi(V::srli(rgbf, 24 + TsdfVoxel::kPassesShift), max_passes);
+    const I cleared = V::andi(rgbf, passes_cleared);
+    const I counted = V::selecti(V::eqi(passes, max_passes), passes, V::addi(passes, one_i));
+    rgbf = V::selecti(passed, V::ori(cleared, V::slli(counted, 24 + TsdfVoxel::kPassesShift)), cleared);
+    V::scatteri(voxel_colour, at_voxel, keep, rgbf);
     V::scatter(voxel_sdf, at_voxel, keep, new_sdf);
     V::scatter(voxel_weight, at_voxel, keep, V::min(max_weight, total)); // std::min(total, max_weight)
 

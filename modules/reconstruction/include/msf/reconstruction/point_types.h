@@ -6,13 +6,15 @@
 namespace msf {
 
 /// One observed voxel of a TsdfVolume as a point: its centre (x y z, metres), sdf (metres),
-/// weight and colour (rgb). A .pcd of these is the volume on disk (TsdfVolume::save), so
-/// tools chain and pcl_viewer shows it (coloured by rgb, or by the sdf field).
+/// weight, colour (rgb) and passes (TsdfVoxel::passes). A .pcd of these is the
+/// volume on disk (TsdfVolume::save), so tools chain and pcl_viewer shows it (coloured by rgb,
+/// or by the sdf field).
 struct EIGEN_ALIGN16 PointTsdf {
   PCL_ADD_POINT4D;
   float sdf;
   float weight;
   PCL_ADD_RGB;
+  std::uint8_t passes;
   PCL_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -20,4 +22,4 @@ struct EIGEN_ALIGN16 PointTsdf {
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(msf::PointTsdf,
                                   (float, x, x)(float, y, y)(float, z, z)(float, sdf, sdf)(float, weight, weight)(
-                                      float, rgb, rgb))
+                                      float, rgb, rgb)(std::uint8_t, passes, passes))
