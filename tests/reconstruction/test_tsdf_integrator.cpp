@@ -16,6 +16,7 @@
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -750,6 +751,52 @@ TEST(TsdfIntegrator, CarvingRemovesTheGhostOfACarAheadAndKeepsTheStreet) {
   // What remains is the rear of the last frames, seen through once or twice.
   EXPECT_GT(ghosts[0], 1000u);
   EXPECT_LT(ghosts[1], ghosts[0] / 20);
+}
+
+TEST(TsdfIntegrator, AStoppedCarsPlaceLosesTheLidarsHoldOnceItLeftAndABollardKeepsIt) {
+  // A car's back (a board) stands 12 m on while the camera drives towards it, then drives off;
+  // a bollard stands beside the lane, and a wall 25 m on ends every ray. Six frames of precise
+  // hits outweigh the few frames that then look through the car's place: its surface stays in
+  // the map, a small piece the LiDAR's weight holds. Once rays passed it twice it loses that
+  // hold; the bollard, a small piece too but hit by every frame, keeps it.
+  const PinholeCamera camera = test::kittiCamera();
+  const Eigen::Vector3d board(0.0, 0.6, 12.0), board_half(0.9, 0.6, 0.1);
+  const Eigen::Vector3d bollard(-2.0, 1.15, 14.0), bollard_half(0.1, 0.5, 0.1);
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume, TsdfIntegrator::Config{});
+  auto near = [](const Eigen::Vector3f& v, const Eigen::Vector3d& centre, const Eigen::Vector3d& half) {
+    return ((v.cast<double>() - centre).cwiseAbs() - half).maxCoeff() < 0.15;
+  };
+  // Vertices of the car's place and of the bollard, meshed with component_release_passes 0, 2.
+  auto meshed = [&](int release_passes) {
+    MarchingCubes::Config c;
+    c.component_release_passes = release_passes;
+    TriangleMesh mesh;
+    MarchingCubes(c).extract(volume, mesh);
+    std::array<std::size_t, 2> n = {0, 0};
+    for (const auto& v : mesh.vertices) {
+      n[0] += near(v, board, board_half);
+      n[1] += near(v, bollard, bollard_half);
+    }
+    return n;
+  };
+  for (int i = 0; i < 8; ++i) {
+    AnalyticScene scene;
+    scene.addHalfSpace(Eigen::Vector3d(0, 0, -1), -25.0);
+    scene.addBox(bollard, bollard_half);
+    if (i < 6)
+      scene.addBox(board, board_half);
+    integrator.integrate(test::renderFrame(scene, camera, streetPose(i), 0.0), streetPose(i));
+    if (i == 6) { // passed once
+      const auto kept = meshed(2);
+      EXPECT_GT(kept[0], 50u) << "one frame's pass releases nothing";
+    }
+  }
+  const auto held = meshed(0), released = meshed(2);
+  EXPECT_GT(held[0], 50u) << "the car's place, held by its weight";
+  EXPECT_EQ(released[0], 0u);
+  EXPECT_GT(held[1], 50u);
+  EXPECT_EQ(released[1], held[1]) << "the bollard";
 }
 
 TEST(TsdfIntegrator, ARoofSeenAtAGrazingAngleIsMeshedWithoutASkirt) {
