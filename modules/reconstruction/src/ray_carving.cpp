@@ -87,8 +87,7 @@ void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rec
                                    const float w = freeWeight(u, v, p.z());
                                    if (!(w > 0.f))
                                      return false;
-                                   detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
-                                   detail::countPass(voxel, true);
+                                   detail::updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc, true);
                                    return true;
                                  });
   });

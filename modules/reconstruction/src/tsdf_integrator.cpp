@@ -41,7 +41,6 @@ float planeBand(float truncation, float voxel_size) { return std::min(truncation
 using Clock = std::chrono::steady_clock;
 
 using detail::PixelBand;
-using detail::countPass;
 using detail::updateVoxel;
 
 constexpr std::uint8_t kUpdated = 1; // TsdfVoxel::flags: changed by this frame, regularized next
@@ -877,8 +876,7 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
                                    const float nearest = free_space.nearestAround(p);
                                    if (!(nearest > 0.f && p.norm() < nearest - margin))
                                      return false;
-                                   updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc);
-                                   countPass(voxel, true);
+                                   updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc, true);
                                    return true;
                                  });
   });
@@ -953,8 +951,9 @@ void TsdfIntegrator::integrateRays(const std::vector<Eigen::Vector3f>& points_wo
       }
       const GridIndex l = v - bi * kSide;
       TsdfVoxel& voxel = last->at(l.x(), l.y(), l.z());
-      updateVoxel(voxel, in_band ? sdf_raw : trunc, w, in_band ? bgr : nullptr, config_.max_weight, trunc);
-      countPass(voxel, sdf_raw > trunc); // a ray of precise depth: passed beyond the truncation
+      // A ray of precise depth: it passed the voxels beyond the truncation in front of its point.
+      updateVoxel(voxel, in_band ? sdf_raw : trunc, w, in_band ? bgr : nullptr, config_.max_weight, trunc,
+                  sdf_raw > trunc);
       voxel.flags |= flag;
       ++updated;
     });

@@ -60,8 +60,7 @@ VoxelUpdateResult blockUpdatePortable(const VoxelUpdateFrame& f, const VoxelCand
     const bool coloured = f.color && in_band && std::abs(sdf) < f.colour_band;
     const std::uint8_t* bgr = coloured ? f.color + static_cast<std::ptrdiff_t>(vi) * f.color_step + 3 * ui : nullptr;
     TsdfVoxel& voxel = voxels[voxel_index];
-    updateVoxel(voxel, sdf, w, bgr, f.max_weight, trunc);
-    countPass(voxel, passedThrough(f, quad_min - z, pixel.weight));
+    updateVoxel(voxel, sdf, w, bgr, f.max_weight, trunc, passedThrough(f, quad_min - z, pixel.weight));
     out.signs |= voxel.sdf < 0.f ? TsdfBlock::kHasNegative : TsdfBlock::kHasPositive;
     out.negative |= voxel.sdf < 0.f ? static_cast<std::uint8_t>(1u << TsdfBlock::subBlockOf(voxel_index)) : 0;
     if (f.regularized && std::abs(voxel.sdf) < f.smooth_band) {

@@ -12,8 +12,10 @@
 
 namespace msf::detail {
 
-/// Running weighted mean of one observation into a voxel (the portable kernel's, and the scan's).
-inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight, float trunc) {
+/// Running weighted mean of one observation into a voxel (the portable kernel's, and the scan's);
+/// `passed`: its ray passed through the voxel, which TsdfVoxel::passes counts (else resets).
+inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight, float trunc,
+                        bool passed) {
   const float total = voxel.weight + w;
   const float inv = 1.f / total;
   // Clamped: rounding may carry a mean of values at the truncation a hair past it.
@@ -24,10 +26,6 @@ inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t
     voxel.b = static_cast<std::uint8_t>((voxel.b * voxel.weight + bgr[0] * w) * inv + 0.5f);
   }
   voxel.weight = std::min(total, max_weight);
-}
-
-/// Counts an update of the voxel whose ray passed through it, or resets the count (TsdfVoxel::passes).
-inline void countPass(TsdfVoxel& voxel, bool passed) {
   const int passes = passed ? std::min(voxel.passes() + 1, TsdfVoxel::kMaxPasses) : 0;
   voxel.flags = static_cast<std::uint8_t>((voxel.flags & ~TsdfVoxel::kPassesMask) | passes << TsdfVoxel::kPassesShift);
 }
@@ -43,7 +41,7 @@ struct VoxelUpdateFrame {
   float trunc, voxel_size, colour_band, max_weight, smooth_band;
   /// Squared sigmas of a pixel's depth that a voxel must lie in front of it (and more than the
   /// truncation) for its ray to have passed through the voxel (TsdfVoxel::passes).
-  float through_sigmas2;
+  float pass_sigmas2;
 };
 
 /// Whether the rays passed a voxel that lies `ahead` in front of the least depth of the 4 pixels
@@ -52,7 +50,7 @@ struct VoxelUpdateFrame {
 /// the nearest pixel may see the background past a foreground voxel. Along the ray, not the
 /// plane distance: a voxel above a grazing road is near its plane.
 inline bool passedThrough(const VoxelUpdateFrame& f, float ahead, float w) {
-  return ahead > f.trunc && ahead * ahead * w > f.through_sigmas2;
+  return ahead > f.trunc && ahead * ahead * w > f.pass_sigmas2;
 }
 
 /// The block's updated voxels, and (when regularized) those within smooth_band of a surface.

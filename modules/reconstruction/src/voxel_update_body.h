@@ -92,7 +92,7 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
   const F vs = V::set1(f.voxel_size), minus_vs = V::set1(-f.voxel_size);
   const F colour_band = V::set1(f.colour_band), max_weight = V::set1(f.max_weight);
   const F smooth_band = V::set1(f.smooth_band), sign = V::set1(-0.f);
-  const F through_sigmas2 = V::set1(f.through_sigmas2);
+  const F pass_sigmas2 = V::set1(f.pass_sigmas2);
   const I max_passes = V::set1i(TsdfVoxel::kMaxPasses);
   const I passes_cleared = V::set1i(~(std::int32_t{TsdfVoxel::kPassesMask} << 24));
   const I one_i = V::set1i(1), zero_i = V::set1i(0);
@@ -138,9 +138,9 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
       if (V::bits(coloured))
         rgbf = blendColours<V>(f, c, k, rgbf, coloured, old_weight, w, inv);
     }
-    // countPass(passedThrough(quad_min - z)): the flags are the word's top byte.
+    // updateVoxel's passes of passedThrough(quad_min - z): the flags are the word's top byte.
     const F ahead = V::sub(quad_min, z);
-    const M passed = V::and_(V::gt(ahead, trunc), V::gt(V::mul(V::mul(ahead, ahead), pixel_weight), through_sigmas2));
+    const M passed = V::and_(V::gt(ahead, trunc), V::gt(V::mul(V::mul(ahead, ahead), pixel_weight), pass_sigmas2));
     const I passes = V::andi(V::srli(rgbf, 24 + TsdfVoxel::kPassesShift), max_passes);
     const I cleared = V::andi(rgbf, passes_cleared);
     const I counted = V::selecti(V::eqi(passes, max_passes), passes, V::addi(passes, one_i));

@@ -10,9 +10,10 @@ namespace msf {
 /// observed); the weighted mean colour; flags. 12 bytes, so a block of 8^3 voxels is 6 KiB.
 struct TsdfVoxel {
   /// flags' bits 1-2: passes(), the updates in a row (up to kMaxPasses) whose ray passed
-  /// through the voxel, its depth beyond it by more than the truncation and the depth's noise;
-  /// any other update resets the count. A surface whose voxels behind it were passed again and
-  /// again was seen to be gone (where a moving object stood), however much weight it gathered.
+  /// through the voxel (its depth beyond it by more than the truncation and the depth's noise,
+  /// or a carving along the ray); any other update resets the count. A surface whose voxels
+  /// behind it were passed again and again was seen to be gone (where a moving object stood),
+  /// however much weight it gathered.
   static constexpr int kPassesShift = 1;
   static constexpr int kMaxPasses = 3;
   static constexpr std::uint8_t kPassesMask = kMaxPasses << kPassesShift;
