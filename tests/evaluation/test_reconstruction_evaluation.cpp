@@ -222,6 +222,35 @@ TEST(CrumbMetric, CountsSmallPiecesOffTheStaticSurfaceWhereAMovingObjectWas) {
   EXPECT_THROW(measureCrumbs(mesh, truth, MovingSpace(), 50, 0.2), InvalidInputError);
   EXPECT_THROW(measureCrumbs(mesh, truth, was_moving, 50, 0.0), InvalidInputError);
   EXPECT_THROW(measureCrumbs(mesh, truth, was_moving, 0, 0.2), InvalidInputError);
+  EXPECT_TRUE(m.by_frames_since_left.empty()); // not asked for
+}
+
+TEST(CrumbMetric, CountsTheCrumbsByTheFramesSinceTheirPlaceWasLeft) {
+  // The ground y = 0. A car drove through the box x in [0, 2], y in [-2, 0], z in [5, 12]: it
+  // left z < 7 five frames before the last one, z in [7, 10) two frames before, z >= 10 one
+  // frame before.
+  const SurfaceDistance ground({{-50.f, 0.f, -50.f}, {50.f, 0.f, -50.f}, {50.f, 0.f, 50.f}, {-50.f, 0.f, 50.f}},
+                               {{0, 1, 2}, {0, 2, 3}});
+  const FramesSinceLeft since_left = [](const Eigen::Vector3f& p) -> std::size_t {
+    const bool inside = p.x() >= 0.f && p.x() <= 2.f && p.y() >= -2.f && p.y() <= 0.f && p.z() >= 5.f && p.z() <= 12.f;
+    return !inside ? 0 : p.z() < 7.f ? 5 : p.z() < 10.f ? 2 : 1;
+  };
+  const MovingSpace was_moving = [&](const Eigen::Vector3f& p) { return since_left(p) > 0; };
+  const TriangleMesh mesh = joined({
+      strip(0.5f, -1.f, 6.f, 3, 0.1f),  // left five frames ago
+      strip(0.5f, -1.f, 8.f, 3, 0.1f),  // two
+      strip(0.5f, -1.f, 11.f, 3, 0.1f), // one
+      strip(0.5f, -1.5f, 11.5f, 2, 0.1f), // one
+      strip(20.f, -3.f, 6.f, 2, 0.1f),  // a speck where no car was: not counted
+  });
+  const CrumbMetrics m = measureCrumbs(mesh, ground, was_moving, 50, 0.2, since_left, 3);
+  EXPECT_EQ(m.crumbs, 4u);
+  EXPECT_EQ(m.specks, 1u);
+  EXPECT_EQ(m.by_frames_since_left, (std::vector<std::size_t>{2, 1, 1})); // 1, 2, 3 or more frames
+  // Two buckets: 1, and 2 or more.
+  EXPECT_EQ(measureCrumbs(mesh, ground, was_moving, 50, 0.2, since_left, 2).by_frames_since_left,
+            (std::vector<std::size_t>{2, 2}));
+  EXPECT_THROW(measureCrumbs(mesh, ground, was_moving, 50, 0.2, since_left, 0), InvalidInputError);
 }
 
 TEST(ReconstructionEvaluation, SmallPiecesInFrontOfTheTrueDepthAreSeenThrough) {

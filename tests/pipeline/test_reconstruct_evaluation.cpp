@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -153,6 +154,16 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_LE(jsonNumber(mesh, "crumbs", "crumbs") + jsonNumber(mesh, "specks", "crumbs"), small_pieces);
   EXPECT_LE(small_pieces, jsonNumber(mesh, "pieces", "crumbs"));
   EXPECT_EQ(jsonNumber(mesh, "max_triangles", "crumbs"), 50);
+  // The crumbs by the frames since their place was left (1, 2, 3 or more) add up to them.
+  const std::size_t ages = mesh.find("\"by_frames_since_left\": [");
+  ASSERT_NE(ages, std::string::npos) << mesh;
+  std::istringstream counts(mesh.substr(mesh.find('[', ages) + 1));
+  double by_age = 0, count = 0;
+  int buckets = 0;
+  for (char separator = ','; separator == ',' && counts >> count >> separator; ++buckets)
+    by_age += count;
+  EXPECT_EQ(buckets, 3);
+  EXPECT_EQ(by_age, jsonNumber(mesh, "crumbs", "crumbs"));
   EXPECT_NE(readFile(out.file("report.md")).find("| ghosts | crumbs | specks |"), std::string::npos);
   EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
   // Split by the class of the nearest true surface (gt/scene_classes.txt): the parts add up

@@ -235,6 +235,21 @@ std::string atCompletenessJson(const RunReport::MapEvaluation& e, const RunRepor
   return "[" + matched + "]";
 }
 
+/// Counts joined by `separator` between `open` and `close`.
+std::string countsJoined(const std::vector<std::size_t>& counts, const char* separator, const char* open,
+                         const char* close) {
+  std::string out = open;
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    out += (i ? separator : "") + std::to_string(counts[i]);
+  return out + close;
+}
+
+/// The crumbs' count, and by the frames since their place was left when measured: "13 (10 / 3 / 0)".
+std::string crumbsCell(const CrumbMetrics& c) {
+  return std::to_string(c.crumbs) +
+         (c.by_frames_since_left.empty() ? "" : " " + countsJoined(c.by_frames_since_left, " / ", "(", ")"));
+}
+
 /// A row's ghosts and crumbs as two JSON members, each line indented by `in`.
 std::string ghostsJson(const RunReport::MapEvaluation::Row& r, const std::string& in) {
   std::ostringstream s;
@@ -243,7 +258,10 @@ std::string ghostsJson(const RunReport::MapEvaluation::Row& r, const std::string
     << num(r.ghosts.distance_m) << "},\n"
     << in << "\"crumbs\": {\"crumbs\": " << r.crumbs.crumbs << ", \"crumb_triangles\": " << r.crumbs.crumb_triangles
     << ", \"specks\": " << r.crumbs.specks << ", \"small_pieces\": " << r.crumbs.small_pieces
-    << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles << "}";
+    << ", \"pieces\": " << r.crumbs.pieces << ", \"max_triangles\": " << r.crumbs.max_triangles;
+  if (!r.crumbs.by_frames_since_left.empty())
+    s << ", \"by_frames_since_left\": " << countsJoined(r.crumbs.by_frames_since_left, ", ", "[", "]");
+  s << "}";
   return s.str();
 }
 
@@ -397,7 +415,7 @@ void writeScoreTable(std::ostream& s, const RunReport::MapEvaluation& e, const S
                                  " % |"
                            : " | |");
     if (c.ghosts)
-      s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % | " + std::to_string(r.crumbs.crumbs) + " | " +
+      s << (r.has_ghosts ? " " + num(100 * r.ghosts.share, 3) + " % | " + crumbsCell(r.crumbs) + " | " +
                                std::to_string(r.crumbs.specks) + " |"
                          : " | | |");
     if (c.seen)
@@ -427,6 +445,18 @@ void writeFusedAtCompleteness(std::ostream& s, const RunReport::MapEvaluation& e
       << rows << "\n";
 }
 
+/// What the brackets of the crumbs' column say, for `buckets` buckets of their ages (none: "").
+std::string crumbAgesNote(std::size_t buckets) {
+  if (buckets == 0)
+    return "";
+  std::string ages;
+  for (std::size_t i = 1; i <= buckets; ++i)
+    ages += (i > 1 ? " / " : "") + std::to_string(i);
+  return "; in brackets, the crumbs whose place the object left " + ages +
+         (buckets > 1 ? " or more" : "") +
+         " frames before the last one (a place left a frame ago has been looked through by one frame at most)";
+}
+
 /// What the ghost, crumb and seen-through columns count (or why there is no ghost figure).
 void writeGhostNotes(std::ostream& s, const RunReport::MapEvaluation& e, const ScoreColumns& c) {
   if (!e.no_ghosts.empty())
@@ -436,7 +466,8 @@ void writeGhostNotes(std::ostream& s, const RunReport::MapEvaluation& e, const S
       << " m from the static true surface inside the space a moving object occupied and had left by the last "
          "frame; crumbs (specks): pieces of fewer than "
       << e.rows.front().crumbs.max_triangles
-      << " triangles mostly that far from it, inside that space (elsewhere).\n";
+      << " triangles mostly that far from it, inside that space (elsewhere)"
+      << crumbAgesNote(e.rows.front().crumbs.by_frames_since_left.size()) << ".\n";
   if (c.seen)
     s << "Pieces seen through: pieces of fewer than " << e.rows.front().seen_through.max_triangles
       << " triangles most of whose vertices lie in front of the true depth by more than D1's threshold at some "

@@ -6,31 +6,34 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 namespace msf {
 
 namespace {
 constexpr double kGhostDistanceM = 0.2; // farther than this from the static surface: not the road under a car
 constexpr std::size_t kCrumbTriangles = 50; // a piece this small is a speck to the eye (a few voxels' faces)
+// Crumbs counted by the frames since their place was left: 1, 2, 3 or more. Letting a place go takes
+// marching_cubes.component_release_passes frames looking through it, once the object is a
+// truncation behind it.
+constexpr std::size_t kCrumbAgeBuckets = 3;
 constexpr float kOffSurfaceM = static_cast<float>(kGhostDistanceM); // off the true surface: a sheet, not an outline
 
-/// Where moving objects were and no longer are: inside a box of a frame up to `last_frame`
-/// (gt/moving_objects.txt), and in none of `last_frame`'s, each grown by `margin_m` (a car's
-/// surface is meshed up to a voxel off its box). Where a car stands when the run ends is what
-/// the last frame saw, a true surface; frames the run never reached are not its past.
-MovingSpace spaceLeftBehind(std::vector<synthetic::MovingBox> boxes, std::size_t last_frame, double margin_m) {
+/// How long ago moving objects left a place: the frames from the latest frame up to `last_frame`
+/// whose box (gt/moving_objects.txt), grown by `margin_m` (a car's surface is meshed up to a voxel
+/// off its box), holds it, to `last_frame`; 0 where no box ever held it or one of `last_frame`'s
+/// does. Where a car stands when the run ends is what the last frame saw, a true surface; frames
+/// the run never reached are not its past.
+FramesSinceLeft framesSinceLeft(std::vector<synthetic::MovingBox> boxes, std::size_t last_frame, double margin_m) {
   boxes.erase(std::remove_if(boxes.begin(), boxes.end(), [&](const auto& box) { return box.frame > last_frame; }),
               boxes.end());
-  return [boxes = std::move(boxes), last_frame, margin_m](const Eigen::Vector3f& p) {
+  return [boxes = std::move(boxes), last_frame, margin_m](const Eigen::Vector3f& p) -> std::size_t {
     const Eigen::Vector3d q = p.cast<double>();
-    bool was_inside = false;
+    std::optional<std::size_t> latest;
     for (const auto& box : boxes)
-      if (box.contains(q, margin_m)) {
-        if (box.frame == last_frame)
-          return false;
-        was_inside = true;
-      }
-    return was_inside;
+      if (box.contains(q, margin_m))
+        latest = std::max(latest.value_or(box.frame), box.frame);
+    return latest ? last_frame - *latest : 0;
   };
 }
 } // namespace
@@ -119,9 +122,12 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
   std::map<std::string, MeshScores> scores;
   if (!score_meshes_ || meshes.empty())
     return scores;
+  FramesSinceLeft since_left;
   MovingSpace was_moving;
-  if (std::filesystem::exists(truth_->movingBoxesPath()) && last_frame_)
-    was_moving = spaceLeftBehind(truth_->movingBoxes(), *last_frame_, voxel_size_m);
+  if (std::filesystem::exists(truth_->movingBoxesPath()) && last_frame_) {
+    since_left = framesSinceLeft(truth_->movingBoxes(), *last_frame_, voxel_size_m);
+    was_moving = [&since_left](const Eigen::Vector3f& p) { return since_left(p) > 0; };
+  }
   const SurfaceDistance static_surface(scene_);
   // The street's road in its world (y down): the camera's height below the cameras' path.
   const Eigen::Hyperplane<float, 3> road(Eigen::Vector3f(0.f, -1.f, 0.f),
@@ -141,7 +147,8 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
                               classes_ ? &*classes_ : nullptr);
     if (was_moving) {
       s.ghosts = measureGhosts(m.mesh->vertices, static_surface, was_moving, kGhostDistanceM);
-      s.crumbs = measureCrumbs(*m.mesh, static_surface, was_moving, kCrumbTriangles, kGhostDistanceM);
+      s.crumbs = measureCrumbs(*m.mesh, static_surface, was_moving, kCrumbTriangles, kGhostDistanceM, since_left,
+                               kCrumbAgeBuckets);
       s.has_ghosts = true;
     }
     if (true_sky_) {
