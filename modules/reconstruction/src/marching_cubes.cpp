@@ -128,9 +128,16 @@ bool gatherNeighbours(const TsdfVolume& volume, const TsdfBlock& block, bool smo
   return signs == (TsdfBlock::kHasPositive | TsdfBlock::kHasNegative);
 }
 
+/// What a block that was never allocated reads as: a block no frame reached. A mesh then does
+/// not depend on which blocks a run allocated and left unobserved, which a saved volume omits.
+const TsdfBlock& unallocatedBlock() {
+  static const TsdfBlock unobserved;
+  return unobserved;
+}
+
 /// Fills the scratch's rows of voxel pointers, the sdf of the grid points (unless smoothing
 /// wrote them) and the bit masks of valid, negative and unseen points; a missing neighbour
-/// block's points are unobserved. False when no valid point is negative or none positive.
+/// block's points are unseen. False when no valid point is negative or none positive.
 bool loadGridPoints(const TsdfBlock* const corner[8], float min_weight, bool smoothed, Scratch& s) {
   std::uint16_t any_negative = 0, any_positive = 0;
   for (int z = 0; z < kPad; ++z)
@@ -139,11 +146,8 @@ bool loadGridPoints(const TsdfBlock* const corner[8], float min_weight, bool smo
       const int sel = ((y >> 3) << 1) | ((z >> 3) << 2);
       std::uint16_t valid = 0, negative = 0, unseen = 0;
       for (int part = 0; part < 2; ++part) {
-        const TsdfBlock* b = corner[sel | part];
-        s.row[r][part] = b ? &b->at(0, y & 7, z & 7) : nullptr;
-        if (!b)
-          continue;
-        const TsdfVoxel* src = s.row[r][part];
+        const TsdfBlock* b = corner[sel | part] ? corner[sel | part] : &unallocatedBlock();
+        const TsdfVoxel* src = s.row[r][part] = &b->at(0, y & 7, z & 7);
         float* sdf = &s.sdf[static_cast<std::size_t>(kPad) * r];
         for (int x = part * kSide, n = part ? 1 : kSide, k = 0; k < n; ++k, ++x) {
           if (!smoothed)
