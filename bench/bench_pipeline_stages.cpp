@@ -9,7 +9,8 @@
 //                                                        path, MSF_CONFIG the configuration)
 //
 // BM_StageIntegrate: the 10 fused frames and each scan's free space into a fresh volume
-// (Reconstructor::integrate's work: TsdfIntegrator::integrate, then carveWithScan), per frame.
+// (Reconstructor::integrate's work: TsdfIntegrator::integrateFrame, the depth and the free space
+// of the scan, the open sky and the rays beyond the range), per frame.
 // BM_StageDepth: steps 1-4 of one frame (Reconstructor::computeDepth), per frame.
 #include "kitti_sample.h"
 
@@ -62,10 +63,11 @@ void BM_StageIntegrate(benchmark::State& state) {
     TsdfIntegrator integrator(volume, d.config.integrator);
     projected = updated = 0;
     for (std::size_t i = 0; i < d.frames.size(); ++i) {
-      integrator.integrate(d.frames[i], d.results[i].T_world_cam0);
+      integrator.integrateFrame(d.frames[i], d.results[i].T_world_cam0,
+                                freeSpaceOf(d.results[i], d.results[i].fused.camera, d.config.fusion,
+                                            d.sequence.calibration()));
       projected += static_cast<double>(integrator.lastStats().voxels_projected);
       updated += static_cast<double>(integrator.lastStats().voxels_updated);
-      carveWithScan(integrator, d.results[i], d.frames[i].camera, d.config.fusion, d.sequence.calibration());
     }
     blocks = static_cast<double>(volume.numBlocks());
   }

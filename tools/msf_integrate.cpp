@@ -164,14 +164,18 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     cv::Rect image;
     const std::optional<msf::PinholeCamera> cloud_camera = cloudCamera(blob, camera, what, image);
     const msf::DepthFrame frame = msf::toDepthFrame(blob, cloud_camera ? &*cloud_camera : nullptr, what);
-    integrator.integrate(frame, T_world_cam);
+    std::optional<msf::ScanFreeSpace> scan;
     if (!frames.scans.empty())
-      integrator.carveWithScan(msf::ScanFreeSpace(loadScan(frames.scans[i])),
-                               T_world_cam * calibration.T_cam0_velo, lidar_weight, frame.camera, T_world_cam);
+      scan.emplace(loadScan(frames.scans[i]));
     const msf::OpenSky sky = readSky(blob, image, what);
-    integrator.carveSky(sky.mask, image.empty() ? frame.camera : camera, T_world_cam, lidar_weight,
-                        sky.column_depth);
-    integrator.carveBeyondRange(frame, T_world_cam, lidar_weight);
+    msf::TsdfIntegrator::FreeSpace free;
+    free.weight = lidar_weight;
+    free.scan = scan ? &*scan : nullptr;
+    free.T_world_lidar = T_world_cam * calibration.T_cam0_velo;
+    free.sky = sky.mask;
+    free.sky_camera = image.empty() ? frame.camera : camera;
+    free.sky_column_depth = sky.column_depth;
+    integrator.integrateFrame(frame, T_world_cam, free);
     const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
     integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;
     msf::tool::printDone(tt.toc(), stats.voxels_updated);

@@ -71,13 +71,15 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
       cv::cvtColor(rgb, frame.color, cv::COLOR_RGB2BGR); // the volume keeps OpenCV's order
     // What msf_integrate does with a fused cloud: the depth, then the free space of its open
     // sky and of its rays beyond the range (each as the configuration's carving allows).
-    tsdf.integrator.integrate(frame, T_world_cam);
+    TsdfIntegrator::FreeSpace free;
+    free.weight = tsdf.free_space_weight;
     if (!sky.empty()) {
-      const OpenSky open_sky = openSkyOf(sky);
-      tsdf.integrator.carveSky(open_sky.mask, frame.camera, T_world_cam, tsdf.free_space_weight,
-                               open_sky.column_depth);
+      OpenSky open_sky = openSkyOf(sky);
+      free.sky = open_sky.mask;
+      free.sky_camera = frame.camera;
+      free.sky_column_depth = std::move(open_sky.column_depth);
     }
-    tsdf.integrator.carveBeyondRange(frame, T_world_cam, tsdf.free_space_weight);
+    tsdf.integrator.integrateFrame(frame, T_world_cam, free);
   });
 }
 

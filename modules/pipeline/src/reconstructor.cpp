@@ -185,24 +185,19 @@ void Reconstructor::computeDepth(const Frame& frame, FrameResult& result) {
   computeSky(result);
 }
 
-void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
-                   const DepthFusionConfig& fusion, const Calibration& calibration) {
-  if (!integrator.carvesWithScans() || result.scan_free_space.empty())
-    return;
-  integrator.carveWithScan(result.scan_free_space, result.T_world_cam0 * calibration.T_cam0_velo,
-                           fusion.lidarRangeWeight(), camera, result.T_world_cam0);
-}
-
-void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
-              const DepthFusionConfig& fusion) {
-  if (result.sky.empty())
-    return;
-  integrator.carveSky(result.sky, camera, result.T_world_cam0, fusion.lidarRangeWeight(), result.sky_column_depth);
-}
-
-void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const FrameResult& result,
-                      const DepthFusionConfig& fusion) {
-  integrator.carveBeyondRange(frame, result.T_world_cam0, fusion.lidarRangeWeight());
+TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCamera& sky_camera,
+                                      const DepthFusionConfig& fusion, const Calibration& calibration,
+                                      bool with_scan) {
+  TsdfIntegrator::FreeSpace free;
+  free.weight = fusion.lidarRangeWeight();
+  if (with_scan && !result.scan_free_space.empty()) {
+    free.scan = &result.scan_free_space;
+    free.T_world_lidar = result.T_world_cam0 * calibration.T_cam0_velo;
+  }
+  free.sky = result.sky;
+  free.sky_camera = sky_camera;
+  free.sky_column_depth = result.sky_column_depth;
+  return free;
 }
 
 void Reconstructor::integrate(FrameResult& result) {
@@ -217,10 +212,7 @@ void Reconstructor::integrate(FrameResult& result) {
     streaming_->beforeIntegration(result.T_world_cam0.translation());
   const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
   fillFromMap(result);
-  integrator_->integrate(frame, result.T_world_cam0);
-  carveWithScan(*integrator_, result, frame.camera, config_.fusion, calibration_);
-  carveSky(*integrator_, result, camera_, config_.fusion);
-  carveBeyondRange(*integrator_, frame, result, config_.fusion);
+  integrator_->integrateFrame(frame, result.T_world_cam0, freeSpaceOf(result, camera_, config_.fusion, calibration_));
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
     streaming_->afterIntegration(result.T_world_cam0.translation());

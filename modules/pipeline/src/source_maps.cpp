@@ -19,11 +19,9 @@ SourceMaps::SourceMaps(const PipelineConfig& config, const Calibration& calibrat
 void SourceMaps::integrate(const FrameResult& result) {
   for (auto& map : maps_) {
     const DepthFrame frame = sourceDepthFrame(result, map->source, config_.fusion, calibration_.focalBaseline());
-    map->integrator.integrate(frame, result.T_world_cam0);
-    if (map->source == DepthSource::Lidar)
-      carveWithScan(map->integrator, result, frame.camera, config_.fusion, calibration_);
-    carveSky(map->integrator, result, result.fused.camera, config_.fusion);
-    carveBeyondRange(map->integrator, frame, result, config_.fusion);
+    map->integrator.integrateFrame(frame, result.T_world_cam0,
+                                   freeSpaceOf(result, result.fused.camera, config_.fusion, calibration_,
+                                               map->source == DepthSource::Lidar));
   }
 }
 

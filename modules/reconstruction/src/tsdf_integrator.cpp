@@ -574,6 +574,16 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   stats_.regularize_ms = msSince(t_reg);
 }
 
+void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam,
+                                    const FreeSpace& free) {
+  integrate(frame, T_world_cam);
+  if (free.scan && carvesWithScans())
+    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam);
+  if (!free.sky.empty())
+    carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth);
+  carveBeyondRange(frame, T_world_cam, free.weight);
+}
+
 FrameView TsdfIntegrator::prepareDepth(const DepthFrame& frame) {
   // Each pixel's weight, the inverse variance of its depth (m^-2); pixels weighing less than
   // min_pixel_weight are no depth, for every phase.

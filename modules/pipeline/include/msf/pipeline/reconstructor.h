@@ -100,25 +100,13 @@ struct FrameResult {
   StageTimes times;
 };
 
-/// Free space from the frame's whole scan, after its depth is integrated (see
-/// TsdfIntegrator::carveWithScan; nothing when tsdf_integrator.scan_carving_m is 0 or
-/// space_carving is off): a return weighs as the fusion weighs a LiDAR-backed pixel, its range noise
-/// (fusion.lidar_range_sigma_m). `camera` is the integrated frame's.
-void carveWithScan(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
-                   const DepthFusionConfig& fusion, const Calibration& calibration);
-
-/// Free space along the frame's open sky (FrameResult::sky; see TsdfIntegrator::carveSky; nothing
-/// without a sky or when tsdf_integrator.sky_carving or space_carving is off): a sky pixel weighs
-/// as a LiDAR return does (fusion.lidar_range_sigma_m), since its ray is as surely free. `camera`
-/// is camera 0's, the sky's.
-void carveSky(TsdfIntegrator& integrator, const FrameResult& result, const PinholeCamera& camera,
-              const DepthFusionConfig& fusion);
-
-/// Free space along the integrated frame's rays that reach beyond the range (see
-/// TsdfIntegrator::carveBeyondRange; nothing when tsdf_integrator.far_carving or space_carving is
-/// off): such a ray weighs as a LiDAR return does, as a sky ray.
-void carveBeyondRange(TsdfIntegrator& integrator, const DepthFrame& frame, const FrameResult& result,
-                      const DepthFusionConfig& fusion);
+/// What the frame showed free beside its depth, for TsdfIntegrator::integrateFrame: its scan's
+/// rays (with `with_scan`), its open sky (FrameResult::sky, of `sky_camera`, camera 0) and its rays
+/// beyond the range, each weighing as a LiDAR return does (fusion.lidar_range_sigma_m), since they
+/// are as surely free.
+TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCamera& sky_camera,
+                                      const DepthFusionConfig& fusion, const Calibration& calibration,
+                                      bool with_scan = true);
 
 /// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per

@@ -295,6 +295,22 @@ public:
   /// InvalidInputError for a weight that is not positive and finite, or a pose that is not rigid.
   void carveBeyondRange(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, float weight);
 
+  /// What a frame showed free beside its depth (integrateFrame): the weight of its free-space
+  /// updates (m^-2; the pipeline's is a LiDAR return's), its scan's rays and its open sky.
+  struct FreeSpace {
+    float weight = 0.f;
+    const ScanFreeSpace* scan = nullptr; ///< the scan's rays (carveWithScan), or none
+    Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
+    cv::Mat sky;                         ///< the open sky (carveSky), or empty
+    PinholeCamera sky_camera;            ///< the camera of the sky's mask
+    std::vector<float> sky_column_depth; ///< carveSky's bound per column, or empty
+  };
+
+  /// A frame as msf_reconstruct integrates it: its depth (integrate), then the free space its
+  /// scan (when carvesWithScans()), its open sky and its rays beyond the range show
+  /// (carveWithScan, carveSky, carveBeyondRange). Throws as they do.
+  void integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, const FreeSpace& free);
+
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
   /// its colour and `weight` field when PointT has them. Without `camera`, the intrinsics are
   /// recovered from the cloud. Throws InvalidInputError when the cloud is not organized.
