@@ -19,11 +19,11 @@ constexpr std::size_t kCrumbTriangles = 50; // a piece this small is a speck to 
 constexpr std::size_t kCrumbAgeBuckets = 3;
 constexpr float kOffSurfaceM = static_cast<float>(kGhostDistanceM); // off the true surface: a sheet, not an outline
 
-/// How long ago moving objects left a place: the frames from the latest frame up to `last_frame`
-/// whose box (gt/moving_objects.txt), grown by `margin_m` (a car's surface is meshed up to a voxel
-/// off its box), holds it, to `last_frame`; 0 where no box ever held it or one of `last_frame`'s
-/// does. Where a car stands when the run ends is what the last frame saw, a true surface; frames
-/// the run never reached are not its past.
+/// How many frames before `last_frame` moving objects left a place: `last_frame` less the latest
+/// frame up to it whose box (gt/moving_objects.txt), grown by `margin_m` (a car's surface is
+/// meshed up to a voxel off its box), holds the place; 0 where no box ever held it or one of
+/// `last_frame`'s does. Where a car stands when the run ends is what the last frame saw, a true
+/// surface; frames the run never reached are not its past.
 FramesSinceLeft framesSinceLeft(std::vector<synthetic::MovingBox> boxes, std::size_t last_frame, double margin_m) {
   boxes.erase(std::remove_if(boxes.begin(), boxes.end(), [&](const auto& box) { return box.frame > last_frame; }),
               boxes.end());
