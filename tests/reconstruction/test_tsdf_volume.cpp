@@ -179,6 +179,25 @@ TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {
   EXPECT_EQ(b->passes(), 0);
 }
 
+TEST(TsdfVolume, AVoxelWithMorePassesThanItCountsIsRefused) {
+  test::TempDir dir;
+  const auto write = [&](const std::string& name, int passes) {
+    std::ofstream(dir.file(name)) << "# .PCD v0.7 - Point Cloud Data file format\n"
+                                     "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
+                                     "VERSION 0.7\nFIELDS x y z sdf weight rgb passes\nSIZE 4 4 4 4 4 4 1\n"
+                                     "TYPE F F F F F U U\nCOUNT 1 1 1 1 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n"
+                                     "0 0 0 -0.05 10 4278190335 "
+                                  << passes << "\n";
+  };
+  write("three.pcd", TsdfVoxel::kMaxPasses);
+  EXPECT_EQ(TsdfVolume::load(dir.file("three.pcd")).findVoxel(GridIndex(0, 0, 0))->passes(), TsdfVoxel::kMaxPasses);
+  write("nine.pcd", 9);
+  const std::string error = test::errorOf([&] { TsdfVolume::load(dir.file("nine.pcd")); });
+  EXPECT_NE(error.find("nine.pcd"), std::string::npos) << error;
+  EXPECT_NE(error.find("voxel 0 has passes 9, more than the 3 a voxel counts"), std::string::npos) << error;
+}
+
 TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
   test::TempDir dir;
   TsdfVolume empty(0.1, 0.3);

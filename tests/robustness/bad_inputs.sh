@@ -147,6 +147,10 @@ def depth_rows(z_of):
 pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
 pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
+open(f + "/passes9.pcd", "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
+    "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS x y z sdf weight rgb passes\n"
+    "SIZE 4 4 4 4 4 4 1\nTYPE F F F F F U U\nCOUNT 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+    "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 0 -0.05 10 4278190335 1\n0.1 0 0 0.05 10 4278190335 9\n")
 inf_rows = depth_rows(lambda u, v: 5.0)
 inf_rows[3][2] = "inf"
 pcd(f + "/inf.pcd", inf_rows)
@@ -391,6 +395,8 @@ check "mesh -config: a number of a million digits" 1 "long_number.yaml' line 2: 
   msf_mesh "$F/dense.pcd" o.ply -config "$F/long_number.yaml"
 check "mesh: passes beyond what a voxel counts" 1 "marching_cubes.component_release_passes must be in 0..3, not 4" -- \
   msf_mesh "$F/dense.pcd" o.ply -component_release_passes 4
+check "mesh: a volume whose voxel has more passes than a voxel counts" 1 "passes9.pcd': voxel 1 has passes 9, more than the 3 a voxel counts" -- \
+  msf_mesh "$F/passes9.pcd" o.ply
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \

@@ -353,6 +353,9 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.sdf) ||
         !std::isfinite(p.weight) || p.weight < 0.f)
       throw InvalidInputError("voxel " + std::to_string(i) + " has a coordinate, sdf or weight that is not a finite value");
+    if (p.passes > TsdfVoxel::kMaxPasses) // no writer makes it: a file edited or of another program
+      throw InvalidInputError("voxel " + std::to_string(i) + " has passes " + std::to_string(p.passes) +
+                              ", more than the " + std::to_string(TsdfVoxel::kMaxPasses) + " a voxel counts");
     const Eigen::Vector3d q(p.x, p.y, p.z);
     const GridIndex v = voxelIndexOf(q);
     if (((q / voxel_size_) - v.cast<double>()).cwiseAbs().maxCoeff() > tolerance)
@@ -367,7 +370,7 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     voxel.r = p.r;
     voxel.g = p.g;
     voxel.b = p.b;
-    voxel.flags = static_cast<std::uint8_t>(std::min<int>(p.passes, TsdfVoxel::kMaxPasses) << TsdfVoxel::kPassesShift);
+    voxel.flags = static_cast<std::uint8_t>(p.passes << TsdfVoxel::kPassesShift);
   }
   const std::uint64_t stamp = beginGeneration();
   for (auto& block : blocks_) {
