@@ -6,13 +6,16 @@
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/streaming_map.h>
 #include <msf/reconstruction/tsdf_integrator.h>
+#include <msf/reconstruction/tsdf_store.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -257,6 +260,69 @@ TEST(StreamingMap, StoreReloadsAndMeshesAgainToTheSameMesh) {
                                                 Eigen::Vector3d(10, 10, 6));
   EXPECT_GT(part, 0u);
   EXPECT_LT(part, memory.mesh.triangles.size());
+}
+
+TEST(StreamingMap, AStoreTileNoWriterMakesIsRefusedNamingTheBlock) {
+  const double length = 10.0;
+  test::TempDir dir;
+  integrateDrive(drive(length, 0.5), length, dir.path(), minimumRadius() + 0.2);
+  const TsdfStore store = TsdfStore::open(dir.path());
+  const auto bytesOf = [](const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  // The tile of the most blocks (a file at least two blocks long).
+  const auto fuller = [&](const GridIndex& a, const GridIndex& b) {
+    return bytesOf(store.blockPath(a)).size() < bytesOf(store.blockPath(b)).size();
+  };
+  const GridIndex tile = *std::max_element(store.tiles().begin(), store.tiles().end(), fuller);
+  const std::string path = store.blockPath(tile);
+  const std::string written = bytesOf(path);
+  std::int32_t count = 0;
+  std::memcpy(&count, written.data() + 28, sizeof(count));
+  ASSERT_GE(count, 2);
+  // The file: a 32-byte header, then per block its index (3 x int32), 4 bytes of sign bits
+  // and 512 voxels of 12 bytes (sdf, weight, r, g, b, flags).
+  const std::size_t header = 32, block = 16 + 512 * 12, first_voxel = header + 16;
+  const auto put = [](std::string bytes, std::size_t at, auto value) {
+    std::memcpy(&bytes[at], &value, sizeof(value));
+    return bytes;
+  };
+  const std::int32_t outside = (tile.x() + 1) * store.tileBlocks(); // the first block's x in the next tile
+  std::int32_t first[3];
+  std::memcpy(first, written.data() + header, sizeof(first));
+  const std::string first_name = TsdfStore::tileName(GridIndex(first[0], first[1], first[2]));
+  const std::string file = "TSDF blocks '" + path + "'";
+  const auto sizeError = [&](std::size_t size) {
+    return file + " declare " + std::to_string(count) + " blocks, " + std::to_string(written.size()) +
+           " bytes, but the file has " + std::to_string(size);
+  };
+  const auto at = [&](int block_number, const std::string& what) {
+    return file + ": block " + std::to_string(block_number) + " of " + std::to_string(count) + " has " + what;
+  };
+  const std::string truncation = ", not within the truncation 0.5 m";
+  const std::string second_as_first =
+      written.substr(0, header + block) + written.substr(header, 12) + written.substr(header + block + 12);
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {written.substr(0, written.size() - 1), sizeError(written.size() - 1)},
+      {written + '\0', sizeError(written.size() + 1)},
+      {put(written, first_voxel, std::nanf("")), at(1, "voxel 0 of sdf nan" + truncation)},
+      {put(written, first_voxel, 0.75f), at(1, "voxel 0 of sdf 0.75" + truncation)},
+      {put(written, first_voxel + 4, -1.f), at(1, "voxel 0 of weight -1, not a finite value >= 0")},
+      {put(written, first_voxel + 11, std::uint8_t{0x41}), at(1, "voxel 0 of flags 65, bits other than the passes'")},
+      {put(written, header, outside), at(1, "index " + std::to_string(outside) + "_" + std::to_string(first[1]) + "_" +
+                                             std::to_string(first[2]) + ", outside tile " + TsdfStore::tileName(tile))},
+      {second_as_first, at(2, "index " + first_name + ", as an earlier block has")},
+  };
+  for (const auto& [bytes, message] : cases) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    const std::string e = test::errorOf([&] { StreamingMap::loadStore(dir.path()); });
+    EXPECT_EQ(e.substr(0, message.size()), message) << e;
+    EXPECT_THROW(StreamingMap::remesh(dir.path(), MarchingCubes::Config(), dir.file("m.ply")), IOError);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
+  }
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << written;
+  EXPECT_NO_THROW(StreamingMap::loadStore(dir.path()));
 }
 
 TEST(StreamingMap, AStoreIndexListingATileTwiceIsRefused) {

@@ -197,6 +197,13 @@ import os
 os.makedirs(f + "/store/tsdf")
 open(f + "/store/tsdf/index.txt", "w").write("msfusion-tsdf-store 1\nvoxel_size_m 0.1\ntruncation_m 0.3\nblock_side 8\n"
                                              "tile_blocks 4\ntiles 3\n0 0 0\n1 0 0\n0 0 0\n")
+# A store whose one tile holds a voxel of NaN sdf (a file damaged or of another program).
+os.makedirs(f + "/store_nan/tsdf")
+open(f + "/store_nan/tsdf/index.txt", "w").write("msfusion-tsdf-store 1\nvoxel_size_m 0.1\ntruncation_m 0.3\n"
+                                                 "block_side 8\ntile_blocks 4\ntiles 1\n0 0 0\n")
+voxels = [struct.pack("<2f4B", float("nan") if i == 0 else 0.1, 1.0, 0, 0, 0, 0) for i in range(512)]
+open(f + "/store_nan/tsdf/0_0_0.blk", "wb").write(b"MSFBLK01" + struct.pack("<2d2i", 0.1, 0.3, 8, 1) +
+                                                   struct.pack("<3i4B", 0, 0, 0, 0, 0, 0, 0) + b"".join(voxels))
 # A folder where a tool's output file would go.
 os.makedirs(f + "/folder.png/inside")
 # A PNG whose header says 30000 x 20000 (the pixels are never read).
@@ -454,6 +461,8 @@ check "pcd2png -calib, a matrix of dt u" 1 "dt_u.yaml': key 'P0' has dt 'u', not
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/dt_u.yaml"
 check "mesh: a store index listing a tile twice" 1 "index.txt' lists tile 0_0_0 twice \(tiles 1 and 3\)" -- \
   msf_mesh "$F/store" m.ply
+check "mesh: a store tile with a voxel of NaN sdf" 1 "0_0_0.blk': block 1 of 1 has voxel 0 of sdf nan, not within the truncation 0.3 m" -- \
+  msf_mesh "$F/store_nan" m.ply
 check "project: a 2 GB sparse scan file" 1 "huge.bin' has 134217728 records \(2147483648 bytes\), more than the 16777216 a scan may hold" -- \
   msf_project "$F/huge.bin" o.pcd -calib "$F/camera.yaml"
 check "project: NaN reflectance everywhere" 1 "nan_reflectance.bin': each of its 100 records has a value that is not finite" -- \

@@ -35,6 +35,24 @@ bool close(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::
 
 std::string indexPath(const std::string& directory) { return (fs::path(directory) / "tsdf" / "index.txt").string(); }
 
+constexpr std::size_t kHeaderBytes = sizeof(kBlockMagic) + 2 * sizeof(double) + 2 * sizeof(std::int32_t);
+constexpr std::size_t kBlockBytes = 3 * sizeof(std::int32_t) + 4 + TsdfBlock::kVoxels * sizeof(TsdfVoxel);
+
+/// What makes a voxel one no writer of ours makes (a file edited, damaged or of another
+/// program), or "" when there is nothing: an sdf beyond the truncation or not finite, a
+/// negative or non-finite weight, flags other than the passes (the integrator's own bits are
+/// zero on disk).
+std::string voxelFault(const TsdfVoxel& v, double truncation) {
+  const double sdf_limit = truncation * (1.0 + 1e-6); // the integrator clamps in float
+  if (!std::isfinite(v.sdf) || std::abs(v.sdf) > sdf_limit)
+    return "sdf " + number(v.sdf) + ", not within the truncation " + number(truncation) + " m";
+  if (!std::isfinite(v.weight) || v.weight < 0.f)
+    return "weight " + number(v.weight) + ", not a finite value >= 0";
+  if (v.flags & ~TsdfVoxel::kPassesMask)
+    return "flags " + std::to_string(v.flags) + ", bits other than the passes'";
+  return "";
+}
+
 } // namespace
 
 TsdfStore::TsdfStore(std::string directory, double voxel_size_m, double truncation_m, int tile_blocks)
@@ -136,21 +154,51 @@ void TsdfStore::readTile(const GridIndex& tile, const std::function<void(const T
   if (std::abs(vs - voxel_size_) > 1e-9 * voxel_size_ || std::abs(trunc - truncation_) > 1e-9 * truncation_)
     throw IOError("TSDF blocks '" + path + "' have voxel size " + number(vs) + " m and truncation " + number(trunc) +
                   " m, the store " + number(voxel_size_) + " and " + number(truncation_));
+  const std::size_t count = static_cast<std::size_t>(header[1]);
+  requireBlockBytes(path, count);
+  const auto fault = [&](std::size_t b, const std::string& what) {
+    return IOError("TSDF blocks '" + path + "': block " + std::to_string(b + 1) + " of " + std::to_string(count) + " " +
+                   what);
+  };
+  const std::size_t per_side = static_cast<std::size_t>(tile_blocks_);
+  std::vector<bool> seen(per_side * per_side * per_side, false); // a block twice would be meshed twice
   TsdfBlock block;
-  for (std::int32_t b = 0; b < header[1]; ++b) {
+  for (std::size_t b = 0; b < count; ++b) {
     std::int32_t index[3];
     std::uint8_t bits[4];
     in.read(reinterpret_cast<char*>(index), sizeof(index));
     in.read(reinterpret_cast<char*>(bits), sizeof(bits));
     in.read(reinterpret_cast<char*>(block.voxels.data()), sizeof(block.voxels));
     if (!in)
-      throw IOError("TSDF blocks '" + path + "' end after " + std::to_string(b) + " of " + std::to_string(header[1]) +
-                    " blocks");
+      throw fault(b, "cannot be read");
     block.index = GridIndex(index[0], index[1], index[2]);
+    if (tileOf(block.index, tile_blocks_) != tile)
+      throw fault(b, "has index " + tileName(block.index) + ", outside tile " + tileName(tile));
+    const GridIndex local = block.index - tile * tile_blocks_;
+    const std::size_t slot = (static_cast<std::size_t>(local.x()) * per_side + static_cast<std::size_t>(local.y())) *
+                                 per_side +
+                             static_cast<std::size_t>(local.z());
+    if (seen[slot])
+      throw fault(b, "has index " + tileName(block.index) + ", as an earlier block has");
+    seen[slot] = true;
+    for (std::size_t v = 0; v < block.voxels.size(); ++v) {
+      const std::string what = voxelFault(block.voxels[v], truncation_);
+      if (!what.empty())
+        throw fault(b, "has voxel " + std::to_string(v) + " of " + what);
+    }
     block.signs = bits[0];
     block.negative_subblocks = bits[1];
     add(block);
   }
+}
+
+void TsdfStore::requireBlockBytes(const std::string& path, std::size_t count) {
+  std::error_code e;
+  const std::uintmax_t size = fs::file_size(path, e);
+  const std::uintmax_t expected = kHeaderBytes + count * kBlockBytes;
+  if (e || size != expected)
+    throw IOError("TSDF blocks '" + path + "' declare " + std::to_string(count) + " blocks, " +
+                  std::to_string(expected) + " bytes, but the file has " + (e ? "no size" : std::to_string(size)));
 }
 
 void TsdfStore::writeIndex(std::vector<GridIndex> tiles) {

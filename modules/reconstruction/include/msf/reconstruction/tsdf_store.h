@@ -36,7 +36,11 @@ public:
   /// DIR/tsdf/X_Y_Z.blk
   std::string blockPath(const GridIndex& tile) const;
   /// Calls `add` with each block of tile `tile` (signs and voxels as written; stamp 0).
-  /// Throws IOError naming the file when it is missing, not a block file of this grid, or cut short.
+  /// Throws IOError naming the file, before any block is added, when it is missing, not a
+  /// block file of this grid, or not as long as its block count says; and, the blocks before
+  /// it added, naming the block that lies outside the tile, repeats an earlier one, or holds a
+  /// voxel no writer makes (an sdf beyond the truncation, a weight below 0, either not
+  /// finite, or flags other than the passes).
   void readTile(const GridIndex& tile, const std::function<void(const TsdfBlock&)>& add) const;
   /// Writes tile `tile`'s blocks (the integrator's flags zeroed), atomically.
   void writeTile(const GridIndex& tile, const std::vector<const TsdfBlock*>& blocks) const;
@@ -51,6 +55,9 @@ public:
   static bool tileOrder(const GridIndex& a, const GridIndex& b);
 
 private:
+  /// Throws IOError unless the block file at `path` is exactly as long as `count` blocks.
+  static void requireBlockBytes(const std::string& path, std::size_t count);
+
   std::string directory_;
   double voxel_size_, truncation_;
   int tile_blocks_;
