@@ -411,6 +411,14 @@ void reportHoldout(const msf::Sequence& sequence, const std::vector<std::size_t>
   std::printf("%s", msf::formatHoldoutTable(results).c_str());
   if (settings.breakdown)
     std::printf("\n%s", msf::formatHoldoutBreakdown(results).c_str());
+  std::vector<std::pair<std::string, msf::FusionLoss>> losses;
+  for (const auto& r : results)
+    if (r.lost_to_bound)
+      losses.emplace_back(r.method, *r.lost_to_bound);
+  if (!losses.empty()) {
+    const auto inputs = split(settings.bounds_text);
+    std::printf("\n%s", msf::formatFusionLoss(losses, inputs[0], inputs[1]).c_str());
+  }
   std::fflush(stdout);
   if (!settings.csv_path.empty())
     msf::writeHoldoutCsv(settings.csv_path, results);
@@ -469,7 +477,8 @@ int main(int argc, char** argv) {
              "ring hold-out: also the rows a per-pixel fusion of methods A and B cannot beat, found with the ground "
              "truth: bound_select (per pixel the input nearer the truth: the least MAE of choosing one) and "
              "bound_blend (the value between the two nearest the truth: the least error of a weighted mean); e.g. "
-             "-bounds interpolated,sgbm_guided")
+             "-bounds interpolated,sgbm_guided; and, for every other method, the pixels it lost to bound_select "
+             "(bad where an input is right) by which input was right and what it gave there")
       .value("-csv", "FILE", settings.csv_path, "also write the rows as CSV")
       .flag("-breakdown", settings.breakdown,
             "ring hold-out: also each method's rows for the ground truth that camera 0 sees (visible) and cannot see "

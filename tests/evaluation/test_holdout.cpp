@@ -149,12 +149,13 @@ TEST(Holdout, FusionBoundsOfTwoMethodsAreNoWorseThanEither) {
     EXPECT_NE(std::string(e.what()).find("'sgbm' is not a method"), std::string::npos) << e.what();
   }
   evaluation.addFusionBounds("interpolated", "ipbasic");
+  evaluation.addMethod("cubic", lidar(msf::CompletionMethod::Cubic)); // a third method, measured against the two
   const auto results = evaluation.run(sequence, {0, 1});
-  ASSERT_EQ(results.size(), 4u);
-  EXPECT_EQ(results[2].method, "bound_select");
-  EXPECT_EQ(results[3].method, "bound_blend");
+  ASSERT_EQ(results.size(), 5u);
+  EXPECT_EQ(results[3].method, "bound_select");
+  EXPECT_EQ(results[4].method, "bound_blend");
   const msf::DepthMetrics &a = results[0].metrics, &b = results[1].metrics;
-  const msf::DepthMetrics &select = results[2].metrics, &blend = results[3].metrics;
+  const msf::DepthMetrics &select = results[3].metrics, &blend = results[4].metrics;
   // Coverage of one input or the other; errors no larger than the better input's, and blending's no
   // larger than choosing's. Both inputs err, so the bounds are not the truth itself.
   EXPECT_GE(select.coverage, std::max(a.coverage, b.coverage));
@@ -165,6 +166,18 @@ TEST(Holdout, FusionBoundsOfTwoMethodsAreNoWorseThanEither) {
   EXPECT_GT(blend.mae_m, 0.0);
   EXPECT_LE(blend.d1_all, std::min(a.d1_all, b.d1_all));
   EXPECT_LE(blend.d1_all, select.d1_all);
+
+  // The third method's losses: its bad pixels where an input is right, which with the
+  // bound's bad pixels cover all of its own.
+  EXPECT_FALSE(results[0].lost_to_bound || results[1].lost_to_bound || results[3].lost_to_bound);
+  ASSERT_TRUE(results[2].lost_to_bound);
+  const msf::FusionLoss& loss = *results[2].lost_to_bound;
+  const msf::DepthMetrics& third = results[2].metrics;
+  ASSERT_EQ(loss.ground_truth, third.gt_pixels);
+  const double lost = static_cast<double>(loss.lost()) / static_cast<double>(loss.ground_truth);
+  EXPECT_GT(lost, 0.0);
+  EXPECT_LE(lost, third.d1_all);
+  EXPECT_LE(third.d1_all, lost + select.d1_all + 1e-12);
 }
 
 TEST(HoldoutTool, PrintsOneRowPerMethodAndWritesCsv) {

@@ -55,7 +55,7 @@ void DepthErrorAccumulator::addPixel(float gt_z, float estimated_z, double focal
   const double dg = focal_baseline / zg, de = focal_baseline / ze;
   const double disp_err = std::abs(de - dg);
   disp_abs_ += disp_err;
-  if (disp_err > d1.abs_px && disp_err > d1.rel * dg)
+  if (d1.exceeded(disp_err, dg))
     ++d1_bad_;
 }
 

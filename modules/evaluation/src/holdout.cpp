@@ -95,6 +95,7 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
   std::vector<std::vector<DepthErrorAccumulator>> region_errors(rows);
   std::vector<std::string> region_names;
   std::vector<std::vector<double>> times(methods_.size());
+  std::vector<FusionLoss> losses(methods_.size());
   std::size_t done = 0;
   for (const std::size_t i : frames) {
     const HoldoutFrame split = makeHoldoutFrame(sequence.load(i, load_color_), calibration, config_);
@@ -112,6 +113,7 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
         region_errors[row][r].add(split.gt_depth, estimate, fB, regions[r].mask, config_.d1);
     };
     cv::Mat bound_inputs[2];
+    std::vector<cv::Mat> estimates(methods_.size());
     for (std::size_t m = 0; m < methods_.size(); ++m) {
       const auto start = std::chrono::steady_clock::now();
       const cv::Mat estimate = methods_[m].second(split.input);
@@ -123,12 +125,17 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
                                 " image of type " + std::to_string(estimate.type()) + ", expected CV_32FC1 " +
                                 std::to_string(split.gt_depth.cols) + "x" + std::to_string(split.gt_depth.rows));
       accumulate(m, estimate);
+      estimates[m] = estimate;
       if (bounds_ && (m == bound_first_ || m == bound_second_))
         bound_inputs[m == bound_first_ ? 0 : 1] = estimate;
     }
-    if (bounds_)
+    if (bounds_) {
       for (std::size_t k = 0; k < 2; ++k)
         accumulate(methods_.size() + k, fusionBoundDepth(split.gt_depth, bound_inputs[0], bound_inputs[1], kBounds[k]));
+      for (std::size_t m = 0; m < methods_.size(); ++m)
+        if (m != bound_first_ && m != bound_second_)
+          losses[m].add(split.gt_depth, bound_inputs[0], bound_inputs[1], estimates[m], fB, config_.d1);
+    }
     if (progress_)
       progress_(++done, frames.size());
   }
@@ -141,6 +148,8 @@ std::vector<HoldoutResult> HoldoutEvaluation::run(const Sequence& sequence,
     r.frames = frames.size();
     for (std::size_t k = 0; k < region_errors[m].size(); ++k)
       r.regions.push_back({region_names[k], region_errors[m][k].metrics()});
+    if (bounds_ && m < methods_.size() && m != bound_first_ && m != bound_second_)
+      r.lost_to_bound = losses[m];
     results.push_back(r);
   }
   return results;

@@ -41,7 +41,7 @@ cv::Mat hiddenGroundTruthMask(const cv::Mat& gt_depth, const cv::Mat& input_dept
       if (!has(g[u]))
         continue;
       const double d_gt = focal_baseline / g[u], excess = d[u] - d_gt;
-      if (excess > d1.abs_px && excess > d1.rel * d_gt)
+      if (d1.exceeded(excess, d_gt))
         out[u] = 255;
     }
   }

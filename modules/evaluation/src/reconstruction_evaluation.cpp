@@ -174,7 +174,7 @@ std::uint8_t ReconstructionEvaluation::seenThrough(const Eigen::Vector3f& p_cam,
       met = true;
       const double true_disparity = focal_baseline_ / z;
       const double in_front = vertex_disparity - true_disparity; // > 0: the vertex is nearer
-      if (!(in_front > d1_.abs_px && in_front > d1_.rel * true_disparity))
+      if (!d1_.exceeded(in_front, true_disparity))
         return 1;
     }
   return met ? 2 : 0;

@@ -11,6 +11,9 @@ namespace msf {
 struct D1Threshold {
   double abs_px = 3.0;
   double rel = 0.05;
+
+  /// Whether a disparity error of `error_px` at the true disparity `true_px` is bad.
+  bool exceeded(double error_px, double true_px) const { return error_px > abs_px && error_px > rel * true_px; }
 };
 
 /// Depth-completion and disparity metrics at the pixels that have ground truth.

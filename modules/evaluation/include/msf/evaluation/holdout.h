@@ -2,6 +2,7 @@
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/evaluation/fusion_bounds.h>
+#include <msf/evaluation/fusion_loss.h>
 #include <msf/evaluation/holdout_breakdown.h>
 #include <msf/io/calibration.h>
 #include <msf/io/sequence.h>
@@ -15,6 +16,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +67,9 @@ struct HoldoutResult {
   double median_ms = 0;        ///< median time of one call, over the frames
   std::size_t frames = 0;
   std::vector<RegionMetrics> regions; ///< holdoutRegions' metrics, with setBreakdown(true)
+  /// With addFusionBounds, for every method but the bounds' two inputs: where it is bad and
+  /// an input right.
+  std::optional<FusionLoss> lost_to_bound;
 };
 
 /// Runs named methods over frames of a sequence under protocol 2.
@@ -75,8 +80,9 @@ public:
   /// Throws InvalidInputError when the name is taken or empty.
   void addMethod(const std::string& name, HoldoutMethod method);
   /// Also the rows bound_select and bound_blend (FusionBound) of the named methods' depths,
-  /// after the methods' rows; their time is 0. Throws InvalidInputError unless both names
-  /// are methods already added, and different.
+  /// after the methods' rows; their time is 0; and each other method's FusionLoss against
+  /// the two (HoldoutResult::lost_to_bound). Throws InvalidInputError unless both names are
+  /// methods already added, and different.
   void addFusionBounds(const std::string& first, const std::string& second);
   /// Load camera 2 for the methods that need colour (off by default: it costs a decode).
   void setLoadColor(bool load) { load_color_ = load; }
