@@ -325,6 +325,22 @@ TEST(StreamingMap, AStoreTileNoWriterMakesIsRefusedNamingTheBlock) {
   EXPECT_NO_THROW(StreamingMap::loadStore(dir.path()));
 }
 
+TEST(StreamingMap, AStoreIndexWhoseTilesNoStreamingMapMakesIsRefused) {
+  // A tile edge beyond the configuration's range: one tile's bookkeeping would not fit memory.
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("tsdf"));
+  const std::string index = dir.file("tsdf/index.txt");
+  for (const int tile_blocks : {0, TsdfStore::kMaxTileBlocks + 1, 100000}) {
+    std::ofstream(index) << "msfusion-tsdf-store 1\nvoxel_size_m 0.1\ntruncation_m 0.3\nblock_side 8\ntile_blocks "
+                         << tile_blocks << "\ntiles 1\n0 0 0\n";
+    const std::string e = test::errorOf([&] { StreamingMap::loadStore(dir.path()); });
+    EXPECT_EQ(e, "TSDF store index '" + index + "' has tile_blocks " + std::to_string(tile_blocks) + ", outside 1.." +
+                     std::to_string(TsdfStore::kMaxTileBlocks));
+    EXPECT_THROW(StreamingMap::remesh(dir.path(), MarchingCubes::Config(), dir.file("m.ply")), IOError);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
+  }
+}
+
 TEST(StreamingMap, AStoreIndexListingATileTwiceIsRefused) {
   // Meshed twice, every triangle of the tile was doubled.
   const double length = 10.0;

@@ -204,6 +204,10 @@ open(f + "/store_nan/tsdf/index.txt", "w").write("msfusion-tsdf-store 1\nvoxel_s
 voxels = [struct.pack("<2f4B", float("nan") if i == 0 else 0.1, 1.0, 0, 0, 0, 0) for i in range(512)]
 open(f + "/store_nan/tsdf/0_0_0.blk", "wb").write(b"MSFBLK01" + struct.pack("<2d2i", 0.1, 0.3, 8, 1) +
                                                    struct.pack("<3i4B", 0, 0, 0, 0, 0, 0, 0) + b"".join(voxels))
+# A store whose index says a tile is 100000 blocks on a side.
+os.makedirs(f + "/store_wide/tsdf")
+open(f + "/store_wide/tsdf/index.txt", "w").write("msfusion-tsdf-store 1\nvoxel_size_m 0.1\ntruncation_m 0.3\n"
+                                                  "block_side 8\ntile_blocks 100000\ntiles 1\n0 0 0\n")
 # A folder where a tool's output file would go.
 os.makedirs(f + "/folder.png/inside")
 # A PNG whose header says 30000 x 20000 (the pixels are never read).
@@ -463,6 +467,8 @@ check "mesh: a store index listing a tile twice" 1 "index.txt' lists tile 0_0_0 
   msf_mesh "$F/store" m.ply
 check "mesh: a store tile with a voxel of NaN sdf" 1 "0_0_0.blk': block 1 of 1 has voxel 0 of sdf nan, not within the truncation 0.3 m" -- \
   msf_mesh "$F/store_nan" m.ply
+check "mesh: a store index of 100000-block tiles" 1 "index.txt' has tile_blocks 100000, outside 1..64" -- \
+  msf_mesh "$F/store_wide" m.ply
 check "project: a 2 GB sparse scan file" 1 "huge.bin' has 134217728 records \(2147483648 bytes\), more than the 16777216 a scan may hold" -- \
   msf_project "$F/huge.bin" o.pcd -calib "$F/camera.yaml"
 check "project: NaN reflectance everywhere" 1 "nan_reflectance.bin': each of its 100 records has a value that is not finite" -- \

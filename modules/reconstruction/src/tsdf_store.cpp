@@ -70,8 +70,11 @@ TsdfStore TsdfStore::open(const std::string& directory) {
   if (!std::getline(in, line) || line != kIndexTag ||
       !(in >> k1 >> voxel_size >> k2 >> truncation >> k3 >> side >> k4 >> tile_blocks >> k5 >> count) ||
       k1 != "voxel_size_m" || k2 != "truncation_m" || k3 != "block_side" || k4 != "tile_blocks" || k5 != "tiles" ||
-      side != kSide || !(voxel_size > 0) || !(truncation > 0) || tile_blocks < 1)
+      side != kSide || !(voxel_size > 0) || !(truncation > 0))
     throw IOError("TSDF store index '" + path + "' is not one a StreamingMap wrote (first line '" + kIndexTag + "')");
+  if (tile_blocks < 1 || tile_blocks > kMaxTileBlocks)
+    throw IOError("TSDF store index '" + path + "' has tile_blocks " + std::to_string(tile_blocks) + ", outside 1.." +
+                  std::to_string(kMaxTileBlocks));
   TsdfStore store(directory, voxel_size, truncation, tile_blocks);
   std::map<std::tuple<int, int, int>, std::size_t> listed; // a tile twice would be meshed twice
   for (std::size_t i = 0; i < count; ++i) {

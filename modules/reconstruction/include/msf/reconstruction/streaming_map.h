@@ -50,7 +50,7 @@ public:
     void keys(Keys& k) {
       k("active_radius_m", active_radius_m, atLeast(0),
         "metres around the sensor that stay in memory (0: the whole map in memory)");
-      k("tile_blocks", tile_blocks, between(1, 64),
+      k("tile_blocks", tile_blocks, between(1, TsdfStore::kMaxTileBlocks),
         "edge of a tile in blocks of 8 voxels: the unit of streaming, of a tile file and of a mesh tile");
     }
     bool enabled() const { return active_radius_m > 0.0; }

@@ -15,10 +15,13 @@ namespace msf {
 /// one. Every file is written atomically (a temporary and a rename).
 class TsdfStore {
 public:
+  /// The largest tile edge in blocks (streaming.tile_blocks): a tile of 64^3 blocks is 1.6 GB.
+  static constexpr int kMaxTileBlocks = 64;
+
   /// A store in `directory` on the grid given (nothing is read or written yet).
   TsdfStore(std::string directory, double voxel_size_m, double truncation_m, int tile_blocks);
   /// The store in `directory`, from its index. Throws IOError naming the index when it is
-  /// missing or not one a StreamingMap wrote.
+  /// missing or not one a StreamingMap wrote (a tile_blocks outside 1..kMaxTileBlocks among them).
   static TsdfStore open(const std::string& directory);
 
   const std::string& directory() const { return directory_; }
