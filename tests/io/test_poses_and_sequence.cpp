@@ -187,6 +187,25 @@ TEST(Sequence, AFrameBeyondThePosesIsNamed) {
   EXPECT_NE(e.find("04.txt', which has 10 (frames 0..9)"), std::string::npos) << e;
 }
 
+TEST(Sequence, TimesThatDoNotIncreaseAreNamed) {
+  // A time that goes back or repeats would match two frames to one TUM pose and write a
+  // poses_tum.txt going backwards.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string seq = odometryWithFrames(dir, {0, 1, 2});
+  const fs::path times = fs::path(seq) / "times.txt";
+  for (const std::string third : {"0.05", "0.1"}) {
+    fs::remove(times);
+    std::ofstream(times) << "0.0\n0.1\n" << third << "\n";
+    EXPECT_EQ(errorOf([&] { msf::Sequence s(seq); }),
+              "timestamps '" + times.string() + "' line 3 '" + third +
+                  "' does not follow line 2's: the times must increase");
+  }
+  fs::remove(times);
+  std::ofstream(times) << "0.0\n0.1\n0.2\n";
+  EXPECT_EQ(msf::Sequence(seq).size(), 3u);
+}
+
 TEST(Sequence, StrayFilesBesideTheFramesAreNotFrames) {
   // macOS and editors leave files in image folders: .DS_Store (first by name: the image size
   // was read from it), a resource fork ._000000.png, a README, a copy.

@@ -327,6 +327,9 @@ if [ $have_kitti = 1 ]; then
   dataset odo_beyond_poses 3 3
   for c in image_0 image_1; do ln -s "$SEQ/$c/000002.png" "$K/odo_beyond_poses/sequences/04/$c/000012.png"; done
   ln -s "$SEQ/velodyne/000002.bin" "$K/odo_beyond_poses/sequences/04/velodyne/000012.bin"
+  # A times.txt whose third time goes back.
+  dataset odo_times_back 3 3
+  printf '0.0\n0.1\n0.05\n' >"$K/odo_times_back/sequences/04/times.txt"
 fi
 
 # ---- limits checked before allocating ---------------------------------------------------
@@ -596,6 +599,8 @@ if [ $have_kitti = 1 ]; then
     msf_odometry "$K/odo_stray/sequences/04" -o p.txt
   check "odometry: a frame beyond the poses" 1 "frame 000012 has no entry in poses '.*04.txt', which has 3 \(frames 0..2\)" -- \
     msf_odometry "$K/odo_beyond_poses/sequences/04" -o p.txt
+  check "reconstruct: a time that goes back" 1 "times.txt' line 3 '0.05' does not follow line 2's: the times must increase" -- \
+    msf_reconstruct "$K/odo_times_back/sequences/04" -panels 0 -o out
   check "reconstruct: NaN in a pose" 1 "poses '.*04.txt' line 2: value 4 'nan' is not finite" -- \
     msf_reconstruct "$K/odo_nan/sequences/04" -o out
   # kitti2pcd -input_dir: a truncated scan among good ones converts nothing.

@@ -68,7 +68,9 @@ double parseTime(const std::string& line, bool raw_format) {
 }
 
 /// The times of a timestamps file from its first line's, line n for frame n; empty when the
-/// file is absent. Throws IOError naming the file and line of a value that is not a time.
+/// file is absent. Throws IOError naming the file and line of a value that is not a time, or
+/// that does not follow the line before (frames matched by time, and the TUM poses written,
+/// need increasing times).
 std::vector<double> readTimestamps(const fs::path& file, bool raw_format) {
   std::vector<double> t;
   std::ifstream in(file);
@@ -77,9 +79,11 @@ std::vector<double> readTimestamps(const fs::path& file, bool raw_format) {
     if (line.find_first_not_of(" \t\r") == std::string::npos && in.peek() == std::char_traits<char>::eof())
       break; // a blank last line
     const double time = parseTime(line, raw_format);
+    const std::string where = "timestamps '" + file.string() + "' line " + std::to_string(line_no) + " '" + line + "'";
     if (!std::isfinite(time))
-      throw IOError("timestamps '" + file.string() + "' line " + std::to_string(line_no) + " '" + line +
-                    "' is not a time");
+      throw IOError(where + " is not a time");
+    if (!t.empty() && !(time > t.back()))
+      throw IOError(where + " does not follow line " + std::to_string(line_no - 1) + "'s: the times must increase");
     t.push_back(time);
   }
   const double t0 = t.empty() ? 0.0 : t.front();
