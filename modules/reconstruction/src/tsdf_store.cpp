@@ -53,6 +53,26 @@ std::string voxelFault(const TsdfVoxel& v, double truncation) {
   return "";
 }
 
+/// What makes a block of tile `tile`'s file one no writer makes, or "" when there is nothing:
+/// an index outside the tile, one an earlier block had (`seen`: a flag per block of the
+/// tile), or a voxel's fault (voxelFault).
+std::string blockFault(const TsdfBlock& block, const GridIndex& tile, int tile_blocks, double truncation,
+                       std::vector<bool>& seen) {
+  if (TsdfStore::tileOf(block.index, tile_blocks) != tile)
+    return "has index " + TsdfStore::tileName(block.index) + ", outside tile " + TsdfStore::tileName(tile);
+  const GridIndex local = block.index - tile * tile_blocks;
+  const std::size_t slot = static_cast<std::size_t>((local.x() * tile_blocks + local.y()) * tile_blocks + local.z());
+  if (seen[slot])
+    return "has index " + TsdfStore::tileName(block.index) + ", as an earlier block has";
+  seen[slot] = true;
+  for (std::size_t v = 0; v < block.voxels.size(); ++v) {
+    const std::string fault = voxelFault(block.voxels[v], truncation);
+    if (!fault.empty())
+      return "has voxel " + std::to_string(v) + " of " + fault;
+  }
+  return "";
+}
+
 } // namespace
 
 TsdfStore::TsdfStore(std::string directory, double voxel_size_m, double truncation_m, int tile_blocks)
@@ -159,36 +179,20 @@ void TsdfStore::readTile(const GridIndex& tile, const std::function<void(const T
                   " m, the store " + number(voxel_size_) + " and " + number(truncation_));
   const std::size_t count = static_cast<std::size_t>(header[1]);
   requireBlockBytes(path, count);
-  const auto fault = [&](std::size_t b, const std::string& what) {
-    return IOError("TSDF blocks '" + path + "': block " + std::to_string(b + 1) + " of " + std::to_string(count) + " " +
-                   what);
-  };
   const std::size_t per_side = static_cast<std::size_t>(tile_blocks_);
   std::vector<bool> seen(per_side * per_side * per_side, false); // a block twice would be meshed twice
   TsdfBlock block;
   for (std::size_t b = 0; b < count; ++b) {
-    std::int32_t index[3];
-    std::uint8_t bits[4];
+    std::int32_t index[3] = {0, 0, 0};
+    std::uint8_t bits[4] = {0, 0, 0, 0};
     in.read(reinterpret_cast<char*>(index), sizeof(index));
     in.read(reinterpret_cast<char*>(bits), sizeof(bits));
     in.read(reinterpret_cast<char*>(block.voxels.data()), sizeof(block.voxels));
-    if (!in)
-      throw fault(b, "cannot be read");
     block.index = GridIndex(index[0], index[1], index[2]);
-    if (tileOf(block.index, tile_blocks_) != tile)
-      throw fault(b, "has index " + tileName(block.index) + ", outside tile " + tileName(tile));
-    const GridIndex local = block.index - tile * tile_blocks_;
-    const std::size_t slot = (static_cast<std::size_t>(local.x()) * per_side + static_cast<std::size_t>(local.y())) *
-                                 per_side +
-                             static_cast<std::size_t>(local.z());
-    if (seen[slot])
-      throw fault(b, "has index " + tileName(block.index) + ", as an earlier block has");
-    seen[slot] = true;
-    for (std::size_t v = 0; v < block.voxels.size(); ++v) {
-      const std::string what = voxelFault(block.voxels[v], truncation_);
-      if (!what.empty())
-        throw fault(b, "has voxel " + std::to_string(v) + " of " + what);
-    }
+    const std::string fault = in ? blockFault(block, tile, tile_blocks_, truncation_, seen) : "cannot be read";
+    if (!fault.empty())
+      throw IOError("TSDF blocks '" + path + "': block " + std::to_string(b + 1) + " of " + std::to_string(count) +
+                    " " + fault);
     block.signs = bits[0];
     block.negative_subblocks = bits[1];
     add(block);
