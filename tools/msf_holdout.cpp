@@ -478,7 +478,8 @@ int main(int argc, char** argv) {
              "truth: bound_select (per pixel the input nearer the truth: the least MAE of choosing one) and "
              "bound_blend (the value between the two nearest the truth: the least error of a weighted mean); e.g. "
              "-bounds interpolated,sgbm_guided; and, for every other method, the pixels it lost to bound_select "
-             "(bad where an input is right) by which input was right and what it gave there")
+             "(bad where an input is right) by which input was right and what it gave there, and, where both "
+             "inputs have a depth and one is right, how often giving each was right and wrong")
       .value("-csv", "FILE", settings.csv_path, "also write the rows as CSV")
       .flag("-breakdown", settings.breakdown,
             "ring hold-out: also each method's rows for the ground truth that camera 0 sees (visible) and cannot see "

@@ -14,10 +14,12 @@ namespace {
 
 constexpr float kNearInput = 0.01f; ///< "gave that input": within this share of its depth
 
+bool near(float fused, float input) { return input > 0.f && std::abs(fused - input) <= kNearInput * input; }
+
 FusionLoss::Gave whatWasGiven(float fused, float wrong_input, float right_input) {
   if (!(fused > 0.f))
     return FusionLoss::Nothing;
-  if (wrong_input > 0.f && std::abs(fused - wrong_input) <= kNearInput * wrong_input)
+  if (near(fused, wrong_input))
     return FusionLoss::TheOtherInput;
   if (wrong_input > 0.f && fused > std::min(wrong_input, right_input) && fused < std::max(wrong_input, right_input))
     return FusionLoss::Between;
@@ -52,6 +54,10 @@ void FusionLoss::add(const cv::Mat& ground_truth_depth, const cv::Mat& first, co
       ++ground_truth;
       const double true_px = focal_baseline / gt[u];
       const bool a_right = right(a[u], true_px), b_right = right(b[u], true_px);
+      // A choice: both inputs have a depth, one of them right.
+      const bool both = a[u] > 0.f && b[u] > 0.f;
+      gave_first_right += both && a_right && !b_right && near(f[u], a[u]);
+      gave_second_right += both && b_right && !a_right && near(f[u], b[u]);
       if (right(f[u], true_px) || !(a_right || b_right))
         continue;
       if (a_right && b_right)
@@ -89,6 +95,20 @@ std::string formatFusionLoss(const std::vector<std::pair<std::string, FusionLoss
     std::snprintf(line, sizeof(line), "%-20s %5s%%   %-30s %-30s %s\n", name.c_str(), share(loss.lost(), total).c_str(),
                   gave(loss.first_right, total).c_str(), gave(loss.second_right, total).c_str(),
                   share(loss.both_right, total).c_str());
+    out << line;
+  }
+  out << "Where both inputs have a depth and one is right, % of the ground truth where the method gave each input:\n"
+      << "right / wrong\n";
+  std::snprintf(line, sizeof(line), "%-20s %-24s %s\n", "method", ("gave " + first).c_str(),
+                ("gave " + second).c_str());
+  out << line;
+  for (const auto& [name, loss] : rows) {
+    const std::size_t total = loss.ground_truth;
+    const std::string gave_first = share(loss.gave_first_right, total) + " / " +
+                                   share(loss.second_right[FusionLoss::TheOtherInput], total);
+    const std::string gave_second = share(loss.gave_second_right, total) + " / " +
+                                    share(loss.first_right[FusionLoss::TheOtherInput], total);
+    std::snprintf(line, sizeof(line), "%-20s %-24s %s\n", name.c_str(), gave_first.c_str(), gave_second.c_str());
     out << line;
   }
   return out.str();
