@@ -254,7 +254,7 @@ int main(int argc, char** argv) {
       .value("-scans", "DIR", settings.scans_dir,
              "every .bin (KITTI velodyne) or .pcd scan of DIR in name order, one per cloud (or the whole sequence's, "
              "picked by -frames as the poses are), in the LiDAR's frame: each "
-             "clears what lies in front of its returns outside the camera's view, within "
+             "clears what lies in front of its returns where the cloud's depth does not, within "
              "tsdf_integrator.scan_carving_m of the LiDAR, as msf_reconstruct does (needs -calib with the LiDAR's "
              "extrinsics, and space carving)")
       .value("-calib", "PATH", settings.calib,

@@ -12,6 +12,7 @@
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <pcl/conversions.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
@@ -1256,6 +1257,61 @@ TEST(TsdfIntegrator, ScanCarvingLeavesWhatTheCameraSeesToTheCamera) {
   EXPECT_EQ(after.vertices.size(), before.vertices.size());
   EXPECT_THROW(integrator.carveWithScan(ScanFreeSpace(ringScan(street(0, -1), T_world_lidar)), T_world_lidar, 0.f,
                                         frame.camera, streetPose(0)),
+               InvalidInputError);
+}
+
+TEST(TsdfIntegrator, ScanCarvingClearsInViewWhereTheCameraHasNoDepth) {
+  // A car 10 m ahead, seen at frame 0, has left at frame 1, taken from the same place; frame 1's
+  // depth has no pixel where the car was (as where the fusion finds no certain depth at a car's
+  // edge). Its scan sees the road and the wall through the car's place: where the camera says
+  // nothing, integrateFrame lets the scan carve. A bollard beside it, which the scan hits, stays.
+  const PinholeCamera camera = test::kittiCamera();
+  AnalyticScene with_car = street(0, -1), without_car = street(0, -1);
+  const Eigen::Vector3d bollard(-2.0, 1.65 - 0.5, 10.0), bollard_half(0.1, 0.5, 0.1);
+  with_car.addBox(bollard, bollard_half);
+  without_car.addBox(bollard, bollard_half);
+  with_car.addBox(Eigen::Vector3d(0, 1.65 - 0.75, 10.0), Eigen::Vector3d(0.9, 0.75, 2.2));
+  const DepthFrame seen = test::renderFrame(with_car, camera, streetPose(0), 0.0);
+  DepthFrame left = test::renderFrame(without_car, camera, streetPose(0), 0.0);
+  cv::Mat car_pixels = cv::abs(seen.depth - left.depth) > 0.05f;
+  cv::dilate(car_pixels, car_pixels, cv::Mat::ones(7, 7, CV_8UC1));
+  left.depth.setTo(0.f, car_pixels);
+  const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d::Zero());
+  const ScanFreeSpace scan(ringScan(without_car, T_world_lidar));
+
+  std::size_t car[2] = {0, 0}, bollard_vertices[2] = {0, 0};
+  for (const bool camera_depth : {false, true}) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator integrator(volume);
+    integrator.integrate(seen, streetPose(0));
+    if (camera_depth) {
+      TsdfIntegrator::FreeSpace free;
+      free.weight = 1111.f;
+      free.scan = &scan;
+      free.T_world_lidar = T_world_lidar;
+      integrator.integrateFrame(left, streetPose(0), free); // the scan told where the camera has no depth
+    } else {
+      integrator.integrate(left, streetPose(0));
+      integrator.carveWithScan(scan, T_world_lidar, 1111.f, camera, streetPose(0)); // the camera's whole view
+    }
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    for (const auto& v : mesh.vertices) {
+      // The car's back, sides and top, half a metre and more above the road; the bollard.
+      car[camera_depth] += std::abs(v.x()) < 1.0f && v.y() < 1.15f && v.z() > 7.5f && v.z() < 12.5f;
+      bollard_vertices[camera_depth] += std::abs(v.x() + 2.f) < 0.2f && v.y() < 1.5f && std::abs(v.z() - 10.f) < 0.2f;
+    }
+    std::printf("  camera depth %d: %zu car vertices, %zu bollard vertices\n", camera_depth, car[camera_depth],
+                bollard_vertices[camera_depth]);
+  }
+  EXPECT_GT(car[0], 100u);
+  EXPECT_LT(car[1], car[0] / 10);
+  EXPECT_GT(bollard_vertices[0], 20u);
+  EXPECT_GE(bollard_vertices[1], bollard_vertices[0] * 95 / 100);
+
+  TsdfVolume volume(0.1, 0.3);
+  TsdfIntegrator integrator(volume);
+  EXPECT_THROW(integrator.carveWithScan(scan, T_world_lidar, 1111.f, camera, streetPose(0), cv::Mat(3, 4, CV_32FC1)),
                InvalidInputError);
 }
 

@@ -106,6 +106,25 @@ bool sphereInView(const Eigen::Vector3f& c, float radius, const PinholeCamera& c
   return u >= -r_px && v >= -r_px && u <= cam.width + r_px && v <= cam.height + r_px;
 }
 
+/// Whether the frame's depth carves a point (camera frame): it lies in front of min_depth and
+/// all four pixels around its projection have a depth, or, on the image's last row or column,
+/// the nearest pixel (voxel_update_body.h's sampleDepth).
+bool cameraSpeaks(const cv::Mat& depth, const PinholeCamera& cam, const Eigen::Vector3f& q, float min_d) {
+  if (!(q.z() > min_d))
+    return false;
+  const float u = static_cast<float>(cam.fx) * q.x() / q.z() + static_cast<float>(cam.cx);
+  const float v = static_cast<float>(cam.fy) * q.y() / q.z() + static_cast<float>(cam.cy);
+  const float width = static_cast<float>(depth.cols), height = static_cast<float>(depth.rows);
+  if (!(u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
+    return false; // outside the image
+  if (!(u >= 0.f && v >= 0.f && u + 1.f < width && v + 1.f < height))
+    return depth.at<float>(static_cast<int>(std::lround(v)), static_cast<int>(std::lround(u))) > 0.f;
+  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+  const float* top = depth.ptr<float>(v0) + u0;
+  const float* bottom = depth.ptr<float>(v0 + 1) + u0;
+  return top[0] > 0.f && top[1] > 0.f && bottom[0] > 0.f && bottom[1] > 0.f;
+}
+
 } // namespace
 
 namespace {
@@ -555,6 +574,7 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   stats_ = Stats();
   const auto t_start = Clock::now();
   const FrameView view = prepareDepth(frame);
+  integrated_depth_ = view.depth;
   computePixelBands(frame, view);
   detail::BlockList list = allocateSubBlocks(findBandSubBlocks(view, T_world_cam));
   if (config_.space_carving)
@@ -578,7 +598,8 @@ void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isomet
                                     const FreeSpace& free) {
   integrate(frame, T_world_cam);
   if (free.scan && carvesWithScans())
-    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam);
+    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam, integrated_depth_);
+  integrated_depth_.release(); // it may share the caller's image
   if (!free.sky.empty())
     carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth);
   carveBeyondRange(frame, T_world_cam, free.weight);
@@ -849,13 +870,19 @@ void TsdfIntegrator::collectChanged(const detail::BlockList& list, const detail:
 }
 
 void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
-                                   const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam) {
+                                   const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
+                                   const cv::Mat& camera_depth) {
   if (!(config_.scan_carving_m > 0.0) || free_space.empty())
     return;
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveWithScan: the LiDAR's weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_lidar, "T_world_lidar (the scan's pose)");
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
+  const bool camera_everywhere = camera_depth.empty();
+  if (!camera_everywhere && (camera_depth.type() != CV_32FC1 || camera_depth.cols != camera.width ||
+                             camera_depth.rows != camera.height))
+    throw InvalidInputError("carveWithScan: the camera's depth must be CV_32FC1 of the camera's " +
+                            std::to_string(camera.width) + "x" + std::to_string(camera.height));
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_range = static_cast<float>(config_.scan_carving_m);
   // A voxel is free when it lies in front of the returns by more than the truncation, a voxel
@@ -873,18 +900,22 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
     if (!block->negative_subblocks)
       continue;
     const Eigen::Vector3f centre = (block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs;
-    if ((T_lidar_world * centre).norm() - radius > max_range || sphereInView(T_cam_world * centre, radius, camera, min_d))
+    if ((T_lidar_world * centre).norm() - radius > max_range ||
+        (camera_everywhere && sphereInView(T_cam_world * centre, radius, camera, min_d)))
       continue;
     blocks.push_back(block);
   }
   const std::uint64_t stamp = volume_.beginGeneration();
   const float max_weight = config_.max_weight;
+  const Eigen::Isometry3f T_cam_lidar = T_cam_world * T_world_lidar.cast<float>();
   parallelFor(cv::Range(0, static_cast<int>(blocks.size())), [&](const cv::Range& range) {
     for (int n = range.start; n < range.end; ++n)
       detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_lidar_world, vs, stamp,
                                  [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
                                    const float nearest = free_space.nearestAround(p);
                                    if (!(nearest > 0.f && p.norm() < nearest - margin))
+                                     return false;
+                                   if (!camera_everywhere && cameraSpeaks(camera_depth, camera, T_cam_lidar * p, min_d))
                                      return false;
                                    updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc, true);
                                    return true;

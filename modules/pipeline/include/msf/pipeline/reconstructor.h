@@ -82,7 +82,7 @@ struct FrameResult {
   cv::Mat lidar_canvas_depth, lidar_canvas_distance;
   PinholeCamera lidar_canvas_camera;
   /// The scan's free space all around (tsdf_integrator.scan_carving_m): what the map clears
-  /// outside the camera's view (TsdfIntegrator::carveWithScan).
+  /// where the camera's depth does not (TsdfIntegrator::carveWithScan).
   ScanFreeSpace scan_free_space;
   /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky; the fusion's when it
   /// found one, fusion.clear_sky) when the map carves along it (tsdf_integrator.sky_carving):

@@ -14,7 +14,8 @@ namespace msf {
 /// through it. A bin without a return (sky, glass, black paint) says nothing.
 ///
 /// The camera sees a quarter of what the LiDAR sees; TsdfIntegrator::carveWithScan uses the
-/// rest to clear what moved away out of the camera's view (an oncoming car that passed).
+/// rest, and the pixels where the camera has no depth, to clear what moved away (an oncoming car
+/// that passed, the old places of a car ahead).
 /// (pcl::RangeImageSpherical keeps the nearest return per cell too, but its lookups and its
 /// construction are several times slower, and the 3 x 3 minimum is what a lookup needs.)
 class ScanFreeSpace {
