@@ -153,13 +153,20 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
     print_info("  no ghost figure: %s\n", e.no_ghosts.c_str());
 }
 
-/// The console's protocol 6 lines: the open sky each mesh covers.
-void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky) {
+/// The console's protocol 6 lines: the open sky each mesh covers, by the image's sky mask and,
+/// on a synthetic sequence, by its true sky (where the mask also takes bright blank façades).
+void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky, const msf::RunReport::MapEvaluation& e) {
   for (const auto& [name, c] : open_sky)
     print_info("  open sky covered by %-11s %.2f %% of %zu pixels in %zu frames (mean per frame %.2f %%, worst "
                "%.2f %% at frame %zu), at a median depth of %.1f m\n",
                name.c_str(), 100 * c.share, c.sky_pixels, c.frames, 100 * c.mean_frame_share, 100 * c.worst_share,
                c.worst_frame, c.covered_depth_median_m);
+  for (const auto& r : e.rows)
+    if (r.true_sky.sky_pixels > 0)
+      print_info("  true sky covered by %-11s %.2f %% of %zu pixels (worst %.2f %% at frame %zu), by sheets off the "
+                 "true surface %.2f %%; the image's mask above also takes bright blank façades for sky\n",
+                 r.score.source.c_str(), 100 * r.true_sky.share, r.true_sky.sky_pixels, 100 * r.true_sky.worst_share,
+                 r.true_sky.worst_frame, 100 * r.true_sky_sheets.share);
 }
 
 void printSummary(const msf::RunReport& report, const std::string& out) {
@@ -176,7 +183,7 @@ void printSummary(const msf::RunReport& report, const std::string& out) {
                100 * report.mesh_accuracy.completeness, report.mesh_accuracy.threshold_m);
   if (!report.map_evaluation.rows.empty())
     printMapEvaluation(report.map_evaluation);
-  printOpenSky(report.open_sky);
+  printOpenSky(report.open_sky, report.map_evaluation);
   print_info("Report: ");
   print_value("%s/report.md\n", out.c_str());
 }

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -166,6 +167,13 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   EXPECT_EQ(by_age, jsonNumber(mesh, "crumbs", "crumbs"));
   EXPECT_NE(readFile(out.file("report.md")).find("| ghosts | crumbs | specks |"), std::string::npos);
   EXPECT_NE(readFile(out.file("report.md")).find("source (moving objects)"), std::string::npos);
+  // The console gives the true sky the mesh covers beside the image mask's open sky.
+  char true_sky[96];
+  std::snprintf(true_sky, sizeof(true_sky), "true sky covered by mesh        %.2f %% of %.0f pixels",
+                100 * jsonNumber(mesh, "share", "true_sky"), jsonNumber(mesh, "sky_pixels", "true_sky"));
+  EXPECT_GT(jsonNumber(mesh, "sky_pixels", "true_sky"), 10000.0);
+  EXPECT_NE(r.out.find(true_sky), std::string::npos) << true_sky << "\n" << r.out;
+  EXPECT_NE(r.out.find("open sky covered by mesh"), std::string::npos) << r.out;
   // Split by the class of the nearest true surface (gt/scene_classes.txt): the parts add up
   // to the mean (each rounded to 4 digits), and the road is there, meshed nearly whole.
   const std::size_t classes = mesh.find("\"by_class\": [");
