@@ -164,7 +164,7 @@ void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky, const
   for (const auto& r : e.rows)
     if (r.true_sky.sky_pixels > 0)
       print_info("  true sky covered by %-11s %.2f %% of %zu pixels (worst %.2f %% at frame %zu), by sheets off the "
-                 "true surface %.2f %%; the image's mask above also takes bright blank façades for sky\n",
+                 "true surface %.2f %% (the image's mask above can also take bright blank façades for sky)\n",
                  r.score.source.c_str(), 100 * r.true_sky.share, r.true_sky.sky_pixels, 100 * r.true_sky.worst_share,
                  r.true_sky.worst_frame, 100 * r.true_sky_sheets.share);
 }

@@ -568,13 +568,16 @@ std::vector<std::uint64_t> visitOrder(const std::vector<TsdfBlock*>& blocks, con
 } // namespace
 
 void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
+  integrateDepth(frame, T_world_cam);
+}
+
+cv::Mat TsdfIntegrator::integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
   checkReach(T_world_cam);
   stats_ = Stats();
   const auto t_start = Clock::now();
   const FrameView view = prepareDepth(frame);
-  integrated_depth_ = view.depth;
   computePixelBands(frame, view);
   detail::BlockList list = allocateSubBlocks(findBandSubBlocks(view, T_world_cam));
   if (config_.space_carving)
@@ -592,14 +595,14 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   if (regularizes())
     regularize(touched, offsets);
   stats_.regularize_ms = msSince(t_reg);
+  return view.depth;
 }
 
 void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam,
                                     const FreeSpace& free) {
-  integrate(frame, T_world_cam);
+  const cv::Mat integrated = integrateDepth(frame, T_world_cam);
   if (free.scan && carvesWithScans())
-    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam, integrated_depth_);
-  integrated_depth_.release(); // it may share the caller's image
+    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam, integrated);
   if (!free.sky.empty())
     carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth);
   carveBeyondRange(frame, T_world_cam, free.weight);
@@ -882,7 +885,9 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
   if (!camera_everywhere && (camera_depth.type() != CV_32FC1 || camera_depth.cols != camera.width ||
                              camera_depth.rows != camera.height))
     throw InvalidInputError("carveWithScan: the camera's depth must be CV_32FC1 of the camera's " +
-                            std::to_string(camera.width) + "x" + std::to_string(camera.height));
+                            std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", got type " +
+                            std::to_string(camera_depth.type()) + " of " + std::to_string(camera_depth.cols) + "x" +
+                            std::to_string(camera_depth.rows));
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_range = static_cast<float>(config_.scan_carving_m);
   // A voxel is free when it lies in front of the returns by more than the truncation, a voxel
@@ -912,10 +917,11 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
     for (int n = range.start; n < range.end; ++n)
       detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_lidar_world, vs, stamp,
                                  [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
+                                   // The projection first: in view it spares most voxels the scan's lookup.
+                                   if (!camera_everywhere && cameraSpeaks(camera_depth, camera, T_cam_lidar * p, min_d))
+                                     return false;
                                    const float nearest = free_space.nearestAround(p);
                                    if (!(nearest > 0.f && p.norm() < nearest - margin))
-                                     return false;
-                                   if (!camera_everywhere && cameraSpeaks(camera_depth, camera, T_cam_lidar * p, min_d))
                                      return false;
                                    updateVoxel(voxel, trunc, w, nullptr, max_weight, trunc, true);
                                    return true;

@@ -258,6 +258,10 @@ public:
   /// Throws InvalidInputError (see DepthFrame::validate).
   void integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
 
+  /// Whether carveWithScan clears anything (space carving with scan_carving_m > 0): whether a
+  /// frame's scan is worth turning into a ScanFreeSpace.
+  bool carvesWithScans() const { return config_.space_carving && config_.scan_carving_m > 0.0; }
+
   /// Free space that a LiDAR scan saw where the camera's depth says nothing (Config::scan_carving_m
   /// > 0): in blocks that hold a surface (a voxel with sdf < 0) within scan_carving_m of the
   /// LiDAR, each such voxel that lies in front of every return around its direction by more than
@@ -269,9 +273,6 @@ public:
   /// a voxel's projection have a depth, as the frame's free-space update needs. Conservative:
   /// only where the scan has returns, and only voxels behind a surface (the ones that make it),
   /// so that a road seen at a grazing angle, whose returns lie around it, is left alone.
-  /// Whether carveWithScan clears anything (space carving with scan_carving_m > 0): whether a
-  /// frame's scan is worth turning into a ScanFreeSpace.
-  bool carvesWithScans() const { return config_.space_carving && config_.scan_carving_m > 0.0; }
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
                      const cv::Mat& camera_depth = cv::Mat());
@@ -374,6 +375,9 @@ private:
   // integrate's phases, in order.
   /// The frame's pixel weights (weight_) and the depth to integrate.
   detail::FrameView prepareDepth(const DepthFrame& frame);
+  /// integrate(); returns the depth it integrated (FrameView::depth: without the pixels below
+  /// min_pixel_weight), which integrateFrame's scan carving reads.
+  cv::Mat integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
   /// Per pixel, its plane scale, bands and weights (pixels_).
   void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
   /// The sorted keys of the sub-blocks that the pixels' bands cross; also the depth ranges of
@@ -402,7 +406,6 @@ private:
   cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
-  cv::Mat integrated_depth_; // the last integrate()'s FrameView::depth, for integrateFrame's scan carving
   DepthWeighting::ConstPtr weighting_;
   SignedDistanceModel::ConstPtr signed_distance_;
   SweepSchedule::ConstPtr sweep_schedule_;
