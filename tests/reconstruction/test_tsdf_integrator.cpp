@@ -1260,11 +1260,12 @@ TEST(TsdfIntegrator, ScanCarvingLeavesWhatTheCameraSeesToTheCamera) {
                InvalidInputError);
 }
 
-TEST(TsdfIntegrator, ScanCarvingClearsInViewWhereTheCameraHasNoDepth) {
-  // A car 10 m ahead, seen at frame 0, has left at frame 1, taken from the same place; frame 1's
-  // depth has no pixel where the car was (as where the fusion finds no certain depth at a car's
-  // edge). Its scan sees the road and the wall through the car's place: where the camera says
-  // nothing, integrateFrame lets the scan carve. A bollard beside it, which the scan hits, stays.
+TEST(TsdfIntegrator, ScanCarvingClearsInViewWhereTheCameraCarvesLessThanTheScan) {
+  // A car 10 m ahead, seen at frame 0, has left at frame 1, taken from the same place. Frame 1's
+  // depth, certain elsewhere, has no pixel where the car was, or a depth there weighing less than
+  // the scan (as the fusion's at a car's edge): the camera then carves its old place a little a
+  // frame. Its scan sees the road and the wall through the car's place: integrateFrame lets the
+  // scan carve wherever the camera carved less. A bollard beside it, which the scan hits, stays.
   const PinholeCamera camera = test::kittiCamera();
   AnalyticScene with_car = street(0, -1), without_car = street(0, -1);
   const Eigen::Vector3d bollard(-2.0, 1.65 - 0.5, 10.0), bollard_half(0.1, 0.5, 0.1);
@@ -1272,51 +1273,60 @@ TEST(TsdfIntegrator, ScanCarvingClearsInViewWhereTheCameraHasNoDepth) {
   without_car.addBox(bollard, bollard_half);
   with_car.addBox(Eigen::Vector3d(0, 1.65 - 0.75, 10.0), Eigen::Vector3d(0.9, 0.75, 2.2));
   const DepthFrame seen = test::renderFrame(with_car, camera, streetPose(0), 0.0);
-  DepthFrame left = test::renderFrame(without_car, camera, streetPose(0), 0.0);
+  const DepthFrame left = test::renderFrame(without_car, camera, streetPose(0), 0.0);
   cv::Mat car_pixels = cv::abs(seen.depth - left.depth) > 0.05f;
   cv::dilate(car_pixels, car_pixels, cv::Mat::ones(7, 7, CV_8UC1));
-  left.depth.setTo(0.f, car_pixels);
+  constexpr float kScanWeight = 1111.f, kCertain = 2000.f, kUncertain = 0.5f; // m^-2
+  DepthFrame blank = left, weak = left;
+  blank.depth = left.depth.clone();
+  blank.depth.setTo(0.f, car_pixels);
+  blank.weight = cv::Mat(left.depth.size(), CV_32FC1, cv::Scalar(kCertain));
+  weak.weight = blank.weight.clone();
+  weak.weight.setTo(kUncertain, car_pixels);
   const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d::Zero());
   const ScanFreeSpace scan(ringScan(without_car, T_world_lidar));
 
-  std::size_t car[2] = {0, 0}, bollard_vertices[2] = {0, 0};
-  for (const bool camera_depth : {false, true}) {
+  enum Case { kWholeView, kBlank, kWeak };
+  std::size_t car[3] = {0, 0, 0}, bollard_vertices[3] = {0, 0, 0};
+  for (const Case c : {kWholeView, kBlank, kWeak}) {
     TsdfVolume volume(0.1, 0.3);
     TsdfIntegrator integrator(volume);
     integrator.integrate(seen, streetPose(0));
-    if (camera_depth) {
+    if (c == kWholeView) {
+      integrator.integrate(blank, streetPose(0));
+      integrator.carveWithScan(scan, T_world_lidar, kScanWeight, camera, streetPose(0)); // the camera's whole view
+    } else {
       TsdfIntegrator::FreeSpace free;
-      free.weight = 1111.f;
+      free.weight = kScanWeight;
       free.scan = &scan;
       free.T_world_lidar = T_world_lidar;
-      integrator.integrateFrame(left, streetPose(0), free); // the scan told where the camera has no depth
-    } else {
-      integrator.integrate(left, streetPose(0));
-      integrator.carveWithScan(scan, T_world_lidar, 1111.f, camera, streetPose(0)); // the camera's whole view
+      integrator.integrateFrame(c == kBlank ? blank : weak, streetPose(0), free);
     }
     TriangleMesh mesh;
     MarchingCubes().extract(volume, mesh);
     for (const auto& v : mesh.vertices) {
       // The car's back, sides and top, half a metre and more above the road; the bollard.
-      car[camera_depth] += std::abs(v.x()) < 1.0f && v.y() < 1.15f && v.z() > 7.5f && v.z() < 12.5f;
-      bollard_vertices[camera_depth] += std::abs(v.x() + 2.f) < 0.2f && v.y() < 1.5f && std::abs(v.z() - 10.f) < 0.2f;
+      car[c] += std::abs(v.x()) < 1.0f && v.y() < 1.15f && v.z() > 7.5f && v.z() < 12.5f;
+      bollard_vertices[c] += std::abs(v.x() + 2.f) < 0.2f && v.y() < 1.5f && std::abs(v.z() - 10.f) < 0.2f;
     }
-    std::printf("  camera depth %d: %zu car vertices, %zu bollard vertices\n", camera_depth, car[camera_depth],
-                bollard_vertices[camera_depth]);
+    std::printf("  case %d: %zu car vertices, %zu bollard vertices\n", c, car[c], bollard_vertices[c]);
   }
-  EXPECT_GT(car[0], 100u);
-  EXPECT_LT(car[1], car[0] / 10);
-  EXPECT_GT(bollard_vertices[0], 20u);
-  EXPECT_GE(bollard_vertices[1], bollard_vertices[0] * 95 / 100);
+  EXPECT_GT(car[kWholeView], 100u);
+  EXPECT_LT(car[kBlank], car[kWholeView] / 10);
+  EXPECT_LT(car[kWeak], car[kWholeView] / 10);
+  EXPECT_GT(bollard_vertices[kWholeView], 20u);
+  for (const Case c : {kBlank, kWeak})
+    EXPECT_GE(bollard_vertices[c], bollard_vertices[kWholeView] * 95 / 100);
 
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator integrator(volume);
   try {
-    integrator.carveWithScan(scan, T_world_lidar, 1111.f, camera, streetPose(0), cv::Mat(3, 4, CV_32FC1));
-    ADD_FAILURE() << "a depth of another size was taken";
+    integrator.carveWithScan(scan, T_world_lidar, kScanWeight, camera, streetPose(0), cv::Mat(3, 4, CV_32FC1));
+    ADD_FAILURE() << "carved weights of another size were taken";
   } catch (const InvalidInputError& e) {
-    EXPECT_NE(std::string(e.what()).find("must be CV_32FC1 of the camera's " + std::to_string(camera.width) + "x" +
-                                         std::to_string(camera.height) + ", got type 5 of 4x3"),
+    EXPECT_NE(std::string(e.what()).find("carved weights must be CV_32FC1 of the camera's " +
+                                         std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                                         ", got type 5 of 4x3"),
               std::string::npos)
         << e.what();
   }

@@ -106,23 +106,25 @@ bool sphereInView(const Eigen::Vector3f& c, float radius, const PinholeCamera& c
   return u >= -r_px && v >= -r_px && u <= cam.width + r_px && v <= cam.height + r_px;
 }
 
-/// Whether the frame's depth carves a point (camera frame): it lies in front of min_depth and
-/// all four pixels around its projection have a depth, or, on the image's last row or column,
-/// the nearest pixel (voxel_update_body.h's sampleDepth).
-bool cameraSpeaks(const cv::Mat& depth, const PinholeCamera& cam, const Eigen::Vector3f& q, float min_d) {
+/// Whether the frame's depth carved a point (camera frame) with at least `weight`: it lies in
+/// front of min_depth and all four pixels around its projection carved that much, or, on the
+/// image's last row or column, the nearest pixel (voxel_update_body.h's sampleDepth, which
+/// needs all four pixels' depth).
+bool cameraCarved(const cv::Mat& carved, const PinholeCamera& cam, const Eigen::Vector3f& q, float min_d,
+                  float weight) {
   if (!(q.z() > min_d))
     return false;
   const float u = static_cast<float>(cam.fx) * q.x() / q.z() + static_cast<float>(cam.cx);
   const float v = static_cast<float>(cam.fy) * q.y() / q.z() + static_cast<float>(cam.cy);
-  const float width = static_cast<float>(depth.cols), height = static_cast<float>(depth.rows);
+  const float width = static_cast<float>(carved.cols), height = static_cast<float>(carved.rows);
   if (!(u > -0.5f && v > -0.5f && u < width - 0.5f && v < height - 0.5f))
     return false; // outside the image
   if (!(u >= 0.f && v >= 0.f && u + 1.f < width && v + 1.f < height))
-    return depth.at<float>(static_cast<int>(std::lround(v)), static_cast<int>(std::lround(u))) > 0.f;
+    return carved.at<float>(static_cast<int>(std::lround(v)), static_cast<int>(std::lround(u))) >= weight;
   const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
-  const float* top = depth.ptr<float>(v0) + u0;
-  const float* bottom = depth.ptr<float>(v0 + 1) + u0;
-  return top[0] > 0.f && top[1] > 0.f && bottom[0] > 0.f && bottom[1] > 0.f;
+  const float* top = carved.ptr<float>(v0) + u0;
+  const float* bottom = carved.ptr<float>(v0 + 1) + u0;
+  return std::min({top[0], top[1], bottom[0], bottom[1]}) >= weight;
 }
 
 } // namespace
@@ -299,7 +301,6 @@ struct FrameView {
   /// `width` floats like the pixel records (pixels_), so that one index finds a pixel in both.
   const cv::Mat& depth;
   const PinholeCamera& cam;
-  bool own_weights; ///< per-pixel weighting with the frame's own weight image
   int width, height;
   float fx, fy, cx, cy;
   float vs, trunc;
@@ -571,6 +572,26 @@ void TsdfIntegrator::integrate(const DepthFrame& frame, const Eigen::Isometry3d&
   integrateDepth(frame, T_world_cam);
 }
 
+const cv::Mat& TsdfIntegrator::freeSpaceWeights(const DepthFrame& frame) const {
+  return takesWeightsOf(frame) && !frame.free_space_weight.empty() ? frame.free_space_weight : weight_;
+}
+
+const cv::Mat& TsdfIntegrator::carvedWeights(const DepthFrame& frame, const cv::Mat& integrated) {
+  const cv::Mat& free_weight = freeSpaceWeights(frame);
+  const float carving_weight = static_cast<float>(config_.carving_weight);
+  carved_weight_.create(integrated.size(), CV_32FC1);
+  parallelFor(cv::Range(0, integrated.rows), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      const float* depth = integrated.ptr<float>(v);
+      const float* f = free_weight.ptr<float>(v);
+      float* carved = carved_weight_.ptr<float>(v);
+      for (int u = 0; u < integrated.cols; ++u)
+        carved[u] = depth[u] > 0.f ? carving_weight * f[u] : 0.f;
+    }
+  });
+  return carved_weight_;
+}
+
 cv::Mat TsdfIntegrator::integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
@@ -602,7 +623,8 @@ void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isomet
                                     const FreeSpace& free) {
   const cv::Mat integrated = integrateDepth(frame, T_world_cam);
   if (free.scan && carvesWithScans())
-    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam, integrated);
+    carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam,
+                  carvedWeights(frame, integrated));
   if (!free.sky.empty())
     carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth);
   carveBeyondRange(frame, T_world_cam, free.weight);
@@ -629,7 +651,6 @@ FrameView TsdfIntegrator::prepareDepth(const DepthFrame& frame) {
   const PinholeCamera& cam = frame.camera;
   return {copied ? masked_depth_ : frame.depth,
           cam,
-          own_weights,
           cam.width,
           cam.height,
           static_cast<float>(cam.fx),
@@ -664,8 +685,7 @@ void TsdfIntegrator::computePixelBands(const DepthFrame& frame, const FrameView&
   // (free space holds the voxels beyond at +truncation, so the full truncation only costs
   // time; one voxel leaves holes wherever a cube's far corner lies a little deeper).
   const float plane_band = planeBand(trunc, view.vs);
-  // Free space weighs the frame's free-space weight where it has one (per-pixel weighting).
-  const cv::Mat& free_weight = view.own_weights ? frame.free_space_weight : cv::Mat();
+  const cv::Mat& free_weight = freeSpaceWeights(frame);
   const float carving_weight = static_cast<float>(config_.carving_weight);
   // The band behind a thin object's pixels reaches no deeper than the object is wide, and at
   // least kSilhouetteFloor truncations (see Config::silhouette_band).
@@ -678,7 +698,7 @@ void TsdfIntegrator::computePixelBands(const DepthFrame& frame, const FrameView&
       const float* s = scale_.ptr<float>(v);
       const float* w = weight_.ptr<float>(v);
       const float* e = extent_.ptr<float>(v);
-      const float* f = free_weight.empty() ? w : free_weight.ptr<float>(v);
+      const float* f = free_weight.ptr<float>(v);
       const float* thick = silhouette ? thickness_.ptr<float>(v) : nullptr;
       PixelBand* out = &pixels_[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
@@ -874,20 +894,20 @@ void TsdfIntegrator::collectChanged(const detail::BlockList& list, const detail:
 
 void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                                    const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-                                   const cv::Mat& camera_depth) {
+                                   const cv::Mat& camera_carved) {
   if (!(config_.scan_carving_m > 0.0) || free_space.empty())
     return;
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveWithScan: the LiDAR's weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_lidar, "T_world_lidar (the scan's pose)");
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
-  const bool camera_everywhere = camera_depth.empty();
-  if (!camera_everywhere && (camera_depth.type() != CV_32FC1 || camera_depth.cols != camera.width ||
-                             camera_depth.rows != camera.height))
-    throw InvalidInputError("carveWithScan: the camera's depth must be CV_32FC1 of the camera's " +
+  const bool camera_everywhere = camera_carved.empty();
+  if (!camera_everywhere && (camera_carved.type() != CV_32FC1 || camera_carved.cols != camera.width ||
+                             camera_carved.rows != camera.height))
+    throw InvalidInputError("carveWithScan: the camera's carved weights must be CV_32FC1 of the camera's " +
                             std::to_string(camera.width) + "x" + std::to_string(camera.height) + ", got type " +
-                            std::to_string(camera_depth.type()) + " of " + std::to_string(camera_depth.cols) + "x" +
-                            std::to_string(camera_depth.rows));
+                            std::to_string(camera_carved.type()) + " of " + std::to_string(camera_carved.cols) + "x" +
+                            std::to_string(camera_carved.rows));
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_range = static_cast<float>(config_.scan_carving_m);
   // A voxel is free when it lies in front of the returns by more than the truncation, a voxel
@@ -918,7 +938,8 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
       detail::carveSurfaceVoxels(*blocks[static_cast<std::size_t>(n)], T_lidar_world, vs, stamp,
                                  [&](TsdfVoxel& voxel, const Eigen::Vector3f& p) {
                                    // The projection first: in view it spares most voxels the scan's lookup.
-                                   if (!camera_everywhere && cameraSpeaks(camera_depth, camera, T_cam_lidar * p, min_d))
+                                   if (!camera_everywhere &&
+                                       cameraCarved(camera_carved, camera, T_cam_lidar * p, min_d, w))
                                      return false;
                                    const float nearest = free_space.nearestAround(p);
                                    if (!(nearest > 0.f && p.norm() < nearest - margin))

@@ -183,8 +183,8 @@ public:
       k("space_carving", space_carving, "voxels seen in front of the band become free space (sdf = +truncation)");
       k("carving_weight", carving_weight, atLeast(0), "a free-space update weighs this times the observation");
       k("scan_carving_m", scan_carving_m, between(0, kMaxDepthM),
-        "also carve with the LiDAR's scan where the camera's depth does not (outside its view, and where a "
-        "voxel's four pixels lack a depth), this far from the LiDAR, m (0: off)");
+        "also carve with the LiDAR's scan where the camera's depth does not, or less (outside its view, and "
+        "where a voxel's four pixels carve with less than the LiDAR's weight), this far from the LiDAR, m (0: off)");
       k("sky_carving", sky_carving,
         "also carve along the rays of the frame's open sky (SkyMask), in front of the LiDAR's highest returns");
       k("far_carving", far_carving, "also carve along the rays whose depth lies beyond max_depth_m, up to it");
@@ -262,20 +262,23 @@ public:
   /// frame's scan is worth turning into a ScanFreeSpace.
   bool carvesWithScans() const { return config_.space_carving && config_.scan_carving_m > 0.0; }
 
-  /// Free space that a LiDAR scan saw where the camera's depth says nothing (Config::scan_carving_m
-  /// > 0): in blocks that hold a surface (a voxel with sdf < 0) within scan_carving_m of the
-  /// LiDAR, each such voxel that lies in front of every return around its direction by more than
-  /// the truncation, a voxel and 0.6 m (a sweep's skew: scans are not motion-compensated) takes a
-  /// free-space update of `weight` (m^-2, the LiDAR's inverse variance) times carving_weight;
-  /// where the camera speaks, the frame's own depth carves instead. Without `camera_depth`, the
-  /// camera speaks in its whole view from T_world_cam; with it (the depth the frame was
-  /// integrated with, CV_32FC1 of the camera's size, 0 = none), only where all four pixels around
-  /// a voxel's projection have a depth, as the frame's free-space update needs. Conservative:
-  /// only where the scan has returns, and only voxels behind a surface (the ones that make it),
-  /// so that a road seen at a grazing angle, whose returns lie around it, is left alone.
+  /// Free space that a LiDAR scan saw where the camera's depth says nothing or little
+  /// (Config::scan_carving_m > 0): in blocks that hold a surface (a voxel with sdf < 0) within
+  /// scan_carving_m of the LiDAR, each such voxel that lies in front of every return around its
+  /// direction by more than the truncation, a voxel and 0.6 m (a sweep's skew: scans are not
+  /// motion-compensated) takes a free-space update of `weight` (m^-2, the LiDAR's inverse
+  /// variance) times carving_weight, unless the camera carved it as much. Without
+  /// `camera_carved`, the camera did so in its whole view from T_world_cam; with it (per pixel,
+  /// the weight with which the frame's depth carved the pixel's ray, carving_weight included,
+  /// 0 where it has no depth; CV_32FC1 of the camera's size), only where all four pixels around
+  /// a voxel's projection carved at least the scan's weight. A crumb at a car's edge, where the
+  /// fusion's depth is uncertain and carves a little a frame, is cleared by the LiDAR that
+  /// made it. Conservative: only where the scan has returns, and only voxels behind a surface
+  /// (the ones that make it), so that a road seen at a grazing angle, whose returns lie around
+  /// it, is left alone.
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-                     const cv::Mat& camera_depth = cv::Mat());
+                     const cv::Mat& camera_carved = cv::Mat());
 
   /// Free space that the open sky shows (Config::sky_carving, with space_carving): a ray through a
   /// pixel of `sky` (CV_8UC1 of `camera`'s size, non-zero = open sky, as SkyMask finds it) passed
@@ -376,8 +379,15 @@ private:
   /// The frame's pixel weights (weight_) and the depth to integrate.
   detail::FrameView prepareDepth(const DepthFrame& frame);
   /// integrate(); returns the depth it integrated (FrameView::depth: without the pixels below
-  /// min_pixel_weight), which integrateFrame's scan carving reads.
+  /// min_pixel_weight).
   cv::Mat integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
+  /// Per pixel, the weight of the frame's free-space evidence: its free_space_weight where it
+  /// weighs its own depth and has one, else its pixel weights (weight_, after prepareDepth).
+  const cv::Mat& freeSpaceWeights(const DepthFrame& frame) const;
+  /// Per pixel, the weight with which the frame's free-space update carved its ray
+  /// (freeSpaceWeights times carving_weight), 0 where `integrated` has no depth: what
+  /// integrateFrame's scan carving reads.
+  const cv::Mat& carvedWeights(const DepthFrame& frame, const cv::Mat& integrated);
   /// Per pixel, its plane scale, bands and weights (pixels_).
   void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
   /// The sorted keys of the sub-blocks that the pixels' bands cross; also the depth ranges of
@@ -406,6 +416,7 @@ private:
   cv::Mat scale_, extent_; // planeDistanceScale and smoothSurfaceExtent of the frame, reused
   std::vector<detail::PixelBand> pixels_; // reused
   cv::Mat masked_depth_; // the depth without the pixels below min_pixel_weight, reused
+  cv::Mat carved_weight_; // carvedWeights of the frame, reused
   DepthWeighting::ConstPtr weighting_;
   SignedDistanceModel::ConstPtr signed_distance_;
   SweepSchedule::ConstPtr sweep_schedule_;
