@@ -166,7 +166,7 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     const msf::DepthFrame frame = msf::toDepthFrame(blob, cloud_camera ? &*cloud_camera : nullptr, what);
     std::optional<msf::ScanFreeSpace> scan;
     if (!frames.scans.empty())
-      scan.emplace(loadScan(frames.scans[i]));
+      scan.emplace(loadScan(frames.scans[i]), calibration.lidar.sweeping);
     const msf::OpenSky sky = readSky(blob, image, what);
     msf::TsdfIntegrator::FreeSpace free;
     free.weight = lidar_weight;

@@ -220,7 +220,8 @@ void bindReconstructor(py::module_& m) {
            "without one is an error), odometry (always) or refine (the frames' own poses, a GPS/INS's, as the "
            "prior the LiDAR odometry refines). threads: of this engine's parallel loops, 0 = all "
            "cores. sweeping_scans: the scans are swept over their period (a spinning LiDAR; the odometry "
-           "deskews them). stream_directory: where a streamed map (streaming.active_radius_m > 0) writes its "
+           "deskews them, the scan's carving allows for their skew). stream_directory: where a streamed map "
+           "(streaming.active_radius_m > 0) writes its "
            "tiles. Raises ConfigError for an invalid config, CalibrationError for a rig without an image size.")
       .def("add_frame", &addFrame, py::arg("frame"),
            "A Frame's depth (steps 1-4), its pose and its integration into the map (step 5): its FrameResult, "

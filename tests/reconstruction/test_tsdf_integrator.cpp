@@ -1332,6 +1332,34 @@ TEST(TsdfIntegrator, ScanCarvingClearsInViewWhereTheCameraCarvesLessThanTheScan)
   }
 }
 
+TEST(TsdfIntegrator, ScanCarvingAllowsForASweepsSkewOnlyInSweptScans) {
+  // The back of a car 10 m ahead, seen at frame 0; 0.8 m farther on in the next scan, taken from
+  // the same place, where the camera carved nothing. The old back lies 0.5-0.8 m in front of the
+  // new returns: within a swept scan's skew, which may have put them there, but not within a
+  // scan of one instant's, which clears it.
+  const PinholeCamera camera = test::kittiCamera();
+  const DepthFrame seen = test::renderFrame(street(0, 10.0), camera, streetPose(0), 0.0);
+  const Eigen::Isometry3d T_world_lidar = lidarPose(Eigen::Vector3d::Zero());
+  const pcl::PointCloud<pcl::PointXYZI> scan = ringScan(street(0, 10.8), T_world_lidar);
+  const cv::Mat carved_nothing = cv::Mat::zeros(camera.height, camera.width, CV_32FC1);
+  std::size_t back[2] = {0, 0};
+  for (const bool swept : {true, false}) {
+    const ScanFreeSpace free_space(scan, swept);
+    EXPECT_EQ(free_space.skew(), swept ? ScanFreeSpace::kSweepSkewM : 0.f);
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator integrator(volume);
+    integrator.integrate(seen, streetPose(0));
+    integrator.carveWithScan(free_space, T_world_lidar, 1111.f, camera, streetPose(0), carved_nothing);
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    for (const auto& v : mesh.vertices)
+      back[swept] += std::abs(v.x()) < 0.8f && v.y() > 0.3f && v.y() < 1.5f && v.z() > 9.8f && v.z() < 10.4f;
+  }
+  std::printf("  the old back: %zu vertices after a swept scan, %zu after a scan of one instant\n", back[1], back[0]);
+  EXPECT_GT(back[1], 100u);
+  EXPECT_LT(back[0], back[1] / 10);
+}
+
 TEST(TsdfIntegrator, ScanCarvingRangeIsAValidatedKey) {
   TsdfIntegrator::Config c;
   c.scan_carving_m = -1.0;

@@ -109,7 +109,7 @@ void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
   if (integrator_->carvesWithScans()) // built here, beside SGBM, rather than on the map's thread
-    result.scan_free_space = ScanFreeSpace(*frame.scan);
+    result.scan_free_space = ScanFreeSpace(*frame.scan, options_.sweeping_scans);
   result.times.lidar_ms = msSince(start);
   if (options_.keep_sparse)
     stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);

@@ -41,7 +41,8 @@ inline bool binOf(float x, float y, float z, int& row, int& column) {
 
 } // namespace
 
-ScanFreeSpace::ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan) {
+ScanFreeSpace::ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan, bool swept)
+    : skew_m_(swept ? kSweepSkewM : 0.f) {
   constexpr float kNone = std::numeric_limits<float>::infinity();
   cv::Mat nearest(kRows, kColumns, CV_32FC1, cv::Scalar(kNone));
   for (const auto& p : scan) {

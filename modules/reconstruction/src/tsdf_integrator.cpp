@@ -911,10 +911,8 @@ void TsdfIntegrator::carveWithScan(const ScanFreeSpace& free_space, const Eigen:
   const float vs = static_cast<float>(volume_.voxelSize()), trunc = static_cast<float>(volume_.truncation());
   const float min_d = static_cast<float>(config_.min_depth_m), max_range = static_cast<float>(config_.scan_carving_m);
   // A voxel is free when it lies in front of the returns by more than the truncation, a voxel
-  // and the sweep's skew: a sweep is not motion-compensated (KITTI's are not), and at 13 m/s
-  // its returns lie up to 0.65 m from where the scan's one pose puts them.
-  constexpr float kSweepSkewM = 0.6f;
-  const float margin = trunc + vs + kSweepSkewM, w = weight * static_cast<float>(config_.carving_weight);
+  // and the scan's skew (a sweep that is not motion-compensated).
+  const float margin = trunc + vs + free_space.skew(), w = weight * static_cast<float>(config_.carving_weight);
   if (!(w > 0.f))
     return;
   const Eigen::Isometry3f T_lidar_world = T_world_lidar.inverse().cast<float>();

@@ -38,7 +38,7 @@ struct NodeParameters {
   std::string config;        ///< the engine's YAML configuration ("" = its defaults)
   std::string rig;           ///< a calibration file instead of CameraInfo and the tf extrinsic
   int threads = 0;           ///< the engine's threads (0 = all cores)
-  bool sweeping_scans = true; ///< scans swept over their period: the odometry deskews them
+  bool sweeping_scans = true; ///< scans swept over their period: deskewed, carving allows for the skew
   int queue_size = 1;        ///< frames waiting for the engine; when full the oldest is dropped
   double sync_slop_s = 0.05; ///< the largest spread of stamps within one frame's messages
   double tf_timeout_s = 0.2; ///< how long a frame waits for its pose and the first for the extrinsic

@@ -20,7 +20,7 @@ namespace msf {
 ///     T_cam_lidar: [16 numbers, row-major 4x4]             # the LiDAR's points into the left camera
 ///     rings: 32                                            # optional: its beams
 ///     beam_elevations_deg: [-15.0, ..., 15.0]              # optional: one per ring
-///     sweeping: true                                       # optional: a spinning LiDAR (deskewed)
+///     sweeping: true                                       # optional: a spinning LiDAR (deskewed; skew allowed)
 ///
 /// True when `path` is a YAML file with the rig's keys (image_width and left).
 bool isRigFile(const std::string& path);

@@ -153,7 +153,8 @@ public:
     /// the machine (a ROS node, a Python program).
     int threads = 0;
     /// Scans swept over their period (a spinning LiDAR): the odometry deskews them
-    /// (odometry.deskew auto); false for scans taken at one instant. run() takes it from its
+    /// (odometry.deskew auto), and the scan's carving allows for their skew
+    /// (ScanFreeSpace::skew); false for scans taken at one instant. run() takes it from its
     /// FrameSource (FrameSource::sweepingScans); set it for addFrame.
     bool sweeping_scans = true;
     /// With `streaming.active_radius_m` > 0 (docs/streaming.md): the folder where the map

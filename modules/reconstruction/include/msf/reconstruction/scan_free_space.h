@@ -23,18 +23,27 @@ public:
   static constexpr float kAzimuthBinDeg = 0.4f, kElevationBinDeg = 0.5f;
   static constexpr float kMinElevationDeg = -30.f, kMaxElevationDeg = 15.f;
 
+  /// How far a swept scan's returns may lie from where its one pose puts them: a spinning LiDAR's
+  /// sweep is not motion-compensated (KITTI's are not), and at 13 m/s it skews by up to 0.65 m.
+  static constexpr float kSweepSkewM = 0.6f;
+
   ScanFreeSpace() = default;
   /// From the returns of one scan, in the sensor's frame (x forward, z up); non-finite points
-  /// and points at the sensor are skipped.
-  explicit ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan);
+  /// and points at the sensor are skipped. `swept`: taken by a spinning LiDAR over its period
+  /// (FrameSource::sweepingScans, the rig's lidar.sweeping), false for a scan of one instant.
+  explicit ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan, bool swept = true);
 
   bool empty() const { return nearest_.empty(); }
+  /// How far a return may lie from where the scan's pose puts it: kSweepSkewM for a swept scan,
+  /// 0 for one taken at one instant.
+  float skew() const { return skew_m_; }
   /// The nearest return around the direction of `p` (sensor frame), or 0 where the direction's
   /// own bin holds no return or lies outside the elevations kept.
   float nearestAround(const Eigen::Vector3f& p) const;
 
 private:
   cv::Mat nearest_; // CV_32FC1, elevation rows x azimuth columns, 0 = nothing known
+  float skew_m_ = kSweepSkewM;
 };
 
 } // namespace msf

@@ -265,17 +265,16 @@ public:
   /// Free space that a LiDAR scan saw where the camera's depth says nothing or little
   /// (Config::scan_carving_m > 0): in blocks that hold a surface (a voxel with sdf < 0) within
   /// scan_carving_m of the LiDAR, each such voxel that lies in front of every return around its
-  /// direction by more than the truncation, a voxel and 0.6 m (a sweep's skew: scans are not
-  /// motion-compensated) takes a free-space update of `weight` (m^-2, the LiDAR's inverse
-  /// variance) times carving_weight, unless the camera carved it as much. Without
-  /// `camera_carved`, the camera did so in its whole view from T_world_cam; with it (per pixel,
-  /// the weight with which the frame's depth carved the pixel's ray, carving_weight included,
-  /// 0 where it has no depth; CV_32FC1 of the camera's size), only where all four pixels around
-  /// a voxel's projection carved at least the scan's weight. A crumb at a car's edge, where the
-  /// fusion's depth is uncertain and carves a little a frame, is cleared by the LiDAR that
-  /// made it. Conservative: only where the scan has returns, and only voxels behind a surface
-  /// (the ones that make it), so that a road seen at a grazing angle, whose returns lie around
-  /// it, is left alone.
+  /// direction by more than the truncation, a voxel and the scan's skew (ScanFreeSpace::skew: 0.6 m
+  /// for a sweep, which is not motion-compensated) takes a free-space update of `weight` (m^-2, the
+  /// LiDAR's inverse variance) times carving_weight, unless the camera carved it as much. Without
+  /// `camera_carved`, the camera did so in its whole view from T_world_cam; with it (per pixel, the
+  /// weight with which the frame's depth carved the pixel's ray, carving_weight included, 0 where
+  /// it has no depth; CV_32FC1 of the camera's size), only where all four pixels around a voxel's
+  /// projection carved at least the scan's weight. A crumb at a car's edge, where the fusion's
+  /// depth is uncertain and carves a little a frame, is cleared by the LiDAR that made it.
+  /// Conservative: only where the scan has returns, and only voxels behind a surface (the ones that
+  /// make it), so that a road seen at a grazing angle, whose returns lie around it, is left alone.
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
                      const cv::Mat& camera_carved = cv::Mat());
