@@ -62,14 +62,14 @@ struct Settings {
   msf::TsdfIntegrator::Config config;
   msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
   msf::RigAdaptationConfig rig;
-  bool carving = false, no_carving = false, print_config = false, instant_scans = false;
+  bool carving = false, no_carving = false, print_config = false;
 };
 
 /// What is integrated: the i-th depth cloud seen from the i-th pose, with the i-th scan when
 /// there are scans; `first_frame` is the line of the first pose in the poses file.
 struct Frames {
   std::vector<std::string> clouds, scans;
-  bool swept_scans = true; ///< the scans were swept by a spinning LiDAR (ScanFreeSpace's skew)
+  bool swept_scans = true; ///< the scans were swept by a spinning LiDAR (the rig's lidar.sweeping)
   msf::PoseList poses;
   std::size_t first_frame = 0;
 };
@@ -131,7 +131,7 @@ void selectScans(const msf::tool::CommandLine& cli, const Settings& settings, co
                                  " scans in '" + settings.scans_dir +
                                  "' (one per cloud, or the whole sequence's with -frames a:b)");
   frames.scans = scans;
-  frames.swept_scans = calibration.lidar.sweeping && !settings.instant_scans;
+  frames.swept_scans = calibration.lidar.sweeping;
 }
 
 /// The camera of a cloud: -calib's, on its canvas when the cloud is the image with a margin
@@ -258,7 +258,7 @@ int main(int argc, char** argv) {
              "picked by -frames as the poses are), in the LiDAR's frame: each "
              "clears what lies in front of its returns where the cloud's depth does not, within "
              "tsdf_integrator.scan_carving_m of the LiDAR, as msf_reconstruct does (needs -calib with the LiDAR's "
-             "extrinsics, and space carving)")
+             "extrinsics, and space carving; a -rig with lidar.sweeping false: scans of one instant, no sweep's skew)")
       .value("-calib", "PATH", settings.calib,
              "camera intrinsics (KITTI calib.txt, raw folder or YAML); default: recovered from each cloud's points "
              "and pixels")
@@ -293,9 +293,6 @@ int main(int argc, char** argv) {
             std::string("space carving on: voxels seen in front of the surface become free (default ") +
                 (config.space_carving ? "on" : "off") + "; tsdf_integrator.space_carving)")
       .flag("-no_carving", settings.no_carving, "space carving off")
-      .flag("-instant_scans", settings.instant_scans,
-            "-scans were each taken at one instant (a solid-state LiDAR, msf_synth's): no margin for a sweep's "
-            "skew (default: the rig's lidar.sweeping; a KITTI calibration's scans sweep)")
       .flag("-print_config", settings.print_config, "print the configuration in use");
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     return run(cli, positional, settings, argv[0]);

@@ -95,11 +95,10 @@ TEST_F(PipelineTest, TheChainOfToolsGivesTheEnginesMapByteForByte) {
       ASSERT_EQ(r.exit_code, 0) << step[0] << ": " << r.err;
     }
   }
-  // The synthetic scans are snapshots, as msf_reconstruct knows from the sequence (no sweep's skew).
-  const std::string instant = sequence.sweepingScans() ? "" : " -instant_scans";
-  auto r = msf::test::runTool("msf_integrate", fused + " -poses " + dataset() + "/poses/00.txt" + calib + " -scans " +
-                                                   sequence.directory() + "/velodyne" + instant + " -o " +
-                                                   out.file("volume.pcd"));
+  // The rig file says what calib.txt cannot: the synthetic scans are snapshots (no sweep's skew).
+  auto r = msf::test::runTool("msf_integrate", fused + " -poses " + dataset() + "/poses/00.txt" + " -rig " +
+                                                   sequence.directory() + "/rig.yaml -scans " + sequence.directory() +
+                                                   "/velodyne -o " + out.file("volume.pcd"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = msf::test::runTool("msf_reconstruct", dataset() + " -panels 0 -o " + out.file("run"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
