@@ -117,8 +117,9 @@ void bindMesh(py::module_& m) {
                            "A welded triangle mesh in metres, world frame: vertices (V, 3) float32, triangles (T, 3) "
                            "int32 (counter-clockwise seen from outside), colors (V, 3) uint8 RGB and, from "
                            "marching cubes, weights (V,) float32 (the lesser inverse variance of the two voxels "
-                           "that made each vertex; 0 where rays passed the one behind the surface "
-                           "component_release_passes frames in a row). The arrays are views of the mesh: no copy.")
+                           "that made each vertex; 0 where rays passed the one behind the surface since it last "
+                           "saw one: once, or component_release_passes frames in a row where a surface "
+                           "reappeared there after a pass). The arrays are views of the mesh: no copy.")
       .def(py::init(&fromArrays), py::arg("vertices"), py::arg("triangles"), py::arg("colors") = py::none(),
            "A mesh from arrays (copied): vertices (V, 3) float32, triangles (T, 3) int32, colors (V, 3) uint8.")
       .def_property_readonly("vertices", [](const py::handle& self) {

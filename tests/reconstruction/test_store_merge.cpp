@@ -141,24 +141,35 @@ TEST_F(StoreMergeTest, SharedVoxelsTakeTheWeightedMeanAndTheCap) {
                                               test::blocksOf(TsdfStore::open(stores_[1])),
                                               test::blocksOf(TsdfStore::open(stores_[2]))};
   StoreMerge::Stats stats;
-  std::size_t checked = 0;
+  std::size_t checked = 0, passed = 0, reappeared_shared = 0;
   for (const GridIndex& tile : merge.tiles())
     for (const TsdfBlock& b : merge.mergeTile(tile, &stats))
       for (int i = 0; i < TsdfBlock::kVoxels; i += 7) {
         double w = 0, sdf_w = 0;
         std::uint8_t signs = 0;
-        int holders = 0;
+        int holders = 0, passes = TsdfVoxel::kMaxPasses;
+        bool reappeared = false;
         for (const test::BlockMap& in : inputs)
           if (const auto it = in.find({b.index.x(), b.index.y(), b.index.z()}); it != in.end()) {
-            w += it->second.voxels[i].weight;
-            sdf_w += static_cast<double>(it->second.voxels[i].sdf) * it->second.voxels[i].weight;
+            const TsdfVoxel& v = it->second.voxels[i];
+            w += v.weight;
+            sdf_w += static_cast<double>(v.sdf) * v.weight;
             signs |= it->second.signs;
             ++holders;
+            if (v.weight > 0) {
+              passes = std::min(passes, v.passes());
+              reappeared |= v.reappeared();
+            }
           }
         EXPECT_EQ(b.signs, signs);
         if (!(w > 0) || holders < 2) // a block of one store is copied
           continue;
         EXPECT_FLOAT_EQ(b.voxels[i].sdf, static_cast<float>(sdf_w / w));
+        // The passes every drive's latest rays made; a surface that reappeared in any drive.
+        EXPECT_EQ(b.voxels[i].passes(), passes);
+        EXPECT_EQ(b.voxels[i].reappeared(), reappeared);
+        passed += passes > 0;
+        reappeared_shared += reappeared;
         const bool shared = std::count_if(inputs.begin(), inputs.end(), [&](const test::BlockMap& in) {
                               const auto it = in.find({b.index.x(), b.index.y(), b.index.z()});
                               return it != in.end() && it->second.voxels[i].weight > 0;
@@ -167,6 +178,8 @@ TEST_F(StoreMergeTest, SharedVoxelsTakeTheWeightedMeanAndTheCap) {
         ++checked;
       }
   EXPECT_GT(checked, 1000u);
+  EXPECT_GT(passed, 10u);
+  EXPECT_GT(reappeared_shared, 10u);
   EXPECT_GT(stats.voxels_capped, 0u);
   EXPECT_LE(stats.voxels_capped, stats.voxels_shared);
 }

@@ -309,7 +309,8 @@ TEST(StreamingMap, AStoreTileNoWriterMakesIsRefusedNamingTheBlock) {
       {put(written, first_voxel, std::nanf("")), at(1, "voxel 0 of sdf nan" + truncation)},
       {put(written, first_voxel, 0.75f), at(1, "voxel 0 of sdf 0.75" + truncation)},
       {put(written, first_voxel + 4, -1.f), at(1, "voxel 0 of weight -1, not a finite value >= 0")},
-      {put(written, first_voxel + 11, std::uint8_t{0x41}), at(1, "voxel 0 of flags 65, bits other than the passes'")},
+      {put(written, first_voxel + 11, std::uint8_t{0x41}),
+       at(1, "voxel 0 of flags 65, bits other than the passes' and reappeared's")},
       {put(written, header, outside), at(1, "index " + std::to_string(outside) + "_" + std::to_string(first[1]) + "_" +
                                              std::to_string(first[2]) + ", outside tile " + TsdfStore::tileName(tile))},
       {second_as_first, at(2, "index " + first_name + ", as an earlier block has")},

@@ -437,12 +437,44 @@ TEST(TsdfIntegrator, SpaceCarvingRemovesASurfaceSeenThrough) {
   }
 }
 
+namespace {
+
+/// Vertices of the old wall (z < 2.5 m) and of the new one, and of each those that keep a
+/// weight (a LiDAR hold), meshed with a given component_release_passes.
+struct HeldWalls {
+  std::size_t old_wall = 0, old_held = 0, new_wall = 0, new_held = 0;
+};
+HeldWalls heldWalls(const TsdfVolume& volume, int release_passes) {
+  MarchingCubes::Config whole;
+  whole.min_component_triangles = 0;
+  whole.component_release_passes = release_passes;
+  TriangleMesh mesh;
+  MarchingCubes(whole).extract(volume, mesh);
+  HeldWalls h;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const bool old = mesh.vertices[i].z() < 2.5f;
+    (old ? h.old_wall : h.new_wall) += 1;
+    (old ? h.old_held : h.new_held) += mesh.weights[i] > 0.f;
+  }
+  return h;
+}
+/// The walls held after one more frame of the wall at 3 m, meshed by default (2), with 1 and 0.
+struct Held {
+  HeldWalls by_default, one, never;
+};
+Held passAndMesh(TsdfIntegrator& integrator, DepthFrame& frame, const TsdfVolume& volume) {
+  frame.depth.setTo(3.0f);
+  integrator.integrate(frame, Eigen::Isometry3d::Identity());
+  return {heldWalls(volume, 2), heldWalls(volume, 1), heldWalls(volume, 0)};
+}
+
+} // namespace
+
 TEST(TsdfIntegrator, TheFramesThatPassedASurfaceSinceItWasSeenAreCounted) {
   // A wall at 2 m seen by twenty frames, then (it moved away) at 3 m: the old wall keeps most of
   // its weight, so the mesh keeps a surface there, but the rays of each later frame pass the
-  // voxels behind it. From component_release_passes such frames on, the mesh gives its
-  // vertices no weight (no LiDAR hold); the new wall's voxels are never passed. When the wall
-  // comes back, the count starts again.
+  // voxels behind it. No ray had passed them before, so from the first such frame on the mesh
+  // gives its vertices no weight (no LiDAR hold); the new wall's voxels are never passed.
   ASSERT_EQ(MarchingCubes::Config{}.component_release_passes, 2);
   TsdfVolume volume(0.05, 0.15);
   TsdfIntegrator::Config c;
@@ -455,53 +487,46 @@ TEST(TsdfIntegrator, TheFramesThatPassedASurfaceSinceItWasSeenAreCounted) {
     integrator.integrate(frame, Eigen::Isometry3d::Identity());
   auto voxelAt = [&](double z) { return volume.findVoxel(volume.voxelIndexOf(Eigen::Vector3d(0.0, 0.0, z))); };
   const double behind_old[] = {2.0, 2.05, 2.1}; // the voxels in front share no sub-block with a surface
-  for (const double z : behind_old)
+  for (const double z : behind_old) {
     ASSERT_EQ(voxelAt(z)->passes(), 0) << z;
-
-  // Mesh vertices of the old wall and of the new one, and of each those that keep a weight.
-  struct Held {
-    std::size_t old_wall = 0, old_held = 0, new_wall = 0, new_held = 0;
-  };
-  auto held = [&](int release_passes) {
-    MarchingCubes::Config whole;
-    whole.min_component_triangles = 0;
-    whole.component_release_passes = release_passes;
-    TriangleMesh mesh;
-    MarchingCubes(whole).extract(volume, mesh);
-    Held h;
-    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-      const bool old = mesh.vertices[i].z() < 2.5f;
-      (old ? h.old_wall : h.new_wall) += 1;
-      (old ? h.old_held : h.new_held) += mesh.weights[i] > 0.f;
-    }
-    return h;
-  };
-  frame.depth.setTo(3.0f);
-  for (int passes = 1; passes <= TsdfVoxel::kMaxPasses + 1; ++passes) {
-    integrator.integrate(frame, Eigen::Isometry3d::Identity());
-    for (const double z : behind_old) {
-      EXPECT_EQ(voxelAt(z)->passes(), std::min(passes, TsdfVoxel::kMaxPasses)) << z;
-      EXPECT_LT(voxelAt(z)->sdf, 0.15f) << z << ": the old wall is still a surface in the mean";
-    }
-    for (const double z : {2.95, 3.0, 3.05})
-      EXPECT_EQ(voxelAt(z)->passes(), 0) << z;
-    if (passes > 2)
-      continue; // then the mean is carved past the surface: no old wall to mesh
-    const Held by_default = held(2);
-    ASSERT_GT(by_default.old_wall, 100u);
-    ASSERT_GT(by_default.new_wall, 100u);
-    EXPECT_EQ(by_default.new_held, by_default.new_wall);
-    if (passes < 2)
-      EXPECT_EQ(by_default.old_held, by_default.old_wall) << passes << " frames passed";
-    else
-      EXPECT_EQ(by_default.old_held, 0u) << passes << " frames passed";
-    EXPECT_EQ(held(1).old_held, 0u);
-    EXPECT_EQ(held(0).old_held, held(0).old_wall) << "0: passes release nothing";
+    ASSERT_FALSE(voxelAt(z)->reappeared()) << z;
   }
+  const Held first_pass = passAndMesh(integrator, frame, volume);
+  for (const double z : behind_old)
+    EXPECT_EQ(voxelAt(z)->passes(), 1) << z;
+  EXPECT_EQ(first_pass.by_default.old_held, 0u) << "no ray had passed the old wall before: one pass releases it";
+  EXPECT_EQ(first_pass.never.old_held, first_pass.never.old_wall) << "0: passes release nothing";
+
+  // The wall comes back (a leaf in the wind): the count starts again, and a surface that
+  // reappeared after a pass needs component_release_passes passes in a row.
   frame.depth.setTo(2.0f);
   integrator.integrate(frame, Eigen::Isometry3d::Identity());
-  for (const double z : behind_old)
+  for (const double z : behind_old) {
     EXPECT_EQ(voxelAt(z)->passes(), 0) << z << ": seen again";
+    EXPECT_TRUE(voxelAt(z)->reappeared()) << z;
+  }
+  for (int passes = 1; passes <= TsdfVoxel::kMaxPasses + 1; ++passes) {
+    const Held h = passAndMesh(integrator, frame, volume);
+    for (const double z : behind_old) {
+      EXPECT_EQ(voxelAt(z)->passes(), std::min(passes, TsdfVoxel::kMaxPasses)) << z;
+      EXPECT_TRUE(voxelAt(z)->reappeared()) << z;
+    }
+    for (const double z : {2.95, 3.0, 3.05}) {
+      EXPECT_EQ(voxelAt(z)->passes(), 0) << z;
+      EXPECT_FALSE(voxelAt(z)->reappeared()) << z;
+    }
+    if (passes > 2)
+      continue; // then the mean is carved past the surface: no old wall to mesh
+    ASSERT_GT(h.by_default.old_wall, 100u);
+    ASSERT_GT(h.by_default.new_wall, 100u);
+    EXPECT_EQ(h.by_default.new_held, h.by_default.new_wall);
+    if (passes < 2)
+      EXPECT_EQ(h.by_default.old_held, h.by_default.old_wall) << passes << " frames passed";
+    else
+      EXPECT_EQ(h.by_default.old_held, 0u) << passes << " frames passed";
+    EXPECT_EQ(h.one.old_held, 0u);
+    EXPECT_EQ(h.never.old_held, h.never.old_wall) << "0: passes release nothing";
+  }
 }
 
 TEST(TsdfIntegrator, FreeSpaceWeighsTheFramesFreeSpaceWeight) {
@@ -758,8 +783,9 @@ TEST(TsdfIntegrator, AStoppedCarsPlaceLosesTheLidarsHoldOnceItLeftAndABollardKee
   // A car's back (a board) stands 12 m on while the camera drives towards it, then drives off;
   // a bollard stands beside the lane, and a wall 25 m on ends every ray. Six frames of precise
   // hits outweigh the few frames that then look through the car's place: its surface stays in
-  // the map, a small piece the LiDAR's weight holds. Once rays passed it twice it loses that
-  // hold; the bollard, a small piece too but hit by every frame, keeps it.
+  // the map, a small piece the LiDAR's weight holds. No ray reached the car's inside before, so
+  // once rays passed it, it loses that hold; the bollard, a small piece too but hit by every
+  // frame, keeps it.
   const PinholeCamera camera = test::kittiCamera();
   const Eigen::Vector3d board(0.0, 0.6, 12.0), board_half(0.9, 0.6, 0.1);
   const Eigen::Vector3d bollard(-2.0, 1.15, 14.0), bollard_half(0.1, 0.5, 0.1);
@@ -788,9 +814,10 @@ TEST(TsdfIntegrator, AStoppedCarsPlaceLosesTheLidarsHoldOnceItLeftAndABollardKee
     if (i < 6)
       scene.addBox(board, board_half);
     integrator.integrate(test::renderFrame(scene, camera, streetPose(i), 0.0), streetPose(i));
-    if (i == 6) { // passed once
-      const auto kept = meshed(2);
-      EXPECT_GT(kept[0], 50u) << "one frame's pass releases nothing";
+    if (i == 6) { // passed once: no ray had passed the car's inside before
+      const auto once = meshed(2);
+      EXPECT_EQ(once[0], 0u) << "one frame's pass releases the car's place";
+      EXPECT_GT(once[1], 50u) << "the bollard";
     }
   }
   const auto held = meshed(0), released = meshed(2);

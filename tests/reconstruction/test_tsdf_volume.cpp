@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <fstream>
+#include <string>
+#include <vector>
 
 using namespace msf;
 
@@ -114,7 +116,7 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
   EXPECT_DOUBLE_EQ(loaded.voxelSize(), 0.04);
   EXPECT_DOUBLE_EQ(loaded.truncation(), 0.12);
   EXPECT_EQ(loaded.numObservedVoxels(), volume.numObservedVoxels());
-  std::size_t compared = 0, passed = 0;
+  std::size_t compared = 0, passed = 0, reappeared = 0;
   for (const auto& block : volume.blocks())
     for (int z = 0; z < 8; ++z)
       for (int y = 0; y < 8; ++y)
@@ -130,11 +132,14 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
           EXPECT_EQ(a.g, b->g);
           EXPECT_EQ(a.b, b->b);
           EXPECT_EQ(a.passes(), b->passes());
+          EXPECT_EQ(a.reappeared(), b->reappeared());
           passed += a.passes() > 0;
+          reappeared += a.reappeared();
           ++compared;
         }
   EXPECT_EQ(compared, volume.numObservedVoxels());
   EXPECT_GT(passed, 100u); // the free space in front of the sphere
+  EXPECT_GT(reappeared, 10u); // its silhouette, passed from one side and seen from another
   const TsdfVoxel* some = nullptr;
   for (const auto& block : loaded.blocks())
     for (const auto& v : block->voxels)
@@ -159,7 +164,7 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
 }
 
 TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {
-  // Volumes saved before the passes field: their voxels load, none passed.
+  // Volumes saved before the passes and reappeared fields: their voxels load, none passed.
   test::TempDir dir;
   std::ofstream(dir.file("older.pcd")) << "# .PCD v0.7 - Point Cloud Data file format\n"
                                           "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
@@ -177,25 +182,56 @@ TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {
   EXPECT_EQ(a->b, 255);
   EXPECT_EQ(a->passes(), 0);
   EXPECT_EQ(b->passes(), 0);
+  EXPECT_FALSE(a->reappeared());
+  EXPECT_FALSE(b->reappeared());
 }
+
+namespace {
+
+/// A volume .pcd of one voxel at the origin, with the uint8 fields `names` of `values` after rgb.
+void writeOneVoxel(const std::string& path, const std::vector<std::string>& names, const std::vector<int>& values) {
+  std::string fields, sizes, types, counts, row;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    fields += " " + names[i];
+    sizes += " 1";
+    types += " U";
+    counts += " 1";
+    row += " " + std::to_string(values[i]);
+  }
+  std::ofstream(path) << "# .PCD v0.7 - Point Cloud Data file format\n"
+                         "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
+                         "VERSION 0.7\nFIELDS x y z sdf weight rgb" << fields << "\nSIZE 4 4 4 4 4 4" << sizes
+                      << "\nTYPE F F F F F U" << types << "\nCOUNT 1 1 1 1 1 1" << counts
+                      << "\nWIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n0 0 0 -0.05 10 4278190335"
+                      << row << "\n";
+}
+
+} // namespace
 
 TEST(TsdfVolume, AVoxelWithMorePassesThanItCountsIsRefused) {
   test::TempDir dir;
-  const auto write = [&](const std::string& name, int passes) {
-    std::ofstream(dir.file(name)) << "# .PCD v0.7 - Point Cloud Data file format\n"
-                                     "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
-                                     "VERSION 0.7\nFIELDS x y z sdf weight rgb passes\nSIZE 4 4 4 4 4 4 1\n"
-                                     "TYPE F F F F F U U\nCOUNT 1 1 1 1 1 1 1\nWIDTH 1\nHEIGHT 1\n"
-                                     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n"
-                                     "0 0 0 -0.05 10 4278190335 "
-                                  << passes << "\n";
-  };
+  const auto write = [&](const std::string& name, int passes) { writeOneVoxel(dir.file(name), {"passes"}, {passes}); };
   write("three.pcd", TsdfVoxel::kMaxPasses);
   EXPECT_EQ(TsdfVolume::load(dir.file("three.pcd")).findVoxel(GridIndex(0, 0, 0))->passes(), TsdfVoxel::kMaxPasses);
   write("nine.pcd", 9);
   const std::string error = test::errorOf([&] { TsdfVolume::load(dir.file("nine.pcd")); });
   EXPECT_NE(error.find("nine.pcd"), std::string::npos) << error;
   EXPECT_NE(error.find("voxel 0 has passes 9, more than the 3 a voxel counts"), std::string::npos) << error;
+}
+
+TEST(TsdfVolume, ReappearedIsLoadedAndAValueOtherThanZeroOrOneIsRefused) {
+  test::TempDir dir;
+  const auto write = [&](const std::string& name, int reappeared) {
+    writeOneVoxel(dir.file(name), {"passes", "reappeared"}, {1, reappeared});
+  };
+  write("one.pcd", 1);
+  const TsdfVolume one = TsdfVolume::load(dir.file("one.pcd"));
+  EXPECT_TRUE(one.findVoxel(GridIndex(0, 0, 0))->reappeared());
+  EXPECT_EQ(one.findVoxel(GridIndex(0, 0, 0))->passes(), 1);
+  write("two.pcd", 2);
+  const std::string error = test::errorOf([&] { TsdfVolume::load(dir.file("two.pcd")); });
+  EXPECT_NE(error.find("two.pcd"), std::string::npos) << error;
+  EXPECT_NE(error.find("voxel 0 has reappeared 2, not 0 or 1"), std::string::npos) << error;
 }
 
 TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {

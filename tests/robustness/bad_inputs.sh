@@ -151,6 +151,10 @@ open(f + "/passes9.pcd", "w").write("# .PCD v0.7 - Point Cloud Data file format\
     "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS x y z sdf weight rgb passes\n"
     "SIZE 4 4 4 4 4 4 1\nTYPE F F F F F U U\nCOUNT 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
     "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 0 -0.05 10 4278190335 1\n0.1 0 0 0.05 10 4278190335 9\n")
+open(f + "/reappeared2.pcd", "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
+    "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS x y z sdf weight rgb passes reappeared\n"
+    "SIZE 4 4 4 4 4 4 1 1\nTYPE F F F F F U U U\nCOUNT 1 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+    "POINTS 2\nDATA ascii\n0 0 0 -0.05 10 4278190335 1 1\n0.1 0 0 0.05 10 4278190335 0 2\n")
 inf_rows = depth_rows(lambda u, v: 5.0)
 inf_rows[3][2] = "inf"
 pcd(f + "/inf.pcd", inf_rows)
@@ -411,6 +415,8 @@ check "mesh: passes beyond what a voxel counts" 1 "marching_cubes.component_rele
   msf_mesh "$F/dense.pcd" o.ply -component_release_passes 4
 check "mesh: a volume whose voxel has more passes than a voxel counts" 1 "passes9.pcd': voxel 1 has passes 9, more than the 3 a voxel counts" -- \
   msf_mesh "$F/passes9.pcd" o.ply
+check "mesh: a voxel's reappeared not 0 or 1" 1 "reappeared2.pcd': voxel 1 has reappeared 2, not 0 or 1" -- \
+  msf_mesh "$F/reappeared2.pcd" o.ply
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \

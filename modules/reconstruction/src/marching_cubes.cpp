@@ -196,9 +196,11 @@ public:
     out_.vertices.push_back(p * voxel_size_);
     out_.colors.push_back(colour(t, a, b));
     // 0 next to an unseen corner (no evidence) and where rays passed the corner behind the
-    // surface release_passes times in a row since it last saw one: the surface was seen to go.
+    // surface since it last saw one: the surface was seen to go. Once is enough where no ray
+    // had passed it before; release_passes times in a row where a surface reappeared after one.
     const TsdfVoxel& behind = a.sdf < b.sdf ? a : b;
-    const bool released = release_passes_ > 0 && behind.passes() >= release_passes_;
+    const int passes_to_release = behind.reappeared() ? release_passes_ : std::min(release_passes_, 1);
+    const bool released = release_passes_ > 0 && behind.passes() >= passes_to_release;
     out_.weights.push_back(released ? 0.f : std::min(a.weight, b.weight));
     out_.keys.push_back(isInterior(px, py, pz, code)
                             ? MarchingCubes::kInterior

@@ -24,6 +24,7 @@ struct MergedBlock {
   struct Sums {
     double sdf_w = 0, w = 0, r_w = 0, g_w = 0, b_w = 0;
     int observers = 0, passes = TsdfVoxel::kMaxPasses;
+    bool reappeared = false;
   };
   TsdfBlock block;
   std::unique_ptr<std::array<Sums, TsdfBlock::kVoxels>> sums;
@@ -58,6 +59,7 @@ struct MergedBlock {
       s.b_w += v.b * w;
       ++s.observers;
       s.passes = std::min(s.passes, v.passes());
+      s.reappeared |= v.reappeared();
     }
   }
 
@@ -79,8 +81,10 @@ struct MergedBlock {
       v.r = static_cast<std::uint8_t>(s.r_w / s.w + 0.5);
       v.g = static_cast<std::uint8_t>(s.g_w / s.w + 0.5);
       v.b = static_cast<std::uint8_t>(s.b_w / s.w + 0.5);
-      // Drives have no order: the passes every drive's latest rays made.
-      v.flags = static_cast<std::uint8_t>(s.passes << TsdfVoxel::kPassesShift);
+      // Drives have no order: the passes every drive's latest rays made, and a surface that
+      // reappeared in any drive.
+      v.flags = static_cast<std::uint8_t>(s.passes << TsdfVoxel::kPassesShift |
+                                          (s.reappeared ? TsdfVoxel::kReappeared : 0));
     }
     sums.reset();
   }

@@ -40,7 +40,7 @@ constexpr std::size_t kBlockBytes = 3 * sizeof(std::int32_t) + 4 + TsdfBlock::kV
 
 /// What makes a voxel one no writer of ours makes (a file edited, damaged or of another
 /// program), or "" when there is nothing: an sdf beyond the truncation or not finite, a
-/// negative or non-finite weight, flags other than the passes (the integrator's own bits are
+/// negative or non-finite weight, flags other than the passes and reappeared (the integrator's own bits are
 /// zero on disk).
 std::string voxelFault(const TsdfVoxel& v, double truncation) {
   const double sdf_limit = truncation * (1.0 + 1e-6); // the integrator clamps in float
@@ -48,8 +48,8 @@ std::string voxelFault(const TsdfVoxel& v, double truncation) {
     return "sdf " + number(v.sdf) + ", not within the truncation " + number(truncation) + " m";
   if (!std::isfinite(v.weight) || v.weight < 0.f)
     return "weight " + number(v.weight) + ", not a finite value >= 0";
-  if (v.flags & ~TsdfVoxel::kPassesMask)
-    return "flags " + std::to_string(v.flags) + ", bits other than the passes'";
+  if (v.flags & ~TsdfVoxel::kSavedFlags)
+    return "flags " + std::to_string(v.flags) + ", bits other than the passes' and reappeared's";
   return "";
 }
 
@@ -154,7 +154,7 @@ void TsdfStore::writeTile(const GridIndex& tile, const std::vector<const TsdfBlo
       out.write(reinterpret_cast<const char*>(bits), sizeof(bits));
       voxels = block->voxels;
       for (TsdfVoxel& v : voxels)
-        v.flags &= TsdfVoxel::kPassesMask;
+        v.flags &= TsdfVoxel::kSavedFlags;
       out.write(reinterpret_cast<const char*>(voxels.data()), sizeof(voxels));
     }
   });

@@ -337,6 +337,7 @@ void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) co
           p.b = voxel.b;
           p.a = 255;
           p.passes = static_cast<std::uint8_t>(voxel.passes());
+          p.reappeared = voxel.reappeared() ? 1 : 0;
           cloud.push_back(p);
         }
   }
@@ -356,6 +357,9 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     if (p.passes > TsdfVoxel::kMaxPasses) // no writer makes it: a file edited or of another program
       throw InvalidInputError("voxel " + std::to_string(i) + " has passes " + std::to_string(p.passes) +
                               ", more than the " + std::to_string(TsdfVoxel::kMaxPasses) + " a voxel counts");
+    if (p.reappeared > 1)
+      throw InvalidInputError("voxel " + std::to_string(i) + " has reappeared " + std::to_string(p.reappeared) +
+                              ", not 0 or 1");
     const Eigen::Vector3d q(p.x, p.y, p.z);
     const GridIndex v = voxelIndexOf(q);
     if (((q / voxel_size_) - v.cast<double>()).cwiseAbs().maxCoeff() > tolerance)
@@ -370,7 +374,8 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
     voxel.r = p.r;
     voxel.g = p.g;
     voxel.b = p.b;
-    voxel.flags = static_cast<std::uint8_t>(p.passes << TsdfVoxel::kPassesShift);
+    voxel.flags =
+        static_cast<std::uint8_t>(p.passes << TsdfVoxel::kPassesShift | (p.reappeared ? TsdfVoxel::kReappeared : 0));
   }
   const std::uint64_t stamp = beginGeneration();
   for (auto& block : blocks_) {
@@ -433,6 +438,8 @@ TsdfVolume TsdfVolume::load(const std::string& path, double voxel_size_m, double
   loadCloudBlob(path, blob);
   if (pcl::getFieldIndex(blob, "passes") < 0)
     addZeroField(blob, "passes"); // written before the field: no voxel known to be passed
+  if (pcl::getFieldIndex(blob, "reappeared") < 0)
+    addZeroField(blob, "reappeared"); // likewise: none known to have reappeared
   pcl::PointCloud<PointTsdf> cloud;
   fromCloudBlob(std::move(blob), cloud, path);
   try {

@@ -13,7 +13,8 @@
 namespace msf::detail {
 
 /// Running weighted mean of one observation into a voxel (the portable kernel's, and the scan's);
-/// `passed`: its ray passed through the voxel, which TsdfVoxel::passes counts (else resets).
+/// `passed`: its ray passed through the voxel, which TsdfVoxel::passes counts (else resets, and
+/// a voxel passed before has TsdfVoxel::reappeared).
 inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t* bgr, float max_weight, float trunc,
                         bool passed) {
   const float total = voxel.weight + w;
@@ -27,7 +28,9 @@ inline void updateVoxel(TsdfVoxel& voxel, float sdf, float w, const std::uint8_t
   }
   voxel.weight = std::min(total, max_weight);
   const int passes = passed ? std::min(voxel.passes() + 1, TsdfVoxel::kMaxPasses) : 0;
-  voxel.flags = static_cast<std::uint8_t>((voxel.flags & ~TsdfVoxel::kPassesMask) | passes << TsdfVoxel::kPassesShift);
+  const std::uint8_t reappeared = !passed && voxel.passes() > 0 ? TsdfVoxel::kReappeared : 0;
+  voxel.flags = static_cast<std::uint8_t>((voxel.flags & ~TsdfVoxel::kPassesMask) | passes << TsdfVoxel::kPassesShift |
+                                          reappeared);
 }
 
 /// What the update reads of a frame and of the integrator's settings.

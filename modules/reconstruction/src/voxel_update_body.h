@@ -138,13 +138,15 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
       if (V::bits(coloured))
         rgbf = blendColours<V>(f, c, k, rgbf, coloured, old_weight, w, inv);
     }
-    // updateVoxel's passes of passedThrough(quad_min - z): the flags are the word's top byte.
+    // updateVoxel's passes and reappeared of passedThrough(quad_min - z): the flags are the word's top byte.
     const F ahead = V::sub(quad_min, z);
     const M passed = V::and_(V::gt(ahead, trunc), V::gt(V::mul(V::mul(ahead, ahead), pixel_weight), pass_sigmas2));
     const I passes = V::andi(V::srli(rgbf, 24 + TsdfVoxel::kPassesShift), max_passes);
     const I cleared = V::andi(rgbf, passes_cleared);
     const I counted = V::selecti(V::eqi(passes, max_passes), passes, V::addi(passes, one_i));
-    rgbf = V::selecti(passed, V::ori(cleared, V::slli(counted, 24 + TsdfVoxel::kPassesShift)), cleared);
+    const I reappeared = V::ori(cleared, V::set1i(std::int32_t{TsdfVoxel::kReappeared} << 24));
+    rgbf = V::selecti(passed, V::ori(cleared, V::slli(counted, 24 + TsdfVoxel::kPassesShift)),
+                      V::selecti(V::eqi(passes, zero_i), cleared, reappeared));
     V::scatteri(voxel_colour, at_voxel, keep, rgbf);
     V::scatter(voxel_sdf, at_voxel, keep, new_sdf);
     V::scatter(voxel_weight, at_voxel, keep, V::min(max_weight, total)); // std::min(total, max_weight)

@@ -20,9 +20,10 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;          ///< metres, world frame
   std::vector<std::array<std::uint8_t, 3>> colors; ///< r, g, b per vertex
   /// Per vertex, the lesser weight (m^-2) of the two voxels whose zero crossing made it: how
-  /// precisely the surface there is known; 0 where rays passed the one behind the surface
-  /// MarchingCubes::Config::component_release_passes times in a row since it last saw one
-  /// (TsdfVoxel::passes). Filled by MarchingCubes; empty for other meshes.
+  /// precisely the surface there is known; 0 where rays passed the one behind the surface since
+  /// it last saw one (TsdfVoxel::passes): once, or MarchingCubes::Config::component_release_passes
+  /// times in a row where a surface reappeared there after a pass (TsdfVoxel::reappeared).
+  /// Filled by MarchingCubes; empty for other meshes.
   std::vector<float> weights;
   std::vector<std::array<std::uint32_t, 3>> triangles; ///< counter-clockwise seen from outside (sdf > 0)
 
@@ -66,9 +67,11 @@ public:
     /// applied to a streamed map, whose tiles are meshed apart.
     int min_component_triangles = 2000;
     float component_keep_weight = 300.f;
-    /// A vertex whose voxel behind the surface rays passed this many times in a row since it last
-    /// saw a surface holds no piece: where a car stood. Two, as vegetation's gaps let a single
-    /// frame's rays through a leaf the LiDAR hit, a car's old place every frame after it left.
+    /// A vertex whose voxel behind the surface rays passed since it last saw a surface holds no
+    /// piece: where a car stood. Once is enough where no ray had passed the voxel before (a car's
+    /// back, whose inside no ray reached); where a surface reappeared after a pass, this many
+    /// times in a row. Two, as vegetation's gaps let a single frame's rays through a leaf the
+    /// LiDAR hit, a car's old place every frame after it left.
     int component_release_passes = 2;
 
     template <class Keys>
@@ -84,7 +87,8 @@ public:
       k("component_keep_weight", component_keep_weight, atLeast(0),
         "a piece with a vertex of at least this weight is kept whatever its size, m^-2 (300: sigma 6 cm)");
       k("component_release_passes", component_release_passes, between(0, TsdfVoxel::kMaxPasses),
-        "a vertex holds no piece once rays passed the voxel behind it this many frames in a row (0: never)");
+        "a vertex holds no piece once rays passed the voxel behind it this many frames in a row, or once where "
+        "no surface reappeared there after a pass (0: never)");
     }
     /// Throws ConfigError naming the key of a value out of range.
     void validate() const;

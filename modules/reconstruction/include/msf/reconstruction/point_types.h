@@ -6,7 +6,7 @@
 namespace msf {
 
 /// One observed voxel of a TsdfVolume as a point: its centre (x y z, metres), sdf (metres),
-/// weight, colour (rgb) and passes (TsdfVoxel::passes). A .pcd of these is the
+/// weight, colour (rgb), passes and reappeared (TsdfVoxel's, 0 or 1). A .pcd of these is the
 /// volume on disk (TsdfVolume::save), so tools chain and pcl_viewer shows it (coloured by rgb,
 /// or by the sdf field).
 struct EIGEN_ALIGN16 PointTsdf {
@@ -15,6 +15,7 @@ struct EIGEN_ALIGN16 PointTsdf {
   float weight;
   PCL_ADD_RGB;
   std::uint8_t passes;
+  std::uint8_t reappeared;
   PCL_MAKE_ALIGNED_OPERATOR_NEW
 };
 
@@ -22,4 +23,5 @@ struct EIGEN_ALIGN16 PointTsdf {
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(msf::PointTsdf,
                                   (float, x, x)(float, y, y)(float, z, z)(float, sdf, sdf)(float, weight, weight)(
-                                      float, rgb, rgb)(std::uint8_t, passes, passes))
+                                      float, rgb, rgb)(std::uint8_t, passes, passes)(
+                                      std::uint8_t, reappeared, reappeared))

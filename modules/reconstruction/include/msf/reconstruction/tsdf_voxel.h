@@ -17,15 +17,21 @@ struct TsdfVoxel {
   static constexpr int kPassesShift = 1;
   static constexpr int kMaxPasses = 3;
   static constexpr std::uint8_t kPassesMask = kMaxPasses << kPassesShift;
+  /// flags' bit 3: reappeared(), a surface was seen in the voxel after rays had passed it (the
+  /// gaps of a bush, a door): one pass more does not show that it went, as it does where no ray
+  /// had passed before (a car's back, whose inside no ray reached).
+  static constexpr std::uint8_t kReappeared = 1 << 3;
+  static constexpr std::uint8_t kSavedFlags = kPassesMask | kReappeared;
 
   float sdf = 0.f;
   float weight = 0.f;
   std::uint8_t r = 0, g = 0, b = 0;
-  /// The passes, and bits internal to the integrator (its regularization mask, 0 between frames)
+  /// The passes, reappeared, and bits internal to the integrator (its regularization mask, 0 between frames)
   std::uint8_t flags = 0;
 
   bool observed() const { return weight > 0.f; }
   int passes() const { return (flags & kPassesMask) >> kPassesShift; }
+  bool reappeared() const { return flags & kReappeared; }
 };
 
 static_assert(sizeof(TsdfVoxel) == 12, "TsdfVoxel is meant to stay 12 bytes");
