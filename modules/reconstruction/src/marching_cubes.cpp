@@ -199,8 +199,7 @@ public:
     // surface since it last saw one: the surface was seen to go. Once is enough where no ray
     // had passed it before; release_passes times in a row where a surface reappeared after one.
     const TsdfVoxel& behind = a.sdf < b.sdf ? a : b;
-    const int passes_to_release = behind.reappeared() ? release_passes_ : std::min(release_passes_, 1);
-    const bool released = release_passes_ > 0 && behind.passes() >= passes_to_release;
+    const bool released = release_passes_ > 0 && behind.passes() >= (behind.reappeared() ? release_passes_ : 1);
     out_.weights.push_back(released ? 0.f : std::min(a.weight, b.weight));
     out_.keys.push_back(isInterior(px, py, pz, code)
                             ? MarchingCubes::kInterior

@@ -95,6 +95,7 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
   const F pass_sigmas2 = V::set1(f.pass_sigmas2);
   const I max_passes = V::set1i(TsdfVoxel::kMaxPasses);
   const I passes_cleared = V::set1i(~(std::int32_t{TsdfVoxel::kPassesMask} << 24));
+  const I reappeared_bit = V::set1i(std::int32_t{TsdfVoxel::kReappeared} << 24);
   const I one_i = V::set1i(1), zero_i = V::set1i(0);
   VoxelUpdateResult out;
   I negative = zero_i;
@@ -144,9 +145,9 @@ VoxelUpdateResult updateBlock(const VoxelUpdateFrame& f, const VoxelCandidates& 
     const I passes = V::andi(V::srli(rgbf, 24 + TsdfVoxel::kPassesShift), max_passes);
     const I cleared = V::andi(rgbf, passes_cleared);
     const I counted = V::selecti(V::eqi(passes, max_passes), passes, V::addi(passes, one_i));
-    const I reappeared = V::ori(cleared, V::set1i(std::int32_t{TsdfVoxel::kReappeared} << 24));
+    const I reappeared = V::selecti(V::eqi(passes, zero_i), zero_i, reappeared_bit); // seen after a pass
     rgbf = V::selecti(passed, V::ori(cleared, V::slli(counted, 24 + TsdfVoxel::kPassesShift)),
-                      V::selecti(V::eqi(passes, zero_i), cleared, reappeared));
+                      V::ori(cleared, reappeared));
     V::scatteri(voxel_colour, at_voxel, keep, rgbf);
     V::scatter(voxel_sdf, at_voxel, keep, new_sdf);
     V::scatter(voxel_weight, at_voxel, keep, V::min(max_weight, total)); // std::min(total, max_weight)
