@@ -40,6 +40,16 @@ function(msf_set_warnings target)
   endif()
 endfunction()
 
+# msf_set_source_options(<file>... OPTIONS ...): files compiled with options of their own, and
+# without the precompiled headers, whose inline functions would keep the flags they were
+# compiled with (a file's floating-point options would not reach them).
+function(msf_set_source_options)
+  cmake_parse_arguments(ARG "" "" "OPTIONS" ${ARGN})
+  set_source_files_properties(${ARG_UNPARSED_ARGUMENTS} PROPERTIES COMPILE_OPTIONS "${ARG_OPTIONS}"
+                              SKIP_PRECOMPILE_HEADERS ON)
+endfunction()
+
+# Call it after target_link_libraries: whether the target links GoogleTest picks its headers.
 function(msf_set_compiler_options target)
   msf_set_warnings(${target})
   if(CMAKE_DISABLE_PRECOMPILE_HEADERS)
