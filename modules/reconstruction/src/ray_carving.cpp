@@ -154,12 +154,14 @@ void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isom
   if (rect.empty() || !(w > 0.f))
     return;
   // Each far pixel's distance to the nearest pixel that is not: a voxel is carved only where its
-  // footprint (half its diagonal, in pixels at its depth) lies wholly within the far rays.
-  cv::distanceTransform(far_rays_, far_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  // footprint (half its diagonal, in pixels at its depth) lies wholly within the far rays. Found
+  // within the far rays' box grown by a pixel: no pixel beyond that ring of near ones is nearer.
+  const cv::Rect around = (rect - cv::Point(1, 1) + cv::Size(2, 2)) & cv::Rect(cv::Point(), far_rays_.size());
+  cv::distanceTransform(far_rays_(around), far_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   const float reach_px = 0.5f * std::sqrt(3.f) * static_cast<float>(volume_.voxelSize()) *
                          static_cast<float>(std::max(frame.camera.fx, frame.camera.fy));
   const auto withinFarRays = [&](int u, int v, float z) {
-    return far_distance_.at<float>(v, u) > reach_px / z + kSilhouetteSlackPx ? w : 0.f;
+    return far_distance_.at<float>(v - around.y, u - around.x) > reach_px / z + kSilhouetteSlackPx ? w : 0.f;
   };
   const float bound = range - static_cast<float>(volume_.truncation() + volume_.voxelSize());
   carveAlongRays(volume_, far_rays_, rect, frame.camera, T_world_cam, static_cast<float>(config_.min_depth_m), bound,
