@@ -49,6 +49,43 @@ function(msf_set_source_options)
                               SKIP_PRECOMPILE_HEADERS ON)
 endfunction()
 
+# msf_check_source_options(): fails the configuration where a file of a target under the project
+# has compile options of its own and still reuses the precompiled headers (options set with a bare
+# set_source_files_properties rather than msf_set_source_options). Call it once every target exists.
+function(msf_check_source_options)
+  if(CMAKE_DISABLE_PRECOMPILE_HEADERS)
+    return()
+  endif()
+  set(directories ${PROJECT_SOURCE_DIR})
+  while(directories)
+    list(POP_FRONT directories directory)
+    get_property(subdirectories DIRECTORY ${directory} PROPERTY SUBDIRECTORIES)
+    list(APPEND directories ${subdirectories})
+    get_property(targets DIRECTORY ${directory} PROPERTY BUILDSYSTEM_TARGETS)
+    foreach(target IN LISTS targets)
+      get_target_property(sources ${target} SOURCES)
+      get_target_property(source_dir ${target} SOURCE_DIR)
+      if(NOT sources)
+        continue()
+      endif()
+      foreach(source IN LISTS sources)
+        if(source MATCHES "^\\$<")
+          continue() # a generator expression: another target's objects
+        endif()
+        get_filename_component(source ${source} ABSOLUTE BASE_DIR ${source_dir})
+        get_source_file_property(options ${source} TARGET_DIRECTORY ${target} COMPILE_OPTIONS)
+        get_source_file_property(flags ${source} TARGET_DIRECTORY ${target} COMPILE_FLAGS)
+        get_source_file_property(skips ${source} TARGET_DIRECTORY ${target} SKIP_PRECOMPILE_HEADERS)
+        if((options OR flags) AND NOT skips)
+          message(FATAL_ERROR "${source} (target ${target}) has compile options of its own but reuses the "
+                              "precompiled headers, whose inline functions keep theirs: set them with "
+                              "msf_set_source_options (cmake/CompilerOptions.cmake)")
+        endif()
+      endforeach()
+    endforeach()
+  endwhile()
+endfunction()
+
 # Call it after target_link_libraries: whether the target links GoogleTest picks its headers.
 function(msf_set_compiler_options target)
   msf_set_warnings(${target})
