@@ -44,30 +44,38 @@ cv::Rect sphereFootprint(const Eigen::Vector3f& c, float r, const PinholeCamera&
   return cv::Rect(first, last) & image;
 }
 
+/// A block test of carveAlongRays that keeps every block whose footprint holds a ray.
+constexpr auto kAnyBlock = [](const cv::Rect&, float) { return true; };
+
 /// Carves the voxels behind a surface (sdf < 0) whose centres project into a non-zero pixel of
 /// `rays` (CV_8UC1 of `camera`'s size) within `rect` of it, from min_d to max_d of depth: a
-/// free-space update of weight freeWeight(u, v, z) each (none where it is 0).
-template <class FreeWeight>
+/// free-space update of weight freeWeight(u, v, z) each (none where it is 0). Only the blocks
+/// whose footprint holds such a pixel are walked, and of them those for which
+/// mayCarve(footprint, farthest depth) holds: freeWeight is 0 at every pixel of a block it rules out.
+template <class FreeWeight, class BlockTest>
 void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rect, const PinholeCamera& camera,
                     const Eigen::Isometry3d& T_world_cam, float min_d, float max_d, float max_weight,
-                    FreeWeight&& freeWeight) {
+                    FreeWeight&& freeWeight, BlockTest&& mayCarve) {
   const float vs = static_cast<float>(volume.voxelSize()), trunc = static_cast<float>(volume.truncation());
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   const float radius = 0.5f * std::sqrt(3.f) * kSide * vs;
-  // Only the blocks whose footprint holds a pixel of `rays` (counted on its integral image).
+  // The rays in a footprint are counted on their integral image.
   cv::Mat count;
   cv::integral(rays(rect) != 0, count, CV_32S);
   std::vector<TsdfBlock*> blocks;
   for (const auto& block : volume.blocks()) {
     if (!block->negative_subblocks)
       continue; // nothing behind a surface: nothing to carve
-    const Eigen::Vector3f centre = (block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs;
-    const cv::Rect seen = (sphereFootprint(T_cam_world * centre, radius, camera, min_d, max_d) & rect) - rect.tl();
-    if (seen.empty())
+    const Eigen::Vector3f centre =
+        T_cam_world * ((block->origin().cast<float>() + Eigen::Vector3f::Constant(3.5f)) * vs);
+    const cv::Rect footprint = sphereFootprint(centre, radius, camera, min_d, max_d) & rect;
+    if (footprint.empty())
       continue;
+    const cv::Rect seen = footprint - rect.tl();
     const int bottom = seen.y + seen.height, right = seen.x + seen.width;
     if (count.at<int>(bottom, right) - count.at<int>(seen.y, right) - count.at<int>(bottom, seen.x) +
-            count.at<int>(seen.y, seen.x) > 0)
+                count.at<int>(seen.y, seen.x) > 0 &&
+        mayCarve(footprint, std::min(centre.z() + radius, max_d)))
       blocks.push_back(block);
   }
   const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
@@ -91,6 +99,34 @@ void carveAlongRays(TsdfVolume& volume, const cv::Mat& rays, const cv::Rect& rec
                                    return true;
                                  });
   });
+}
+
+constexpr int kDistanceTile = 16;
+
+/// The largest value of each kDistanceTile-pixel square tile of `values` (CV_32FC1, >= 0).
+void tileMaxima(const cv::Mat& values, cv::Mat& maxima) {
+  maxima.create((values.rows + kDistanceTile - 1) / kDistanceTile, (values.cols + kDistanceTile - 1) / kDistanceTile,
+                CV_32FC1);
+  maxima.setTo(0.f);
+  for (int v = 0; v < values.rows; ++v) {
+    const float* row = values.ptr<float>(v);
+    float* tiles = maxima.ptr<float>(v / kDistanceTile);
+    for (int t = 0; t < maxima.cols; ++t)
+      for (int u = t * kDistanceTile; u < std::min(values.cols, (t + 1) * kDistanceTile); ++u)
+        tiles[t] = std::max(tiles[t], row[u]);
+  }
+}
+
+/// The largest of `maxima`'s tiles that `rect` (pixels of the image they were taken of) overlaps:
+/// no value within `rect` is larger.
+float largestOver(const cv::Mat& maxima, const cv::Rect& rect) {
+  float largest = 0.f;
+  const int last_row = std::min(maxima.rows - 1, (rect.y + rect.height - 1) / kDistanceTile);
+  const int last_col = std::min(maxima.cols - 1, (rect.x + rect.width - 1) / kDistanceTile);
+  for (int r = rect.y / kDistanceTile; r <= last_row; ++r)
+    for (int c = rect.x / kDistanceTile; c <= last_col; ++c)
+      largest = std::max(largest, maxima.at<float>(r, c));
+  return largest;
 }
 
 /// The pixels whose depth lies beyond `range` by more than `sigmas` of its sigma (1/sqrt of its
@@ -135,7 +171,7 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
     return free ? w : 0.f;
   };
   carveAlongRays(volume_, sky, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),
-                 static_cast<float>(farthestDepth()), config_.max_weight, inFrontOfWall);
+                 static_cast<float>(farthestDepth()), config_.max_weight, inFrontOfWall, kAnyBlock);
 }
 
 void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, float weight) {
@@ -163,9 +199,14 @@ void TsdfIntegrator::carveBeyondRange(const DepthFrame& frame, const Eigen::Isom
   const auto withinFarRays = [&](int u, int v, float z) {
     return far_distance_.at<float>(v - around.y, u - around.x) > reach_px / z + kSilhouetteSlackPx ? w : 0.f;
   };
+  // Most blocks the far rays pass lie near their edge, too near for a voxel's footprint to fit.
+  tileMaxima(far_distance_, far_tile_max_);
+  const auto mayFit = [&](const cv::Rect& footprint, float farthest) {
+    return largestOver(far_tile_max_, footprint - around.tl()) > reach_px / farthest + kSilhouetteSlackPx;
+  };
   const float bound = range - static_cast<float>(volume_.truncation() + volume_.voxelSize());
   carveAlongRays(volume_, far_rays_, rect, frame.camera, T_world_cam, static_cast<float>(config_.min_depth_m), bound,
-                 config_.max_weight, withinFarRays);
+                 config_.max_weight, withinFarRays, mayFit);
 }
 
 } // namespace msf

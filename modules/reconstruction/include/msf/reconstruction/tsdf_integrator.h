@@ -421,7 +421,9 @@ private:
   SweepSchedule::ConstPtr sweep_schedule_;
   cv::Mat weight_;       // pixelWeights of the frame: its weight image, or computed_weight_
   cv::Mat computed_weight_;
-  cv::Mat far_rays_, far_distance_; // carveBeyondRange: the pixels whose rays reach beyond the range
+  // carveBeyondRange: the pixels whose rays reach beyond the range, their distances to the nearest
+  // that does not, and the largest distance in each tile of them
+  cv::Mat far_rays_, far_distance_, far_tile_max_;
 };
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.
