@@ -90,6 +90,12 @@ void bindCalibration(py::module_& m) {
       .def_property_readonly("has_velodyne", [](const Calibration& c) { return c.has_velodyne; },
                              "False for a calibration of the cameras only (no LiDAR extrinsics).")
       .def_property_readonly("source", [](const Calibration& c) { return c.source; }, "Where it was read from.")
+      .def_property(
+          "lidar_sweeping", [](const Calibration& c) { return c.lidar.sweeping; },
+          [](Calibration& c, bool sweeping) { c.lidar.sweeping = sweeping; },
+          "True for a spinning LiDAR, each scan swept over its period (the odometry deskews it, the scan's "
+          "carving allows for its skew); False for scans taken at one instant. A rig file's lidar.sweeping; "
+          "False for a synthetic sequence's.")
       .def("K", &Calibration::K, py::arg("camera") = 0, "The 3x3 intrinsic matrix of a camera (0..3).")
       .def("baseline", &Calibration::baseline, py::arg("camera_a") = 0, py::arg("camera_b") = 1,
            "Distance between two optical centres in metres.")

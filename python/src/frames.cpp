@@ -139,7 +139,8 @@ void bindSources(py::module_& m) {
       .def("load", &load, py::arg("index"), py::arg("with_color") = true,
            "Frame `index`; with_color=False skips reading the colour camera.")
       .def("__iter__", [](const py::object& self) { return FrameIterator{self, 0}; })
-      .def_property_readonly("calibration", &FrameSource::calibration)
+      .def_property_readonly("calibration", [](const FrameSource& s) { return s.calibration(); },
+                             "A copy of the source's rig: changing it leaves the source as it is.")
       .def_property_readonly("poses", &posesOf, "(N, 4, 4) float64 T_world_cam0 per frame, or None.")
       .def("frame_name", &FrameSource::frameName, py::arg("index"))
       .def("__repr__", [](const FrameSource& s) {

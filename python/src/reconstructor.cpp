@@ -46,11 +46,10 @@ Reconstructor::PoseMode parsePoseMode(const std::string& text) {
 }
 
 std::unique_ptr<Engine> makeEngine(const Calibration& rig, const PipelineConfig& config, const std::string& poses,
-                                   int threads, bool sweeping_scans, const std::string& stream_directory) {
+                                   int threads, const std::string& stream_directory) {
   Reconstructor::Options options;
   options.poses = parsePoseMode(poses);
   options.threads = threads;
-  options.sweeping_scans = sweeping_scans;
   options.stream_directory = stream_directory;
   py::gil_scoped_release release;
   return std::make_unique<Engine>(rig, config, options);
@@ -214,15 +213,13 @@ void bindReconstructor(py::module_& m) {
                      "LiDAR odometry's), the regularized TSDF volume and its mesh. The same classes and "
                      "settings as msf_reconstruct, so the same depth and mesh.")
       .def(py::init(&makeEngine), py::arg("calibration"), py::arg("config") = PipelineConfig(),
-           py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("sweeping_scans") = true,
-           py::arg("stream_directory") = "",
+           py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("stream_directory") = "",
            "poses: auto (the frame's own pose; LiDAR odometry when the first frame has none), given (a frame "
            "without one is an error), odometry (always) or refine (the frames' own poses, a GPS/INS's, as the "
            "prior the LiDAR odometry refines). threads: of this engine's parallel loops, 0 = all "
-           "cores. sweeping_scans: the scans are swept over their period (a spinning LiDAR; the odometry "
-           "deskews them, the scan's carving allows for their skew). stream_directory: where a streamed map "
-           "(streaming.active_radius_m > 0) writes its "
-           "tiles. Raises ConfigError for an invalid config, CalibrationError for a rig without an image size.")
+           "cores. How the scans are taken is the rig's (calibration.lidar_sweeping). stream_directory: where "
+           "a streamed map (streaming.active_radius_m > 0) writes its tiles. Raises ConfigError for an invalid "
+           "config, CalibrationError for a rig without an image size.")
       .def("add_frame", &addFrame, py::arg("frame"),
            "A Frame's depth (steps 1-4), its pose and its integration into the map (step 5): its FrameResult, "
            "whose depth, weight and pose are the fused depth, its inverse variance and the pose used.")

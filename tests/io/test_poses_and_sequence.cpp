@@ -81,6 +81,7 @@ TEST(Sequence, OdometryLayout) {
   EXPECT_EQ(seq.layout(), msf::Sequence::Layout::Odometry);
   ASSERT_EQ(seq.size(), 10u);
   EXPECT_TRUE(seq.hasPoses());
+  EXPECT_TRUE(seq.calibration().lidar.sweeping); // KITTI's Velodyne spins
   EXPECT_EQ(seq.frameName(3), "000003");
   const msf::Frame f = seq.load(3);
   EXPECT_GT(f.scan->size(), 100000u);
@@ -103,6 +104,7 @@ TEST(Sequence, RawLayout) {
   EXPECT_EQ(seq.layout(), msf::Sequence::Layout::Raw);
   ASSERT_EQ(seq.size(), 5u);
   EXPECT_TRUE(seq.hasPoses());
+  EXPECT_TRUE(seq.calibration().lidar.sweeping);
   const msf::Frame f = seq.load(1, false);
   EXPECT_EQ(f.left.size(), cv::Size(1242, 375));
   EXPECT_TRUE(f.color.empty());

@@ -24,15 +24,7 @@ std::pair<std::string, std::string> savedMap(msf::Reconstructor& engine, const m
   return {readFile(dir.file("mesh.ply")), readFile(dir.file("volume.pcd"))};
 }
 
-/// Frames 0-2 of the test street fed one call each into an engine of `options`.
-/// The engine's options for a sequence's frames, as msf_reconstruct's run() takes them from it:
-/// the synthetic scans are snapshots, with no sweep's skew.
-msf::Reconstructor::Options optionsOf(const msf::Sequence& sequence) {
-  msf::Reconstructor::Options options;
-  options.sweeping_scans = sequence.sweepingScans();
-  return options;
-}
-
+/// Frames 0-2 of the test street fed one call each into `engine`.
 void feed(msf::Reconstructor& engine, const msf::Sequence& sequence) {
   for (std::size_t i = 0; i < 3; ++i) {
     const msf::FrameResult r = engine.addFrame(sequence.load(i));
@@ -49,7 +41,7 @@ TEST_F(PipelineTest, TheEngineFedFrameByFrameGivesTheToolsMapByteForByte) {
   const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:2 -panels 0 -o " + dir.file("out"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const msf::Sequence sequence(dataset());
-  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{}, optionsOf(sequence));
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
   feed(engine, sequence);
   msf::test::TempDir mine;
   const auto [mesh, volume] = savedMap(engine, mine);
@@ -65,16 +57,33 @@ TEST_F(PipelineTest, WithEarlierScansTheEngineFedFrameByFrameGivesTheToolsMap) {
                                                            " -o " + dir.file("out"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const msf::Sequence sequence(dataset());
-  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig::load(config_path), optionsOf(sequence));
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig::load(config_path));
   feed(engine, sequence);
   msf::test::TempDir mine;
   const auto [mesh, volume] = savedMap(engine, mine);
   EXPECT_TRUE(mesh == readFile(dir.file("out/mesh.ply"))) << "the mesh differs from msf_reconstruct's";
   EXPECT_TRUE(volume == readFile(dir.file("out/volume.pcd"))) << "the volume differs from msf_reconstruct's";
-  msf::Reconstructor own_scans(sequence.calibration(), msf::PipelineConfig{}, optionsOf(sequence));
+  msf::Reconstructor own_scans(sequence.calibration(), msf::PipelineConfig{});
   feed(own_scans, sequence);
   msf::test::TempDir other;
   EXPECT_FALSE(savedMap(own_scans, other).second == volume) << "the earlier scans changed nothing";
+}
+
+TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {
+  // The street's scans are taken at one instant: its rig says so, and the engine takes it from
+  // the rig whether fed frame by frame or run (the tests above give msf_reconstruct's map). A rig
+  // that says its scans sweep carves with a sweep's margin: another map.
+  const msf::Sequence sequence(dataset());
+  ASSERT_FALSE(sequence.calibration().lidar.sweeping);
+  msf::Calibration sweeping = sequence.calibration();
+  sweeping.lidar.sweeping = true;
+  msf::Reconstructor snapshots(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor swept(sweeping, msf::PipelineConfig{});
+  feed(snapshots, sequence);
+  feed(swept, sequence);
+  msf::test::TempDir a, b;
+  EXPECT_FALSE(savedMap(snapshots, a).second == savedMap(swept, b).second)
+      << "the rig's lidar.sweeping changed nothing";
 }
 
 TEST_F(PipelineTest, OneThreadGivesTheSameMapAsAllCores) {

@@ -178,9 +178,7 @@ TEST_F(PipelineTest, FramesWithoutAPoseAreTrackedByTheEngineAlikeInBothWaysOfFee
   });
   ASSERT_EQ(run_poses.size(), frames.size());
   EXPECT_EQ(overlapped.odometryMs().size(), frames.size());
-  msf::Reconstructor::Options options;
-  options.sweeping_scans = sequence.sweepingScans(); // what run() takes from its source
-  msf::Reconstructor one_by_one(sequence.calibration(), msf::PipelineConfig{}, options);
+  msf::Reconstructor one_by_one(sequence.calibration(), msf::PipelineConfig{});
   for (std::size_t i : frames) {
     msf::Frame frame = sequence.load(i);
     frame.has_pose = false;

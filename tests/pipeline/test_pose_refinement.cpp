@@ -114,7 +114,6 @@ TEST_F(PipelineTest, RefineNeedsEachFramesOwnPose) {
   const msf::Sequence sequence(dataset());
   msf::Reconstructor::Options options;
   options.poses = msf::Reconstructor::PoseMode::Refine;
-  options.sweeping_scans = sequence.sweepingScans();
   msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{}, options);
   msf::Frame frame = sequence.load(0);
   frame.has_pose = false;
@@ -133,7 +132,6 @@ TEST_F(PipelineTest, RefinedExactPosesStayExactAlikeInBothWaysOfFeedingTheEngine
   msf::PoseList run_poses;
   overlapped.run(sequence, frames, [&](msf::FrameResult& r) { run_poses.push_back(r.T_world_cam0); });
   ASSERT_EQ(run_poses.size(), frames.size());
-  options.sweeping_scans = sequence.sweepingScans();
   msf::Reconstructor one_by_one(sequence.calibration(), msf::PipelineConfig{}, options);
   for (std::size_t i : frames) {
     const msf::FrameResult r = one_by_one.addFrame(sequence.load(i));

@@ -61,6 +61,18 @@ def test_the_calibration_is_the_files(calibration, odometry04, tmp_path):
     assert again.image_size == calibration.image_size
 
 
+def test_the_rig_says_how_its_lidar_takes_scans(calibration, run_tool, tmp_path):
+    assert calibration.lidar_sweeping  # KITTI's Velodyne spins
+    run_tool("msf_synth", "-o", tmp_path / "street", "-frames", 2)
+    street = msfusion.Sequence(str(tmp_path / "street" / "sequences" / "00"))
+    assert not street.calibration.lidar_sweeping  # the synthetic LiDAR's scans are snapshots
+    rig = street.calibration
+    rig.lidar_sweeping = True
+    assert not street.calibration.lidar_sweeping  # a copy: the sequence's rig is as it was
+    rig.save_yaml(str(tmp_path / "rig.yaml"))
+    assert msfusion.load_calibration(str(tmp_path / "rig.yaml")).lidar_sweeping
+
+
 def test_a_raw_date_folder_is_a_calibration(kitti_dir):
     calibration = msfusion.load_calibration(os.path.join(kitti_dir, "raw", "2011_09_26"))
     assert calibration.image_size == (1242, 375) and calibration.has_velodyne

@@ -109,7 +109,7 @@ void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
   if (integrator_->carvesWithScans()) // built here, beside SGBM, rather than on the map's thread
-    result.scan_free_space = ScanFreeSpace(*frame.scan, options_.sweeping_scans);
+    result.scan_free_space = ScanFreeSpace(*frame.scan, calibration_.lidar.sweeping);
   result.times.lidar_ms = msSince(start);
   if (options_.keep_sparse)
     stages_->lidar.projector().projectToImage(*frame.scan, result.lidar_sparse);
@@ -260,7 +260,7 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
   if (!odometry_) {
     LidarOdometry::Config odometry = config_.odometry;
     if (odometry.deskew == "auto")
-      odometry.deskew = options_.sweeping_scans ? "sweep" : "none";
+      odometry.deskew = calibration_.lidar.sweeping ? "sweep" : "none";
     odometry_ = std::make_unique<LidarOdometry>(odometry);
     T_world_cam0_first_ = frame.has_pose ? frame.T_world_cam0 : Eigen::Isometry3d::Identity();
   }

@@ -186,7 +186,6 @@ struct Reconstructor::Run {
 
 Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std::vector<std::size_t>& frames,
                                            const FrameCallback& on_frame, const std::atomic<bool>* stop) {
-  options_.sweeping_scans = source.sweepingScans();
   Run r(*this, source, frames, stop);
   std::thread loader([&] {
     r.guarded([&] { r.loadFrames(); });

@@ -173,7 +173,7 @@ Eigen::Isometry3d keepPriorWhereFree(const Eigen::Isometry3d& prior, const Eigen
 
 LidarOdometry::Config resolveDeskew(LidarOdometry::Config config, const FrameSource& source) {
   if (config.deskew == "auto")
-    config.deskew = source.sweepingScans() ? "sweep" : "none";
+    config.deskew = source.calibration().lidar.sweeping ? "sweep" : "none";
   return config;
 }
 

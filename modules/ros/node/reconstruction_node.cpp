@@ -76,7 +76,11 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
     readParam(nh, name, *value, "a string");
   readParam(nh, "threads", p.threads, "an integer");
   readParam(nh, "queue_size", p.queue_size, "an integer");
-  readParam(nh, "sweeping_scans", p.sweeping_scans, "true or false");
+  if (nh.hasParam("sweeping_scans")) {
+    bool sweeping = true;
+    readParam(nh, "sweeping_scans", sweeping, "true or false");
+    p.sweeping_scans = sweeping;
+  }
   for (auto [name, value] : {std::pair{"sync_slop_s", &p.sync_slop_s}, {"tf_timeout_s", &p.tf_timeout_s},
                              {"mesh_rate_hz", &p.mesh_rate_hz}})
     readParam(nh, name, *value, "a number");
@@ -228,10 +232,11 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
     rig = rigFromCameraInfo(*pending.left_info, *pending.right_info, pending.color_info.get(), T_cam0_velo, size,
                             "the CameraInfo on " + cameraInfoTopic(params_.left_topic));
   }
+  if (params_.sweeping_scans)
+    rig.lidar.sweeping = *params_.sweeping_scans;
   Reconstructor::Options options;
   options.poses = kPoseModes.at(params_.poses);
   options.threads = params_.threads;
-  options.sweeping_scans = params_.sweeping_scans;
   engine_ = std::make_unique<Reconstructor>(rig, config_, options);
   tracking_ = params_.poses == "odometry";
   first_scan_ns_ = stampNs(pending.cloud->header.stamp);

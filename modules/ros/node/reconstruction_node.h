@@ -21,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -38,7 +39,9 @@ struct NodeParameters {
   std::string config;        ///< the engine's YAML configuration ("" = its defaults)
   std::string rig;           ///< a calibration file instead of CameraInfo and the tf extrinsic
   int threads = 0;           ///< the engine's threads (0 = all cores)
-  bool sweeping_scans = true; ///< scans swept over their period: deskewed, carving allows for the skew
+  /// How the LiDAR takes its scans, when given: swept over their period (deskewed, carving allows
+  /// for the skew) or at one instant; else the rig file's lidar.sweeping, or swept.
+  std::optional<bool> sweeping_scans;
   int queue_size = 1;        ///< frames waiting for the engine; when full the oldest is dropped
   double sync_slop_s = 0.05; ///< the largest spread of stamps within one frame's messages
   double tf_timeout_s = 0.2; ///< how long a frame waits for its pose and the first for the extrinsic

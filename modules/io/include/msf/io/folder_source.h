@@ -44,7 +44,6 @@ public:
   double timestamp(std::size_t i) const override { return timestamps_.at(i) - timestamps_.front(); }
   std::string scanName(std::size_t i) const override { return "scan '" + frames_.at(i).scan + "'"; }
   bool hasColor() const override { return has_color_; }
-  bool sweepingScans() const override { return calibration_.lidar.sweeping; }
 
 private:
   struct FrameFiles {

@@ -79,9 +79,6 @@ public:
   virtual std::string scanName(std::size_t i) const { return "the scan of frame " + frameName(i); }
   /// Whether frames carry a colour image (camera 2).
   virtual bool hasColor() const { return false; }
-  /// Whether a scan is swept over its period (a spinning LiDAR: deskewed by the odometry) rather
-  /// than taken at one instant.
-  virtual bool sweepingScans() const { return true; }
   /// Folder of synthetic ground truth, "" when there is none.
   virtual std::string groundTruthDir() const { return {}; }
   /// What the reader skipped or assumed, one line each, for the tool to print (a bag's frames

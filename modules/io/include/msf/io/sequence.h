@@ -46,8 +46,6 @@ public:
   double timestamp(std::size_t i) const override;
   std::string scanName(std::size_t i) const override { return "scan '" + scanPath(i) + "'"; }
   bool hasColor() const override;
-  /// A synthetic sequence's scans are taken at one instant; KITTI's are swept.
-  bool sweepingScans() const override { return gt_dir_.empty(); }
 
   std::string scanPath(std::size_t i) const;
   /// camera 0..3

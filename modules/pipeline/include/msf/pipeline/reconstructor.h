@@ -152,11 +152,6 @@ public:
     /// (run() still overlaps its stages), n = at most n at a time. For a process that shares
     /// the machine (a ROS node, a Python program).
     int threads = 0;
-    /// Scans swept over their period (a spinning LiDAR): the odometry deskews them
-    /// (odometry.deskew auto), and the scan's carving allows for their skew
-    /// (ScanFreeSpace::skew); false for scans taken at one instant. run() takes it from its
-    /// FrameSource (FrameSource::sweepingScans); set it for addFrame.
-    bool sweeping_scans = true;
     /// With `streaming.active_radius_m` > 0 (docs/streaming.md): the folder where the map
     /// streams the tiles that leave the active radius (tiles/*.ply, tsdf/*.blk); integration
     /// needs it then.
@@ -166,8 +161,10 @@ public:
     bool keep_sparse = false;
   };
 
-  /// Throws ConfigError for an invalid config or streaming options, CalibrationError when the
-  /// rig has no image size.
+  /// The rig's LiDAR decides how its scans are taken (rig.lidar.sweeping): swept over their
+  /// period, the odometry deskews them (odometry.deskew auto) and the scan's carving allows for
+  /// their skew (ScanFreeSpace::skew). Throws ConfigError for an invalid config or streaming
+  /// options, CalibrationError when the rig has no image size.
   Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options);
   Reconstructor(const Calibration& rig, const PipelineConfig& config);
   ~Reconstructor();

@@ -30,7 +30,7 @@ public:
   ScanFreeSpace() = default;
   /// From the returns of one scan, in the sensor's frame (x forward, z up); non-finite points
   /// and points at the sensor are skipped. `swept`: taken by a spinning LiDAR over its period
-  /// (FrameSource::sweepingScans, the rig's lidar.sweeping), false for a scan of one instant.
+  /// (the rig's lidar.sweeping), false for a scan of one instant.
   explicit ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan, bool swept = true);
 
   bool empty() const { return nearest_.empty(); }
