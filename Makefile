@@ -118,10 +118,12 @@ test-sanitize: deps
 	$(SANITIZE_CTEST) $(CTEST_ARGS)
 
 # The fast subset .ci/run runs: the file readers and their tools (tests labelled common, io),
-# built without the precompiled headers, so that a file missing an include of its own fails.
+# built without the precompiled headers, so that a file missing an include of its own fails,
+# and every public header compiled alone (msf_header_check).
 test-sanitize-fast: deps
-	$(SANITIZE_CONFIGURE) -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON
-	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS) --target test_common test_io msf_info msf_kitti2pcd msf_pcd2png
+	$(SANITIZE_CONFIGURE) -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON -DMSF_CHECK_HEADERS=ON
+	cmake --build $(SANITIZE_BUILD_DIR) -j$(JOBS) --target test_common test_io msf_info msf_kitti2pcd msf_pcd2png \
+	  msf_header_check
 	$(SANITIZE_CTEST) -L '^(common|io)$$'
 
 fuzz: deps-fuzz
