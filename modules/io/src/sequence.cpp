@@ -180,8 +180,6 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
   }
   if (!calibration.empty())
     calibration_ = loadCalibration(calibration);
-  if (!gt_dir_.empty())
-    calibration_.lidar.sweeping = false; // msf_synth's scans are taken at one instant, whatever rig is named
   if (frame_names_.empty())
     throw IOError("sequence '" + dir_ + "' has no frames (no images named by a frame number in camera 0's folder)");
   if (!times.empty())
