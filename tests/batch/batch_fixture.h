@@ -4,6 +4,7 @@
 // build, the options that keep their runs short, and reading what a batch wrote.
 #include "test_support.h"
 
+#include <msf/common/atomic_file.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/sequence.h>
@@ -67,10 +68,11 @@ protected:
     }
     config_ = (root / "batch.yaml").string();
     plain_config_ = (root / "plain_mean.yaml").string();
-    std::ofstream(config_) << "%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.2\n";
+    // Replaced whole, never truncated: a test process already set up may be reading them.
+    writeText(config_, "%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.2\n");
     // Integration as a plain weighted mean: no carving, no weight cap reached.
-    std::ofstream(plain_config_) << "%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.2\ntsdf_integrator:\n"
-                                    "  space_carving: false\n  max_weight: 1.0e+30\n";
+    writeText(plain_config_, "%YAML:1.0\ntsdf_volume:\n  voxel_size_m: 0.2\ntsdf_integrator:\n"
+                             "  space_carving: false\n  max_weight: 1.0e+30\n");
     ::flock(lock, LOCK_UN);
     ::close(lock);
   }
@@ -93,6 +95,10 @@ protected:
   /// The map of batch `out` against its drives' maps: more complete than each (by 5 points), and
   /// where a drive's map has a surface, within 5 mm of its accuracy. Returns the map's scores.
   static MeshAccuracy expectBetterThanEachDrive(const std::string& out, const StreetTruth& truth);
+
+  static void writeText(const std::string& path, const std::string& text) {
+    writeAtomically(path, [&](const std::string& temporary) { std::ofstream(temporary) << text; });
+  }
 
   inline static std::vector<std::string> drives_;
   inline static std::string config_, plain_config_;
