@@ -140,6 +140,13 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
       print_info(", small pieces seen through %zu", r.seen_through.seen_through);
     print_info("\n");
   }
+  if (e.transient_split)
+    for (const auto& r : e.rows) {
+      const msf::DepthMetrics &a = r.score.lasting_within_range, &b = r.score.transient_within_range;
+      print_info("  %-12s within range, lasting %.4f / %.2f%% (%zu px), transient %.4f / %.2f%% (%zu px)\n",
+                 r.score.source.c_str(), a.coverage, 100 * a.d1_all, a.gt_pixels, b.coverage, 100 * b.d1_all,
+                 b.gt_pixels);
+    }
   // The fused mesh's surest surface as complete as each other mesh (its weight curve).
   if (const auto* fused = e.fusedCurveRow())
     for (const auto& other : e.rows)
@@ -420,9 +427,11 @@ private:
       truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m);
     }
     if (evaluation_) {
-      if (request_.holdout)
+      if (request_.holdout) {
         evaluation_->addGroundTruth(r.index, r.T_world_cam0, holdout_.take(r.index));
-      else
+        // The held-out rings do not say what moved; the scans of the frames around them do.
+        evaluation_->addScan(r.index, r.T_world_cam0 * source_.calibration().T_cam0_velo, r.scan_free_space);
+      } else
         evaluation_->addGroundTruth(r.index, r.T_world_cam0, true_depth,
                                     moving_split_ ? truth_->truth().movingMask(truth_->truth().indexOf(r.name))
                                                   : cv::Mat());
@@ -616,6 +625,7 @@ private:
                                  : "the synthetic sequence's exact depth (gt/depth_0)";
       e.range_m = on_rig_.integrator.max_depth_m;
       e.moving_split = moving_split_;
+      e.transient_split = evaluation_->splitsTransient();
       bool any_ghosts = false;
       for (const auto& [name, s] : scores)
         any_ghosts = any_ghosts || s.has_ghosts;

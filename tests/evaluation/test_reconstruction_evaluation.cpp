@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
 
 #include <cmath>
 
@@ -74,7 +76,68 @@ int footprint(float z, float x0, float x1, float y0, float y1) {
   return n;
 }
 
+/// The LiDAR beside the camera, x forward and z up (KITTI's axes): T_cam_lidar.
+Eigen::Isometry3d cameraFromLidar() {
+  Eigen::Matrix3d lidar_from_cam;
+  lidar_from_cam << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = lidar_from_cam.transpose();
+  return T;
+}
+
+/// The scan, in the LiDAR's frame, of what the camera sees as `depth`: a return every third of a
+/// pixel, denser than the free space's bins.
+ScanFreeSpace scanOf(const cv::Mat& depth) {
+  const PinholeCamera c = camera();
+  const Eigen::Isometry3d T_lidar_cam = cameraFromLidar().inverse();
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  for (float v = 0; v < c.height; v += 1.f / 3)
+    for (float u = 0; u < c.width; u += 1.f / 3) {
+      const double z = depth.at<float>(static_cast<int>(v), static_cast<int>(u));
+      const Eigen::Vector3d p = T_lidar_cam * Eigen::Vector3d((u - c.cx) * z / c.fx, (v - c.cy) * z / c.fy, z);
+      pcl::PointXYZI point;
+      point.getVector3fMap() = p.cast<float>();
+      scan.push_back(point);
+    }
+  return ScanFreeSpace(scan);
+}
+
 } // namespace
+
+TEST(ReconstructionEvaluation, AReturnAScanOfAnotherFrameSawThroughIsTransient) {
+  // Frame 0 sees a car at 5 m in the lower left quarter (2000 pixels) before a wall at 10 m; a
+  // frame later, from the same place, the car has left and the scan sees the wall there.
+  cv::Mat with_car = constantDepth(10.f);
+  with_car(cv::Rect(0, 40, 50, 40)).setTo(5.f);
+  const Eigen::Isometry3d T_world_lidar = cameraFromLidar();
+  ReconstructionEvaluation evaluation(camera(), kFocalBaseline, 40.0);
+  evaluation.addGroundTruth(0, Eigen::Isometry3d::Identity(), with_car);
+  // A frame's own scan is not asked: its returns and the held-out ones are one sweep's.
+  evaluation.addScan(0, T_world_lidar, scanOf(constantDepth(10.f)));
+  EXPECT_TRUE(evaluation.splitsTransient());
+  evaluation.scoreDepth("map", 0, constantDepth(10.f));
+  EXPECT_EQ(evaluation.scores().at(0).transient_within_range.gt_pixels, 0u);
+  evaluation.addScan(1, T_world_lidar, scanOf(constantDepth(10.f)));
+  const ReconstructionScore s = evaluation.scores().at(0);
+  EXPECT_EQ(s.within_range.gt_pixels, 8000u);
+  EXPECT_EQ(s.transient_within_range.gt_pixels, 2000u);
+  EXPECT_EQ(s.lasting_within_range.gt_pixels, 6000u);
+  EXPECT_DOUBLE_EQ(s.lasting_within_range.d1_all, 0.0);
+  EXPECT_DOUBLE_EQ(s.transient_within_range.d1_all, 1.0); // a map of what stays holds the wall there
+  EXPECT_DOUBLE_EQ(s.within_range.d1_all, 0.25);            // the static figures are as before
+
+  // A scan may come before the ground truth it sees through; not from beyond the window.
+  ReconstructionEvaluation later(camera(), kFocalBaseline, 40.0);
+  EXPECT_FALSE(later.splitsTransient());
+  later.addScan(0, T_world_lidar, scanOf(constantDepth(10.f)));
+  later.addGroundTruth(ReconstructionEvaluation::kScanWindow, Eigen::Isometry3d::Identity(), with_car);
+  later.addGroundTruth(ReconstructionEvaluation::kScanWindow + 1, Eigen::Isometry3d::Identity(), with_car);
+  later.scoreDepth("map", ReconstructionEvaluation::kScanWindow, constantDepth(10.f));
+  later.scoreDepth("map", ReconstructionEvaluation::kScanWindow + 1, constantDepth(10.f));
+  EXPECT_EQ(later.scores().at(0).transient_within_range.gt_pixels, 2000u);
+  EXPECT_THROW(later.addScan(2, Eigen::Isometry3d(Eigen::Matrix4d::Constant(NAN)), scanOf(with_car)),
+               InvalidInputError);
+}
 
 TEST(ReconstructionEvaluation, AMeshOffsetFromThePlaneHasThatErrorOverItsFootprint) {
   // Ground truth: a wall at 10 m over the whole image. The mesh: a 4 m square of it, 0.1 m

@@ -100,6 +100,21 @@ TEST(ReconstructEvaluation, HoldoutOnKittiScoresTheMeshesBesideTheFusedDepth) {
   EXPECT_LE(small_pieces, jsonNumber(mesh_row, "all_pieces", "seen_through"));
   EXPECT_LE(jsonNumber(mesh_row, "pieces", "seen_through"), small_pieces);
   EXPECT_EQ(jsonNumber(mesh_row, "max_triangles", "seen_through"), 50);
+  // The scans split the pixels in range: where frame 1's scan saw through frame 0's held-out
+  // returns (the van ahead moved on), the per-frame depth has the van and the map has not.
+  EXPECT_NE(json.find("\"transient_split\": true"), std::string::npos);
+  for (const char* source : {"mesh", "fused"}) {
+    const std::string row = rowOf(json, source);
+    const double lasting = jsonNumber(row, "gt_pixels", "lasting_within_range");
+    EXPECT_EQ(lasting + jsonNumber(row, "gt_pixels", "transient_within_range"),
+              jsonNumber(row, "gt_pixels", "within_range"))
+        << source;
+  }
+  EXPECT_GT(jsonNumber(mesh_row, "gt_pixels", "transient_within_range"), 0.0);
+  EXPECT_LT(jsonNumber(rowOf(json, "fused"), "d1_all", "transient_within_range"),
+            jsonNumber(mesh_row, "d1_all", "transient_within_range"));
+  EXPECT_LT(jsonNumber(mesh_row, "d1_all", "lasting_within_range"), jsonNumber(mesh_row, "d1_all", "within_range"));
+  EXPECT_NE(readFile(out.file("report.md")).find("| source | lasting pixels |"), std::string::npos);
   for (const char* file : {"mesh.ply", "mesh_lidar.ply", "mesh_stereo.ply", "config.yaml", "report.md"})
     EXPECT_TRUE(msf::test::fileExists(out.file(file))) << file;
   EXPECT_NE(readFile(out.file("report.md")).find("evaluation protocol 4"), std::string::npos);

@@ -10,8 +10,8 @@
 namespace msf {
 
 namespace {
-constexpr std::uint32_t kMoving = 1u << 31;
-enum Set { kStatic = 0, kStaticInRange = 1, kMovingAll = 2, kMovingInRange = 3 };
+constexpr std::uint32_t kMoving = 1u << 31, kTransient = 1u << 30, kPixel = kTransient - 1;
+enum Set { kStatic, kStaticInRange, kMovingAll, kMovingInRange, kLastingInRange, kTransientInRange, kSets };
 } // namespace
 
 ReconstructionEvaluation::ReconstructionEvaluation(const PinholeCamera& camera, double focal_baseline,
@@ -61,8 +61,52 @@ void ReconstructionEvaluation::addGroundTruth(std::size_t frame, const Eigen::Is
   truth.pixels.shrink_to_fit();
   truth.depth.shrink_to_fit();
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (!frames_.emplace(frame, std::move(truth)).second)
+  const auto [added, fresh] = frames_.emplace(frame, std::move(truth));
+  if (!fresh)
     throw InvalidInputError("protocol 4: " + name + " was given twice");
+  for (const auto& [index, scan] : scans_)
+    if (index != frame && std::max(index, frame) - std::min(index, frame) <= kScanWindow)
+      markTransient(added->second, scan);
+}
+
+void ReconstructionEvaluation::addScan(std::size_t frame, const Eigen::Isometry3d& T_world_lidar,
+                                       const ScanFreeSpace& free_space) {
+  if (!T_world_lidar.matrix().allFinite())
+    throw InvalidInputError("protocol 4: the LiDAR pose of frame " + std::to_string(frame) + " is not finite");
+  if (free_space.empty())
+    return;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  splits_transient_ = true;
+  const Scan scan{T_world_lidar.inverse(), free_space};
+  for (auto truth = frames_.lower_bound(frame > kScanWindow ? frame - kScanWindow : 0);
+       truth != frames_.end() && truth->first <= frame + kScanWindow; ++truth)
+    if (truth->first != frame)
+      markTransient(truth->second, scan);
+  scans_[frame] = scan;
+  while (scans_.begin()->first + kScanWindow < frame)
+    scans_.erase(scans_.begin());
+}
+
+bool ReconstructionEvaluation::splitsTransient() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return splits_transient_;
+}
+
+void ReconstructionEvaluation::markTransient(FrameTruth& truth, const Scan& scan) const {
+  const Eigen::Isometry3d T_lidar_cam = scan.T_lidar_world * truth.T_world_cam;
+  const auto width = static_cast<std::uint32_t>(camera_.width);
+  for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
+    const std::uint32_t pixel = truth.pixels[k] & kPixel;
+    const double z = truth.depth[k];
+    const Eigen::Vector3d p_cam((pixel % width - camera_.cx) * z / camera_.fx,
+                                (pixel / width - camera_.cy) * z / camera_.fy, z);
+    const Eigen::Vector3f p = (T_lidar_cam * p_cam).cast<float>();
+    const double behind = scan.free_space.nearestAround(p) - scan.free_space.skew();
+    const double range = p.norm();
+    // Seen from the scan as protocol 4 sees depth: its returns lie a D1 outlier behind this one.
+    if (behind > range && d1_.exceeded(focal_baseline_ / range - focal_baseline_ / behind, focal_baseline_ / behind))
+      truth.pixels[k] |= kTransient;
+  }
 }
 
 ReconstructionEvaluation::Row& ReconstructionEvaluation::row(const std::string& source) {
@@ -73,17 +117,39 @@ ReconstructionEvaluation::Row& ReconstructionEvaluation::row(const std::string& 
   return rows_.back();
 }
 
-void ReconstructionEvaluation::score(Row& row, const FrameTruth& truth, const cv::Mat& depth) const {
+std::vector<float> ReconstructionEvaluation::sample(const FrameTruth& truth, const cv::Mat& depth) const {
   const auto width = static_cast<std::uint32_t>(camera_.width);
+  std::vector<float> estimates(truth.pixels.size());
   for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
-    const std::uint32_t pixel = truth.pixels[k] & ~kMoving;
-    const float gt = truth.depth[k];
-    const float estimate = depth.ptr<float>(static_cast<int>(pixel / width))[pixel % width];
-    const int set = truth.pixels[k] & kMoving ? kMovingAll : kStatic;
-    row.errors[set].addPixel(gt, estimate, focal_baseline_, d1_);
-    if (gt <= max_depth_m_)
-      row.errors[set + 1].addPixel(gt, estimate, focal_baseline_, d1_);
+    const std::uint32_t pixel = truth.pixels[k] & kPixel;
+    estimates[k] = depth.ptr<float>(static_cast<int>(pixel / width))[pixel % width];
   }
+  return estimates;
+}
+
+ReconstructionScore ReconstructionEvaluation::score(const Row& row) const {
+  DepthErrorAccumulator errors[kSets];
+  for (const auto& [frame, estimates] : row.estimates) {
+    const FrameTruth& truth = frames_.at(frame);
+    for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
+      const float gt = truth.depth[k], estimate = estimates[k];
+      const bool moving = truth.pixels[k] & kMoving, in_range = gt <= max_depth_m_;
+      const int set = moving ? kMovingAll : kStatic;
+      errors[set].addPixel(gt, estimate, focal_baseline_, d1_);
+      if (in_range)
+        errors[set + 1].addPixel(gt, estimate, focal_baseline_, d1_);
+      if (in_range && !moving)
+        errors[truth.pixels[k] & kTransient ? kTransientInRange : kLastingInRange].addPixel(gt, estimate,
+                                                                                            focal_baseline_, d1_);
+    }
+  }
+  return {row.source,
+          errors[kStatic].metrics(),
+          errors[kStaticInRange].metrics(),
+          errors[kMovingAll].metrics(),
+          errors[kMovingInRange].metrics(),
+          errors[kLastingInRange].metrics(),
+          errors[kTransientInRange].metrics()};
 }
 
 void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t frame, const cv::Mat& depth) {
@@ -93,7 +159,7 @@ void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t
   if (truth == frames_.end())
     throw InvalidInputError("protocol 4: frame " + std::to_string(frame) + " has no ground truth to score its " +
                             source + " depth against");
-  score(row(source), truth->second, depth);
+  row(source).estimates[frame] = sample(truth->second, depth);
 }
 
 void ReconstructionEvaluation::scoreMesh(const std::string& source, const TriangleMesh& mesh) {
@@ -101,7 +167,7 @@ void ReconstructionEvaluation::scoreMesh(const std::string& source, const Triang
   Row& r = row(source);
   for (const auto& [frame, truth] : frames_) {
     rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_);
-    score(r, truth, rendered_);
+    r.estimates[frame] = sample(truth, rendered_);
   }
 }
 
@@ -131,7 +197,7 @@ SeenThroughPieces ReconstructionEvaluation::seenThroughPieces(const TriangleMesh
   for (const auto& [frame, truth] : frames_) {
     truth_depth.setTo(0.f);
     for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
-      const std::uint32_t pixel = truth.pixels[k] & ~kMoving;
+      const std::uint32_t pixel = truth.pixels[k] & kPixel;
       truth_depth.at<float>(static_cast<int>(pixel / width), static_cast<int>(pixel % width)) = truth.depth[k];
     }
     const Eigen::Isometry3f T_cam_world = truth.T_world_cam.inverse().cast<float>();
@@ -197,8 +263,7 @@ std::vector<ReconstructionScore> ReconstructionEvaluation::scores() const {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<ReconstructionScore> out;
   for (const Row& r : rows_)
-    out.push_back({r.source, r.errors[kStatic].metrics(), r.errors[kStaticInRange].metrics(),
-                   r.errors[kMovingAll].metrics(), r.errors[kMovingInRange].metrics()});
+    out.push_back(score(r));
   return out;
 }
 

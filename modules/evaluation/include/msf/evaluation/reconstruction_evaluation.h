@@ -4,6 +4,7 @@
 #include <msf/io/pinhole_camera.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/mesh_rasterizer.h>
+#include <msf/reconstruction/scan_free_space.h>
 
 #include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
@@ -26,6 +27,10 @@ struct ReconstructionScore {
   DepthMetrics within_range;   ///< those whose true depth is within the reconstruction's range
   DepthMetrics moving_all;     ///< ground-truth pixels on moving objects (none without a moving mask)
   DepthMetrics moving_within_range;
+  /// within_range split by whether a nearby frame's scan saw through the true return (see
+  /// ReconstructionEvaluation::addScan): the surface stayed, or it left (an object that moved on).
+  DepthMetrics lasting_within_range;
+  DepthMetrics transient_within_range;
 };
 
 /// The small pieces of a mesh that the ground truth sees through: crumbs on real frames, where
@@ -50,8 +55,14 @@ struct SeenThroughPieces {
 /// (tsdf_integrator.max_depth_m: the map holds nothing farther) and whether they are on a
 /// moving object.
 ///
+/// Where the dataset does not say what moved (KITTI), the scans do: a true return that the scan
+/// of a nearby frame saw through lay on a surface that left, and a map that holds what stayed is
+/// scored there apart (addScan, the lasting and transient pixels).
+///
 /// addGroundTruth and scoreDepth may be called from different threads (the pipeline's
-/// loading and integration threads); all calls are serialized by one lock.
+/// loading and integration threads); all calls are serialized by one lock. Depth is kept at the
+/// ground-truth pixels as it is scored and reduced to metrics by scores(), so that what later
+/// scans say of a frame's pixels counts for every source.
 class ReconstructionEvaluation {
 public:
   /// camera: of the ground truth (camera 0); focal_baseline: f B of the grey pair, for the
@@ -69,6 +80,19 @@ public:
   /// of the wrong type or size, or a pose that is not finite.
   void addGroundTruth(std::size_t frame, const Eigen::Isometry3d& T_world_cam, const cv::Mat& depth,
                       const cv::Mat& moving = cv::Mat());
+  /// Frames whose scans test each other's ground truth: a frame's scan sees through the true
+  /// returns of frames up to this many before and after it (a second of KITTI's: what moved
+  /// has left, what stood is still in view).
+  static constexpr std::size_t kScanWindow = 10;
+  /// The free space of `frame`'s scan, the LiDAR at T_world_lidar: a true pixel of another frame
+  /// within kScanWindow whose return lies in it, in front of the scan's returns around its
+  /// direction by more than the scan's skew and D1's threshold (seen from the scan), is
+  /// transient. Frames are given in order; the scans of the last kScanWindow are kept. An empty
+  /// free space is ignored. Throws InvalidInputError for a pose that is not finite.
+  void addScan(std::size_t frame, const Eigen::Isometry3d& T_world_lidar, const ScanFreeSpace& free_space);
+  /// True once a scan was given: the rows' lasting and transient pixels mean something.
+  bool splitsTransient() const;
+
   /// Scores `depth` (CV_32FC1 of the camera's size, metres, not > 0 = none) of `frame` as
   /// row `source`. Throws InvalidInputError for a frame without ground truth or a wrong image.
   void scoreDepth(const std::string& source, std::size_t frame, const cv::Mat& depth);
@@ -91,16 +115,25 @@ public:
 private:
   struct FrameTruth {
     Eigen::Isometry3d T_world_cam;
-    std::vector<std::uint32_t> pixels; ///< v * width + u; the top bit marks a moving object
+    /// v * width + u; the top bit marks a moving object, the next a transient return
+    std::vector<std::uint32_t> pixels;
     std::vector<float> depth;
   };
-  /// Accumulators of one source: static all / within range, moving all / within range.
+  struct Scan {
+    Eigen::Isometry3d T_lidar_world;
+    ScanFreeSpace free_space;
+  };
+  /// One source's depth at each frame's ground-truth pixels.
   struct Row {
     std::string source;
-    DepthErrorAccumulator errors[4];
+    std::map<std::size_t, std::vector<float>> estimates;
   };
   Row& row(const std::string& source);
-  void score(Row& row, const FrameTruth& truth, const cv::Mat& depth) const;
+  /// `depth` at the pixels of `truth`.
+  std::vector<float> sample(const FrameTruth& truth, const cv::Mat& depth) const;
+  ReconstructionScore score(const Row& row) const;
+  /// Marks the pixels of `truth` (frame `frame`) that `scan` (of another frame) saw through.
+  void markTransient(FrameTruth& truth, const Scan& scan) const;
   void checkImage(const cv::Mat& image, int type, const std::string& what) const;
   /// 2 when all true depth around p_cam's pixel lies behind it (D1), 1 when some does not, 0
   /// when it has none.
@@ -111,6 +144,8 @@ private:
   D1Threshold d1_;
   mutable std::mutex mutex_;
   std::map<std::size_t, FrameTruth> frames_;
+  std::map<std::size_t, Scan> scans_; ///< the last kScanWindow frames'
+  bool splits_transient_ = false;
   std::vector<Row> rows_;
   MeshRasterizer rasterizer_;
   cv::Mat rendered_;

@@ -60,6 +60,8 @@ public:
     double range_m = 0;            ///< "within range": true depth <= this (tsdf_integrator.max_depth_m)
     std::size_t frames = 0, gt_pixels = 0;
     bool moving_split = false;     ///< the dataset marks moving objects (gt/moving_0)
+    /// the scans split the static pixels within range into lasting and transient ones
+    bool transient_split = false;
     std::string no_ghosts;         ///< why there is no ghost figure, when there is none
     std::vector<Row> rows;         ///< empty without ground truth
     /// The fused mesh's row ("mesh") when it has a weight curve (MeshAccuracy::by_weight), else null.
