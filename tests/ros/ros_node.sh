@@ -9,6 +9,7 @@
 #  - the mesh the node saves on shutdown equal, byte for byte, to msf_reconstruct's of the bag
 #    (both read the poses and the extrinsic through tf's quaternions, so no rounding differs),
 #  - the node's account at shutdown: every frame reconstructed, none dropped,
+#  - ~sweeping_scans false (the rig's scans taken at one instant) making another map,
 #  - nothing it started left running (ros_session.sh).
 #   ros_node.sh BUILD_DIR KITTI_DIR [LAST_FRAME]
 set -euo pipefail
@@ -48,27 +49,34 @@ refuse bad_type "parameter /bad_type/queue_size must be an integer" _queue_size:
 refuse bad_range "parameter /bad_range/queue_size must be 1..8 frames, not 20" _queue_size:=20
 refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refine, not 'gps'" _poses:=gps
 refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
+refuse bad_sweep "parameter /bad_sweep/sweeping_scans must be true or false" _sweeping_scans:=maybe
+
+# Plays the bag to the node started by launch/kitti_bag.launch with ARGS...; returns when it has
+# published a depth image per frame (rostopic echo -n exits then) and has been stopped.
+play_to_node() { # NAME ARGS...
+  local name=$1 counter launcher seen
+  local log="$work/${name}_depth_seen.log"
+  shift
+  background "${name}_depth_seen" rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
+  counter=$started
+  background "$name" roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames "$@"
+  launcher=$started
+  for ((k = 0; ; ++k)); do
+    kill -0 "$counter" 2>/dev/null || break
+    ((k < 600)) || fail "the node published $(grep -c '^---' "$log") depth images of $frames in 60 s"
+    sleep 0.1
+  done
+  seen=$(grep -c '^---' "$log" || true)
+  ((seen >= frames)) || fail "rostopic counted $seen of $frames depth images: $(tr '\n' ' ' <"$log")"
+  stop_group "$launcher" 30 # the node publishes the last mesh marker, saves the mesh, gives its account
+}
 
 # The recorder first, so that it hears the first frame; then the node, and the player, which
 # waits for the node's subscriptions. queue_size: every frame, however slow the machine.
 background record rosbag record -q -O "$work/published.bag" /msf_ros_node/depth /msf_ros_node/weight \
   /msf_ros_node/points /msf_ros_node/mesh
 recorder=$started
-background depth_seen rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
-counter=$started
-background launch roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames \
-  mesh_path:="$work/node_mesh.ply"
-launcher=$started
-
-# The node is done when it has published a depth image per frame: rostopic echo -n exits then.
-for ((k = 0; ; ++k)); do
-  kill -0 "$counter" 2>/dev/null || break
-  ((k < 600)) || fail "the node published $(grep -c '^---' "$work/depth_seen.log") depth images of $frames in 60 s"
-  sleep 0.1
-done
-seen=$(grep -c '^---' "$work/depth_seen.log" || true)
-((seen >= frames)) || fail "rostopic counted $seen of $frames depth images: $(tr '\n' ' ' < "$work/depth_seen.log")"
-stop_group "$launcher" 30 # the node publishes the last mesh marker, saves the mesh, gives its account
+play_to_node launch mesh_path:="$work/node_mesh.ply"
 stop_group "$recorder" 10
 node_lines "$work/launch.log"
 
@@ -85,6 +93,17 @@ account=$(node_lines "$work/launch.log" | grep -a "scans received")
 cmp "$work/node_mesh.ply" "$work/reconstruct/mesh.ply" ||
   fail "the node's mesh differs from msf_reconstruct's of the same bag"
 echo "ok: the node's mesh is msf_reconstruct's, byte for byte ($(stat -c %s "$work/node_mesh.ply") bytes)"
+
+# ~sweeping_scans sets the rig's lidar.sweeping: scans of one instant keep no margin for a sweep's
+# skew when they carve, and make another map of the same bag.
+node_params=$(rospack find msfusion)/config/kitti_bag.yaml
+sed 's/^sweeping_scans: true /sweeping_scans: false/' "$node_params" >"$work/snapshots.yaml"
+grep -q "^sweeping_scans: false" "$work/snapshots.yaml" || fail "kitti_bag.yaml has no 'sweeping_scans: true' line"
+play_to_node snapshots params:="$work/snapshots.yaml" mesh_path:="$work/snapshot_mesh.ply"
+[ -f "$work/snapshot_mesh.ply" ] || fail "the node saved no mesh with sweeping_scans false"
+! cmp -s "$work/node_mesh.ply" "$work/snapshot_mesh.ply" ||
+  fail "sweeping_scans false made the same mesh as the sweeping rig: the parameter did not reach the engine"
+echo "ok: sweeping_scans false makes another map"
 
 ros_session_stop
 echo "ok: roscore, the node, the player and the recorder stopped; no process left"
