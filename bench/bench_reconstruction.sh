@@ -5,7 +5,8 @@
 # msf_reconstruct -compare_sources on a 40-frame synthetic street (exact depth, true surface).
 # Prints one table per dataset: per depth source (the fused mesh, the per-frame fused depth,
 # the mesh of the interpolated LiDAR alone, of SGBM alone) coverage and D1 (missing = bad)
-# within the map's depth range and over all ground-truth pixels; on the street also the
+# within the map's depth range and over all ground-truth pixels, on KITTI also within range on
+# the lasting pixels (those no nearby frame's scan saw through); on the street also the
 # meshes' accuracy, completeness and ghost share, and completeness by the nearest distance
 # each piece of the surface was seen from.
 #
@@ -64,6 +65,9 @@ for name, title in titles.items():
     head = f"  {'':12s} {'within range':>16s}   {'all pixels':>16s}"
     cols = f"  {'source':12s} {'coverage':>8s} {'D1':>7s}   {'coverage':>8s} {'D1':>7s}"
     synthetic = any("accuracy" in r for r in e["rows"].values())
+    if e.get("transient_split"):
+        head += f"   {'lasting, in range':>16s}"
+        cols += f"   {'coverage':>8s} {'D1':>7s}"
     if synthetic:
         head += f"   {'mesh vs true surface':>27s}"
         cols += f"   {'accuracy':>8s} {'complete':>8s} {'ghosts':>7s}"
@@ -72,6 +76,9 @@ for name, title in titles.items():
     for source, r in e["rows"].items():
         line = (f"  {source:12s} {num(r['within_range']['coverage'], '8.3f')} {pct(r['within_range']['d1_all'])}"
                 f"   {num(r['all']['coverage'], '8.3f')} {pct(r['all']['d1_all'])}")
+        if e.get("transient_split"):
+            lasting = r["lasting_within_range"]
+            line += f"   {num(lasting['coverage'], '8.4f')} {pct(lasting['d1_all'])}"
         if synthetic:
             a, g = r.get("accuracy"), r.get("ghosts")
             line += (f"   {num(a and a['accuracy_mean_m'], '7.3f')}{' m' if a else '  '} {pct(a and a['completeness'])}"
@@ -79,6 +86,9 @@ for name, title in titles.items():
         print(line)
     if e.get("moving_split"):
         print("  (static pixels; moving objects apart in summary.json)")
+    if e.get("transient_split"):
+        print("  (lasting: the held-out returns no scan of a frame around saw through; the transient ones in"
+              " summary.json)")
     if synthetic:
         for source, r in e["rows"].items():
             bands = (r.get("accuracy") or {}).get("completeness_by_nearest_view", [])
