@@ -605,6 +605,23 @@ if [ $have_kitti = 1 ]; then
     msf_odometry "$K/odo_stray/sequences/04" -o p.txt
   check "odometry: a frame beyond the poses" 1 "frame 000012 has no entry in poses '.*04.txt', which has 3 \(frames 0..2\)" -- \
     msf_odometry "$K/odo_beyond_poses/sequences/04" -o p.txt
+  # The evaluation tools: a trajectory or a method that cannot be scored is named with its fault.
+  P5=$K/poses5
+  mkdir -p "$P5"
+  head -n 5 "$KITTI/odometry/poses/04.txt" >"$P5/five.txt"
+  head -n 3 "$P5/five.txt" >"$P5/three.txt"
+  printf '1 0 0 0 0 1 0 0 0 0 1\n' >"$P5/eleven.txt"
+  sed '3s/^[^ ]*/2/' "$P5/five.txt" >"$P5/stretched.txt"
+  check "eval_odometry: 3 poses against 5" 1 "three.txt' has 3 poses and '.*five.txt' 5 \(use -frames a:b" -- \
+    msf_eval_odometry "$P5/three.txt" "$P5/five.txt"
+  check "eval_odometry: a line of 11 numbers" 1 "poses '.*eleven.txt' line 1: expected 12 numbers \(a 3x4 row-major matrix\), got 11" -- \
+    msf_eval_odometry "$P5/eleven.txt" "$P5/five.txt"
+  check "eval_odometry: a pose that is not rigid" 1 "stretched.txt' line 3 is not a rigid transform: its rotation is not orthonormal" -- \
+    msf_eval_odometry "$P5/stretched.txt" "$P5/five.txt"
+  check "holdout -methods with a typo" 1 "unknown method 'fussed'; known methods: interpolated," -- \
+    msf_holdout "$SEQ" -frames 0:0 -methods fused,fussed
+  check "holdout -csv into a missing folder" 1 "cannot write '/nonexistent/h.csv': output folder '/nonexistent' does not exist" -- \
+    msf_holdout "$SEQ" -frames 0:0 -methods interpolated -csv /nonexistent/h.csv
   check "reconstruct: a time that goes back" 1 "times.txt' line 3 '0.05' does not follow line 2's: the times must increase" -- \
     msf_reconstruct "$K/odo_times_back/sequences/04" -panels 0 -o out
   check "reconstruct: NaN in a pose" 1 "poses '.*04.txt' line 2: value 4 'nan' is not finite" -- \
