@@ -85,6 +85,8 @@ void ReconstructionEvaluation::addScan(std::size_t frame, const Eigen::Isometry3
   scans_[frame] = scan;
   while (scans_.begin()->first + kScanWindow < frame)
     scans_.erase(scans_.begin());
+  last_scan_ = std::max(last_scan_, frame);
+  scoreSettledFrames();
 }
 
 bool ReconstructionEvaluation::splitsTransient() const {
@@ -113,7 +115,7 @@ ReconstructionEvaluation::Row& ReconstructionEvaluation::row(const std::string& 
   for (Row& r : rows_)
     if (r.source == source)
       return r;
-  rows_.push_back(Row{source, {}});
+  rows_.push_back(Row{source, std::vector<DepthErrorAccumulator>(kSets), {}});
   return rows_.back();
 }
 
@@ -127,29 +129,35 @@ std::vector<float> ReconstructionEvaluation::sample(const FrameTruth& truth, con
   return estimates;
 }
 
-ReconstructionScore ReconstructionEvaluation::score(const Row& row) const {
-  DepthErrorAccumulator errors[kSets];
-  for (const auto& [frame, estimates] : row.estimates) {
-    const FrameTruth& truth = frames_.at(frame);
-    for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
-      const float gt = truth.depth[k], estimate = estimates[k];
-      const bool moving = truth.pixels[k] & kMoving, in_range = gt <= max_depth_m_;
-      const int set = moving ? kMovingAll : kStatic;
-      errors[set].addPixel(gt, estimate, focal_baseline_, d1_);
-      if (in_range)
-        errors[set + 1].addPixel(gt, estimate, focal_baseline_, d1_);
-      if (in_range && !moving)
-        errors[truth.pixels[k] & kTransient ? kTransientInRange : kLastingInRange].addPixel(gt, estimate,
-                                                                                            focal_baseline_, d1_);
-    }
+void ReconstructionEvaluation::accumulate(std::vector<DepthErrorAccumulator>& errors, const FrameTruth& truth,
+                                          const std::vector<float>& estimates) const {
+  for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
+    const float gt = truth.depth[k], estimate = estimates[k];
+    const bool moving = truth.pixels[k] & kMoving, in_range = gt <= max_depth_m_;
+    const int set = moving ? kMovingAll : kStatic;
+    errors[set].addPixel(gt, estimate, focal_baseline_, d1_);
+    if (in_range)
+      errors[set + 1].addPixel(gt, estimate, focal_baseline_, d1_);
+    if (in_range && !moving)
+      errors[truth.pixels[k] & kTransient ? kTransientInRange : kLastingInRange].addPixel(gt, estimate,
+                                                                                          focal_baseline_, d1_);
   }
-  return {row.source,
-          errors[kStatic].metrics(),
-          errors[kStaticInRange].metrics(),
-          errors[kMovingAll].metrics(),
-          errors[kMovingInRange].metrics(),
-          errors[kLastingInRange].metrics(),
-          errors[kTransientInRange].metrics()};
+}
+
+void ReconstructionEvaluation::score(Row& row, std::size_t frame, const FrameTruth& truth, const cv::Mat& depth) {
+  std::vector<float> estimates = sample(truth, depth);
+  if (splits_transient_ && last_scan_ < frame + kScanWindow)
+    row.waiting[frame] = std::move(estimates);
+  else
+    accumulate(row.errors, truth, estimates);
+}
+
+void ReconstructionEvaluation::scoreSettledFrames() {
+  for (Row& r : rows_)
+    while (!r.waiting.empty() && r.waiting.begin()->first + kScanWindow <= last_scan_) {
+      accumulate(r.errors, frames_.at(r.waiting.begin()->first), r.waiting.begin()->second);
+      r.waiting.erase(r.waiting.begin());
+    }
 }
 
 void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t frame, const cv::Mat& depth) {
@@ -159,7 +167,7 @@ void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t
   if (truth == frames_.end())
     throw InvalidInputError("protocol 4: frame " + std::to_string(frame) + " has no ground truth to score its " +
                             source + " depth against");
-  row(source).estimates[frame] = sample(truth->second, depth);
+  score(row(source), frame, truth->second, depth);
 }
 
 void ReconstructionEvaluation::scoreMesh(const std::string& source, const TriangleMesh& mesh) {
@@ -167,7 +175,7 @@ void ReconstructionEvaluation::scoreMesh(const std::string& source, const Triang
   Row& r = row(source);
   for (const auto& [frame, truth] : frames_) {
     rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_);
-    r.estimates[frame] = sample(truth, rendered_);
+    score(r, frame, truth, rendered_);
   }
 }
 
@@ -262,8 +270,14 @@ std::size_t ReconstructionEvaluation::groundTruthPixels() const {
 std::vector<ReconstructionScore> ReconstructionEvaluation::scores() const {
   const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<ReconstructionScore> out;
-  for (const Row& r : rows_)
-    out.push_back(score(r));
+  for (const Row& r : rows_) {
+    std::vector<DepthErrorAccumulator> errors = r.errors;
+    for (const auto& [frame, estimates] : r.waiting)
+      accumulate(errors, frames_.at(frame), estimates);
+    out.push_back({r.source, errors[kStatic].metrics(), errors[kStaticInRange].metrics(),
+                   errors[kMovingAll].metrics(), errors[kMovingInRange].metrics(), errors[kLastingInRange].metrics(),
+                   errors[kTransientInRange].metrics()});
+  }
   return out;
 }
 

@@ -60,9 +60,9 @@ struct SeenThroughPieces {
 /// scored there apart (addScan, the lasting and transient pixels).
 ///
 /// addGroundTruth and scoreDepth may be called from different threads (the pipeline's
-/// loading and integration threads); all calls are serialized by one lock. Depth is kept at the
-/// ground-truth pixels as it is scored and reduced to metrics by scores(), so that what later
-/// scans say of a frame's pixels counts for every source.
+/// loading and integration threads); all calls are serialized by one lock. Once scans are given,
+/// a frame's depth waits at its ground-truth pixels until the scans of the kScanWindow frames
+/// after it have marked them (or scores() is asked), so that every source is split alike.
 class ReconstructionEvaluation {
 public:
   /// camera: of the ground truth (camera 0); focal_baseline: f B of the grey pair, for the
@@ -87,8 +87,9 @@ public:
   /// The free space of `frame`'s scan, the LiDAR at T_world_lidar: a true pixel of another frame
   /// within kScanWindow whose return lies in it, in front of the scan's returns around its
   /// direction by more than the scan's skew and D1's threshold (seen from the scan), is
-  /// transient. Frames are given in order; the scans of the last kScanWindow are kept. An empty
-  /// free space is ignored. Throws InvalidInputError for a pose that is not finite.
+  /// transient. Frames are given in order, each scan before its frame's depth is scored; the
+  /// scans of the last kScanWindow are kept. An empty free space is ignored. Throws
+  /// InvalidInputError for a pose that is not finite.
   void addScan(std::size_t frame, const Eigen::Isometry3d& T_world_lidar, const ScanFreeSpace& free_space);
   /// True once a scan was given: the rows' lasting and transient pixels mean something.
   bool splitsTransient() const;
@@ -123,15 +124,24 @@ private:
     Eigen::Isometry3d T_lidar_world;
     ScanFreeSpace free_space;
   };
-  /// One source's depth at each frame's ground-truth pixels.
+  /// Accumulators of one source (static all / within range, moving all / within range, lasting
+  /// and transient within range), and its depth at the pixels of frames later scans may still mark.
   struct Row {
     std::string source;
-    std::map<std::size_t, std::vector<float>> estimates;
+    std::vector<DepthErrorAccumulator> errors;
+    std::map<std::size_t, std::vector<float>> waiting;
   };
   Row& row(const std::string& source);
+  /// Scores `depth` of `frame` into `row`, or keeps it at the truth's pixels while scans to come
+  /// may still mark them.
+  void score(Row& row, std::size_t frame, const FrameTruth& truth, const cv::Mat& depth);
   /// `depth` at the pixels of `truth`.
   std::vector<float> sample(const FrameTruth& truth, const cv::Mat& depth) const;
-  ReconstructionScore score(const Row& row) const;
+  /// Adds `estimates` (at the pixels of `truth`) to `errors`.
+  void accumulate(std::vector<DepthErrorAccumulator>& errors, const FrameTruth& truth,
+                  const std::vector<float>& estimates) const;
+  /// Scores the waiting frames that no scan to come can mark any more.
+  void scoreSettledFrames();
   /// Marks the pixels of `truth` (frame `frame`) that `scan` (of another frame) saw through.
   void markTransient(FrameTruth& truth, const Scan& scan) const;
   void checkImage(const cv::Mat& image, int type, const std::string& what) const;
@@ -146,6 +156,7 @@ private:
   std::map<std::size_t, FrameTruth> frames_;
   std::map<std::size_t, Scan> scans_; ///< the last kScanWindow frames'
   bool splits_transient_ = false;
+  std::size_t last_scan_ = 0;
   std::vector<Row> rows_;
   MeshRasterizer rasterizer_;
   cv::Mat rendered_;
