@@ -402,7 +402,7 @@ private:
       evaluation_ = std::make_unique<msf::ReconstructionEvaluation>(
           msf::PinholeCamera::fromCalibration(source_.calibration(), 0), source_.calibration().focalBaseline(),
           on_rig_.integrator.max_depth_m, holdout_.config().d1);
-    moving_split_ = !request_.holdout && truth_ && truth_->truth().hasMovingMasks();
+    moving_split_ = truth_ && truth_->truth().hasMovingMasks();
     // Protocol 6 renders the whole mesh too.
     if (!streaming())
       sky_ = std::make_unique<msf::SkyScoring>(source_.calibration(), config_.projection, panel_frames_);
@@ -427,14 +427,15 @@ private:
       truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m);
     }
     if (evaluation_) {
+      const cv::Mat moving =
+          moving_split_ ? truth_->truth().movingMask(truth_->truth().indexOf(r.name)) : cv::Mat();
       if (request_.holdout) {
-        evaluation_->addGroundTruth(r.index, r.T_world_cam0, holdout_.take(r.index));
+        evaluation_->addGroundTruth(r.index, r.T_world_cam0, holdout_.take(r.index), moving);
         // The held-out rings do not say what moved; the scans of the frames around them do.
         evaluation_->addScan(r.index, r.T_world_cam0 * source_.calibration().T_cam0_velo, r.scan_free_space);
-      } else
-        evaluation_->addGroundTruth(r.index, r.T_world_cam0, true_depth,
-                                    moving_split_ ? truth_->truth().movingMask(truth_->truth().indexOf(r.name))
-                                                  : cv::Mat());
+      } else {
+        evaluation_->addGroundTruth(r.index, r.T_world_cam0, true_depth, moving);
+      }
       evaluation_->scoreDepth("fused", r.index, r.fused.depth);
     }
     if (source_maps_)

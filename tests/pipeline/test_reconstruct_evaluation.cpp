@@ -125,6 +125,23 @@ TEST(ReconstructEvaluation, HoldoutOnKittiScoresTheMeshesBesideTheFusedDepth) {
   EXPECT_NE(readFile(out.file("config.yaml")).find("heldout_remainder: 2"), std::string::npos);
 }
 
+TEST_F(PipelineTest, SyntheticHoldoutScoresMovingCarsApartAndSplitsTheRestByTheScans) {
+  // Under -holdout the street's held-out rings are the truth; its moving cars are still scored
+  // apart, and the scans split the static pixels in range: few of them transient.
+  msf::test::TempDir out;
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:2 -holdout -panels 0 -o " + out.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string json = readFile(out.file("summary.json"));
+  EXPECT_NE(json.find("\"moving_split\": true"), std::string::npos);
+  EXPECT_NE(json.find("\"transient_split\": true"), std::string::npos);
+  const std::string mesh = rowOf(json, "mesh");
+  const double in_range = jsonNumber(mesh, "gt_pixels", "within_range");
+  EXPECT_GT(jsonNumber(mesh, "gt_pixels", "moving_all"), 100.0);
+  const double transient = jsonNumber(mesh, "gt_pixels", "transient_within_range");
+  EXPECT_EQ(jsonNumber(mesh, "gt_pixels", "lasting_within_range") + transient, in_range);
+  EXPECT_LT(transient, 0.02 * in_range);
+}
+
 TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   // The default street has moving cars: their pixels (gt/moving_0) are scored apart, and the
   // ghost figure counts the mesh's vertices where a car was (gt/moving_objects.txt).
