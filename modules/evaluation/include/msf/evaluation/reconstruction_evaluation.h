@@ -142,7 +142,7 @@ private:
                   const std::vector<float>& estimates) const;
   /// Scores the waiting frames that no scan to come can mark any more.
   void scoreSettledFrames();
-  /// Marks the pixels of `truth` (frame `frame`) that `scan` (of another frame) saw through.
+  /// Marks the pixels of `truth` that `scan`, of another frame, saw through.
   void markTransient(FrameTruth& truth, const Scan& scan) const;
   void checkImage(const cv::Mat& image, int type, const std::string& what) const;
   /// 2 when all true depth around p_cam's pixel lies behind it (D1), 1 when some does not, 0
