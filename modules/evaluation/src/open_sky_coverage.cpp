@@ -80,8 +80,7 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
       const auto u = static_cast<float>(p % static_cast<std::uint32_t>(camera_.width));
       const auto v = static_cast<float>(p / static_cast<std::uint32_t>(camera_.width));
       const float z = depth[p];
-      return !counts ||
-             counts(T * Eigen::Vector3f((u - camera_.cx) * z / camera_.fx, (v - camera_.cy) * z / camera_.fy, z));
+      return !counts || counts(T * camera_.point(u, v, z));
     };
     std::size_t covered = 0;
     for (std::size_t r = 0; r < sky.runs.size(); r += 2)

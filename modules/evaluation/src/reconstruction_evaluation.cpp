@@ -95,14 +95,13 @@ bool ReconstructionEvaluation::splitsTransient() const {
 }
 
 void ReconstructionEvaluation::markTransient(FrameTruth& truth, const Scan& scan) const {
-  const Eigen::Isometry3d T_lidar_cam = scan.T_lidar_world * truth.T_world_cam;
+  const Eigen::Isometry3f T_lidar_cam = (scan.T_lidar_world * truth.T_world_cam).cast<float>();
   const auto width = static_cast<std::uint32_t>(camera_.width);
   for (std::size_t k = 0; k < truth.pixels.size(); ++k) {
     const std::uint32_t pixel = truth.pixels[k] & kPixel;
-    const double z = truth.depth[k];
-    const Eigen::Vector3d p_cam((pixel % width - camera_.cx) * z / camera_.fx,
-                                (pixel / width - camera_.cy) * z / camera_.fy, z);
-    const Eigen::Vector3f p = (T_lidar_cam * p_cam).cast<float>();
+    const Eigen::Vector3f p_cam = camera_.point(static_cast<float>(pixel % width), static_cast<float>(pixel / width),
+                                                truth.depth[k]);
+    const Eigen::Vector3f p = T_lidar_cam * p_cam;
     const double behind = scan.free_space.nearestAround(p) - scan.free_space.skew();
     const double range = p.norm();
     // Seen from the scan as protocol 4 sees depth: its returns lie a D1 outlier behind this one.

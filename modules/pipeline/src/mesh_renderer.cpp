@@ -32,7 +32,7 @@ cv::Mat MeshRenderer::render(const TriangleMesh& mesh, const Eigen::Isometry3d& 
       if (!(n2 > 0.f))
         continue;
       const float z = depth.at<float>(y, x);
-      const Eigen::Vector3f p((x - camera.cx) * z / camera.fx, (y - camera.cy) * z / camera.fy, z);
+      const Eigen::Vector3f p = camera.point(static_cast<float>(x), static_cast<float>(y), z);
       // Lambert-like shading toward the viewer, both sides lit.
       const float shade = 0.35f + 0.65f * std::abs(normal.dot(p.normalized())) / std::sqrt(n2);
       float r = 170.f, g = 170.f, bl = 170.f;

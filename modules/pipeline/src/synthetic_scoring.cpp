@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/fusion/sky_mask.h>
 #include <msf/io/cloud_io.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/synthetic_scoring.h>
 #include <msf/synthetic/kitti_rig.h>
 
@@ -104,14 +105,13 @@ void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth,
   // Every 4th pixel of the true static surface in range, for the mesh's completeness against
   // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
   const cv::Mat moving = truth_->movingMask(gt_index);
-  const float fx = static_cast<float>(calibration.fx()), fy = static_cast<float>(calibration.fy());
-  const float cx = static_cast<float>(calibration.cx()), cy = static_cast<float>(calibration.cy());
+  const PinholeCamera camera = PinholeCamera::fromCalibration(calibration, 0);
   const Eigen::Isometry3f T = r.T_world_cam0.cast<float>();
   for (int v = 0; v < true_depth.rows; v += 4)
     for (int u = 0; u < true_depth.cols; u += 4) {
       const float z = true_depth.at<float>(v, u);
       if (z > 0.f && z <= max_depth_m && moving.at<std::uint8_t>(v, u) == 0) {
-        seen_surface_.push_back(T * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
+        seen_surface_.push_back(T * camera.point(static_cast<float>(u), static_cast<float>(v), z));
         seen_depth_.push_back(z);
       }
     }

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/synthetic/ground_truth.h>
 #include <msf/synthetic/seen_surface.h>
 
@@ -16,9 +17,7 @@ void SeenSurface::add(const Sequence& sequence, const std::vector<std::size_t>& 
   if (!sequence.hasPoses())
     throw IOError("sequence '" + sequence.directory() + "' has no poses to place its ground truth with");
   const GroundTruth truth(sequence.groundTruthDir());
-  const Calibration& c = sequence.calibration();
-  const float fx = static_cast<float>(c.fx()), fy = static_cast<float>(c.fy());
-  const float cx = static_cast<float>(c.cx()), cy = static_cast<float>(c.cy());
+  const PinholeCamera camera = PinholeCamera::fromCalibration(sequence.calibration(), 0);
   const float far = static_cast<float>(max_depth_m);
   for (const std::size_t i : frames) {
     const std::size_t k = truth.indexOf(sequence.frameName(i));
@@ -29,7 +28,7 @@ void SeenSurface::add(const Sequence& sequence, const std::vector<std::size_t>& 
         const float z = depth.at<float>(v, u);
         if (!(z > 0.f) || z > far || moving.at<std::uint8_t>(v, u) != 0)
           continue;
-        points.push_back(T_world_cam0 * Eigen::Vector3f((u - cx) * z / fx, (v - cy) * z / fy, z));
+        points.push_back(T_world_cam0 * camera.point(static_cast<float>(u), static_cast<float>(v), z));
         depths.push_back(z);
       }
   }

@@ -2,6 +2,7 @@
 #pragma once
 #include <msf/io/calibration.h>
 
+#include <Eigen/Core>
 #include <opencv2/core/types.hpp>
 #include <pcl/point_cloud.h>
 
@@ -16,6 +17,8 @@ struct PinholeCamera {
   int width = 0, height = 0;
 
   bool valid() const { return fx > 0.f && fy > 0.f && width > 0 && height > 0; }
+  /// The point the camera sees at pixel (u, v) with depth z, in its frame.
+  Eigen::Vector3f point(float u, float v, float z) const { return {(u - cx) * z / fx, (v - cy) * z / fy, z}; }
   /// Camera `camera` (0..3) of a calibration; throws CalibrationError when the calibration
   /// has no image size, InvalidInputError for a camera index out of range.
   static PinholeCamera fromCalibration(const Calibration& calibration, int camera = 0);
