@@ -43,7 +43,7 @@ lidar_truth() {
   local name=$1 calib=$2 scan=$3 frame=$4
   shift 4
   mkdir -p "$out/$name/gt"
-  quiet "$out/$name/project.log" "$bin/msf_project" "$scan" "$out/$name/scan.pcd" -calib "$calib" "$@"
+  quiet "$out/$name/project.log" "$bin/msf_project" "$scan" "$out/$name/scan.pcd" -calib "$calib" -overwrite "$@"
   quiet "$out/$name/png.log" "$bin/msf_pcd2png" "$out/$name/scan.pcd" "$out/$name/gt/$frame.png" -disparity \
     -calib "$calib"
 }

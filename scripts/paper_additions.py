@@ -92,7 +92,7 @@ def depth_figures(bin_dir, dataset, frames, config, work):
     """Protocol 2 of `config`'s steps 1-4: (D1 % with missing = bad, MAE m); the street's all pixels."""
     table = os.path.join(work, "rows.csv")
     run([os.path.join(bin_dir, "msf_holdout"), dataset, "-frames", frames, "-methods", "fused", "-config", config,
-         "-csv", table])
+         "-csv", table, "-overwrite"])
     for row in csv.DictReader(open(table)):
         if row.get("region", "all") == "all":
             return 100 * float(row["d1_all"]), float(row["mae_m"])

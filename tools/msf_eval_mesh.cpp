@@ -47,6 +47,7 @@ void writeJson(const std::string& path, const msf::MeshAccuracy& a, std::size_t 
 int main(int argc, char** argv) {
   std::string frames = "0:", json;
   double max_depth_m = 40.0, threshold_m = 0.2;
+  bool overwrite = false;
   msf::tool::CommandLine cli(
       "msf_eval_mesh", "<mesh.ply> <synthetic sequence>... [options]",
       "Scores a mesh against the true surface of synthetic sequences of one world (msf_synth, the same -seed and "
@@ -57,10 +58,12 @@ int main(int argc, char** argv) {
   cli.value("-frames", "a:b", frames, "the frames of each sequence that saw the surface (default {default})")
       .value("-max_depth", "M", max_depth_m, "the depth up to which a frame saw the surface (default {default} m)")
       .value("-threshold", "T", threshold_m, "completeness and precision distance (default {default} m)")
-      .value("-o", "FILE", json, "also write the scores as JSON");
+      .value("-o", "FILE", json, "also write the scores as JSON")
+      .overwriteOption(overwrite);
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& args) {
     if (!(max_depth_m > 0) || !(threshold_m > 0))
       throw msf::InvalidInputError("-max_depth and -threshold must be > 0");
+    msf::tool::requireNewOutputs({json}, overwrite);
     pcl::console::TicToc tt;
     tt.tic();
     print_highlight("Reading the truth ");

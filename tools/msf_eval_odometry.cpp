@@ -45,6 +45,7 @@ msf::PoseList loadReference(const std::string& path, const std::string& frames_t
 
 int main(int argc, char** argv) {
   std::string plot_path, frames_text;
+  bool overwrite = false;
   msf::tool::CommandLine cli(
       "msf_eval_odometry", "est.txt REFERENCE [options]",
       "Scores an estimated trajectory (KITTI poses format: T_world_cam0, a 3x4 row-major matrix a line, one line per "
@@ -59,7 +60,8 @@ int main(int argc, char** argv) {
             "(msf_odometry -frames a:b)")
       .value("-plot", "FILE", plot_path,
              "PNG of both trajectories from above, in the reference's first camera frame (default: next to est.txt, "
-             "<name>_trajectory.png)");
+             "<name>_trajectory.png)")
+      .overwriteOption(overwrite);
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 2)
       throw msf::InvalidInputError("expected est.txt and a reference, got " + std::to_string(positional.size()) +
@@ -71,6 +73,7 @@ int main(int argc, char** argv) {
     }
     if (msf::fileExtension(plot_path) != ".png")
       throw msf::InvalidInputError("-plot '" + plot_path + "': the picture is a .png");
+    msf::tool::requireNewOutputs({plot_path}, overwrite);
 
     const msf::PoseList estimate = msf::loadOdometryPoses(estimate_path);
     const msf::PoseList reference = loadReference(reference_path, frames_text);

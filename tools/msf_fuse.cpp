@@ -69,7 +69,7 @@ void loadStereo(const std::string& path, pcl::PointCloud<msf::PointXYZRGBConfide
 /// What the command line sets.
 struct Settings {
   std::string calib_path, image_size_text, color_path, left_path;
-  bool print_config = false;
+  bool print_config = false, overwrite = false;
   msf::DepthFusionConfig config;
   msf::RigAdaptationConfig rig;
 };
@@ -88,6 +88,7 @@ msf::Calibration configure(const msf::tool::Arguments& files, Settings& settings
   const std::string ext = msf::fileExtension(files[2]);
   if (ext != ".pcd" && ext != ".ply")
     throw msf::InvalidInputError("output '" + files[2] + "' must end in .pcd or .ply");
+  msf::tool::requireNewOutputs({files[2]}, settings.overwrite);
   const cv::Size image_size = msf::parseImageSize(settings.image_size_text);
   if (settings.calib_path.empty())
     throw msf::InvalidInputError("-calib PATH is required (focal length and baseline of the grey pair)");
@@ -184,6 +185,7 @@ int main(int argc, char** argv) {
       .value("-left", "PATH", settings.left_path,
              "camera 0's grey image (image_0): a LiDAR-backed wall goes on upward over the blank pixels above it "
              "(fusion.facade_extension), as in msf_reconstruct")
-      .flag("-print_config", settings.print_config, "print the fusion settings in use");
+      .flag("-print_config", settings.print_config, "print the fusion settings in use")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) { return run(files, settings); });
 }

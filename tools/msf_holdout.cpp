@@ -326,7 +326,7 @@ using NamedMethods = std::vector<std::pair<std::string, msf::HoldoutMethod>>;
 /// What the command line sets.
 struct Settings {
   std::string frames_text = "0:", methods_text, config_path, csv_path, bounds_text;
-  bool gt_switch = false, holdout_switch = false, breakdown = false;
+  bool gt_switch = false, holdout_switch = false, breakdown = false, overwrite = false;
 };
 
 /// The help of -methods: the table's methods, a line each.
@@ -359,6 +359,7 @@ bool chooseFullImageMode(const msf::tool::CommandLine& cli, const std::string& s
                                  "' by ring hold-out)");
   if (!settings.csv_path.empty() && msf::fileExtension(settings.csv_path) != ".csv")
     throw msf::InvalidInputError("-csv '" + settings.csv_path + "' must end in .csv");
+  msf::tool::requireNewOutputs({settings.csv_path}, settings.overwrite);
   return gt_mode;
 }
 
@@ -485,7 +486,8 @@ int main(int argc, char** argv) {
             "ring hold-out: also each method's rows for the ground truth that camera 0 sees (visible) and cannot see "
             "(hidden: an input return within 1 px in front of it), and for the depth bands < 20, 20-40, >= 40 m; "
             "'MAE part' adds up to the MAE; and the share of estimates off by >= 10 m (another surface) with their "
-            "part of it");
+            "part of it")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1,
                  [&](const msf::tool::Arguments& positional) { return run(cli, positional, settings); });
 }

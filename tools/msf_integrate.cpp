@@ -62,7 +62,7 @@ struct Settings {
   msf::TsdfIntegrator::Config config;
   msf::DepthFusionConfig fusion; // the LiDAR's range noise weighs a scan's free space
   msf::RigAdaptationConfig rig;
-  bool carving = false, no_carving = false, print_config = false;
+  bool carving = false, no_carving = false, print_config = false, overwrite = false;
 };
 
 /// What is integrated: the i-th depth cloud seen from the i-th pose, with the i-th scan when
@@ -88,6 +88,7 @@ std::vector<std::string> listClouds(const msf::tool::CommandLine& cli, const msf
   }
   if (msf::fileExtension(settings.output) != ".pcd")
     throw msf::InvalidInputError("output '" + settings.output + "' must be a .pcd file");
+  msf::tool::requireNewOutputs({settings.output}, settings.overwrite);
   return clouds;
 }
 
@@ -293,7 +294,8 @@ int main(int argc, char** argv) {
             std::string("space carving on: voxels seen in front of the surface become free (default ") +
                 (config.space_carving ? "on" : "off") + "; tsdf_integrator.space_carving)")
       .flag("-no_carving", settings.no_carving, "space carving off")
-      .flag("-print_config", settings.print_config, "print the configuration in use");
+      .flag("-print_config", settings.print_config, "print the configuration in use")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     return run(cli, positional, settings, argv[0]);
   });

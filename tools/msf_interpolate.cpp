@@ -42,7 +42,7 @@ struct Settings {
   msf::InterpolationConfig interpolation;
   msf::IpBasicConfig ip_basic;
   msf::RigAdaptationConfig rig;
-  bool no_gaussian = false, canvas = false;
+  bool no_gaussian = false, canvas = false, overwrite = false;
 };
 
 /// The method and the calibration, if any; configure() sets the stages' configs for them.
@@ -124,6 +124,7 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
     throw msf::InvalidInputError("input '" + in + "' must be a .pcd cloud or a KITTI .bin scan");
   if (msf::fileExtension(out) != ".pcd")
     throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
+  msf::tool::requireNewOutputs({out}, settings.overwrite);
   const Completion completion = configure(settings);
 
   // A .bin is a scan; a .pcd is a scan when it is not organized.
@@ -208,6 +209,7 @@ int main(int argc, char** argv) {
             "takes around the fused image (msf_fuse then writes the frame msf_reconstruct integrates)")
       .flag("-no_gaussian", settings.no_gaussian,
             "no Gaussian hole filling after the slices (interpolation.gaussian: false)")
-      .value("-threads", "N", interpolation.threads, "at most N threads of OpenCV's pool (0: all)");
+      .value("-threads", "N", interpolation.threads, "at most N threads of OpenCV's pool (0: all)")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) { return run(files, settings); });
 }

@@ -54,14 +54,15 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
 
 int main(int argc, char** argv) {
   std::string input_dir, output_dir;
-  bool ascii = false;
+  bool ascii = false, overwrite = false;
   msf::tool::CommandLine cli(
       "msf_kitti2pcd", "<scan.bin> <out.pcd> [options]\n-input_dir DIR -output_dir DIR [options]",
       "Reads KITTI Velodyne scans (float32 x, y, z, reflectance) into pcl::PointXYZI clouds, in file order (which "
       "carries the ring structure). Records with NaN or Inf are dropped.");
   cli.value("-input_dir", "DIR", input_dir, "convert every *.bin of DIR ...")
       .value("-output_dir", "DIR", output_dir, "... into DIR/<name>.pcd (DIR: absent, empty, or written by an earlier batch, which it replaces)")
-      .flag("-ascii", ascii, "write ASCII .pcd instead of binary compressed");
+      .flag("-ascii", ascii, "write ASCII .pcd instead of binary compressed")
+      .overwriteOption(overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (!input_dir.empty() || !output_dir.empty()) {
       if (input_dir.empty() || output_dir.empty())
@@ -88,6 +89,7 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("expected <scan.bin> <out.pcd> (see -h)");
     if (msf::fileExtension(files[1]) != ".pcd")
       throw msf::InvalidInputError("output '" + files[1] + "' must end in .pcd");
+    msf::tool::requireNewOutputs({files[1]}, overwrite);
     convert(files[0], files[1], ascii);
     return 0;
   });

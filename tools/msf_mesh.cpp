@@ -30,6 +30,7 @@ struct Settings {
   msf::MarchingCubes::Config config;
   double voxel = 0, trunc = 0;
   std::string region;
+  bool overwrite = false;
 };
 
 /// A streamed store: tile by tile (the small-piece filter is not applied across tiles).
@@ -89,6 +90,7 @@ int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& files, co
   const std::string ext = msf::fileExtension(files[1]);
   if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
     throw msf::InvalidInputError("output mesh '" + files[1] + "' must end in .ply, .obj or .vtk");
+  msf::tool::requireNewOutputs({files[1]}, settings.overwrite);
   const msf::MarchingCubes::Config& config = settings.config;
   msf::MarchingCubes mesher(config);
   if (std::filesystem::is_directory(files[0]))
@@ -173,7 +175,8 @@ int main(int argc, char** argv) {
              "and checked if given)")
       .value("-trunc", "T", settings.trunc, "its truncation (m), as -voxel")
       .value("-region", "x0,y0,z0,x1,y1,z1", settings.region,
-             "a store's tiles within this box only (metres, world frame)");
+             "a store's tiles within this box only (metres, world frame)")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1,
                  [&](const msf::tool::Arguments& files) { return run(cli, files, settings, argv[0]); });
 }

@@ -41,7 +41,7 @@ void printMetrics(const msf::OdometryMetrics& m) {
 /// What the command line sets.
 struct Settings {
   std::string output, config_path, frames_text = "0:";
-  bool print_config = false;
+  bool print_config = false, overwrite = false;
 };
 
 /// Camera 0's pose of each frame tracked, and the time each scan's registration took.
@@ -105,6 +105,7 @@ int run(const msf::tool::Arguments& positional, const Settings& settings) {
                                  " positional arguments (see -h)");
   if (settings.output.empty())
     throw msf::InvalidInputError("no output file: give -o poses.txt");
+  msf::tool::requireNewOutputs({settings.output}, settings.overwrite);
   msf::LidarOdometry::Config config;
   if (!settings.config_path.empty())
     msf::readConfigSection(settings.config_path, config);
@@ -147,6 +148,7 @@ int main(int argc, char** argv) {
   cli.value("-o", "FILE", settings.output, "output poses file (written whole or not at all)")
       .value("-frames", "a:b", settings.frames_text, "frame range, inclusive (default: all)")
       .value("-config", "FILE", settings.config_path, "YAML configuration; its `odometry` section (config/kitti.yaml)")
-      .flag("-print_config", settings.print_config, "print the configuration in effect");
+      .flag("-print_config", settings.print_config, "print the configuration in effect")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) { return run(positional, settings); });
 }

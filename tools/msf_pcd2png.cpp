@@ -22,7 +22,7 @@ using namespace pcl::console;
 
 int main(int argc, char** argv) {
   std::string calib_path;
-  bool disparity = false, colour = false;
+  bool disparity = false, colour = false, overwrite = false;
   double range_min = 0, range_max = 0;
   msf::tool::CommandLine cli("msf_pcd2png", "<organized.pcd> <out.png> [options]",
                              "Writes the z of each pixel of an organized cloud (NaN = no depth) as a picture: by "
@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
                    !std::isfinite(range_min) || !std::isfinite(range_max) || range_max <= range_min)
                  throw msf::InvalidInputError("-range must be MIN,MAX in metres with MIN < MAX");
              },
-             "colour range in metres for -color (default: 2nd-98th percentile)");
+             "colour range in metres for -color (default: 2nd-98th percentile)")
+      .overwriteOption(overwrite);
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <organized.pcd> <out.png> (see -h)");
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("-disparity and -color exclude each other");
     if (disparity && calib_path.empty())
       throw msf::InvalidInputError("-disparity needs -calib PATH (the focal length and baseline)");
+    msf::tool::requireNewOutputs({files[1]}, overwrite);
 
     TicToc tt;
     tt.tic();

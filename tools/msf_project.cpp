@@ -19,6 +19,7 @@ using namespace pcl::console;
 
 int main(int argc, char** argv) {
   std::string calib_path, image_size_text;
+  bool overwrite = false;
   msf::ProjectionConfig config;
   msf::tool::CommandLine cli("msf_project", "<scan.bin|scan.pcd> <out.pcd> -calib PATH [options]",
                              "Projects a Velodyne scan (velodyne frame, KITTI .bin or PointXYZI .pcd) into an "
@@ -33,7 +34,8 @@ int main(int argc, char** argv) {
              "rectified camera 0..3 (default: {default}, or projection.camera of -config)")
       .value("-min_range", "M", config.min_range_m,
              "drop returns closer than M metres to the LiDAR (default {default})")
-      .value("-max_range", "M", config.max_range_m, "drop returns farther than M metres (default {default})");
+      .value("-max_range", "M", config.max_range_m, "drop returns farther than M metres (default {default})")
+      .overwriteOption(overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& files) {
     if (files.size() != 2)
       throw msf::InvalidInputError("expected <scan.bin|scan.pcd> <out.pcd> (see -h)");
@@ -43,6 +45,7 @@ int main(int argc, char** argv) {
       throw msf::InvalidInputError("input '" + in + "' must be a KITTI .bin scan or a .pcd cloud");
     if (msf::fileExtension(out) != ".pcd")
       throw msf::InvalidInputError("output '" + out + "' must end in .pcd");
+    msf::tool::requireNewOutputs({out}, overwrite);
     const cv::Size image_size = msf::parseImageSize(image_size_text);
     if (calib_path.empty())
       throw msf::InvalidInputError("-calib PATH is required: the projection needs the camera and T_cam0_velo");

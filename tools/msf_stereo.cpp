@@ -65,7 +65,7 @@ void loadPrior(const std::string& path, bool guided, cv::Mat& prior, cv::Mat& gu
 /// What the command line sets.
 struct Settings {
   std::string calib_path, image_size_text, color_path, disparity_path, prior_path;
-  bool print_config = false;
+  bool print_config = false, overwrite = false;
   msf::SgbmConfig config;
   msf::RigAdaptationConfig rig;
 };
@@ -87,6 +87,7 @@ msf::Calibration configure(const msf::tool::Arguments& files, Settings& settings
     throw msf::InvalidInputError("-calib PATH is required (focal length, baseline, colour camera)");
   if (!settings.disparity_path.empty() && msf::fileExtension(settings.disparity_path) != ".png")
     throw msf::InvalidInputError("-disparity_png '" + settings.disparity_path + "' must end in .png");
+  msf::tool::requireNewOutputs({files[2], settings.disparity_path}, settings.overwrite);
   settings.config.validate();
   msf::Calibration calibration = msf::loadCalibration(settings.calib_path, image_size);
   msf::adaptToRig(settings.config, msf::rigAdaptation(settings.rig, calibration));
@@ -191,6 +192,7 @@ int main(int argc, char** argv) {
              "the paths, guided or not: ground_3way | sgbm (5 paths) | sgbm_3way | hh | hh4 (default: sgbm guided by "
              "-prior, ground_3way without)")
       .flag("-lr_check", config.left_right_check, "drop matches that fail a left-right check (twice the time)")
-      .flag("-print_config", settings.print_config, "print the stereo settings in use");
+      .flag("-print_config", settings.print_config, "print the stereo settings in use")
+      .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 3, [&](const msf::tool::Arguments& files) { return run(files, settings); });
 }

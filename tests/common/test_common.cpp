@@ -249,4 +249,30 @@ TEST(Tool, RunShowsTheHelpOrRunsTheBody) {
             1);
 }
 
+TEST(Tool, AnOutputFileThatExistsIsRefusedUnlessOverwriteIsGiven) {
+  msf::test::TempDir dir;
+  writeText(dir.file("mine.pcd"), "the user's");
+  std::filesystem::create_directory(dir.file("folder.pcd"));
+  bool overwrite = false;
+  msf::tool::CommandLine cli("msf_test", "<out.pcd>", "Test.");
+  cli.overwriteOption(overwrite);
+  Argv plain({"tool", "x"}), forced({"tool", "x", "-overwrite"});
+  cli.parse(plain.argc(), plain.argv());
+  msf::tool::requireNewOutputs({"", dir.file("new.pcd")}, overwrite); // absent or not asked for: fine
+  try {
+    msf::tool::requireNewOutputs({dir.file("new.pcd"), dir.file("mine.pcd")}, overwrite);
+    FAIL() << "expected IOError";
+  } catch (const msf::IOError& e) {
+    EXPECT_EQ(std::string(e.what()), "output '" + dir.file("mine.pcd") + "' exists; give -overwrite to replace it");
+  }
+  cli.parse(forced.argc(), forced.argv());
+  ASSERT_TRUE(overwrite);
+  msf::tool::requireNewOutputs({dir.file("mine.pcd")}, overwrite);
+  EXPECT_THROW(msf::tool::requireNewOutputs({dir.file("folder.pcd")}, overwrite), msf::IOError);
+  std::ifstream in(dir.file("mine.pcd"));
+  std::string first;
+  in >> first;
+  EXPECT_EQ(first, "the");
+}
+
 } // namespace

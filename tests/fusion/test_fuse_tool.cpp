@@ -71,7 +71,7 @@ TEST(FuseTool, FusesTwoOrganizedCloudsWithBothMethods) {
   Files f;
   for (const char* method : {"paper", "uncertainty"}) {
     const auto r = msf::test::runTool("msf_fuse", f.lidar + " " + f.stereo + " " + f.out + " -calib " + f.calib +
-                                                      " -method " + method);
+                                                      " -method " + method + " -overwrite");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     pcl::PointCloud<msf::PointXYZRGBWeight> fused;
     msf::loadCloud(f.out, fused); // the file has x y z rgb weight
@@ -143,7 +143,7 @@ TEST(FuseTool, TheLeftImageContinuesABlankWallUpward) {
       EXPECT_GT(p.weight, 0.f);
       EXPECT_LT(p.weight, fused.at(u, 45).weight); // less sure than the LiDAR
     }
-  r = msf::test::runTool("msf_fuse", inputs + " -calib " + f.calib);
+  r = msf::test::runTool("msf_fuse", inputs + " -calib " + f.calib + " -overwrite");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   msf::loadCloud(f.out, fused);
   EXPECT_FALSE(std::isfinite(fused.at(5, 10).z));

@@ -149,7 +149,7 @@ TEST(PaperConfig, RowsOnTheSharedFramesAreTheDocumentedOnes) {
       methods += (methods.empty() ? "" : ",") + row->method;
     const auto r = msf::test::runTool("msf_holdout", msf::test::kittiDir() + "/" + run.first + " -frames " +
                                                          run.second + " -methods " + methods + " -csv " +
-                                                         dir.file("rows.csv"));
+                                                         dir.file("rows.csv") + " -overwrite");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto measured = holdoutRows(dir.file("rows.csv"));
     for (const DocumentedRow* row : expected) {

@@ -482,7 +482,7 @@ check "project: a 2 GB sparse scan file" 1 "huge.bin' has 134217728 records \(21
   msf_project "$F/huge.bin" o.pcd -calib "$F/camera.yaml"
 check "project: NaN reflectance everywhere" 1 "nan_reflectance.bin': each of its 100 records has a value that is not finite" -- \
   msf_project "$F/nan_reflectance.bin" o.pcd -calib "$F/camera.yaml"
-check "pcd2png: the output is a folder" 1 "folder.png': rename failed: Is a directory" -- \
+check "pcd2png: the output is a folder" 1 "output '.*folder.png' is a folder, not a file" -- \
   msf_pcd2png "$F/dense.pcd" "$F/folder.png"
 check "info --version" 0 "^msf_info \(msfusion\) [0-9]+\.[0-9]+\.[0-9]+, commit ([0-9a-f]{12}(-dirty)?|unknown)$" -- msf_info --version
 
@@ -664,6 +664,8 @@ if [ $have_kitti = 1 ]; then
   head -n 1 "$KITTI/odometry/poses/04.txt" >"$D/poses/04.txt"
   echo "my notes" >"$D/home/notes.txt" && echo "a,b" >"$D/home/data.csv" &&
     printf '%%YAML:1.0\npipeline:\n  queue_capacity: 2\n' >"$D/home/my.yaml" && cp "$D/seq/image_2/000000.png" "$D/home/photo.png"
+  mkdir -p "$D/mine/folder.pcd" && cp "$F/dense.pcd" "$D/mine/cloud.pcd" && cp "$F/bomb.ply" "$D/mine/mesh.ply" &&
+    cp "$D/home/notes.txt" "$D/home/data.csv" "$D/home/photo.png" "$D/mine/"
   before=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
   check "reconstruct -o HOME/. over a user's files" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/home/."
@@ -691,8 +693,42 @@ if [ $have_kitti = 1 ]; then
     msf_kitti2pcd -input_dir "$D/seq/velodyne" -output_dir "$D/home"
   check "lambda_study -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_lambda_study -frames 1 -o "$D/home"
+  # A file the user names as a tool's output is theirs: refused unless -overwrite says otherwise.
+  check "project over a user's .pcd" 1 "output '.*/mine/cloud.pcd' exists; give -overwrite to replace it" -- \
+    msf_project "$SCAN" "$D/mine/cloud.pcd" -calib "$SEQ/calib.txt"
+  check "project into a folder named .pcd" 1 "output '.*/mine/folder.pcd' is a folder, not a file" -- \
+    msf_project "$SCAN" "$D/mine/folder.pcd" -calib "$SEQ/calib.txt" -overwrite
+  check "interpolate over a user's .pcd" 1 "output '.*/mine/cloud.pcd' exists; give -overwrite" -- \
+    msf_interpolate "$SCAN" "$D/mine/cloud.pcd" -calib "$SEQ/calib.txt"
+  check "kitti2pcd over a user's .pcd" 1 "output '.*/mine/cloud.pcd' exists; give -overwrite" -- \
+    msf_kitti2pcd "$SCAN" "$D/mine/cloud.pcd"
+  check "stereo -disparity_png over a user's photo" 1 "output '.*/mine/photo.png' exists; give -overwrite" -- \
+    msf_stereo "$L" "$R" o.pcd -calib "$SEQ/calib.txt" -disparity_png "$D/mine/photo.png"
+  check "fuse over a user's .pcd" 1 "output '.*/mine/cloud.pcd' exists; give -overwrite" -- \
+    msf_fuse "$F/dense.pcd" "$F/dense.pcd" "$D/mine/cloud.pcd" -calib "$F/camera.yaml"
+  check "pcd2png over a user's photo" 1 "output '.*/mine/photo.png' exists; give -overwrite" -- \
+    msf_pcd2png "$F/dense.pcd" "$D/mine/photo.png"
+  check "integrate -o over a user's .pcd" 1 "output '.*/mine/cloud.pcd' exists; give -overwrite" -- \
+    msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o "$D/mine/cloud.pcd"
+  check "mesh over a user's .ply" 1 "output '.*/mine/mesh.ply' exists; give -overwrite" -- \
+    msf_mesh "$F/dense.pcd" "$D/mine/mesh.ply"
+  check "odometry -o over a user's notes" 1 "output '.*/mine/notes.txt' exists; give -overwrite" -- \
+    msf_odometry "$SEQ" -frames 0:1 -o "$D/mine/notes.txt"
+  check "holdout -csv over a user's .csv" 1 "output '.*/mine/data.csv' exists; give -overwrite" -- \
+    msf_holdout "$SEQ" -frames 0:0 -csv "$D/mine/data.csv"
+  check "eval_odometry -plot over a user's photo" 1 "output '.*/mine/photo.png' exists; give -overwrite" -- \
+    msf_eval_odometry "$D/poses/04.txt" "$D/poses/04.txt" -plot "$D/mine/photo.png"
+  check "eval_mesh -o over a user's notes" 1 "output '.*/mine/notes.txt' exists; give -overwrite" -- \
+    msf_eval_mesh "$F/bomb.ply" "$SEQ" -o "$D/mine/notes.txt"
   after=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
-  if [ "$before" != "$after" ] || [ -n "$(ls -A "$D" | grep -v -x -e seq -e poses -e home)" ]; then
+  cp "$F/dense.pcd" "$T/replaced.pcd"
+  check "project -overwrite replaces a file" 0 "Projecting" -- \
+    msf_project "$SCAN" "$T/replaced.pcd" -calib "$SEQ/calib.txt" -overwrite
+  if cmp -s "$F/dense.pcd" "$T/replaced.pcd"; then
+    failures=$((failures + 1))
+    echo "FAIL  project -overwrite left the file as it was"
+  fi
+  if [ "$before" != "$after" ] || [ -n "$(ls -A "$D" | grep -v -x -e seq -e poses -e home -e mine)" ]; then
     failures=$((failures + 1))
     echo "FAIL  data loss: a user's folder changed"
     diff <(echo "$before") <(echo "$after") | head
@@ -703,7 +739,10 @@ else
            reconstruct-right reconstruct-empty-scan reconstruct-missing-color reconstruct-nan kitti2pcd-batch reconstruct-foreign reconstruct-failed-in-out \
            dataloss-dot dataloss-image2 dataloss-poses dataloss-poses-input dataloss-config-input dataloss-dataset \
            dataloss-synth dataloss-kitti2pcd dataloss-lambda odometry-stray-files odometry-beyond-poses \
-           dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth; do
+           dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth overwrite-project overwrite-folder \
+           overwrite-interpolate overwrite-kitti2pcd overwrite-stereo overwrite-fuse overwrite-pcd2png \
+           overwrite-integrate overwrite-mesh overwrite-odometry overwrite-holdout overwrite-eval-odometry \
+           overwrite-eval-mesh overwrite-replaces; do
     skip "$c"
   done
 fi

@@ -62,7 +62,7 @@ TEST(StereoTool, ConfigSectionAndOverrides) {
   EXPECT_NE(r.out.find("(64 disparities)"), std::string::npos) << r.out;
   // A flag overrides the file.
   r = msf::test::runTool("msf_stereo", s.left + " " + s.right + " " + s.out + " -calib " + s.calib + " -config " +
-                                           config + " -num_disparities 32");
+                                           config + " -num_disparities 32 -overwrite");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(32 disparities)"), std::string::npos) << r.out;
 }
@@ -84,7 +84,7 @@ TEST(StereoTool, APriorGuidesThroughItsRealReturnsOnly) {
   auto r = msf::test::runTool("msf_stereo", s.args("-prior " + guided));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("distance"), std::string::npos) << r.err;
-  r = msf::test::runTool("msf_stereo", s.args("-prior " + plain));
+  r = msf::test::runTool("msf_stereo", s.args("-prior " + plain + " -overwrite"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("has no field 'distance'"), std::string::npos) << r.err;
   EXPECT_TRUE(msf::test::fileExists(s.out));

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -191,6 +192,10 @@ CommandLine& CommandLine::note(const std::string& text) {
   return *this;
 }
 
+CommandLine& CommandLine::overwriteOption(bool& target) {
+  return flag("-overwrite", target, "replace output files that exist (without it, they are refused before the run)");
+}
+
 void CommandLine::printHelp(const char* program) const {
   std::istringstream forms(usage_);
   std::string form;
@@ -274,6 +279,19 @@ int CommandLine::run(int argc, char** argv, int min_arguments, const std::functi
     return help ? 0 : 1;
   }
   return tool::run(name_.c_str(), [&] { return body(parse(argc, argv)); });
+}
+
+void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite) {
+  for (const std::string& path : outputs) {
+    std::error_code ec;
+    const auto status = std::filesystem::symlink_status(path, ec);
+    if (path.empty() || !std::filesystem::exists(status))
+      continue;
+    if (std::filesystem::is_directory(std::filesystem::status(path, ec)))
+      throw IOError("output '" + path + "' is a folder, not a file");
+    if (!overwrite)
+      throw IOError("output '" + path + "' exists; give -overwrite to replace it");
+  }
 }
 
 void printDone(double milliseconds, std::size_t points) {

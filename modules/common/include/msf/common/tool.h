@@ -60,6 +60,9 @@ public:
   CommandLine& flag(const std::string& option, bool& target, const std::string& help);
   /// A paragraph of the help after the options.
   CommandLine& note(const std::string& text);
+  /// Declares -overwrite into `target`, for a tool that writes files the user names: what
+  /// requireNewOutputs() is told.
+  CommandLine& overwriteOption(bool& target);
 
   /// "Syntax is: ..." on stderr, the rest on stdout (PCL's print_error and print_info), the
   /// texts wrapped to 100 columns; a line break in a text is kept, with its indentation.
@@ -92,6 +95,11 @@ private:
   std::vector<std::string> notes_;
   std::vector<std::string> given_;
 };
+
+/// Before any work: throws IOError naming the first of `outputs` ("" is skipped) that is a
+/// folder, or that exists while `overwrite` (-overwrite) is false, so that nothing of the
+/// user's is written over.
+void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite);
 
 /// Prints PCL's done line: "[done, 12.3 ms : 465750 points]".
 void printDone(double milliseconds, std::size_t points);
