@@ -86,6 +86,22 @@ TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {
       << "the rig's lidar.sweeping changed nothing";
 }
 
+TEST_F(PipelineTest, AStreetWithoutARigFileIsStillScannedAtOneInstant) {
+  // The street as an msf_synth older than rig files wrote it: its ground truth says it is
+  // msf_synth's, whose LiDAR takes each scan at one instant. A KITTI sequence without a rig
+  // file (no truth) sweeps.
+  namespace fs = std::filesystem;
+  msf::test::TempDir copy;
+  const fs::path sequence = fs::path(copy.path()) / "sequences" / "00";
+  fs::create_directories(sequence);
+  for (const auto& entry : fs::directory_iterator(fs::path(dataset()) / "sequences" / "00"))
+    if (entry.path().filename() != "rig.yaml")
+      fs::create_symlink(entry.path(), sequence / entry.path().filename());
+  EXPECT_TRUE(msf::Sequence(copy.path()).calibration().lidar.sweeping);
+  fs::create_directory_symlink(fs::path(dataset()) / "gt", fs::path(copy.path()) / "gt");
+  EXPECT_FALSE(msf::Sequence(copy.path()).calibration().lidar.sweeping);
+}
+
 TEST_F(PipelineTest, OneThreadGivesTheSameMapAsAllCores) {
   const msf::Sequence sequence(dataset());
   msf::Reconstructor all(sequence.calibration(), msf::PipelineConfig{});

@@ -163,6 +163,10 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
     if (fs::is_regular_file(root / "gt" / "poses.txt", ec))
       true_poses_ = ofFrames(loadOdometryPoses((root / "gt" / "poses.txt").string()), frame_names_,
                              "the true poses '" + (root / "gt" / "poses.txt").string() + "'");
+    // msf_synth's LiDAR takes a scan at one instant; a sequence it wrote before it wrote rig
+    // files says so by its truth alone.
+    if (!gt_dir_.empty() && !fs::is_regular_file(p / "rig.yaml", ec))
+      calibration_.lidar.sweeping = false;
   } else if (fs::is_directory(p / "image_00" / "data", ec) &&
              fs::is_regular_file(p.parent_path() / "calib_cam_to_cam.txt", ec)) {
     layout_ = Layout::Raw;
