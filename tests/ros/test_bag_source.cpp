@@ -293,7 +293,10 @@ TEST(KittiBag, ReadBackEqualsTheKittiReader) {
   const std::vector<std::size_t> frames{0, 1, 2, 3};
   msf::writeKittiBag(sequence, frames, dir.file("04.bag"));
   EXPECT_TRUE(contains(errorOf([&] { msf::writeKittiBag(sequence, frames, dir.file("04.bag")); }),
-                       "exists: a bag is never written over a file"));
+                       "exists: a bag is not written over a file unless told to"));
+  msf::KittiBagOptions replace;
+  replace.overwrite = true;
+  msf::writeKittiBag(sequence, frames, dir.file("04.bag"), replace); // the same bag again
 
   const msf::BagSource bag(dir.file("04.bag")); // kitti2bag's topics, the default
   ASSERT_EQ(bag.size(), frames.size());
@@ -346,7 +349,7 @@ TEST(KittiBag, MsfReconstructOfTheBagMakesTheKittiFoldersMesh) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = msf::test::runTool("msf_kitti2bag", "'" + sequence + "' -o '" + bag + "'");
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_TRUE(contains(r.err, "msf_kitti2bag: error: '" + bag + "' exists")) << r.err;
+  EXPECT_TRUE(contains(r.err, "msf_kitti2bag: error: output '" + bag + "' exists; give -overwrite")) << r.err;
 
   r = msf::test::runTool("msf_reconstruct", "'" + bag + "' -panels 0 -o '" + dir.file("bag") + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;

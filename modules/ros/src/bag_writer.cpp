@@ -104,8 +104,8 @@ void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source,
 void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& frames, const std::string& path,
                    const KittiBagOptions& options) {
   std::error_code ec;
-  if (std::filesystem::exists(path, ec))
-    throw IOError("'" + path + "' exists: a bag is never written over a file; remove it or name another");
+  if (!options.overwrite && std::filesystem::exists(path, ec))
+    throw IOError("'" + path + "' exists: a bag is not written over a file unless told to (overwrite)");
   source.calibration().requireVelodyne();
   const rosbag::compression::CompressionType compression = compressionOf(options.compression);
   if (!(options.start_time_s > 0.0) || !(options.start_time_s < 4.0e9))

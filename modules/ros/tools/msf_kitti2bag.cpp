@@ -27,18 +27,20 @@ int main(int argc, char** argv) {
       "camera_info} (CameraInfo's P: the calibration's P0, P1, P2), the LiDAR extrinsic and the cameras' places on "
       "/tf_static, the poses on /tf (camera_init -> camera_gray_left). All messages of a frame carry its stamp: the "
       "start time plus the frame's time in the dataset.");
-  cli.value("-o", "FILE", output, "the bag to write; an existing file is refused")
+  cli.value("-o", "FILE", output, "the bag to write")
       .value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)")
       .value("-start_time", "S", options.start_time_s,
              "stamp of the dataset's time 0, in seconds since the epoch (default {default}; kitti2bag takes the "
              "time of conversion)")
-      .value("-compression", "C", options.compression, "none (default, kitti2bag's), lz4 or bz2");
+      .value("-compression", "C", options.compression, "none (default, kitti2bag's), lz4 or bz2")
+      .overwriteOption(options.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 1)
       throw msf::InvalidInputError("expected one DATASET_DIR, got " + std::to_string(positional.size()) +
                                    " positional arguments (see -h)");
     if (output.empty())
       throw msf::InvalidInputError("no output bag: give -o file.bag");
+    msf::tool::requireNewOutputs({output}, options.overwrite);
     msf::tool::installStopSignals({"msf_kitti2bag: stopping; the bag is not written"});
     const auto source = msf::openDataset(positional.front());
     const std::vector<std::size_t> frames = source->indices(msf::FrameRange::parse(frames_text));

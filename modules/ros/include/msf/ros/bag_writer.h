@@ -17,6 +17,8 @@ struct KittiBagOptions {
   double start_time_s = 1.0e9;
   /// "none" (kitti2bag's), "lz4" or "bz2".
   std::string compression = "none";
+  /// Replace a file at the bag's path (otherwise it is refused).
+  bool overwrite = false;
   /// After each frame written: (frames written, frames in all).
   std::function<void(std::size_t, std::size_t)> progress;
 };
@@ -34,7 +36,8 @@ struct KittiBagOptions {
 ///    (the inverse of T_cam0_velo), as kitti2bag writes them;
 ///  - /tf, when the dataset has poses: camera_init -> camera_gray_left, T_world_cam0.
 /// All messages of frame i carry one stamp. Written through a temporary file and a rename;
-/// an existing `path` is refused (IOError), as is a source without a LiDAR extrinsic.
+/// an existing `path` is refused (IOError) unless options.overwrite, as is a source without a
+/// LiDAR extrinsic.
 void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& frames, const std::string& path,
                    const KittiBagOptions& options = {});
 
