@@ -2,35 +2,54 @@
 // The configuration: a file checked and printed in full, and the files made from the keys'
 // declarations (config/*.yaml, docs/configuration.md) written.
 #include <msf/common/atomic_file.h>
+#include <msf/common/checked_write.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/pipeline/config_catalog.h>
 #include <msf/pipeline/config_documents.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
-void writeText(const std::string& path, const std::string& text) {
-  msf::writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out.flush())
-      throw msf::IOError("cannot write '" + tmp + "'");
-  });
-  std::cout << "wrote " << path << "\n";
+/// What -write makes: config/<name>.yaml for each shipped configuration and
+/// docs/configuration.md under `root` (the repository), with their texts.
+std::vector<std::pair<std::string, std::string>> documents(const std::string& root) {
+  std::vector<std::pair<std::string, std::string>> files;
+  for (const std::string& name : msf::shippedConfigNames())
+    files.emplace_back(root + "/config/" + name + ".yaml", msf::shippedConfigText(name));
+  files.emplace_back(root + "/docs/configuration.md", msf::configurationReference());
+  return files;
 }
 
-/// config/<name>.yaml for each shipped configuration and docs/configuration.md, under `root`
-/// (the repository), whose config/ and docs/ folders must exist.
+/// Whether `path` is a file -write made: each names the command that makes it.
+bool madeByWrite(const std::string& path) {
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return text.find("make config-files") != std::string::npos;
+}
+
+/// Writes the documents, after checking that root's config/ and docs/ folders exist and that
+/// every file to be replaced is one -write made: a file of the user's under the same name is
+/// refused, and nothing is written.
 void writeDocuments(const std::string& root) {
   msf::requireDirectory(root + "/config", "-write's config folder");
   msf::requireDirectory(root + "/docs", "-write's docs folder");
-  for (const std::string& name : msf::shippedConfigNames())
-    writeText(root + "/config/" + name + ".yaml", msf::shippedConfigText(name));
-  writeText(root + "/docs/configuration.md", msf::configurationReference());
+  const auto files = documents(root);
+  for (const auto& [path, text] : files)
+    if (std::filesystem::exists(path) && !madeByWrite(path))
+      throw msf::IOError("'" + path + "' is not a file msf_config -write made (it does not name make config-files): "
+                         "-write writes into the repository only; nothing was written");
+  for (const auto& [path, text] : files) {
+    msf::writeStreamAtomically(path, [&text = text](std::ostream& out) { out << text; });
+    std::cout << "wrote " << path << "\n";
+  }
 }
 
 } // namespace
@@ -50,7 +69,8 @@ int main(int argc, char** argv) {
       .value("-write", "DIR",
              write_root,
              "write DIR/config/kitti.yaml, synthetic.yaml, paper.yaml and DIR/docs/configuration.md, made from the "
-             "keys' declarations (DIR: the repository; make config-files)");
+             "keys' declarations (DIR: the repository; make config-files); a file there that -write did not make is "
+             "refused");
   return cli.run(argc, argv, 0, [&](const msf::tool::Arguments& arguments) {
     if (!arguments.empty())
       throw msf::InvalidInputError("unexpected argument '" + arguments[0] + "' (see -h)");

@@ -666,6 +666,7 @@ if [ $have_kitti = 1 ]; then
     printf '%%YAML:1.0\npipeline:\n  queue_capacity: 2\n' >"$D/home/my.yaml" && cp "$D/seq/image_2/000000.png" "$D/home/photo.png"
   mkdir -p "$D/mine/folder.pcd" && cp "$F/dense.pcd" "$D/mine/cloud.pcd" && cp "$F/bomb.ply" "$D/mine/mesh.ply" &&
     cp "$D/home/notes.txt" "$D/home/data.csv" "$D/home/photo.png" "$D/mine/"
+  mkdir -p "$D/mine/config" "$D/mine/docs" && cp "$D/home/my.yaml" "$D/mine/config/kitti.yaml"
   before=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
   check "reconstruct -o HOME/. over a user's files" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/home/."
@@ -718,6 +719,8 @@ if [ $have_kitti = 1 ]; then
     msf_holdout "$SEQ" -frames 0:0 -csv "$D/mine/data.csv"
   check "eval_odometry -plot over a user's photo" 1 "output '.*/mine/photo.png' exists; give -overwrite" -- \
     msf_eval_odometry "$D/poses/04.txt" "$D/poses/04.txt" -plot "$D/mine/photo.png"
+  check "config -write over a user's config/kitti.yaml" 1 "'.*/mine/config/kitti.yaml' is not a file msf_config -write made.*nothing was written" -- \
+    msf_config -write "$D/mine"
   check "eval_mesh -o over a user's notes" 1 "output '.*/mine/notes.txt' exists; give -overwrite" -- \
     msf_eval_mesh "$F/bomb.ply" "$SEQ" -o "$D/mine/notes.txt"
   after=$(cd "$D" && find . -type f -exec md5sum {} + | sort)
@@ -742,7 +745,7 @@ else
            dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth overwrite-project overwrite-folder \
            overwrite-interpolate overwrite-kitti2pcd overwrite-stereo overwrite-fuse overwrite-pcd2png \
            overwrite-integrate overwrite-mesh overwrite-odometry overwrite-holdout overwrite-eval-odometry \
-           overwrite-eval-mesh overwrite-replaces; do
+           overwrite-eval-mesh overwrite-replaces config-write-foreign; do
     skip "$c"
   done
 fi
