@@ -719,7 +719,8 @@ if [ $have_kitti = 1 ]; then
     msf_holdout "$SEQ" -frames 0:0 -csv "$D/mine/data.csv"
   check "eval_odometry -plot over a user's photo" 1 "output '.*/mine/photo.png' exists; give -overwrite" -- \
     msf_eval_odometry "$D/poses/04.txt" "$D/poses/04.txt" -plot "$D/mine/photo.png"
-  check "config -write over a user's config/kitti.yaml" 1 "'.*/mine/config/kitti.yaml' is not a file msf_config -write made.*nothing was written" -- \
+  check "config -write over a user's config/kitti.yaml" 1 \
+    "'.*/mine/config/kitti.yaml' is not a file msf_config -write made.*nothing was written" -- \
     msf_config -write "$D/mine"
   check "eval_mesh -o over a user's notes" 1 "output '.*/mine/notes.txt' exists; give -overwrite" -- \
     msf_eval_mesh "$F/bomb.ply" "$SEQ" -o "$D/mine/notes.txt"
