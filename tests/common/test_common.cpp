@@ -269,6 +269,13 @@ TEST(Tool, AnOutputFileThatExistsIsRefusedUnlessOverwriteIsGiven) {
   ASSERT_TRUE(overwrite);
   msf::tool::requireNewOutputs({dir.file("mine.pcd")}, overwrite);
   EXPECT_THROW(msf::tool::requireNewOutputs({dir.file("folder.pcd")}, overwrite), msf::IOError);
+  try {
+    msf::tool::requireNewOutputs({dir.file("missing/out.pcd")}, overwrite); // before the work, not after
+    FAIL() << "expected IOError";
+  } catch (const msf::IOError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("output folder '" + dir.file("missing") + "' does not exist"), std::string::npos) << message;
+  }
   std::ifstream in(dir.file("mine.pcd"));
   std::string first;
   in >> first;

@@ -622,6 +622,13 @@ if [ $have_kitti = 1 ]; then
     msf_holdout "$SEQ" -frames 0:0 -methods fused,fussed
   check "holdout -csv into a missing folder" 1 "cannot write '/nonexistent/h.csv': output folder '/nonexistent' does not exist" -- \
     msf_holdout "$SEQ" -frames 0:0 -methods interpolated -csv /nonexistent/h.csv
+  check "odometry -o into a missing folder, before tracking" 1 \
+    "cannot write '/nonexistent/p.txt': output folder '/nonexistent' does not exist" -- \
+    msf_odometry "$SEQ" -frames 0:1 -o /nonexistent/p.txt
+  if grep -q Tracking "$T/out"; then
+    failures=$((failures + 1))
+    echo "FAIL  odometry -o into a missing folder tracked the frames first"
+  fi
   check "reconstruct: a time that goes back" 1 "times.txt' line 3 '0.05' does not follow line 2's: the times must increase" -- \
     msf_reconstruct "$K/odo_times_back/sequences/04" -panels 0 -o out
   check "reconstruct: NaN in a pose" 1 "poses '.*04.txt' line 2: value 4 'nan' is not finite" -- \
@@ -746,7 +753,7 @@ else
            dataloss-batch batch-no-poses batch-radius eval-mesh-no-truth overwrite-project overwrite-folder \
            overwrite-interpolate overwrite-kitti2pcd overwrite-stereo overwrite-fuse overwrite-pcd2png \
            overwrite-integrate overwrite-mesh overwrite-odometry overwrite-holdout overwrite-eval-odometry \
-           overwrite-eval-mesh overwrite-replaces config-write-foreign; do
+           overwrite-eval-mesh overwrite-replaces config-write-foreign odometry-missing-folder; do
     skip "$c"
   done
 fi

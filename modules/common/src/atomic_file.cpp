@@ -63,7 +63,7 @@ void ensureOutputDirectory(const std::string& path) {
     throw IOError("cannot create output folder '" + path + "': " + ec.message());
 }
 
-void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+void requireWritableFolder(const std::string& path) {
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
@@ -71,6 +71,13 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' does not exist");
   if (::access(dir.c_str(), W_OK) != 0)
     throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' is not writable");
+}
+
+void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+  requireWritableFolder(path);
+  const fs::path target(path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
 
   static std::atomic<unsigned> counter{0};
   const fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +

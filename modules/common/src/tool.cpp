@@ -1,4 +1,5 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/message_text.h>
 #include <msf/common/tool.h>
@@ -283,14 +284,14 @@ int CommandLine::run(int argc, char** argv, int min_arguments, const std::functi
 
 void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite) {
   for (const std::string& path : outputs) {
-    std::error_code ec;
-    const auto status = std::filesystem::symlink_status(path, ec);
-    if (path.empty() || !std::filesystem::exists(status))
+    if (path.empty())
       continue;
-    if (std::filesystem::is_directory(std::filesystem::status(path, ec)))
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
       throw IOError("output '" + path + "' is a folder, not a file");
-    if (!overwrite)
+    if (!overwrite && std::filesystem::exists(std::filesystem::symlink_status(path, ec)))
       throw IOError("output '" + path + "' exists; give -overwrite to replace it");
+    requireWritableFolder(path);
   }
 }
 

@@ -15,6 +15,10 @@ namespace msf {
 /// the file if `write` did not produce it.
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write);
 
+/// Throws IOError naming `path` and its folder when the folder does not exist or is not
+/// writable: what writeAtomically checks first, for a tool to check before its work.
+void requireWritableFolder(const std::string& path);
+
 /// Throws IOError if `path` is not an existing regular file; `what` names its role ("scan").
 void requireFile(const std::string& path, const std::string& what = "file");
 

@@ -97,8 +97,8 @@ private:
 };
 
 /// Before any work: throws IOError naming the first of `outputs` ("" is skipped) that is a
-/// folder, or that exists while `overwrite` (-overwrite) is false, so that nothing of the
-/// user's is written over.
+/// folder, that exists while `overwrite` (-overwrite) is false (so that nothing of the user's
+/// is written over), or whose folder is missing or not writable (requireWritableFolder).
 void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite);
 
 /// Prints PCL's done line: "[done, 12.3 ms : 465750 points]".
