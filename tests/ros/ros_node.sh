@@ -41,7 +41,7 @@ refuse() { # NAME EXPECTED _param:=value...
   echo "ok: msf_ros_node $* refused: $expected"
 }
 touch "$work/mine.ply"
-refuse bad_path "parameter /bad_path/mesh_path: '$work/mine.ply' exists, and a mesh is never written over a file" \
+refuse bad_path "parameter /bad_path/mesh_path: '$work/mine.ply' exists; set /bad_path/overwrite true to replace it" \
   _mesh_path:="$work/mine.ply"
 [ ! -s "$work/mine.ply" ] || fail "the node wrote over '$work/mine.ply'"
 refuse bad_name "unknown parameter /bad_name/queue_sise" _queue_sise:=2
@@ -50,6 +50,7 @@ refuse bad_range "parameter /bad_range/queue_size must be 1..8 frames, not 20" _
 refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refine, not 'gps'" _poses:=gps
 refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
 refuse bad_sweep "parameter /bad_sweep/sweeping_scans must be true or false" _sweeping_scans:=maybe
+refuse bad_overwrite "parameter /bad_overwrite/overwrite must be true or false" _overwrite:=sometimes
 
 # Plays the bag to the node started by launch/kitti_bag.launch with ARGS...; returns when it has
 # published a depth image per frame (rostopic echo -n exits then) and has been stopped.
@@ -99,11 +100,12 @@ echo "ok: the node's mesh is msf_reconstruct's, byte for byte ($(stat -c %s "$wo
 node_params=$(rospack find msfusion)/config/kitti_bag.yaml
 sed 's/^sweeping_scans: true /sweeping_scans: false/' "$node_params" >"$work/snapshots.yaml"
 grep -q "^sweeping_scans: false" "$work/snapshots.yaml" || fail "kitti_bag.yaml has no 'sweeping_scans: true' line"
-play_to_node snapshots params:="$work/snapshots.yaml" mesh_path:="$work/snapshot_mesh.ply"
-[ -f "$work/snapshot_mesh.ply" ] || fail "the node saved no mesh with sweeping_scans false"
-! cmp -s "$work/node_mesh.ply" "$work/snapshot_mesh.ply" ||
+# Into the file the node refused above, now with ~overwrite: replaced whole at shutdown.
+play_to_node snapshots params:="$work/snapshots.yaml" mesh_path:="$work/mine.ply" overwrite:=true
+[ -s "$work/mine.ply" ] || fail "the node with overwrite true did not replace '$work/mine.ply'"
+! cmp -s "$work/node_mesh.ply" "$work/mine.ply" ||
   fail "sweeping_scans false made the same mesh as the sweeping rig: the parameter did not reach the engine"
-echo "ok: sweeping_scans false makes another map"
+echo "ok: sweeping_scans false makes another map, written over mine.ply with overwrite true"
 
 ros_session_stop
 echo "ok: roscore, the node, the player and the recorder stopped; no process left"

@@ -68,7 +68,7 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
   NodeParameters p;
   refuseUnknownParams(nh, {"lidar_topic", "left_topic", "right_topic", "color_topic", "world_frame", "poses", "config",
                            "rig", "threads", "sweeping_scans", "queue_size", "sync_slop_s", "tf_timeout_s",
-                           "mesh_rate_hz", "mesh_path"});
+                           "mesh_rate_hz", "mesh_path", "overwrite"});
   for (auto [name, value] : {std::pair{"lidar_topic", &p.lidar_topic}, {"left_topic", &p.left_topic},
                              {"right_topic", &p.right_topic}, {"color_topic", &p.color_topic},
                              {"world_frame", &p.world_frame}, {"poses", &p.poses}, {"config", &p.config},
@@ -76,6 +76,7 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
     readParam(nh, name, *value, "a string");
   readParam(nh, "threads", p.threads, "an integer");
   readParam(nh, "queue_size", p.queue_size, "an integer");
+  readParam(nh, "overwrite", p.overwrite, "true or false");
   if (nh.hasParam("sweeping_scans")) {
     bool sweeping = true;
     readParam(nh, "sweeping_scans", sweeping, "true or false");
@@ -101,9 +102,9 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
   if (!p.mesh_path.empty()) {
     p.mesh_path = std::filesystem::absolute(p.mesh_path).string(); // the node's folder is ROS_HOME
     std::error_code ec;
-    if (std::filesystem::exists(p.mesh_path, ec))
-      throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": '" + p.mesh_path +
-                        "' exists, and a mesh is never written over a file");
+    if (!p.overwrite && std::filesystem::exists(p.mesh_path, ec))
+      throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": '" + p.mesh_path + "' exists; set " +
+                        nh.resolveName("overwrite") + " true to replace it");
   }
   return p;
 }

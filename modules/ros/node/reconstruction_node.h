@@ -47,10 +47,12 @@ struct NodeParameters {
   double tf_timeout_s = 0.2; ///< how long a frame waits for its pose and the first for the extrinsic
   double mesh_rate_hz = 1.0; ///< mesh marker refresh (0 = none)
   std::string mesh_path;     ///< the mesh saved at shutdown (.ply/.obj/.vtk), "" = none
+  bool overwrite = false;    ///< replace a mesh_path that exists (else refused at start)
 
   NodeParameters();
   /// Reads the private parameters; throws ConfigError naming the parameter for an unknown
-  /// name, a wrong type or a value out of range, and for a mesh_path that exists.
+  /// name, a wrong type or a value out of range, and for a mesh_path that exists unless
+  /// overwrite.
   static NodeParameters read(const ros::NodeHandle& private_nh);
 };
 
