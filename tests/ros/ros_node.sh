@@ -51,6 +51,9 @@ refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refin
 refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
 refuse bad_sweep "parameter /bad_sweep/sweeping_scans must be true or false" _sweeping_scans:=maybe
 refuse bad_overwrite "parameter /bad_overwrite/overwrite must be true or false" _overwrite:=sometimes
+refuse bad_folder \
+  "parameter /bad_folder/mesh_path: cannot write '$work/none/m.ply': output folder '$work/none' does not exist" \
+  _mesh_path:="$work/none/m.ply"
 
 # Plays the bag to the node started by launch/kitti_bag.launch with ARGS...; returns when it has
 # published a depth image per frame (rostopic echo -n exits then) and has been stopped.

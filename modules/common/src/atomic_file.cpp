@@ -63,9 +63,15 @@ void ensureOutputDirectory(const std::string& path) {
     throw IOError("cannot create output folder '" + path + "': " + ec.message());
 }
 
+namespace {
+
+/// The folder a file `path` goes into.
+fs::path folderOf(const fs::path& path) { return path.has_parent_path() ? path.parent_path() : fs::path("."); }
+
+} // namespace
+
 void requireWritableFolder(const std::string& path) {
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const fs::path dir = folderOf(path);
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' does not exist");
@@ -75,8 +81,7 @@ void requireWritableFolder(const std::string& path) {
 
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {
   requireWritableFolder(path);
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const fs::path target(path), dir = folderOf(target);
   std::error_code ec;
 
   static std::atomic<unsigned> counter{0};

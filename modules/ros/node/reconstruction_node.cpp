@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "reconstruction_node.h"
 
+#include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/bag_options.h>
 #include <msf/io/cloud_io.h>
@@ -105,6 +106,11 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
     if (!p.overwrite && std::filesystem::exists(p.mesh_path, ec))
       throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": '" + p.mesh_path + "' exists; set " +
                         nh.resolveName("overwrite") + " true to replace it");
+    try { // its folder at start too, not when the session ends
+      requireWritableFolder(p.mesh_path);
+    } catch (const IOError& e) {
+      throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": " + e.what());
+    }
   }
   return p;
 }

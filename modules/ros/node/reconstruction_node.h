@@ -51,8 +51,8 @@ struct NodeParameters {
 
   NodeParameters();
   /// Reads the private parameters; throws ConfigError naming the parameter for an unknown
-  /// name, a wrong type or a value out of range, and for a mesh_path that exists unless
-  /// overwrite.
+  /// name, a wrong type or a value out of range, for a mesh_path that exists unless overwrite,
+  /// and for one whose folder is missing or not writable.
   static NodeParameters read(const ros::NodeHandle& private_nh);
 };
 
