@@ -22,6 +22,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// msf_reconstruct of a dataset with `options` into `out` (its figures only, -panels 0): what
+/// it printed, and its summary.json ("" after a failure, reported with its stderr).
+struct Reconstruction {
+  msf::test::CommandResult run;
+  std::string summary;
+};
+Reconstruction reconstruct(const std::string& dataset, const std::string& options, const msf::test::TempDir& out) {
+  Reconstruction r{msf::test::runTool("msf_reconstruct", dataset + " " + options + " -panels 0 -o " + out.path()), ""};
+  EXPECT_EQ(r.run.exit_code, 0) << r.run.err;
+  if (r.run.exit_code == 0)
+    r.summary = readFile(out.file("summary.json"));
+  return r;
+}
+
 /// KITTI odometry 04 as a dataset of its own under `root`, its folders linked: without the
 /// poses when `poses` is false; with the scans of frames 0-1 sorted by azimuth (one sweep,
 /// no ring order) when `sorted_scans` is true.
@@ -129,9 +143,8 @@ TEST_F(PipelineTest, SyntheticHoldoutScoresMovingCarsApartAndSplitsTheRestByTheS
   // Under -holdout the street's held-out rings are the truth; its moving cars are still scored
   // apart, and the scans split the static pixels in range: few of them transient.
   msf::test::TempDir out;
-  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:2 -holdout -panels 0 -o " + out.path());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string json = readFile(out.file("summary.json"));
+  const std::string json = reconstruct(dataset(), "-frames 0:2 -holdout", out).summary;
+  ASSERT_FALSE(json.empty());
   EXPECT_NE(json.find("\"moving_split\": true"), std::string::npos);
   EXPECT_NE(json.find("\"transient_split\": true"), std::string::npos);
   const std::string mesh = rowOf(json, "mesh");
@@ -155,9 +168,8 @@ TEST_F(PipelineTest, SyntheticGroundTruthScoresStaticAndMovingPixelsApart) {
   }
   ASSERT_GT(expected_moving, 100u) << "the street's first frames show no moving car";
   msf::test::TempDir out;
-  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:1 -panels 0 -o " + out.path());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string json = readFile(out.file("summary.json"));
+  const auto [r, json] = reconstruct(dataset(), "-frames 0:1", out);
+  ASSERT_FALSE(json.empty());
   EXPECT_NE(json.find("\"moving_split\": true"), std::string::npos);
   EXPECT_NE(json.find("\"no_ghosts\": null"), std::string::npos);
   const std::string mesh = rowOf(json, "mesh"), fused = rowOf(json, "fused");
@@ -227,9 +239,8 @@ TEST_F(PipelineTest, SyntheticCarsWhereTheLastFrameSawThemAreNoGhosts) {
   // One frame: every car in the mesh is where the run's last frame saw it, a true surface off
   // the static one (gt/scene.ply leaves the cars out): no ghost, no crumb of one.
   msf::test::TempDir out;
-  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:0 -panels 0 -o " + out.path());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string json = readFile(out.file("summary.json"));
+  const std::string json = reconstruct(dataset(), "-frames 0:0", out).summary;
+  ASSERT_FALSE(json.empty());
   const std::string mesh = rowOf(json, "mesh");
   ASSERT_FALSE(mesh.empty()) << json;
   EXPECT_EQ(jsonNumber(mesh, "ghost_vertices", "ghosts"), 0.0);
@@ -243,11 +254,9 @@ TEST_F(PipelineTest, ComparePaperScoresThePaperAsPublishedBesideOurs) {
   // -compare_paper runs config/paper.yaml on the same frames at the same poses into a map of its
   // own: its per-frame depth ("paper") and its mesh ("mesh_paper") are scored as ours are.
   msf::test::TempDir out;
-  const auto r =
-      msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:1 -panels 0 -compare_paper -o " + out.path());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto [r, json] = reconstruct(dataset(), "-frames 0:1 -compare_paper", out);
+  ASSERT_FALSE(json.empty());
   EXPECT_TRUE(msf::test::fileExists(out.file("mesh_paper.ply")));
-  const std::string json = readFile(out.file("summary.json"));
 
   // The per-frame depth against the synthetic ground truth: the paper's row beside ours.
   const std::size_t depth_at = json.find("\"depth\": {"), depth_end = json.find("\"mesh_accuracy\"");
