@@ -12,11 +12,14 @@
 // (Reconstructor::integrate's work: TsdfIntegrator::integrateFrame, the depth and the free space
 // of the scan, the open sky and the rays beyond the range), per frame.
 // BM_StageDepth: steps 1-4 of one frame (Reconstructor::computeDepth), per frame.
+// BM_StageMapPrior: the map of the 10 frames rendered into each frame's holes (no fused depth,
+// not open sky), as map_prior.enabled does after each frame is integrated (MapRaycaster), per frame.
 #include "kitti_sample.h"
 
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/pipeline/source_depth_frame.h>
+#include <msf/reconstruction/map_raycaster.h>
 
 #include <benchmark/benchmark.h>
 
@@ -90,6 +93,39 @@ void BM_StageDepth(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
 }
 BENCHMARK(BM_StageDepth)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_StageMapPrior(benchmark::State& state) {
+  Data& d = data();
+  TsdfVolume volume(d.config.volume.voxel_size_m, d.config.volume.truncation_m);
+  TsdfIntegrator integrator(volume, d.config.integrator);
+  std::vector<cv::Mat> holes;
+  for (std::size_t i = 0; i < d.frames.size(); ++i) {
+    const FrameResult& r = d.results[i];
+    integrator.integrateFrame(d.frames[i], r.T_world_cam0,
+                              freeSpaceOf(r, r.fused.camera, d.config.fusion, d.sequence.calibration()));
+    holes.push_back(~(r.fused.depth > 0.f));
+    if (!r.sky.empty())
+      holes.back().setTo(0, r.sky);
+  }
+  MapPriorConfig prior = d.config.map_prior;
+  prior.enabled = true;
+  const MapRaycaster raycaster(volume, prior);
+  double rays = 0, found = 0;
+  cv::Mat depth, weight;
+  for (auto _ : state) {
+    rays = found = 0;
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      raycaster.render(d.results[i].fused.camera, d.results[i].T_world_cam0, holes[i], depth, weight);
+      rays += cv::countNonZero(holes[i]);
+      found += cv::countNonZero(depth > 0.f);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(holes.size()));
+  // Per frame: the rays cast (holes) and those that met the map's surface.
+  state.counters["rays"] = rays / static_cast<double>(holes.size());
+  state.counters["found"] = found / static_cast<double>(holes.size());
+}
+BENCHMARK(BM_StageMapPrior)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
 
 } // namespace
 

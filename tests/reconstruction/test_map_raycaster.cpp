@@ -82,6 +82,47 @@ TEST(MapRaycaster, OnlyTheMaskedPixelsAndWithinTheDepthRange) {
   EXPECT_EQ(cv::countNonZero(depth), 0);
 }
 
+TEST(MapRaycaster, FindsATiltedWallBehindMetresOfFreeSpaceAtEveryPixel) {
+  // The exact distance to the wall z = 6 + 0.3 x + 0.1 y (metres, positive on the camera's
+  // side) in front of it and up to a truncation behind, written voxel by voxel: from 2.5 m on,
+  // the rays cross blocks and sub-blocks of free space that hold no surface before they meet it.
+  const double voxel = 0.05, truncation = 0.2;
+  TsdfVolume volume(voxel, truncation);
+  const Eigen::Vector3d normal = Eigen::Vector3d(-0.3, -0.1, 1.0).normalized();
+  const auto distance = [&](const Eigen::Vector3d& p) {
+    return (6.0 + 0.3 * p.x() + 0.1 * p.y() - p.z()) * normal.z();
+  };
+  for (int z = 50; z <= 170; ++z)
+    for (int y = -50; y <= 50; ++y)
+      for (int x = -50; x <= 50; ++x) {
+        const GridIndex v(x, y, z);
+        const double d = distance(volume.voxelCenter(v));
+        if (d < -truncation)
+          continue;
+        const GridIndex b = blockOf(v), l = v - b * TsdfBlock::kSide;
+        TsdfVoxel& voxel_ref = volume.allocateBlock(b).at(l.x(), l.y(), l.z());
+        voxel_ref.sdf = static_cast<float>(std::min(d, truncation));
+        voxel_ref.weight = 10.f;
+      }
+  for (TsdfBlock* block : volume.blocks())
+    block->updateSigns();
+  const PinholeCamera camera = test::smallCamera();
+  cv::Mat depth, weight;
+  const cv::Mat all(240, 320, CV_8UC1, cv::Scalar(255));
+  MapRaycaster(volume, MapPriorConfig()).render(camera, Eigen::Isometry3d::Identity(), all, depth, weight);
+  int checked = 0;
+  for (int v = 0; v < 240; v += 3)
+    for (int u = 0; u < 320; u += 3) {
+      const double x = (u - camera.cx) / camera.fx, y = (v - camera.cy) / camera.fy;
+      const double z = 6.0 / (1.0 - 0.3 * x - 0.1 * y); // where the pixel's ray meets the wall
+      if (std::abs(x * z) > 2.2 || std::abs(y * z) > 2.2) // beyond the voxels written, with a margin
+        continue;
+      ASSERT_NEAR(depth.at<float>(v, u), z, 0.005) << "pixel " << u << ", " << v;
+      ++checked;
+    }
+  EXPECT_GT(checked, 4000);
+}
+
 TEST(MapRaycaster, RefusesABadMaskAndConfig) {
   const TsdfVolume volume = twoWalls();
   const MapRaycaster raycaster(volume, MapPriorConfig());

@@ -27,18 +27,27 @@ MapRaycaster::MapRaycaster(const TsdfVolume& volume, const MapPriorConfig& confi
 
 namespace {
 
-/// The ray parameter at which the ray o + d t (in voxels) leaves the block of voxel v.
-float blockExit(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const GridIndex& v) {
-  const GridIndex block = blockOf(v);
+constexpr int kSubBlockSide = TsdfBlock::kSide / 2; // the cubes of TsdfBlock::negative_subblocks
+
+/// The ray parameter at which the ray o + d t (in voxels) leaves the cube of `side` voxels
+/// (a block, or a sub-block of it) that holds voxel v.
+float cellExit(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const GridIndex& v, int side) {
   float exit = std::numeric_limits<float>::infinity();
   for (int a = 0; a < 3; ++a) {
-    const float lo = static_cast<float>(block[a] * TsdfBlock::kSide) - 0.5f, hi = lo + TsdfBlock::kSide;
+    const float lo = static_cast<float>(floorDiv(v[a], side) * side) - 0.5f, hi = lo + static_cast<float>(side);
     if (d[a] > 0.f)
       exit = std::min(exit, (hi - o[a]) / d[a]);
     else if (d[a] < 0.f)
       exit = std::min(exit, (lo - o[a]) / d[a]);
   }
   return exit;
+}
+
+/// x rounded to the nearest integer, halves up: inline, where std::lround is a library call.
+int roundToInt(float x) {
+  const float shifted = x + 0.5f;
+  const int truncated = static_cast<int>(shifted);
+  return truncated - (shifted < static_cast<float>(truncated));
 }
 
 /// Voxel look-ups along one ray: most fall in the block of the one before.
@@ -58,9 +67,13 @@ public:
   }
   /// The voxel nearest to p (in voxels).
   const TsdfVoxel* nearest(const Eigen::Vector3f& p, GridIndex& v) {
-    v = GridIndex(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y())),
-                  static_cast<int>(std::lround(p.z())));
+    v = GridIndex(roundToInt(p.x()), roundToInt(p.y()), roundToInt(p.z()));
     return find(v);
+  }
+  /// Whether the sub-block of v, the last voxel found, may hold a surface: an observed voxel with sdf < 0.
+  bool mayHoldSurface(const GridIndex& v) const {
+    const GridIndex l = v - block_->origin();
+    return block_->negative_subblocks & (1u << TsdfBlock::subBlockOf(TsdfBlock::linear(l.x(), l.y(), l.z())));
   }
   bool known(const TsdfVoxel* voxel) const { return voxel && voxel->weight > min_weight_; }
 
@@ -92,15 +105,16 @@ private:
 
 /// The crossing between ray parameters a (in front, its voxel's distance sdf_a) and b (behind,
 /// sdf_b) of the ray o + d t (in voxels). The voxels' distances are their centres' and may be
-/// clamped at the truncation: from a to a voxel beyond b the ray is walked in half voxels on the
-/// trilinear distance and interpolated between the first two samples that straddle the surface
-/// (`weight` becomes the least of their voxels'); the samples' own estimate where none do.
+/// clamped at the truncation: from a voxel before a (a's nearest voxel may lie in front of the
+/// surface while a itself lies behind it) to a voxel beyond b the ray is walked in half voxels on
+/// the trilinear distance and interpolated between the first two samples that straddle the
+/// surface (`weight` becomes the least of their voxels'); the samples' own estimate where none do.
 float refineCrossing(RayVoxels& voxels, const Eigen::Vector3f& o, const Eigen::Vector3f& d, float a, float sdf_a,
                      float b, float sdf_b, float& weight) {
   const float estimate = a + (b - a) * sdf_a / (sdf_a - sdf_b);
   const float half_voxel = 0.5f / d.norm();
   float t_front = -1.f, sdf_front = 0.f, w_front = 0.f;
-  for (float t = a; t <= b + 2.f * half_voxel; t += half_voxel) {
+  for (float t = a - 2.f * half_voxel; t <= b + 2.f * half_voxel; t += half_voxel) {
     float sdf, w;
     if (!voxels.trilinear(o + d * t, sdf, w)) {
       t_front = -1.f;
@@ -125,14 +139,22 @@ bool MapRaycaster::castRay(const Eigen::Vector3f& origin, const Eigen::Vector3f&
   const float vs = static_cast<float>(volume_.voxelSize());
   const Eigen::Vector3f o = origin / vs, d = direction / vs; // in voxels per metre of t
   RayVoxels voxels(volume_, config_.min_weight);
+  const float nudge = 0.01f * vs; // past a cell's face, into the next one
   float t_before = -1.f, sdf_before = 0.f; // the last known sample in front of a surface
   for (t = t_near; t <= t_far;) {
     GridIndex v;
     const TsdfVoxel* voxel = voxels.nearest(o + d * t, v);
     if (!voxel) { // no block: no surface before the ray leaves it
       t_before = -1.f;
-      t = std::max(t + 0.01f * vs, blockExit(o, d, v));
+      t = std::max(t, cellExit(o, d, v, TsdfBlock::kSide)) + nudge;
       continue;
+    }
+    if (!voxels.mayHoldSurface(v)) { // no crossing in its sub-block: on to its last sample there
+      const float last = cellExit(o, d, v, kSubBlockSide) - nudge;
+      if (last > t) {
+        t = last;
+        continue;
+      }
     }
     if (!voxels.known(voxel)) {
       t_before = -1.f;

@@ -39,8 +39,9 @@ struct MapPriorConfig {
 /// Renders a TsdfVolume into a camera, as KinectFusion's raycast: along each pixel's ray, the
 /// first crossing of the signed distance from positive to negative between observed voxels
 /// (weight > min_weight), refined by trilinear interpolation. Rays step by the distance the
-/// voxels say is free (at least a voxel), by a voxel through unobserved ones and across a
-/// block that is not allocated in one step.
+/// voxels say is free (at least a voxel), by a voxel through unobserved ones, and across a
+/// block that is not allocated, or a sub-block without a voxel behind a surface
+/// (TsdfBlock::negative_subblocks), in one step.
 ///
 ///   msf::MapRaycaster raycaster(volume, config.map_prior);
 ///   raycaster.render(camera, T_world_cam, holes, depth, weight);  // depth along the optical axis
