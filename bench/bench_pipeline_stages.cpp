@@ -103,9 +103,7 @@ void BM_StageMapPrior(benchmark::State& state) {
     const FrameResult& r = d.results[i];
     integrator.integrateFrame(d.frames[i], r.T_world_cam0,
                               freeSpaceOf(r, r.fused.camera, d.config.fusion, d.sequence.calibration()));
-    holes.push_back(~(r.fused.depth > 0.f));
-    if (!r.sky.empty())
-      holes.back().setTo(0, r.sky);
+    holes.push_back(mapPriorHoles(r));
   }
   MapPriorConfig prior = d.config.map_prior;
   prior.enabled = true;

@@ -222,15 +222,20 @@ void Reconstructor::integrate(FrameResult& result) {
   result.times.integrate_ms = msSince(start);
 }
 
+cv::Mat mapPriorHoles(const FrameResult& result) {
+  cv::Mat holes = ~(result.fused.depth > 0.f); // no depth (0 or NaN)
+  if (!result.sky.empty())
+    holes.setTo(0, result.sky);
+  return holes;
+}
+
 void Reconstructor::fillFromMap(FrameResult& result) const {
   DepthFrame& fused = result.fused;
   if (!config_.map_prior.enabled || volume_->numBlocks() == 0 || fused.weight.empty())
     return;
-  cv::Mat holes = ~(fused.depth > 0.f); // no depth (0 or NaN)
-  if (!result.sky.empty())
-    holes.setTo(0, result.sky);
   cv::Mat depth, weight;
-  MapRaycaster(*volume_, config_.map_prior).render(fused.camera, result.T_world_cam0, holes, depth, weight);
+  MapRaycaster(*volume_, config_.map_prior)
+      .render(fused.camera, result.T_world_cam0, mapPriorHoles(result), depth, weight);
   const cv::Mat found = depth > 0.f;
   // New images: the frame being integrated may share the fused ones.
   fused.depth = fused.depth.clone();

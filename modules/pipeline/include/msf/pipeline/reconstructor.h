@@ -108,6 +108,10 @@ TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCa
                                       const DepthFusionConfig& fusion, const Calibration& calibration,
                                       bool with_scan = true);
 
+/// The pixels the map prior fills (section map_prior): the fused depth's holes (no depth, 0 or
+/// NaN) that are not open sky. CV_8UC1 of the fused depth's size, 255 = a hole.
+cv::Mat mapPriorHoles(const FrameResult& result);
+
 /// The reconstruction engine: the whole method (the data flow of docs/design.md) as one object that
 /// any door drives (msf_reconstruct, the Python module, the ROS node, the batch job). Per
 /// frame, LiDAR projection and compound interpolation (LidarCompletion: the scan is projected
