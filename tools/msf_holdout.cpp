@@ -11,6 +11,7 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
 #include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/hole_fill.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
@@ -149,6 +150,8 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
     fuser->setCalibration(*in.calibration);
     fuser->setInputImage(in.left);
     fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
+    cv::Mat no_weight;
+    msf::fillSmallHoles(depth, no_weight, no_weight, fuser->getOpenSky(), fusion.hole_fill_px); // as the engine
     return depth;
   };
 }

@@ -140,9 +140,11 @@ TEST_F(PipelineTest, AStreamedEngineWritesItsTilesWhereItIsTold) {
 
 TEST_F(PipelineTest, TheMapAsAPriorFillsTheFusedDepthsHolesAndLeavesTheMapAsItWas) {
   const msf::Sequence sequence(dataset());
-  msf::PipelineConfig with_prior;
+  msf::PipelineConfig without; // the holes the map leaves are the small-hole fill's
+  without.fusion.hole_fill_px = 0;
+  msf::PipelineConfig with_prior = without;
   with_prior.map_prior.enabled = true;
-  msf::Reconstructor plain(sequence.calibration(), msf::PipelineConfig{});
+  msf::Reconstructor plain(sequence.calibration(), without);
   msf::Reconstructor prior(sequence.calibration(), with_prior);
   for (std::size_t i = 0; i < 3; ++i) {
     const msf::FrameResult a = plain.addFrame(sequence.load(i));
@@ -160,4 +162,24 @@ TEST_F(PipelineTest, TheMapAsAPriorFillsTheFusedDepthsHolesAndLeavesTheMapAsItWa
   }
   msf::test::TempDir a, b;
   EXPECT_TRUE(savedMap(plain, a) == savedMap(prior, b)) << "the map's depth went back into the map";
+}
+
+TEST_F(PipelineTest, TheSmallHolesFillTheFusedDepthAtWeightZeroAndLeaveTheMapAsItWas) {
+  const msf::Sequence sequence(dataset());
+  msf::PipelineConfig without;
+  without.fusion.hole_fill_px = 0;
+  msf::Reconstructor plain(sequence.calibration(), without);
+  msf::Reconstructor filling(sequence.calibration(), msf::PipelineConfig{}); // the default fills
+  for (std::size_t i = 0; i < 2; ++i) {
+    const msf::FrameResult a = plain.addFrame(sequence.load(i));
+    const msf::FrameResult b = filling.addFrame(sequence.load(i));
+    const cv::Mat had_depth = a.fused.depth > 0.f;
+    EXPECT_EQ(cv::countNonZero((a.fused.depth != b.fused.depth) & had_depth), 0) << "frame " << i;
+    const cv::Mat filled = (b.fused.depth > 0.f) & ~had_depth;
+    EXPECT_GT(cv::countNonZero(filled), 0) << "frame " << i << ": no hole filled";
+    EXPECT_EQ(cv::countNonZero(filled & (b.fused.weight != 0.f)), 0) << "a filled pixel with a weight";
+    EXPECT_EQ(cv::countNonZero(filled & b.sky), 0) << "the open sky filled";
+  }
+  msf::test::TempDir a, b;
+  EXPECT_TRUE(savedMap(plain, a) == savedMap(filling, b)) << "a filled pixel went into the map";
 }

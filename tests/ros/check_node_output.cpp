@@ -51,7 +51,7 @@ int differingPixels(const cv::Mat& published, const cv::Mat& engine, bool nan_fo
   return differ;
 }
 
-/// Each frame's depth and weight image: the engine's on the played bag's frame, bit for bit.
+/// Each frame's depth and weight image: the engine's (addFrame) on the played bag's frame, bit for bit.
 void checkImages(const std::vector<sensor_msgs::Image::ConstPtr>& depth,
                  const std::vector<sensor_msgs::Image::ConstPtr>& weight, const msf::BagSource& played) {
   expect(depth.size() == played.size(), std::to_string(depth.size()) + " depth images for " +
@@ -60,7 +60,8 @@ void checkImages(const std::vector<sensor_msgs::Image::ConstPtr>& depth,
   msf::Reconstructor engine(played.calibration(), msf::PipelineConfig());
   const cv::Size size = played.calibration().image_size;
   for (std::size_t i = 0; i < std::min({depth.size(), weight.size(), played.size()}); ++i) {
-    const msf::FrameResult expected = engine.computeDepth(played.load(i));
+    // As the node runs it: the small holes filled after the map took the frame.
+    const msf::FrameResult expected = engine.addFrame(played.load(i));
     const std::string frame = "frame " + std::to_string(i);
     for (const auto& [name, message, image, nan] :
          {std::tuple{"depth", depth[i], expected.fused.depth, true}, {"weight", weight[i], expected.fused.weight, false}}) {

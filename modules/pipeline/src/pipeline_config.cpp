@@ -55,6 +55,7 @@ PipelineConfig PipelineConfig::paper() {
   c.integrator.lambda = 5.0;
   c.integrator.solve = TsdfIntegrator::Solve::Argmin;
   c.map_prior.enabled = false;
+  c.fusion.hole_fill_px = 0;
   c.mesher.min_weight = 0.f;
   c.mesher.max_unseen_corners = 0;
   c.mesher.smoothing_lambda = 0.f;

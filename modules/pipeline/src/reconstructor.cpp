@@ -4,6 +4,7 @@
 #include <msf/common/parallel.h>
 #include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
+#include <msf/fusion/hole_fill.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/run_report.h>
@@ -212,6 +213,7 @@ void Reconstructor::integrate(FrameResult& result) {
     streaming_->beforeIntegration(result.T_world_cam0.translation());
   const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
   fillFromMap(result);
+  fillSmallHoles(result);
   integrator_->integrateFrame(frame, result.T_world_cam0, freeSpaceOf(result, camera_, config_.fusion, calibration_));
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
@@ -246,6 +248,19 @@ void Reconstructor::fillFromMap(FrameResult& result) const {
     fused.free_space_weight = fused.free_space_weight.clone();
     fused.free_space_weight.setTo(0.f, found);
   }
+}
+
+void Reconstructor::fillSmallHoles(FrameResult& result) const {
+  DepthFrame& fused = result.fused;
+  if (config_.fusion.hole_fill_px <= 0 || fused.depth.empty())
+    return;
+  // New images: the frame being integrated may share the fused ones.
+  fused.depth = fused.depth.clone();
+  if (!fused.weight.empty())
+    fused.weight = fused.weight.clone();
+  if (!fused.free_space_weight.empty())
+    fused.free_space_weight = fused.free_space_weight.clone();
+  msf::fillSmallHoles(fused.depth, fused.weight, fused.free_space_weight, result.sky, config_.fusion.hole_fill_px);
 }
 
 bool Reconstructor::tracks(const Frame& first) const {

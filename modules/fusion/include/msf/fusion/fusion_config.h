@@ -87,6 +87,10 @@ struct DepthFusionConfig {
   // last: no depth in the open sky's clear pixels, clipped or blue (clear_sky.h), found in the
   // sky image (DepthImageFusion::setSkyImage; msf_fuse's -color, or -left).
   bool clear_sky = true;
+  // after the map took the frame: the small holes left take the nearest depth along their row or
+  // column (hole_fill.h), at weight 0, so that the depth a user gets is dense where the sensors
+  // left gaps and the map integrates none of them (Reconstructor::integrate, msf_holdout).
+  int hole_fill_px = 8;
   float facade_anchor_sigma_m = 0.2f;
   float facade_grey_tolerance = 8.f;
   float facade_max_texture = 4.f;
@@ -130,6 +134,8 @@ struct DepthFusionConfig {
     k("facade_extension", facade_extension,
       "a LiDAR-backed wall goes on upward above the top ring where the image stays blank");
     k("clear_sky", clear_sky, "no depth in the open sky's clipped or blue pixels (SkyMask), where stereo smears crowns");
+    k("hole_fill_px", hole_fill_px, atLeast(0),
+      "a hole this near a depth along its row or column takes the nearest one, at weight 0 (not integrated); 0: off");
     k("facade_anchor_sigma_m", facade_anchor_sigma_m, above(0), "anchors: fused pixels known to within this, m");
     k("facade_grey_tolerance", facade_grey_tolerance, atLeast(0),
       "grey levels from the anchors' mean (5x5 box-filtered image)");

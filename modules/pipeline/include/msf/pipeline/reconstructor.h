@@ -95,7 +95,8 @@ struct FrameResult {
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
   /// the integrator (step 5) consumes. Once integrated, with map_prior.enabled, its holes hold the
-  /// map's depth where earlier frames saw a surface (those pixels were not integrated).
+  /// map's depth where earlier frames saw a surface, and the small holes left the nearest depth at
+  /// weight 0 (fusion.hole_fill_px); neither was integrated.
   DepthFrame fused;
   StageTimes times;
 };
@@ -276,6 +277,9 @@ private:
   /// the map's surface seen from the frame's pose (MapRaycaster, section map_prior), before the
   /// frame is integrated: what earlier frames saw where this one sees nothing.
   void fillFromMap(FrameResult& result) const;
+  /// The small holes the fused depth has left (fusion.hole_fill_px, fillSmallHoles), after the
+  /// map took the frame.
+  void fillSmallHoles(FrameResult& result) const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
