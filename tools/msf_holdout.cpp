@@ -150,8 +150,7 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
     fuser->setCalibration(*in.calibration);
     fuser->setInputImage(in.left);
     fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
-    cv::Mat no_weight;
-    msf::fillSmallHoles(depth, no_weight, no_weight, fuser->getOpenSky(), fusion.hole_fill_px); // as the engine
+    msf::fillSmallHoles(depth, fuser->getOpenSky(), fusion.hole_fill_px); // as the engine
     return depth;
   };
 }

@@ -212,8 +212,7 @@ void Reconstructor::integrate(FrameResult& result) {
   if (streaming_)
     streaming_->beforeIntegration(result.T_world_cam0.translation());
   const DepthFrame frame = fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline());
-  fillFromMap(result);
-  fillSmallHoles(result);
+  fillHoles(result);
   integrator_->integrateFrame(frame, result.T_world_cam0, freeSpaceOf(result, camera_, config_.fusion, calibration_));
   if (streaming_) {
     const std::size_t freed = streaming_->stats().blocks_freed;
@@ -231,36 +230,34 @@ cv::Mat mapPriorHoles(const FrameResult& result) {
   return holes;
 }
 
-void Reconstructor::fillFromMap(FrameResult& result) const {
+void Reconstructor::fillHoles(FrameResult& result) const {
   DepthFrame& fused = result.fused;
-  if (!config_.map_prior.enabled || volume_->numBlocks() == 0 || fused.weight.empty())
+  const bool from_map = config_.map_prior.enabled && volume_->numBlocks() > 0 && !fused.weight.empty();
+  const bool small = config_.fusion.hole_fill_px > 0 && !fused.depth.empty();
+  if (!from_map && !small)
     return;
-  cv::Mat depth, weight;
-  MapRaycaster(*volume_, config_.map_prior)
-      .render(fused.camera, result.T_world_cam0, mapPriorHoles(result), depth, weight);
-  const cv::Mat found = depth > 0.f;
-  // New images: the frame being integrated may share the fused ones.
-  fused.depth = fused.depth.clone();
-  depth.copyTo(fused.depth, found);
-  fused.weight = fused.weight.clone();
-  weight.copyTo(fused.weight, found);
-  if (!fused.free_space_weight.empty()) {
-    fused.free_space_weight = fused.free_space_weight.clone();
-    fused.free_space_weight.setTo(0.f, found);
-  }
-}
-
-void Reconstructor::fillSmallHoles(FrameResult& result) const {
-  DepthFrame& fused = result.fused;
-  if (config_.fusion.hole_fill_px <= 0 || fused.depth.empty())
-    return;
-  // New images: the frame being integrated may share the fused ones.
+  // New images: the frame being integrated shares the fused ones.
   fused.depth = fused.depth.clone();
   if (!fused.weight.empty())
     fused.weight = fused.weight.clone();
   if (!fused.free_space_weight.empty())
     fused.free_space_weight = fused.free_space_weight.clone();
-  msf::fillSmallHoles(fused.depth, fused.weight, fused.free_space_weight, result.sky, config_.fusion.hole_fill_px);
+  if (from_map)
+    fillFromMap(result);
+  if (small)
+    msf::fillSmallHoles(fused.depth, fused.weight, fused.free_space_weight, result.sky, config_.fusion.hole_fill_px);
+}
+
+void Reconstructor::fillFromMap(FrameResult& result) const {
+  DepthFrame& fused = result.fused;
+  cv::Mat depth, weight;
+  MapRaycaster(*volume_, config_.map_prior)
+      .render(fused.camera, result.T_world_cam0, mapPriorHoles(result), depth, weight);
+  const cv::Mat found = depth > 0.f;
+  depth.copyTo(fused.depth, found);
+  weight.copyTo(fused.weight, found);
+  if (!fused.free_space_weight.empty())
+    fused.free_space_weight.setTo(0.f, found);
 }
 
 bool Reconstructor::tracks(const Frame& first) const {

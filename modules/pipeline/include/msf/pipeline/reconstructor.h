@@ -273,13 +273,13 @@ private:
   bool lidarBeforeStereo() const;
   /// Steps 1-4 into a started result, at its pose (the earlier scans are placed by it).
   void computeDepth(const Frame& frame, FrameResult& result);
-  /// The fused depth's holes (no depth; not open sky) filled with
-  /// the map's surface seen from the frame's pose (MapRaycaster, section map_prior), before the
-  /// frame is integrated: what earlier frames saw where this one sees nothing.
+  /// The fused depth's holes filled before the frame is integrated, in new images (the
+  /// integration frame shares the old): first from the map (section map_prior, fillFromMap),
+  /// then the small holes left (fusion.hole_fill_px, msf::fillSmallHoles).
+  void fillHoles(FrameResult& result) const;
+  /// The fused depth's holes (no depth; not open sky) filled with the map's surface seen from
+  /// the frame's pose (MapRaycaster): what earlier frames saw where this one sees nothing.
   void fillFromMap(FrameResult& result) const;
-  /// The small holes the fused depth has left (fusion.hole_fill_px, fillSmallHoles), after the
-  /// map took the frame.
-  void fillSmallHoles(FrameResult& result) const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
