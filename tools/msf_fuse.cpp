@@ -135,6 +135,7 @@ void fuse(const Inputs& inputs, const msf::Calibration& calibration, const msf::
   fusion.setInputStereo(inputs.stereo);
   fusion.setInputColor(inputs.color);
   fusion.setInputImage(inputs.left);
+  fusion.setFillSmallHoles(true); // the engine's depth
   fusion.fuse(fused);
   std::size_t valid = 0;
   for (const auto& p : fused)
@@ -166,8 +167,9 @@ int main(int argc, char** argv) {
       "msf_fuse", "<lidar.pcd> <stereo.pcd> <out.pcd> -calib PATH [options]",
       "Fuses two organized depth clouds of camera 0 of the same size, pixel by pixel, into one organized cloud with "
       "fields x y z rgb weight free_space_weight sky_depth (NaN where neither has depth; sky_depth NaN but in the "
-      "open sky). lidar.pcd: interpolated LiDAR, ideally with the field 'distance' (pixels to the nearest real "
-      "return; without it every point counts as a real return); msf_interpolate -canvas's canvas makes the output "
+      "open sky). A small hole (fusion.hole_fill_px) takes the nearest depth at weight 0, which msf_integrate "
+      "does not integrate. lidar.pcd: interpolated LiDAR, ideally with the field 'distance' (pixels to the nearest "
+      "real return; without it every point counts as a real return); msf_interpolate -canvas's canvas makes the output "
       "the canvas, the frame msf_reconstruct integrates. stereo.pcd: msf_stereo's output, ideally with "
       "'confidence' (without it every match counts as confident) and 'rgb'.");
   cli.value("-calib", "PATH", settings.calib_path,

@@ -84,7 +84,7 @@ struct FusionStage {
 
 py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::handle& lidar_distance,
                const py::handle& stereo_depth, const py::handle& stereo_confidence, const py::handle& left,
-               bool free_space, const py::handle& sky) {
+               bool free_space, const py::handle& sky, bool fill_holes) {
   const cv::Mat ld = imageView(lidar_depth, "lidar_depth", CV_32FC1);
   const cv::Size size = ld.size();
   const cv::Mat dist = optionalImageView(lidar_distance, "lidar_distance", CV_32FC1, size);
@@ -101,6 +101,8 @@ py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::hand
     stage.fusion.setInputImage(grey);
     stage.fusion.setSkyImage(sky_image);
     stage.fusion.fuse(ld, dist, sd, conf, depth, &weight, &free_weight);
+    if (fill_holes)
+      stage.fusion.fillSmallHoles(depth, weight, free_weight);
     stage.fusion.setInputImage(cv::Mat());
     stage.fusion.setSkyImage(cv::Mat());
   });
@@ -159,13 +161,15 @@ void bindStages(py::module_& m) {
       .def(py::init<const Calibration&, const PipelineConfig&>(), py::arg("calibration"), py::arg("config") = defaults)
       .def("fuse", &fuse, py::arg("lidar_depth"), py::arg("lidar_distance"), py::arg("stereo_depth"),
            py::arg("stereo_confidence"), py::arg("left") = py::none(), py::arg("free_space") = false,
-           py::arg("sky") = py::none(),
+           py::arg("sky") = py::none(), py::arg("fill_holes") = false,
            "(H, W) float32 images: the LiDAR's depth and its distance to the nearest real return (None: all "
            "real), the stereo depth and its confidence (None: all 1). left: camera 0's grey image, for the "
            "facade extension (as the pipeline does). sky: the image to find the open sky in, the colour "
            "camera's (H, W, 3) uint8 RGB or the (H, W) grey one: with fusion.clear_sky no depth in its clear "
            "(clipped or blue) sky, as the pipeline does. Returns (depth, weight), the weight the inverse "
-           "variance in m^-2; with free_space=True also the weight of the free space in front of each depth.");
+           "variance in m^-2; with free_space=True also the weight of the free space in front of each depth. "
+           "fill_holes=True: the small holes (fusion.hole_fill_px) take the nearest depth at weight 0, as in "
+           "the engine's depth and msf_fuse's.");
 
   m.def("real_returns", [](const py::handle& depth, const py::handle& distance) {
     const cv::Mat d = imageView(depth, "depth", CV_32FC1);

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 
 namespace {
@@ -68,10 +69,13 @@ struct Files {
 };
 
 TEST(FuseTool, FusesTwoOrganizedCloudsWithBothMethods) {
+  // Without the small holes' fill: a pixel neither cloud has stays NaN.
   Files f;
+  std::ofstream(f.dir.file("no_fill.yaml")) << "%YAML:1.0\nfusion:\n  hole_fill_px: 0\n";
   for (const char* method : {"paper", "uncertainty"}) {
     const auto r = msf::test::runTool("msf_fuse", f.lidar + " " + f.stereo + " " + f.out + " -calib " + f.calib +
-                                                      " -method " + method + " -overwrite");
+                                                      " -method " + method + " -config " +
+                                                      f.dir.file("no_fill.yaml") + " -overwrite");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     pcl::PointCloud<msf::PointXYZRGBWeight> fused;
     msf::loadCloud(f.out, fused); // the file has x y z rgb weight
@@ -96,6 +100,30 @@ TEST(FuseTool, FusesTwoOrganizedCloudsWithBothMethods) {
         EXPECT_GT(p.weight, 0.f);
       }
   }
+}
+
+TEST(FuseTool, FillsTheSmallHolesAtWeightZeroAsTheEngine) {
+  // fusion.hole_fill_px (8 by default): a pixel neither cloud has takes its row neighbour's
+  // depth, at weight 0, which msf_integrate does not integrate.
+  Files f;
+  const auto r = msf::test::runTool("msf_fuse", f.lidar + " " + f.stereo + " " + f.out + " -calib " + f.calib);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  pcl::PointCloud<msf::PointXYZRGBWeight> fused;
+  msf::loadCloud(f.out, fused);
+  int filled = 0;
+  for (int v = 0; v < kH; ++v)
+    for (int u = 0; u < kW; ++u) {
+      if ((u + v) % 3 != 0 || (u + v) % 4 != 0)
+        continue; // a depth of its own
+      const auto& p = fused.at(u, v);
+      ASSERT_TRUE(std::isfinite(p.z)) << "hole (" << u << ", " << v << ") not filled";
+      EXPECT_GE(p.z, 10.f);
+      EXPECT_LE(p.z, 10.4f);
+      EXPECT_EQ(p.weight, 0.f);
+      EXPECT_EQ(p.free_space_weight, 0.f);
+      ++filled;
+    }
+  EXPECT_GT(filled, 0);
 }
 
 TEST(FuseTool, AcceptsCloudsWithoutDistanceOrConfidence) {

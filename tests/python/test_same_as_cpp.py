@@ -61,8 +61,11 @@ def per_stage(sequence):
                                                         guidance=msfusion.real_returns(lidar_depth, distance))
         depth, weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left,
                                     sky=frame.color)
+        filled, filled_weight = fusion.fuse(lidar_depth, distance, stereo_depth, confidence, left=frame.left,
+                                            sky=frame.color, fill_holes=True)
         color = msfusion.colorize_depth(depth, calibration, frame.color, fallback=frame.left)
-        results.append(dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color))
+        results.append(dict(lidar=lidar_depth, stereo=stereo_depth, depth=depth, weight=weight, color=color,
+                            filled=filled, filled_weight=filled_weight))
     return results
 
 
@@ -99,18 +102,19 @@ def test_each_stage_gives_the_tools_output(sequence, tool_chain, per_stage, pipe
         assert np.count_nonzero(fused) > fused.size / 2
         assert_same_image(ours["lidar"], lidar, f"frame {i}: LiDAR depth against msf_interpolate")
         assert_same_image(ours["stereo"], stereo, f"frame {i}: stereo depth against msf_stereo")
-        assert_same_image(ours["depth"], fused, f"frame {i}: fused depth against msf_fuse")
+        # msf_fuse, as the engine, fills the fusion's small holes at weight 0 (fusion.hole_fill_px).
+        assert_same_image(ours["filled"], fused, f"frame {i}: fused depth against msf_fuse")
         has_depth = fused > 0
-        assert_same_image(ours["weight"][has_depth], weight[has_depth], f"frame {i}: weight against msf_fuse")
+        assert_same_image(ours["filled_weight"][has_depth], weight[has_depth], f"frame {i}: weight against msf_fuse")
         assert_same_image(ours["color"], color, f"frame {i}: colour against msf_fuse")
+        filled = (ours["filled"] > 0) & ~(ours["depth"] > 0)
+        assert np.count_nonzero(filled) > 0, f"frame {i}: no hole filled"
+        assert np.all(ours["filled_weight"][filled] == 0), f"frame {i}: a filled pixel with a weight"
+        assert_same_image(ours["depth"][~filled], ours["filled"][~filled], f"frame {i}: the fill changed a depth")
         pipeline = pipeline_run[0][i]
-        # The engine's fused depth is the fusion's with its small holes filled, at weight 0, after
-        # the map took the frame (fusion.hole_fill_px).
-        assert_same_image(ours["depth"][has_depth], pipeline["depth"][has_depth],
-                          f"frame {i}: fused depth against the pipeline's")
-        filled = ~has_depth & (pipeline["depth"] > 0)
-        assert np.count_nonzero(filled) > 0, f"frame {i}: the pipeline filled no hole"
-        assert np.all(pipeline["weight"][filled] == 0), f"frame {i}: a filled pixel with a weight"
+        assert_same_image(ours["filled"], pipeline["depth"], f"frame {i}: fused depth against the pipeline's")
+        assert_same_image(ours["filled_weight"][has_depth], pipeline["weight"][has_depth],
+                          f"frame {i}: weight against the pipeline's")
         assert_same_image(ours["color"], pipeline["color"], f"frame {i}: colour against the pipeline's")
 
 

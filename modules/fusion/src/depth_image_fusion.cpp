@@ -4,6 +4,7 @@
 #include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/fusion/facade_extension.h>
+#include <msf/fusion/hole_fill.h>
 #include <msf/range_image/real_returns.h>
 
 #include <opencv2/core/utility.hpp>
@@ -109,6 +110,15 @@ void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_dept
   }
   sky = open_sky_.empty() ? sky_.compute(sky_image_, returns_) : open_sky_;
   column_depth = sky_.topReturnDepth(returns_);
+}
+
+void DepthImageFusion::fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight) const {
+  if (config_.hole_fill_px <= 0)
+    return;
+  cv::Mat sky;
+  std::vector<float> column_depth;
+  findOpenSky(sky, column_depth);
+  msf::fillSmallHoles(depth, weight, free_weight, sky, config_.hole_fill_px);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

@@ -86,6 +86,11 @@ public:
   void setInputImage(const cv::Mat& left) { left_ = left; }
   void setColorCamera(int camera) { color_camera_ = camera; }
   int getColorCamera() const { return color_camera_; }
+  /// Whether fuse() fills the image's small holes at weight 0 (fusion.hole_fill_px, never in the
+  /// open sky; DepthImageFusion::fillSmallHoles): the depth the engine gives once the map took
+  /// the frame, which an integrator ignores. Off by default: the fusion's own depth.
+  void setFillSmallHoles(bool fill) { fill_small_holes_ = fill; }
+  bool getFillSmallHoles() const { return fill_small_holes_; }
 
   /// Fuses the inputs into `output` (resized to the LiDAR cloud's width x height).
   /// Throws InvalidInputError naming the input that is missing, not organized, or of
@@ -113,6 +118,7 @@ private:
   PointCloudStereoConstPtr stereo_;
   cv::Mat color_, left_;
   int color_camera_{2};
+  bool fill_small_holes_{false};
   cv::Rect image_in_canvas_; ///< where the stereo's image lies in the LiDAR cloud; empty: the same size
   DepthImageFusion image_fusion_;
   // Work buffers, kept between frames.

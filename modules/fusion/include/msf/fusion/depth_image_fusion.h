@@ -50,6 +50,10 @@ public:
   /// LiDAR's highest return (SkyMask::topReturnDepth, 0 where there is none), which bounds
   /// the carving along the sky's rays (TsdfIntegrator::carveSky). Both empty without a sky image.
   void findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const;
+  /// The last fuse()'s depth with its small holes filled at weight 0 (fusion.hole_fill_px,
+  /// msf::fillSmallHoles), never in its open sky (findOpenSky): the depth the engine gives once
+  /// the map took the frame. weight and free_weight are fuse()'s (empty: none).
+  void fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight) const;
 
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]

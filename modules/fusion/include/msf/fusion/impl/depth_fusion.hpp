@@ -143,6 +143,12 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
   if (on_canvas)
     growOntoCanvas(lidar_depth_, lidar_distance_, config_, static_cast<float>(calibration_.focalBaseline()),
                    fused_depth_, fused_weight_, fused_free_weight_, &fused_color_);
+  if (fill_small_holes_) {
+    // The image's holes, after the canvas grew from the fusion's own depth (as the engine's).
+    const cv::Rect image = on_canvas ? image_in_canvas_ : cv::Rect(cv::Point(), size);
+    cv::Mat depth = fused_depth_(image), weight = fused_weight_(image), free_weight = fused_free_weight_(image);
+    image_fusion_.fillSmallHoles(depth, weight, free_weight);
+  }
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
