@@ -190,6 +190,29 @@ void BM_MarchingCubesFullTriangleMesh(benchmark::State& state) {
 }
 BENCHMARK(BM_MarchingCubesFullTriangleMesh)->Unit(benchmark::kMillisecond);
 
+/// The 10-frame map written as volume.pcd (binary compressed, what msf_reconstruct saves), into
+/// /dev/shm: the CPU's cost, not a disk's.
+void BM_VolumeSave(benchmark::State& state) {
+  const TsdfVolume& volume = tenFrameMap();
+  const std::string path = "/dev/shm/msf_bench_volume_" + std::to_string(::getpid()) + ".pcd";
+  for (auto _ : state)
+    volume.save(path);
+  state.counters["voxels"] = static_cast<double>(volume.numObservedVoxels());
+  state.counters["MB"] = static_cast<double>(fs::file_size(path)) / 1e6;
+  fs::remove(path);
+}
+BENCHMARK(BM_VolumeSave)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The same file read back (msf_mesh, msf_integrate -volume).
+void BM_VolumeLoad(benchmark::State& state) {
+  const std::string path = "/dev/shm/msf_bench_volume_load_" + std::to_string(::getpid()) + ".pcd";
+  tenFrameMap().save(path);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(TsdfVolume::load(path).numBlocks());
+  fs::remove(path);
+}
+BENCHMARK(BM_VolumeLoad)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 double cpuMs() {
   timespec t;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);

@@ -2,7 +2,8 @@
 // The cost of writing checked to the end (msf/common/checked_write.h) beside PCL's own writers,
 // in the same run, into /dev/shm (the CPU's cost, not a disk's): an organized KITTI-sized
 // cloud as a binary compressed .pcd (PCL's file writer maps the file; saveCloud writes the same
-// bytes by writeCompressedPcd into a checked stream) and a mesh as a binary .ply (PCL's writer alone;
+// points by writeCompressedPcd, compressed in pieces on every core, into a checked stream) and a
+// mesh as a binary .ply (PCL's writer alone;
 // saveMesh, the same writer through the checked pipe). 10 repetitions of 5 writes; median and
 // minimum over the repetitions.
 //

@@ -6,11 +6,11 @@
 #include <pcl/io/lzf.h>
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <locale>
-#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -31,25 +31,70 @@ std::vector<FieldPlane> fieldPlanes(const pcl::PCLPointCloud2& blob) {
   return planes;
 }
 
-/// The points' fields, each field's values side by side (x x x ... y y y ...), which compresses
-/// better than whole points.
-std::unique_ptr<char[]> fieldsSideBySide(const std::uint8_t* data, std::size_t step,
-                                         const std::vector<FieldPlane>& fields, std::size_t points, std::size_t bytes) {
-  std::unique_ptr<char[]> planes(new char[bytes]);
-  std::vector<char*> starts;
-  std::size_t start = 0;
-  for (const FieldPlane& f : fields) {
-    starts.push_back(planes.get() + start);
-    start += f.bytes * points;
+/// The points' fields laid out as the body holds them, each field's values side by side
+/// (x x x ... y y y ...), which compresses better than whole points.
+struct FieldsSideBySide {
+  const std::uint8_t* data;
+  std::size_t step, points;
+  std::vector<FieldPlane> fields;
+
+  std::size_t bytes() const {
+    std::size_t total = 0;
+    for (const FieldPlane& f : fields)
+      total += f.bytes * points;
+    return total;
   }
-  parallelFor(cv::Range(0, static_cast<int>(points)), [&](const cv::Range& range) {
-    for (std::size_t j = 0; j < fields.size(); ++j) {
-      const FieldPlane& f = fields[j];
-      for (int i = range.start; i < range.end; ++i)
-        std::memcpy(starts[j] + static_cast<std::size_t>(i) * f.bytes, data + i * step + f.offset, f.bytes);
+
+  /// Bytes [begin, end) of the layout into `out`; a piece may start or end within a value.
+  void copy(std::size_t begin, std::size_t end, char* out) const {
+    std::size_t plane = 0; // where the field's plane starts
+    for (const FieldPlane& f : fields) {
+      const std::size_t plane_end = plane + f.bytes * points;
+      std::size_t b = std::max(begin, plane);
+      const std::size_t to = std::min(end, plane_end);
+      if (b < to) {
+        char* o = out + (b - begin);
+        const std::uint8_t* value = data + (b - plane) / f.bytes * step + f.offset;
+        if (const std::size_t within = (b - plane) % f.bytes) { // the end of a value the last piece began
+          const std::size_t n = std::min(f.bytes - within, to - b);
+          std::memcpy(o, value + within, n);
+          o += n, b += n, value += step;
+        }
+        for (; b + f.bytes <= to; o += f.bytes, b += f.bytes, value += step)
+          std::memcpy(o, value, f.bytes);
+        if (b < to)
+          std::memcpy(o, value, to - b);
+      }
+      plane = plane_end;
+    }
+  }
+};
+
+/// LZF's stream of the layout (pcl::lzfCompress), compressed in pieces of kPieceBytes on every
+/// core. LZF refers back only within what its stream wrote, so the pieces' streams one after
+/// another are one stream that any LZF reader (PCL's) decompresses whole; a body of one piece
+/// is PCL's own. Pieces of a fixed size: the same bytes on any number of threads.
+std::vector<std::vector<char>> compressInPieces(const FieldsSideBySide& layout) {
+  constexpr std::size_t kPieceBytes = std::size_t{1} << 20; // LZF's window is 8 KiB: the ratio barely changes
+  const std::size_t bytes = layout.bytes(), pieces = (bytes + kPieceBytes - 1) / kPieceBytes;
+  std::vector<std::vector<char>> compressed(pieces);
+  parallelFor(cv::Range(0, static_cast<int>(pieces)), [&](const cv::Range& range) {
+    std::vector<char> piece(kPieceBytes);
+    for (int k = range.start; k < range.end; ++k) {
+      const std::size_t start = static_cast<std::size_t>(k) * kPieceBytes;
+      const std::size_t length = std::min(kPieceBytes, bytes - start);
+      layout.copy(start, start + length, piece.data());
+      std::vector<char>& out = compressed[static_cast<std::size_t>(k)];
+      out.resize(length * 3 / 2 + 16);
+      const unsigned int written = pcl::lzfCompress(piece.data(), static_cast<unsigned int>(length), out.data(),
+                                                    static_cast<unsigned int>(out.size()));
+      out.resize(written); // 0: it did not compress
     }
   });
-  return planes;
+  for (const std::vector<char>& piece : compressed)
+    if (piece.empty())
+      throw IOError("its " + std::to_string(bytes) + " bytes do not compress");
+  return compressed;
 }
 
 /// PCL's header, with `comment` after its first line.
@@ -80,7 +125,7 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
   for (const FieldPlane& f : fields)
     point_bytes += f.bytes;
   // The format keeps its sizes in 32 bits, and the compressed body may need half as much again.
-  const std::size_t bytes = points * point_bytes, room = bytes * 3 / 2;
+  const std::size_t bytes = points * point_bytes;
   constexpr std::size_t kMaxBytes = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
   if (bytes > kMaxBytes)
     throw IOError("its " + std::to_string(points) + " points of " + std::to_string(point_bytes) + " bytes make " +
@@ -89,21 +134,19 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
   if (data_bytes < points * layout.point_step)
     throw IOError("its data holds " + std::to_string(data_bytes) + " bytes, not its " +
                   std::to_string(points) + " points of " + std::to_string(layout.point_step));
-  std::uint32_t sizes[2] = {0, 0}; // compressed, uncompressed
-  std::unique_ptr<char[]> compressed;
-  if (bytes > 0) {
-    const std::unique_ptr<char[]> planes = fieldsSideBySide(data, layout.point_step, fields, points, bytes);
-    compressed.reset(new char[room]);
-    sizes[0] = pcl::lzfCompress(planes.get(), static_cast<unsigned int>(bytes), compressed.get(),
-                                static_cast<unsigned int>(room));
-    sizes[1] = static_cast<std::uint32_t>(bytes);
-    if (sizes[0] == 0)
-      throw IOError("its " + std::to_string(bytes) + " bytes do not compress");
-  }
+  const FieldsSideBySide body{data, layout.point_step, points, fields};
+  const std::vector<std::vector<char>> pieces = compressInPieces(body);
+  std::size_t compressed = 0;
+  for (const std::vector<char>& piece : pieces)
+    compressed += piece.size();
+  if (compressed > std::numeric_limits<std::uint32_t>::max())
+    throw IOError("its " + std::to_string(bytes) + " bytes compress to more than the format's 32-bit sizes hold");
+  const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(compressed), static_cast<std::uint32_t>(bytes)};
   const std::string text = header(layout, origin, orientation, comment);
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
   out.write(reinterpret_cast<const char*>(sizes), sizeof(sizes));
-  out.write(compressed.get(), static_cast<std::streamsize>(sizes[0]));
+  for (const std::vector<char>& piece : pieces)
+    out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
 }
 
 } // namespace msf

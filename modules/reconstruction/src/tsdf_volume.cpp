@@ -25,6 +25,7 @@
 #include <fstream>
 #include <iterator>
 #include <new>
+#include <numeric>
 #include <ostream>
 #include <sstream>
 #include <type_traits>
@@ -315,32 +316,45 @@ void TsdfVolume::clear() {
 }
 
 void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) const {
+  const auto kept = [min_weight](const TsdfVoxel& voxel) { return voxel.observed() && voxel.weight > min_weight; };
+  // Each block's place in the cloud first, so that the blocks fill theirs side by side, in order.
+  const int blocks = static_cast<int>(blocks_.size());
+  std::vector<std::size_t> first(blocks_.size() + 1, 0);
+  parallelFor(cv::Range(0, blocks), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b)
+      first[static_cast<std::size_t>(b) + 1] = static_cast<std::size_t>(
+          std::count_if(std::begin(blocks_[b]->voxels), std::end(blocks_[b]->voxels), kept));
+  });
+  std::partial_sum(first.begin(), first.end(), first.begin());
   cloud.clear();
-  cloud.reserve(numObservedVoxels());
+  cloud.resize(first.back());
   const float vs = static_cast<float>(voxel_size_);
-  for (const auto& block : blocks_) {
-    const GridIndex o = block->origin();
-    for (int z = 0; z < TsdfBlock::kSide; ++z)
-      for (int y = 0; y < TsdfBlock::kSide; ++y)
-        for (int x = 0; x < TsdfBlock::kSide; ++x) {
-          const TsdfVoxel& voxel = block->at(x, y, z);
-          if (!voxel.observed() || voxel.weight <= min_weight)
-            continue;
-          PointTsdf p;
-          p.x = static_cast<float>(o.x() + x) * vs;
-          p.y = static_cast<float>(o.y() + y) * vs;
-          p.z = static_cast<float>(o.z() + z) * vs;
-          p.sdf = voxel.sdf;
-          p.weight = voxel.weight;
-          p.r = voxel.r;
-          p.g = voxel.g;
-          p.b = voxel.b;
-          p.a = 255;
-          p.passes = static_cast<std::uint8_t>(voxel.passes());
-          p.reappeared = voxel.reappeared() ? 1 : 0;
-          cloud.push_back(p);
-        }
-  }
+  parallelFor(cv::Range(0, blocks), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
+      const TsdfBlock& block = *blocks_[b];
+      const GridIndex o = block.origin();
+      PointTsdf* p = &cloud[first[static_cast<std::size_t>(b)]];
+      for (int z = 0; z < TsdfBlock::kSide; ++z)
+        for (int y = 0; y < TsdfBlock::kSide; ++y)
+          for (int x = 0; x < TsdfBlock::kSide; ++x) {
+            const TsdfVoxel& voxel = block.at(x, y, z);
+            if (!kept(voxel))
+              continue;
+            p->x = static_cast<float>(o.x() + x) * vs;
+            p->y = static_cast<float>(o.y() + y) * vs;
+            p->z = static_cast<float>(o.z() + z) * vs;
+            p->sdf = voxel.sdf;
+            p->weight = voxel.weight;
+            p->r = voxel.r;
+            p->g = voxel.g;
+            p->b = voxel.b;
+            p->a = 255;
+            p->passes = static_cast<std::uint8_t>(voxel.passes());
+            p->reappeared = voxel.reappeared() ? 1 : 0;
+            ++p;
+          }
+    }
+  });
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   cloud.is_dense = true;

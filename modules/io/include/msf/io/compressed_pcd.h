@@ -13,13 +13,15 @@
 
 namespace msf {
 
-/// Writes `blob` to `out` as a binary_compressed .pcd: byte for byte what PCL's
-/// PCDWriter::writeBinaryCompressed writes (its header, each field's values side by side,
-/// compressed by pcl::lzfCompress), with `comment` (whole "# ..." lines, each ending in a
-/// newline) after the first line, where PCD readers skip it. PCL's stream writer hands the
-/// compressed body to the stream a character at a time, which dominates the writing of a
-/// large cloud; here it is one write. Throws IOError when the points are more than the
-/// format's 32-bit sizes hold or do not compress.
+/// Writes `blob` to `out` as a binary_compressed .pcd, as PCL's PCDWriter::writeBinaryCompressed
+/// does (its header, each field's values side by side, compressed by pcl::lzfCompress), with
+/// `comment` (whole "# ..." lines, each ending in a newline) after the first line, where PCD
+/// readers skip it. A body up to 1 MiB is byte for byte PCL's; a larger one is compressed in
+/// pieces of 1 MiB on every core, one LZF stream that PCL reads as its own (the same bytes on
+/// any number of threads). PCL's stream writer hands the compressed body to the stream a
+/// character at a time, which dominates the writing of a large cloud; here it is one write.
+/// Throws IOError when the points are more than the format's 32-bit sizes hold or do not
+/// compress.
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
                         const Eigen::Quaternionf& orientation, const std::string& comment = "");
 
