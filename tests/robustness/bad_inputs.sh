@@ -382,6 +382,9 @@ check "synth -config: an unknown sky" 1 "sky_cloudy.yaml' line 2: synthetic.sky 
 printf 'accumulation:\n  scans: 40\n' >"$F/scans_40.yaml"
 check "interpolate -config: 40 earlier scans" 1 "scans_40.yaml' line 2: accumulation.scans must be a whole number in 0..16, not 40" -- \
   msf_interpolate "$F/sparse.pcd" o.pcd -config "$F/scans_40.yaml"
+printf 'fusion:\n  hole_fill_px: -1\n' >"$F/fill_negative.yaml"
+check "fuse -config: a negative hole fill" 1 "fill_negative.yaml' line 2: fusion.hole_fill_px must be a whole number in 0..2147483647, not -1" -- \
+  msf_fuse "$F/dense.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera.yaml" -config "$F/fill_negative.yaml"
 printf 'map_prior:\n  min_depth_m: 50\n' >"$F/prior_inverted.yaml"
 check "mesh -config: the map prior's rays end before they start" 1 \
   "prior_inverted.yaml': map_prior.max_depth_m \(40.000000\) must exceed min_depth_m \(50.000000\)" -- \
