@@ -278,7 +278,8 @@ private:
   /// then the small holes left (fusion.hole_fill_px, msf::fillSmallHoles).
   void fillHoles(FrameResult& result) const;
   /// The fused depth's holes (no depth; not open sky) filled with the map's surface seen from
-  /// the frame's pose (MapRaycaster): what earlier frames saw where this one sees nothing.
+  /// the frame's pose (MapRaycaster): what earlier frames saw where this one sees nothing. In
+  /// the images fillHoles made new.
   void fillFromMap(FrameResult& result) const;
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
