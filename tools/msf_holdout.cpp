@@ -10,8 +10,8 @@
 #include <msf/common/statistics.h>
 #include <msf/common/tool.h>
 #include <msf/evaluation/holdout.h>
+#include <msf/fusion/clear_sky.h>
 #include <msf/fusion/depth_image_fusion.h>
-#include <msf/fusion/hole_fill.h>
 #include <msf/io/sequence.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/range_image/lidar_completion.h>
@@ -149,8 +149,9 @@ msf::HoldoutMethod fusedWith(const msf::ProjectionConfig& projection, const msf:
     sgbm->computeDisparity();
     fuser->setCalibration(*in.calibration);
     fuser->setInputImage(in.left);
+    fuser->setSkyImage(msf::skyImage(in.color, in.left, in.left.size())); // as the engine
     fuser->fuse(lidar_depth, distance, sgbm->getDepth(), sgbm->getConfidence(), depth);
-    msf::fillSmallHoles(depth, fuser->getOpenSky(), fusion.hole_fill_px); // as the engine
+    fuser->fillSmallHoles(depth);
     return depth;
   };
 }

@@ -102,7 +102,7 @@ py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::hand
     stage.fusion.setSkyImage(sky_image);
     stage.fusion.fuse(ld, dist, sd, conf, depth, &weight, &free_weight);
     if (fill_holes)
-      stage.fusion.fillSmallHoles(depth, weight, free_weight);
+      stage.fusion.fillSmallHoles(depth, &weight, &free_weight);
     stage.fusion.setInputImage(cv::Mat());
     stage.fusion.setSkyImage(cv::Mat());
   });

@@ -112,13 +112,14 @@ void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_dept
   column_depth = sky_.topReturnDepth(returns_);
 }
 
-void DepthImageFusion::fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight) const {
+void DepthImageFusion::fillSmallHoles(cv::Mat& fused_depth, cv::Mat* fused_weight, cv::Mat* free_space_weight) const {
   if (config_.hole_fill_px <= 0)
     return;
-  cv::Mat sky;
+  cv::Mat sky, no_weight;
   std::vector<float> column_depth;
   findOpenSky(sky, column_depth);
-  msf::fillSmallHoles(depth, weight, free_weight, sky, config_.hole_fill_px);
+  msf::fillSmallHoles(fused_depth, fused_weight ? *fused_weight : no_weight,
+                      free_space_weight ? *free_space_weight : no_weight, sky, config_.hole_fill_px);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

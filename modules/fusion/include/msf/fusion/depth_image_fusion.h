@@ -52,8 +52,9 @@ public:
   void findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const;
   /// The last fuse()'s depth with its small holes filled at weight 0 (fusion.hole_fill_px,
   /// msf::fillSmallHoles), never in its open sky (findOpenSky): the depth the engine gives once
-  /// the map took the frame. weight and free_weight are fuse()'s (empty: none).
-  void fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight) const;
+  /// the map took the frame. fused_weight and free_space_weight, when given, are fuse()'s.
+  void fillSmallHoles(cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr,
+                      cv::Mat* free_space_weight = nullptr) const;
 
   /// lidar_depth, stereo_depth: CV_32FC1 metres (0, negative or NaN = none); lidar_distance: CV_32FC1
   /// pixels to the nearest real return (empty: all 0); stereo_confidence: CV_32FC1 in [0, 1]

@@ -89,7 +89,7 @@ struct DepthFusionConfig {
   bool clear_sky = true;
   // after the map took the frame: the small holes left take the nearest depth along their row or
   // column (hole_fill.h), at weight 0, so that the depth a user gets is dense where the sensors
-  // left gaps and the map integrates none of them (Reconstructor::integrate, msf_holdout).
+  // left gaps and the map integrates none of them (Reconstructor::integrate, msf_fuse, msf_holdout).
   int hole_fill_px = 8;
   float facade_anchor_sigma_m = 0.2f;
   float facade_grey_tolerance = 8.f;

@@ -147,7 +147,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
     // The image's holes, after the canvas grew from the fusion's own depth (as the engine's).
     const cv::Rect image = on_canvas ? image_in_canvas_ : cv::Rect(cv::Point(), size);
     cv::Mat depth = fused_depth_(image), weight = fused_weight_(image), free_weight = fused_free_weight_(image);
-    image_fusion_.fillSmallHoles(depth, weight, free_weight);
+    image_fusion_.fillSmallHoles(depth, &weight, &free_weight);
   }
 }
 
