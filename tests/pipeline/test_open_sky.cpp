@@ -116,6 +116,26 @@ TEST(OpenSky, AClearSkyGivesNoDepth) {
   EXPECT_EQ(cv::countNonZero(differs & ~clear), 0);
 }
 
+TEST(OpenSky, TheHoleFillKeepsOutOfTheSkyHoweverTheMapCarves) {
+  // The frame's depth is the fusion's, whatever the map does with it: with sky carving off the
+  // open sky is still found, and the small-hole fill (fusion.hole_fill_px) still leaves it empty.
+  MSF_REQUIRE_KITTI();
+  const msf::Sequence sequence(drive());
+  const msf::Frame frame = sequence.load(20);
+  msf::PipelineConfig config;
+  msf::Reconstructor carving(sequence.calibration(), config);
+  config.integrator.sky_carving = false;
+  msf::Reconstructor not_carving(sequence.calibration(), config);
+  const msf::FrameResult with = carving.addFrame(frame), without = not_carving.addFrame(frame);
+  ASSERT_GT(cv::countNonZero(with.sky), 20000);
+  ASSERT_EQ(without.sky.size(), with.sky.size()) << "no open sky found without sky carving";
+  EXPECT_EQ(cv::norm(with.sky, without.sky, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero((without.fused.depth > 0.f) & without.sky), 0) << "a hole filled in the open sky";
+  const cv::Mat had = with.fused.depth > 0.f, has = without.fused.depth > 0.f;
+  EXPECT_EQ(cv::countNonZero(had != has), 0);
+  EXPECT_EQ(cv::countNonZero((with.fused.depth != without.fused.depth) & had), 0);
+}
+
 TEST(OpenSky, AFusedCloudCarriesTheFramesOpenSky) {
   // What msf_fuse writes (field sky_depth) and msf_integrate and msfusion read back: the
   // frame's open sky and each column's depth of its highest LiDAR return, as sky carving takes them.

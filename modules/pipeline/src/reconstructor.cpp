@@ -149,8 +149,6 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
 }
 
 void Reconstructor::computeSky(FrameResult& result) {
-  if (!config_.integrator.sky_carving || !config_.integrator.space_carving)
-    return;
   stages_->fusion.findOpenSky(result.sky, result.sky_column_depth);
 }
 

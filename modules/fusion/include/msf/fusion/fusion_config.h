@@ -135,7 +135,8 @@ struct DepthFusionConfig {
       "a LiDAR-backed wall goes on upward above the top ring where the image stays blank");
     k("clear_sky", clear_sky, "no depth in the open sky's clipped or blue pixels (SkyMask), where stereo smears crowns");
     k("hole_fill_px", hole_fill_px, atLeast(0),
-      "a hole this near a depth along its row or column takes the nearest one, at weight 0 (not integrated); 0: off");
+      "a hole outside the open sky this near a depth along its row or column takes the nearest one, at "
+      "weight 0 (not integrated); 0: off");
     k("facade_anchor_sigma_m", facade_anchor_sigma_m, above(0), "anchors: fused pixels known to within this, m");
     k("facade_grey_tolerance", facade_grey_tolerance, atLeast(0),
       "grey levels from the anchors' mean (5x5 box-filtered image)");

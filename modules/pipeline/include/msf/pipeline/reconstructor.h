@@ -85,8 +85,8 @@ struct FrameResult {
   /// where the camera's depth does not (TsdfIntegrator::carveWithScan).
   ScanFreeSpace scan_free_space;
   /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky; the fusion's when it
-  /// found one, fusion.clear_sky) when the map carves along it (tsdf_integrator.sky_carving):
-  /// what the map clears in front of the sky (carveSky).
+  /// found one, fusion.clear_sky): where no hole is filled, and what the map clears in front of
+  /// the sky when it carves along it (tsdf_integrator.sky_carving, carveSky).
   cv::Mat sky;
   /// Per image column, the depth of the LiDAR's highest return near it (SkyMask::topReturnDepth):
   /// how far the sky's rays are carved there.
@@ -284,7 +284,7 @@ private:
   void computeLidar(const Frame& frame, FrameResult& result);   // steps 1-2
   void computeStereo(const Frame& frame, FrameResult& result);  // step 3
   void computeFusion(const Frame& frame, FrameResult& result);  // step 4
-  /// The frame's open sky (FrameResult::sky), when the map carves along it.
+  /// The frame's open sky (FrameResult::sky), whether or not the map carves along it.
   void computeSky(FrameResult& result);
   /// Whether frames from `first` on are tracked by the odometry (PoseMode).
   bool tracks(const Frame& first) const;
