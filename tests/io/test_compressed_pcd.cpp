@@ -16,6 +16,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -121,6 +122,86 @@ TEST(CompressedPcd, ALargeBodyIsCompressedInPiecesThatPclReadsBackOnAnyNumberOfT
     differ += back[i].x != original[i].x || back[i].z != original[i].z || back[i].rgba != original[i].rgba ||
               back[i].normal_x != original[i].normal_x || back[i].curvature != original[i].curvature;
   EXPECT_EQ(differ, 0u);
+}
+
+/// The body read by readCompressedPieces after PCL's readHeader; false as it returns.
+bool readInPieces(const std::string& path, pcl::PCLPointCloud2& blob) {
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0, data_type = 0;
+  unsigned int data_index = 0;
+  EXPECT_EQ(pcl::PCDReader().readHeader(path, blob, origin, orientation, version, data_type, data_index), 0);
+  return msf::readCompressedPieces(path, data_index, blob);
+}
+
+void expectSameAsPclReads(const pcl::PCLPointCloud2& blob, const std::string& path) {
+  pcl::PCLPointCloud2 pcls;
+  ASSERT_EQ(pcl::PCDReader().read(path, pcls), 0);
+  EXPECT_EQ(blob.width, pcls.width);
+  EXPECT_EQ(blob.height, pcls.height);
+  EXPECT_EQ(blob.point_step, pcls.point_step);
+  EXPECT_EQ(pcl::getFieldsList(blob), pcl::getFieldsList(pcls));
+  EXPECT_EQ(blob.is_dense, pcls.is_dense);
+  EXPECT_TRUE(blob.data == pcls.data) << "the points differ from PCL's reading";
+}
+
+TEST(CompressedPcd, ALargeBodyIsReadInPiecesAsPclReadsIt) {
+  // 70 000 points of 32 bytes: three pieces. A value that is not finite, in the last piece,
+  // makes the cloud not dense, as PCL's reader says (an alpha of 0: rgb, a float field, finite).
+  for (const bool with_nan : {false, true}) {
+    pcl::PointCloud<pcl::PointXYZRGBNormal> cloud = surfaceCloud(70000);
+    for (auto& p : cloud)
+      p.a = 0;
+    if (with_nan)
+      cloud[69000].curvature = std::numeric_limits<float>::quiet_NaN();
+    msf::test::TempDir dir;
+    const std::string path = dir.file("c.pcd");
+    msf::saveCloud(path, cloud);
+    pcl::PCLPointCloud2 blob;
+    ASSERT_TRUE(readInPieces(path, blob)) << "the pieces were not found";
+    EXPECT_EQ(blob.is_dense, !with_nan);
+    expectSameAsPclReads(blob, path);
+    const int threads = cv::getNumThreads();
+    cv::setNumThreads(1);
+    pcl::PCLPointCloud2 on_one_thread;
+    msf::loadCloudBlob(path, on_one_thread);
+    cv::setNumThreads(threads);
+    expectSameAsPclReads(on_one_thread, path);
+  }
+}
+
+TEST(CompressedPcd, PiecesTheHeaderMisplacesAreLeftToPclsReader) {
+  msf::test::TempDir dir;
+  const std::string path = dir.file("c.pcd");
+  msf::saveCloud(path, surfaceCloud(70000));
+  std::stringstream text;
+  text << std::ifstream(path, std::ios::binary).rdbuf();
+  const std::string file = text.str(), tag = "# msfusion lzf_pieces ";
+  const std::size_t line = file.find(tag), end = file.find('\n', line);
+  ASSERT_NE(line, std::string::npos);
+  std::istringstream words(file.substr(line + tag.size(), end - line - tag.size()));
+  std::size_t unpacked = 0, first = 0, second = 0, third = 0;
+  ASSERT_TRUE(words >> unpacked >> first >> second >> third);
+  ASSERT_NE(first, second);
+  const std::string swapped = tag + std::to_string(unpacked) + " " + std::to_string(second) + " " +
+                              std::to_string(first) + " " + std::to_string(third);
+  const std::string short_of_one = tag + std::to_string(unpacked) + " " + std::to_string(first + second + third);
+  // Sizes whose sum wraps around to the body's: the first would lie far beyond the file.
+  const std::string wrapping = tag + std::to_string(unpacked) + " " +
+                               std::to_string(std::numeric_limits<std::size_t>::max()) + " 1 " +
+                               std::to_string(first + second + third);
+  for (const std::string& lie : {swapped, short_of_one, wrapping}) {
+    std::string damaged = file;
+    damaged.replace(line, end - line, lie);
+    std::ofstream(path, std::ios::binary) << damaged;
+    pcl::PCLPointCloud2 blob;
+    EXPECT_FALSE(readInPieces(path, blob)) << lie;
+    msf::loadCloudBlob(path, blob); // PCL reads the one stream whole
+    expectSameAsPclReads(blob, path);
+    pcl::PointCloud<pcl::PointXYZRGBNormal> back;
+    pcl::fromPCLPointCloud2(blob, back);
+    EXPECT_EQ(back[69999].z, surfaceCloud(70000)[69999].z) << lie;
+  }
 }
 
 TEST(CompressedPcd, DataShorterThanItsPointsIsRefused) {

@@ -632,7 +632,8 @@ void loadCloudBlob(const std::string& path, pcl::PCLPointCloud2& blob) {
       checkPcdBody(path, blob, data_type, data_index, false); // the values were checked above
       if (data_type == 2)
         checkCompressedSizes(path, blob, data_index);
-      result = reader.read(path, blob);
+      const bool in_pieces = data_type == 2 && readCompressedPieces(path, data_index, blob);
+      result = in_pieces ? 0 : reader.read(path, blob);
     } else if (ext == ".ply") {
       checkPlyHeader(path, "cloud");
       result = pcl::PLYReader().read(path, blob);

@@ -18,8 +18,9 @@ namespace msf {
 /// `comment` (whole "# ..." lines, each ending in a newline) after the first line, where PCD
 /// readers skip it. A body up to 1 MiB is byte for byte PCL's; a larger one is compressed in
 /// pieces of 1 MiB on every core, one LZF stream that PCL reads as its own (the same bytes on
-/// any number of threads). PCL's stream writer hands the compressed body to the stream a
-/// character at a time, which dominates the writing of a large cloud; here it is one write.
+/// any number of threads), and a comment line says where the pieces lie (readCompressedPieces).
+/// PCL's stream writer hands the compressed body to the stream a character at a time, which
+/// dominates the writing of a large cloud; here it is one write.
 /// Throws IOError when the points are more than the format's 32-bit sizes hold or do not
 /// compress.
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
@@ -30,6 +31,13 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, cons
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
                         std::size_t bytes, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
                         const std::string& comment = "");
+
+/// Reads the body of a binary_compressed .pcd that writeCompressedPcd wrote in pieces into
+/// `blob`, which holds the file's fields and size (pcl::PCDReader::readHeader), as
+/// PCDReader::read does (the points, is_dense), the pieces unpacked on every core: the header
+/// line the writer adds says where each begins. False, with `blob` as it was, for any other
+/// file, or one whose pieces do not make up its body: PCL's reader reads it whole.
+bool readCompressedPieces(const std::string& path, std::size_t data_index, pcl::PCLPointCloud2& blob);
 
 /// What a PCLPointCloud2 of `cloud` holds but its points: the fields and the size.
 template <typename PointT>
