@@ -15,6 +15,7 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -168,6 +169,26 @@ TEST(CompressedPcd, ALargeBodyIsReadInPiecesAsPclReadsIt) {
     cv::setNumThreads(threads);
     expectSameAsPclReads(on_one_thread, path);
   }
+}
+
+TEST(CompressedPcd, AValueThatAPieceEndsWithinIsWrittenAndReadWhole) {
+  // A field of three floats: the first piece ends within one of its values (its plane begins
+  // at 400 004 bytes; 1 MiB is no multiple of 12 bytes from there).
+  pcl::PCLPointCloud2 blob;
+  blob.fields = {{"x", 0, pcl::PCLPointField::FLOAT32, 1}, {"v", 4, pcl::PCLPointField::FLOAT32, 3}};
+  blob.width = 100001, blob.height = 1, blob.point_step = 16, blob.row_step = 16 * blob.width;
+  blob.data.resize(static_cast<std::size_t>(blob.row_step));
+  for (std::size_t i = 0; i < blob.data.size() / 4; ++i) {
+    const float value = 0.001f * static_cast<float>(i % 7919);
+    std::memcpy(&blob.data[i * 4], &value, 4);
+  }
+  msf::test::TempDir dir;
+  const std::string path = dir.file("c.pcd");
+  std::ofstream(path, std::ios::binary) << weWrite(blob, Eigen::Vector4f::Zero());
+  pcl::PCLPointCloud2 back;
+  ASSERT_TRUE(readInPieces(path, back));
+  EXPECT_TRUE(back.data == blob.data) << "read in pieces";
+  expectSameAsPclReads(back, path); // PCL's reader, the one stream whole
 }
 
 TEST(CompressedPcd, PiecesTheHeaderMisplacesAreLeftToPclsReader) {

@@ -80,9 +80,19 @@ TEST_F(PipelineTest, ThePredictedPeakHoldsTheMeasuredOneAndABudgetBelowItStreams
   EXPECT_EQ(yes.out.find("streaming the map"), std::string::npos) << yes.out;
   expectPredictionHolds(above, "in memory");
 
-  // Below it: the run streams on its own (its mesh written tile by tile), says so, and stays
-  // within the budget.
-  const long budget = in_memory - 40;
+  // The streamed prediction, as a run with a budget just below the in-memory one prints it,
+  // streaming or refused.
+  const auto probe = msf::test::runTool("msf_reconstruct", dataset() + " -o " + dir.file("probe") + frames +
+                                                               " -max_memory " + std::to_string(in_memory - 1));
+  ASSERT_TRUE(std::regex_search(probe.out, m, std::regex("predicted peak streamed ([0-9]+) MiB")) ||
+              std::regex_search(probe.err, m, std::regex("and ([0-9]+) MiB streamed")))
+      << probe.out << probe.err;
+  const long streamed = std::stol(m[1]);
+  ASSERT_GT(in_memory, streamed + 4) << "streaming predicts no less than keeping the map in memory";
+
+  // Between the two: the run streams on its own (its mesh written tile by tile), says so, and
+  // stays within the budget.
+  const long budget = (in_memory + streamed) / 2;
   const std::string between = dir.file("between");
   const auto streams = msf::test::runTool("msf_reconstruct", dataset() + " -o " + between + frames + " -max_memory " +
                                                                  std::to_string(budget));

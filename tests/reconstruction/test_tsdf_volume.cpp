@@ -3,14 +3,17 @@
 #include "test_support.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/io/compressed_pcd.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 #include <msf/reconstruction/tsdf_volume.h>
 
+#include <opencv2/core/utility.hpp>
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -97,9 +100,12 @@ TEST(TsdfVolume, AllocatingManyBlocksAtOnceEqualsOneAtATime) {
   EXPECT_GE(many.memoryBytes(), many.numBlocks() * sizeof(TsdfBlock));
 }
 
-TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
+namespace {
+
+/// A sphere seen from ten poses on an arc, coloured (10, 120, 250) BGR.
+TsdfVolume sphereVolume(double voxel_size, double truncation) {
   const AnalyticScene scene = test::makeScene(test::SceneKind::Sphere);
-  TsdfVolume volume(0.04, 0.12);
+  TsdfVolume volume(voxel_size, truncation);
   TsdfIntegrator integrator(volume);
   const auto camera = test::smallCamera();
   for (const auto& pose : test::arcPoses(Eigen::Vector3d(0, 0, 2.5), 2.5, 10, 3)) {
@@ -108,6 +114,13 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
     frame.color.setTo(cv::Scalar(10, 120, 250));
     integrator.integrate(frame, pose);
   }
+  return volume;
+}
+
+} // namespace
+
+TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
+  const TsdfVolume volume = sphereVolume(0.04, 0.12);
   ASSERT_GT(volume.numObservedVoxels(), 1000u);
 
   test::TempDir dir;
@@ -161,6 +174,34 @@ TEST(TsdfVolume, SaveLoadRoundTripKeepsEveryVoxelAndTheMesh) {
   pcl::PointCloud<PointTsdf> cloud;
   ASSERT_EQ(pcl::io::loadPCDFile(dir.file("volume.pcd"), cloud), 0);
   EXPECT_EQ(cloud.size(), volume.numObservedVoxels());
+}
+
+TEST(TsdfVolume, TheFileSavedFromTheBlocksIsTheCloudOfToCloudByteForByte) {
+  // save() writes the voxels' values straight from the blocks; the file is the one of
+  // toCloud's cloud, over several pieces of the compressed body, on any number of threads.
+  const TsdfVolume volume = sphereVolume(0.02, 0.06);
+  ASSERT_GT(volume.numObservedVoxels() * 26, 3u << 20) << "fewer than three pieces of 1 MiB";
+  test::TempDir dir;
+  volume.save(dir.file("all.pcd"));
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  volume.save(dir.file("one.pcd"));
+  cv::setNumThreads(threads);
+  const auto bytes = [](const std::string& path) {
+    std::ostringstream text;
+    text << std::ifstream(path, std::ios::binary).rdbuf();
+    return text.str();
+  };
+  const std::string saved = bytes(dir.file("all.pcd"));
+  EXPECT_TRUE(saved == bytes(dir.file("one.pcd")));
+
+  pcl::PointCloud<PointTsdf> cloud;
+  volume.toCloud(cloud);
+  const std::size_t comment = saved.find('\n') + 1; // the volume's parameters
+  std::ostringstream expected;
+  writeCompressedPcd(expected, cloud, saved.substr(comment, saved.find('\n', comment) + 1 - comment));
+  EXPECT_EQ(saved.size(), expected.str().size());
+  EXPECT_TRUE(saved == expected.str()) << "save() and toCloud() differ";
 }
 
 TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {

@@ -36,11 +36,31 @@ std::vector<FieldPlane> fieldPlanes(const pcl::PCLPointCloud2& blob) {
   return planes;
 }
 
+/// `n` values of `bytes` each from `in`, every `in_step` bytes, to `out`, every `out_step`
+/// bytes; the common sizes copied as such, not by a call per value.
+void copyValues(const std::uint8_t* in, std::size_t in_step, std::uint8_t* out, std::size_t out_step,
+                std::size_t bytes, std::size_t n) {
+  auto copy = [&](auto value_bytes) {
+    constexpr std::size_t size = decltype(value_bytes)::value;
+    for (std::size_t i = 0; i < n; ++i, in += in_step, out += out_step)
+      std::memcpy(out, in, size);
+  };
+  switch (bytes) {
+  case 1: return copy(std::integral_constant<std::size_t, 1>());
+  case 2: return copy(std::integral_constant<std::size_t, 2>());
+  case 4: return copy(std::integral_constant<std::size_t, 4>());
+  case 8: return copy(std::integral_constant<std::size_t, 8>());
+  default:
+    for (std::size_t i = 0; i < n; ++i, in += in_step, out += out_step)
+      std::memcpy(out, in, bytes);
+  }
+}
+
 /// The points' fields laid out as the body holds them, each field's values side by side
 /// (x x x ... y y y ...), which compresses better than whole points.
 struct FieldsSideBySide {
-  const std::uint8_t* data;
-  std::size_t step, points;
+  const FieldValues& values;
+  std::size_t points;
   std::vector<FieldPlane> fields;
 
   std::size_t bytes() const {
@@ -52,23 +72,29 @@ struct FieldsSideBySide {
 
   /// Bytes [begin, end) of the layout into `out`; a piece may start or end within a value.
   void copy(std::size_t begin, std::size_t end, char* out) const {
-    std::size_t plane = 0; // where the field's plane starts
-    for (const FieldPlane& f : fields) {
-      const std::size_t plane_end = plane + f.bytes * points;
+    std::vector<char> value; // a value cut by the piece's start or end
+    std::size_t plane = 0;   // where the field's plane starts
+    for (std::size_t j = 0; j < fields.size(); ++j) {
+      const std::size_t bytes = fields[j].bytes, plane_end = plane + bytes * points;
       std::size_t b = std::max(begin, plane);
       const std::size_t to = std::min(end, plane_end);
       if (b < to) {
         char* o = out + (b - begin);
-        const std::uint8_t* value = data + (b - plane) / f.bytes * step + f.offset;
-        if (const std::size_t within = (b - plane) % f.bytes) { // the end of a value the last piece began
-          const std::size_t n = std::min(f.bytes - within, to - b);
-          std::memcpy(o, value + within, n);
-          o += n, b += n, value += step;
+        std::size_t point = (b - plane) / bytes;
+        value.resize(bytes);
+        if (const std::size_t within = (b - plane) % bytes) { // the end of a value the last piece began
+          values(j, point++, 1, value.data());
+          const std::size_t n = std::min(bytes - within, to - b);
+          std::memcpy(o, value.data() + within, n);
+          o += n, b += n;
         }
-        for (; b + f.bytes <= to; o += f.bytes, b += f.bytes, value += step)
-          std::memcpy(o, value, f.bytes);
-        if (b < to)
-          std::memcpy(o, value, to - b);
+        const std::size_t whole = (to - b) / bytes;
+        values(j, point, whole, o);
+        o += whole * bytes, b += whole * bytes, point += whole;
+        if (b < to) { // the start of a value the next piece ends
+          values(j, point, 1, value.data());
+          std::memcpy(o, value.data(), to - b);
+        }
       }
       plane = plane_end;
     }
@@ -89,22 +115,37 @@ std::vector<std::vector<char>> compressInPieces(const FieldsSideBySide& layout) 
   const std::size_t bytes = layout.bytes(), pieces = (bytes + kPieceBytes - 1) / kPieceBytes;
   std::vector<std::vector<char>> compressed(pieces);
   parallelFor(cv::Range(0, static_cast<int>(pieces)), [&](const cv::Range& range) {
-    std::vector<char> piece(kPieceBytes);
+    // Each piece keeps only its compressed bytes: the room LZF may need is the task's, once.
+    std::vector<char> piece(kPieceBytes), room(kPieceBytes * 3 / 2 + 16);
     for (int k = range.start; k < range.end; ++k) {
       const std::size_t start = static_cast<std::size_t>(k) * kPieceBytes;
       const std::size_t length = std::min(kPieceBytes, bytes - start);
       layout.copy(start, start + length, piece.data());
-      std::vector<char>& out = compressed[static_cast<std::size_t>(k)];
-      out.resize(length * 3 / 2 + 16);
-      const unsigned int written = pcl::lzfCompress(piece.data(), static_cast<unsigned int>(length), out.data(),
-                                                    static_cast<unsigned int>(out.size()));
-      out.resize(written); // 0: it did not compress
+      const unsigned int written = pcl::lzfCompress(piece.data(), static_cast<unsigned int>(length), room.data(),
+                                                    static_cast<unsigned int>(length * 3 / 2 + 16));
+      compressed[static_cast<std::size_t>(k)].assign(room.data(), room.data() + written); // 0: it did not compress
     }
   });
   for (const std::vector<char>& piece : compressed)
     if (piece.empty())
       throw IOError("its " + std::to_string(bytes) + " bytes do not compress");
   return compressed;
+}
+
+/// The bytes of the body of `layout`'s points, when the format's 32-bit sizes hold them (the
+/// compressed body may need half as much again).
+std::size_t bodyBytes(const pcl::PCLPointCloud2& layout) {
+  const std::size_t points = static_cast<std::size_t>(layout.width) * layout.height;
+  std::size_t point_bytes = 0;
+  for (const FieldPlane& f : fieldPlanes(layout))
+    point_bytes += f.bytes;
+  const std::size_t bytes = points * point_bytes;
+  constexpr std::size_t kMaxBytes = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
+  if (bytes > kMaxBytes)
+    throw IOError("its " + std::to_string(points) + " points of " + std::to_string(point_bytes) + " bytes make " +
+                  std::to_string(bytes) + " bytes, more than a binary_compressed .pcd holds (" +
+                  std::to_string(kMaxBytes) + ": its sizes are 32-bit)");
+  return bytes;
 }
 
 /// PCL's header, with `comment` after its first line.
@@ -208,25 +249,6 @@ bool allFinite(const char* plane, std::size_t values, std::uint8_t datatype) {
   return datatype != pcl::PCLPointField::FLOAT64 || finite(0.0);
 }
 
-/// `n` values of `bytes` each from `in`, one after another, to `out` every `step` bytes; the
-/// common sizes copied as such, not by a call per value.
-void scatter(const char* in, std::size_t bytes, std::size_t n, std::uint8_t* out, std::size_t step) {
-  auto copy = [&](auto value_bytes) {
-    constexpr std::size_t size = decltype(value_bytes)::value;
-    for (std::size_t i = 0; i < n; ++i, in += size, out += step)
-      std::memcpy(out, in, size);
-  };
-  switch (bytes) {
-  case 1: return copy(std::integral_constant<std::size_t, 1>());
-  case 2: return copy(std::integral_constant<std::size_t, 2>());
-  case 4: return copy(std::integral_constant<std::size_t, 4>());
-  case 8: return copy(std::integral_constant<std::size_t, 8>());
-  default:
-    for (std::size_t i = 0; i < n; ++i, in += bytes, out += step)
-      std::memcpy(out, in, bytes);
-  }
-}
-
 /// The fields' planes (x x x ... y y y ...) laid out as whole points in `blob`, on every core,
 /// with is_dense as PCL's reader sets it: false when a value is not finite.
 void scatterPlanes(const Buffer& layout, pcl::PCLPointCloud2& blob) {
@@ -244,7 +266,7 @@ void scatterPlanes(const Buffer& layout, pcl::PCLPointCloud2& blob) {
         const std::size_t bytes = fields[j].bytes;
         const char* in = layout.data() + starts[j] + first * bytes;
         std::uint8_t* out = blob.data.data() + first * blob.point_step + fields[j].offset;
-        scatter(in, bytes, n, out, blob.point_step);
+        copyValues(reinterpret_cast<const std::uint8_t*>(in), bytes, out, blob.point_step, bytes, n);
         if (!allFinite(layout.data() + starts[j] + first * bytes, n * blob.fields[j].count, blob.fields[j].datatype))
           dense = false;
       }
@@ -263,22 +285,26 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, cons
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
                         std::size_t data_bytes, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
                         const std::string& comment) {
-  const std::vector<FieldPlane> fields = fieldPlanes(layout);
   const std::size_t points = static_cast<std::size_t>(layout.width) * layout.height;
-  std::size_t point_bytes = 0;
-  for (const FieldPlane& f : fields)
-    point_bytes += f.bytes;
-  // The format keeps its sizes in 32 bits, and the compressed body may need half as much again.
-  const std::size_t bytes = points * point_bytes;
-  constexpr std::size_t kMaxBytes = std::numeric_limits<std::uint32_t>::max() / 3 * 2;
-  if (bytes > kMaxBytes)
-    throw IOError("its " + std::to_string(points) + " points of " + std::to_string(point_bytes) + " bytes make " +
-                  std::to_string(bytes) + " bytes, more than a binary_compressed .pcd holds (" +
-                  std::to_string(kMaxBytes) + ": its sizes are 32-bit)");
+  bodyBytes(layout); // too many points are named as such, whatever the data
   if (data_bytes < points * layout.point_step)
     throw IOError("its data holds " + std::to_string(data_bytes) + " bytes, not its " +
                   std::to_string(points) + " points of " + std::to_string(layout.point_step));
-  const FieldsSideBySide body{data, layout.point_step, points, fields};
+  const std::vector<FieldPlane> fields = fieldPlanes(layout);
+  const std::size_t step = layout.point_step;
+  const FieldValues values = [&](std::size_t field, std::size_t first, std::size_t count, char* to) {
+    copyValues(data + first * step + fields[field].offset, step, reinterpret_cast<std::uint8_t*>(to),
+               fields[field].bytes, fields[field].bytes, count);
+  };
+  writeCompressedPcd(out, layout, values, origin, orientation, comment);
+}
+
+void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const FieldValues& values,
+                        const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+                        const std::string& comment) {
+  const std::vector<FieldPlane> fields = fieldPlanes(layout);
+  const std::size_t points = static_cast<std::size_t>(layout.width) * layout.height, bytes = bodyBytes(layout);
+  const FieldsSideBySide body{values, points, fields};
   const std::vector<std::vector<char>> pieces = compressInPieces(body);
   std::size_t compressed = 0;
   for (const std::vector<char>& piece : pieces)
@@ -288,7 +314,7 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
   const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(compressed), static_cast<std::uint32_t>(bytes)};
   const std::string text = header(layout, origin, orientation, comment + piecesLine(pieces));
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  out.write(reinterpret_cast<const char*>(sizes), sizeof(sizes));
+  out.write(reinterpret_cast<const char*>(sizes), sizeof sizes);
   for (const std::vector<char>& piece : pieces)
     out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
 }

@@ -39,9 +39,9 @@ constexpr double kFrameBytesPerPixel = 24;
 // A frame whose ground truth the run keeps to score the mesh at the end (protocol 4).
 constexpr double kScoredFrameBytesPerPixel = 12;
 // What the end of an in-memory run adds (the mesh, its per-block cache, the copy written and
-// the volume.pcd cloud), in units of the predicted volume's bytes: above the most measured in
-// units of the real volume's, since the predicted volume can be as little as the real one.
-constexpr double kEndOfRunShare = 4.0;
+// volume.pcd's compressed pieces), in units of the predicted volume's bytes: above the most
+// measured in units of the real volume's, since the predicted volume can be as little as the real one.
+constexpr double kEndOfRunShare = 2.0;
 // A streamed run's tiles meshed as they leave, in units of the window's volume bytes.
 constexpr double kStreamedEndShare = 1.0;
 // A map of one source alone or of the paper's method (-compare_sources, -compare_paper), its

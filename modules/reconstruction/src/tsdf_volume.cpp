@@ -21,6 +21,7 @@
 #include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -28,11 +29,15 @@
 #include <numeric>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 namespace msf {
 
 namespace {
+/// Whether a voxel is one of toCloud's points.
+bool isKept(const TsdfVoxel& voxel, float min_weight) { return voxel.observed() && voxel.weight > min_weight; }
+
 std::uint64_t newVolumeId() {
   static std::atomic<std::uint64_t> counter{0};
   return ++counter;
@@ -315,17 +320,23 @@ void TsdfVolume::clear() {
   id_ = newVolumeId();
 }
 
-void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) const {
-  const auto kept = [min_weight](const TsdfVoxel& voxel) { return voxel.observed() && voxel.weight > min_weight; };
-  // Each block's place in the cloud first, so that the blocks fill theirs side by side, in order.
-  const int blocks = static_cast<int>(blocks_.size());
+std::vector<std::size_t> TsdfVolume::keptVoxelStarts(float min_weight) const {
   std::vector<std::size_t> first(blocks_.size() + 1, 0);
-  parallelFor(cv::Range(0, blocks), [&](const cv::Range& range) {
+  parallelFor(cv::Range(0, static_cast<int>(blocks_.size())), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b)
-      first[static_cast<std::size_t>(b) + 1] = static_cast<std::size_t>(
-          std::count_if(std::begin(blocks_[b]->voxels), std::end(blocks_[b]->voxels), kept));
+      first[static_cast<std::size_t>(b) + 1] = static_cast<std::size_t>(std::count_if(
+          std::begin(blocks_[b]->voxels), std::end(blocks_[b]->voxels),
+          [min_weight](const TsdfVoxel& voxel) { return isKept(voxel, min_weight); }));
   });
   std::partial_sum(first.begin(), first.end(), first.begin());
+  return first;
+}
+
+void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) const {
+  const auto kept = [min_weight](const TsdfVoxel& voxel) { return isKept(voxel, min_weight); };
+  // Each block's place in the cloud first, so that the blocks fill theirs side by side, in order.
+  const int blocks = static_cast<int>(blocks_.size());
+  const std::vector<std::size_t> first = keptVoxelStarts(min_weight);
   cloud.clear();
   cloud.resize(first.back());
   const float vs = static_cast<float>(voxel_size_);
@@ -398,19 +409,79 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
   }
 }
 
+void TsdfVolume::writeVoxelValues(const std::string& field, const std::vector<std::size_t>& first, std::size_t point,
+                                  std::size_t count, char* out) const {
+  auto b = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), point) - first.begin()) - 1;
+  std::size_t skip = point - first[b];
+  // Each value as toCloud sets it, for the voxels from `point` on, in its order.
+  const auto write = [&](std::size_t bytes, auto&& value) {
+    for (; count > 0; ++b) {
+      const TsdfBlock& block = *blocks_[b];
+      for (int i = 0; i < TsdfBlock::kVoxels && count > 0; ++i) {
+        if (!isKept(block.voxels[i], 0.f))
+          continue;
+        if (skip > 0) {
+          --skip;
+          continue;
+        }
+        value(block, i, out);
+        out += bytes;
+        --count;
+      }
+    }
+  };
+  const auto put = [](auto v, char* to) { std::memcpy(to, &v, sizeof v); };
+  const float vs = static_cast<float>(voxel_size_);
+  const int axis = field == "x" ? 0 : field == "y" ? 1 : field == "z" ? 2 : -1;
+  constexpr int kSide = TsdfBlock::kSide;
+  if (axis >= 0)
+    return write(4, [&](const TsdfBlock& block, int i, char* to) {
+      const int local[3] = {i % kSide, i / kSide % kSide, i / (kSide * kSide)};
+      put(static_cast<float>(block.origin()[axis] + local[axis]) * vs, to);
+    });
+  if (field == "sdf")
+    return write(4, [&](const TsdfBlock& block, int i, char* to) { put(block.voxels[i].sdf, to); });
+  if (field == "weight")
+    return write(4, [&](const TsdfBlock& block, int i, char* to) { put(block.voxels[i].weight, to); });
+  if (field == "rgb") // PCL's rgb: b g r a in memory
+    return write(4, [&](const TsdfBlock& block, int i, char* to) {
+      const TsdfVoxel& v = block.voxels[i];
+      const std::uint8_t bgra[4] = {v.b, v.g, v.r, 255};
+      std::memcpy(to, bgra, 4);
+    });
+  if (field == "passes")
+    return write(1, [&](const TsdfBlock& block, int i, char* to) {
+      put(static_cast<std::uint8_t>(block.voxels[i].passes()), to);
+    });
+  if (field == "reappeared")
+    return write(1, [&](const TsdfBlock& block, int i, char* to) {
+      put(static_cast<std::uint8_t>(block.voxels[i].reappeared() ? 1 : 0), to);
+    });
+  throw std::logic_error("TsdfVolume::writeVoxelValues: no field '" + field + "' in PointTsdf");
+}
+
 void TsdfVolume::save(const std::string& path) const {
   if (fileExtension(path) != ".pcd")
     throw IOError("cannot write volume '" + path + "': a TSDF volume is written as .pcd");
-  pcl::PointCloud<PointTsdf> cloud;
-  toCloud(cloud);
-  if (cloud.empty())
+  const std::vector<std::size_t> first = keptVoxelStarts(0.f);
+  if (first.back() == 0)
     throw InvalidInputError("cannot write volume '" + path + "': it has no observed voxel");
+  // The voxels' values straight from the blocks, the bytes toCloud's cloud would give: no
+  // cloud of them is made, which would be the largest allocation at the end of a run.
+  const pcl::PCLPointCloud2 layout = pointLayout<PointTsdf>(static_cast<std::uint32_t>(first.back()), 1, true);
+  std::vector<std::string> fields;
+  for (const pcl::PCLPointField& f : layout.fields)
+    if (f.name != "_")
+      fields.push_back(f.name);
+  const FieldValues values = [&](std::size_t field, std::size_t point, std::size_t count, char* out) {
+    writeVoxelValues(fields[field], first, point, count, out);
+  };
   // The parameters go into a comment line after the file's first line, which PCD readers
   // (pcl_viewer included) skip.
   const std::string comment = std::string(kHeaderTag) + " voxel_size_m " + number(voxel_size_) + " truncation_m " +
                               number(truncation_) + "\n";
   writeStreamAtomically(path, [&](std::ostream& out) {
-    writeCompressedPcd(out, cloud, comment);
+    writeCompressedPcd(out, layout, values, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(), comment);
   });
 }
 

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <ostream>
 #include <string>
 
@@ -26,6 +27,16 @@ namespace msf {
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, const Eigen::Vector4f& origin,
                         const Eigen::Quaternionf& orientation, const std::string& comment = "");
 
+/// The values of one field of a run of points, one after another into `out`: `field` counts
+/// the layout's fields but padding ("_"), `first` and `count` the points.
+using FieldValues = std::function<void(std::size_t field, std::size_t first, std::size_t count, char* out)>;
+
+/// The same with the points' values given field by field by `values`, for points that lie
+/// nowhere whole (a volume's voxels in its blocks); `layout`'s data is not read.
+void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const FieldValues& values,
+                        const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+                        const std::string& comment = "");
+
 /// The same with the points in `data` (`bytes` of them), laid out as `layout` says; its own
 /// data is not read.
 void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, const std::uint8_t* data,
@@ -39,18 +50,25 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& layout, co
 /// file, or one whose pieces do not make up its body: PCL's reader reads it whole.
 bool readCompressedPieces(const std::string& path, std::size_t data_index, pcl::PCLPointCloud2& blob);
 
-/// What a PCLPointCloud2 of `cloud` holds but its points: the fields and the size.
+/// What a PCLPointCloud2 of `width` x `height` points of PointT holds but its points: the fields and the size.
 template <typename PointT>
-pcl::PCLPointCloud2 pointLayout(const pcl::PointCloud<PointT>& cloud) {
+pcl::PCLPointCloud2 pointLayout(std::uint32_t width, std::uint32_t height, bool is_dense) {
   pcl::PCLPointCloud2 layout;
   pcl::toPCLPointCloud2(pcl::PointCloud<PointT>(), layout); // the fields
-  const bool unsized = cloud.width == 0 && cloud.height == 0; // as pcl::toPCLPointCloud2 takes it
-  layout.width = unsized ? static_cast<std::uint32_t>(cloud.size()) : cloud.width;
-  layout.height = unsized ? 1 : cloud.height;
+  layout.width = width;
+  layout.height = height;
   layout.point_step = sizeof(PointT);
   layout.row_step = layout.point_step * layout.width;
-  layout.is_dense = cloud.is_dense;
+  layout.is_dense = is_dense;
   return layout;
+}
+
+/// The same for `cloud`'s points.
+template <typename PointT>
+pcl::PCLPointCloud2 pointLayout(const pcl::PointCloud<PointT>& cloud) {
+  const bool unsized = cloud.width == 0 && cloud.height == 0; // as pcl::toPCLPointCloud2 takes it
+  return pointLayout<PointT>(unsized ? static_cast<std::uint32_t>(cloud.size()) : cloud.width,
+                             unsized ? 1 : cloud.height, cloud.is_dense);
 }
 
 /// The same for a cloud, read where it lies (no copy into a PCLPointCloud2).

@@ -159,6 +159,13 @@ private:
   void reserve(std::size_t blocks);
   /// Where block number `block` (position in blocks_) lives.
   void* storage(std::size_t block) const;
+  /// Where each block's observed voxels (weight > min_weight) begin among all of them, block
+  /// after block, and their number last: toCloud's order.
+  std::vector<std::size_t> keptVoxelStarts(float min_weight) const;
+  /// `field` of PointTsdf (x, sdf, rgb, ...) of toCloud's points [point, point + count), from
+  /// the blocks (`first`: keptVoxelStarts(0)), one value after another into `out`.
+  void writeVoxelValues(const std::string& field, const std::vector<std::size_t>& first, std::size_t point,
+                        std::size_t count, char* out) const;
   /// Calls source_ with `indices` unless there is none or it is running.
   void askSource(const std::vector<GridIndex>& indices);
 
