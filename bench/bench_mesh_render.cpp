@@ -5,7 +5,10 @@
 //  - BM_RenderStreetMillionTriangles: a 1M-triangle street canyon (ground and two facades
 //    with relief) wholly in view, the worst case: every triangle is projected and drawn;
 //  - BM_RenderKittiMap: the map of odometry 04 frames 0-9 made by the pipeline (default
-//    configuration), rendered at each frame's pose in turn.
+//    configuration), rendered at each frame's pose in turn;
+//  - BM_RenderLongDrive/layout:0|1/bounds:0|1: that map copied 21 or 25 times, along a straight
+//    road or on a town's grid of streets, rendered whole and with its runs' bounds
+//    (MeshRasterizer::triangleRunBounds), which skip what is outside the view.
 //
 // cpu_ms_all_threads is the process CPU time per render (all threads): on a machine shared with
 // other work it stays close to the quiet figure when the wall time does not.
@@ -21,6 +24,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <map>
 #include <ctime>
 
 using namespace msf;
@@ -119,6 +123,58 @@ void BM_RenderKittiMap(benchmark::State& state) {
   state.counters["covered_px"] = cv::countNonZero(depth);
 }
 BENCHMARK(BM_RenderKittiMap)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The KITTI map copied 21 times: along the drive, 60 m apart (layout 0: a straight road, half
+/// of it behind the camera), or on a 5 x 5 grid 100 m apart, the middle copy at the centre
+/// (layout 1: a town's streets); the camera at the middle copy's poses.
+const TriangleMesh& copiedMap(const KittiMap& map, int layout) {
+  static std::map<int, TriangleMesh> made;
+  TriangleMesh& mesh = made[layout];
+  if (!mesh.triangles.empty())
+    return mesh;
+  const Eigen::Vector3d along = (map.poses.back().translation() - map.poses.front().translation()).normalized();
+  const Eigen::Vector3d across = along.cross(Eigen::Vector3d::UnitY()).normalized(); // camera y is down
+  std::vector<Eigen::Vector3d> offsets;
+  for (int k = -10; k <= 10 && layout == 0; ++k)
+    offsets.push_back(60.0 * k * along);
+  for (int i = -2; i <= 2 && layout == 1; ++i)
+    for (int j = -2; j <= 2; ++j)
+      offsets.push_back(100.0 * i * along + 100.0 * j * across);
+  for (const Eigen::Vector3d& offset : offsets) {
+    const auto first = static_cast<std::uint32_t>(mesh.vertices.size());
+    for (const Eigen::Vector3f& v : map.mesh.vertices)
+      mesh.vertices.push_back(v + offset.cast<float>());
+    for (const auto& t : map.mesh.triangles)
+      mesh.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+  }
+  return mesh;
+}
+
+void BM_RenderLongDrive(benchmark::State& state) {
+  static const KittiMap map;
+  const TriangleMesh& drive = copiedMap(map, static_cast<int>(state.range(0)));
+  const bool with_bounds = state.range(1) != 0;
+  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(drive);
+  MeshRasterizer rasterizer;
+  cv::Mat depth;
+  std::size_t frame = 0;
+  const std::clock_t cpu_start = std::clock();
+  for (auto _ : state) {
+    rasterizer.render(drive, map.camera, map.poses[frame], depth, nullptr, with_bounds ? &bounds : nullptr);
+    benchmark::DoNotOptimize(depth.data);
+    frame = (frame + 1) % map.poses.size();
+  }
+  state.counters["cpu_ms_all_threads"] = cpuMsPerIteration(cpu_start, state);
+  state.counters["triangles"] = static_cast<double>(drive.triangles.size());
+}
+BENCHMARK(BM_RenderLongDrive)
+    ->ArgNames({"layout", "bounds"})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 } // namespace
 

@@ -309,6 +309,45 @@ TEST(MeshRasterizer, AgreesWithRayCastingOnRandomTrianglesWhateverTheThreads) {
   EXPECT_EQ(cv::norm(one_thread, depth, cv::NORM_INF), 0.0);
 }
 
+TEST(MeshRasterizer, ALongMeshRenderedRunByRunIsTheWholeMeshRendered) {
+  // A 600 m drive's worth of small triangles, in clusters along it (as marching cubes emits a
+  // block's together), seen from poses along it, turned, and from inside a cluster (its
+  // triangles cross the near plane): with the runs' bounds, what is outside the view is
+  // skipped, and every depth and triangle id is the whole mesh's.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> across(-12.f, 12.f), height(-3.f, 3.f), edge(-1.f, 1.f);
+  TriangleMesh mesh;
+  for (int cluster = 0; cluster < 40; ++cluster)
+    for (int t = 0; t < 1100; ++t) {
+      const Eigen::Vector3f a(across(rng), height(rng), -50.f + 15.f * static_cast<float>(cluster) + 3.f * edge(rng));
+      const std::uint32_t i = addVertex(mesh, a),
+                          j = addVertex(mesh, a + Eigen::Vector3f(edge(rng), edge(rng), edge(rng))),
+                          k = addVertex(mesh, a + Eigen::Vector3f(edge(rng), edge(rng), edge(rng)));
+      mesh.triangles.push_back({i, j, k});
+    }
+  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh);
+  MeshRasterizer whole, by_runs;
+  int drawn = 0;
+  for (const double z : {-60.0, 0.0, 101.0, 300.0, 590.0})
+    for (const double yaw : {0.0, 0.7, 3.1}) {
+      const Eigen::Isometry3d pose =
+          Eigen::Translation3d(1.0, 0.5, z) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY());
+      cv::Mat depth, ids, culled_depth, culled_ids;
+      whole.render(mesh, camera(), pose, depth, &ids);
+      by_runs.render(mesh, camera(), pose, culled_depth, &culled_ids, &bounds);
+      EXPECT_EQ(cv::norm(depth, culled_depth, cv::NORM_INF), 0.0) << "z " << z << ", yaw " << yaw;
+      EXPECT_EQ(cv::countNonZero(ids != culled_ids), 0) << "z " << z << ", yaw " << yaw;
+      drawn += cv::countNonZero(depth);
+    }
+  EXPECT_GT(drawn, 10000);
+  // Bounds of another mesh are refused by name.
+  TriangleMesh shorter = mesh;
+  shorter.triangles.resize(1000);
+  cv::Mat depth;
+  EXPECT_THROW(by_runs.render(shorter, camera(), Eigen::Isometry3d::Identity(), depth, nullptr, &bounds),
+               InvalidInputError);
+}
+
 TEST(MeshRasterizer, BadInputIsAClearError) {
   MeshRasterizer rasterizer;
   EXPECT_THROW(rasterizer.setNearPlane(0.f), InvalidInputError);
@@ -323,6 +362,7 @@ TEST(MeshRasterizer, BadInputIsAClearError) {
   } catch (const InvalidInputError& e) {
     EXPECT_NE(std::string(e.what()).find("out of range"), std::string::npos) << e.what();
   }
+  EXPECT_THROW(MeshRasterizer::triangleRunBounds(mesh), InvalidInputError);
   EXPECT_THROW(rasterizer.render(TriangleMesh(), PinholeCamera(), Eigen::Isometry3d::Identity(), depth),
                InvalidInputError);
   Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();

@@ -67,13 +67,14 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
   SkyCoverage out;
   double share_sum = 0;
   std::vector<float> covered_depth;
+  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
   for (const auto& [index, sky] : frames_) {
     if (!sky.has_pose || !sky.has_mask)
       continue;
     ++out.frames;
     if (sky.pixels == 0)
       continue;
-    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_);
+    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_, nullptr, &bounds);
     const float* depth = rendered_.ptr<float>(0);
     const Eigen::Isometry3f T = sky.T_world_cam.cast<float>();
     const auto counted = [&](std::uint32_t p) { // the surface point seen at pixel p, in the world

@@ -172,8 +172,9 @@ void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t
 void ReconstructionEvaluation::scoreMesh(const std::string& source, const TriangleMesh& mesh) {
   const std::lock_guard<std::mutex> lock(mutex_);
   Row& r = row(source);
+  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
   for (const auto& [frame, truth] : frames_) {
-    rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_);
+    rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_, nullptr, &bounds);
     score(r, frame, truth, rendered_);
   }
 }

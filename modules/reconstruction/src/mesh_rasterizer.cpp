@@ -18,6 +18,32 @@ constexpr int kBandRows = 8;                     // small triangles mostly fall 
 constexpr std::uint32_t kCulled = ~0u;           // rows_ of a triangle that covers no pixel centre
 constexpr std::size_t kChunkTriangles = 1 << 15; // triangles per binning chunk
 constexpr std::size_t kChunkVertices = 1 << 15;
+constexpr std::size_t kRunTriangles = 1 << 10;    // triangles per bounded run; a binning chunk holds whole runs
+static_assert(kChunkTriangles % kRunTriangles == 0);
+
+/// Whether a box (world frame) lies wholly outside the view: behind the near plane, or beyond
+/// one side of the image by more than a pixel (a triangle there covers no pixel centre).
+bool outsideView(const Eigen::AlignedBox3f& box, const PinholeCamera& camera, const Eigen::Isometry3f& T_cam_world,
+                 float near_m) {
+  // Each side as a half-space through the camera centre: a.x * x + a.y * y + a.z * z >= 0 inside.
+  const Eigen::Vector3f sides[5] = {{0.f, 0.f, 1.f}, // the near plane, tested against near_m
+                                    {camera.fx, 0.f, camera.cx + 1.f},
+                                    {-camera.fx, 0.f, static_cast<float>(camera.width) - camera.cx},
+                                    {0.f, camera.fy, camera.cy + 1.f},
+                                    {0.f, -camera.fy, static_cast<float>(camera.height) - camera.cy}};
+  Eigen::Vector3f corners[8];
+  for (int k = 0; k < 8; ++k)
+    corners[k] = T_cam_world * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(k));
+  for (int s = 0; s < 5; ++s) {
+    const float least = s == 0 ? near_m : 0.f;
+    bool all_out = true;
+    for (int k = 0; k < 8 && all_out; ++k)
+      all_out = sides[s].dot(corners[k]) < least;
+    if (all_out)
+      return true;
+  }
+  return false;
+}
 
 /// Pixel of a camera-frame point in front of the camera. Every corner of every triangle is
 /// projected by this one expression, so triangles sharing a corner share its pixel exactly.
@@ -174,6 +200,82 @@ void MeshRasterizer::setNearPlane(float near_m) {
   near_m_ = near_m;
 }
 
+MeshRasterizer::RunBounds MeshRasterizer::triangleRunBounds(const TriangleMesh& mesh) {
+  const std::size_t n = mesh.triangles.size(), vertices = mesh.vertices.size();
+  RunBounds bounds((n + kRunTriangles - 1) / kRunTriangles);
+  std::atomic<bool> bad_index{false};
+  parallelFor(cv::Range(0, static_cast<int>(bounds.size())), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r) {
+      TriangleRun& run = bounds[static_cast<std::size_t>(r)];
+      const std::size_t end = std::min(n, (static_cast<std::size_t>(r) + 1) * kRunTriangles);
+      for (std::size_t t = static_cast<std::size_t>(r) * kRunTriangles; t < end; ++t)
+        for (const std::uint32_t v : mesh.triangles[t]) {
+          if (v >= vertices) {
+            bad_index = true;
+            continue;
+          }
+          run.box.extend(mesh.vertices[v]);
+          run.first_vertex = std::min(run.first_vertex, v);
+          run.last_vertex = std::max(run.last_vertex, v);
+        }
+    }
+  });
+  if (bad_index)
+    throw InvalidInputError("mesh rasterizer: a triangle has a vertex index out of range (the mesh has " +
+                            std::to_string(vertices) + " vertices)");
+  return bounds;
+}
+
+void MeshRasterizer::cullRuns(const TriangleMesh& mesh, const RunBounds* bounds, const PinholeCamera& camera,
+                              const Eigen::Isometry3f& T_cam_world) {
+  const std::size_t runs = (mesh.triangles.size() + kRunTriangles - 1) / kRunTriangles;
+  visible_.assign(runs, 1);
+  vertex_ranges_.assign(1, {0, mesh.vertices.size()});
+  if (!bounds)
+    return;
+  if (bounds->size() != runs)
+    throw InvalidInputError("mesh rasterizer: bounds of " + std::to_string(bounds->size()) + " runs for a mesh of " +
+                            std::to_string(runs) + " (triangleRunBounds of another mesh?)");
+  parallelFor(cv::Range(0, static_cast<int>(runs)), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r)
+      visible_[static_cast<std::size_t>(r)] =
+          !outsideView((*bounds)[static_cast<std::size_t>(r)].box, camera, T_cam_world, near_m_);
+  });
+  // The visible runs' vertices, as few ranges as they make: marching cubes emits a block's
+  // vertices with its triangles, so a run uses a short range.
+  vertex_ranges_.clear();
+  for (std::size_t r = 0; r < runs; ++r)
+    if (visible_[r])
+      vertex_ranges_.push_back({(*bounds)[r].first_vertex, std::size_t{(*bounds)[r].last_vertex} + 1});
+  std::sort(vertex_ranges_.begin(), vertex_ranges_.end());
+  std::size_t merged = 0;
+  for (const auto& range : vertex_ranges_) {
+    if (merged > 0 && range.first <= vertex_ranges_[merged - 1].second)
+      vertex_ranges_[merged - 1].second = std::max(vertex_ranges_[merged - 1].second, range.second);
+    else
+      vertex_ranges_[merged++] = range;
+  }
+  vertex_ranges_.resize(merged);
+}
+
+void MeshRasterizer::transformVertices(const TriangleMesh& mesh, const PinholeCamera& camera,
+                                       const Eigen::Isometry3f& T_cam_world) {
+  cam_.resize(mesh.vertices.size());
+  pixel_.resize(mesh.vertices.size());
+  std::vector<std::pair<std::size_t, std::size_t>> tasks; // the ranges in pieces of kChunkVertices
+  for (const auto& [first, end] : vertex_ranges_)
+    for (std::size_t i = first; i < end; i += kChunkVertices)
+      tasks.push_back({i, std::min(end, i + kChunkVertices)});
+  parallelFor(cv::Range(0, static_cast<int>(tasks.size())), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k)
+      for (std::size_t i = tasks[static_cast<std::size_t>(k)].first; i < tasks[static_cast<std::size_t>(k)].second;
+           ++i) {
+        cam_[i] = T_cam_world * mesh.vertices[i];
+        pixel_[i] = cam_[i].z() >= near_m_ ? project(cam_[i], camera) : Eigen::Vector2f::Zero();
+      }
+  });
+}
+
 bool MeshRasterizer::binTriangles(const TriangleMesh& mesh, const PinholeCamera& camera) {
   const std::size_t n = mesh.triangles.size(), vertices = mesh.vertices.size();
   const std::size_t chunks = std::max<std::size_t>(1, (n + kChunkTriangles - 1) / kChunkTriangles);
@@ -188,6 +290,10 @@ bool MeshRasterizer::binTriangles(const TriangleMesh& mesh, const PinholeCamera&
       std::uint32_t* count = &offsets_[static_cast<std::size_t>(c) * bands];
       const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunkTriangles);
       for (std::size_t t = static_cast<std::size_t>(c) * kChunkTriangles; t < end; ++t) {
+        if (!visible_[t / kRunTriangles]) {
+          t = (t / kRunTriangles + 1) * kRunTriangles - 1; // on to the next run
+          continue;
+        }
         const auto& tri = mesh.triangles[t];
         rows_[t] = kCulled;
         if (tri[0] >= vertices || tri[1] >= vertices || tri[2] >= vertices) {
@@ -241,6 +347,10 @@ bool MeshRasterizer::binTriangles(const TriangleMesh& mesh, const PinholeCamera&
       std::uint32_t* next = &offsets_[static_cast<std::size_t>(c) * bands];
       const std::size_t end = std::min(n, (static_cast<std::size_t>(c) + 1) * kChunkTriangles);
       for (std::size_t t = static_cast<std::size_t>(c) * kChunkTriangles; t < end; ++t) {
+        if (!visible_[t / kRunTriangles]) {
+          t = (t / kRunTriangles + 1) * kRunTriangles - 1;
+          continue;
+        }
         if (rows_[t] == kCulled)
           continue;
         const int y0 = static_cast<int>(rows_[t] >> 16), y1 = static_cast<int>(rows_[t] & 0xffffu);
@@ -276,7 +386,8 @@ void MeshRasterizer::drawBand(int band, const TriangleMesh& mesh, const PinholeC
 }
 
 void MeshRasterizer::render(const TriangleMesh& mesh, const PinholeCamera& camera,
-                            const Eigen::Isometry3d& T_world_cam, cv::Mat& depth, cv::Mat* triangle_ids) {
+                            const Eigen::Isometry3d& T_world_cam, cv::Mat& depth, cv::Mat* triangle_ids,
+                            const RunBounds* bounds) {
   if (!camera.valid() || camera.height > 0xffff)
     throw InvalidInputError("mesh rasterizer: invalid camera (fx " + std::to_string(camera.fx) + ", fy " +
                             std::to_string(camera.fy) + ", " + std::to_string(camera.width) + "x" +
@@ -289,19 +400,12 @@ void MeshRasterizer::render(const TriangleMesh& mesh, const PinholeCamera& camer
   if (triangle_ids)
     triangle_ids->create(camera.height, camera.width, CV_32SC1);
 
-  // Vertices into the camera frame, and onto the image when in front of the near plane.
+  // The runs of triangles in the view; their vertices into the camera frame, and onto the
+  // image when in front of the near plane.
   const Eigen::Isometry3f T_cam_world = T_world_cam.inverse().cast<float>();
   const std::size_t vertices = mesh.vertices.size();
-  cam_.resize(vertices);
-  pixel_.resize(vertices);
-  const int vertex_chunks = static_cast<int>((vertices + kChunkVertices - 1) / kChunkVertices);
-  parallelFor(cv::Range(0, vertex_chunks), [&](const cv::Range& range) {
-    const std::size_t end = std::min(vertices, static_cast<std::size_t>(range.end) * kChunkVertices);
-    for (std::size_t i = static_cast<std::size_t>(range.start) * kChunkVertices; i < end; ++i) {
-      cam_[i] = T_cam_world * mesh.vertices[i];
-      pixel_[i] = cam_[i].z() >= near_m_ ? project(cam_[i], camera) : Eigen::Vector2f::Zero();
-    }
-  });
+  cullRuns(mesh, bounds, camera, T_cam_world);
+  transformVertices(mesh, camera, T_cam_world);
 
   bands_ = (camera.height + kBandRows - 1) / kBandRows;
   if (!binTriangles(mesh, camera))

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace msf {
@@ -40,16 +41,35 @@ public:
   void setNearPlane(float near_m);
   float getNearPlane() const { return near_m_; }
 
+  /// The bounding box of each run of consecutive triangles of `mesh` (marching cubes emits a
+  /// block's triangles together, so a run is a small piece of the map). Given to render(),
+  /// the runs outside the view are skipped whole: rendering a long drive's mesh at each of its
+  /// poses then costs what each view holds, not the whole mesh, with the same result. Throws
+  /// InvalidInputError for a triangle whose vertex index is out of range.
+  struct TriangleRun {
+    Eigen::AlignedBox3f box;                     ///< of its triangles' corners
+    std::uint32_t first_vertex = ~0u, last_vertex = 0; ///< the least and the greatest index they use
+  };
+  using RunBounds = std::vector<TriangleRun>;
+  static RunBounds triangleRunBounds(const TriangleMesh& mesh);
+
   /// Renders `mesh` (world frame) through `camera` at `T_world_cam`. depth: CV_32FC1 of the
   /// camera's size, z in metres, 0 where no triangle covers the pixel centre. triangle_ids,
   /// when given: CV_32SC1, the index into mesh.triangles of the surface seen, -1 where none.
-  /// Throws InvalidInputError for an invalid camera (or one taller than 65535 rows), a pose
-  /// that is not finite, or a triangle whose vertex index is out of range.
+  /// bounds, when given: triangleRunBounds(mesh). Throws InvalidInputError for an invalid
+  /// camera (or one taller than 65535 rows), a pose that is not finite, a triangle whose vertex
+  /// index is out of range, or bounds of another mesh's size.
   void render(const TriangleMesh& mesh, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-              cv::Mat& depth, cv::Mat* triangle_ids = nullptr);
+              cv::Mat& depth, cv::Mat* triangle_ids = nullptr, const RunBounds* bounds = nullptr);
 
 private:
-  /// Sorts the triangles into bands_ (bin_start_, binned_); returns false on a bad index.
+  /// Which runs of triangles (triangleRunBounds) may cover a pixel centre (visible_), and the
+  /// vertices they use (vertex_ranges_); all of them without bounds.
+  void cullRuns(const TriangleMesh& mesh, const RunBounds* bounds, const PinholeCamera& camera,
+                const Eigen::Isometry3f& T_cam_world);
+  /// The vertices of vertex_ranges_ into the camera frame (cam_) and onto the image (pixel_).
+  void transformVertices(const TriangleMesh& mesh, const PinholeCamera& camera, const Eigen::Isometry3f& T_cam_world);
+  /// Sorts the triangles of the visible runs into bands_ (bin_start_, binned_); returns false on a bad index.
   bool binTriangles(const TriangleMesh& mesh, const PinholeCamera& camera);
   /// Draws the triangles of band `band` into its rows.
   void drawBand(int band, const TriangleMesh& mesh, const PinholeCamera& camera, cv::Mat& depth,
@@ -63,6 +83,8 @@ private:
   std::vector<std::uint32_t> offsets_;      ///< per chunk and band: where its triangles go in binned_
   std::vector<std::uint32_t> bin_start_;    ///< per band (and one past): its triangles in binned_
   std::vector<std::uint32_t> binned_;       ///< triangle indices, band after band
+  std::vector<std::uint8_t> visible_;       ///< per run of triangles: whether it may be in the view
+  std::vector<std::pair<std::size_t, std::size_t>> vertex_ranges_; ///< [first, end) of the vertices the view's runs use
 };
 
 } // namespace msf
