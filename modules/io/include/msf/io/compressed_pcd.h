@@ -28,7 +28,8 @@ void writeCompressedPcd(std::ostream& out, const pcl::PCLPointCloud2& blob, cons
                         const Eigen::Quaternionf& orientation, const std::string& comment = "");
 
 /// The values of one field of a run of points, one after another into `out`: `field` counts
-/// the layout's fields but padding ("_"), `first` and `count` the points.
+/// the layout's fields but padding ("_"), `first` and `count` the points. Called for the body's
+/// pieces on every core at once: it must only read what it shares.
 using FieldValues = std::function<void(std::size_t field, std::size_t first, std::size_t count, char* out)>;
 
 /// The same with the points' values given field by field by `values`, for points that lie
