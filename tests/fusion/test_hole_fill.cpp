@@ -106,10 +106,11 @@ TEST(HoleFill, ADepthWithoutWeightsFillsAsTheWeightedOne) {
   weighted.hole(cv::Rect(25, 5, 10, 4)); // across the wall's edge with the car
   bare.hole(cv::Rect(25, 5, 10, 4));
   const cv::Mat by_weighted = fillSmallHoles(weighted.depth, weighted.weight, weighted.free_weight, cv::Mat(), 8);
-  const cv::Mat by_bare = fillSmallHoles(bare.depth, cv::Mat(), 8);
+  cv::Mat none; // no weights: the depth alone is filled
+  const cv::Mat by_bare = fillSmallHoles(bare.depth, none, none, cv::Mat(), 8);
   EXPECT_EQ(cv::countNonZero(by_bare), 10 * 4);
   EXPECT_EQ(cv::countNonZero(by_bare != by_weighted), 0);
   EXPECT_EQ(cv::countNonZero(bare.depth != weighted.depth), 0);
   cv::Mat wrong_mask(bare.depth.size(), CV_32FC1, cv::Scalar(0.f));
-  EXPECT_THROW(fillSmallHoles(bare.depth, wrong_mask, 8), InvalidInputError);
+  EXPECT_THROW(fillSmallHoles(bare.depth, none, none, wrong_mask, 8), InvalidInputError);
 }

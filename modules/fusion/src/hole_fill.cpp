@@ -89,9 +89,11 @@ float nearestInColumn(const cv::Mat& depth, const cv::Mat& filled, const cv::Mat
 
 } // namespace
 
-cv::Mat fillSmallHoles(cv::Mat& depth, const cv::Mat& excluded, int radius_px) {
+cv::Mat fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight, const cv::Mat& excluded, int radius_px) {
   if (depth.type() != CV_32FC1)
     throw InvalidInputError("fillSmallHoles: the depth is not CV_32FC1");
+  requireOfDepthSize(weight, CV_32FC1, depth.size(), "weight");
+  requireOfDepthSize(free_weight, CV_32FC1, depth.size(), "free-space weight");
   requireOfDepthSize(excluded, CV_8UC1, depth.size(), "excluded mask");
   cv::Mat filled(depth.size(), CV_8UC1, cv::Scalar(0));
   if (radius_px <= 0 || depth.empty())
@@ -111,15 +113,6 @@ cv::Mat fillSmallHoles(cv::Mat& depth, const cv::Mat& excluded, int radius_px) {
     }
   }
   filled.setTo(255, filled);
-  return filled;
-}
-
-cv::Mat fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight, const cv::Mat& excluded, int radius_px) {
-  if (depth.type() != CV_32FC1)
-    throw InvalidInputError("fillSmallHoles: the depth is not CV_32FC1");
-  requireOfDepthSize(weight, CV_32FC1, depth.size(), "weight");
-  requireOfDepthSize(free_weight, CV_32FC1, depth.size(), "free-space weight");
-  const cv::Mat filled = fillSmallHoles(depth, excluded, radius_px);
   if (!weight.empty())
     weight.setTo(0.f, filled);
   if (!free_weight.empty())

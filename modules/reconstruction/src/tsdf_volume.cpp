@@ -29,7 +29,6 @@
 #include <numeric>
 #include <ostream>
 #include <sstream>
-#include <stdexcept>
 #include <type_traits>
 
 namespace msf {
@@ -37,6 +36,26 @@ namespace msf {
 namespace {
 /// Whether a voxel is one of toCloud's points.
 bool isKept(const TsdfVoxel& voxel, float min_weight) { return voxel.observed() && voxel.weight > min_weight; }
+
+/// Voxel `i` of `block` as toCloud's and save()'s point: its centre, sdf, weight and colour.
+PointTsdf voxelPoint(const TsdfBlock& block, int i, float voxel_size) {
+  constexpr int kSide = TsdfBlock::kSide;
+  const GridIndex v = block.origin() + GridIndex(i % kSide, i / kSide % kSide, i / (kSide * kSide));
+  const TsdfVoxel& voxel = block.voxels[static_cast<std::size_t>(i)];
+  PointTsdf p;
+  p.x = static_cast<float>(v.x()) * voxel_size;
+  p.y = static_cast<float>(v.y()) * voxel_size;
+  p.z = static_cast<float>(v.z()) * voxel_size;
+  p.sdf = voxel.sdf;
+  p.weight = voxel.weight;
+  p.r = voxel.r;
+  p.g = voxel.g;
+  p.b = voxel.b;
+  p.a = 255;
+  p.passes = static_cast<std::uint8_t>(voxel.passes());
+  p.reappeared = voxel.reappeared() ? 1 : 0;
+  return p;
+}
 
 std::uint64_t newVolumeId() {
   static std::atomic<std::uint64_t> counter{0};
@@ -343,27 +362,10 @@ void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) co
   parallelFor(cv::Range(0, blocks), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b) {
       const TsdfBlock& block = *blocks_[b];
-      const GridIndex o = block.origin();
       PointTsdf* p = &cloud[first[static_cast<std::size_t>(b)]];
-      for (int z = 0; z < TsdfBlock::kSide; ++z)
-        for (int y = 0; y < TsdfBlock::kSide; ++y)
-          for (int x = 0; x < TsdfBlock::kSide; ++x) {
-            const TsdfVoxel& voxel = block.at(x, y, z);
-            if (!kept(voxel))
-              continue;
-            p->x = static_cast<float>(o.x() + x) * vs;
-            p->y = static_cast<float>(o.y() + y) * vs;
-            p->z = static_cast<float>(o.z() + z) * vs;
-            p->sdf = voxel.sdf;
-            p->weight = voxel.weight;
-            p->r = voxel.r;
-            p->g = voxel.g;
-            p->b = voxel.b;
-            p->a = 255;
-            p->passes = static_cast<std::uint8_t>(voxel.passes());
-            p->reappeared = voxel.reappeared() ? 1 : 0;
-            ++p;
-          }
+      for (int i = 0; i < TsdfBlock::kVoxels; ++i) // x fastest, then y, then z
+        if (kept(block.voxels[static_cast<std::size_t>(i)]))
+          *p++ = voxelPoint(block, i, vs);
     }
   });
   cloud.width = static_cast<std::uint32_t>(cloud.size());
@@ -409,55 +411,26 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
   }
 }
 
-void TsdfVolume::writeVoxelValues(const std::string& field, const std::vector<std::size_t>& first, std::size_t point,
-                                  std::size_t count, char* out) const {
+void TsdfVolume::writeVoxelValues(std::size_t offset, std::size_t bytes, const std::vector<std::size_t>& first,
+                                  std::size_t point, std::size_t count, char* out) const {
   auto b = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), point) - first.begin()) - 1;
   std::size_t skip = point - first[b];
-  // Each value as toCloud sets it, for the voxels from `point` on, in its order.
-  const auto write = [&](std::size_t bytes, auto&& value) {
-    for (; count > 0; ++b) {
-      const TsdfBlock& block = *blocks_[b];
-      for (int i = 0; i < TsdfBlock::kVoxels && count > 0; ++i) {
-        if (!isKept(block.voxels[i], 0.f))
-          continue;
-        if (skip > 0) {
-          --skip;
-          continue;
-        }
-        value(block, i, out);
-        out += bytes;
-        --count;
-      }
-    }
-  };
-  const auto put = [](auto v, char* to) { std::memcpy(to, &v, sizeof v); };
   const float vs = static_cast<float>(voxel_size_);
-  const int axis = field == "x" ? 0 : field == "y" ? 1 : field == "z" ? 2 : -1;
-  constexpr int kSide = TsdfBlock::kSide;
-  if (axis >= 0)
-    return write(4, [&](const TsdfBlock& block, int i, char* to) {
-      const int local[3] = {i % kSide, i / kSide % kSide, i / (kSide * kSide)};
-      put(static_cast<float>(block.origin()[axis] + local[axis]) * vs, to);
-    });
-  if (field == "sdf")
-    return write(4, [&](const TsdfBlock& block, int i, char* to) { put(block.voxels[i].sdf, to); });
-  if (field == "weight")
-    return write(4, [&](const TsdfBlock& block, int i, char* to) { put(block.voxels[i].weight, to); });
-  if (field == "rgb") // PCL's rgb: b g r a in memory
-    return write(4, [&](const TsdfBlock& block, int i, char* to) {
-      const TsdfVoxel& v = block.voxels[i];
-      const std::uint8_t bgra[4] = {v.b, v.g, v.r, 255};
-      std::memcpy(to, bgra, 4);
-    });
-  if (field == "passes")
-    return write(1, [&](const TsdfBlock& block, int i, char* to) {
-      put(static_cast<std::uint8_t>(block.voxels[i].passes()), to);
-    });
-  if (field == "reappeared")
-    return write(1, [&](const TsdfBlock& block, int i, char* to) {
-      put(static_cast<std::uint8_t>(block.voxels[i].reappeared() ? 1 : 0), to);
-    });
-  throw std::logic_error("TsdfVolume::writeVoxelValues: no field '" + field + "' in PointTsdf");
+  for (; count > 0; ++b) {
+    const TsdfBlock& block = *blocks_[b];
+    for (int i = 0; i < TsdfBlock::kVoxels && count > 0; ++i) {
+      if (!isKept(block.voxels[static_cast<std::size_t>(i)], 0.f))
+        continue;
+      if (skip > 0) {
+        --skip;
+        continue;
+      }
+      const PointTsdf p = voxelPoint(block, i, vs);
+      std::memcpy(out, reinterpret_cast<const char*>(&p) + offset, bytes);
+      out += bytes;
+      --count;
+    }
+  }
 }
 
 void TsdfVolume::save(const std::string& path) const {
@@ -469,12 +442,13 @@ void TsdfVolume::save(const std::string& path) const {
   // The voxels' values straight from the blocks, the bytes toCloud's cloud would give: no
   // cloud of them is made, which would be the largest allocation at the end of a run.
   const pcl::PCLPointCloud2 layout = pointLayout<PointTsdf>(static_cast<std::uint32_t>(first.back()), 1, true);
-  std::vector<std::string> fields;
+  std::vector<const pcl::PCLPointField*> fields; // where each lies in a PointTsdf
   for (const pcl::PCLPointField& f : layout.fields)
     if (f.name != "_")
-      fields.push_back(f.name);
+      fields.push_back(&f);
   const FieldValues values = [&](std::size_t field, std::size_t point, std::size_t count, char* out) {
-    writeVoxelValues(fields[field], first, point, count, out);
+    const pcl::PCLPointField& f = *fields[field];
+    writeVoxelValues(f.offset, f.count * pcl::getFieldSize(f.datatype), first, point, count, out);
   };
   // The parameters go into a comment line after the file's first line, which PCD readers
   // (pcl_viewer included) skip.

@@ -15,7 +15,4 @@ namespace msf {
 /// of the depth's size.
 cv::Mat fillSmallHoles(cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight, const cv::Mat& excluded, int radius_px);
 
-/// The same for a depth image without weights.
-cv::Mat fillSmallHoles(cv::Mat& depth, const cv::Mat& excluded, int radius_px);
-
 } // namespace msf
