@@ -332,6 +332,28 @@ TEST_F(PipelineTest, ASecondCtrlCStillLeavesAValidMeshAndSummary) {
   EXPECT_NE(readFile(out + "/report.md").find("Stopped a second time: skipped `mesh_preview`"), std::string::npos);
 }
 
+TEST_F(PipelineTest, AReaderThatGoesStopsTheRunOnceAndTheRunStillEnds) {
+  // `msf_reconstruct ... | head -n 3`: the pipe's reader goes after the first frame's line. The
+  // SIGPIPE that follows is one stop request, and the writes after it are no more requests: the
+  // handler's message to the same closed pipe used to raise SIGPIPE again, for ever. A SIGKILL
+  // after two minutes fails the test instead of hanging it.
+  for (const bool stderr_too : {true, false}) {
+    msf::test::TempDir dir, logs;
+    const std::string out = dir.file("out"), err = logs.file("err");
+    const auto r = msf::test::runCommand("bash -c 'timeout -s KILL 120 " + msf::test::binDir() + "/msf_reconstruct " +
+                                         dataset() + " -o " + out + " -panels 0 " +
+                                         (stderr_too ? "2>&1" : "2>" + err) + " | head -n 3; exit ${PIPESTATUS[0]}'");
+    ASSERT_EQ(r.exit_code, 130) << "stderr to the pipe too: " << stderr_too << "\n" << r.out << r.err;
+    const std::string json = expectInterruptedOutputs(dir, out);
+    EXPECT_NE(json.find("\"skipped\": []"), std::string::npos) << "one request, not a second: " << json;
+    if (!stderr_too) {
+      const std::string said = readFile(err);
+      EXPECT_NE(said.find("msf_reconstruct: stopping after the frames under way"), std::string::npos) << said;
+      EXPECT_EQ(said.find("msf_reconstruct: skipping"), std::string::npos) << said;
+    }
+  }
+}
+
 TEST_F(PipelineTest, AKilledRunLeavesThePreviousOutputAndTheNextRunRemovesItsStaging) {
   msf::test::TempDir dir;
   const std::string out = dir.file("out");

@@ -21,8 +21,19 @@ static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_alw
 // The messages, kept for the life of the process: a handler may only read them.
 std::vector<std::string>* g_messages = nullptr;
 
+/// Discards SIGPIPE from now on (async-signal-safe): once a reader has gone, each write to it
+/// raises one more, this handler's own message to a closed stderr included, and none of them is
+/// a new request; the writes fail with EPIPE instead.
+void ignoreBrokenPipes() {
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  ::sigaction(SIGPIPE, &ignore, nullptr);
+}
+
 void onStopSignal(int) {
   const int saved_errno = errno;
+  ignoreBrokenPipes();
   const int n = ++g_requests;
   g_stop = true;
   if (g_messages && !g_messages->empty()) {

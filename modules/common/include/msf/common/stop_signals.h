@@ -9,8 +9,10 @@ namespace msf::tool {
 /// Makes SIGINT, SIGTERM, SIGHUP (a closed terminal) and SIGPIPE (`| head`) requests to stop
 /// instead of deaths, so that a tool ends its work cleanly: no partial output, no temporary
 /// left. The k-th signal prints messages[k-1] on stderr (the last one for later signals);
-/// the tool polls stopRequests() at the points where it can stop. Throws IOError when a
-/// handler cannot be installed.
+/// the tool polls stopRequests() at the points where it can stop. After the first request
+/// SIGPIPE is ignored: writes to a reader that went fail with EPIPE instead of each being
+/// another request (a `| head` that exits, or a `| tee` that a Ctrl-C ended with the tool).
+/// Throws IOError when a handler cannot be installed.
 void installStopSignals(const std::vector<std::string>& messages);
 
 /// How many stop signals have come since installStopSignals.
