@@ -399,21 +399,19 @@ double Reconstructor::blocksPerBandBlock(const FrameSource& source, const std::v
     Frame frame = source.load(frames[k]);
     ScanBandBlocks bands = scanBands();
     bands.addScan(*frame.scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
-    // The depth from this engine's own stages, whose buffers the run then reuses; integrated
-    // into a volume of its own (the scan's carving updates only blocks that exist).
+    // The depth from this engine's own stages, whose buffers the run then reuses; its blocks are
+    // those its bands allocate in an empty volume (the carvings update only blocks that exist).
     stages_->history.clear(); // frames far apart: none is another's earlier scan
     FrameResult result = computeDepth(frame);
     stages_->history.clear();
-    TsdfVolume volume(config_.volume.voxel_size_m, config_.volume.truncation_m);
-    volume.setMaxMemoryMb(config_.volume.max_memory_mb);
-    TsdfIntegrator integrator(volume, config_.integrator);
-    try {
-      integrator.integrate(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()), T_world_cam0[k]);
-    } catch (const InvalidInputError&) {
+    TsdfVolume empty(config_.volume);
+    const std::size_t blocks = TsdfIntegrator(empty, config_.integrator)
+                                   .bandBlocks(fusedDepthFrame(result, config_.fusion, calibration_.focalBaseline()),
+                                               T_world_cam0[k]);
+    if (TsdfVolume::bytesFor(blocks) > empty.maxMemoryBytes())
       return 0.0; // a frame whose blocks do not fit the volume's budget: no measure, the bound stays
-    }
     if (bands.blocks() > 0)
-      most = std::max(most, static_cast<double>(volume.numBlocks()) / static_cast<double>(bands.blocks()));
+      most = std::max(most, static_cast<double>(blocks) / static_cast<double>(bands.blocks()));
   }
   return most;
 }

@@ -50,6 +50,19 @@ constexpr int kSide = TsdfBlock::kSide;
 // 60 bits leave 3 for a sub-block.
 using BlockKey = GridKey<20>;
 
+/// The blocks of sorted sub-block keys (a block's key and its sub-block in the low 3 bits), each
+/// with the mask of its sub-blocks that the keys name.
+void groupByBlock(const std::vector<std::uint64_t>& keys, std::vector<GridIndex>& blocks,
+                  std::vector<std::uint8_t>& masks) {
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == 0 || (keys[i] >> 3) != (keys[i - 1] >> 3)) {
+      blocks.push_back(BlockKey::unpack(keys[i] >> 3));
+      masks.push_back(0);
+    }
+    masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
+  }
+}
+
 /// floor(x) as an int, inline: without SSE4.1 (not in x86-64's baseline) std::floor is a call.
 inline int floorToInt(float x) {
   const int i = static_cast<int>(x);
@@ -592,14 +605,26 @@ const cv::Mat& TsdfIntegrator::carvedWeights(const DepthFrame& frame, const cv::
   return carved_weight_;
 }
 
-cv::Mat TsdfIntegrator::integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
+std::size_t TsdfIntegrator::bandBlocks(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
+  std::vector<GridIndex> blocks;
+  std::vector<std::uint8_t> masks;
+  groupByBlock(findBandSubBlocks(prepareBands(frame, T_world_cam), T_world_cam), blocks, masks);
+  return blocks.size();
+}
+
+FrameView TsdfIntegrator::prepareBands(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
   frame.validate();
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
   checkReach(T_world_cam);
-  stats_ = Stats();
-  const auto t_start = Clock::now();
   const FrameView view = prepareDepth(frame);
   computePixelBands(frame, view);
+  return view;
+}
+
+cv::Mat TsdfIntegrator::integrateDepth(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam) {
+  stats_ = Stats();
+  const auto t_start = Clock::now();
+  const FrameView view = prepareBands(frame, T_world_cam);
   detail::BlockList list = allocateSubBlocks(findBandSubBlocks(view, T_world_cam));
   if (config_.space_carving)
     addBlocksToCarve(view, T_world_cam, list);
@@ -763,13 +788,7 @@ detail::BlockList TsdfIntegrator::allocateSubBlocks(const std::vector<std::uint6
   const std::size_t blocks_before = volume_.numBlocks();
   std::vector<GridIndex> block_indices;
   detail::BlockList list;
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (i == 0 || (keys[i] >> 3) != (keys[i - 1] >> 3)) {
-      block_indices.push_back(BlockKey::unpack(keys[i] >> 3));
-      list.masks.push_back(0);
-    }
-    list.masks.back() |= static_cast<std::uint8_t>(1u << (keys[i] & 7));
-  }
+  groupByBlock(keys, block_indices, list.masks);
   volume_.allocateBlocks(block_indices, list.blocks);
   stats_.blocks_allocated = volume_.numBlocks() - blocks_before;
   return list;

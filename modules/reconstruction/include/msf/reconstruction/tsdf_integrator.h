@@ -257,6 +257,10 @@ public:
   /// Integrates a depth frame seen from T_world_cam (camera to world).
   /// Throws InvalidInputError (see DepthFrame::validate).
   void integrate(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
+  /// The blocks that the surface bands of `frame`'s pixels cross from T_world_cam: those
+  /// integrate() allocates in an empty volume, counted without allocating or updating any.
+  /// Throws as integrate() does.
+  std::size_t bandBlocks(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
 
   /// Whether carveWithScan clears anything (space carving with scan_carving_m > 0): whether a
   /// frame's scan is worth turning into a ScanFreeSpace.
@@ -389,6 +393,9 @@ private:
   const cv::Mat& carvedWeights(const DepthFrame& frame, const cv::Mat& integrated);
   /// Per pixel, its plane scale, bands and weights (pixels_).
   void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
+  /// The frame and pose checked, then prepareDepth and computePixelBands: the view whose bands
+  /// findBandSubBlocks walks.
+  detail::FrameView prepareBands(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam);
   /// The sorted keys of the sub-blocks that the pixels' bands cross; also the depth ranges of
   /// the image's tiles (tile_min_, tile_max_, tile_band_).
   std::vector<std::uint64_t> findBandSubBlocks(const detail::FrameView& view, const Eigen::Isometry3d& T_world_cam);
