@@ -3,6 +3,7 @@
 # msf_ros_node against a real ROS master: a roscore of its own on a free port, a bag of KITTI
 # odometry 04 frames 0..LAST written by msf_kitti2bag, the node and the player started by
 # launch/kitti_bag.launch, what the node publishes recorded by `rosbag record`; then
+#  - its wait for a master that is not there, which a SIGTERM ends,
 #  - its refusals of bad parameters,
 #  - each frame's depth and weight image, fused points and the mesh marker checked against the
 #    engine on the same frames (check_node_output),
@@ -30,6 +31,30 @@ source "$(dirname "$0")/ros_session.sh"
 ros_session_start "$build"
 "$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -o "$work/04.bag" >/dev/null
 ros_session_wait_master
+
+# No master at the URI: the node waits for one, says so, and a SIGTERM ends the wait (exit 130).
+no_master=http://localhost:$(python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
+ROS_MASTER_URI=$no_master "$build/bin/msf_ros_node" __name:=waiting >"$work/waiting.log" 2>&1 &
+waiting=$!
+for _ in $(seq 100); do
+  grep -q "waiting for the ROS master at $no_master" "$work/waiting.log" && break
+  sleep 0.1
+done
+kill -TERM "$waiting"
+for _ in $(seq 50); do
+  kill -0 "$waiting" 2>/dev/null || break
+  sleep 0.1
+done
+if kill -0 "$waiting" 2>/dev/null; then
+  kill -KILL "$waiting"
+  fail "msf_ros_node waiting for a master went on 5 s after a SIGTERM: $(tr '\n' ' ' <"$work/waiting.log")"
+fi
+status=0
+wait "$waiting" || status=$?
+[ "$status" = 130 ] && grep -q "waiting for the ROS master at $no_master" "$work/waiting.log" &&
+  grep -q "stopped while waiting for the ROS master; nothing was done" "$work/waiting.log" ||
+  fail "msf_ros_node without a master: exit $status, '$(tr '\n' ' ' <"$work/waiting.log")'"
+echo "ok: without a master the node waits for one, and a SIGTERM ends the wait"
 
 # Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
 refuse() { # NAME EXPECTED _param:=value...

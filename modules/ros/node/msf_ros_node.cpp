@@ -6,13 +6,28 @@
 // config/kitti_bag.yaml.
 #include "reconstruction_node.h"
 
+#include <ros/master.h>
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 
 namespace {
 std::atomic<bool> g_stop{false};
+
+/// Waits for the ROS master, as ROS's nodes do, until a stop signal: ROS's own retries would not
+/// see one, since its SIGINT handler is replaced. False when stopped first.
+bool waitForMaster() {
+  for (bool said = false; !g_stop; ros::WallDuration(0.2).sleep()) {
+    if (ros::master::check())
+      return true;
+    if (!said)
+      std::fprintf(stderr, "msf_ros_node: waiting for the ROS master at %s\n", ros::master::getURI().c_str());
+    said = true;
+  }
+  return false;
 }
+} // namespace
 
 int main(int argc, char** argv) {
   // SIGINT and SIGTERM stop the node while ROS still runs, so that it finishes the frames
@@ -20,6 +35,10 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "msf_ros_node", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { g_stop = true; });
   std::signal(SIGTERM, [](int) { g_stop = true; });
+  if (!waitForMaster()) {
+    std::fprintf(stderr, "msf_ros_node: stopped while waiting for the ROS master; nothing was done\n");
+    return 130;
+  }
   ros::NodeHandle nh, private_nh("~");
   try {
     msf::ReconstructionNode node(nh, private_nh);
