@@ -187,6 +187,25 @@ TEST(OpenSkyCoverage, CountsTheSkyPixelsASheetCovers) {
   EXPECT_NEAR(c.mean_frame_share, (0.5 + 0.25) / 2, 1e-12);
   EXPECT_NEAR(c.worst_share, 0.5, 1e-12);
   EXPECT_EQ(c.worst_frame, 0u);
+  // Filters on the covering point, all from one render a frame: only x > 0 (the right half of
+  // each frame's cover), and none; each as when scored alone.
+  const TriangleMesh sheet = square(-20.f, 20.f, -5.f, -3.f, 10.f);
+  const OpenSkyCoverage::SurfaceFilter right = [](const Eigen::Vector3f& p) { return p.x() > 0.f; };
+  const OpenSkyCoverage::SurfaceFilter nothing = [](const Eigen::Vector3f&) { return false; };
+  const std::vector<SkyCoverage> filtered = coverage.scoreMesh(sheet, {right, {}, nothing});
+  ASSERT_EQ(filtered.size(), 3u);
+  const SkyCoverage alone = coverage.scoreMesh(sheet, right);
+  EXPECT_NEAR(static_cast<double>(alone.covered_pixels), 15.0 * kWidth, 2.0 * 30) << "the right half, within a pixel a row";
+  for (const SkyCoverage& f : {filtered[0], alone}) {
+    EXPECT_EQ(f.covered_pixels, alone.covered_pixels);
+    EXPECT_EQ(f.frame_share, alone.frame_share);
+    EXPECT_EQ(f.covered_depth_median_m, alone.covered_depth_median_m);
+  }
+  EXPECT_EQ(filtered[1].covered_pixels, c.covered_pixels);
+  EXPECT_EQ(filtered[1].frame_share, c.frame_share);
+  EXPECT_EQ(filtered[2].covered_pixels, 0u);
+  EXPECT_EQ(filtered[2].frames, 2u);
+  EXPECT_EQ(filtered[2].sky_pixels, c.sky_pixels);
   // A mesh below the sky covers none of it.
   EXPECT_EQ(coverage.scoreMesh(square(-20.f, 20.f, 1.f, 4.f, 10.f)).covered_pixels, 0u);
   EXPECT_THROW(coverage.addMask(0, mask), InvalidInputError);

@@ -61,38 +61,18 @@ void OpenSkyCoverage::setPose(std::size_t frame, const Eigen::Isometry3d& T_worl
   sky.has_pose = true;
 }
 
-SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
-                                       const std::function<bool(const Eigen::Vector3f&)>& counts) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+namespace {
+
+/// One SkyCoverage summed frame by frame.
+struct SkyTally {
   SkyCoverage out;
   double share_sum = 0;
   std::vector<float> covered_depth;
-  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
-  for (const auto& [index, sky] : frames_) {
-    if (!sky.has_pose || !sky.has_mask)
-      continue;
-    ++out.frames;
-    if (sky.pixels == 0)
-      continue;
-    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_, nullptr, &bounds);
-    const float* depth = rendered_.ptr<float>(0);
-    const Eigen::Isometry3f T = sky.T_world_cam.cast<float>();
-    const auto counted = [&](std::uint32_t p) { // the surface point seen at pixel p, in the world
-      const auto u = static_cast<float>(p % static_cast<std::uint32_t>(camera_.width));
-      const auto v = static_cast<float>(p / static_cast<std::uint32_t>(camera_.width));
-      const float z = depth[p];
-      return !counts || counts(T * camera_.point(u, v, z));
-    };
-    std::size_t covered = 0;
-    for (std::size_t r = 0; r < sky.runs.size(); r += 2)
-      for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
-        if (depth[p] > 0.f && counted(p)) {
-          ++covered;
-          covered_depth.push_back(depth[p]);
-        }
-    const double share = static_cast<double>(covered) / static_cast<double>(sky.pixels);
+
+  void addFrame(std::size_t index, std::size_t sky_pixels, std::size_t covered) {
+    const double share = static_cast<double>(covered) / static_cast<double>(sky_pixels);
     out.frame_share[index] = share;
-    out.sky_pixels += sky.pixels;
+    out.sky_pixels += sky_pixels;
     out.covered_pixels += covered;
     share_sum += share;
     if (share > out.worst_share || out.frame_share.size() == 1) {
@@ -100,15 +80,61 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
       out.worst_frame = index;
     }
   }
-  if (!covered_depth.empty()) {
-    const auto middle = covered_depth.begin() + static_cast<long>(covered_depth.size() / 2);
-    std::nth_element(covered_depth.begin(), middle, covered_depth.end());
-    out.covered_depth_median_m = *middle;
+
+  SkyCoverage finish() {
+    if (!covered_depth.empty()) {
+      const auto middle = covered_depth.begin() + static_cast<long>(covered_depth.size() / 2);
+      std::nth_element(covered_depth.begin(), middle, covered_depth.end());
+      out.covered_depth_median_m = *middle;
+    }
+    if (out.sky_pixels > 0) {
+      out.share = static_cast<double>(out.covered_pixels) / static_cast<double>(out.sky_pixels);
+      out.mean_frame_share = share_sum / static_cast<double>(out.frame_share.size());
+    }
+    return out;
   }
-  if (out.sky_pixels > 0) {
-    out.share = static_cast<double>(out.covered_pixels) / static_cast<double>(out.sky_pixels);
-    out.mean_frame_share = share_sum / static_cast<double>(out.frame_share.size());
+};
+
+} // namespace
+
+SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh, const SurfaceFilter& counts) {
+  return scoreMesh(mesh, std::vector<SurfaceFilter>{counts}).front();
+}
+
+std::vector<SkyCoverage> OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
+                                                    const std::vector<SurfaceFilter>& filters) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<SkyTally> tallies(filters.size());
+  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
+  for (const auto& [index, sky] : frames_) {
+    if (!sky.has_pose || !sky.has_mask)
+      continue;
+    for (SkyTally& t : tallies)
+      ++t.out.frames;
+    if (sky.pixels == 0)
+      continue;
+    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_, nullptr, &bounds);
+    const float* depth = rendered_.ptr<float>(0);
+    const Eigen::Isometry3f T = sky.T_world_cam.cast<float>();
+    const auto point = [&](std::uint32_t p) { // the surface point seen at pixel p, in the world
+      const auto u = static_cast<float>(p % static_cast<std::uint32_t>(camera_.width));
+      const auto v = static_cast<float>(p / static_cast<std::uint32_t>(camera_.width));
+      return T * camera_.point(u, v, depth[p]);
+    };
+    for (std::size_t f = 0; f < filters.size(); ++f) {
+      std::size_t covered = 0;
+      for (std::size_t r = 0; r < sky.runs.size(); r += 2)
+        for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
+          if (depth[p] > 0.f && (!filters[f] || filters[f](point(p)))) {
+            ++covered;
+            tallies[f].covered_depth.push_back(depth[p]);
+          }
+      tallies[f].addFrame(index, sky.pixels, covered);
+    }
   }
+  std::vector<SkyCoverage> out;
+  for (SkyTally& t : tallies)
+    out.push_back(t.finish());
   return out;
 }
 

@@ -152,10 +152,12 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
       s.has_ghosts = true;
     }
     if (true_sky_) {
-      s.true_sky = true_sky_->scoreMesh(*m.mesh);
-      s.true_sky_sheets = true_sky_->scoreMesh(*m.mesh, [&](const Eigen::Vector3f& p) {
+      const OpenSkyCoverage::SurfaceFilter off_surface = [&](const Eigen::Vector3f& p) {
         return static_surface.distance(p, 2.f * kOffSurfaceM) > kOffSurfaceM;
-      });
+      };
+      const std::vector<SkyCoverage> sky = true_sky_->scoreMesh(*m.mesh, {{}, off_surface});
+      s.true_sky = sky[0];
+      s.true_sky_sheets = sky[1];
     }
     s.off_surface = splitOffSurface(*m.mesh, static_surface, road, lidar_, kGhostDistanceM, offSurfaceBands());
   }

@@ -49,11 +49,17 @@ public:
   /// The pose of `frame` (mask before or after). Throws InvalidInputError for a pose that is
   /// not finite.
   void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam);
+  /// Which covering surface points (world frame) count; empty: all of them.
+  using SurfaceFilter = std::function<bool(const Eigen::Vector3f&)>;
+
   /// Renders `mesh` (world frame) at the pose of every frame that has a mask and counts the sky
-  /// it covers; with `counts`, only the pixels whose covering surface point (world frame) it
-  /// accepts (e.g. those off a true surface: a sheet, not a blurred outline). Frames without a
-  /// pose (a run stopped early) are left out.
-  SkyCoverage scoreMesh(const TriangleMesh& mesh, const std::function<bool(const Eigen::Vector3f&)>& counts = {});
+  /// it covers; with `counts`, only the pixels whose covering surface point it accepts (e.g.
+  /// those off a true surface: a sheet, not a blurred outline). Frames without a pose (a run
+  /// stopped early) are left out.
+  SkyCoverage scoreMesh(const TriangleMesh& mesh, const SurfaceFilter& counts = {});
+  /// The same for each filter in turn, each frame rendered once for all of them: one
+  /// SkyCoverage per filter, in their order.
+  std::vector<SkyCoverage> scoreMesh(const TriangleMesh& mesh, const std::vector<SurfaceFilter>& filters);
 
   /// A picture of one frame: `image` (CV_8UC1 or CV_8UC3 of the camera's size) with its open
   /// sky tinted cyan and the sky a mesh covers (`rendered`: depth, > 0 where a surface is) in
