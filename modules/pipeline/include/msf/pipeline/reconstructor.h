@@ -24,11 +24,11 @@ namespace msf {
 /// What a run is predicted to hold at its peak, before it starts (Reconstructor::predictMemory), in
 /// MiB. The TSDF volume's blocks are the blocks within the truncation band of the scans' returns
 /// in view (ScanBandBlocks, from the scans and the poses), times the blocks the fused depth
-/// allocates per such block, measured by integrating a few of the run's frames, and never more
-/// than the blocks of every frame's view (BlockFootprint, the bound from the poses alone); the
-/// rest is a model (per pixel of the frames in flight, and a share of the volume for the mesh
-/// and files written at the end) measured on KITTI and the synthetic street (docs/robustness.md,
-/// "Memory budget").
+/// allocates per such block, counted on a few of the run's frames (TsdfIntegrator::bandBlocks),
+/// and never more than the blocks of every frame's view (BlockFootprint, the bound from the
+/// poses alone); the rest is a model (per pixel of the frames in flight, and a share of the
+/// volume for the mesh and files written at the end) measured on KITTI and the synthetic
+/// street (docs/robustness.md, "Memory budget").
 struct MemoryPrediction {
   std::size_t frames = 0;
   std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all: the bound
@@ -228,9 +228,9 @@ public:
   /// What the peak memory of run() over `frames` of `source` seen from `T_world_cam0` (one per
   /// frame, known before the run: a dataset's or a file's; not estimated ones) is predicted from:
   /// it reads every frame's scan, and computes the depth of a few frames (with this object's
-  /// stages) and integrates it into a volume of their own. Throws ConfigError when the
-  /// integrator's band has no bound (reach() is infinite), InvalidInputError for views too large
-  /// to enumerate or frames and poses of different counts.
+  /// stages) and counts the blocks it would allocate (TsdfIntegrator::bandBlocks). Throws
+  /// ConfigError when the integrator's band has no bound (reach() is infinite),
+  /// InvalidInputError for views too large to enumerate or frames and poses of different counts.
   MemoryEvidence measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
                                const PoseList& T_world_cam0);
   /// The peak memory of run() predicted from `evidence` (measured by an engine of the same volume,
