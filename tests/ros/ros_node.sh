@@ -3,7 +3,7 @@
 # msf_ros_node against a real ROS master: a roscore of its own on a free port, a bag of KITTI
 # odometry 04 frames 0..LAST written by msf_kitti2bag, the node and the player started by
 # launch/kitti_bag.launch, what the node publishes recorded by `rosbag record`; then
-#  - its wait for a master that is not there, which a SIGTERM ends,
+#  - its wait for a master that is not there, which a SIGTERM ends, and a master URI it refuses,
 #  - its refusals of bad parameters,
 #  - each frame's depth and weight image, fused points and the mesh marker checked against the
 #    engine on the same frames (check_node_output),
@@ -55,6 +55,21 @@ wait "$waiting" || status=$?
   grep -q "stopped while waiting for the ROS master; nothing was done" "$work/waiting.log" ||
   fail "msf_ros_node without a master: exit $status, '$(tr '\n' ' ' <"$work/waiting.log")'"
 echo "ok: without a master the node waits for one, and a SIGTERM ends the wait"
+# A master URI that ROS cannot parse (it would stop the node with a breakpoint trap): exit 1,
+# naming the URI and where it came from.
+for bad in "env:notauri" "arg:http//localhost"; do
+  status=0
+  if [ "${bad%%:*}" = env ]; then
+    out=$(ROS_MASTER_URI=${bad#env:} timeout 30 "$build/bin/msf_ros_node" __name:=bad_uri 2>&1) || status=$?
+    expected="the ROS master's URI '${bad#env:}' (ROS_MASTER_URI) is not of the form http://host:port"
+  else
+    out=$(timeout 30 "$build/bin/msf_ros_node" __name:=bad_uri "__master:=${bad#arg:}" 2>&1) || status=$?
+    expected="the ROS master's URI '${bad#arg:}' (the argument __master:=) is not of the form http://host:port"
+  fi
+  [ "$status" = 1 ] && [[ "$out" == *"msf_ros_node: error: $expected"* ]] ||
+    fail "msf_ros_node with the master URI ${bad#*:}: exit $status, '$out' (expected exit 1 and '$expected')"
+  echo "ok: a master URI of '${bad#*:}' refused: $expected"
+done
 
 # Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
 refuse() { # NAME EXPECTED _param:=value...

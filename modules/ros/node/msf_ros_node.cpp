@@ -7,13 +7,37 @@
 #include "reconstruction_node.h"
 
 #include <ros/master.h>
+#include <ros/network.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 namespace {
 std::atomic<bool> g_stop{false};
+
+/// The master's URI as ros::init takes it (a __master:= argument, else ROS_MASTER_URI) and
+/// where it comes from, checked before ros::init: ROS ends a node whose master URI it cannot
+/// parse with a breakpoint trap. Empty when the URI parses or none is given.
+std::string unparsableMasterUri(int argc, char** argv) {
+  const std::string remap = "__master:=";
+  std::string uri, from;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind(remap, 0) == 0) {
+      uri = std::string(argv[i]).substr(remap.size());
+      from = "the argument " + remap;
+    }
+  if (from.empty() && std::getenv("ROS_MASTER_URI")) {
+    uri = std::getenv("ROS_MASTER_URI");
+    from = "ROS_MASTER_URI";
+  }
+  std::string host;
+  std::uint32_t port = 0;
+  return from.empty() || ros::network::splitURI(uri, host, port) ? "" : "'" + uri + "' (" + from + ")";
+}
 
 /// Waits for the ROS master, as ROS's nodes do, until a stop signal: ROS's own retries would not
 /// see one, since its SIGINT handler is replaced. False when stopped first.
@@ -32,6 +56,12 @@ bool waitForMaster() {
 int main(int argc, char** argv) {
   // SIGINT and SIGTERM stop the node while ROS still runs, so that it finishes the frames
   // waiting (their poses from tf), publishes the last mesh and logs what it dropped.
+  const std::string bad_uri = unparsableMasterUri(argc, argv);
+  if (!bad_uri.empty()) {
+    std::fprintf(stderr, "msf_ros_node: error: the ROS master's URI %s is not of the form http://host:port\n",
+                 bad_uri.c_str());
+    return 1;
+  }
   ros::init(argc, argv, "msf_ros_node", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { g_stop = true; });
   std::signal(SIGTERM, [](int) { g_stop = true; });
