@@ -1548,4 +1548,14 @@ TEST(TsdfIntegrator, TheBandBlocksOfAFrameAreTheBlocksItsIntegrationAllocates) {
     EXPECT_GT(blocks, 500u);
     EXPECT_EQ(blocks, integrated.numBlocks()) << toString(distance);
   }
+  // Refused as integrate() refuses: a depth of another type, a pose that is not rigid.
+  TsdfVolume untouched(0.1, 0.3);
+  TsdfIntegrator counter(untouched);
+  DepthFrame wrong = frame;
+  wrong.depth = cv::Mat(frame.depth.size(), CV_16UC1, cv::Scalar(1));
+  EXPECT_THROW(counter.bandBlocks(wrong, pose), InvalidInputError);
+  Eigen::Isometry3d scaled = pose;
+  scaled.linear() *= 2.0;
+  EXPECT_THROW(counter.bandBlocks(frame, scaled), InvalidInputError);
+  EXPECT_EQ(untouched.numBlocks(), 0u);
 }
