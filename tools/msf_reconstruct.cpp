@@ -581,9 +581,13 @@ private:
     msf::saveMesh(path(name), moved);
   }
 
-  /// The meshes against the true surface (synthetic) and protocol 4 (rendered at every pose).
+  using MeshesToScore = std::map<std::string, msf::SyntheticScoring::MeshToScore>;
+  using MeshScores = std::map<std::string, msf::SyntheticScoring::MeshScores>;
+
+  /// The meshes against the true surface (synthetic), then seen from every frame's pose
+  /// (protocol 4, protocol 6, the synthetic true sky).
   void scoreMeshes() {
-    std::map<std::string, msf::SyntheticScoring::MeshToScore> meshes;
+    MeshesToScore meshes;
     if (!streaming())
       meshes["mesh"] = {mesh_, &polygons_["mesh"]};
     if (source_maps_)
@@ -591,12 +595,10 @@ private:
         meshes[map->name()] = {&map->mesh, polygons_.count(map->name()) ? &polygons_[map->name()] : nullptr};
     if (paper_mesh_)
       meshes["mesh_paper"] = {paper_mesh_, polygons_.count("mesh_paper") ? &polygons_["mesh_paper"] : nullptr};
-    std::map<std::string, msf::SyntheticScoring::MeshScores> scores;
+    MeshScores scores;
     if (truth_)
       truth_->writeDepthScores(report_);
-    if (truth_ && hurried()) {
-      report_.skipped.push_back("mesh_accuracy");
-    } else if (truth_) {
+    if (truth_ && goesAhead("mesh_accuracy")) {
       TicToc tt;
       tt.tic();
       print_highlight("Scoring the mesh%s against ", meshes.size() > 1 ? "es" : "");
@@ -608,54 +610,73 @@ private:
       }
       msf::tool::printDone(tt.toc(), scores.size());
     }
-    if (evaluation_ && hurried()) {
-      report_.skipped.push_back("reconstruction_evaluation");
-    } else if (evaluation_) {
-      TicToc tt;
-      tt.tic();
-      print_highlight("Rendering the mesh%s at every frame's pose ", meshes.size() > 1 ? "es" : "");
-      std::map<std::string, msf::SeenThroughPieces> seen_through;
-      for (const auto& [name, m] : meshes) {
-        evaluation_->scoreMesh(name, *m.mesh);
-        seen_through[name] = evaluation_->seenThroughPieces(*m.mesh);
-      }
-      msf::tool::printDone(tt.toc(), evaluation_->frames() * meshes.size());
-      msf::RunReport::MapEvaluation& e = report_.map_evaluation;
-      e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
-                                       std::to_string(config_.rings.heldout_remainder) + ") projected into camera 0"
-                                 : "the synthetic sequence's exact depth (gt/depth_0)";
-      e.range_m = on_rig_.integrator.max_depth_m;
-      e.moving_split = moving_split_;
-      e.transient_split = evaluation_->splitsTransient();
-      bool any_ghosts = false;
-      for (const auto& [name, s] : scores)
-        any_ghosts = any_ghosts || s.has_ghosts;
-      if (!any_ghosts)
-        e.no_ghosts = truth_ ? truth_->noGhostsReason()
-                             : "no synthetic ground truth: the places of moving objects are unknown";
-      msf::summarizeMapEvaluation(*evaluation_, scores, seen_through, e);
-    }
-    scoreOpenSky(meshes);
+    scoreViews(meshes, scores);
   }
 
-  /// Protocol 6: the open sky each mesh covers, and pictures of the fused mesh's.
-  void scoreOpenSky(const std::map<std::string, msf::SyntheticScoring::MeshToScore>& meshes) {
-    if (!sky_ || meshes.empty())
+  /// Whether a step after the run goes ahead: not once stopped twice (said in the summary).
+  bool goesAhead(const char* step) {
+    if (!hurried())
+      return true;
+    report_.skipped.push_back(step);
+    return false;
+  }
+
+  /// Each mesh rendered at every frame's pose once for all that score its views: protocol 4
+  /// at the ground truth's pixels, protocol 6 over the open sky, and the synthetic true sky.
+  void scoreViews(const MeshesToScore& meshes, MeshScores& scores) {
+    const bool protocol4 = evaluation_ && goesAhead("reconstruction_evaluation");
+    const bool protocol6 = sky_ && !meshes.empty() && goesAhead("open_sky");
+    if (!protocol4 && !protocol6 && scores.empty())
       return;
-    if (hurried()) {
-      report_.skipped.push_back("open_sky");
-      return;
-    }
     TicToc tt;
     tt.tic();
-    print_highlight("Rendering the mesh%s at every frame's pose over the open sky ", meshes.size() > 1 ? "es" : "");
-    std::map<std::string, const msf::TriangleMesh*> to_score;
-    for (const auto& [name, m] : meshes)
-      to_score[name] = m.mesh;
-    report_.open_sky = sky_->score(to_score);
-    if (meshes.count("mesh"))
-      report_.sky_pictures = sky_->drawPictures(stage_, *meshes.at("mesh").mesh, pose_of_, name_of_);
-    msf::tool::printDone(tt.toc(), to_score.size());
+    print_highlight("Rendering the mesh%s at every frame's pose ", meshes.size() > 1 ? "es" : "");
+    std::size_t views = 0;
+    std::map<std::string, msf::SeenThroughPieces> seen_through;
+    for (const auto& [name, m] : meshes) {
+      msf::MeshViewScoring scoring;
+      if (protocol4)
+        evaluation_->addViews(scoring, name);
+      if (protocol6)
+        sky_->addViews(scoring, name);
+      msf::SyntheticScoring::TrueSky true_sky;
+      const auto score = scores.find(name);
+      if (score != scores.end())
+        truth_->addTrueSkyViews(scoring, true_sky);
+      views += scoring.score(*m.mesh);
+      if (score != scores.end()) {
+        score->second.true_sky = true_sky.all.coverage();
+        score->second.true_sky_sheets = true_sky.sheets.coverage();
+      }
+      if (protocol4)
+        seen_through[name] = evaluation_->seenThroughPieces(*m.mesh);
+    }
+    msf::tool::printDone(tt.toc(), views);
+    if (protocol4)
+      summarizeProtocol4(scores, seen_through);
+    if (protocol6) {
+      report_.open_sky = sky_->scores();
+      if (meshes.count("mesh"))
+        report_.sky_pictures = sky_->drawPictures(stage_, *meshes.at("mesh").mesh, pose_of_, name_of_);
+    }
+  }
+
+  /// Protocol 4's rows into the report, each mesh's synthetic scores beside its row.
+  void summarizeProtocol4(const MeshScores& scores, const std::map<std::string, msf::SeenThroughPieces>& seen_through) {
+    msf::RunReport::MapEvaluation& e = report_.map_evaluation;
+    e.truth = request_.holdout ? "held-out rings (ring id % " + std::to_string(config_.rings.modulo) + " == " +
+                                     std::to_string(config_.rings.heldout_remainder) + ") projected into camera 0"
+                               : "the synthetic sequence's exact depth (gt/depth_0)";
+    e.range_m = on_rig_.integrator.max_depth_m;
+    e.moving_split = moving_split_;
+    e.transient_split = evaluation_->splitsTransient();
+    bool any_ghosts = false;
+    for (const auto& [name, s] : scores)
+      any_ghosts = any_ghosts || s.has_ghosts;
+    if (!any_ghosts)
+      e.no_ghosts = truth_ ? truth_->noGhostsReason()
+                           : "no synthetic ground truth: the places of moving objects are unknown";
+    msf::summarizeMapEvaluation(*evaluation_, scores, seen_through, e);
   }
 
   const Request& request_;

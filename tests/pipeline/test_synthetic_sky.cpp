@@ -28,12 +28,13 @@ msf::SkyCoverage sheetsOverTheTrueSky(const msf::Sequence& sequence, bool clear_
   engine.run(sequence, frames, [&](msf::FrameResult& r) {
     truth.addFrame(r, truth.depth(r.name), sequence.calibration(), config.integrator.max_depth_m);
   });
-  pcl::PolygonMesh polygons;
-  engine.mesh().toPolygonMesh(polygons);
-  const auto scores = truth.scoreMeshes({{"mesh", {&engine.mesh(), &polygons}}}, config.volume.voxel_size_m);
-  const msf::SkyCoverage& sheets = scores.at("mesh").true_sky_sheets;
+  msf::MeshViewScoring views;
+  msf::SyntheticScoring::TrueSky sky;
+  truth.addTrueSkyViews(views, sky);
+  views.score(engine.mesh());
+  const msf::SkyCoverage sheets = sky.sheets.coverage();
   std::printf("  clear_sky %d: %.4f of the true sky covered by sheets (all cover %.4f), worst frame %.4f\n", clear_sky,
-              sheets.share, scores.at("mesh").true_sky.share, sheets.worst_share);
+              sheets.share, sky.all.coverage().share, sheets.worst_share);
   return sheets;
 }
 

@@ -61,41 +61,32 @@ void OpenSkyCoverage::setPose(std::size_t frame, const Eigen::Isometry3d& T_worl
   sky.has_pose = true;
 }
 
-namespace {
-
-/// One SkyCoverage summed frame by frame.
-struct SkyTally {
-  SkyCoverage out;
-  double share_sum = 0;
-  std::vector<float> covered_depth;
-
-  void addFrame(std::size_t index, std::size_t sky_pixels, std::size_t covered) {
-    const double share = static_cast<double>(covered) / static_cast<double>(sky_pixels);
-    out.frame_share[index] = share;
-    out.sky_pixels += sky_pixels;
-    out.covered_pixels += covered;
-    share_sum += share;
-    if (share > out.worst_share || out.frame_share.size() == 1) {
-      out.worst_share = share;
-      out.worst_frame = index;
-    }
+void OpenSkyCoverage::Tally::addFrame(std::size_t index, std::size_t sky_pixels, std::size_t covered) {
+  const double share = static_cast<double>(covered) / static_cast<double>(sky_pixels);
+  out_.frame_share[index] = share;
+  out_.sky_pixels += sky_pixels;
+  out_.covered_pixels += covered;
+  share_sum_ += share;
+  if (share > out_.worst_share || out_.frame_share.size() == 1) {
+    out_.worst_share = share;
+    out_.worst_frame = index;
   }
+}
 
-  SkyCoverage finish() {
-    if (!covered_depth.empty()) {
-      const auto middle = covered_depth.begin() + static_cast<long>(covered_depth.size() / 2);
-      std::nth_element(covered_depth.begin(), middle, covered_depth.end());
-      out.covered_depth_median_m = *middle;
-    }
-    if (out.sky_pixels > 0) {
-      out.share = static_cast<double>(out.covered_pixels) / static_cast<double>(out.sky_pixels);
-      out.mean_frame_share = share_sum / static_cast<double>(out.frame_share.size());
-    }
-    return out;
+SkyCoverage OpenSkyCoverage::Tally::coverage() const {
+  SkyCoverage out = out_;
+  if (!covered_depth_.empty()) {
+    std::vector<float> depth = covered_depth_;
+    const auto middle = depth.begin() + static_cast<long>(depth.size() / 2);
+    std::nth_element(depth.begin(), middle, depth.end());
+    out.covered_depth_median_m = *middle;
   }
-};
-
-} // namespace
+  if (out.sky_pixels > 0) {
+    out.share = static_cast<double>(out.covered_pixels) / static_cast<double>(out.sky_pixels);
+    out.mean_frame_share = share_sum_ / static_cast<double>(out.frame_share.size());
+  }
+  return out;
+}
 
 SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh, const SurfaceFilter& counts) {
   return scoreMesh(mesh, std::vector<SurfaceFilter>{counts}).front();
@@ -103,39 +94,48 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh, const SurfaceFi
 
 std::vector<SkyCoverage> OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
                                                     const std::vector<SurfaceFilter>& filters) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<SkyTally> tallies(filters.size());
-  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
-  for (const auto& [index, sky] : frames_) {
-    if (!sky.has_pose || !sky.has_mask)
-      continue;
-    for (SkyTally& t : tallies)
-      ++t.out.frames;
-    if (sky.pixels == 0)
-      continue;
-    rasterizer_.render(mesh, camera_, sky.T_world_cam, rendered_, nullptr, &bounds);
-    const float* depth = rendered_.ptr<float>(0);
+  std::vector<Tally> tallies(filters.size());
+  MeshViewScoring views;
+  for (std::size_t f = 0; f < filters.size(); ++f)
+    addViews(views, tallies[f], filters[f]);
+  views.score(mesh);
+  std::vector<SkyCoverage> out;
+  for (const Tally& t : tallies)
+    out.push_back(t.coverage());
+  return out;
+}
+
+void OpenSkyCoverage::addViews(MeshViewScoring& views, Tally& tally, const SurfaceFilter& counts) {
+  std::map<std::size_t, Eigen::Isometry3d> poses;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [index, sky] : frames_) {
+      if (!sky.has_pose || !sky.has_mask)
+        continue;
+      ++tally.out_.frames;
+      if (sky.pixels > 0) // a frame without sky counts, with nothing to render
+        poses[index] = sky.T_world_cam;
+    }
+  }
+  views.add(camera_, poses, [this, &tally, counts](std::size_t index, const cv::Mat& rendered) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const FrameSky& sky = frames_.at(index);
+    const float* depth = rendered.ptr<float>(0);
     const Eigen::Isometry3f T = sky.T_world_cam.cast<float>();
     const auto point = [&](std::uint32_t p) { // the surface point seen at pixel p, in the world
       const auto u = static_cast<float>(p % static_cast<std::uint32_t>(camera_.width));
       const auto v = static_cast<float>(p / static_cast<std::uint32_t>(camera_.width));
       return T * camera_.point(u, v, depth[p]);
     };
-    for (std::size_t f = 0; f < filters.size(); ++f) {
-      std::size_t covered = 0;
-      for (std::size_t r = 0; r < sky.runs.size(); r += 2)
-        for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
-          if (depth[p] > 0.f && (!filters[f] || filters[f](point(p)))) {
-            ++covered;
-            tallies[f].covered_depth.push_back(depth[p]);
-          }
-      tallies[f].addFrame(index, sky.pixels, covered);
-    }
-  }
-  std::vector<SkyCoverage> out;
-  for (SkyTally& t : tallies)
-    out.push_back(t.finish());
-  return out;
+    std::size_t covered = 0;
+    for (std::size_t r = 0; r < sky.runs.size(); r += 2)
+      for (std::uint32_t p = sky.runs[r], end = p + sky.runs[r + 1]; p < end; ++p)
+        if (depth[p] > 0.f && (!counts || counts(point(p)))) {
+          ++covered;
+          tally.covered_depth_.push_back(depth[p]);
+        }
+    tally.addFrame(index, sky.pixels, covered);
+  });
 }
 
 cv::Mat OpenSkyCoverage::drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered) {

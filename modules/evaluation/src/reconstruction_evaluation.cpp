@@ -26,11 +26,6 @@ ReconstructionEvaluation::ReconstructionEvaluation(const PinholeCamera& camera, 
     throw ConfigError("protocol 4: the reconstruction's depth range must be > 0 m, not " + std::to_string(max_depth_m));
 }
 
-void ReconstructionEvaluation::setNearPlane(float near_m) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  rasterizer_.setNearPlane(near_m);
-}
-
 void ReconstructionEvaluation::checkImage(const cv::Mat& image, int type, const std::string& what) const {
   if (image.type() != type || image.cols != camera_.width || image.rows != camera_.height)
     throw InvalidInputError("protocol 4: " + what + " is a " + std::to_string(image.cols) + "x" +
@@ -170,13 +165,21 @@ void ReconstructionEvaluation::scoreDepth(const std::string& source, std::size_t
 }
 
 void ReconstructionEvaluation::scoreMesh(const std::string& source, const TriangleMesh& mesh) {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  Row& r = row(source);
-  const MeshRasterizer::RunBounds bounds = MeshRasterizer::triangleRunBounds(mesh); // each view renders its part
-  for (const auto& [frame, truth] : frames_) {
-    rasterizer_.render(mesh, camera_, truth.T_world_cam, rendered_, nullptr, &bounds);
-    score(r, frame, truth, rendered_);
+  MeshViewScoring views;
+  addViews(views, source);
+  views.score(mesh);
+}
+
+void ReconstructionEvaluation::addViews(MeshViewScoring& views, const std::string& source) {
+  std::map<std::size_t, Eigen::Isometry3d> poses;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    row(source); // the row's place among the sources: where it is asked, as scoreDepth's
+    for (const auto& [frame, truth] : frames_)
+      poses[frame] = truth.T_world_cam;
   }
+  views.add(camera_, poses,
+            [this, source](std::size_t frame, const cv::Mat& rendered) { scoreDepth(source, frame, rendered); });
 }
 
 SeenThroughPieces ReconstructionEvaluation::seenThroughPieces(const TriangleMesh& mesh,

@@ -34,8 +34,25 @@ void SkyScoring::addFrame(const Frame& frame) {
 
 std::map<std::string, SkyCoverage> SkyScoring::score(const std::map<std::string, const TriangleMesh*>& meshes) {
   std::map<std::string, SkyCoverage> out;
-  for (const auto& [name, mesh] : meshes)
-    out[name] = coverage_.scoreMesh(*mesh);
+  for (const auto& [name, mesh] : meshes) {
+    MeshViewScoring views;
+    addViews(views, name);
+    views.score(*mesh);
+    out[name] = tallies_.at(name).coverage();
+  }
+  return out;
+}
+
+void SkyScoring::addViews(MeshViewScoring& views, const std::string& name) {
+  OpenSkyCoverage::Tally& tally = tallies_[name];
+  tally = OpenSkyCoverage::Tally();
+  coverage_.addViews(views, tally);
+}
+
+std::map<std::string, SkyCoverage> SkyScoring::scores() const {
+  std::map<std::string, SkyCoverage> out;
+  for (const auto& [name, tally] : tallies_)
+    out[name] = tally.coverage();
   return out;
 }
 

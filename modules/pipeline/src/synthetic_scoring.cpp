@@ -50,6 +50,7 @@ SyntheticScoring::SyntheticScoring(const std::string& ground_truth_dir, bool sco
   if (!score_meshes_)
     return;
   loadMesh(truth_->sceneMeshPath(), scene_);
+  static_surface_ = std::make_unique<SurfaceDistance>(scene_);
   if (truth_->hasSceneClasses())
     classes_ = truth_->sceneClasses(static_cast<std::size_t>(scene_.cloud.width) * scene_.cloud.height);
 }
@@ -128,7 +129,7 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
     since_left = framesSinceLeft(truth_->movingBoxes(), *last_frame_, voxel_size_m);
     was_moving = [&since_left](const Eigen::Vector3f& p) { return since_left(p) > 0; };
   }
-  const SurfaceDistance static_surface(scene_);
+  const SurfaceDistance& static_surface = *static_surface_;
   // The street's road in its world (y down): the camera's height below the cameras' path.
   const Eigen::Hyperplane<float, 3> road(Eigen::Vector3f(0.f, -1.f, 0.f),
                                          static_cast<float>(synthetic::kCameraHeightM));
@@ -151,17 +152,19 @@ SyntheticScoring::scoreMeshes(const std::map<std::string, MeshToScore>& meshes, 
                                kCrumbAgeBuckets);
       s.has_ghosts = true;
     }
-    if (true_sky_) {
-      const OpenSkyCoverage::SurfaceFilter off_surface = [&](const Eigen::Vector3f& p) {
-        return static_surface.distance(p, 2.f * kOffSurfaceM) > kOffSurfaceM;
-      };
-      const std::vector<SkyCoverage> sky = true_sky_->scoreMesh(*m.mesh, {{}, off_surface});
-      s.true_sky = sky[0];
-      s.true_sky_sheets = sky[1];
-    }
     s.off_surface = splitOffSurface(*m.mesh, static_surface, road, lidar_, kGhostDistanceM, offSurfaceBands());
   }
   return scores;
+}
+
+void SyntheticScoring::addTrueSkyViews(MeshViewScoring& views, TrueSky& tally) const {
+  if (!true_sky_)
+    return;
+  const SurfaceDistance& surface = *static_surface_;
+  true_sky_->addViews(views, tally.all);
+  true_sky_->addViews(views, tally.sheets, [&surface](const Eigen::Vector3f& p) {
+    return surface.distance(p, 2.f * kOffSurfaceM) > kOffSurfaceM;
+  });
 }
 
 void SyntheticScoring::writeDepthScores(RunReport& report) const {

@@ -2,7 +2,7 @@
 #pragma once
 #include <msf/io/pinhole_camera.h>
 #include <msf/reconstruction/marching_cubes.h>
-#include <msf/reconstruction/mesh_rasterizer.h>
+#include <msf/evaluation/mesh_view_scoring.h>
 
 #include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
@@ -52,6 +52,19 @@ public:
   /// Which covering surface points (world frame) count; empty: all of them.
   using SurfaceFilter = std::function<bool(const Eigen::Vector3f&)>;
 
+  /// One mesh's SkyCoverage, counted view by view (addViews).
+  class Tally {
+  public:
+    SkyCoverage coverage() const;
+
+  private:
+    friend class OpenSkyCoverage;
+    void addFrame(std::size_t index, std::size_t sky_pixels, std::size_t covered);
+    SkyCoverage out_;
+    double share_sum_ = 0;
+    std::vector<float> covered_depth_;
+  };
+
   /// Renders `mesh` (world frame) at the pose of every frame that has a mask and counts the sky
   /// it covers; with `counts`, only the pixels whose covering surface point it accepts (e.g.
   /// those off a true surface: a sheet, not a blurred outline). Frames without a pose (a run
@@ -60,6 +73,10 @@ public:
   /// The same for each filter in turn, each frame rendered once for all of them: one
   /// SkyCoverage per filter, in their order.
   std::vector<SkyCoverage> scoreMesh(const TriangleMesh& mesh, const std::vector<SurfaceFilter>& filters);
+  /// The same through `views`, whose renderings other scorers of the same frames share: the sky
+  /// each frame's view of the mesh covers is counted into `tally` (which must outlive `views`'
+  /// scoring), with `counts` as in scoreMesh.
+  void addViews(MeshViewScoring& views, Tally& tally, const SurfaceFilter& counts = {});
 
   /// A picture of one frame: `image` (CV_8UC1 or CV_8UC3 of the camera's size) with its open
   /// sky tinted cyan and the sky a mesh covers (`rendered`: depth, > 0 where a surface is) in
@@ -67,6 +84,7 @@ public:
   static cv::Mat drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered);
 
   std::size_t frames() const;
+  const PinholeCamera& camera() const { return camera_; }
 
 private:
   struct FrameSky {
@@ -79,8 +97,6 @@ private:
   PinholeCamera camera_;
   mutable std::mutex mutex_;
   std::map<std::size_t, FrameSky> frames_;
-  MeshRasterizer rasterizer_;
-  cv::Mat rendered_;
 };
 
 } // namespace msf

@@ -3,7 +3,7 @@
 #include <msf/evaluation/depth_metrics.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/reconstruction/marching_cubes.h>
-#include <msf/reconstruction/mesh_rasterizer.h>
+#include <msf/evaluation/mesh_view_scoring.h>
 #include <msf/reconstruction/scan_free_space.h>
 
 #include <Eigen/Geometry>
@@ -71,9 +71,6 @@ public:
   ReconstructionEvaluation(const PinholeCamera& camera, double focal_baseline, double max_depth_m,
                            const D1Threshold& d1 = {});
 
-  /// The near plane of the mesh render (MeshRasterizer::setNearPlane).
-  void setNearPlane(float near_m);
-
   /// Keeps the ground truth of `frame`: depth (CV_32FC1 of the camera's size; > 0 and finite
   /// = true depth) seen from T_world_cam, and optionally `moving` (CV_8UC1 of the same size,
   /// non-zero = a moving object). Throws InvalidInputError for a frame given twice, an image
@@ -99,6 +96,9 @@ public:
   void scoreDepth(const std::string& source, std::size_t frame, const cv::Mat& depth);
   /// Renders `mesh` at every frame's pose and scores it as row `source`.
   void scoreMesh(const std::string& source, const TriangleMesh& mesh);
+  /// The same through `views`, whose renderings other scorers of the same frames share: each
+  /// frame's view of the mesh `views` renders is scored as row `source`.
+  void addViews(MeshViewScoring& views, const std::string& source);
   /// The pieces of `mesh` with fewer than `max_triangles` triangles that lie in front of the
   /// ground truth: a vertex is seen through when, at some frame, the true depth is known in the
   /// 3x3 pixels it projects to and all of it lies behind the vertex by more than D1's
@@ -107,6 +107,7 @@ public:
   SeenThroughPieces seenThroughPieces(const TriangleMesh& mesh, std::size_t max_triangles = 50) const;
 
   std::size_t frames() const;
+  const PinholeCamera& camera() const { return camera_; }
   /// Ground-truth pixels kept over all frames (static and moving).
   std::size_t groundTruthPixels() const;
   double maxDepth() const { return max_depth_m_; }
@@ -158,8 +159,6 @@ private:
   bool splits_transient_ = false;
   std::size_t last_scan_ = 0;
   std::vector<Row> rows_;
-  MeshRasterizer rasterizer_;
-  cv::Mat rendered_;
 };
 
 } // namespace msf

@@ -32,6 +32,11 @@ public:
   void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam) { coverage_.setPose(frame, T_world_cam); }
   /// Each mesh (by name: "mesh", "mesh_lidar", ...) rendered at every pose.
   std::map<std::string, SkyCoverage> score(const std::map<std::string, const TriangleMesh*>& meshes);
+  /// The same for the mesh `views` renders, its sky counted anew as `name` in scores(): the
+  /// views are shared with the other scorers of the frames.
+  void addViews(MeshViewScoring& views, const std::string& name);
+  /// What addViews counted, by name, once `views` scored.
+  std::map<std::string, SkyCoverage> scores() const;
   /// sky_NNNNNN.png in `dir` for each picture frame with a pose (OpenSkyCoverage::drawCoverage
   /// with `mesh`); returns the file names written.
   std::vector<std::string> drawPictures(const std::string& dir, const TriangleMesh& mesh,
@@ -51,6 +56,7 @@ private:
   std::set<std::size_t> picture_frames_;
   std::mutex mutex_;
   std::map<std::size_t, Picture> pictures_;
+  std::map<std::string, OpenSkyCoverage::Tally> tallies_;
   cv::Mat returns_;
 };
 

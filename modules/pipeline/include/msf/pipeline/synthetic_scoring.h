@@ -65,7 +65,7 @@ public:
     bool has_ghosts = false;  ///< ghosts and crumbs: the dataset has moving-object boxes
     GhostMetrics ghosts;
     CrumbMetrics crumbs;
-    SkyCoverage true_sky;          ///< the true sky the mesh rendered at every frame's pose covers
+    SkyCoverage true_sky;          ///< the true sky the mesh rendered at every frame's pose covers (addTrueSkyViews)
     SkyCoverage true_sky_sheets;   ///< of it, the pixels whose covering surface is off the true surface
     OffSurfaceSplit off_surface;   ///< by height above the road and the LiDAR's support
   };
@@ -76,8 +76,17 @@ public:
   /// Each mesh against the true surface; `voxel_size_m` sets the completeness threshold (2
   /// voxels) and the margin around moving boxes (a voxel). Ghosts and crumbs lie where a moving
   /// object was at a frame scored and is not at the last one (where it stands then is real).
+  /// The true sky is counted apart, from the mesh's views (addTrueSkyViews).
   std::map<std::string, MeshScores> scoreMeshes(const std::map<std::string, MeshToScore>& meshes,
                                                 double voxel_size_m) const;
+  /// The true sky a mesh covers, counted view by view: all of it, and where the covering surface
+  /// is off the true surface (a sheet, not a blurred outline).
+  struct TrueSky {
+    OpenSkyCoverage::Tally all, sheets;
+  };
+  /// Counts into `tally` the true sky of every frame scored that the mesh `views` renders covers
+  /// (the views are shared with the other scorers of the frames); nothing without mesh scores.
+  void addTrueSkyViews(MeshViewScoring& views, TrueSky& tally) const;
   /// The depth scores by method into the report.
   void writeDepthScores(RunReport& report) const;
   /// Why a ghost figure is absent, in words ("" when moving boxes exist).
@@ -89,6 +98,7 @@ private:
   std::vector<Eigen::Vector3f> seen_surface_;  // ground-truth depth back-projected to the world
   std::vector<float> seen_depth_;              // the depth each was seen at
   pcl::PolygonMesh scene_;                     // gt/scene.ply
+  std::unique_ptr<SurfaceDistance> static_surface_; // the distance to it
   std::optional<SurfaceClasses> classes_;      // gt/scene_classes.txt, when the dataset has it
   bool score_meshes_ = true;
   std::optional<std::size_t> last_frame_;      // the latest ground-truth frame scored: where cars stand at the end
