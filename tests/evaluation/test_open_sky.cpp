@@ -192,8 +192,13 @@ TEST(OpenSkyCoverage, CountsTheSkyPixelsASheetCovers) {
   const TriangleMesh sheet = square(-20.f, 20.f, -5.f, -3.f, 10.f);
   const OpenSkyCoverage::SurfaceFilter right = [](const Eigen::Vector3f& p) { return p.x() > 0.f; };
   const OpenSkyCoverage::SurfaceFilter nothing = [](const Eigen::Vector3f&) { return false; };
-  const std::vector<SkyCoverage> filtered = coverage.scoreMesh(sheet, {right, {}, nothing});
-  ASSERT_EQ(filtered.size(), 3u);
+  std::vector<OpenSkyCoverage::Tally> tallies(3);
+  MeshViewScoring views;
+  coverage.addViews(views, tallies[0], right);
+  coverage.addViews(views, tallies[1]);
+  coverage.addViews(views, tallies[2], nothing);
+  EXPECT_EQ(views.score(sheet), 2u) << "one rendering a frame";
+  const std::vector<SkyCoverage> filtered = {tallies[0].coverage(), tallies[1].coverage(), tallies[2].coverage()};
   const SkyCoverage alone = coverage.scoreMesh(sheet, right);
   EXPECT_NEAR(static_cast<double>(alone.covered_pixels), 15.0 * kWidth, 2.0 * 30) << "the right half, within a pixel a row";
   for (const SkyCoverage& f : {filtered[0], alone}) {

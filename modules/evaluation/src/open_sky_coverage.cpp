@@ -89,20 +89,11 @@ SkyCoverage OpenSkyCoverage::Tally::coverage() const {
 }
 
 SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh, const SurfaceFilter& counts) {
-  return scoreMesh(mesh, std::vector<SurfaceFilter>{counts}).front();
-}
-
-std::vector<SkyCoverage> OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh,
-                                                    const std::vector<SurfaceFilter>& filters) {
-  std::vector<Tally> tallies(filters.size());
+  Tally tally;
   MeshViewScoring views;
-  for (std::size_t f = 0; f < filters.size(); ++f)
-    addViews(views, tallies[f], filters[f]);
+  addViews(views, tally, counts);
   views.score(mesh);
-  std::vector<SkyCoverage> out;
-  for (const Tally& t : tallies)
-    out.push_back(t.coverage());
-  return out;
+  return tally.coverage();
 }
 
 void OpenSkyCoverage::addViews(MeshViewScoring& views, Tally& tally, const SurfaceFilter& counts) {

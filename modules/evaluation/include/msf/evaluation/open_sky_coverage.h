@@ -70,12 +70,9 @@ public:
   /// those off a true surface: a sheet, not a blurred outline). Frames without a pose (a run
   /// stopped early) are left out.
   SkyCoverage scoreMesh(const TriangleMesh& mesh, const SurfaceFilter& counts = {});
-  /// The same for each filter in turn, each frame rendered once for all of them: one
-  /// SkyCoverage per filter, in their order.
-  std::vector<SkyCoverage> scoreMesh(const TriangleMesh& mesh, const std::vector<SurfaceFilter>& filters);
-  /// The same through `views`, whose renderings other scorers of the same frames share: the sky
-  /// each frame's view of the mesh covers is counted into `tally` (which must outlive `views`'
-  /// scoring), with `counts` as in scoreMesh.
+  /// The same through `views`, whose renderings other scorers of the same frames share (several
+  /// filters, several protocols): the sky each frame's view of the mesh covers is counted into
+  /// `tally` (which must outlive `views`' scoring), with `counts` as in scoreMesh.
   void addViews(MeshViewScoring& views, Tally& tally, const SurfaceFilter& counts = {});
 
   /// A picture of one frame: `image` (CV_8UC1 or CV_8UC3 of the camera's size) with its open
