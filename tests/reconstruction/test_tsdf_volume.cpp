@@ -204,27 +204,62 @@ TEST(TsdfVolume, TheFileSavedFromTheBlocksIsTheCloudOfToCloudByteForByte) {
   EXPECT_TRUE(saved == expected.str()) << "save() and toCloud() differ";
 }
 
-TEST(TsdfVolume, AVolumeWrittenWithoutThePassesFieldLoads) {
-  // Volumes saved before the passes and reappeared fields: their voxels load, none passed.
+namespace {
+
+struct VoxelValues {
+  float sdf, weight;
+  int r, b, passes;
+  bool reappeared;
+};
+
+void expectVoxel(const TsdfVoxel& v, const VoxelValues& e, const char* what) {
+  EXPECT_FLOAT_EQ(v.sdf, e.sdf) << what;
+  EXPECT_FLOAT_EQ(v.weight, e.weight) << what;
+  EXPECT_EQ(v.r, e.r) << what;
+  EXPECT_EQ(v.b, e.b) << what;
+  EXPECT_EQ(v.passes(), e.passes) << what;
+  EXPECT_EQ(v.reappeared(), e.reappeared) << what;
+}
+
+} // namespace
+
+TEST(TsdfVolume, AVolumeFileLoadsWhateverItsFieldsOrderTypesOrAge) {
   test::TempDir dir;
-  std::ofstream(dir.file("older.pcd")) << "# .PCD v0.7 - Point Cloud Data file format\n"
-                                          "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\n"
-                                          "VERSION 0.7\nFIELDS x y z sdf weight rgb\nSIZE 4 4 4 4 4 4\n"
-                                          "TYPE F F F F F U\nCOUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
-                                          "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
-                                          "0 0 0 -0.05 10 4278190335\n0.1 0 0 0.05 12 4278190335\n";
-  const TsdfVolume older = TsdfVolume::load(dir.file("older.pcd"));
-  ASSERT_EQ(older.numObservedVoxels(), 2u);
-  const TsdfVoxel* a = older.findVoxel(GridIndex(0, 0, 0));
-  const TsdfVoxel* b = older.findVoxel(GridIndex(1, 0, 0));
-  ASSERT_TRUE(a && b);
-  EXPECT_FLOAT_EQ(a->sdf, -0.05f);
-  EXPECT_FLOAT_EQ(b->weight, 12.f);
-  EXPECT_EQ(a->b, 255);
-  EXPECT_EQ(a->passes(), 0);
-  EXPECT_EQ(b->passes(), 0);
-  EXPECT_FALSE(a->reappeared());
-  EXPECT_FALSE(b->reappeared());
+  // Two voxels of an ASCII volume of 0.1 m voxels: the voxel at the origin and `second`'s.
+  const auto load = [&](const std::string& name, const std::string& fields_to_points, const GridIndex& second) {
+    std::ofstream(dir.file(name)) << "# .PCD v0.7 - Point Cloud Data file format\n"
+                                     "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\n"
+                                  << fields_to_points;
+    const TsdfVolume volume = TsdfVolume::load(dir.file(name));
+    EXPECT_EQ(volume.numObservedVoxels(), 2u) << name;
+    const TsdfVoxel *a = volume.findVoxel(GridIndex(0, 0, 0)), *b = volume.findVoxel(second);
+    return std::make_pair(a ? *a : TsdfVoxel(), b ? *b : TsdfVoxel());
+  };
+  struct Case {
+    const char* name;
+    std::string fields_to_points;
+    GridIndex second;
+    VoxelValues first_values, second_values;
+  };
+  const Case cases[] = {
+      // Saved before the passes and reappeared fields: their voxels load, none passed.
+      {"older.pcd",
+       "FIELDS x y z sdf weight rgb\nSIZE 4 4 4 4 4 4\nTYPE F F F F F U\nCOUNT 1 1 1 1 1 1\n"
+       "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
+       "0 0 0 -0.05 10 4278190335\n0.1 0 0 0.05 12 4278190335\n",
+       GridIndex(1, 0, 0), {-0.05f, 10.f, 0, 255, 0, false}, {0.05f, 12.f, 0, 255, 0, false}},
+      // Fields read where the file has them: another order, rgba for rgb, a float64 x y z.
+      {"reordered.pcd",
+       "FIELDS weight rgba reappeared x y z passes sdf\nSIZE 4 4 1 8 8 8 1 4\nTYPE F U U F F F U F\n"
+       "COUNT 1 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
+       "10 4278190335 0 0 0 0 2 -0.05\n12 4294901760 1 0.1 0 0.8 1 0.05\n",
+       GridIndex(1, 0, 8), {-0.05f, 10.f, 0, 255, 2, false}, {0.05f, 12.f, 255, 0, 1, true}},
+  };
+  for (const Case& c : cases) {
+    const auto [first, second] = load(c.name, c.fields_to_points, c.second);
+    expectVoxel(first, c.first_values, c.name);
+    expectVoxel(second, c.second_values, c.name);
+  }
 }
 
 namespace {

@@ -71,24 +71,61 @@ std::string number(double v) {
 
 constexpr const char* kHeaderTag = "# msfusion tsdf";
 
-/// Adds a uint8 field of zeros named `name` to every point of `blob`.
-void addZeroField(pcl::PCLPointCloud2& blob, const std::string& name) {
-  pcl::PCLPointCloud2 zeros;
-  zeros.width = blob.width;
-  zeros.height = blob.height;
-  pcl::PCLPointField field;
-  field.name = name;
-  field.offset = 0;
-  field.datatype = pcl::PCLPointField::UINT8;
-  field.count = 1;
-  zeros.fields.push_back(field);
-  zeros.point_step = 1;
-  zeros.row_step = blob.width;
-  zeros.data.assign(static_cast<std::size_t>(blob.width) * blob.height, 0);
-  pcl::PCLPointCloud2 joined;
-  pcl::concatenateFields(blob, zeros, joined);
-  blob = std::move(joined);
-}
+/// The voxels of a volume file where its reader left them: each field read at its offset, no
+/// cloud of them made (the largest allocation of a load). passes and reappeared, which files
+/// written before them lack, are 0 there.
+class BlobVoxels {
+public:
+  /// Throws IOError naming `path` and the field when the blob lacks one a voxel needs, or one
+  /// holds values its type cannot (convertFieldTypes).
+  BlobVoxels(pcl::PCLPointCloud2& blob, const std::string& path) : blob_(blob) {
+    std::vector<pcl::PCLPointField> wanted;
+    pcl::for_each_type<pcl::traits::fieldList<PointTsdf>::type>(pcl::detail::FieldAdder<PointTsdf>(wanted));
+    wanted.erase(std::remove_if(wanted.begin(), wanted.end(),
+                                [&](const pcl::PCLPointField& f) {
+                                  return (f.name == "passes" || f.name == "reappeared") &&
+                                         pcl::getFieldIndex(blob, f.name) < 0;
+                                }),
+                 wanted.end());
+    for (const pcl::PCLPointField& f : wanted)
+      if (pcl::getFieldIndex(blob, f.name) < 0 && !(f.name == "rgb" && pcl::getFieldIndex(blob, "rgba") >= 0))
+        throw IOError("cloud '" + path + "' has no field '" + f.name + "'");
+    convertFieldTypes(blob, wanted, path);
+    const auto offset = [&](const char* name) {
+      const int i = pcl::getFieldIndex(blob, name);
+      return i < 0 ? -1 : static_cast<long>(blob.fields[static_cast<std::size_t>(i)].offset);
+    };
+    for (const char* name : {"x", "y", "z", "sdf", "weight"})
+      float_offsets_.push_back(static_cast<std::size_t>(offset(name)));
+    rgb_ = static_cast<std::size_t>(std::max(offset("rgb"), offset("rgba")));
+    passes_ = offset("passes");
+    reappeared_ = offset("reappeared");
+    dense_ = blob.row_step == static_cast<std::uint64_t>(blob.width) * blob.point_step;
+  }
+
+  std::size_t size() const { return static_cast<std::size_t>(blob_.width) * blob_.height; }
+
+  PointTsdf operator()(std::size_t i) const {
+    const std::uint8_t* p = blob_.data.data() + (dense_ ? i * blob_.point_step
+                                                        : i / blob_.width * blob_.row_step +
+                                                              i % blob_.width * blob_.point_step);
+    PointTsdf v;
+    float* floats[] = {&v.x, &v.y, &v.z, &v.sdf, &v.weight};
+    for (std::size_t f = 0; f < 5; ++f)
+      std::memcpy(floats[f], p + float_offsets_[f], sizeof(float));
+    std::memcpy(&v.rgba, p + rgb_, sizeof(v.rgba));
+    v.passes = passes_ < 0 ? 0 : p[passes_];
+    v.reappeared = reappeared_ < 0 ? 0 : p[reappeared_];
+    return v;
+  }
+
+private:
+  const pcl::PCLPointCloud2& blob_;
+  std::vector<std::size_t> float_offsets_; // x y z sdf weight
+  std::size_t rgb_ = 0;
+  long passes_ = -1, reappeared_ = -1;     // -1: not in the file
+  bool dense_ = true;                      // no padding at the rows' ends
+};
 
 // TsdfBlock is trivially destructible: a chunk is freed without destroying its blocks.
 static_assert(std::is_trivially_destructible_v<TsdfBlock>);
@@ -374,10 +411,17 @@ void TsdfVolume::toCloud(pcl::PointCloud<PointTsdf>& cloud, float min_weight) co
 }
 
 void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
+  insertVoxels(cloud.size(), [&cloud](std::size_t i) -> const PointTsdf& { return cloud[i]; });
+}
+
+template <typename VoxelAt>
+void TsdfVolume::insertVoxels(std::size_t count, const VoxelAt& at) {
   clear();
   const double tolerance = 0.01; // of a voxel: float coordinates of far voxels round a little
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const PointTsdf& p = cloud[i];
+  TsdfBlock* current = nullptr;  // the last voxel's: a file holds its voxels block by block
+  GridIndex current_index = GridIndex::Zero();
+  for (std::size_t i = 0; i < count; ++i) {
+    const PointTsdf& p = at(i);
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.sdf) ||
         !std::isfinite(p.weight) || p.weight < 0.f)
       throw InvalidInputError("voxel " + std::to_string(i) + " has a coordinate, sdf or weight that is not a finite value");
@@ -393,9 +437,12 @@ void TsdfVolume::fromCloud(const pcl::PointCloud<PointTsdf>& cloud) {
       throw InvalidInputError("voxel " + std::to_string(i) + " at (" + number(p.x) + ", " + number(p.y) + ", " +
                               number(p.z) + ") is not on the " + number(voxel_size_) + " m grid");
     const GridIndex b = blockOf(v);
-    TsdfBlock& block = allocateBlock(b);
+    if (!current || b != current_index) {
+      current = &allocateBlock(b);
+      current_index = b;
+    }
     const GridIndex l = v - b * TsdfBlock::kSide;
-    TsdfVoxel& voxel = block.at(l.x(), l.y(), l.z());
+    TsdfVoxel& voxel = current->at(l.x(), l.y(), l.z());
     voxel.sdf = std::max(-static_cast<float>(truncation_), std::min(static_cast<float>(truncation_), p.sdf));
     voxel.weight = p.weight;
     voxel.r = p.r;
@@ -495,14 +542,9 @@ TsdfVolume TsdfVolume::load(const std::string& path, double voxel_size_m, double
   TsdfVolume volume(voxel_size, truncation);
   pcl::PCLPointCloud2 blob;
   loadCloudBlob(path, blob);
-  if (pcl::getFieldIndex(blob, "passes") < 0)
-    addZeroField(blob, "passes"); // written before the field: no voxel known to be passed
-  if (pcl::getFieldIndex(blob, "reappeared") < 0)
-    addZeroField(blob, "reappeared"); // likewise: none known to have reappeared
-  pcl::PointCloud<PointTsdf> cloud;
-  fromCloudBlob(std::move(blob), cloud, path);
+  const BlobVoxels voxels(blob, path);
   try {
-    volume.fromCloud(cloud);
+    volume.insertVoxels(voxels.size(), voxels);
   } catch (const InvalidInputError& e) {
     throw IOError("volume '" + path + "': " + e.what());
   }

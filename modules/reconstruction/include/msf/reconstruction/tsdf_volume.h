@@ -142,6 +142,11 @@ public:
   static TsdfVolume load(const std::string& path, double voxel_size_m = 0, double truncation_m = 0);
 
 private:
+  /// Replaces the content with the `count` voxels `at(i)` gives (PointTsdf: fromCloud's and
+  /// load's), checked as fromCloud says.
+  template <typename VoxelAt>
+  void insertVoxels(std::size_t count, const VoxelAt& at);
+
   double voxel_size_;
   double truncation_;
   std::size_t max_memory_bytes_ = 0;
