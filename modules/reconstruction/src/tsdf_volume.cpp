@@ -29,6 +29,7 @@
 #include <numeric>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 namespace msf {
@@ -458,25 +459,54 @@ void TsdfVolume::insertVoxels(std::size_t count, const VoxelAt& at) {
   }
 }
 
-void TsdfVolume::writeVoxelValues(std::size_t offset, std::size_t bytes, const std::vector<std::size_t>& first,
-                                  std::size_t point, std::size_t count, char* out) const {
-  auto b = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), point) - first.begin()) - 1;
-  std::size_t skip = point - first[b];
-  const float vs = static_cast<float>(voxel_size_);
-  for (; count > 0; ++b) {
-    const TsdfBlock& block = *blocks_[b];
-    for (int i = 0; i < TsdfBlock::kVoxels && count > 0; ++i) {
-      if (!isKept(block.voxels[static_cast<std::size_t>(i)], 0.f))
-        continue;
-      if (skip > 0) {
-        --skip;
-        continue;
+void TsdfVolume::writeVoxelValues(const std::string& name, const std::vector<std::size_t>& first, std::size_t point,
+                                  std::size_t count, char* out) const {
+  // Each field from the voxel alone, as voxelPoint has it: a whole point per value would be
+  // built once per field.
+  const auto each = [&](const auto& value) {
+    auto b = static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), point) - first.begin()) - 1;
+    std::size_t skip = point - first[b];
+    for (; count > 0; ++b) {
+      const TsdfBlock& block = *blocks_[b];
+      for (int i = 0; i < TsdfBlock::kVoxels && count > 0; ++i) {
+        if (!isKept(block.voxels[static_cast<std::size_t>(i)], 0.f))
+          continue;
+        if (skip > 0) {
+          --skip;
+          continue;
+        }
+        const auto v = value(block, i);
+        std::memcpy(out, &v, sizeof v);
+        out += sizeof v;
+        --count;
       }
-      const PointTsdf p = voxelPoint(block, i, vs);
-      std::memcpy(out, reinterpret_cast<const char*>(&p) + offset, bytes);
-      out += bytes;
-      --count;
     }
+  };
+  constexpr int kSide = TsdfBlock::kSide;
+  const float vs = static_cast<float>(voxel_size_);
+  const auto voxel = [](const TsdfBlock& block, int i) -> const TsdfVoxel& {
+    return block.voxels[static_cast<std::size_t>(i)];
+  };
+  if (name == "x" || name == "y" || name == "z") {
+    const int axis = name[0] - 'x', stride = axis == 0 ? 1 : axis == 1 ? kSide : kSide * kSide;
+    each([&](const TsdfBlock& block, int i) {
+      return static_cast<float>(block.origin()[axis] + i / stride % kSide) * vs;
+    });
+  } else if (name == "sdf") {
+    each([&](const TsdfBlock& block, int i) { return voxel(block, i).sdf; });
+  } else if (name == "weight") {
+    each([&](const TsdfBlock& block, int i) { return voxel(block, i).weight; });
+  } else if (name == "rgb") { // PCL's packed colour, opaque
+    each([&](const TsdfBlock& block, int i) {
+      const TsdfVoxel& v = voxel(block, i);
+      return std::uint32_t{255} << 24 | std::uint32_t{v.r} << 16 | std::uint32_t{v.g} << 8 | std::uint32_t{v.b};
+    });
+  } else if (name == "passes") {
+    each([&](const TsdfBlock& block, int i) { return static_cast<std::uint8_t>(voxel(block, i).passes()); });
+  } else if (name == "reappeared") {
+    each([&](const TsdfBlock& block, int i) { return std::uint8_t{voxel(block, i).reappeared()}; });
+  } else {
+    throw std::logic_error("TsdfVolume::writeVoxelValues: no field '" + name + "' in a PointTsdf");
   }
 }
 
@@ -494,8 +524,7 @@ void TsdfVolume::save(const std::string& path) const {
     if (f.name != "_")
       fields.push_back(&f);
   const FieldValues values = [&](std::size_t field, std::size_t point, std::size_t count, char* out) {
-    const pcl::PCLPointField& f = *fields[field];
-    writeVoxelValues(f.offset, f.count * pcl::getFieldSize(f.datatype), first, point, count, out);
+    writeVoxelValues(fields[field]->name, first, point, count, out);
   };
   // The parameters go into a comment line after the file's first line, which PCD readers
   // (pcl_viewer included) skip.

@@ -167,10 +167,10 @@ private:
   /// Where each block's observed voxels (weight > min_weight) begin among all of them, block
   /// after block, and their number last: toCloud's order.
   std::vector<std::size_t> keptVoxelStarts(float min_weight) const;
-  /// The field at `offset` (of `bytes`) of toCloud's points [point, point + count), from the
-  /// blocks (`first`: keptVoxelStarts(0)), one value after another into `out`.
-  void writeVoxelValues(std::size_t offset, std::size_t bytes, const std::vector<std::size_t>& first,
-                        std::size_t point, std::size_t count, char* out) const;
+  /// The field `name` of toCloud's points [point, point + count), from the blocks (`first`:
+  /// keptVoxelStarts(0)), one value after another into `out`.
+  void writeVoxelValues(const std::string& name, const std::vector<std::size_t>& first, std::size_t point,
+                        std::size_t count, char* out) const;
   /// Calls source_ with `indices` unless there is none or it is running.
   void askSource(const std::vector<GridIndex>& indices);
 
