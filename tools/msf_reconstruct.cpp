@@ -418,7 +418,6 @@ private:
     used_poses_.push_back(r.T_world_cam0);
     if (sky_) {
       sky_->setPose(r.index, r.T_world_cam0);
-      pose_of_[r.index] = r.T_world_cam0;
       name_of_[r.index] = r.name;
     }
     cv::Mat true_depth;
@@ -638,7 +637,7 @@ private:
       if (protocol4)
         evaluation_->addViews(scoring, name);
       if (protocol6)
-        sky_->addViews(scoring, name);
+        sky_->addViews(scoring, name, name == "mesh"); // the pictures show the fused mesh
       msf::SyntheticScoring::TrueSky true_sky;
       const auto score = scores.find(name);
       if (score != scores.end())
@@ -657,7 +656,7 @@ private:
     if (protocol6) {
       report_.open_sky = sky_->scores();
       if (meshes.count("mesh"))
-        report_.sky_pictures = sky_->drawPictures(stage_, *meshes.at("mesh").mesh, pose_of_, name_of_);
+        report_.sky_pictures = sky_->drawPictures(stage_, name_of_);
     }
   }
 
@@ -693,8 +692,7 @@ private:
   std::unique_ptr<msf::SyntheticScoring> truth_;
   std::unique_ptr<msf::ReconstructionEvaluation> evaluation_;
   std::unique_ptr<msf::SkyScoring> sky_;
-  std::map<std::size_t, Eigen::Isometry3d> pose_of_; // of the frames integrated, for protocol 6's pictures
-  std::map<std::size_t, std::string> name_of_;
+  std::map<std::size_t, std::string> name_of_; // of the frames integrated, for protocol 6's pictures
   bool moving_split_ = false;
   std::unique_ptr<msf::SourceMaps> source_maps_;
   std::unique_ptr<msf::Reconstructor> engine_, paper_;

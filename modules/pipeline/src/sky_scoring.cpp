@@ -28,7 +28,9 @@ void SkyScoring::addFrame(const Frame& frame) {
   coverage_.addMask(frame.index, mask);
   if (picture_frames_.count(frame.index)) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    pictures_[frame.index] = {imageOf(frame).clone(), mask};
+    Picture& picture = pictures_[frame.index]; // its pose may have come first
+    picture.image = imageOf(frame).clone();
+    picture.mask = mask;
   }
 }
 
@@ -43,10 +45,35 @@ std::map<std::string, SkyCoverage> SkyScoring::score(const std::map<std::string,
   return out;
 }
 
-void SkyScoring::addViews(MeshViewScoring& views, const std::string& name) {
+void SkyScoring::setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam) {
+  coverage_.setPose(frame, T_world_cam);
+  if (!picture_frames_.count(frame))
+    return;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  Picture& picture = pictures_[frame];
+  picture.T_world_cam = T_world_cam;
+  picture.has_pose = true;
+}
+
+void SkyScoring::addViews(MeshViewScoring& views, const std::string& name, bool with_pictures) {
   OpenSkyCoverage::Tally& tally = tallies_[name];
   tally = OpenSkyCoverage::Tally();
   coverage_.addViews(views, tally);
+  if (!with_pictures)
+    return;
+  std::map<std::size_t, Eigen::Isometry3d> poses;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [index, picture] : pictures_) {
+      picture.rendered.release();
+      if (picture.has_pose && !picture.image.empty())
+        poses[index] = picture.T_world_cam;
+    }
+  }
+  views.add(camera_, poses, [this](std::size_t frame, const cv::Mat& rendered) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    pictures_[frame].rendered = rendered.clone();
+  });
 }
 
 std::map<std::string, SkyCoverage> SkyScoring::scores() const {
@@ -56,20 +83,16 @@ std::map<std::string, SkyCoverage> SkyScoring::scores() const {
   return out;
 }
 
-std::vector<std::string> SkyScoring::drawPictures(const std::string& dir, const TriangleMesh& mesh,
-                                                  const std::map<std::size_t, Eigen::Isometry3d>& poses,
+std::vector<std::string> SkyScoring::drawPictures(const std::string& dir,
                                                   const std::map<std::size_t, std::string>& names) {
   std::vector<std::string> written;
-  MeshRasterizer rasterizer;
-  cv::Mat rendered;
   const std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& [index, picture] : pictures_) {
-    const auto pose = poses.find(index);
-    if (pose == poses.end())
+    if (picture.rendered.empty())
       continue;
-    rasterizer.render(mesh, camera_, pose->second, rendered);
     const std::string name = "sky_" + names.at(index) + ".png";
-    writeImage((std::filesystem::path(dir) / name).string(), OpenSkyCoverage::drawCoverage(picture.image, picture.mask, rendered));
+    writeImage((std::filesystem::path(dir) / name).string(),
+               OpenSkyCoverage::drawCoverage(picture.image, picture.mask, picture.rendered));
     written.push_back(name);
   }
   return written;

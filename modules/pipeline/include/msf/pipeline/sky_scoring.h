@@ -29,25 +29,27 @@ public:
   /// The open sky of a frame (CV_8UC1, 255 = sky): SkyMask of its colour image where it has
   /// camera 0's size, else of the grey one, and of its whole scan projected into camera 0.
   cv::Mat maskOf(const Frame& frame);
-  void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam) { coverage_.setPose(frame, T_world_cam); }
+  void setPose(std::size_t frame, const Eigen::Isometry3d& T_world_cam);
   /// Each mesh (by name: "mesh", "mesh_lidar", ...) rendered at every pose.
   std::map<std::string, SkyCoverage> score(const std::map<std::string, const TriangleMesh*>& meshes);
   /// The same for the mesh `views` renders, its sky counted anew as `name` in scores(): the
-  /// views are shared with the other scorers of the frames.
-  void addViews(MeshViewScoring& views, const std::string& name);
+  /// views are shared with the other scorers of the frames. `with_pictures`: the mesh's
+  /// renderings at the picture frames are kept for drawPictures.
+  void addViews(MeshViewScoring& views, const std::string& name, bool with_pictures = false);
   /// What addViews counted, by name, once `views` scored.
   std::map<std::string, SkyCoverage> scores() const;
-  /// sky_NNNNNN.png in `dir` for each picture frame with a pose (OpenSkyCoverage::drawCoverage
-  /// with `mesh`); returns the file names written.
-  std::vector<std::string> drawPictures(const std::string& dir, const TriangleMesh& mesh,
-                                        const std::map<std::size_t, Eigen::Isometry3d>& poses,
-                                        const std::map<std::size_t, std::string>& names);
+  /// sky_NAME.png in `dir` for each picture frame whose rendering addViews kept
+  /// (OpenSkyCoverage::drawCoverage), NAME from `names`; returns the file names written.
+  std::vector<std::string> drawPictures(const std::string& dir, const std::map<std::size_t, std::string>& names);
 
 private:
   const cv::Mat& imageOf(const Frame& frame) const;
 
   struct Picture {
     cv::Mat image, mask;
+    bool has_pose = false;
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+    cv::Mat rendered; ///< the mesh's depth seen from the pose (addViews with pictures)
   };
   PinholeCamera camera_;
   LidarProjector projector_;
