@@ -249,7 +249,8 @@ std::vector<RegionResults> runFullImage(const msf::Sequence& sequence, const std
   for (const std::size_t i : frames) {
     const std::size_t g = gt.indexOf(sequence.frameName(i));
     const cv::Mat gt_depth = gt.depth(g);
-    const cv::Mat masks[3] = {cv::Mat(), gt.backgroundMask(g), gt.foregroundMask(g)};
+    const msf::synthetic::GroundTruth::Split split = gt.split(g, gt_depth);
+    const cv::Mat masks[3] = {cv::Mat(), split.background, split.foreground};
     const msf::Frame frame = sequence.load(i, false);
     msf::HoldoutInput input;
     input.frame = i;

@@ -144,7 +144,7 @@ TEST_F(SyntheticGtTest, EvalDisparityFoldersSplitByObjectMap) {
   std::size_t foreground = 0;
   for (std::size_t i = 0; i < gt.size(); ++i) {
     cv::Mat d = gt.disparity(i).clone();
-    const cv::Mat fg = gt.foregroundMask(i);
+    const cv::Mat fg = gt.split(i).foreground;
     foreground += static_cast<std::size_t>(cv::countNonZero(fg));
     d.setTo(0.f, fg);
     msf::writeKittiDisparityPng(est.file(gt.frameName(i) + ".png"), d);

@@ -164,7 +164,9 @@ TEST_F(SyntheticDataset, FilesHoldWhatTheGeneratorRendered) {
           ASSERT_NEAR(disparity.at<float>(v, u), fB / z, 0.5 / 256 + 1e-4);
         }
       }
-    const int fg = cv::countNonZero(gt.foregroundMask(0)), bg = cv::countNonZero(gt.backgroundMask(0));
+    const msf::synthetic::GroundTruth::Split split = gt.split(0);
+    const int fg = cv::countNonZero(split.foreground), bg = cv::countNonZero(split.background);
+    EXPECT_EQ(cv::countNonZero(split.foreground != gt.split(0, depth).foreground), 0) << "the depth given or read";
     EXPECT_GT(fg, 1000);
     EXPECT_EQ(fg + bg, cv::countNonZero(depth > 0.f));
     EXPECT_TRUE(fs::is_regular_file(gt.sceneMeshPath()));

@@ -61,10 +61,14 @@ cv::Mat SyntheticScoring::depth(const std::string& frame_name) const {
 
 void SyntheticScoring::addDepth(const std::string& method, const std::string& frame_name, const cv::Mat& true_depth,
                                 const cv::Mat& estimate, double focal_baseline) {
-  const std::size_t gt_index = truth_->indexOf(frame_name);
+  addDepth(method, truth_->split(truth_->indexOf(frame_name), true_depth), true_depth, estimate, focal_baseline);
+}
+
+void SyntheticScoring::addDepth(const std::string& method, const synthetic::GroundTruth::Split& split,
+                                const cv::Mat& true_depth, const cv::Mat& estimate, double focal_baseline) {
   all_[method].add(true_depth, estimate, focal_baseline);
-  background_[method].add(true_depth, estimate, focal_baseline, truth_->backgroundMask(gt_index));
-  foreground_[method].add(true_depth, estimate, focal_baseline, truth_->foregroundMask(gt_index));
+  background_[method].add(true_depth, estimate, focal_baseline, split.background);
+  foreground_[method].add(true_depth, estimate, focal_baseline, split.foreground);
 }
 
 void SyntheticScoring::addScan(const Frame& frame) {
@@ -77,13 +81,14 @@ void SyntheticScoring::addScan(const Frame& frame) {
 void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth, const Calibration& calibration,
                                 double max_depth_m) {
   const double fb = calibration.focalBaseline();
+  const std::size_t gt_index = truth_->indexOf(r.name);
+  const synthetic::GroundTruth::Split split = truth_->split(gt_index, true_depth); // for every method
   const std::pair<const char*, cv::Mat> methods[] = {
       {"sgbm", r.stereo_depth}, {"interpolated", r.lidar_depth}, {"fused", r.fused.depth}};
   for (const auto& [name, estimate] : methods)
-    addDepth(name, r.name, true_depth, estimate, fb);
+    addDepth(name, split, true_depth, estimate, fb);
   if (!score_meshes_)
     return;
-  const std::size_t gt_index = truth_->indexOf(r.name);
   last_frame_ = std::max(last_frame_.value_or(gt_index), gt_index);
   if (!true_sky_)
     true_sky_ = std::make_unique<OpenSkyCoverage>(PinholeCamera::fromCalibration(calibration, 0));

@@ -114,18 +114,11 @@ cv::Mat GroundTruth::objectMap(std::size_t i) const { return readByteImage(objec
 
 std::vector<MovingBox> GroundTruth::movingBoxes() const { return readMovingBoxes(movingBoxesPath()); }
 
-cv::Mat GroundTruth::foregroundMask(std::size_t i) const {
-  const cv::Mat valid = depth(i) > 0.f, objects = objectMap(i);
+GroundTruth::Split GroundTruth::split(std::size_t i, const cv::Mat& depth) const {
+  const cv::Mat valid = (depth.empty() ? this->depth(i) : depth) > 0.f, objects = objectMap(i);
   if (valid.size() != objects.size())
     throw IOError("object map '" + objectMapPath(i) + "' and depth '" + depthPath(i) + "' differ in size");
-  return valid & (objects > 0);
-}
-
-cv::Mat GroundTruth::backgroundMask(std::size_t i) const {
-  const cv::Mat valid = depth(i) > 0.f, objects = objectMap(i);
-  if (valid.size() != objects.size())
-    throw IOError("object map '" + objectMapPath(i) + "' and depth '" + depthPath(i) + "' differ in size");
-  return valid & (objects == 0);
+  return {valid & (objects == 0), valid & (objects > 0)};
 }
 
 cv::Mat GroundTruth::movingMask(std::size_t i) const {

@@ -93,6 +93,10 @@ public:
   std::string noGhostsReason() const;
 
 private:
+  /// Scores `estimate` against the frame's true depth, over all its pixels and split.
+  void addDepth(const std::string& method, const synthetic::GroundTruth::Split& split, const cv::Mat& true_depth,
+                const cv::Mat& estimate, double focal_baseline);
+
   std::unique_ptr<synthetic::GroundTruth> truth_;
   std::map<std::string, DepthErrorAccumulator> all_, background_, foreground_;
   std::vector<Eigen::Vector3f> seen_surface_;  // ground-truth depth back-projected to the world

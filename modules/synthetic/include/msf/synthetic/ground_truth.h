@@ -60,10 +60,14 @@ public:
   cv::Mat disparity(std::size_t i) const;
   /// CV_8U, 0 = background.
   cv::Mat objectMap(std::size_t i) const;
-  /// CV_8U masks (255 = in) of the pixels with ground truth that are foreground
-  /// (objectMap > 0) or background, as the KITTI devkit splits its error.
-  cv::Mat foregroundMask(std::size_t i) const;
-  cv::Mat backgroundMask(std::size_t i) const;
+  /// The pixels of frame i with ground truth (depth > 0) split as the KITTI devkit splits its
+  /// error: CV_8U masks (255 = in) of the background and of the foreground (objectMap > 0).
+  struct Split {
+    cv::Mat background, foreground;
+  };
+  /// `depth`: the frame's depth(i), when the caller has read it already (read here otherwise).
+  /// Throws IOError when the object map and the depth differ in size.
+  Split split(std::size_t i, const cv::Mat& depth = cv::Mat()) const;
   /// CV_8U, 255 where the pixel sees a moving object. A dataset written before moving
   /// objects existed has no moving_0/: its street was static, and the mask is all zero
   /// (of the depth's size). Throws IOError when moving_0/ exists and the frame's file does
