@@ -380,8 +380,19 @@ ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::
                                           const PoseList& T_world_cam0) const {
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   ScanBandBlocks bands = scanBands();
-  for (std::size_t k = 0; k < frames.size(); ++k)
-    bands.addScan(*source.loadScan(frames[k]), calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+  // The next scan is read while this one's bands are found (one read at a time, off this thread).
+  const auto read = [&source, &frames](std::size_t k) {
+    return std::async(std::launch::async, [&source, i = frames[k]] { return source.loadScan(i); });
+  };
+  std::future<pcl::PointCloud<pcl::PointXYZI>::Ptr> next;
+  if (!frames.empty())
+    next = read(0);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const pcl::PointCloud<pcl::PointXYZI>::Ptr scan = next.get();
+    if (k + 1 < frames.size())
+      next = read(k + 1);
+    bands.addScan(*scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+  }
   return bands;
 }
 
