@@ -147,14 +147,24 @@ def depth_rows(z_of):
 pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
 pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
-open(f + "/passes9.pcd", "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
-    "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS x y z sdf weight rgb passes\n"
-    "SIZE 4 4 4 4 4 4 1\nTYPE F F F F F U U\nCOUNT 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\n"
-    "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 0 -0.05 10 4278190335 1\n0.1 0 0 0.05 10 4278190335 9\n")
-open(f + "/reappeared2.pcd", "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
-    "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS x y z sdf weight rgb passes reappeared\n"
-    "SIZE 4 4 4 4 4 4 1 1\nTYPE F F F F F U U U\nCOUNT 1 1 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
-    "POINTS 2\nDATA ascii\n0 0 0 -0.05 10 4278190335 1 1\n0.1 0 0 0.05 10 4278190335 0 2\n")
+def volume_pcd(path, fields, sizes, types, rows):
+    """A volume .pcd of 0.1 m voxels (ASCII) with the fields given, one row a voxel."""
+    open(path, "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
+        "# msfusion tsdf voxel_size_m 0.1 truncation_m 0.3\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " + sizes +
+        "\nTYPE " + types + "\nCOUNT" + " 1" * len(fields.split()) + "\nWIDTH %d\nHEIGHT 1\n" % len(rows) +
+        "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS %d\nDATA ascii\n" % len(rows) + "".join(r + "\n" for r in rows))
+volume_pcd(f + "/passes9.pcd", "x y z sdf weight rgb passes", "4 4 4 4 4 4 1", "F F F F F U U",
+           ["0 0 0 -0.05 10 4278190335 1", "0.1 0 0 0.05 10 4278190335 9"])
+volume_pcd(f + "/reappeared2.pcd", "x y z sdf weight rgb passes reappeared", "4 4 4 4 4 4 1 1", "F F F F F U U U",
+           ["0 0 0 -0.05 10 4278190335 1 1", "0.1 0 0 0.05 10 4278190335 0 2"])
+volume_pcd(f + "/noweight.pcd", "x y z sdf rgb", "4 4 4 4 4", "F F F F U",
+           ["0 0 0 -0.05 4278190335", "0.1 0 0 0.05 4278190335"])
+volume_pcd(f + "/offgrid.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
+           ["0 0 0 -0.05 10 4278190335", "0.05 0 0 0.05 10 4278190335"])
+volume_pcd(f + "/nansdf.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
+           ["0 0 0 -0.05 10 4278190335", "0.1 0 0 nan 10 4278190335"])
+volume_pcd(f + "/negweight.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
+           ["0 0 0 -0.05 10 4278190335", "0.1 0 0 0.05 -1 4278190335"])
 inf_rows = depth_rows(lambda u, v: 5.0)
 inf_rows[3][2] = "inf"
 pcd(f + "/inf.pcd", inf_rows)
@@ -420,6 +430,14 @@ check "mesh: a volume whose voxel has more passes than a voxel counts" 1 "passes
   msf_mesh "$F/passes9.pcd" o.ply
 check "mesh: a voxel's reappeared not 0 or 1" 1 "reappeared2.pcd': voxel 1 has reappeared 2, not 0 or 1" -- \
   msf_mesh "$F/reappeared2.pcd" o.ply
+check "mesh: a volume without the weight field" 1 "noweight.pcd' has no field 'weight'" -- \
+  msf_mesh "$F/noweight.pcd" o.ply
+check "mesh: a voxel off the volume's grid" 1 "offgrid.pcd': voxel 1 at \(0.05, 0, 0\) is not on the 0.1 m grid" -- \
+  msf_mesh "$F/offgrid.pcd" o.ply
+check "mesh: a voxel's sdf not a number" 1 "nansdf.pcd': voxel 1 has a coordinate, sdf or weight that is not a finite value" -- \
+  msf_mesh "$F/nansdf.pcd" o.ply
+check "mesh: a voxel of negative weight" 1 "negweight.pcd': voxel 1 has a negative weight \(-1\)" -- \
+  msf_mesh "$F/negweight.pcd" o.ply
 check "pcd2png -disparity, fx 0" 1 "fx0.yaml': P0 has fx 0" -- \
   msf_pcd2png "$F/dense.pcd" d.png -disparity -calib "$F/fx0.yaml"
 check "pcd2png -disparity, NaN in P0" 1 "nan.yaml': P0 has a value that is not finite" -- \

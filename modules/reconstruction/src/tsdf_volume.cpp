@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <new>
 #include <numeric>
 #include <ostream>
@@ -66,6 +67,14 @@ std::uint64_t newVolumeId() {
 std::string number(double v) {
   std::ostringstream ss;
   ss.precision(9);
+  ss << v;
+  return ss.str();
+}
+
+/// A float as a file would have given it: 0.05, not the 0.0500000007 of its nearest double.
+std::string floatText(float v) {
+  std::ostringstream ss;
+  ss.precision(std::numeric_limits<float>::digits10 + 1);
   ss << v;
   return ss.str();
 }
@@ -424,8 +433,10 @@ void TsdfVolume::insertVoxels(std::size_t count, const VoxelAt& at) {
   for (std::size_t i = 0; i < count; ++i) {
     const PointTsdf& p = at(i);
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.sdf) ||
-        !std::isfinite(p.weight) || p.weight < 0.f)
+        !std::isfinite(p.weight))
       throw InvalidInputError("voxel " + std::to_string(i) + " has a coordinate, sdf or weight that is not a finite value");
+    if (p.weight < 0.f)
+      throw InvalidInputError("voxel " + std::to_string(i) + " has a negative weight (" + floatText(p.weight) + ")");
     if (p.passes > TsdfVoxel::kMaxPasses) // no writer makes it: a file edited or of another program
       throw InvalidInputError("voxel " + std::to_string(i) + " has passes " + std::to_string(p.passes) +
                               ", more than the " + std::to_string(TsdfVoxel::kMaxPasses) + " a voxel counts");
@@ -435,8 +446,8 @@ void TsdfVolume::insertVoxels(std::size_t count, const VoxelAt& at) {
     const Eigen::Vector3d q(p.x, p.y, p.z);
     const GridIndex v = voxelIndexOf(q);
     if (((q / voxel_size_) - v.cast<double>()).cwiseAbs().maxCoeff() > tolerance)
-      throw InvalidInputError("voxel " + std::to_string(i) + " at (" + number(p.x) + ", " + number(p.y) + ", " +
-                              number(p.z) + ") is not on the " + number(voxel_size_) + " m grid");
+      throw InvalidInputError("voxel " + std::to_string(i) + " at (" + floatText(p.x) + ", " + floatText(p.y) + ", " +
+                              floatText(p.z) + ") is not on the " + number(voxel_size_) + " m grid");
     const GridIndex b = blockOf(v);
     if (!current || b != current_index) {
       current = &allocateBlock(b);
