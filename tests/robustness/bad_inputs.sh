@@ -159,12 +159,10 @@ volume_pcd(f + "/reappeared2.pcd", "x y z sdf weight rgb passes reappeared", "4 
            ["0 0 0 -0.05 10 4278190335 1 1", "0.1 0 0 0.05 10 4278190335 0 2"])
 volume_pcd(f + "/noweight.pcd", "x y z sdf rgb", "4 4 4 4 4", "F F F F U",
            ["0 0 0 -0.05 4278190335", "0.1 0 0 0.05 4278190335"])
-volume_pcd(f + "/offgrid.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
-           ["0 0 0 -0.05 10 4278190335", "0.05 0 0 0.05 10 4278190335"])
-volume_pcd(f + "/nansdf.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
-           ["0 0 0 -0.05 10 4278190335", "0.1 0 0 nan 10 4278190335"])
-volume_pcd(f + "/negweight.pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
-           ["0 0 0 -0.05 10 4278190335", "0.1 0 0 0.05 -1 4278190335"])
+for name, second in [("offgrid", "0.05 0 0 0.05 10 4278190335"), ("nansdf", "0.1 0 0 nan 10 4278190335"),
+                     ("negweight", "0.1 0 0 0.05 -1 4278190335")]:  # the second voxel at fault
+    volume_pcd(f + "/" + name + ".pcd", "x y z sdf weight rgb", "4 4 4 4 4 4", "F F F F F U",
+               ["0 0 0 -0.05 10 4278190335", second])
 inf_rows = depth_rows(lambda u, v: 5.0)
 inf_rows[3][2] = "inf"
 pcd(f + "/inf.pcd", inf_rows)
@@ -434,7 +432,7 @@ check "mesh: a volume without the weight field" 1 "noweight.pcd' has no field 'w
   msf_mesh "$F/noweight.pcd" o.ply
 check "mesh: a voxel off the volume's grid" 1 "offgrid.pcd': voxel 1 at \(0.05, 0, 0\) is not on the 0.1 m grid" -- \
   msf_mesh "$F/offgrid.pcd" o.ply
-check "mesh: a voxel's sdf not a number" 1 "nansdf.pcd': voxel 1 has a coordinate, sdf or weight that is not a finite value" -- \
+check "mesh: a voxel's sdf not a number" 1 "nansdf.pcd': voxel 1 has a coordinate, sdf or weight that is not a finite" -- \
   msf_mesh "$F/nansdf.pcd" o.ply
 check "mesh: a voxel of negative weight" 1 "negweight.pcd': voxel 1 has a negative weight \(-1\)" -- \
   msf_mesh "$F/negweight.pcd" o.ply
