@@ -1,8 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/evaluation/mesh_view_scoring.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/reconstruction/marching_cubes.h>
-#include <msf/evaluation/mesh_view_scoring.h>
 
 #include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>

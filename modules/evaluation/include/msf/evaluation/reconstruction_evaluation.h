@@ -1,9 +1,9 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 #include <msf/evaluation/depth_metrics.h>
+#include <msf/evaluation/mesh_view_scoring.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/reconstruction/marching_cubes.h>
-#include <msf/evaluation/mesh_view_scoring.h>
 #include <msf/reconstruction/scan_free_space.h>
 
 #include <Eigen/Geometry>
