@@ -14,10 +14,14 @@
 // BM_StageDepth: steps 1-4 of one frame (Reconstructor::computeDepth), per frame.
 // BM_StageMapPrior: the map of the 10 frames rendered into each frame's holes (no fused depth,
 // not open sky), as map_prior.enabled does after each frame is integrated (MapRaycaster), per frame.
+// BM_StageOpenSky: protocol 6's open sky of each frame (SkyScoring::addFrame: the whole scan
+// projected, SkyMask, the mask kept as runs), which msf_reconstruct's loading thread computes for
+// every frame, per frame.
 #include "kitti_sample.h"
 
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/sky_scoring.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/reconstruction/map_raycaster.h>
 
@@ -93,6 +97,20 @@ void BM_StageDepth(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
 }
 BENCHMARK(BM_StageDepth)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_StageOpenSky(benchmark::State& state) {
+  Data& d = data();
+  std::vector<Frame> frames;
+  for (std::size_t i = 0; i < msf::bench::kFrames; ++i)
+    frames.push_back(d.sequence.load(i));
+  for (auto _ : state) {
+    SkyScoring sky(d.sequence.calibration(), d.config.projection, {});
+    for (const Frame& frame : frames)
+      sky.addFrame(frame);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));
+}
+BENCHMARK(BM_StageOpenSky)->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_StageMapPrior(benchmark::State& state) {
   Data& d = data();
