@@ -81,6 +81,35 @@ TEST(MeshViewScoring, EachCameraAndPoseIsRenderedOnceForEveryScorerOfIt) {
   EXPECT_EQ(d.frames, (Frames{{1, true}}));
 }
 
+TEST(MeshViewScoring, AViewWhoseScorersReadTheTopRowsRendersOnlyThoseAndTheyMatchTheFullImage) {
+  const TriangleMesh mesh = twoSquares();
+  const std::map<std::size_t, Eigen::Isometry3d> views = {{0, shifted(0, 0)}, {1, shifted(0.5, 0)}};
+  MeshRasterizer alone;
+  std::map<std::size_t, cv::Mat> full;
+  for (const auto& [frame, pose] : views)
+    alone.render(mesh, camera(), pose, full[frame]);
+  // Frame 0: a scorer of its top 30 rows alone; frame 1: beside one that reads every row.
+  std::map<std::size_t, cv::Size> top_seen, all_seen;
+  std::map<std::size_t, bool> same;
+  MeshViewScoring scoring;
+  scoring.add(camera(), views, [&](std::size_t frame, const cv::Mat& rendered) {
+    top_seen[frame] = rendered.size();
+    same[frame] = cv::norm(rendered, full[frame].rowRange(0, rendered.rows), cv::NORM_INF) == 0.0;
+  }, {{0, 30}, {1, 30}});
+  scoring.add(camera(), {{1, views.at(1)}}, [&](std::size_t frame, const cv::Mat& rendered) {
+    all_seen[frame] = rendered.size();
+  });
+  EXPECT_EQ(scoring.score(mesh), 2u);
+  EXPECT_EQ(top_seen[0], cv::Size(100, 30));
+  EXPECT_EQ(top_seen[1], cv::Size(100, 80)) << "the view's other scorer reads every row";
+  EXPECT_EQ(all_seen[1], cv::Size(100, 80));
+  EXPECT_TRUE(same[0]);
+  EXPECT_TRUE(same[1]);
+  EXPECT_GT(cv::countNonZero(full[0].rowRange(0, 30)), 0) << "the top rows hold surface";
+  EXPECT_THROW(scoring.add(camera(), views, [](std::size_t, const cv::Mat&) {}, {{0, 81}}), InvalidInputError);
+  EXPECT_THROW(scoring.add(camera(), views, [](std::size_t, const cv::Mat&) {}, {{0, 0}}), InvalidInputError);
+}
+
 TEST(MeshViewScoring, ProtocolsFourAndSixThroughSharedViewsScoreAsAlone) {
   // Three frames along x; the truth a wall at 10 m; the sky the top 20 rows.
   const TriangleMesh mesh = twoSquares();

@@ -16,13 +16,17 @@ bool sameCamera(const PinholeCamera& a, const PinholeCamera& b) {
 } // namespace
 
 void MeshViewScoring::add(const PinholeCamera& camera, const std::map<std::size_t, Eigen::Isometry3d>& views,
-                          Scorer scorer) {
+                          Scorer scorer, const std::map<std::size_t, int>& top_rows) {
   if (!camera.valid())
     throw InvalidInputError("mesh views: invalid camera (" + std::to_string(camera.width) + "x" +
                             std::to_string(camera.height) + " px, fx " + std::to_string(camera.fx) + ")");
   for (const auto& [frame, T_world_cam] : views)
     if (!T_world_cam.matrix().allFinite())
       throw InvalidInputError("mesh views: the pose of frame " + std::to_string(frame) + " is not finite");
+  for (const auto& [frame, rows] : top_rows)
+    if (rows < 1 || rows > camera.height)
+      throw InvalidInputError("mesh views: frame " + std::to_string(frame) + "'s scorer reads " + std::to_string(rows) +
+                              " rows, not 1.." + std::to_string(camera.height));
   const std::size_t index = scorers_.size();
   scorers_.push_back(std::move(scorer));
   for (const auto& [frame, T_world_cam] : views) {
@@ -31,7 +35,9 @@ void MeshViewScoring::add(const PinholeCamera& camera, const std::map<std::size_
       return sameCamera(v.camera, camera) && v.T_world_cam.matrix() == T_world_cam.matrix();
     });
     if (shared == at_frame.end())
-      shared = at_frame.insert(at_frame.end(), View{camera, T_world_cam, {}});
+      shared = at_frame.insert(at_frame.end(), View{camera, T_world_cam, 0, {}});
+    const auto rows = top_rows.find(frame);
+    shared->rows = std::max(shared->rows, rows == top_rows.end() ? camera.height : rows->second);
     shared->scorers.push_back(index);
   }
 }
@@ -41,7 +47,10 @@ std::size_t MeshViewScoring::score(const TriangleMesh& mesh) {
   std::size_t rendered = 0;
   for (const auto& [frame, at_frame] : views_)
     for (const View& view : at_frame) {
-      rasterizer_.render(mesh, view.camera, view.T_world_cam, rendered_, nullptr, &bounds);
+      // The top rows alone: the same camera cut short sees the same surface at each of its pixels.
+      PinholeCamera top = view.camera;
+      top.height = view.rows;
+      rasterizer_.render(mesh, top, view.T_world_cam, rendered_, nullptr, &bounds);
       ++rendered;
       for (std::size_t s : view.scorers)
         scorers_[s](frame, rendered_);

@@ -98,17 +98,20 @@ SkyCoverage OpenSkyCoverage::scoreMesh(const TriangleMesh& mesh, const SurfaceFi
 
 void OpenSkyCoverage::addViews(MeshViewScoring& views, Tally& tally, const SurfaceFilter& counts) {
   std::map<std::size_t, Eigen::Isometry3d> poses;
+  std::map<std::size_t, int> sky_rows; // down to the lowest sky pixel: what the sky's scoring reads
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& [index, sky] : frames_) {
       if (!sky.has_pose || !sky.has_mask)
         continue;
       ++tally.out_.frames;
-      if (sky.pixels > 0) // a frame without sky counts, with nothing to render
-        poses[index] = sky.T_world_cam;
+      if (sky.pixels == 0)
+        continue; // a frame without sky counts, with nothing to render
+      poses[index] = sky.T_world_cam;
+      sky_rows[index] = static_cast<int>(sky.runs[sky.runs.size() - 2] / static_cast<std::uint32_t>(camera_.width)) + 1;
     }
   }
-  views.add(camera_, poses, [this, &tally, counts](std::size_t index, const cv::Mat& rendered) {
+  const auto count = [this, &tally, counts](std::size_t index, const cv::Mat& rendered) {
     const std::lock_guard<std::mutex> lock(mutex_);
     const FrameSky& sky = frames_.at(index);
     const float* depth = rendered.ptr<float>(0);
@@ -126,7 +129,8 @@ void OpenSkyCoverage::addViews(MeshViewScoring& views, Tally& tally, const Surfa
           tally.covered_depth_.push_back(depth[p]);
         }
     tally.addFrame(index, sky.pixels, covered);
-  });
+  };
+  views.add(camera_, poses, count, sky_rows);
 }
 
 cv::Mat OpenSkyCoverage::drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered) {

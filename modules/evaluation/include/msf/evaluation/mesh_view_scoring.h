@@ -18,17 +18,22 @@ namespace msf {
 /// open sky, a synthetic sequence's true sky) share each rendering: a view, one camera at one
 /// pose, is rendered once (MeshRasterizer: the first surface along each pixel's ray) and handed
 /// to every scorer that looks through it. Views are rendered one at a time in frame order, so
-/// a long sequence holds one rendering, not one per frame.
+/// a long sequence holds one rendering, not one per frame. A scorer that reads only the top rows
+/// of an image (the sky) says so, and a view none of whose scorers reads more renders only those.
 class MeshViewScoring {
 public:
   /// Scores one view: the frame and the mesh's depth seen from it (CV_32FC1 of the camera's
-  /// size, z in metres, 0 where no surface).
+  /// width, z in metres, 0 where no surface): the image's top rows, as many as the view's
+  /// scorers read (all of them, unless every scorer gave top_rows).
   using Scorer = std::function<void(std::size_t frame, const cv::Mat& rendered)>;
 
   /// `scorer` looks through `camera` at the frames of `views` (frame -> T_world_cam). A frame
   /// another scorer looks at through the same camera from the same pose shares its view.
-  /// Throws InvalidInputError for an invalid camera or a pose that is not finite.
-  void add(const PinholeCamera& camera, const std::map<std::size_t, Eigen::Isometry3d>& views, Scorer scorer);
+  /// `top_rows`: of the frames it lists, the scorer reads only that many rows from the top
+  /// (1 .. the camera's height). Throws InvalidInputError for an invalid camera, a pose that is
+  /// not finite or rows out of range.
+  void add(const PinholeCamera& camera, const std::map<std::size_t, Eigen::Isometry3d>& views, Scorer scorer,
+           const std::map<std::size_t, int>& top_rows = {});
 
   /// Renders `mesh` (world frame) at every view once and hands the rendering to each scorer of
   /// that view; returns how many views were rendered.
@@ -41,6 +46,7 @@ private:
   struct View {
     PinholeCamera camera;
     Eigen::Isometry3d T_world_cam;
+    int rows = 0;                     ///< the most its scorers read, from the top
     std::vector<std::size_t> scorers; ///< indices into scorers_
   };
   std::vector<Scorer> scorers_;
