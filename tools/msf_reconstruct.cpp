@@ -420,14 +420,16 @@ private:
       sky_->setPose(r.index, r.T_world_cam0);
       name_of_[r.index] = r.name;
     }
-    cv::Mat true_depth;
+    cv::Mat true_depth, moving; // moving: read once for the synthetic scores and protocol 4
     if (truth_) {
       true_depth = truth_->depth(r.name);
-      truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m);
+      if (!streaming()) // the meshes are scored
+        moving = truth_->truth().movingMask(truth_->truth().indexOf(r.name));
+      truth_->addFrame(r, true_depth, source_.calibration(), on_rig_.integrator.max_depth_m, moving);
     }
     if (evaluation_) {
-      const cv::Mat moving =
-          moving_split_ ? truth_->truth().movingMask(truth_->truth().indexOf(r.name)) : cv::Mat();
+      if (!moving_split_)
+        moving.release(); // no moving masks: protocol 4 splits no pixel off as moving
       if (request_.holdout) {
         evaluation_->addGroundTruth(r.index, r.T_world_cam0, holdout_.take(r.index), moving);
         // The held-out rings do not say what moved; the scans of the frames around them do.

@@ -49,7 +49,7 @@ void DepthErrorAccumulator::addPixel(float gt_z, float estimated_z, double focal
     ++gross_;
     gross_abs_ += err;
   }
-  const double inv_zg = 1.0 / zg, inv_ze = 1.0 / ze; // two divisions a pixel, not four
+  const double inv_zg = 1.0 / zg, inv_ze = 1.0 / ze; // each reciprocal serves both errors below
   const double inv_err = 1000.0 * std::abs(inv_ze - inv_zg); // 1/km
   inv_abs_ += inv_err;
   inv_sq_ += inv_err * inv_err;

@@ -84,6 +84,17 @@ std::vector<Field> convertedLayout(const std::vector<Field>& fields, const std::
 
 } // namespace
 
+void requireFields(const pcl::PCLPointCloud2& blob, const std::vector<Field>& wanted, const std::string& path) {
+  const auto colour = [](const std::string& name) { return name == "rgb" || name == "rgba"; };
+  for (const Field& field : wanted) {
+    const bool found = std::any_of(blob.fields.begin(), blob.fields.end(), [&](const Field& f) {
+      return f.name == field.name || (colour(f.name) && colour(field.name));
+    });
+    if (!found)
+      throw IOError("cloud '" + path + "' has no field '" + field.name + "'");
+  }
+}
+
 void convertFieldTypes(pcl::PCLPointCloud2& blob, const std::vector<Field>& wanted, const std::string& path) {
   std::vector<std::uint8_t> types;
   bool convert = false;

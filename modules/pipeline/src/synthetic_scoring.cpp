@@ -79,7 +79,7 @@ void SyntheticScoring::addScan(const Frame& frame) {
 }
 
 void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth, const Calibration& calibration,
-                                double max_depth_m) {
+                                double max_depth_m, const cv::Mat& moving_mask) {
   const double fb = calibration.focalBaseline();
   const std::size_t gt_index = truth_->indexOf(r.name);
   const synthetic::GroundTruth::Split split = truth_->split(gt_index, true_depth); // for every method
@@ -110,7 +110,7 @@ void SyntheticScoring::addFrame(const FrameResult& r, const cv::Mat& true_depth,
     lidar_.addScan(*scan, r.T_world_cam0 * calibration.T_cam0_velo);
   // Every 4th pixel of the true static surface in range, for the mesh's completeness against
   // gt/scene.ply: a moving car's pixels are where it was at that frame, not part of the map.
-  const cv::Mat moving = truth_->movingMask(gt_index);
+  const cv::Mat moving = moving_mask.empty() ? truth_->movingMask(gt_index) : moving_mask;
   const PinholeCamera camera = PinholeCamera::fromCalibration(calibration, 0);
   const Eigen::Isometry3f T = r.T_world_cam0.cast<float>();
   for (int v = 0; v < true_depth.rows; v += 4)

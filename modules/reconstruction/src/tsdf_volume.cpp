@@ -39,21 +39,29 @@ namespace {
 /// Whether a voxel is one of toCloud's points.
 bool isKept(const TsdfVoxel& voxel, float min_weight) { return voxel.observed() && voxel.weight > min_weight; }
 
+/// The centre of voxel `i` of `block` along `axis` (0 x, 1 y, 2 z), as toCloud's and save()'s
+/// points have it.
+float voxelCentre(const TsdfBlock& block, int i, int axis, float voxel_size) {
+  constexpr int kBits = 3; // x fastest, then y, then z: kBits of the index each
+  static_assert(TsdfBlock::kSide == 1 << kBits);
+  return static_cast<float>(block.origin()[axis] + (i >> (kBits * axis) & (TsdfBlock::kSide - 1))) * voxel_size;
+}
+
+/// A voxel's colour as PCL packs it, opaque.
+std::uint32_t voxelRgba(const TsdfVoxel& v) {
+  return std::uint32_t{255} << 24 | std::uint32_t{v.r} << 16 | std::uint32_t{v.g} << 8 | std::uint32_t{v.b};
+}
+
 /// Voxel `i` of `block` as toCloud's and save()'s point: its centre, sdf, weight and colour.
 PointTsdf voxelPoint(const TsdfBlock& block, int i, float voxel_size) {
-  constexpr int kSide = TsdfBlock::kSide;
-  const GridIndex v = block.origin() + GridIndex(i % kSide, i / kSide % kSide, i / (kSide * kSide));
   const TsdfVoxel& voxel = block.voxels[static_cast<std::size_t>(i)];
   PointTsdf p;
-  p.x = static_cast<float>(v.x()) * voxel_size;
-  p.y = static_cast<float>(v.y()) * voxel_size;
-  p.z = static_cast<float>(v.z()) * voxel_size;
+  p.x = voxelCentre(block, i, 0, voxel_size);
+  p.y = voxelCentre(block, i, 1, voxel_size);
+  p.z = voxelCentre(block, i, 2, voxel_size);
   p.sdf = voxel.sdf;
   p.weight = voxel.weight;
-  p.r = voxel.r;
-  p.g = voxel.g;
-  p.b = voxel.b;
-  p.a = 255;
+  p.rgba = voxelRgba(voxel);
   p.passes = static_cast<std::uint8_t>(voxel.passes());
   p.reappeared = voxel.reappeared() ? 1 : 0;
   return p;
@@ -97,9 +105,7 @@ public:
                                          pcl::getFieldIndex(blob, f.name) < 0;
                                 }),
                  wanted.end());
-    for (const pcl::PCLPointField& f : wanted)
-      if (pcl::getFieldIndex(blob, f.name) < 0 && !(f.name == "rgb" && pcl::getFieldIndex(blob, "rgba") >= 0))
-        throw IOError("cloud '" + path + "' has no field '" + f.name + "'");
+    requireFields(blob, wanted, path);
     convertFieldTypes(blob, wanted, path);
     const auto offset = [&](const char* name) {
       const int i = pcl::getFieldIndex(blob, name);
@@ -493,25 +499,19 @@ void TsdfVolume::writeVoxelValues(const std::string& name, const std::vector<std
       }
     }
   };
-  constexpr int kSide = TsdfBlock::kSide;
   const float vs = static_cast<float>(voxel_size_);
   const auto voxel = [](const TsdfBlock& block, int i) -> const TsdfVoxel& {
     return block.voxels[static_cast<std::size_t>(i)];
   };
   if (name == "x" || name == "y" || name == "z") {
-    const int axis = name[0] - 'x', stride = axis == 0 ? 1 : axis == 1 ? kSide : kSide * kSide;
-    each([&](const TsdfBlock& block, int i) {
-      return static_cast<float>(block.origin()[axis] + i / stride % kSide) * vs;
-    });
+    const int axis = name[0] - 'x';
+    each([&](const TsdfBlock& block, int i) { return voxelCentre(block, i, axis, vs); });
   } else if (name == "sdf") {
     each([&](const TsdfBlock& block, int i) { return voxel(block, i).sdf; });
   } else if (name == "weight") {
     each([&](const TsdfBlock& block, int i) { return voxel(block, i).weight; });
-  } else if (name == "rgb") { // PCL's packed colour, opaque
-    each([&](const TsdfBlock& block, int i) {
-      const TsdfVoxel& v = voxel(block, i);
-      return std::uint32_t{255} << 24 | std::uint32_t{v.r} << 16 | std::uint32_t{v.g} << 8 | std::uint32_t{v.b};
-    });
+  } else if (name == "rgb") {
+    each([&](const TsdfBlock& block, int i) { return voxelRgba(voxel(block, i)); });
   } else if (name == "passes") {
     each([&](const TsdfBlock& block, int i) { return static_cast<std::uint8_t>(voxel(block, i).passes()); });
   } else if (name == "reappeared") {

@@ -18,4 +18,9 @@ namespace msf {
 void convertFieldTypes(pcl::PCLPointCloud2& blob, const std::vector<pcl::PCLPointField>& wanted,
                        const std::string& path);
 
+/// Throws IOError "cloud 'PATH' has no field 'NAME'" for the first field `wanted` names that
+/// `blob` lacks (PCL's rgb and rgba stand for each other): PCL itself only warns and fills zeros.
+void requireFields(const pcl::PCLPointCloud2& blob, const std::vector<pcl::PCLPointField>& wanted,
+                   const std::string& path);
+
 } // namespace msf

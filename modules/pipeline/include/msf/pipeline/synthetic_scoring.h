@@ -48,8 +48,10 @@ public:
   /// Scores the frame's SGBM, interpolated LiDAR and fused depth against `true_depth`, keeps
   /// every 4th pixel of the true static surface within `max_depth_m` for completeness, the
   /// true sky (zero true depth) at the frame's pose and its scan (addScan) in the world.
+  /// `moving`: the frame's GroundTruth::movingMask, when the caller has read it (read here
+  /// otherwise, if the meshes are scored).
   void addFrame(const FrameResult& result, const cv::Mat& true_depth, const Calibration& calibration,
-                double max_depth_m);
+                double max_depth_m, const cv::Mat& moving = cv::Mat());
   /// Scores another method's depth of the frame (the paper's).
   void addDepth(const std::string& method, const std::string& frame_name, const cv::Mat& true_depth,
                 const cv::Mat& estimate, double focal_baseline);

@@ -26,14 +26,7 @@ template <typename PointT>
 void fromCloudBlob(pcl::PCLPointCloud2 blob, pcl::PointCloud<PointT>& cloud, const std::string& path) {
   std::vector<pcl::PCLPointField> wanted;
   pcl::for_each_type<typename pcl::traits::fieldList<PointT>::type>(pcl::detail::FieldAdder<PointT>(wanted));
-  for (const auto& field : wanted) {
-    // PCL's rgb and rgba are interchangeable; anything else must be present.
-    const bool found = std::any_of(blob.fields.begin(), blob.fields.end(), [&](const pcl::PCLPointField& f) {
-      return f.name == field.name || ((f.name == "rgb" || f.name == "rgba") && (field.name == "rgb" || field.name == "rgba"));
-    });
-    if (!found)
-      throw IOError("cloud '" + path + "' has no field '" + field.name + "'");
-  }
+  requireFields(blob, wanted, path);
   if (static_cast<std::uint64_t>(blob.width) * blob.height == 0) {
     // PCL's conversion indexes each row's first point, which an empty cloud of rows has not.
     cloud.clear();
