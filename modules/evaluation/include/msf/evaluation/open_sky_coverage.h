@@ -81,7 +81,6 @@ public:
   static cv::Mat drawCoverage(const cv::Mat& image, const cv::Mat& mask, const cv::Mat& rendered);
 
   std::size_t frames() const;
-  const PinholeCamera& camera() const { return camera_; }
 
 private:
   struct FrameSky {

@@ -107,7 +107,6 @@ public:
   SeenThroughPieces seenThroughPieces(const TriangleMesh& mesh, std::size_t max_triangles = 50) const;
 
   std::size_t frames() const;
-  const PinholeCamera& camera() const { return camera_; }
   /// Ground-truth pixels kept over all frames (static and moving).
   std::size_t groundTruthPixels() const;
   double maxDepth() const { return max_depth_m_; }
