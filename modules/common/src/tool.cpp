@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/huge_page_images.h>
 #include <msf/common/message_text.h>
 #include <msf/common/tool.h>
 #include <msf/common/version.h>
@@ -279,6 +280,7 @@ int CommandLine::run(int argc, char** argv, int min_arguments, const std::functi
     printHelp(argv[0]);
     return help ? 0 : 1;
   }
+  useHugePagesForLargeImages();
   return tool::run(name_.c_str(), [&] { return body(parse(argc, argv)); });
 }
 

@@ -6,6 +6,8 @@
 // config/kitti_bag.yaml.
 #include "reconstruction_node.h"
 
+#include <msf/common/huge_page_images.h>
+
 #include <ros/master.h>
 #include <ros/network.h>
 
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "msf_ros_node: stopped while waiting for the ROS master; nothing was done\n");
     return 130;
   }
+  msf::useHugePagesForLargeImages();
   ros::NodeHandle nh, private_nh("~");
   try {
     msf::ReconstructionNode node(nh, private_nh);
