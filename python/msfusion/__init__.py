@@ -44,6 +44,7 @@ from ._core import (  # noqa: F401  (the package's API)
     read_mesh,
     real_returns,
     set_num_threads,
+    use_huge_pages_for_large_images,
 )
 from .config import load_config  # noqa: F401
 from .depth_cloud import DepthCloud, read_depth_cloud  # noqa: F401

@@ -1,6 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include "bindings.h"
 
+#include <msf/common/huge_page_images.h>
+
 #include <opencv2/core/utility.hpp>
 
 PYBIND11_MODULE(_core, m) {
@@ -19,4 +21,8 @@ PYBIND11_MODULE(_core, m) {
         "Threads of the library's parallel loops (OpenCV's pool, shared by every object): n, 1 or 0 = "
         "the calling thread only, negative = all the cores (the default).");
   m.def("get_num_threads", &cv::getNumThreads, "Threads of the library's parallel loops.");
+  m.def("use_huge_pages_for_large_images", &msf::useHugePagesForLargeImages,
+        "Images of 1 MiB or more on transparent huge pages, for the rest of the process, as the tools have them: "
+        "fewer page faults for the images each frame allocates. The same values; it changes OpenCV's allocator "
+        "for everything in the process.");
 }

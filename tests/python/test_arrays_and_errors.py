@@ -116,6 +116,18 @@ def test_stage_outputs_are_owned_contiguous_arrays(calibration, frame):
     assert len(fused) == 3 and all(a.shape == (370, 1226) and a.dtype == np.float32 for a in fused)
 
 
+def test_images_on_huge_pages_are_the_same_values_on_2_mib_boundaries(calibration, frame):
+    with open("/sys/kernel/mm/transparent_hugepage/enabled") as f:
+        if "[never]" in f.read():
+            pytest.skip("this system has no transparent huge pages")
+    lidar = msfusion.LidarCompletion(calibration)
+    before, _ = lidar.compute_depth(frame.scan)
+    msfusion.use_huge_pages_for_large_images()
+    after, _ = lidar.compute_depth(frame.scan)
+    assert after.ctypes.data % (2 << 20) == 0 and before.ctypes.data % (2 << 20) != 0
+    np.testing.assert_array_equal(after, before)
+
+
 def test_inputs_are_viewed_and_results_are_views(frame):
     left, right = frame.left.copy(), frame.right.copy()
     made = msfusion.Frame(left, right, frame.scan)
