@@ -81,22 +81,23 @@ class HugePageAllocator final : public cv::MatAllocator {
 public:
   cv::UMatData* allocate(int dims, const int* sizes, int type, void* data, std::size_t* step, cv::AccessFlag flags,
                          cv::UMatUsageFlags usage) const override {
-    std::vector<std::size_t> strides(static_cast<std::size_t>(dims));
     std::size_t bytes = CV_ELEM_SIZE(type);
-    for (int i = dims - 1; i >= 0; --i) {
-      strides[static_cast<std::size_t>(i)] = bytes;
+    for (int i = 0; i < dims; ++i)
       bytes *= static_cast<std::size_t>(sizes[i]);
-    }
     void* mapped = nullptr;
     if (!data && bytes >= kMinBytes) {
-      mapped = cache_.take(roundUpToHugePages(bytes));
+      const std::size_t mapping = roundUpToHugePages(bytes);
+      mapped = cache_.take(mapping);
       if (!mapped)
-        mapped = mapAligned(roundUpToHugePages(bytes));
+        mapped = mapAligned(mapping);
     }
     if (!mapped)
       return std_->allocate(dims, sizes, type, data, step, flags, usage);
     if (step)
-      std::copy(strides.begin(), strides.end(), step);
+      for (std::size_t i = static_cast<std::size_t>(dims), stride = CV_ELEM_SIZE(type); i-- > 0;) {
+        step[i] = stride;
+        stride *= static_cast<std::size_t>(sizes[i]);
+      }
     auto* u = new cv::UMatData(this);
     u->data = u->origdata = static_cast<uchar*>(mapped);
     u->size = bytes;
@@ -108,8 +109,9 @@ public:
   void deallocate(cv::UMatData* u) const override {
     if (!u)
       return;
-    if (!cache_.keep(u->origdata, roundUpToHugePages(u->size)))
-      munmap(u->origdata, roundUpToHugePages(u->size));
+    const std::size_t mapping = roundUpToHugePages(u->size);
+    if (!cache_.keep(u->origdata, mapping))
+      munmap(u->origdata, mapping);
     delete u;
   }
 
