@@ -4,7 +4,8 @@
 namespace msf {
 
 /// Makes OpenCV allocate every image of 1 MiB or more on transparent huge pages: its own
-/// mapping, aligned to 2 MiB and advised so, returned to the system when the image is freed.
+/// mapping, aligned to 2 MiB and advised so. A freed image's mapping is kept (up to 64 MiB in all)
+/// for the next image of its size, and returned to the system beyond that.
 /// The pipeline allocates its per-frame images anew while frames are in flight, and the kernel
 /// faults fresh memory in 4 KiB at a time: a 2 MiB page takes one fault where 512 took one each,
 /// the larger share of that memory's cost on a virtual machine. Smaller images, and images on a
