@@ -560,6 +560,38 @@ TEST(DepthImageFusion, NoDepthInTheClearSkyTheCloudClassNeither) {
   EXPECT_EQ(cv::countNonZero(depth != 20.f), 0);
 }
 
+TEST(DepthImageFusion, TheClearSkyBesideAThinPoleGivesNoDepthUpToItsTexture) {
+  // A dark pole (columns 28-31) against a clipped white sky (rows 0-24), the LiDAR's returns
+  // from row 28 down. Stereo widened the pole by 5 blank pixels a side (columns 23-36), as SGBM
+  // does against a blank background. The depth is withheld up to the pixels whose 5x5 window
+  // sees the pole (columns 26-27 and 32-33 keep it), not a mask's border short of them, and the
+  // open sky holds the withheld pixels, so that the small-hole fill leaves them empty.
+  const int w = 60, h = 40, pole_first = 28, pole_last = 31, widened = 5;
+  cv::Mat zl(h, w, CV_32FC1, cv::Scalar(0)), zs(h, w, CV_32FC1, cv::Scalar(0));
+  cv::Mat colour(h, w, CV_8UC3, cv::Scalar(100, 100, 100));
+  colour.rowRange(0, 25).setTo(cv::Scalar(255, 255, 255));
+  colour.colRange(pole_first, pole_last + 1).setTo(cv::Scalar(60, 60, 60));
+  for (int v = 28; v < h; v += 2)
+    zl.row(v).setTo(10.f);
+  zs.rowRange(25, h).setTo(10.f);
+  zs(cv::Range(0, 25), cv::Range(pole_first - widened, pole_last + widened + 1)).setTo(12.f);
+  msf::DepthImageFusion fusion;
+  fusion.setCalibration(calibration(w, h));
+  fusion.setSkyImage(colour);
+  cv::Mat fused, weight;
+  fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused, &weight);
+  fusion.fillSmallHoles(fused, &weight);
+  const int row = 10;
+  for (int u = pole_first - widened; u <= pole_last + widened; ++u) {
+    const bool textured = u >= pole_first - 2 && u <= pole_last + 2; // the 5x5 window sees the pole
+    EXPECT_EQ(fused.at<float>(row, u) > 0.f, textured) << "column " << u;
+    EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(row, u) != 0, !textured) << "column " << u;
+  }
+  // The mask's border still applies where nothing was withheld: the grey ground below the sky.
+  EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(24, 10), 0);
+  EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(row, 10), 255);
+}
+
 TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {
   cv::Mat depth(3, 5, CV_32FC1, cv::Scalar(0));
   depth.at<float>(1, 1) = static_cast<float>(kFB / 10.0); // disparity 10

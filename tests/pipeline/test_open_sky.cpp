@@ -76,9 +76,9 @@ TEST(OpenSky, SkyCarvingClearsTheSheetsOverTheRoadInFrontOfTheSky) {
   const msf::SkyCoverage& without = covered[false];
   EXPECT_EQ(without.frames, 16u);
   EXPECT_GT(without.sky_pixels, 16u * 20000);
-  EXPECT_GT(without.share, 0.02);
+  EXPECT_GT(without.share, 0.01);
   EXPECT_EQ(without.worst_frame, 35u);
-  EXPECT_GT(without.worst_share, 0.25);
+  EXPECT_GT(without.worst_share, 0.15);
   EXPECT_LT(without.covered_depth_median_m, 10.0); // near the camera, over the road
   const msf::SkyCoverage& with = covered[true];
   EXPECT_EQ(with.sky_pixels, without.sky_pixels);
@@ -91,7 +91,8 @@ TEST(OpenSky, AClearSkyGivesNoDepth) {
   // Frame 2 of raw drive 0009: SGBM smears the crowns' disparity over the overexposed sky
   // between them, thousands of pixels of depth 15-25 m, which hung in the map as sheets. With
   // fusion.clear_sky the fused frame has no depth in the clear sky, and is the same everywhere
-  // else; the open sky sky carving takes is the one the fusion found.
+  // else; the open sky that sky carving takes is the one the fusion found, with the pixels it
+  // withheld.
   MSF_REQUIRE_KITTI();
   const msf::Sequence sequence(msf::test::kittiDir() + "/raw/2011_09_26/2011_09_26_drive_0009_sync");
   const msf::Frame frame = sequence.load(2);
@@ -102,8 +103,10 @@ TEST(OpenSky, AClearSkyGivesNoDepth) {
   config.fusion.clear_sky = true;
   const msf::FrameResult with = msf::Reconstructor(sequence.calibration(), config).computeDepth(frame);
   ASSERT_FALSE(with.sky.empty());
-  EXPECT_EQ(cv::norm(with.sky, without.sky, cv::NORM_INF), 0.0);
   const cv::Mat clear = msf::SkyMask().clearSky(frame.color, with.sky);
+  EXPECT_EQ(cv::countNonZero(without.sky & ~with.sky), 0);
+  EXPECT_EQ(cv::countNonZero(with.sky & ~without.sky & ~clear), 0);
+  EXPECT_GT(cv::countNonZero(with.sky & ~without.sky), 100); // withheld beside the crowns, within the border
   const cv::Mat had = without.fused.depth > 0.f, has = with.fused.depth > 0.f;
   EXPECT_GT(cv::countNonZero(clear), 15000);
   EXPECT_GT(cv::countNonZero(had & clear), 3000);

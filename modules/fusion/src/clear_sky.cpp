@@ -13,12 +13,13 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
   for (const cv::Mat* values : images) // all checked before any is changed
     if (!values->empty() && (values->type() != CV_32FC1 || values->size() != image.size()))
       throw InvalidInputError("withholdClearSky: the depth and weights must be CV_32FC1 of the sky image's size");
-  const cv::Mat open = sky.compute(image, returns);
+  cv::Mat open = sky.computeWithoutBorder(image, returns);
   const cv::Mat clear = sky.clearSky(image, open);
   for (cv::Mat* values : images)
     if (!values->empty())
       values->setTo(0.f, clear);
-  return open;
+  sky.takeBorder(open);
+  return open | clear;
 }
 
 const cv::Mat& skyImage(const cv::Mat& colour, const cv::Mat& grey, const cv::Size& size) {

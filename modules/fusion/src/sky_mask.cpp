@@ -110,6 +110,12 @@ std::vector<float> SkyMask::topReturnDepth(const cv::Mat& returns) const {
 }
 
 cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
+  cv::Mat mask = computeWithoutBorder(image, returns);
+  takeBorder(mask);
+  return mask;
+}
+
+cv::Mat SkyMask::computeWithoutBorder(const cv::Mat& image, const cv::Mat& returns) const {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
   if (returns.type() != CV_32FC1 || returns.size() != image.size())
@@ -120,11 +126,11 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
                       std::to_string(column_window_) + " and " + std::to_string(border_));
   const std::vector<TopReturn> top = topReturns(returns);
   // Only the rows above the lowest column's highest return can be sky: the steps run on them,
-  // with the rows that the texture window and the border reach below.
+  // with the rows that the texture window reaches below.
   int lowest = 0;
   for (const TopReturn& t : top)
     lowest = std::max(lowest, t.row);
-  const int band_rows = std::min(image.rows, lowest + std::max(kTextureWindow / 2, border_) + 1);
+  const int band_rows = std::min(image.rows, lowest + kTextureWindow / 2 + 1);
   cv::Mat mask(image.size(), CV_8UC1, cv::Scalar(0));
   cv::Mat band = mask.rowRange(0, band_rows);
   skyLike(image.rowRange(0, band_rows)).copyTo(band);
@@ -135,7 +141,6 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
         s[u] = 0;
   }
   keepOpenToTheTop(band);
-  takeBorder(band);
   return mask;
 }
 
@@ -155,9 +160,15 @@ void SkyMask::keepOpenToTheTop(cv::Mat& sky) {
 }
 
 void SkyMask::takeBorder(cv::Mat& mask) const {
-  if (border_ > 0)
-    cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
-              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  if (border_ <= 0)
+    return;
+  // Only the rows down to the mask's lowest pixel, with the border's below them, can change.
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty())
+    return;
+  cv::Mat band = mask.rowRange(0, std::min(mask.rows, box.y + box.height + border_ + 1));
+  cv::erode(band, band, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
+            cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
 }
 
 OpenSky openSkyOf(const cv::Mat& sky_depth) {

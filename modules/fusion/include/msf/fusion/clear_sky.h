@@ -8,11 +8,15 @@ namespace msf {
 
 /// No depth in the clear sky (fusion.clear_sky): SGBM's paths carry a crown's disparity over the
 /// blank sky beside it and the interpolation carries the LiDAR there, and the map would hang
-/// them as sheets. Finds the open sky of `image` (SkyMask::compute, CV_8UC1 grey or CV_8UC3 BGR
-/// of camera 0's view) above the LiDAR's real returns `returns` (CV_32FC1, > 0 at a return),
-/// and empties `depth`, `weight` and `free_weight` (those not empty, CV_32FC1 of the image's
-/// size) at its clear pixels (SkyMask::clearSky). Returns the open sky's mask. Throws
-/// InvalidInputError, changing nothing, for a depth or weight image of another type or size.
+/// them as sheets. Finds the open sky of `image` (CV_8UC1 grey or CV_8UC3 BGR of camera 0's
+/// view) above the LiDAR's real returns `returns` (CV_32FC1, > 0 at a return), and empties
+/// `depth`, `weight` and `free_weight` (those not empty, CV_32FC1 of the image's size) at its
+/// clear pixels (SkyMask::clearSky) up to where the image's texture starts
+/// (SkyMask::computeWithoutBorder): SGBM widens a thin pole or a crown's rim by a few pixels of
+/// blank sky, which the mask's border would leave. Returns the open sky's mask
+/// (SkyMask::compute) with every pixel withheld in it, so that no hole fill gives them depth
+/// again. Throws InvalidInputError, changing nothing, for a depth or weight image of another
+/// type or size.
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& returns, cv::Mat& depth,
                          cv::Mat& weight, cv::Mat& free_weight);
 

@@ -53,12 +53,15 @@ public:
   /// > 0 where a return lands). Throws InvalidInputError for another type or size, or
   /// ConfigError for a setting out of range (a negative window or border).
   cv::Mat compute(const cv::Mat& image, const cv::Mat& returns) const;
+  /// Steps 1-3 alone: the open sky up to where the image's texture starts, its outline kept
+  /// (takeBorder then gives compute's mask). Throws as compute does.
+  cv::Mat computeWithoutBorder(const cv::Mat& image, const cv::Mat& returns) const;
 
   /// Takes the border off `mask` (CV_8UC1, 255 = sky) in place, as compute's step 4 does: a
   /// surface's outline blurred by the image or by a map's voxels is not counted as sky.
   void takeBorder(cv::Mat& mask) const;
 
-  /// The pixels of `sky` (compute's mask of `image`, CV_8UC1) whose colour only the sky has: a
+  /// The pixels of `sky` (a mask of `image` as compute finds it, CV_8UC1) whose colour only the sky has: a
   /// channel clipped (at least the clipped level) or, in colour, blue with more saturation
   /// than a grey-white pixel (the maximum saturation) has. CV_8UC1, 255 = clear sky. Throws
   /// InvalidInputError for an image or mask of another type or size.
