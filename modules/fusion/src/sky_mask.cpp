@@ -160,15 +160,9 @@ void SkyMask::keepOpenToTheTop(cv::Mat& sky) {
 }
 
 void SkyMask::takeBorder(cv::Mat& mask) const {
-  if (border_ <= 0)
-    return;
-  // Only the rows down to the mask's lowest pixel, with the border's below them, can change.
-  const cv::Rect box = cv::boundingRect(mask);
-  if (box.empty())
-    return;
-  cv::Mat band = mask.rowRange(0, std::min(mask.rows, box.y + box.height + border_ + 1));
-  cv::erode(band, band, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
-            cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  if (border_ > 0)
+    cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * border_ + 1, 2 * border_ + 1)),
+              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
 }
 
 OpenSky openSkyOf(const cv::Mat& sky_depth) {
