@@ -10,12 +10,14 @@
 #include "test_support.h"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <pcl/point_types.h>
 
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 namespace {
 
@@ -556,7 +558,8 @@ TEST(DepthImageFusion, NoDepthInTheClearSkyTheCloudClassNeither) {
             std::string::npos);
   // A weight of another size is refused before the depth is touched.
   cv::Mat depth = zs.clone(), small(h - 1, w, CV_32FC1, cv::Scalar(1.f)), none;
-  EXPECT_THROW(msf::withholdClearSky(msf::SkyMask(), colour, zl, depth, small, none), msf::InvalidInputError);
+  EXPECT_THROW(msf::withholdClearSky(msf::SkyMask(), colour, cv::Mat(), zl, depth, small, none),
+               msf::InvalidInputError);
   EXPECT_EQ(cv::countNonZero(depth != 20.f), 0);
 }
 
@@ -590,6 +593,54 @@ TEST(DepthImageFusion, TheClearSkyBesideAThinPoleGivesNoDepthUpToItsTexture) {
   // The mask's border still applies where nothing was withheld: the grey ground below the sky.
   EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(24, 10), 0);
   EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(row, 10), 255);
+}
+
+TEST(DepthImageFusion, TheSkyBesideANearPoleIsCameraZerosWhereTheColourCameraSeesThePoleShifted) {
+  // Camera 0 sees a dark pole at columns 28-31 against a clipped white sky (rows 0-24); the
+  // colour camera beside it sees the pole 3 columns to the right, by their parallax. Stereo
+  // widened the pole by 5 pixels a side in camera 0 (columns 23-36). Given camera 0's grey image,
+  // the depth is withheld up to where camera 0's own texture starts on both sides (columns 26-33
+  // keep it): neither the pole's left edge, where the colour camera sees sky, nor the sky to its
+  // right, where the colour camera sees the pole, is decided by the colour image alone.
+  const int w = 60, h = 40, pole_first = 28, pole_last = 31, parallax = 3, widened = 5;
+  cv::Mat grey(h, w, CV_8UC1, cv::Scalar(100));
+  grey.rowRange(0, 25).setTo(255);
+  cv::Mat colour;
+  cv::cvtColor(grey, colour, cv::COLOR_GRAY2BGR);
+  grey.colRange(pole_first, pole_last + 1).setTo(60);
+  colour.colRange(pole_first + parallax, pole_last + parallax + 1).setTo(cv::Scalar(60, 60, 60));
+  cv::Mat zl(h, w, CV_32FC1, cv::Scalar(0)), zs(h, w, CV_32FC1, cv::Scalar(0));
+  for (int v = 28; v < h; v += 2)
+    zl.row(v).setTo(10.f);
+  zs.rowRange(25, h).setTo(10.f);
+  zs(cv::Range(0, 25), cv::Range(pole_first - widened, pole_last + widened + 1)).setTo(12.f);
+  msf::DepthFusionConfig config;
+  config.facade_extension = false; // the pole's columns keep stereo's depth
+  msf::DepthImageFusion fusion(config);
+  fusion.setCalibration(calibration(w, h));
+  fusion.setSkyImage(colour);
+  const auto keptAtRow10 = [&](const cv::Mat& left) {
+    fusion.setInputImage(left);
+    cv::Mat fused;
+    fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused);
+    std::vector<int> kept;
+    for (int u = 0; u < w; ++u)
+      if (fused.at<float>(10, u) > 0.f)
+        kept.push_back(u);
+    return kept;
+  };
+  std::vector<int> seen_by_camera_0; // its 5x5 window sees the pole
+  for (int u = pole_first - 2; u <= pole_last + 2; ++u)
+    seen_by_camera_0.push_back(u);
+  EXPECT_EQ(keptAtRow10(grey), seen_by_camera_0);
+  // The colour image alone takes the pole's left edge for sky and keeps the sky to its right.
+  const std::vector<int> by_colour_alone = keptAtRow10(cv::Mat());
+  EXPECT_EQ(by_colour_alone.front(), pole_first + parallax - 2);
+  EXPECT_EQ(by_colour_alone.back(), pole_last + widened);
+  // A grey image of another size is refused.
+  cv::Mat depth = zs.clone(), none;
+  EXPECT_THROW(msf::withholdClearSky(msf::SkyMask(), colour, grey.rowRange(0, h - 1), zl, depth, none, none),
+               msf::InvalidInputError);
 }
 
 TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {

@@ -216,6 +216,34 @@ TEST(FacadeExtension, AColumnStopsWhereStereoSeesABuildingBehindTheWall) {
   EXPECT_NEAR(wall.depth.at<float>(30, 120), kWall, 1e-3f);
 }
 
+TEST(FacadeExtension, FarStereoBehindTheWallStopsItsColumnThoughItsSigmaInDepthIsWide) {
+  // The building behind is 60 m away, where stereo's sigma is 12 m (0.4 px of disparity at
+  // 60 m with f B = 500 * 0.6): 50 m behind the wall is only 4 of those sigmas in depth, but
+  // 25 in inverse depth, in which stereo's error is spread evenly. The column stops as for a
+  // near building: stereo's error is judged at the wall's depth, not at its own.
+  Wall wall;
+  wall.grey.setTo(120);
+  const cv::Rect behind(40, 20, 40, 26);
+  wall.depth(behind).setTo(60.f);
+  wall.weight(behind).setTo(1.f / 144.f);
+  wall.run();
+  for (int u = behind.x; u < behind.x + behind.width; ++u) {
+    for (int v = 46; v < kLidarTop; ++v)
+      ASSERT_NEAR(wall.depth.at<float>(v, u), kWall, 1e-3f) << v << "," << u;
+    for (int v = behind.y; v <= 43; ++v)
+      ASSERT_EQ(wall.depth.at<float>(v, u), 60.f) << v << "," << u;
+  }
+  // A guess 2 m behind at sigma 0.5 m is 5 of its sigmas behind in inverse depth: no stop,
+  // and replaced by the wall.
+  Wall guessed;
+  guessed.grey.setTo(120);
+  guessed.depth(behind).setTo(12.f);
+  guessed.weight(behind).setTo(4.f);
+  guessed.run();
+  for (int v = behind.y; v < kLidarTop; ++v)
+    ASSERT_NEAR(guessed.depth.at<float>(v, 60), kWall, 1e-3f) << v;
+}
+
 TEST(FacadeExtension, TheWallGoesOnVerticalWhateverItsAnchorsSlope) {
   // Anchors whose inverse depth falls 4e-5 per row upward (n_y 0.2, within the bar): carried
   // on, their line would put row 25 at 10.18 m. The wall goes on at the run's own inverse

@@ -99,7 +99,7 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
                             "x" + std::to_string(size.height));
   returns_ = realReturns(lidar, distance);
   if (config_.clear_sky)
-    open_sky_ = withholdClearSky(sky_, sky_image_, returns_, fused_depth, weight, free_weight);
+    open_sky_ = withholdClearSky(sky_, sky_image_, left_, returns_, fused_depth, weight, free_weight);
 }
 
 void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const {

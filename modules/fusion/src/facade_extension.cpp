@@ -31,9 +31,11 @@ struct ColumnFit {
   bool gap_seen = false;     ///< stereo in that gap saw the wall
 
   /// That many stereo pixels of a column in a row (no other depth between them), each more
-  /// than kBehindSigmas of its sigmas behind the wall, see the surface above the wall's top
-  /// edge (a building behind a lower one of the same grey): the column stops. SGBM's guesses on
-  /// a blank wall come in runs too (its paths carry them), but nearer, hence the wide margin.
+  /// than kBehindSigmas of its sigmas behind the wall in inverse depth (stereo's error is even
+  /// in disparity: 1/w - 1/z > k sigma / z^2, that is z - w > k sigma w / z), see the surface
+  /// above the wall's top edge (a building behind a lower one of the same grey): the column
+  /// stops. SGBM's guesses on a blank wall come in runs too (its paths carry them), but
+  /// nearer, hence the wide margin.
   static constexpr int kBehindToStop = 3;
   static constexpr float kBehindSigmas = 6.f;
 
@@ -251,7 +253,7 @@ private:
         fit.behind = 0;
         return 0;
       }
-      if (z - wall_depth > ColumnFit::kBehindSigmas * own_sigma) {
+      if (z - wall_depth > ColumnFit::kBehindSigmas * own_sigma * wall_depth / z) {
         if (++fit.behind >= ColumnFit::kBehindToStop) {
           fit.stop(); // the wall ended below: what stereo sees behind it stays
           return 0;

@@ -13,12 +13,16 @@ namespace msf {
 /// `depth`, `weight` and `free_weight` (those not empty, CV_32FC1 of the image's size) at its
 /// clear pixels (SkyMask::clearSky) up to where the image's texture starts
 /// (SkyMask::computeWithoutBorder): SGBM widens a thin pole or a crown's rim by a few pixels of
-/// blank sky, which the mask's border would leave. Returns the open sky's mask
-/// (SkyMask::compute) with every pixel withheld in it, so that no hole fill gives them depth
-/// again. Throws InvalidInputError, changing nothing, for a depth or weight image of another
-/// type or size.
-cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& returns, cv::Mat& depth,
-                         cv::Mat& weight, cv::Mat& free_weight);
+/// blank sky, which the mask's border would leave. A colour camera beside camera 0 sees a near
+/// pole shifted by their parallax: given `grey` (CV_8UC1, camera 0's own image; empty, or
+/// `image` itself: none), camera 0's own open sky decides within the mask's border, and its
+/// clipped pixels are withheld too, the sky camera 0 sees beside the pole where the colour
+/// camera sees the pole. Returns the open
+/// sky's mask (SkyMask::compute of `image`) with every pixel withheld in it, so that no hole fill
+/// gives them depth again. Throws InvalidInputError, changing nothing, for a depth, weight or grey
+/// image of another type or size.
+cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& grey, const cv::Mat& returns,
+                         cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight);
 
 /// The image to find camera 0's open sky in: the colour camera's (BGR) when it has camera 0's
 /// `size` (rectified, one image plane: it sees the far sky at camera 0's pixels, and colour tells

@@ -81,8 +81,8 @@ public:
   /// Optional grey image of camera 0 (CV_8UC1, the clouds' width x height): with it and
   /// fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank pixels above
   /// it (extendFacades), as in the pipeline; and with fusion.clear_sky no depth in its clear
-  /// sky (withholdClearSky) when no colour image of its size is set. Empty: nothing after the
-  /// fusion but edge support.
+  /// sky (withholdClearSky), which decides near an edge when a colour image of its size is set.
+  /// Empty: nothing after the fusion but edge support.
   void setInputImage(const cv::Mat& left) { left_ = left; }
   void setColorCamera(int camera) { color_camera_ = camera; }
   int getColorCamera() const { return color_camera_; }

@@ -35,7 +35,9 @@ public:
   void setCalibration(const Calibration& calibration);
   /// Optional grey image of camera 0 (CV_8UC1, the depth images' size), for the next fuse():
   /// with it and fusion.facade_extension, a LiDAR-backed wall goes on upward over the blank
-  /// pixels above it (extendFacades). Empty: nothing after the fusion but edge support.
+  /// pixels above it (extendFacades); with fusion.clear_sky and a colour sky image, camera 0's
+  /// own sky decides the clear sky withheld near an edge (withholdClearSky). Empty: nothing
+  /// after the fusion but edge support.
   void setInputImage(const cv::Mat& left) { left_ = left; }
   /// Optional image of camera 0's view to find the open sky in (CV_8UC3 BGR, the colour
   /// camera's at camera 0's pixels, which tells a blue sky from a white wall; or CV_8UC1 grey),
