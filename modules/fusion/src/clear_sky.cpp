@@ -18,16 +18,15 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
     throw InvalidInputError("withholdClearSky: camera 0's grey image must be CV_8UC1 of the sky image's size");
   cv::Mat open = sky.computeWithoutBorder(image, returns);
   cv::Mat clear = sky.clearSky(image, open);
-  cv::Mat bordered = open.clone();
-  sky.takeBorder(bordered);
+  sky.takeBorder(open);
   if (own_grey) { // within the border, where the parallax moves an edge, camera 0's own sky decides
     const cv::Mat open_in_grey = sky.computeWithoutBorder(grey, returns);
-    clear = (clear & (bordered | open_in_grey)) | sky.clearSky(grey, open_in_grey);
+    clear = (clear & (open | open_in_grey)) | sky.clearSky(grey, open_in_grey);
   }
   for (cv::Mat* values : images)
     if (!values->empty())
       values->setTo(0.f, clear);
-  return bordered | clear;
+  return open | clear;
 }
 
 const cv::Mat& skyImage(const cv::Mat& colour, const cv::Mat& grey, const cv::Size& size) {
