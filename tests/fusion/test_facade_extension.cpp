@@ -217,8 +217,8 @@ TEST(FacadeExtension, AColumnStopsWhereStereoSeesABuildingBehindTheWall) {
 }
 
 TEST(FacadeExtension, FarStereoBehindTheWallStopsItsColumnThoughItsSigmaInDepthIsWide) {
-  // The building behind is 60 m away, where stereo's sigma is 12 m (0.4 px of disparity at
-  // 60 m with f B = 500 * 0.6): 50 m behind the wall is only 4 of those sigmas in depth, but
+  // The building behind is 60 m away, where stereo's sigma is 12 m (1 px of disparity for
+  // f B = 300 px m): 50 m behind the wall is only 4 of those sigmas in depth, but
   // 25 in inverse depth, in which stereo's error is spread evenly. The column stops as for a
   // near building: stereo's error is judged at the wall's depth, not at its own.
   Wall wall;
