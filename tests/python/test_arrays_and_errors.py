@@ -1,6 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Shapes, dtypes and errors: what the binding takes and gives, and how it refuses."""
 import gc
+import math
 import os
 import threading
 import time
@@ -219,9 +220,10 @@ def test_config_overrides_are_read_as_a_file_reads():
 
 
 def test_heavy_calls_release_the_gil(calibration, frame):
-    """Python code runs while a stage works: a loop of ~0.1 s of bytecode ends while five stereo
-    matches (~1 s) are still running. Were the GIL held, the loop would run only between two
-    matches, ~5 ms each time (the switch interval), and end after the worker."""
+    """Python code runs while a stage works: a loop of ~0.1 s of bytecode ends while stereo
+    matches of ~1 s in all (as many as this host needs) are still running. Were the GIL held,
+    the loop would run only between two matches, ~5 ms each time (the switch interval), and end
+    after the worker."""
 
     def spin(n):
         for _ in range(n):
@@ -231,11 +233,14 @@ def test_heavy_calls_release_the_gil(calibration, frame):
     spin(1_000_000)
     loop = int(1_000_000 * 0.1 / (time.perf_counter() - start))
     stereo = msfusion.SgbmStereo(calibration)
+    start = time.perf_counter()
+    stereo.compute_depth(frame.left, frame.right)
+    matches = max(5, math.ceil(1.0 / (time.perf_counter() - start)))
     started, done = threading.Event(), threading.Event()
 
     def match():
         started.set()
-        for _ in range(5):
+        for _ in range(matches):
             stereo.compute_depth(frame.left, frame.right)
         done.set()
 
