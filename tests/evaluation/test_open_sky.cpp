@@ -130,6 +130,35 @@ TEST(SkyMask, GivesEachColumnTheDepthOfItsHighestReturn) {
   EXPECT_THROW(SkyMask().topReturnDepth(cv::Mat(kHeight, kWidth, CV_8UC1)), InvalidInputError);
 }
 
+TEST(SkyMask, AWallsDepthIsTheFartherSidesSoACrownBesideAColumnDoesNotStandForIt) {
+  // The returns of GivesEachColumnTheDepthOfItsHighestReturn. On each side of a column, within
+  // 8 columns and the column included, the nearest return on that side's highest ring; of the
+  // two sides the farther.
+  const SkyMask masker;
+  const std::vector<float> depth = masker.wallDepth(drawnReturns());
+  ASSERT_EQ(depth.size(), static_cast<std::size_t>(kWidth));
+  EXPECT_EQ(depth[40], 8.f);
+  EXPECT_EQ(depth[59], 8.f);  // the crown's last column: the crown on both sides
+  EXPECT_EQ(depth[65], 10.f); // the crown on one side only: the road's on the other is farther
+  EXPECT_EQ(masker.topReturnDepth(drawnReturns())[65], 8.f);
+  EXPECT_EQ(depth[100], 9.f);
+  EXPECT_EQ(depth[185], 12.f); // the wall on one side, the nearer road on the other
+  const cv::Mat none(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  EXPECT_EQ(masker.wallDepth(none), std::vector<float>(kWidth, 0.f));
+  // One ring passes a far wall (30 m, columns 100-104) and a near one (12 m, a row lower,
+  // 106-110) above a lower ring's nearer returns (5 m): a column of the near wall takes its
+  // depth, the column between the walls sees past both, one beside the far wall alone takes it.
+  cv::Mat ring = none.clone();
+  ring(cv::Rect(100, 10, 5, 1)).setTo(30.f);
+  ring(cv::Rect(106, 11, 5, 1)).setTo(12.f);
+  ring(cv::Rect(100, 20, 11, 1)).setTo(5.f);
+  const std::vector<float> ring_depth = masker.wallDepth(ring);
+  EXPECT_EQ(ring_depth[108], 12.f);
+  EXPECT_EQ(ring_depth[105], 30.f);
+  EXPECT_EQ(ring_depth[92], 30.f);
+  EXPECT_THROW(masker.wallDepth(cv::Mat(kHeight, kWidth, CV_8UC1)), InvalidInputError);
+}
+
 TEST(SkyMask, ItsClearSkyIsClippedOrBlueNotGreyWhite) {
   // No return anywhere. The blue sky is clear; a grey-white wall as bright as it (grey 175) is
   // sky but not clear (a blank wall may look so); a clipped white patch at the top edge is.

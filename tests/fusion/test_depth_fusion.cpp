@@ -643,6 +643,46 @@ TEST(DepthImageFusion, TheSkyBesideANearPoleIsCameraZerosWhereTheColourCameraSee
                msf::InvalidInputError);
 }
 
+TEST(DepthImageFusion, StereoCarriedFromAPoleOverAPaleSkyIsWithheldWhereABlankWallKeepsItsDepth) {
+  // A pale, grey-white sky (neither clipped nor blue: a blank wall may look so) over rows 0-29.
+  // A dark pole at columns 28-31, its LiDAR returns (10 m) from row 26 down; a blank wall of the
+  // sky's colour at columns 55-79, its returns (20 m) from row 26 down; between them the returns
+  // of a building 30 m away from row 32 down. Stereo widened the pole by 5 pixels a side over
+  // the sky (columns 23-36) and matched the wall above its returns. The widened pixels past the
+  // pole's texture lie in front of the building's returns on their other side: withheld, and
+  // held in the open sky. The wall's pixels lie at their column's returns: kept.
+  const int w = 80, h = 40, pole_first = 28, pole_last = 31, widened = 5, wall_first = 55;
+  cv::Mat colour(h, w, CV_8UC3, cv::Scalar(100, 100, 100));
+  colour.rowRange(0, 30).setTo(cv::Scalar(235, 215, 200));
+  colour.colRange(pole_first, pole_last + 1).setTo(cv::Scalar(60, 60, 60));
+  cv::Mat zl(h, w, CV_32FC1, cv::Scalar(0)), zs(h, w, CV_32FC1, cv::Scalar(0));
+  for (int v = 26; v < h; v += 2) {
+    zl(cv::Range(v, v + 1), cv::Range(pole_first, pole_last + 1)).setTo(10.f);
+    zl(cv::Range(v, v + 1), cv::Range(wall_first, w)).setTo(20.f);
+    if (v >= 32) {
+      zl(cv::Range(v, v + 1), cv::Range(0, pole_first)).setTo(30.f);
+      zl(cv::Range(v, v + 1), cv::Range(pole_last + 1, wall_first)).setTo(30.f);
+    }
+  }
+  zs(cv::Range(0, 30), cv::Range(pole_first - widened, pole_last + widened + 1)).setTo(10.f);
+  zs(cv::Range(0, 30), cv::Range(wall_first, w)).setTo(20.f);
+  msf::DepthImageFusion fusion;
+  fusion.setCalibration(calibration(w, h));
+  fusion.setSkyImage(colour);
+  cv::Mat fused, weight;
+  fusion.fuse(zl, cv::Mat(), zs, cv::Mat(), fused, &weight);
+  const int row = 10;
+  for (int u = pole_first - widened; u <= pole_last + widened; ++u) {
+    const bool textured = u >= pole_first - 2 && u <= pole_last + 2; // the 5x5 window sees the pole
+    EXPECT_EQ(fused.at<float>(row, u) > 0.f, textured) << "column " << u;
+    EXPECT_EQ(weight.at<float>(row, u) > 0.f, textured) << "column " << u;
+    EXPECT_EQ(fusion.getOpenSky().at<std::uint8_t>(row, u) != 0, !textured) << "column " << u;
+  }
+  for (int u = wall_first; u < w; ++u)
+    EXPECT_NEAR(fused.at<float>(row, u), 20.f, 0.01f) << "column " << u;
+  EXPECT_NE(fusion.getOpenSky().at<std::uint8_t>(row, 70), 0); // the wall taken for sky
+}
+
 TEST(LocalDisparityRange, MaxMinusMinOfValidNeighbours) {
   cv::Mat depth(3, 5, CV_32FC1, cv::Scalar(0));
   depth.at<float>(1, 1) = static_cast<float>(kFB / 10.0); // disparity 10

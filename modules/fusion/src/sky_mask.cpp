@@ -75,7 +75,26 @@ cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
   return clear;
 }
 
-std::vector<SkyMask::TopReturn> SkyMask::topReturns(const cv::Mat& returns) const {
+namespace {
+
+/// The highest return among `first`..`last` (its row; the image's height: none) and the nearest on
+/// its ring: a pixel's row decides the highest among returns at one elevation, and a far one must
+/// not stand for a near wall beside it.
+template <class It>
+auto nearestOnHighestRing(It first, It last) {
+  auto t = *std::min_element(first, last, [](const auto& a, const auto& b) { return a.row < b.row; });
+  for (auto it = first; it != last; ++it)
+    if (it->row <= t.row + kOneRingRows && it->depth > 0.f)
+      t.depth = std::min(t.depth, it->depth);
+  return t;
+}
+
+} // namespace
+
+std::vector<SkyMask::TopReturn> SkyMask::highestReturns(const cv::Mat& returns) {
+  if (returns.type() != CV_32FC1)
+    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1, not of type " +
+                            std::to_string(returns.type()));
   std::vector<TopReturn> highest(static_cast<std::size_t>(returns.cols), TopReturn{returns.rows, 0.f});
   for (int v = returns.rows - 1; v >= 0; --v) {
     const float* z = returns.ptr<float>(v);
@@ -83,29 +102,38 @@ std::vector<SkyMask::TopReturn> SkyMask::topReturns(const cv::Mat& returns) cons
       if (z[u] > 0.f)
         highest[static_cast<std::size_t>(u)] = TopReturn{v, z[u]};
   }
-  const auto higher = [](const TopReturn& a, const TopReturn& b) { return a.row < b.row; };
+  return highest;
+}
+
+std::vector<SkyMask::TopReturn> SkyMask::topReturns(const cv::Mat& returns) const {
+  const std::vector<TopReturn> highest = highestReturns(returns);
   std::vector<TopReturn> top(highest.size());
   for (int u = 0; u < returns.cols; ++u) {
     const auto first = highest.begin() + std::max(0, u - column_window_);
     const auto last = highest.begin() + std::min(returns.cols, u + column_window_ + 1);
-    TopReturn t = *std::min_element(first, last, higher);
-    // The nearest of the returns on the same ring: a pixel's row decides the highest among
-    // returns at one elevation, and a far one must not stand for a near wall beside it.
-    for (auto it = first; it != last; ++it)
-      if (it->row <= t.row + kOneRingRows && it->depth > 0.f)
-        t.depth = std::min(t.depth, it->depth);
-    top[static_cast<std::size_t>(u)] = t;
+    top[static_cast<std::size_t>(u)] = nearestOnHighestRing(first, last);
   }
   return top;
 }
 
 std::vector<float> SkyMask::topReturnDepth(const cv::Mat& returns) const {
-  if (returns.type() != CV_32FC1)
-    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1, not of type " +
-                            std::to_string(returns.type()));
   const std::vector<TopReturn> top = topReturns(returns);
   std::vector<float> depth(top.size());
   std::transform(top.begin(), top.end(), depth.begin(), [](const TopReturn& t) { return t.depth; });
+  return depth;
+}
+
+std::vector<float> SkyMask::wallDepth(const cv::Mat& returns) const {
+  const std::vector<TopReturn> highest = highestReturns(returns);
+  std::vector<float> depth(highest.size());
+  for (int u = 0; u < returns.cols; ++u) {
+    const auto first = highest.begin() + std::max(0, u - column_window_);
+    const auto last = highest.begin() + std::min(returns.cols, u + column_window_ + 1);
+    const auto at = highest.begin() + u;
+    const float left = nearestOnHighestRing(first, at + 1).depth;
+    const float right = nearestOnHighestRing(at, last).depth;
+    depth[static_cast<std::size_t>(u)] = std::max(left, right); // a side with none (0): the other's
+  }
   return depth;
 }
 

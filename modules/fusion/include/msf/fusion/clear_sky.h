@@ -17,7 +17,10 @@ namespace msf {
 /// pole shifted by their parallax: given `grey` (CV_8UC1, camera 0's own image; empty, or
 /// `image` itself: none), camera 0's own open sky decides within the mask's border, and its
 /// clipped pixels are withheld too, the sky camera 0 sees beside the pole where the colour
-/// camera sees the pole. Returns the open sky's mask (SkyMask::compute of `image`) with every
+/// camera sees the pole. A grey-white sky looks like a blank wall, so there the depth is
+/// withheld only in front of the wall its column's returns allow (SkyMask::wallDepth, by more
+/// than three of the pixel's sigmas, from `weight`), up to where either camera's texture starts:
+/// stereo's paths carry a pole's depth over a pale sky beside it too. Returns the open sky's mask (SkyMask::compute of `image`) with every
 /// pixel withheld in it, so that no hole fill gives them depth again. Throws InvalidInputError,
 /// changing nothing, for a depth, weight or grey image of another type or size.
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& grey, const cv::Mat& returns,

@@ -41,8 +41,8 @@ public:
   void setInputImage(const cv::Mat& left) { left_ = left; }
   /// Optional image of camera 0's view to find the open sky in (CV_8UC3 BGR, the colour
   /// camera's at camera 0's pixels, which tells a blue sky from a white wall; or CV_8UC1 grey),
-  /// for the next fuse(): with it and fusion.clear_sky, no depth in the clear sky
-  /// (withholdClearSky). Empty: none withheld.
+  /// for the next fuse(): with it and fusion.clear_sky, no depth in the clear sky, nor in the
+  /// open sky in front of its column's returns (withholdClearSky). Empty: none withheld.
   void setSkyImage(const cv::Mat& image) { sky_image_ = image; }
   /// The open sky (SkyMask, CV_8UC1, 255 = sky) the last fuse() found; empty when it had no sky
   /// image or clear_sky is off.

@@ -84,8 +84,9 @@ struct DepthFusionConfig {
   // depth; stereo that agrees on the way is averaged with it, stereo that disagrees replaced,
   // unless it sees a surface behind the wall (three pixels beyond 6 sigmas stop the column).
   bool facade_extension = true;
-  // last: no depth in the open sky's clear pixels, clipped or blue (clear_sky.h), found in the
-  // sky image (DepthImageFusion::setSkyImage; msf_fuse's -color, or -left).
+  // last: no depth in the open sky's clear pixels, clipped or blue, nor in front of the wall its
+  // column's returns allow (clear_sky.h), found in the sky image (DepthImageFusion::setSkyImage;
+  // msf_fuse's -color, or -left).
   bool clear_sky = true;
   // after the map took the frame: the small holes left take the nearest depth along their row or
   // column (hole_fill.h), at weight 0, so that the depth a user gets is dense where the sensors
@@ -133,7 +134,9 @@ struct DepthFusionConfig {
     k("edge_tolerance_px", edge_tolerance_px, atLeast(0), "a fused disparity this near a return is on its surface, px");
     k("facade_extension", facade_extension,
       "a LiDAR-backed wall goes on upward above the top ring where the image stays blank");
-    k("clear_sky", clear_sky, "no depth in the open sky's clipped or blue pixels (SkyMask), where stereo smears crowns");
+    k("clear_sky", clear_sky,
+      "no depth in the open sky's clipped or blue pixels (SkyMask), nor in front of its column's returns: stereo "
+      "smears crowns and poles there");
     k("hole_fill_px", hole_fill_px, atLeast(0),
       "a hole outside the open sky this near a depth along its row or column takes the nearest one, at "
       "weight 0 (not integrated); 0: off");

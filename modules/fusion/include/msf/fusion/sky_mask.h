@@ -75,12 +75,21 @@ public:
   /// Throws InvalidInputError for `returns` not CV_32FC1.
   std::vector<float> topReturnDepth(const cv::Mat& returns) const;
 
+  /// Per image column, the depth a blank wall covering it would have: on each side of the column
+  /// within its window (the column itself on both), the nearest return on that side's highest
+  /// ring, and of the two sides the farther (a side with none: the other's; 0 where the window
+  /// has none). A wall goes on past a pixel on both sides; a pole or a crown's edge beside it lies
+  /// on one side only, and does not stand for the sky beyond it. Throws as topReturnDepth does.
+  std::vector<float> wallDepth(const cv::Mat& returns) const;
+
 private:
   /// The highest return within each column's window: its row (the image's height: none) and depth.
   struct TopReturn {
     int row;
     float depth;
   };
+  /// Each column's own highest return. Throws InvalidInputError for `returns` not CV_32FC1.
+  static std::vector<TopReturn> highestReturns(const cv::Mat& returns);
   std::vector<TopReturn> topReturns(const cv::Mat& returns) const;
   /// Step 1: bright, blank and sky-coloured pixels (255).
   cv::Mat skyLike(const cv::Mat& image) const;
