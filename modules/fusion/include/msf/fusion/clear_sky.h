@@ -20,9 +20,10 @@ namespace msf {
 /// camera sees the pole. A grey-white sky looks like a blank wall, so there the depth is
 /// withheld only in front of the wall its column's returns allow (SkyMask::wallDepth, by more
 /// than three of the pixel's sigmas, from `weight`), up to where either camera's texture starts:
-/// stereo's paths carry a pole's depth over a pale sky beside it too. Returns the open sky's mask (SkyMask::compute of `image`) with every
-/// pixel withheld in it, so that no hole fill gives them depth again. Throws InvalidInputError,
-/// changing nothing, for a depth, weight or grey image of another type or size.
+/// stereo's paths carry a pole's depth over a pale sky beside it too. Returns the open sky's
+/// mask (SkyMask::compute of `image`) with every pixel withheld in it, so that no hole fill gives
+/// them depth again. Throws InvalidInputError, changing nothing, for a depth, weight or grey
+/// image of another type or size.
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& grey, const cv::Mat& returns,
                          cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight);
 

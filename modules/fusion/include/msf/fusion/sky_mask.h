@@ -83,7 +83,8 @@ public:
   std::vector<float> wallDepth(const cv::Mat& returns) const;
 
 private:
-  /// The highest return within each column's window: its row (the image's height: none) and depth.
+  /// A column's highest return, or the nearest on the highest ring within its window: its row
+  /// (the image's height: none) and depth.
   struct TopReturn {
     int row;
     float depth;
