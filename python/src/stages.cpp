@@ -166,7 +166,8 @@ void bindStages(py::module_& m) {
            "real), the stereo depth and its confidence (None: all 1). left: camera 0's grey image, for the "
            "facade extension (as the pipeline does). sky: the image to find the open sky in, the colour "
            "camera's (H, W, 3) uint8 RGB or the (H, W) grey one: with fusion.clear_sky no depth in its clear "
-           "(clipped or blue) sky, as the pipeline does. Returns (depth, weight), the weight the inverse "
+           "(clipped or blue) sky, nor in its open sky in front of the column's LiDAR returns, as the pipeline "
+           "does. Returns (depth, weight), the weight the inverse "
            "variance in m^-2; with free_space=True also the weight of the free space in front of each depth. "
            "fill_holes=True: the small holes (fusion.hole_fill_px) take the nearest depth at weight 0, as in "
            "the engine's depth and msf_fuse's.");
