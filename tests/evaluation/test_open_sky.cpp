@@ -187,6 +187,41 @@ TEST(SkyMask, ItsClearSkyIsClippedOrBlueNotGreyWhite) {
   EXPECT_THROW(masker.clearSky(cv::Mat(kHeight, kWidth, CV_32FC1), mask), InvalidInputError);
 }
 
+TEST(SkyMask, TheClippedOutlineIsTheClippedSkyBesideAnEdgeThatTheTextureKeptOut) {
+  // A grey camera's clipped sky (255) over rows 0-39, a dark crown at columns 60-79 from the top
+  // edge, a grey-white (200) strip of columns 120-129 across the sky, and a white clipped wall at
+  // columns 150-169 from row 20 with its returns from row 24 down. The 5x5 texture keeps the
+  // two columns beside each edge out of the mask; the outline holds the clipped ones within
+  // the border (3) of it (beside the crown and beside the strip), not the strip's own edge
+  // columns (grey-white, not clipped) nor the wall's pixels below its returns.
+  cv::Mat grey(kHeight, kWidth, CV_8UC1, cv::Scalar(100));
+  grey.rowRange(0, 40).setTo(255);
+  grey(cv::Rect(60, 0, 20, 40)).setTo(30);
+  grey(cv::Rect(120, 0, 10, 40)).setTo(200);
+  cv::Mat returns(kHeight, kWidth, CV_32FC1, cv::Scalar(0));
+  for (int v = 44; v < kHeight; v += 4)
+    returns.row(v).setTo(10.f);
+  for (int v = 24; v < 40; v += 4)
+    returns(cv::Rect(150, v, 20, 1)).setTo(12.f);
+  const SkyMask masker;
+  const cv::Mat open = masker.computeWithoutBorder(grey, returns);
+  ASSERT_TRUE(sky(open, 50, 10));
+  ASSERT_FALSE(sky(open, 58, 10)); // the crown within the texture window
+  const cv::Mat outline = masker.clippedOutline(grey, returns, open);
+  ASSERT_EQ(outline.type(), CV_8UC1);
+  EXPECT_EQ(cv::countNonZero(outline & open), 0);
+  for (int u : {58, 59, 80, 81, 118, 119, 130, 131})
+    EXPECT_TRUE(sky(outline, u, 10)) << "column " << u;
+  for (int u : {57, 60, 79, 82, 120, 121, 125, 128, 129})
+    EXPECT_FALSE(sky(outline, u, 10)) << "column " << u;
+  EXPECT_FALSE(sky(outline, 160, 25)); // the clipped wall below its highest returns (row 24)
+  // Without a border nothing is reached; a mask of another size is refused.
+  SkyMask no_border;
+  no_border.setBorder(0);
+  EXPECT_EQ(cv::countNonZero(no_border.clippedOutline(grey, returns, open)), 0);
+  EXPECT_THROW(masker.clippedOutline(grey, returns, open.rowRange(1, kHeight)), InvalidInputError);
+}
+
 TEST(SkyMask, RefusesImagesOfAnotherTypeOrSize) {
   const cv::Mat returns = drawnReturns();
   EXPECT_THROW(SkyMask().compute(cv::Mat(kHeight, kWidth, CV_32FC3), returns), InvalidInputError);

@@ -599,9 +599,10 @@ TEST(DepthImageFusion, TheSkyBesideANearPoleIsCameraZerosWhereTheColourCameraSee
   // Camera 0 sees a dark pole at columns 28-31 against a clipped white sky (rows 0-24); the
   // colour camera beside it sees the pole 3 columns to the right, by their parallax. Stereo
   // widened the pole by 5 pixels a side in camera 0 (columns 23-36). Given camera 0's grey image,
-  // the depth is withheld up to where camera 0's own texture starts on both sides (columns 26-33
-  // keep it): neither the pole's left edge, where the colour camera sees sky, nor the sky to its
-  // right, where the colour camera sees the pole, is decided by the colour image alone.
+  // the depth is withheld up to the pole's own columns: its clipped sky decides, the pixels
+  // beside the pole that its texture window keeps out of the mask included. Neither the pole's
+  // left edge, where the colour camera sees sky, nor the sky to its right, where the colour
+  // camera sees the pole, is decided by the colour image alone.
   const int w = 60, h = 40, pole_first = 28, pole_last = 31, parallax = 3, widened = 5;
   cv::Mat grey(h, w, CV_8UC1, cv::Scalar(100));
   grey.rowRange(0, 25).setTo(255);
@@ -629,10 +630,10 @@ TEST(DepthImageFusion, TheSkyBesideANearPoleIsCameraZerosWhereTheColourCameraSee
         kept.push_back(u);
     return kept;
   };
-  std::vector<int> seen_by_camera_0; // its 5x5 window sees the pole
-  for (int u = pole_first - 2; u <= pole_last + 2; ++u)
-    seen_by_camera_0.push_back(u);
-  EXPECT_EQ(keptAtRow10(grey), seen_by_camera_0);
+  std::vector<int> pole_in_camera_0;
+  for (int u = pole_first; u <= pole_last; ++u)
+    pole_in_camera_0.push_back(u);
+  EXPECT_EQ(keptAtRow10(grey), pole_in_camera_0);
   // The colour image alone takes the pole's left edge for sky and keeps the sky to its right.
   const std::vector<int> by_colour_alone = keptAtRow10(cv::Mat());
   EXPECT_EQ(by_colour_alone.front(), pole_first + parallax - 2);

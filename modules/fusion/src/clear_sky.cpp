@@ -56,7 +56,8 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
   sky.takeBorder(open);
   if (own_grey) { // within the border, where the parallax moves an edge, camera 0's own sky decides
     const cv::Mat open_in_grey = sky.computeWithoutBorder(grey, returns);
-    withheld = (withheld & (open | open_in_grey)) | sky.clearSky(grey, open_in_grey);
+    withheld = (withheld & (open | open_in_grey)) | sky.clearSky(grey, open_in_grey) |
+               sky.clippedOutline(grey, returns, open_in_grey);
     open_in_both &= open_in_grey;
   }
   if (!depth.empty())

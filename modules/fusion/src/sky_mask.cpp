@@ -21,6 +21,11 @@ constexpr int kOneRingRows = 3;
 
 std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
 
+void checkImage(const cv::Mat& image) {
+  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
+}
+
 } // namespace
 
 cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
@@ -46,9 +51,21 @@ cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
   return sky;
 }
 
+namespace {
+
+/// The pixels (255) of `image` (CV_8UC1 or CV_8UC3) with a channel at `level` or above.
+cv::Mat clippedPixels(const cv::Mat& image, double level) {
+  if (image.channels() == 1)
+    return image >= level;
+  cv::Mat channel[3];
+  cv::split(image, channel);
+  return cv::max(cv::max(channel[0], channel[1]), channel[2]) >= level;
+}
+
+} // namespace
+
 cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
-  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
+  checkImage(image);
   if (sky.type() != CV_8UC1 || sky.size() != image.size())
     throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
                             sizeText(sky) + " of type " + std::to_string(sky.type()));
@@ -57,13 +74,7 @@ cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
   if (area.empty())
     return clear;
   const cv::Mat pixels = image(area);
-  cv::Mat brightest = pixels;
-  if (pixels.channels() == 3) {
-    cv::Mat channel[3];
-    cv::split(pixels, channel);
-    brightest = cv::max(cv::max(channel[0], channel[1]), channel[2]);
-  }
-  cv::Mat out = brightest >= clipped_level_;
+  cv::Mat out = clippedPixels(pixels, clipped_level_);
   if (pixels.channels() == 3) {
     cv::Mat hsv, blue;
     cv::cvtColor(pixels, hsv, cv::COLOR_BGR2HSV);
@@ -73,6 +84,24 @@ cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
   cv::Mat clear_area = clear(area);
   cv::bitwise_and(out, sky(area), clear_area);
   return clear;
+}
+
+cv::Mat SkyMask::clippedOutline(const cv::Mat& image, const cv::Mat& returns, const cv::Mat& sky) const {
+  checkImage(image);
+  if (sky.type() != CV_8UC1 || sky.size() != image.size())
+    throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
+                            sizeText(sky) + " of type " + std::to_string(sky.type()));
+  cv::Mat passable = clippedPixels(image, clipped_level_);
+  const std::vector<TopReturn> top = topReturns(returns);
+  for (int u = 0; u < passable.cols; ++u) // step 2: nothing below the LiDAR's highest returns
+    passable.col(u).rowRange(std::min(top[static_cast<std::size_t>(u)].row, passable.rows), passable.rows).setTo(0);
+  passable |= sky;
+  cv::Mat reached = sky.clone();
+  for (int step = 0; step < border_; ++step) {
+    cv::dilate(reached, reached, cv::Mat());
+    reached &= passable;
+  }
+  return reached & ~sky;
 }
 
 namespace {
@@ -144,8 +173,7 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
 }
 
 cv::Mat SkyMask::computeWithoutBorder(const cv::Mat& image, const cv::Mat& returns) const {
-  if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
+  checkImage(image);
   if (returns.type() != CV_32FC1 || returns.size() != image.size())
     throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1 of the image's " + sizeText(image) +
                             ", not " + sizeText(returns) + " of type " + std::to_string(returns.type()));

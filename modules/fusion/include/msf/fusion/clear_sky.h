@@ -17,7 +17,9 @@ namespace msf {
 /// pole shifted by their parallax: given `grey` (CV_8UC1, camera 0's own image; empty, or
 /// `image` itself: none), camera 0's own open sky decides within the mask's border, and its
 /// clipped pixels are withheld too, the sky camera 0 sees beside the pole where the colour
-/// camera sees the pole. A grey-white sky looks like a blank wall, so there the depth is
+/// camera sees the pole, and the clipped ones beside an edge that its texture kept out of its
+/// mask (SkyMask::clippedOutline): a clipped pixel has no texture of its own, and camera 0
+/// sees the depth's pixels without parallax. A grey-white sky looks like a blank wall, so there the depth is
 /// withheld only in front of the wall its column's returns allow (SkyMask::wallDepth, by more
 /// than three of the pixel's sigmas, from `weight`), up to where either camera's texture starts:
 /// stereo's paths carry a pole's depth over a pale sky beside it too. Returns the open sky's

@@ -67,6 +67,13 @@ public:
   /// InvalidInputError for an image or mask of another type or size.
   cv::Mat clearSky(const cv::Mat& image, const cv::Mat& sky) const;
 
+  /// The clipped pixels along the outline of `sky` (a mask of `image` as computeWithoutBorder
+  /// finds it, CV_8UC1) that the texture keeps out of it: those reached from the mask within the
+  /// border through pixels with a channel clipped, above the LiDAR's highest returns (step 2).
+  /// A clipped pixel has no texture of its own; its window sees the edge of the surface beside
+  /// it. CV_8UC1, 255 = reached. Throws as compute does.
+  cv::Mat clippedOutline(const cv::Mat& image, const cv::Mat& returns, const cv::Mat& sky) const;
+
   /// Per image column, the depth of the nearest return on the highest ring within its column
   /// window (the returns within 3 rows of the highest, the one that bounds step 2), 0 where the
   /// window has none. A blank wall that the mask takes for sky continues above its highest
