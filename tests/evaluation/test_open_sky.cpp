@@ -215,11 +215,12 @@ TEST(SkyMask, TheClippedOutlineIsTheClippedSkyBesideAnEdgeThatTheTextureKeptOut)
   for (int u : {57, 60, 79, 82, 120, 121, 125, 128, 129})
     EXPECT_FALSE(sky(outline, u, 10)) << "column " << u;
   EXPECT_FALSE(sky(outline, 160, 25)); // the clipped wall below its highest returns (row 24)
-  // Without a border nothing is reached; a mask of another size is refused.
+  // Without a border nothing is reached; a mask or returns of another size are refused.
   SkyMask no_border;
   no_border.setBorder(0);
   EXPECT_EQ(cv::countNonZero(no_border.clippedOutline(grey, returns, open)), 0);
   EXPECT_THROW(masker.clippedOutline(grey, returns, open.rowRange(1, kHeight)), InvalidInputError);
+  EXPECT_THROW(masker.clippedOutline(grey, returns.colRange(1, kWidth), open), InvalidInputError);
 }
 
 TEST(SkyMask, RefusesImagesOfAnotherTypeOrSize) {

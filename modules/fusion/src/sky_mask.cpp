@@ -26,6 +26,23 @@ void checkImage(const cv::Mat& image) {
     throw InvalidInputError("sky mask: the image must be CV_8UC1 grey or CV_8UC3 BGR");
 }
 
+void checkMask(const cv::Mat& sky, const cv::Mat& image) {
+  if (sky.type() != CV_8UC1 || sky.size() != image.size())
+    throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
+                            sizeText(sky) + " of type " + std::to_string(sky.type()));
+}
+
+/// The image, its LiDAR returns (CV_32FC1 of its size) and the settings a mask is found with.
+void checkInputs(const cv::Mat& image, const cv::Mat& returns, int column_window, int border) {
+  checkImage(image);
+  if (returns.type() != CV_32FC1 || returns.size() != image.size())
+    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1 of the image's " + sizeText(image) +
+                            ", not " + sizeText(returns) + " of type " + std::to_string(returns.type()));
+  if (column_window < 0 || border < 0)
+    throw ConfigError("sky mask: the column window and the border must be >= 0, not " +
+                      std::to_string(column_window) + " and " + std::to_string(border));
+}
+
 } // namespace
 
 cv::Mat SkyMask::skyLike(const cv::Mat& image) const {
@@ -66,9 +83,7 @@ cv::Mat clippedPixels(const cv::Mat& image, double level) {
 
 cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
   checkImage(image);
-  if (sky.type() != CV_8UC1 || sky.size() != image.size())
-    throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
-                            sizeText(sky) + " of type " + std::to_string(sky.type()));
+  checkMask(sky, image);
   cv::Mat clear(sky.size(), CV_8UC1, cv::Scalar(0));
   const cv::Rect area = cv::boundingRect(sky);
   if (area.empty())
@@ -87,10 +102,8 @@ cv::Mat SkyMask::clearSky(const cv::Mat& image, const cv::Mat& sky) const {
 }
 
 cv::Mat SkyMask::clippedOutline(const cv::Mat& image, const cv::Mat& returns, const cv::Mat& sky) const {
-  checkImage(image);
-  if (sky.type() != CV_8UC1 || sky.size() != image.size())
-    throw InvalidInputError("sky mask: the mask must be CV_8UC1 of the image's " + sizeText(image) + ", not " +
-                            sizeText(sky) + " of type " + std::to_string(sky.type()));
+  checkInputs(image, returns, column_window_, border_);
+  checkMask(sky, image);
   cv::Mat passable = clippedPixels(image, clipped_level_);
   const std::vector<TopReturn> top = topReturns(returns);
   for (int u = 0; u < passable.cols; ++u) // step 2: nothing below the LiDAR's highest returns
@@ -173,13 +186,7 @@ cv::Mat SkyMask::compute(const cv::Mat& image, const cv::Mat& returns) const {
 }
 
 cv::Mat SkyMask::computeWithoutBorder(const cv::Mat& image, const cv::Mat& returns) const {
-  checkImage(image);
-  if (returns.type() != CV_32FC1 || returns.size() != image.size())
-    throw InvalidInputError("sky mask: the LiDAR returns must be CV_32FC1 of the image's " + sizeText(image) +
-                            ", not " + sizeText(returns) + " of type " + std::to_string(returns.type()));
-  if (column_window_ < 0 || border_ < 0)
-    throw ConfigError("sky mask: the column window and the border must be >= 0, not " +
-                      std::to_string(column_window_) + " and " + std::to_string(border_));
+  checkInputs(image, returns, column_window_, border_);
   const std::vector<TopReturn> top = topReturns(returns);
   // Only the rows above the lowest column's highest return can be sky: the steps run on them,
   // with the rows that the texture window reaches below.

@@ -19,10 +19,11 @@ namespace msf {
 /// clipped pixels are withheld too, the sky camera 0 sees beside the pole where the colour
 /// camera sees the pole, and the clipped ones beside an edge that its texture kept out of its
 /// mask (SkyMask::clippedOutline): a clipped pixel has no texture of its own, and camera 0
-/// sees the depth's pixels without parallax. A grey-white sky looks like a blank wall, so there the depth is
-/// withheld only in front of the wall its column's returns allow (SkyMask::wallDepth, by more
-/// than three of the pixel's sigmas, from `weight`), up to where either camera's texture starts:
-/// stereo's paths carry a pole's depth over a pale sky beside it too. Returns the open sky's
+/// sees the depth's pixels without parallax. A grey-white sky looks like a blank wall, so there
+/// the depth is withheld only in front of the wall its column's returns allow
+/// (SkyMask::wallDepth, by more than three of the pixel's sigmas, from `weight`), up to where
+/// either camera's texture starts: stereo's paths carry a pole's depth over a pale sky beside it
+/// too. Returns the open sky's
 /// mask (SkyMask::compute of `image`) with every pixel withheld in it, so that no hole fill gives
 /// them depth again. Throws InvalidInputError, changing nothing, for a depth, weight or grey
 /// image of another type or size.
