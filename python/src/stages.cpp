@@ -164,10 +164,11 @@ void bindStages(py::module_& m) {
            py::arg("sky") = py::none(), py::arg("fill_holes") = false,
            "(H, W) float32 images: the LiDAR's depth and its distance to the nearest real return (None: all "
            "real), the stereo depth and its confidence (None: all 1). left: camera 0's grey image, for the "
-           "facade extension (as the pipeline does). sky: the image to find the open sky in, the colour "
-           "camera's (H, W, 3) uint8 RGB or the (H, W) grey one: with fusion.clear_sky no depth in its clear "
-           "(clipped or blue) sky, nor in its open sky in front of the column's LiDAR returns, as the pipeline "
-           "does. Returns (depth, weight), the weight the inverse "
+           "facade extension and, near an edge, camera 0's own clear sky (as the pipeline does). sky: the "
+           "image to find the open sky in, the colour camera's (H, W, 3) uint8 RGB or the (H, W) grey one: "
+           "with fusion.clear_sky no depth in its clear (clipped or blue) sky, nor in its open sky in front "
+           "of the column's LiDAR returns, nor at left's clipped pixels beside an edge that the texture keeps "
+           "out of the mask, as the pipeline does. Returns (depth, weight), the weight the inverse "
            "variance in m^-2; with free_space=True also the weight of the free space in front of each depth. "
            "fill_holes=True: the small holes (fusion.hole_fill_px) take the nearest depth at weight 0, as in "
            "the engine's depth and msf_fuse's.");
