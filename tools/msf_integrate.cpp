@@ -178,6 +178,7 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     free.sky = sky.mask;
     free.sky_camera = image.empty() ? frame.camera : camera;
     free.sky_column_depth = sky.column_depth;
+    free.sky_unbounded = sky.unbounded;
     integrator.integrateFrame(frame, T_world_cam, free);
     const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
     integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;

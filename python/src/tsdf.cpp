@@ -78,6 +78,7 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
       free.sky = open_sky.mask;
       free.sky_camera = frame.camera;
       free.sky_column_depth = std::move(open_sky.column_depth);
+      free.sky_unbounded = open_sky.unbounded;
     }
     tsdf.integrator.integrateFrame(frame, T_world_cam, free);
   });

@@ -114,6 +114,10 @@ TEST(OpenSky, AClearSkyGivesNoDepth) {
   EXPECT_GT(cv::countNonZero(had & clear), 3000);
   EXPECT_EQ(cv::countNonZero(has & clear), 0);
   EXPECT_GT(cv::countNonZero((with.stereo_depth > 0.f) & clear), 3000); // the stages' own images are kept
+  // The clear sky that the map carves past the returns: within the open sky, only with clear_sky.
+  EXPECT_TRUE(without.clear_sky.empty());
+  EXPECT_GT(cv::countNonZero(with.clear_sky), 10000);
+  EXPECT_EQ(cv::countNonZero(with.clear_sky & ~(clear & with.sky)), 0);
   cv::Mat differs;
   cv::compare(without.fused.depth, with.fused.depth, differs, cv::CMP_NE);
   EXPECT_EQ(cv::countNonZero(differs & ~clear_in_either), 0);
@@ -143,7 +147,8 @@ TEST(OpenSky, TheHoleFillKeepsOutOfTheSkyHoweverTheMapCarves) {
 
 TEST(OpenSky, AFusedCloudCarriesTheFramesOpenSky) {
   // What msf_fuse writes (field sky_depth) and msf_integrate and msfusion read back: the
-  // frame's open sky and each column's depth of its highest LiDAR return, as sky carving takes them.
+  // frame's open sky, each column's depth of its highest LiDAR return and the clear sky, whose
+  // rays nothing bounds, as sky carving takes them.
   MSF_REQUIRE_KITTI();
   const msf::Sequence sequence(drive());
   msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig());
@@ -153,15 +158,22 @@ TEST(OpenSky, AFusedCloudCarriesTheFramesOpenSky) {
   pcl::toPCLPointCloud2(msf::fusedCloud(r, sequence.calibration()), blob);
   const msf::OpenSky sky = msf::openSkyOf(msf::readSkyDepth(blob, "fused"));
   EXPECT_EQ(cv::norm(sky.mask, r.sky, cv::NORM_INF), 0.0);
+  ASSERT_EQ(r.clear_sky.size(), r.sky.size());
+  EXPECT_GT(cv::countNonZero(r.clear_sky), 10000); // a blue sky
+  EXPECT_EQ(cv::countNonZero(r.clear_sky & ~r.sky), 0);
   std::size_t bounded = 0;
   for (int u = 0; u < r.sky.cols; ++u) {
-    if (cv::countNonZero(r.sky.col(u)) == 0)
-      continue;
     const auto column = static_cast<std::size_t>(u);
+    const bool has_return = r.sky_column_depth[column] > 0.f;
+    // Unbounded: the clear sky, and the sky of a column without a return.
+    const cv::Mat unbounded = has_return ? r.clear_sky.col(u) : r.sky.col(u);
+    EXPECT_EQ(cv::norm(sky.unbounded.col(u), unbounded, cv::NORM_INF), 0.0) << u;
+    if (cv::countNonZero(r.sky.col(u) & ~r.clear_sky.col(u)) == 0)
+      continue;
     EXPECT_EQ(sky.column_depth[column], r.sky_column_depth[column]) << u;
-    bounded += r.sky_column_depth[column] > 0.f;
+    bounded += has_return;
   }
-  EXPECT_GT(bounded, 100u); // most of the sky's columns have a return below it
+  EXPECT_GT(bounded, 100u); // most of the grey-white sky's columns have a return below it
   // A cloud without the field carries no sky; a field of another type is refused, named.
   pcl::toPCLPointCloud2(pcl::PointCloud<pcl::PointXYZ>(4, 3), blob);
   EXPECT_TRUE(msf::readSkyDepth(blob, "plain").empty());

@@ -17,6 +17,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace msf {
@@ -158,6 +159,54 @@ TEST(SkyCarving, KeepsAWallTheMaskTakesForSkyInFrontOfItsReturns) {
   EXPECT_LT(bounded.van_top, truth.van_top * 2 / 3);
 }
 
+/// A wall to the right, 4 m off the camera's path and 2.5 m above it (`widened`: its top 0.4 m
+/// higher, as a far frame's facade extension can carry it over what stands behind).
+AnalyticScene lowWall(bool widened) {
+  AnalyticScene s;
+  s.addHalfSpace(Eigen::Vector3d(0, -1, 0), -1.65);
+  const double top = widened ? 2.9 : 2.5;
+  s.addBox(Eigen::Vector3d(4.2, (1.65 - top) / 2, 25), Eigen::Vector3d(0.2, (1.65 + top) / 2, 20));
+  return s;
+}
+
+TEST(SkyCarving, TheClearSkyClearsAWallsWidenedTopThatLiesAtItsReturnsDepth) {
+  // Frames 0-2 integrate the wall 0.4 m too high; frames 3-6 see its true top against the sky. A
+  // sky ray just over the top meets the widened band at the depth of the column's highest return
+  // (the wall's own), where the bound stops; the clear sky's rays go on through it.
+  const PinholeCamera camera = test::kittiCamera();
+  auto drive = [&](bool clear) {
+    TsdfVolume volume(0.1, 0.3);
+    TsdfIntegrator::Config config;
+    TsdfIntegrator integrator(volume, config);
+    for (int i = 0; i <= 6; ++i) {
+      const AnalyticScene scene = lowWall(i <= 2);
+      integrator.integrate(test::renderFrame(scene, camera, drivePose(i), 0.0), drivePose(i));
+      if (i <= 2)
+        continue;
+      const cv::Mat sky = openSky(scene, camera, drivePose(i));
+      integrator.carveSky(sky, camera, drivePose(i), 1111.f, topReturnDepth(scene, camera, drivePose(i)),
+                          clear ? sky : cv::Mat());
+    }
+    TriangleMesh mesh;
+    MarchingCubes().extract(volume, mesh);
+    std::size_t band = 0, wall = 0;
+    for (const auto& v : mesh.vertices) {
+      if (!(v.x() > 3.8f && v.x() < 4.2f && v.z() > 16.f && v.z() < 21.f))
+        continue;
+      band += v.y() < -2.6f;
+      wall += v.y() > -2.4f && v.y() < 0.f;
+    }
+    std::printf("  clear sky %d: band %zu vertices, wall %zu\n", clear, band, wall);
+    return std::make_pair(band, wall);
+  };
+  const auto [band_bounded, wall_bounded] = drive(false);
+  const auto [band_clear, wall_clear] = drive(true);
+  EXPECT_GT(band_bounded, 100u); // the bound keeps it: 0.4 m x 5 m of face
+  EXPECT_LT(band_clear, band_bounded / 10);
+  EXPECT_GT(wall_bounded, 1000u);
+  EXPECT_GE(wall_clear, wall_bounded * 99 / 100); // the wall below its top stays whole
+}
+
 TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
   // A wall seen from the street; a mask that holds every pixel but the wall's leaves it whole,
   // one that holds it too clears it.
@@ -229,6 +278,10 @@ TEST(SkyCarving, OffEmptyOrRefused) {
               integrator.carveSky(everything, camera, drivePose(0), 1111.f, std::vector<float>(10, 5.f));
             }),
             "carveSky: the column depths must be one per image column (1241), not 10");
+  EXPECT_EQ(test::errorOf([&] {
+              integrator.carveSky(everything, camera, drivePose(0), 1111.f, {}, cv::Mat(10, 10, CV_8UC1));
+            }),
+            "carveSky: the unbounded pixels must be a CV_8UC1 mask of the sky's 1241x376, not 10x10 of type 0");
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), 0.f), InvalidInputError);
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), std::nanf("")), InvalidInputError);
   EXPECT_EQ(vertices(volume), before);

@@ -42,7 +42,7 @@ cv::Mat inFrontOfEveryWall(const cv::Mat& depth, const cv::Mat& weight, const st
 } // namespace
 
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& grey, const cv::Mat& returns,
-                         cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight) {
+                         cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight, cv::Mat* clear_sky) {
   const std::initializer_list<cv::Mat*> images = {&depth, &weight, &free_weight};
   for (const cv::Mat* values : images) // all checked before any is changed
     if (!values->empty() && (values->type() != CV_32FC1 || values->size() != image.size()))
@@ -60,6 +60,8 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
                sky.clippedOutline(grey, returns, open_in_grey);
     open_in_both &= open_in_grey;
   }
+  if (clear_sky)
+    *clear_sky = sky.clearSky(image, open) & open_in_both;
   if (!depth.empty())
     withheld |= inFrontOfEveryWall(depth, weight, sky.wallDepth(returns), open_in_both);
   for (cv::Mat* values : images)

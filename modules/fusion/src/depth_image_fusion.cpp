@@ -90,6 +90,7 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
   if (config_.facade_extension && !left_.empty())
     extendFacades(left_, calibration_, config_, fused_depth, weight, free_weight);
   open_sky_.release();
+  clear_sky_.release();
   returns_.release();
   if (sky_image_.empty())
     return;
@@ -99,7 +100,7 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
                             "x" + std::to_string(size.height));
   returns_ = realReturns(lidar, distance);
   if (config_.clear_sky)
-    open_sky_ = withholdClearSky(sky_, sky_image_, left_, returns_, fused_depth, weight, free_weight);
+    open_sky_ = withholdClearSky(sky_, sky_image_, left_, returns_, fused_depth, weight, free_weight, &clear_sky_);
 }
 
 void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const {

@@ -233,6 +233,7 @@ OpenSky openSkyOf(const cv::Mat& sky_depth) {
     throw InvalidInputError("sky_depth must be one float32 per pixel (CV_32FC1)");
   OpenSky sky;
   sky.mask = cv::Mat::zeros(sky_depth.size(), CV_8UC1);
+  sky.unbounded = cv::Mat::zeros(sky_depth.size(), CV_8UC1);
   sky.column_depth.assign(static_cast<std::size_t>(sky_depth.cols), 0.f);
   for (int v = 0; v < sky_depth.rows; ++v) {
     const float* depth = sky_depth.ptr<float>(v);
@@ -240,7 +241,10 @@ OpenSky openSkyOf(const cv::Mat& sky_depth) {
       if (std::isnan(depth[u]))
         continue;
       sky.mask.ptr<std::uint8_t>(v)[u] = 255;
-      sky.column_depth[static_cast<std::size_t>(u)] = std::isfinite(depth[u]) ? depth[u] : 0.f;
+      if (std::isfinite(depth[u]))
+        sky.column_depth[static_cast<std::size_t>(u)] = depth[u];
+      else
+        sky.unbounded.ptr<std::uint8_t>(v)[u] = 255;
     }
   }
   return sky;

@@ -10,6 +10,7 @@ pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const C
   const DepthFrame& fused = result.fused;
   const cv::Mat& free_weight = fused.free_space_weight.empty() ? fused.weight : fused.free_space_weight;
   const bool has_sky = !result.sky.empty() && result.sky.size() == fused.depth.size();
+  const bool has_clear = has_sky && result.clear_sky.size() == result.sky.size();
   pcl::PointCloud<PointXYZRGBWeight> cloud;
   depthImageToCloud(fused.depth, calibration, 0, cloud);
   for (int v = 0; v < fused.depth.rows; ++v)
@@ -23,9 +24,9 @@ pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const C
       p.weight = fused.weight.at<float>(v, u);
       p.free_space_weight = free_weight.at<float>(v, u);
       const bool sky = has_sky && result.sky.at<std::uint8_t>(v, u) != 0;
-      p.sky_depth = skyDepth(sky, sky && static_cast<std::size_t>(u) < result.sky_column_depth.size()
-                                      ? result.sky_column_depth[static_cast<std::size_t>(u)]
-                                      : 0.f);
+      const bool bounded = sky && !(has_clear && result.clear_sky.at<std::uint8_t>(v, u) != 0) &&
+                           static_cast<std::size_t>(u) < result.sky_column_depth.size();
+      p.sky_depth = skyDepth(sky, bounded ? result.sky_column_depth[static_cast<std::size_t>(u)] : 0.f);
     }
   return cloud;
 }

@@ -150,6 +150,7 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
 
 void Reconstructor::computeSky(FrameResult& result) {
   stages_->fusion.findOpenSky(result.sky, result.sky_column_depth);
+  result.clear_sky = stages_->fusion.getClearSky();
 }
 
 bool Reconstructor::lidarBeforeStereo() const {
@@ -196,6 +197,7 @@ TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCa
   free.sky = result.sky;
   free.sky_camera = sky_camera;
   free.sky_column_depth = result.sky_column_depth;
+  free.sky_unbounded = result.clear_sky;
   return free;
 }
 

@@ -147,7 +147,7 @@ void raysBeyondRange(const cv::Mat& depth, const cv::Mat& weight, float range, f
 } // namespace
 
 void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-                              float weight, const std::vector<float>& column_depth) {
+                              float weight, const std::vector<float>& column_depth, const cv::Mat& unbounded) {
   if (!config_.sky_carving || !config_.space_carving || sky.empty())
     return;
   if (sky.type() != CV_8UC1 || sky.cols != camera.width || sky.rows != camera.height)
@@ -157,6 +157,11 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
   if (!column_depth.empty() && column_depth.size() != static_cast<std::size_t>(camera.width))
     throw InvalidInputError("carveSky: the column depths must be one per image column (" +
                             std::to_string(camera.width) + "), not " + std::to_string(column_depth.size()));
+  if (!unbounded.empty() && (unbounded.type() != CV_8UC1 || unbounded.size() != sky.size()))
+    throw InvalidInputError("carveSky: the unbounded pixels must be a CV_8UC1 mask of the sky's " +
+                            std::to_string(sky.cols) + "x" + std::to_string(sky.rows) + ", not " +
+                            std::to_string(unbounded.cols) + "x" + std::to_string(unbounded.rows) + " of type " +
+                            std::to_string(unbounded.type()));
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveSky: the weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
@@ -165,9 +170,10 @@ void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, c
   if (rect.empty() || !(w > 0.f))
     return;
   const float wall_margin = static_cast<float>(volume_.truncation() + volume_.voxelSize());
-  const auto inFrontOfWall = [&](int u, int, float z) {
+  const auto inFrontOfWall = [&](int u, int v, float z) {
     const bool free = column_depth.empty() || !(column_depth[static_cast<std::size_t>(u)] > 0.f) ||
-                      z < column_depth[static_cast<std::size_t>(u)] - wall_margin;
+                      z < column_depth[static_cast<std::size_t>(u)] - wall_margin ||
+                      (!unbounded.empty() && unbounded.ptr<std::uint8_t>(v)[u] != 0);
     return free ? w : 0.f;
   };
   carveAlongRays(volume_, sky, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),

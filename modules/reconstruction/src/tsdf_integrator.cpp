@@ -651,7 +651,7 @@ void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isomet
     carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam,
                   carvedWeights(frame, integrated));
   if (!free.sky.empty())
-    carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth);
+    carveSky(free.sky, free.sky_camera, T_world_cam, free.weight, free.sky_column_depth, free.sky_unbounded);
   carveBeyondRange(frame, T_world_cam, free.weight);
 }
 

@@ -25,10 +25,12 @@ namespace msf {
 /// either camera's texture starts: stereo's paths carry a pole's depth over a pale sky beside it
 /// too. Returns the open sky's
 /// mask (SkyMask::compute of `image`) with every pixel withheld in it, so that no hole fill gives
-/// them depth again. Throws InvalidInputError, changing nothing, for a depth, weight or grey
-/// image of another type or size.
+/// them depth again. `clear_sky`, when given, receives the mask's clear pixels (CV_8UC1, 255;
+/// in camera 0's own open sky too, given `grey`): rays that nothing but the sky stopped, which
+/// the map may carve past the returns (TsdfIntegrator::carveSky). Throws InvalidInputError,
+/// changing nothing, for a depth, weight or grey image of another type or size.
 cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat& grey, const cv::Mat& returns,
-                         cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight);
+                         cv::Mat& depth, cv::Mat& weight, cv::Mat& free_weight, cv::Mat* clear_sky = nullptr);
 
 /// The image to find camera 0's open sky in: the colour camera's (BGR) when it has camera 0's
 /// `size` (rectified, one image plane: it sees the far sky at camera 0's pixels, and colour tells

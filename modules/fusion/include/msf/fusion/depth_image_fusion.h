@@ -47,6 +47,10 @@ public:
   /// The open sky (SkyMask, CV_8UC1, 255 = sky) the last fuse() found; empty when it had no sky
   /// image or clear_sky is off.
   const cv::Mat& getOpenSky() const { return open_sky_; }
+  /// Its clear pixels (CV_8UC1, 255; withholdClearSky's clear_sky): rays that nothing but the sky
+  /// stopped, which the map carves past the LiDAR's returns (TsdfIntegrator::carveSky). Empty
+  /// when getOpenSky() is.
+  const cv::Mat& getClearSky() const { return clear_sky_; }
   /// The open sky in the last fuse()'s sky image (CV_8UC1, 255 = sky): getOpenSky()'s when
   /// clear_sky found it, else found now (SkyMask); and per image column the depth of the
   /// LiDAR's highest return (SkyMask::topReturnDepth, 0 where there is none), which bounds
@@ -76,6 +80,7 @@ private:
   LidarParallax parallax_;
   cv::Mat left_;                        ///< setInputImage's
   cv::Mat sky_image_, open_sky_;        ///< setSkyImage's, and the last fuse's open sky
+  cv::Mat clear_sky_;                   ///< the last fuse's clear sky
   cv::Mat returns_;                     ///< the last fuse's real LiDAR returns, with a sky image
   SkyMask sky_;
   cv::Mat edge_;                        ///< the LiDAR's edge cue, kept between frames

@@ -113,8 +113,9 @@ private:
 };
 
 /// A pixel's sky_depth as the fused cloud carries it (PointXYZRGBWeight): NaN where the pixel is
-/// not open sky, else the depth of its column's highest LiDAR return (topReturnDepth), +inf
-/// where that column has none.
+/// not open sky, else the depth that bounds its ray, the depth of its column's highest LiDAR
+/// return (topReturnDepth), +inf where nothing does (`column_depth` 0: the column has no return,
+/// or the pixel is clear sky, SkyMask::clearSky).
 inline float skyDepth(bool open_sky, float column_depth) {
   if (!open_sky)
     return std::numeric_limits<float>::quiet_NaN();
@@ -122,11 +123,13 @@ inline float skyDepth(bool open_sky, float column_depth) {
 }
 
 /// The open sky that a sky_depth image carries (as skyDepth writes it), as
-/// TsdfIntegrator::carveSky takes it: the mask (255 where the pixel is open sky) and each
-/// column's depth of its highest LiDAR return (0 where the column has none or no open sky).
+/// TsdfIntegrator::carveSky takes it: the mask (255 where the pixel is open sky), each
+/// column's depth of its highest LiDAR return (0 where the column has none or no open sky) and
+/// the pixels whose ray nothing bounds (+inf).
 struct OpenSky {
   cv::Mat mask;                    ///< CV_8UC1
   std::vector<float> column_depth; ///< one per column
+  cv::Mat unbounded;               ///< CV_8UC1, 255 where sky_depth is +inf
 };
 
 /// Throws InvalidInputError when `sky_depth` is not CV_32FC1.

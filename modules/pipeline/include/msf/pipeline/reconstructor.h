@@ -91,6 +91,9 @@ struct FrameResult {
   /// Per image column, the depth of the LiDAR's highest return near it (SkyMask::topReturnDepth):
   /// how far the sky's rays are carved there.
   std::vector<float> sky_column_depth;
+  /// The open sky's clear pixels (DepthImageFusion::getClearSky, CV_8UC1; empty without them):
+  /// only the sky looks like them, so their rays are carved past the column's returns.
+  cv::Mat clear_sky;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what

@@ -186,7 +186,8 @@ public:
         "also carve with the LiDAR's scan where the camera's depth does not, or less (outside its view, and "
         "where a voxel's four pixels carve with less than the LiDAR's weight), this far from the LiDAR, m (0: off)");
       k("sky_carving", sky_carving,
-        "also carve along the rays of the frame's open sky (SkyMask), in front of the LiDAR's highest returns");
+        "also carve along the rays of the frame's open sky (SkyMask), in front of the LiDAR's highest returns (the "
+        "clear sky's past them)");
       k("far_carving", far_carving, "also carve along the rays whose depth lies beyond max_depth_m, up to it");
       k("weight_dropoff", weight_dropoff, "behind the surface the weight falls to 0 at the band's end");
       k("silhouette_band", silhouette_band,
@@ -290,11 +291,15 @@ public:
   /// times carving_weight. `column_depth` (one per image column, or empty: no bound) bounds each
   /// column's rays: where it is positive (the depth of the LiDAR's highest return there,
   /// SkyMask::topReturnDepth), only voxels nearer by more than the truncation and a voxel are
-  /// carved, so that a blank wall above the returns that the mask takes for sky is kept. Throws
-  /// InvalidInputError for a mask of another type or size, a bound of another length, a weight
-  /// that is not positive and finite, or a pose that is not rigid.
+  /// carved, so that a blank wall above the returns that the mask takes for sky is kept. The
+  /// pixels of `unbounded` (CV_8UC1 of the mask's size, non-zero; or empty: none) are carved along
+  /// their whole ray all the same: the clear sky (SkyMask::clearSky), clipped or blue as a wall
+  /// rarely is, so that a wall's top widened over the sky by an earlier frame, which lies at the
+  /// returns' depth, is cleared too. Throws InvalidInputError for a mask of another type or size,
+  /// a bound of another length, a weight that is not positive and finite, or a pose that is not
+  /// rigid.
   void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight,
-                const std::vector<float>& column_depth = {});
+                const std::vector<float>& column_depth = {}, const cv::Mat& unbounded = {});
 
   /// Free space that the rays beyond the range show (Config::far_carving, with space_carving): a
   /// pixel of `frame` whose depth lies beyond max_depth_m by more than truncation_sigmas of its
@@ -315,6 +320,7 @@ public:
     cv::Mat sky;                         ///< the open sky (carveSky), or empty
     PinholeCamera sky_camera;            ///< the camera of the sky's mask
     std::vector<float> sky_column_depth; ///< carveSky's bound per column, or empty
+    cv::Mat sky_unbounded;               ///< the sky's pixels carved past that bound, or empty
   };
 
   /// A frame as msf_reconstruct integrates it: its depth (integrate), then the free space its

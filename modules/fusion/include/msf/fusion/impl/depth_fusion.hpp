@@ -126,8 +126,10 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
   image_fusion_.setSkyImage(skyImage(color_, left_, size));
   image_fusion_.fuse(lidar, distance, stereo_depth_, stereo_confidence_, fused_depth_, &fused_weight_,
                      &fused_free_weight_);
-  if constexpr (detail::has_sky_depth_v<PointOutT>)
+  if constexpr (detail::has_sky_depth_v<PointOutT>) {
     image_fusion_.findOpenSky(sky_, sky_column_depth_);
+    clear_sky_ = image_fusion_.getClearSky();
+  }
   // The colour camera's at the fused points, as the pipeline colours them (camera 0's grey where
   // that camera does not see); without it, or where neither has a colour, the stereo points'.
   if (color_.empty() || left_.empty())
@@ -229,7 +231,8 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOu
           p.free_space_weight = fused_free_weight_.at<float>(v, u);
         if constexpr (detail::has_sky_depth_v<PointOutT>) {
           const bool sky = in_image && !sky_.empty() && sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
-          p.sky_depth = skyDepth(sky, sky ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
+          const bool clear = sky && !clear_sky_.empty() && clear_sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
+          p.sky_depth = skyDepth(sky, sky && !clear ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
         }
       }
     }
