@@ -6,8 +6,9 @@ from ._core import _read_depth_cloud
 class DepthCloud(tuple):
     """(depth, weight, color) of an organized .pcd, unpacked as a tuple of three, with what a fused
     cloud carries beside them as attributes: `free_space_weight` and `sky_depth` (NaN where the
-    pixel is not open sky, else the depth its ray passed every surface to; +inf where no LiDAR
-    return bounds it). TsdfVolume.integrate takes them all, as msf_integrate reads them."""
+    pixel is not open sky, else the depth its ray passed every surface to; +inf in the clear sky,
+    clipped or blue, and where no LiDAR return bounds it). TsdfVolume.integrate takes them all, as
+    msf_integrate reads them."""
 
     def __new__(cls, depth, weight, color, free_space_weight, sky_depth):
         cloud = super().__new__(cls, (depth, weight, color))

@@ -63,7 +63,8 @@ struct EIGEN_ALIGN16 PointXYZRGBConfidence {
 /// beside the depth: `free_space_weight`, the weight of the free space in front of it (the
 /// fusion's differs from `weight` where it averaged two samples that disagree), and
 /// `sky_depth`, NaN where the pixel is not open sky, else the depth up to which its ray passed
-/// every surface (the LiDAR's highest return in its column, +inf where the column has none).
+/// every surface (the LiDAR's highest return in its column; +inf in the clear sky, clipped or
+/// blue, and where the column has none).
 /// Registered, so .pcd files keep the field names and pcl_viewer still colours by `rgb`.
 struct EIGEN_ALIGN16 PointXYZRGBWeight {
   PCL_ADD_POINT4D;
