@@ -294,10 +294,10 @@ public:
   /// carved, so that a blank wall above the returns that the mask takes for sky is kept. The
   /// pixels of `unbounded` (CV_8UC1 of the mask's size, non-zero; or empty: none) are carved along
   /// their whole ray all the same: the clear sky (SkyMask::clearSky), clipped or blue as a wall
-  /// rarely is, so that a wall's top widened over the sky by an earlier frame, which lies at the
-  /// returns' depth, is cleared too. Throws InvalidInputError for a mask of another type or size,
-  /// a bound of another length, a weight that is not positive and finite, or a pose that is not
-  /// rigid.
+  /// rarely is, so that a wall's top that an earlier frame carried too high (against the sky now,
+  /// at the returns' depth) is cleared too. Throws InvalidInputError for a mask of another type or
+  /// size, a bound of another length, a weight that is not positive and finite, or a pose that is
+  /// not rigid.
   void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight,
                 const std::vector<float>& column_depth = {}, const cv::Mat& unbounded = {});
 
