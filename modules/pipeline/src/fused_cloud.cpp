@@ -24,9 +24,10 @@ pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const C
       p.weight = fused.weight.at<float>(v, u);
       p.free_space_weight = free_weight.at<float>(v, u);
       const bool sky = has_sky && result.sky.at<std::uint8_t>(v, u) != 0;
-      const bool bounded = sky && !(has_clear && result.clear_sky.at<std::uint8_t>(v, u) != 0) &&
-                           static_cast<std::size_t>(u) < result.sky_column_depth.size();
-      p.sky_depth = skyDepth(sky, bounded ? result.sky_column_depth[static_cast<std::size_t>(u)] : 0.f);
+      const bool clear = has_clear && result.clear_sky.at<std::uint8_t>(v, u) != 0;
+      const auto column = static_cast<std::size_t>(u);
+      const float column_depth = column < result.sky_column_depth.size() ? result.sky_column_depth[column] : 0.f;
+      p.sky_depth = skyDepth(sky, clear, column_depth);
     }
   return cloud;
 }

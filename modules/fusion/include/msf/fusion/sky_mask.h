@@ -114,12 +114,12 @@ private:
 
 /// A pixel's sky_depth as the fused cloud carries it (PointXYZRGBWeight): NaN where the pixel is
 /// not open sky, else the depth that bounds its ray, the depth of its column's highest LiDAR
-/// return (topReturnDepth), +inf where nothing does (`column_depth` 0: the column has no return,
-/// or the pixel is clear sky, SkyMask::clearSky).
-inline float skyDepth(bool open_sky, float column_depth) {
+/// return (topReturnDepth), +inf where nothing does: in the clear sky (SkyMask::clearSky), and
+/// where the column has no return (`column_depth` 0).
+inline float skyDepth(bool open_sky, bool clear_sky, float column_depth) {
   if (!open_sky)
     return std::numeric_limits<float>::quiet_NaN();
-  return column_depth > 0.f ? column_depth : std::numeric_limits<float>::infinity();
+  return !clear_sky && column_depth > 0.f ? column_depth : std::numeric_limits<float>::infinity();
 }
 
 /// The open sky that a sky_depth image carries (as skyDepth writes it), as

@@ -232,7 +232,7 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOu
         if constexpr (detail::has_sky_depth_v<PointOutT>) {
           const bool sky = in_image && !sky_.empty() && sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
           const bool clear = sky && !clear_sky_.empty() && clear_sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
-          p.sky_depth = skyDepth(sky, sky && !clear ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
+          p.sky_depth = skyDepth(sky, clear, sky ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
         }
       }
     }
