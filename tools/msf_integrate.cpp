@@ -8,7 +8,6 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
 #include <msf/fusion/fusion_config.h>
-#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/poses.h>
@@ -48,11 +47,9 @@ pcl::PointCloud<pcl::PointXYZI> loadScan(const std::string& path) {
 /// The open sky a fused cloud carries (field sky_depth, msf_fuse's), in the part of the cloud
 /// that is the camera's image (`image`; empty: the whole cloud). Empty when the cloud has no
 /// such field.
-msf::OpenSky readSky(const pcl::PCLPointCloud2& blob, const cv::Rect& image, const std::string& what) {
+cv::Mat skyDepthInImage(const pcl::PCLPointCloud2& blob, const cv::Rect& image, const std::string& what) {
   const cv::Mat sky_depth = msf::readSkyDepth(blob, what);
-  if (sky_depth.empty())
-    return {};
-  return msf::openSkyOf(image.empty() ? sky_depth : sky_depth(image));
+  return sky_depth.empty() || image.empty() ? sky_depth : sky_depth(image);
 }
 
 /// What the command line sets.
@@ -170,15 +167,12 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     std::optional<msf::ScanFreeSpace> scan;
     if (!frames.scans.empty())
       scan.emplace(loadScan(frames.scans[i]), frames.swept_scans);
-    const msf::OpenSky sky = readSky(blob, image, what);
     msf::TsdfIntegrator::FreeSpace free;
     free.weight = lidar_weight;
     free.scan = scan ? &*scan : nullptr;
     free.T_world_lidar = T_world_cam * calibration.T_cam0_velo;
-    free.sky = sky.mask;
+    free.sky_depth = skyDepthInImage(blob, image, what);
     free.sky_camera = image.empty() ? frame.camera : camera;
-    free.sky_column_depth = sky.column_depth;
-    free.sky_unbounded = sky.unbounded;
     integrator.integrateFrame(frame, T_world_cam, free);
     const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
     integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;

@@ -5,7 +5,6 @@
 #include "bindings.h"
 
 #include <msf/common/exceptions.h>
-#include <msf/fusion/sky_mask.h>
 #include <msf/io/calibration.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/reconstruction/depth_frame.h>
@@ -73,13 +72,8 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
     // sky and of its rays beyond the range (each as the configuration's carving allows).
     TsdfIntegrator::FreeSpace free;
     free.weight = tsdf.free_space_weight;
-    if (!sky.empty()) {
-      OpenSky open_sky = openSkyOf(sky);
-      free.sky = open_sky.mask;
-      free.sky_camera = frame.camera;
-      free.sky_column_depth = std::move(open_sky.column_depth);
-      free.sky_unbounded = open_sky.unbounded;
-    }
+    free.sky_depth = sky;
+    free.sky_camera = frame.camera;
     tsdf.integrator.integrateFrame(frame, T_world_cam, free);
   });
 }
@@ -130,7 +124,8 @@ void bindTsdf(py::module_& m) {
            "A depth image seen from `pose` (4x4 T_world_cam): depth (H, W) float32 metres (0 = none), camera a "
            "PinholeCamera (or a Calibration: its camera 0) of that size; optional (H, W) float32 weight (inverse "
            "variance, m^-2: DepthFusion's) and free_space_weight, (H, W, 3) uint8 RGB color, (H, W) float32 "
-           "sky_depth (NaN where not open sky: a DepthCloud's). As msf_integrate does, the rays of the open sky "
+           "sky_depth (a DepthCloud's: NaN where not open sky, else the depth its ray is carved to in front of, +inf "
+           "for the whole ray; 0 or below is refused). As msf_integrate does, the rays of the open sky "
            "and those beyond tsdf_integrator.max_depth_m then carve the free space they passed (sky_carving, "
            "far_carving, with space_carving).")
       .def("integrate_points", &integratePoints, py::arg("points"), py::arg("pose"), py::arg("colors") = py::none(),

@@ -13,6 +13,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
 using namespace msf;
 
 namespace {
@@ -128,6 +133,35 @@ TEST(SkyMask, GivesEachColumnTheDepthOfItsHighestReturn) {
   EXPECT_EQ(ring_depth[105], 12.f);
   EXPECT_EQ(ring_depth[92], 30.f); // only the far wall within its window
   EXPECT_THROW(SkyMask().topReturnDepth(cv::Mat(kHeight, kWidth, CV_8UC1)), InvalidInputError);
+}
+
+TEST(SkyMask, ItsSkyDepthBoundsEachRayByItsColumnOrNotAtAllInTheClearSky) {
+  // Rows 0-1 of four columns are sky; column 0 has no return below it, columns 1-3 at 5, 5 and
+  // 7 m; pixel (2, 0) is clear sky. Off the sky NaN; unbounded rays +inf.
+  cv::Mat sky(3, 4, CV_8UC1, cv::Scalar(0));
+  sky.rowRange(0, 2).setTo(255);
+  cv::Mat clear(sky.size(), CV_8UC1, cv::Scalar(0));
+  clear.at<std::uint8_t>(0, 2) = 255;
+  const std::vector<float> column_depth{0.f, 5.f, 5.f, 7.f};
+  const float inf = std::numeric_limits<float>::infinity();
+  const cv::Mat depth = skyDepthImage(sky, column_depth, clear);
+  ASSERT_EQ(depth.type(), CV_32FC1);
+  ASSERT_EQ(depth.size(), sky.size());
+  const std::vector<std::vector<float>> expected{{inf, 5.f, inf, 7.f}, {inf, 5.f, 5.f, 7.f}};
+  for (int v = 0; v < 2; ++v)
+    for (int u = 0; u < 4; ++u)
+      EXPECT_EQ(depth.at<float>(v, u), expected[static_cast<std::size_t>(v)][static_cast<std::size_t>(u)])
+          << u << "," << v;
+  for (int u = 0; u < 4; ++u)
+    EXPECT_TRUE(std::isnan(depth.at<float>(2, u))) << u;
+  EXPECT_EQ(skyDepthImage(sky, column_depth).at<float>(0, 2), 5.f); // without a clear sky: the bound
+  // What does not describe one image's sky is refused, named.
+  EXPECT_EQ(test::errorOf([&] { skyDepthImage(cv::Mat(3, 4, CV_32FC1), column_depth); }),
+            "sky depth: the sky mask must be CV_8UC1, not of type 5");
+  EXPECT_EQ(test::errorOf([&] { skyDepthImage(sky, std::vector<float>(3)); }),
+            "sky depth: the column depths must be one per image column (4), not 3");
+  EXPECT_EQ(test::errorOf([&] { skyDepthImage(sky, column_depth, cv::Mat(4, 3, CV_8UC1)); }),
+            "sky depth: the clear sky must be a CV_8UC1 mask of the sky's 4x3, not 3x4 of type 0");
 }
 
 TEST(SkyMask, AWallsDepthIsTheFartherSidesSoACrownBesideAColumnDoesNotStandForIt) {

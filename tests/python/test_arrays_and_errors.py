@@ -185,6 +185,21 @@ def test_poses_must_be_rigid():
         volume.integrate(depth, np.eye(4), "camera 0")
 
 
+def test_a_sky_depth_bound_of_zero_is_refused_before_the_volume_changes():
+    volume = msfusion.TsdfVolume()
+    camera = msfusion.PinholeCamera(100, 100, 50, 40, 100, 80)
+    depth = np.full((80, 100), 2.0, np.float32)
+    sky = np.full((80, 100), np.nan, np.float32)
+    sky[3, 7] = 0.0
+    with pytest.raises(msfusion.InvalidInputError,
+                       match=r"sky depth at pixel \(7, 3\) is 0\.0+: a pixel's bound is NaN \(not sky\), a depth > 0"):
+        volume.integrate(depth, np.eye(4), camera, sky_depth=sky)
+    assert volume.num_blocks == 0
+    sky[3, 7] = np.inf  # the whole ray
+    volume.integrate(depth, np.eye(4), camera, sky_depth=sky)
+    assert volume.num_blocks > 0
+
+
 def test_a_frame_without_pose_takes_the_odometrys_or_is_refused(calibration, sequence):
     def bare(i):  # the frame as a driver without poses gives it
         f = sequence[i]

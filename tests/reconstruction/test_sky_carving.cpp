@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -65,16 +66,22 @@ struct DriveResult {
   std::size_t wall_upper = 0;  ///< of those, more than 0.5 m above the camera
 };
 
-/// What a frame's sky carving is given: the mask, and the depth that bounds each column (empty:
-/// none).
-struct FrameSky {
-  cv::Mat mask;
-  std::vector<float> column_depth;
-};
-using SkyOfFrame = std::function<FrameSky(const AnalyticScene&, const PinholeCamera&, const Eigen::Isometry3d&)>;
+/// What carveSky takes: NaN off `mask`, on it the depth that bounds its column's rays (`bound`,
+/// one per column) or +inf, the whole ray (where `bound` is empty or 0).
+cv::Mat skyDepth(const cv::Mat& mask, const std::vector<float>& bound = {}) {
+  cv::Mat sky_depth(mask.size(), CV_32FC1, cv::Scalar(std::nanf("")));
+  for (int u = 0; u < mask.cols; ++u) {
+    const float b = bound.empty() ? 0.f : bound[static_cast<std::size_t>(u)];
+    sky_depth.col(u).setTo(b > 0.f ? b : std::numeric_limits<float>::infinity(), mask.col(u));
+  }
+  return sky_depth;
+}
 
-FrameSky trueSky(const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose) {
-  return {openSky(scene, camera, pose), {}};
+/// What a frame's sky carving is given (carveSky's sky_depth).
+using SkyOfFrame = std::function<cv::Mat(const AnalyticScene&, const PinholeCamera&, const Eigen::Isometry3d&)>;
+
+cv::Mat trueSky(const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose) {
+  return skyDepth(openSky(scene, camera, pose));
 }
 
 /// Frames 0-2 see the van; it drives off, and frames 3-8 see the road behind. What the rays
@@ -89,8 +96,7 @@ DriveResult driveAfterTheVan(bool sky_carving, const SkyOfFrame& sky_of = trueSk
     const AnalyticScene scene = road(i <= 2);
     const DepthFrame frame = test::renderFrame(scene, camera, drivePose(i), 0.0);
     integrator.integrate(frame, drivePose(i));
-    const FrameSky sky = sky_of(scene, camera, drivePose(i));
-    integrator.carveSky(sky.mask, camera, drivePose(i), 1111.f, sky.column_depth);
+    integrator.carveSky(sky_of(scene, camera, drivePose(i)), camera, drivePose(i), 1111.f);
   }
   DriveResult r;
   TriangleMesh mesh;
@@ -145,10 +151,10 @@ TEST(SkyCarving, KeepsAWallTheMaskTakesForSkyInFrontOfItsReturns) {
   // rays stop in front of the wall (a vertical plane keeps one depth down a column) and still
   // pass through the van's ghost, which hangs in front of the returns beyond it.
   const auto unboundedSky = [](const AnalyticScene&, const PinholeCamera& camera, const Eigen::Isometry3d&) {
-    return FrameSky{everythingAboveTheHorizon(camera), {}};
+    return skyDepth(everythingAboveTheHorizon(camera));
   };
   const auto boundedSky = [](const AnalyticScene& scene, const PinholeCamera& camera, const Eigen::Isometry3d& pose) {
-    return FrameSky{everythingAboveTheHorizon(camera), topReturnDepth(scene, camera, pose)};
+    return skyDepth(everythingAboveTheHorizon(camera), topReturnDepth(scene, camera, pose));
   };
   const DriveResult truth = driveAfterTheVan(false), unbounded = driveAfterTheVan(true, unboundedSky),
                     bounded = driveAfterTheVan(true, boundedSky);
@@ -184,8 +190,8 @@ TEST(SkyCarving, TheClearSkyClearsAWallsWidenedTopThatLiesAtItsReturnsDepth) {
       if (i <= 2)
         continue;
       const cv::Mat sky = openSky(scene, camera, drivePose(i));
-      integrator.carveSky(sky, camera, drivePose(i), 1111.f, topReturnDepth(scene, camera, drivePose(i)),
-                          clear ? sky : cv::Mat());
+      const std::vector<float> bound = clear ? std::vector<float>() : topReturnDepth(scene, camera, drivePose(i));
+      integrator.carveSky(skyDepth(sky, bound), camera, drivePose(i), 1111.f);
     }
     TriangleMesh mesh;
     MarchingCubes().extract(volume, mesh);
@@ -233,10 +239,10 @@ TEST(SkyCarving, CarvesOnlyAlongTheSkysRays) {
       const float z = depth.at<float>(v, u);
       wall_pixels.at<std::uint8_t>(v, u) = z > 0.f && (u - camera.cx) / camera.fx * z > 3.9 ? 255 : 0;
     }
-  integrator.carveSky(~wall_pixels, camera, drivePose(0), 1111.f);
+  integrator.carveSky(skyDepth(~wall_pixels), camera, drivePose(0), 1111.f);
   EXPECT_GE(wallVertices(), before * 99 / 100); // a voxel at its top edge may round into the sky
   EXPECT_GT(before, 1000u);
-  integrator.carveSky(cv::Mat(depth.size(), CV_8UC1, cv::Scalar(255)), camera, drivePose(0), 1111.f);
+  integrator.carveSky(skyDepth(cv::Mat(depth.size(), CV_8UC1, cv::Scalar(255))), camera, drivePose(0), 1111.f);
   EXPECT_LT(wallVertices(), before / 20);
 }
 
@@ -244,7 +250,7 @@ TEST(SkyCarving, OffEmptyOrRefused) {
   const PinholeCamera camera = test::kittiCamera();
   const AnalyticScene scene = road(true);
   const DepthFrame frame = test::renderFrame(scene, camera, drivePose(0), 0.0);
-  const cv::Mat everything(camera.height, camera.width, CV_8UC1, cv::Scalar(255));
+  const cv::Mat everything = skyDepth(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(255)));
   auto vertices = [](const TsdfVolume& volume) {
     TriangleMesh mesh;
     MarchingCubes().extract(volume, mesh);
@@ -268,20 +274,25 @@ TEST(SkyCarving, OffEmptyOrRefused) {
   integrator.integrate(frame, drivePose(0));
   const std::size_t before = vertices(volume);
   integrator.carveSky(cv::Mat(), camera, drivePose(0), 1111.f); // no sky: nothing
-  integrator.carveSky(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(0)), camera, drivePose(0), 1111.f);
+  integrator.carveSky(skyDepth(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(0))), camera, drivePose(0),
+                      1111.f);
   EXPECT_EQ(vertices(volume), before);
   EXPECT_EQ(test::errorOf([&] {
-              integrator.carveSky(cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)), camera, drivePose(0), 1111.f);
+              integrator.carveSky(cv::Mat(10, 10, CV_32FC1, cv::Scalar(5.f)), camera, drivePose(0), 1111.f);
             }),
-            "carveSky: the sky mask must be CV_8UC1 of the camera's 1241x376, not 10x10 of type 0");
+            "carveSky: the sky depth must be CV_32FC1 of the camera's 1241x376, not 10x10 of type 5");
   EXPECT_EQ(test::errorOf([&] {
-              integrator.carveSky(everything, camera, drivePose(0), 1111.f, std::vector<float>(10, 5.f));
+              integrator.carveSky(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(255)), camera, drivePose(0),
+                                  1111.f);
             }),
-            "carveSky: the column depths must be one per image column (1241), not 10");
-  EXPECT_EQ(test::errorOf([&] {
-              integrator.carveSky(everything, camera, drivePose(0), 1111.f, {}, cv::Mat(10, 10, CV_8UC1));
-            }),
-            "carveSky: the unbounded pixels must be a CV_8UC1 mask of the sky's 1241x376, not 10x10 of type 0");
+            "carveSky: the sky depth must be CV_32FC1 of the camera's 1241x376, not 1241x376 of type 0");
+  for (const float bound : {0.f, -2.f, -std::numeric_limits<float>::infinity()}) {
+    cv::Mat sky_depth = everything.clone();
+    sky_depth.at<float>(7, 30) = bound;
+    const std::string error = test::errorOf([&] { integrator.carveSky(sky_depth, camera, drivePose(0), 1111.f); });
+    EXPECT_EQ(error.rfind("carveSky: the sky depth at pixel (30, 7) is ", 0), 0u) << error;
+    EXPECT_NE(error.find("a pixel's bound is NaN (not sky), a depth > 0 or +inf"), std::string::npos) << error;
+  }
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), 0.f), InvalidInputError);
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), std::nanf("")), InvalidInputError);
   EXPECT_EQ(vertices(volume), before);

@@ -146,6 +146,9 @@ def depth_rows(z_of):
     return rows
 pcd(f + "/sparse.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u if (u + v) % 3 == 0 else None))
 pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
+# The same with msf_fuse's sky_depth field, a bound of 0 at pixel (2, 1): no sky carves to there.
+sky_rows = [r + ["0" if i == 1 * W + 2 else "nan"] for i, r in enumerate(depth_rows(lambda u, v: 5.0 + 0.1 * u))]
+pcd(f + "/sky_zero.pcd", sky_rows, fields="x y z intensity sky_depth")
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
 def volume_pcd(path, fields, sizes, types, rows):
     """A volume .pcd of 0.1 m voxels (ASCII) with the fields given, one row a voxel."""
@@ -363,6 +366,8 @@ check "integrate -trunc 1e6" 1 "truncation_m \(-trunc\) must be > 0 and at most 
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -trunc 1e6
 check "integrate -sweeps 1000000" 1 "tsdf_integrator.sweeps must be in 0..100, not 1000000" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps 1000000
+check "integrate: a sky_depth bound of 0" 1 "sky_zero.pcd': field 'sky_depth' at pixel \(2, 1\) is 0\.0+: a pixel's bound" -- \
+  msf_integrate "$F/sky_zero.pcd" -poses "$F/pose.txt" -o v.pcd
 check "integrate: rotation scaled by 1000" 1 "pose_scaled.txt' line 1 is not a rigid transform" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose_scaled.txt" -o v.pcd
 check "integrate: translation 1e30" 1 "pose_far.txt' line 1 has a translation of 1e\+30 m" -- \

@@ -103,24 +103,27 @@ void DepthImageFusion::fuse(const cv::Mat& lidar_depth, const cv::Mat& lidar_dis
     open_sky_ = withholdClearSky(sky_, sky_image_, left_, returns_, fused_depth, weight, free_weight, &clear_sky_);
 }
 
-void DepthImageFusion::findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const {
-  if (returns_.empty()) {
-    sky.release();
-    column_depth.clear();
+cv::Mat DepthImageFusion::openSkyMask() const {
+  if (returns_.empty())
+    return {};
+  return open_sky_.empty() ? sky_.compute(sky_image_, returns_) : open_sky_;
+}
+
+void DepthImageFusion::findOpenSky(cv::Mat& sky, cv::Mat& sky_depth) const {
+  sky = openSkyMask();
+  if (sky.empty()) {
+    sky_depth.release();
     return;
   }
-  sky = open_sky_.empty() ? sky_.compute(sky_image_, returns_) : open_sky_;
-  column_depth = sky_.topReturnDepth(returns_);
+  sky_depth = skyDepthImage(sky, sky_.topReturnDepth(returns_), clear_sky_);
 }
 
 void DepthImageFusion::fillSmallHoles(cv::Mat& fused_depth, cv::Mat* fused_weight, cv::Mat* free_space_weight) const {
   if (config_.hole_fill_px <= 0)
     return;
-  cv::Mat sky, no_weight;
-  std::vector<float> column_depth;
-  findOpenSky(sky, column_depth);
+  cv::Mat no_weight;
   msf::fillSmallHoles(fused_depth, fused_weight ? *fused_weight : no_weight,
-                      free_space_weight ? *free_space_weight : no_weight, sky, config_.hole_fill_px);
+                      free_space_weight ? *free_space_weight : no_weight, openSkyMask(), config_.hole_fill_px);
 }
 
 void fuseDepthImages(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance, const cv::Mat& stereo_depth,

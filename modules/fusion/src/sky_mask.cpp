@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 namespace msf {
@@ -228,26 +230,30 @@ void SkyMask::takeBorder(cv::Mat& mask) const {
               cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
 }
 
-OpenSky openSkyOf(const cv::Mat& sky_depth) {
-  if (sky_depth.type() != CV_32FC1)
-    throw InvalidInputError("sky_depth must be one float32 per pixel (CV_32FC1)");
-  OpenSky sky;
-  sky.mask = cv::Mat::zeros(sky_depth.size(), CV_8UC1);
-  sky.unbounded = cv::Mat::zeros(sky_depth.size(), CV_8UC1);
-  sky.column_depth.assign(static_cast<std::size_t>(sky_depth.cols), 0.f);
-  for (int v = 0; v < sky_depth.rows; ++v) {
-    const float* depth = sky_depth.ptr<float>(v);
-    for (int u = 0; u < sky_depth.cols; ++u) {
-      if (std::isnan(depth[u]))
-        continue;
-      sky.mask.ptr<std::uint8_t>(v)[u] = 255;
-      if (std::isfinite(depth[u]))
-        sky.column_depth[static_cast<std::size_t>(u)] = depth[u];
-      else
-        sky.unbounded.ptr<std::uint8_t>(v)[u] = 255;
+cv::Mat skyDepthImage(const cv::Mat& sky, const std::vector<float>& column_depth, const cv::Mat& clear_sky) {
+  if (sky.type() != CV_8UC1)
+    throw InvalidInputError("sky depth: the sky mask must be CV_8UC1, not of type " + std::to_string(sky.type()));
+  if (!clear_sky.empty() && (clear_sky.type() != CV_8UC1 || clear_sky.size() != sky.size()))
+    throw InvalidInputError("sky depth: the clear sky must be a CV_8UC1 mask of the sky's " + std::to_string(sky.cols) +
+                            "x" + std::to_string(sky.rows) + ", not " + std::to_string(clear_sky.cols) + "x" +
+                            std::to_string(clear_sky.rows) + " of type " + std::to_string(clear_sky.type()));
+  if (column_depth.size() != static_cast<std::size_t>(sky.cols))
+    throw InvalidInputError("sky depth: the column depths must be one per image column (" + std::to_string(sky.cols) +
+                            "), not " + std::to_string(column_depth.size()));
+  constexpr float kNotSky = std::numeric_limits<float>::quiet_NaN();
+  constexpr float kUnbounded = std::numeric_limits<float>::infinity();
+  cv::Mat sky_depth(sky.size(), CV_32FC1);
+  for (int v = 0; v < sky.rows; ++v) {
+    const std::uint8_t* open = sky.ptr<std::uint8_t>(v);
+    const std::uint8_t* clear = clear_sky.empty() ? nullptr : clear_sky.ptr<std::uint8_t>(v);
+    float* depth = sky_depth.ptr<float>(v);
+    for (int u = 0; u < sky.cols; ++u) {
+      const float bound = column_depth[static_cast<std::size_t>(u)];
+      const bool unbounded = (clear && clear[u] != 0) || !(bound > 0.f);
+      depth[u] = open[u] == 0 ? kNotSky : unbounded ? kUnbounded : bound;
     }
   }
-  return sky;
+  return sky_depth;
 }
 
 } // namespace msf

@@ -1,16 +1,15 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/io/impl/organized_conversion.hpp> // depthImageToCloud for the fused point type
-#include <msf/fusion/sky_mask.h>
 #include <msf/pipeline/fused_cloud.h>
 
+#include <limits>
 
 namespace msf {
 
 pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const Calibration& calibration) {
   const DepthFrame& fused = result.fused;
   const cv::Mat& free_weight = fused.free_space_weight.empty() ? fused.weight : fused.free_space_weight;
-  const bool has_sky = !result.sky.empty() && result.sky.size() == fused.depth.size();
-  const bool has_clear = has_sky && result.clear_sky.size() == result.sky.size();
+  const bool has_sky = result.sky_depth.size() == fused.depth.size();
   pcl::PointCloud<PointXYZRGBWeight> cloud;
   depthImageToCloud(fused.depth, calibration, 0, cloud);
   for (int v = 0; v < fused.depth.rows; ++v)
@@ -23,11 +22,7 @@ pcl::PointCloud<PointXYZRGBWeight> fusedCloud(const FrameResult& result, const C
       p.a = 255;
       p.weight = fused.weight.at<float>(v, u);
       p.free_space_weight = free_weight.at<float>(v, u);
-      const bool sky = has_sky && result.sky.at<std::uint8_t>(v, u) != 0;
-      const bool clear = has_clear && result.clear_sky.at<std::uint8_t>(v, u) != 0;
-      const auto column = static_cast<std::size_t>(u);
-      const float column_depth = column < result.sky_column_depth.size() ? result.sky_column_depth[column] : 0.f;
-      p.sky_depth = skyDepth(sky, clear, column_depth);
+      p.sky_depth = has_sky ? result.sky_depth.at<float>(v, u) : std::numeric_limits<float>::quiet_NaN();
     }
   return cloud;
 }

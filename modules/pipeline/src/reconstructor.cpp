@@ -149,8 +149,7 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
 }
 
 void Reconstructor::computeSky(FrameResult& result) {
-  stages_->fusion.findOpenSky(result.sky, result.sky_column_depth);
-  result.clear_sky = stages_->fusion.getClearSky();
+  stages_->fusion.findOpenSky(result.sky, result.sky_depth);
 }
 
 bool Reconstructor::lidarBeforeStereo() const {
@@ -194,10 +193,8 @@ TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCa
     free.scan = &result.scan_free_space;
     free.T_world_lidar = result.T_world_cam0 * calibration.T_cam0_velo;
   }
-  free.sky = result.sky;
+  free.sky_depth = result.sky_depth;
   free.sky_camera = sky_camera;
-  free.sky_column_depth = result.sky_column_depth;
-  free.sky_unbounded = result.clear_sky;
   return free;
 }
 

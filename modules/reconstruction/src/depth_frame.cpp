@@ -7,6 +7,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace msf {
@@ -134,7 +135,19 @@ cv::Mat readSkyDepth(const pcl::PCLPointCloud2& cloud, const std::string& what) 
     for (int u = 0; u < cols; ++u)
       sky_depth.ptr<float>(v)[u] =
           readFloat(cloud.data.data() + (static_cast<std::size_t>(v) * cols + u) * cloud.point_step + field->offset);
+  checkSkyDepthBounds(sky_depth, what + ": field 'sky_depth'");
   return sky_depth;
+}
+
+void checkSkyDepthBounds(const cv::Mat& sky_depth, const std::string& what) {
+  for (int v = 0; v < sky_depth.rows; ++v) {
+    const float* depth = sky_depth.ptr<float>(v);
+    for (int u = 0; u < sky_depth.cols; ++u)
+      if (!std::isnan(depth[u]) && !(depth[u] > 0.f))
+        throw InvalidInputError(what + " at pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") is " +
+                                std::to_string(depth[u]) + ": a pixel's bound is NaN (not sky), a depth > 0 or +inf "
+                                "(the whole ray)");
+  }
 }
 
 #define MSF_INSTANTIATE_DEPTH_FRAME(T)                                                        \

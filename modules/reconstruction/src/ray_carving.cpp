@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 #include <msf/common/parallel.h>
+#include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/tsdf_integrator.h>
 
 #include "surface_voxel_walk.h"
@@ -146,37 +147,32 @@ void raysBeyondRange(const cv::Mat& depth, const cv::Mat& weight, float range, f
 
 } // namespace
 
-void TsdfIntegrator::carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
-                              float weight, const std::vector<float>& column_depth, const cv::Mat& unbounded) {
-  if (!config_.sky_carving || !config_.space_carving || sky.empty())
+void TsdfIntegrator::checkSkyDepth(const cv::Mat& sky_depth, const PinholeCamera& camera) {
+  if (sky_depth.type() != CV_32FC1 || sky_depth.cols != camera.width || sky_depth.rows != camera.height)
+    throw InvalidInputError("carveSky: the sky depth must be CV_32FC1 of the camera's " + std::to_string(camera.width) +
+                            "x" + std::to_string(camera.height) + ", not " + std::to_string(sky_depth.cols) + "x" +
+                            std::to_string(sky_depth.rows) + " of type " + std::to_string(sky_depth.type()));
+  checkSkyDepthBounds(sky_depth, "carveSky: the sky depth");
+}
+
+void TsdfIntegrator::carveSky(const cv::Mat& sky_depth, const PinholeCamera& camera,
+                              const Eigen::Isometry3d& T_world_cam, float weight) {
+  if (!config_.sky_carving || !config_.space_carving || sky_depth.empty())
     return;
-  if (sky.type() != CV_8UC1 || sky.cols != camera.width || sky.rows != camera.height)
-    throw InvalidInputError("carveSky: the sky mask must be CV_8UC1 of the camera's " + std::to_string(camera.width) +
-                            "x" + std::to_string(camera.height) + ", not " + std::to_string(sky.cols) + "x" +
-                            std::to_string(sky.rows) + " of type " + std::to_string(sky.type()));
-  if (!column_depth.empty() && column_depth.size() != static_cast<std::size_t>(camera.width))
-    throw InvalidInputError("carveSky: the column depths must be one per image column (" +
-                            std::to_string(camera.width) + "), not " + std::to_string(column_depth.size()));
-  if (!unbounded.empty() && (unbounded.type() != CV_8UC1 || unbounded.size() != sky.size()))
-    throw InvalidInputError("carveSky: the unbounded pixels must be a CV_8UC1 mask of the sky's " +
-                            std::to_string(sky.cols) + "x" + std::to_string(sky.rows) + ", not " +
-                            std::to_string(unbounded.cols) + "x" + std::to_string(unbounded.rows) + " of type " +
-                            std::to_string(unbounded.type()));
+  checkSkyDepth(sky_depth, camera);
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveSky: the weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");
-  const cv::Rect rect = cv::boundingRect(sky);
+  cv::compare(sky_depth, sky_depth, sky_rays_, cv::CMP_EQ); // not NaN: open sky
+  const cv::Rect rect = cv::boundingRect(sky_rays_);
   const float w = weight * static_cast<float>(config_.carving_weight);
   if (rect.empty() || !(w > 0.f))
     return;
   const float wall_margin = static_cast<float>(volume_.truncation() + volume_.voxelSize());
   const auto inFrontOfWall = [&](int u, int v, float z) {
-    const bool free = column_depth.empty() || !(column_depth[static_cast<std::size_t>(u)] > 0.f) ||
-                      z < column_depth[static_cast<std::size_t>(u)] - wall_margin ||
-                      (!unbounded.empty() && unbounded.ptr<std::uint8_t>(v)[u] != 0);
-    return free ? w : 0.f;
+    return z < sky_depth.ptr<float>(v)[u] - wall_margin ? w : 0.f; // +inf: the whole ray
   };
-  carveAlongRays(volume_, sky, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),
+  carveAlongRays(volume_, sky_rays_, rect, camera, T_world_cam, static_cast<float>(config_.min_depth_m),
                  static_cast<float>(farthestDepth()), config_.max_weight, inFrontOfWall, kAnyBlock);
 }
 

@@ -123,8 +123,7 @@ private:
   DepthImageFusion image_fusion_;
   // Work buffers, kept between frames.
   cv::Mat lidar_depth_, lidar_distance_, stereo_depth_, stereo_confidence_;
-  cv::Mat fused_depth_, fused_weight_, fused_free_weight_, fused_color_, sky_, clear_sky_;
-  std::vector<float> sky_column_depth_;
+  cv::Mat fused_depth_, fused_weight_, fused_free_weight_, fused_color_, sky_, sky_depth_;
 };
 
 } // namespace msf

@@ -47,17 +47,15 @@ public:
   /// The open sky (SkyMask, CV_8UC1, 255 = sky) the last fuse() found; empty when it had no sky
   /// image or clear_sky is off.
   const cv::Mat& getOpenSky() const { return open_sky_; }
-  /// Its clear pixels (CV_8UC1, 255; withholdClearSky's clear_sky): rays that nothing but the sky
-  /// stopped, which the map carves past the LiDAR's returns (TsdfIntegrator::carveSky). Empty
-  /// when getOpenSky() is.
-  const cv::Mat& getClearSky() const { return clear_sky_; }
-  /// The open sky in the last fuse()'s sky image (CV_8UC1, 255 = sky): getOpenSky()'s when
-  /// clear_sky found it, else found now (SkyMask); and per image column the depth of the
-  /// LiDAR's highest return (SkyMask::topReturnDepth, 0 where there is none), which bounds
-  /// the carving along the sky's rays (TsdfIntegrator::carveSky). Both empty without a sky image.
-  void findOpenSky(cv::Mat& sky, std::vector<float>& column_depth) const;
+  /// The open sky in the last fuse()'s sky image: `sky` (CV_8UC1, 255 = sky), getOpenSky()'s
+  /// when clear_sky found it, else found now (SkyMask); and `sky_depth` (CV_32FC1, skyDepthImage),
+  /// how far each of its rays is carved (TsdfIntegrator::carveSky): NaN off the sky, the depth of
+  /// its column's highest LiDAR return (SkyMask::topReturnDepth), +inf in its clear pixels
+  /// (withholdClearSky's: rays that nothing but the sky stopped) and where the column has no
+  /// return. Both empty without a sky image.
+  void findOpenSky(cv::Mat& sky, cv::Mat& sky_depth) const;
   /// The last fuse()'s depth with its small holes filled at weight 0 (fusion.hole_fill_px,
-  /// msf::fillSmallHoles), never in its open sky (findOpenSky): the depth the engine gives once
+  /// msf::fillSmallHoles), never in its open sky (findOpenSky's): the depth the engine gives once
   /// the map took the frame. fused_weight and free_space_weight, when given, are fuse()'s.
   void fillSmallHoles(cv::Mat& fused_depth, cv::Mat* fused_weight = nullptr,
                       cv::Mat* free_space_weight = nullptr) const;
@@ -74,6 +72,9 @@ public:
             cv::Mat* free_space_weight = nullptr);
 
 private:
+  /// findOpenSky's mask alone (empty without a sky image).
+  cv::Mat openSkyMask() const;
+
   DepthFusionConfig config_;
   double focal_baseline_{0.0};
   Calibration calibration_;

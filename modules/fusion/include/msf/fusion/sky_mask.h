@@ -2,7 +2,6 @@
 #pragma once
 #include <opencv2/core/mat.hpp>
 
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -112,27 +111,13 @@ private:
   int border_ = 3;
 };
 
-/// A pixel's sky_depth as the fused cloud carries it (PointXYZRGBWeight): NaN where the pixel is
-/// not open sky, else the depth that bounds its ray, the depth of its column's highest LiDAR
-/// return (topReturnDepth), +inf where nothing does: in the clear sky (SkyMask::clearSky), and
-/// where the column has no return (`column_depth` 0).
-inline float skyDepth(bool open_sky, bool clear_sky, float column_depth) {
-  if (!open_sky)
-    return std::numeric_limits<float>::quiet_NaN();
-  return !clear_sky && column_depth > 0.f ? column_depth : std::numeric_limits<float>::infinity();
-}
-
-/// The open sky that a sky_depth image carries (as skyDepth writes it), as
-/// TsdfIntegrator::carveSky takes it: the mask (255 where the pixel is open sky), each
-/// column's depth of its highest LiDAR return (0 where the column has none or no open sky) and
-/// the pixels whose ray nothing bounds (+inf).
-struct OpenSky {
-  cv::Mat mask;                    ///< CV_8UC1
-  std::vector<float> column_depth; ///< one per column
-  cv::Mat unbounded;               ///< CV_8UC1, 255 where sky_depth is +inf
-};
-
-/// Throws InvalidInputError when `sky_depth` is not CV_32FC1.
-OpenSky openSkyOf(const cv::Mat& sky_depth);
+/// The open sky as the fused cloud carries it (PointXYZRGBWeight::sky_depth) and
+/// TsdfIntegrator::carveSky takes it: CV_32FC1 of the mask's size, NaN where the pixel is not open
+/// sky (`sky`, CV_8UC1, non-zero = sky), else the depth that bounds its ray, the depth of its
+/// column's highest LiDAR return (`column_depth`, topReturnDepth); +inf where nothing does: in the
+/// clear sky (`clear_sky`, CV_8UC1 of the mask's size, non-zero; or empty: none; SkyMask::clearSky)
+/// and where the column has no return (0). Throws InvalidInputError for a mask of another type,
+/// a clear sky of another type or size, or column depths not one per column.
+cv::Mat skyDepthImage(const cv::Mat& sky, const std::vector<float>& column_depth, const cv::Mat& clear_sky = {});
 
 } // namespace msf

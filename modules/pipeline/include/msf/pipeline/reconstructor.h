@@ -85,15 +85,13 @@ struct FrameResult {
   /// where the camera's depth does not (TsdfIntegrator::carveWithScan).
   ScanFreeSpace scan_free_space;
   /// The frame's open sky (SkyMask, CV_8UC1 of camera 0's size, 255 = sky; the fusion's when it
-  /// found one, fusion.clear_sky): where no hole is filled, and what the map clears in front of
-  /// the sky when it carves along it (tsdf_integrator.sky_carving, carveSky).
+  /// found one, fusion.clear_sky): where no hole is filled.
   cv::Mat sky;
-  /// Per image column, the depth of the LiDAR's highest return near it (SkyMask::topReturnDepth):
-  /// how far the sky's rays are carved there.
-  std::vector<float> sky_column_depth;
-  /// The open sky's clear pixels (DepthImageFusion::getClearSky, CV_8UC1; empty without them):
-  /// only the sky looks like them, so their rays are carved past the column's returns.
-  cv::Mat clear_sky;
+  /// How far the map clears along each of its rays (tsdf_integrator.sky_carving,
+  /// TsdfIntegrator::carveSky; CV_32FC1, DepthImageFusion::findOpenSky): NaN off the sky, the
+  /// depth of the LiDAR's highest return near the pixel's column, +inf in the clear sky, which only
+  /// the sky looks like, and where the column has no return. The fused cloud's sky_depth.
+  cv::Mat sky_depth;
   cv::Mat stereo_depth;       ///< SGBM (step 3)
   cv::Mat stereo_confidence;  ///< SGBM's confidence in [0, 1]
   /// Fused depth (step 4) with its per-pixel weight and the colour camera's colour: what
@@ -105,7 +103,7 @@ struct FrameResult {
 };
 
 /// What the frame showed free beside its depth, for TsdfIntegrator::integrateFrame: its scan's
-/// rays (with `with_scan`), its open sky (FrameResult::sky, of `sky_camera`, camera 0) and its rays
+/// rays (with `with_scan`), its open sky (FrameResult::sky_depth, of `sky_camera`, camera 0) and its rays
 /// beyond the range, each weighing as a LiDAR return does (fusion.lidar_range_sigma_m), since they
 /// are as surely free.
 TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCamera& sky_camera,

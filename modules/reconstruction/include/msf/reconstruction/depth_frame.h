@@ -47,10 +47,16 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
                         const std::string& what = "cloud");
 
 /// The field `sky_depth` of an organized cloud (the fused cloud's: NaN where the pixel is not
-/// open sky, else the depth its ray passed every surface to) as a CV_32FC1 image of the cloud's
-/// size; empty when the cloud has no such field. Throws InvalidInputError naming `what` when
-/// the field is not one float32 or the cloud is not organized.
+/// open sky, else the depth in front of which its ray is carved, +inf for the whole ray) as a
+/// CV_32FC1 image of the cloud's size, as TsdfIntegrator::carveSky takes it; empty when the cloud
+/// has no such field. Throws InvalidInputError naming `what` when the field is not one float32,
+/// the cloud is not organized or a pixel's bound is neither NaN nor above 0 (checkSkyDepthBounds).
 cv::Mat readSkyDepth(const pcl::PCLPointCloud2& cloud, const std::string& what = "cloud");
+
+/// Throws InvalidInputError, naming `what` and the first pixel at fault, where `sky_depth`
+/// (CV_32FC1) holds a bound that is neither NaN (not sky) nor above 0 (a depth; +inf: the whole
+/// ray).
+void checkSkyDepthBounds(const cv::Mat& sky_depth, const std::string& what);
 
 } // namespace msf
 

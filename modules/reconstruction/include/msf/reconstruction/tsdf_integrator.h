@@ -285,21 +285,20 @@ public:
                      const cv::Mat& camera_carved = cv::Mat());
 
   /// Free space that the open sky shows (Config::sky_carving, with space_carving): a ray through a
-  /// pixel of `sky` (CV_8UC1 of `camera`'s size, non-zero = open sky, as SkyMask finds it) passed
-  /// every surface, so each voxel behind a surface (sdf < 0) whose centre projects into such a
-  /// pixel, from min_depth_m to farthestDepth(), takes a free-space update of `weight` (m^-2)
-  /// times carving_weight. `column_depth` (one per image column, or empty: no bound) bounds each
-  /// column's rays: where it is positive (the depth of the LiDAR's highest return there,
-  /// SkyMask::topReturnDepth), only voxels nearer by more than the truncation and a voxel are
-  /// carved, so that a blank wall above the returns that the mask takes for sky is kept. The
-  /// pixels of `unbounded` (CV_8UC1 of the mask's size, non-zero; or empty: none) are carved along
-  /// their whole ray all the same: the clear sky (SkyMask::clearSky), clipped or blue as a wall
-  /// rarely is, so that a wall's top that an earlier frame carried too high (against the sky now,
-  /// at the returns' depth) is cleared too. Throws InvalidInputError for a mask of another type or
-  /// size, a bound of another length, a weight that is not positive and finite, or a pose that is
-  /// not rigid.
-  void carveSky(const cv::Mat& sky, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam, float weight,
-                const std::vector<float>& column_depth = {}, const cv::Mat& unbounded = {});
+  /// pixel of open sky passed every surface, so each voxel behind a surface (sdf < 0) whose centre
+  /// projects into such a pixel, from min_depth_m to farthestDepth(), takes a free-space update of
+  /// `weight` (m^-2) times carving_weight. `sky_depth` (CV_32FC1 of `camera`'s size; the fused
+  /// cloud's field, DepthImageFusion::findOpenSky's image) holds each pixel's bound: NaN where the
+  /// pixel is not open sky; a depth (that of its column's highest LiDAR return,
+  /// SkyMask::topReturnDepth) in front of which, by more than the truncation and a voxel, the ray
+  /// is carved, so that a blank wall above the returns that the mask takes for sky is kept; +inf
+  /// where the whole ray is carved (the clear sky, SkyMask::clearSky, clipped or blue as a wall
+  /// rarely is, so that a wall's top an earlier frame carried too high, against the sky now at the
+  /// returns' depth, is cleared too). Throws InvalidInputError for an image of another type or
+  /// size, a bound that is neither NaN nor above 0, a weight that is not positive and finite, or
+  /// a pose that is not rigid.
+  void carveSky(const cv::Mat& sky_depth, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
+                float weight);
 
   /// Free space that the rays beyond the range show (Config::far_carving, with space_carving): a
   /// pixel of `frame` whose depth lies beyond max_depth_m by more than truncation_sigmas of its
@@ -317,15 +316,14 @@ public:
     float weight = 0.f;
     const ScanFreeSpace* scan = nullptr; ///< the scan's rays (carveWithScan), or none
     Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
-    cv::Mat sky;                         ///< the open sky (carveSky), or empty
-    PinholeCamera sky_camera;            ///< the camera of the sky's mask
-    std::vector<float> sky_column_depth; ///< carveSky's bound per column, or empty
-    cv::Mat sky_unbounded;               ///< the sky's pixels carved past that bound, or empty
+    cv::Mat sky_depth;                   ///< the open sky and its rays' bounds (carveSky), or empty
+    PinholeCamera sky_camera;            ///< the camera of sky_depth
   };
 
   /// A frame as msf_reconstruct integrates it: its depth (integrate), then the free space its
   /// scan (when carvesWithScans()), its open sky and its rays beyond the range show
-  /// (carveWithScan, carveSky, carveBeyondRange). Throws as they do.
+  /// (carveWithScan, carveSky, carveBeyondRange). Throws as they do; a sky depth they would refuse
+  /// before the volume changes.
   void integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, const FreeSpace& free);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
@@ -397,6 +395,9 @@ private:
   /// (freeSpaceWeights times carving_weight), 0 where `integrated` has no depth: what
   /// integrateFrame's scan carving reads.
   const cv::Mat& carvedWeights(const DepthFrame& frame, const cv::Mat& integrated);
+  /// Throws InvalidInputError, as carveSky does, for a sky depth that is not CV_32FC1 of
+  /// `camera`'s size or holds a bound neither NaN nor above 0.
+  static void checkSkyDepth(const cv::Mat& sky_depth, const PinholeCamera& camera);
   /// Per pixel, its plane scale, bands and weights (pixels_).
   void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
   /// The frame and pose checked, then prepareDepth and computePixelBands: the view whose bands
@@ -437,6 +438,7 @@ private:
   // carveBeyondRange: the pixels whose rays reach beyond the range, their distances to the nearest
   // that does not, and the largest distance in each tile of them
   cv::Mat far_rays_, far_distance_, far_tile_max_;
+  cv::Mat sky_rays_; // carveSky's open sky (255), the pixels of its sky_depth that are not NaN
 };
 
 /// "constant", "inverse_square", "per_pixel"; parse throws ConfigError naming the text.

@@ -126,10 +126,8 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::fuseImages() {
   image_fusion_.setSkyImage(skyImage(color_, left_, size));
   image_fusion_.fuse(lidar, distance, stereo_depth_, stereo_confidence_, fused_depth_, &fused_weight_,
                      &fused_free_weight_);
-  if constexpr (detail::has_sky_depth_v<PointOutT>) {
-    image_fusion_.findOpenSky(sky_, sky_column_depth_);
-    clear_sky_ = image_fusion_.getClearSky();
-  }
+  if constexpr (detail::has_sky_depth_v<PointOutT>)
+    image_fusion_.findOpenSky(sky_, sky_depth_);
   // The colour camera's at the fused points, as the pipeline colours them (camera 0's grey where
   // that camera does not see); without it, or where neither has a colour, the stereo points'.
   if (color_.empty() || left_.empty())
@@ -229,11 +227,8 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::writePoints(PointCloudOu
           p.weight = fused_weight_.at<float>(v, u);
         if constexpr (detail::has_free_space_weight_v<PointOutT>)
           p.free_space_weight = fused_free_weight_.at<float>(v, u);
-        if constexpr (detail::has_sky_depth_v<PointOutT>) {
-          const bool sky = in_image && !sky_.empty() && sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
-          const bool clear = sky && !clear_sky_.empty() && clear_sky_.at<std::uint8_t>(v - image.y, u - image.x) != 0;
-          p.sky_depth = skyDepth(sky, clear, sky ? sky_column_depth_[static_cast<std::size_t>(u - image.x)] : 0.f);
-        }
+        if constexpr (detail::has_sky_depth_v<PointOutT>)
+          p.sky_depth = in_image && !sky_depth_.empty() ? sky_depth_.at<float>(v - image.y, u - image.x) : nan;
       }
     }
     if (!range_dense)
