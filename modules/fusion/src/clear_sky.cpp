@@ -51,7 +51,9 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
   if (own_grey && (grey.type() != CV_8UC1 || grey.size() != image.size()))
     throw InvalidInputError("withholdClearSky: camera 0's grey image must be CV_8UC1 of the sky image's size");
   cv::Mat open = sky.computeWithoutBorder(image, returns);
-  cv::Mat withheld = sky.clearSky(image, open);
+  // clearSky tests each pixel alone: the bordered mask's clear pixels are these within it.
+  const cv::Mat clear = sky.clearSky(image, open);
+  cv::Mat withheld = clear.clone();
   cv::Mat open_in_both = open.clone(); // a pixel both cameras see as blank sky
   sky.takeBorder(open);
   if (own_grey) { // within the border, where the parallax moves an edge, camera 0's own sky decides
@@ -61,7 +63,7 @@ cv::Mat withholdClearSky(const SkyMask& sky, const cv::Mat& image, const cv::Mat
     open_in_both &= open_in_grey;
   }
   if (clear_sky)
-    *clear_sky = sky.clearSky(image, open) & open_in_both;
+    *clear_sky = clear & open & open_in_both;
   if (!depth.empty())
     withheld |= inFrontOfEveryWall(depth, weight, sky.wallDepth(returns), open_in_both);
   for (cv::Mat* values : images)

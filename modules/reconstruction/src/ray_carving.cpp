@@ -157,9 +157,14 @@ void TsdfIntegrator::checkSkyDepth(const cv::Mat& sky_depth, const PinholeCamera
 
 void TsdfIntegrator::carveSky(const cv::Mat& sky_depth, const PinholeCamera& camera,
                               const Eigen::Isometry3d& T_world_cam, float weight) {
-  if (!config_.sky_carving || !config_.space_carving || sky_depth.empty())
+  if (!carvesSky() || sky_depth.empty())
     return;
   checkSkyDepth(sky_depth, camera);
+  carveCheckedSky(sky_depth, camera, T_world_cam, weight);
+}
+
+void TsdfIntegrator::carveCheckedSky(const cv::Mat& sky_depth, const PinholeCamera& camera,
+                                     const Eigen::Isometry3d& T_world_cam, float weight) {
   if (!(weight > 0.f) || !std::isfinite(weight))
     throw InvalidInputError("carveSky: the weight must be positive and finite, got " + std::to_string(weight));
   limits::checkRigid(T_world_cam, "T_world_cam (the frame's pose)");

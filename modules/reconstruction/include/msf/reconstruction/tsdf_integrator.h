@@ -398,6 +398,11 @@ private:
   /// Throws InvalidInputError, as carveSky does, for a sky depth that is not CV_32FC1 of
   /// `camera`'s size or holds a bound neither NaN nor above 0.
   static void checkSkyDepth(const cv::Mat& sky_depth, const PinholeCamera& camera);
+  /// Whether carveSky carves (Config::sky_carving, with space_carving).
+  bool carvesSky() const { return config_.sky_carving && config_.space_carving; }
+  /// carveSky once its sky depth is checked (checkSkyDepth).
+  void carveCheckedSky(const cv::Mat& sky_depth, const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
+                       float weight);
   /// Per pixel, its plane scale, bands and weights (pixels_).
   void computePixelBands(const DepthFrame& frame, const detail::FrameView& view);
   /// The frame and pose checked, then prepareDepth and computePixelBands: the view whose bands
