@@ -325,15 +325,12 @@ TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
   } catch (const IOError& e) {
     EXPECT_NE(std::string(e.what()).find("absent.pcd"), std::string::npos) << e.what();
   }
-  // A plain cloud without the volume's header comment.
+  // A plain cloud without the volume's header comment: one default point (every field 0) given a weight.
   pcl::PointCloud<PointTsdf> cloud;
-  PointTsdf p;
-  p.x = p.y = p.z = 0.f;
-  p.sdf = 0.f;
-  p.weight = 1.f;
-  p.rgba = 0;
-  p.passes = 0;
-  cloud.push_back(p);
+  cloud.resize(1);
+  cloud[0].weight = 1.f;
+  EXPECT_EQ(cloud[0].passes, 0);
+  EXPECT_EQ(cloud[0].reappeared, 0);
   pcl::io::savePCDFileBinary(dir.file("plain.pcd"), cloud);
   try {
     TsdfVolume::load(dir.file("plain.pcd"));
