@@ -12,7 +12,9 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
+#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -308,6 +310,21 @@ TEST(TsdfVolume, ReappearedIsLoadedAndAValueOtherThanZeroOrOneIsRefused) {
   const std::string error = test::errorOf([&] { TsdfVolume::load(dir.file("two.pcd")); });
   EXPECT_NE(error.find("two.pcd"), std::string::npos) << error;
   EXPECT_NE(error.find("voxel 0 has reappeared 2, not 0 or 1"), std::string::npos) << error;
+}
+
+TEST(PointTsdf, ADefaultPointIsAnUnobservedVoxelAtTheOrigin) {
+  // Built over memory full of garbage, so that a field the constructor forgets keeps it.
+  alignas(PointTsdf) unsigned char storage[sizeof(PointTsdf)];
+  std::memset(storage, 0xAB, sizeof(storage));
+  const PointTsdf* p = new (storage) PointTsdf;
+  EXPECT_EQ(p->x, 0.f);
+  EXPECT_EQ(p->y, 0.f);
+  EXPECT_EQ(p->z, 0.f);
+  EXPECT_EQ(p->sdf, 0.f);
+  EXPECT_EQ(p->weight, 0.f);
+  EXPECT_EQ(p->rgba, 0xFF000000u); // black, opaque
+  EXPECT_EQ(p->passes, 0);
+  EXPECT_EQ(p->reappeared, 0);
 }
 
 TEST(TsdfVolume, SaveAndLoadRejectBadFiles) {
