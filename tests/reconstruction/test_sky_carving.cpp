@@ -266,6 +266,11 @@ TEST(SkyCarving, OffEmptyOrRefused) {
     const std::size_t before = vertices(volume);
     integrator.carveSky(everything, camera, drivePose(0), 1111.f);
     EXPECT_EQ(vertices(volume), before);
+    TsdfIntegrator::FreeSpace free; // carving off, integrateFrame reads no sky depth, a bad one neither
+    free.weight = 1111.f;
+    free.sky_depth = cv::Mat(10, 10, CV_32FC1, cv::Scalar(0.f));
+    free.sky_camera = camera;
+    EXPECT_NO_THROW(integrator.integrateFrame(frame, drivePose(1), free));
   }
   TsdfVolume volume(0.1, 0.3);
   TsdfIntegrator::Config config;

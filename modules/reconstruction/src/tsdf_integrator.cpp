@@ -646,13 +646,14 @@ cv::Mat TsdfIntegrator::integrateDepth(const DepthFrame& frame, const Eigen::Iso
 
 void TsdfIntegrator::integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam,
                                     const FreeSpace& free) {
-  if (!free.sky_depth.empty())
+  const bool carves_sky = !free.sky_depth.empty() && carvesSky();
+  if (carves_sky)
     checkSkyDepth(free.sky_depth, free.sky_camera); // refused before the volume changes
   const cv::Mat integrated = integrateDepth(frame, T_world_cam);
   if (free.scan && carvesWithScans())
     carveWithScan(*free.scan, free.T_world_lidar, free.weight, frame.camera, T_world_cam,
                   carvedWeights(frame, integrated));
-  if (!free.sky_depth.empty() && carvesSky())
+  if (carves_sky)
     carveCheckedSky(free.sky_depth, free.sky_camera, T_world_cam, free.weight);
   carveBeyondRange(frame, T_world_cam, free.weight);
 }

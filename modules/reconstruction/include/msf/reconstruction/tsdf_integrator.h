@@ -322,8 +322,8 @@ public:
 
   /// A frame as msf_reconstruct integrates it: its depth (integrate), then the free space its
   /// scan (when carvesWithScans()), its open sky and its rays beyond the range show
-  /// (carveWithScan, carveSky, carveBeyondRange). Throws as they do; a sky depth they would refuse
-  /// before the volume changes.
+  /// (carveWithScan, carveSky, carveBeyondRange). Throws as they do; a sky depth that carveSky
+  /// would carve with and refuses, before the volume changes.
   void integrateFrame(const DepthFrame& frame, const Eigen::Isometry3d& T_world_cam, const FreeSpace& free);
 
   /// Integrates an organized cloud in the camera frame (NaN where there is no depth), with
