@@ -565,6 +565,19 @@ check "synth -reverse off the street's start" 1 "synthetic.start_m' = 3.* leaves
 check "synth -street_m shorter than the drive" 1 "synthetic.street_length_m' = 5.* is shorter than the drive" -- \
   msf_synth -o out -frames 20 -street_m 5
 
+# ---- the ROS node's command line (built with ROS 1), before any master is reached ---------
+if [ -x "$BIN/msf_ros_node" ]; then
+  check "ros_node: an argument that is not ROS's" 1 \
+    "unexpected argument '-frames': the node takes -h, remappings \\(topic:=name\\) and parameters" -- \
+    msf_ros_node -frames 0:9
+  check "ros_node -h: every parameter, no master" 0 "overwrite = false" -- msf_ros_node -h
+else
+  for c in "ros_node: an argument that is not ROS's" "ros_node -h: every parameter, no master"; do
+    skipped=$((skipped + 1))
+    printf 'skip  %-44s (built without ROS 1)\n' "$c"
+  done
+fi
+
 # ---- cases on the KITTI sample ---------------------------------------------------------------
 if [ $have_kitti = 1 ]; then
   SCAN=$SEQ/velodyne/000000.bin

@@ -4,6 +4,7 @@
 # odometry 04 frames 0..LAST written by msf_kitti2bag, the node and the player started by
 # launch/kitti_bag.launch, what the node publishes recorded by `rosbag record`; then
 #  - its wait for a master that is not there, which a SIGTERM ends, and a master URI it refuses,
+#  - its help (-h), every parameter of launch/kitti_bag.launch's YAML with the same default,
 #  - its refusals of bad parameters,
 #  - each frame's depth and weight image, fused points and the mesh marker checked against the
 #    engine on the same frames (check_node_output),
@@ -70,6 +71,24 @@ for bad in "env:notauri" "arg:http//localhost"; do
     fail "msf_ros_node with the master URI ${bad#*:}: exit $status, '$out' (expected exit 1 and '$expected')"
   echo "ok: a master URI of '${bad#*:}' refused: $expected"
 done
+
+# -h lists every parameter of the launch file's YAML with the value it gives there (the node's
+# defaults), and needs no master.
+help=$(ROS_MASTER_URI=$no_master timeout 10 "$build/bin/msf_ros_node" -h) || fail "msf_ros_node -h failed"
+python3 - "$(dirname "$0")/../../modules/ros/config/kitti_bag.yaml" "$help" <<'PY' || fail "msf_ros_node -h and kitti_bag.yaml differ"
+import re, sys, yaml
+params = yaml.safe_load(open(sys.argv[1]))
+shown = dict(re.findall(r"^  (\w+) = (.*)$", sys.argv[2], re.M))
+assert set(shown) == set(params), (sorted(shown), sorted(params))
+for name, value in params.items():
+    if name == "sweeping_scans":  # unset in the node: the rig's, else true, as the file sets it
+        assert shown[name] == "the rig's, else true", shown[name]
+    elif isinstance(value, str):
+        assert shown[name] == '"%s"' % value, (name, shown[name], value)
+    else:
+        assert yaml.safe_load(shown[name]) == value, (name, shown[name], value)
+PY
+echo "ok: msf_ros_node -h lists kitti_bag.yaml's parameters with its values, without a master"
 
 # Bad parameters: each stops the node at once, exit 1, with an error that names the parameter.
 refuse() { # NAME EXPECTED _param:=value...

@@ -3,11 +3,12 @@
 // PointCloud2 and a rectified stereo pair with its CameraInfo (and a colour camera), the poses
 // from tf or the engine's odometry; publishes ~depth and ~weight (32FC1), ~points (PointCloud2)
 // and ~mesh (a Marker triangle list), and saves the mesh at shutdown. Parameters:
-// config/kitti_bag.yaml.
+// config/kitti_bag.yaml, and `msf_ros_node -h`.
 #include "reconstruction_node.h"
 
 #include <msf/common/huge_page_images.h>
 
+#include <ros/init.h>
 #include <ros/master.h>
 #include <ros/network.h>
 
@@ -56,6 +57,20 @@ bool waitForMaster() {
 } // namespace
 
 int main(int argc, char** argv) {
+  // ROS's arguments are remappings (name:=value); -h is the only other one the node takes.
+  ros::V_string arguments;
+  ros::removeROSArgs(argc, argv, arguments);
+  for (std::size_t i = 1; i < arguments.size(); ++i) {
+    if (arguments[i] == "-h" || arguments[i] == "--help") {
+      std::fputs(msf::NodeParameters::help().c_str(), stdout);
+      return 0;
+    }
+    std::fprintf(stderr,
+                 "msf_ros_node: error: unexpected argument '%s': the node takes -h, remappings (topic:=name) "
+                 "and parameters (_name:=value)\n",
+                 arguments[i].c_str());
+    return 1;
+  }
   // SIGINT and SIGTERM stop the node while ROS still runs, so that it finishes the frames
   // waiting (their poses from tf), publishes the last mesh and logs what it dropped.
   const std::string bad_uri = unparsableMasterUri(argc, argv);

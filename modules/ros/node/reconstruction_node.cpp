@@ -17,6 +17,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace msf {
 
@@ -55,7 +56,52 @@ void refuseUnknownParams(const ros::NodeHandle& nh, const std::set<std::string>&
   }
 }
 
+/// A parameter's name, its default as text and what it sets: the node's help, and the names it knows.
+struct ParamDoc {
+  std::string name, default_value, meaning;
+};
+
+std::string quoted(const std::string& text) { return "\"" + text + "\""; }
+
+std::string numberText(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+std::vector<ParamDoc> paramDocs(const NodeParameters& d) {
+  return {
+      {"lidar_topic", quoted(d.lidar_topic), "sensor_msgs/PointCloud2: x y z (intensity, ring, time)"},
+      {"left_topic", quoted(d.left_topic), "rectified Image (its CameraInfo: camera_info beside it); the depth's"},
+      {"right_topic", quoted(d.right_topic), "rectified Image of the pair's right camera"},
+      {"color_topic", quoted(d.color_topic), "the mesh's colour (\"\" = a grey mesh)"},
+      {"sync_slop_s", numberText(d.sync_slop_s), "the largest spread of stamps within one frame's messages"},
+      {"world_frame", quoted(d.world_frame), "tf frame of the poses and of the mesh"},
+      {"poses", quoted(d.poses), "auto, tf, odometry or refine (tf's poses refined by the LiDAR)"},
+      {"tf_timeout_s", numberText(d.tf_timeout_s), "how long a frame waits for its pose (the first, its extrinsic)"},
+      {"sweeping_scans", "the rig's, else true", "a spinning LiDAR's swept scans (false: taken at one instant)"},
+      {"config", quoted(d.config), "the engine's YAML configuration (\"\" = its defaults)"},
+      {"rig", quoted(d.rig), "a calibration file (KITTI calib.txt or rig YAML) instead of CameraInfo and tf"},
+      {"threads", std::to_string(d.threads), "the engine's threads (0 = all cores)"},
+      {"queue_size", std::to_string(d.queue_size), "frames waiting for the engine (1..8), the oldest dropped"},
+      {"mesh_rate_hz", numberText(d.mesh_rate_hz), "~mesh refresh (0 = none)"},
+      {"mesh_path", quoted(d.mesh_path), "the mesh saved at shutdown (.ply/.obj/.vtk; \"\" = none)"},
+      {"overwrite", d.overwrite ? "true" : "false", "replace a mesh_path that exists (else refused at start)"}};
+}
+
 } // namespace
+
+std::string NodeParameters::help() {
+  std::ostringstream text;
+  text << "msf_ros_node: the msfusion engine as a ROS 1 node (docs/ros.md).\n"
+          "usage: rosrun or roslaunch (launch/kitti_bag.launch), or msf_ros_node [_param:=value] [topic:=remap]\n"
+          "  in:  ~lidar_topic, ~left_topic, ~right_topic (and their camera_info), ~color_topic, /tf, /tf_static\n"
+          "  out: ~depth, ~weight (Image 32FC1), ~points (PointCloud2), ~mesh (Marker)\n"
+          "parameters (private: _name:=value, or a launch file's rosparam), with their defaults:\n";
+  for (const ParamDoc& doc : paramDocs(NodeParameters()))
+    text << "  " << doc.name << " = " << doc.default_value << "\n      " << doc.meaning << "\n";
+  return text.str();
+}
 
 NodeParameters::NodeParameters() {
   const BagOptions kitti2bag;
@@ -67,9 +113,10 @@ NodeParameters::NodeParameters() {
 
 NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
   NodeParameters p;
-  refuseUnknownParams(nh, {"lidar_topic", "left_topic", "right_topic", "color_topic", "world_frame", "poses", "config",
-                           "rig", "threads", "sweeping_scans", "queue_size", "sync_slop_s", "tf_timeout_s",
-                           "mesh_rate_hz", "mesh_path", "overwrite"});
+  std::set<std::string> known;
+  for (const ParamDoc& doc : paramDocs(p))
+    known.insert(doc.name);
+  refuseUnknownParams(nh, known);
   for (auto [name, value] : {std::pair{"lidar_topic", &p.lidar_topic}, {"left_topic", &p.left_topic},
                              {"right_topic", &p.right_topic}, {"color_topic", &p.color_topic},
                              {"world_frame", &p.world_frame}, {"poses", &p.poses}, {"config", &p.config},

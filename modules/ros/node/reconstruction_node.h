@@ -35,7 +35,7 @@ struct NodeParameters {
   std::string right_topic;
   std::string color_topic;   ///< "" = no colour camera
   std::string world_frame = "camera_init"; ///< tf frame of the poses and of the mesh
-  std::string poses = "auto";              ///< auto | tf | odometry (Reconstructor::PoseMode)
+  std::string poses = "auto";              ///< auto | tf | odometry | refine (Reconstructor::PoseMode)
   std::string config;        ///< the engine's YAML configuration ("" = its defaults)
   std::string rig;           ///< a calibration file instead of CameraInfo and the tf extrinsic
   int threads = 0;           ///< the engine's threads (0 = all cores)
@@ -54,6 +54,8 @@ struct NodeParameters {
   /// name, a wrong type or a value out of range, for a mesh_path that exists unless overwrite,
   /// and for one whose folder is missing or not writable.
   static NodeParameters read(const ros::NodeHandle& private_nh);
+  /// The node's usage: its topics and every parameter with its meaning and default (-h).
+  static std::string help();
 };
 
 class ReconstructionNode {
