@@ -11,6 +11,7 @@
 #include <msf/batch/slurm_jobs.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
+#include <msf/pipeline/run_report.h>
 
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>
@@ -69,10 +70,12 @@ std::vector<msf::Drive> collectDrives(const msf::tool::Arguments& paths, const s
 
 /// Predicts each drive's memory (the run's own model) and prints the plan.
 void predictResources(msf::BatchPlan& plan) {
+  // Each prediction grows this process; each drive's run starts from a new one.
+  const double process_mb = msf::residentMemoryMb();
   print_info("%-28s %8s %14s %12s\n", "drive", "frames", "predicted MiB", "request MiB");
   for (std::size_t i = 0; i < plan.drives().size(); ++i) {
     const msf::DriveResources r =
-        msf::predictDriveResources(plan.drives()[i], plan.pipelineConfig(), plan.options().frames);
+        msf::predictDriveResources(plan.drives()[i], plan.pipelineConfig(), plan.options().frames, process_mb);
     plan.setResources(i, r.predicted_mb, r.request_mb);
     print_info("%-28s %8zu %14.0f %12zu%s\n", plan.drives()[i].name.c_str(), r.frames, r.predicted_mb, r.request_mb,
                plan.driveDone(i) ? "   done" : "");

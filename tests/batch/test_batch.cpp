@@ -149,6 +149,16 @@ TEST_F(BatchPlanTest, LocalBatchMergesToTheOneProcessMapAndNeverRedoesADrive) {
   EXPECT_NEAR(merged.accuracy_mean_m, together.accuracy_mean_m, 0.001);
   EXPECT_NEAR(merged.completeness, together.completeness, 0.002);
 
+  // Each drive asks for the peak its own run predicts, whatever its place in the list.
+  const BatchPlan plan = BatchPlan::load(dir.file("batch"));
+  for (std::size_t i = 0; i < plan.drives().size(); ++i) {
+    const std::string log = test::readText(dir.file("batch/logs/" + plan.drives()[i].name + ".log"));
+    const std::size_t at = log.find("Memory: predicted peak ");
+    ASSERT_NE(at, std::string::npos) << log;
+    const double run_mb = std::stod(log.substr(at + std::string("Memory: predicted peak ").size()));
+    EXPECT_NEAR(plan.predictedMb(i), run_mb, 0.05 * run_mb) << plan.drives()[i].name;
+  }
+
   // Run again: nothing is redone (one attempt per drive in its times), the map stays.
   const auto mesh_time = fs::last_write_time(map + "/mesh.ply");
   const test::CommandResult again =

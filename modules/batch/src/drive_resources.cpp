@@ -10,7 +10,8 @@
 
 namespace msf {
 
-DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames) {
+DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames,
+                                     double process_mb) {
   const Sequence sequence(drive.dataset);
   const std::vector<std::size_t> indices = sequence.indices(FrameRange::parse(frames));
   if (drive.poses.empty() && !sequence.hasPoses())
@@ -26,7 +27,9 @@ DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& c
   Reconstructor engine(sequence.calibration(), config);
   DriveResources r;
   r.frames = indices.size();
-  r.predicted_mb = engine.predictMemory(sequence, indices, poses.knownPoses(indices)).total_mb;
+  MemoryEvidence evidence = engine.measureMemory(sequence, indices, poses.knownPoses(indices));
+  evidence.process_mb = process_mb; // the drive's own process, not this one grown by the drives before
+  r.predicted_mb = engine.predictMemory(evidence).total_mb;
   const double step = static_cast<double>(DriveResources::kRequestStepMb);
   r.request_mb = static_cast<std::size_t>(std::ceil(r.predicted_mb * DriveResources::kMargin / step) * step);
   return r;
