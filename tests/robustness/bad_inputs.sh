@@ -508,7 +508,12 @@ check "project: NaN reflectance everywhere" 1 "nan_reflectance.bin': each of its
   msf_project "$F/nan_reflectance.bin" o.pcd -calib "$F/camera.yaml"
 check "pcd2png: the output is a folder" 1 "output '.*folder.png' is a folder, not a file" -- \
   msf_pcd2png "$F/dense.pcd" "$F/folder.png"
-check "info --version" 0 "^msf_info \(msfusion\) [0-9]+\.[0-9]+\.[0-9]+, commit ([0-9a-f]{12}(-dirty)?|unknown)$" -- msf_info --version
+# Every tool, the ROS node among them, prints its version and commit (README.md says so).
+for tool in "$BIN"/msf_*; do
+  tool=$(basename "$tool")
+  check "$tool --version" 0 "^$tool \(msfusion\) [0-9]+\.[0-9]+\.[0-9]+, commit ([0-9a-f]{12}(-dirty)?|unknown)$" -- \
+    "$tool" --version
+done
 
 # ---- every write checked to the end: a full disk -----------------------------------------
 # A small tmpfs, filled: each writer meets ENOSPC at its first block. Mounting needs root, as CI
@@ -568,7 +573,7 @@ check "synth -street_m shorter than the drive" 1 "synthetic.street_length_m' = 5
 # ---- the ROS node's command line (built with ROS 1), before any master is reached ---------
 if [ -x "$BIN/msf_ros_node" ]; then
   check "ros_node: an argument that is not ROS's" 1 \
-    "unexpected argument '-frames': the node takes -h, remappings \\(topic:=name\\) and parameters" -- \
+    "unexpected argument '-frames': the node takes -h, --version, remappings \\(topic:=name\\) and parameters" -- \
     msf_ros_node -frames 0:9
   check "ros_node -h: every parameter, no master" 0 "overwrite = false" -- msf_ros_node -h
 else

@@ -7,6 +7,7 @@
 #include "reconstruction_node.h"
 
 #include <msf/common/huge_page_images.h>
+#include <msf/common/tool.h>
 
 #include <ros/init.h>
 #include <ros/master.h>
@@ -42,6 +43,13 @@ std::string unparsableMasterUri(int argc, char** argv) {
   return from.empty() || ros::network::splitURI(uri, host, port) ? "" : "'" + uri + "' (" + from + ")";
 }
 
+/// The first argument that is not a ROS remapping (name:=value), or "".
+std::string firstArgumentNotRos(int argc, char** argv) {
+  ros::V_string arguments;
+  ros::removeROSArgs(argc, argv, arguments);
+  return arguments.size() > 1 ? arguments[1] : "";
+}
+
 /// Waits for the ROS master, as ROS's nodes do, until a stop signal: ROS's own retries would not
 /// see one, since its SIGINT handler is replaced. False when stopped first.
 bool waitForMaster() {
@@ -57,18 +65,20 @@ bool waitForMaster() {
 } // namespace
 
 int main(int argc, char** argv) {
-  // ROS's arguments are remappings (name:=value); -h is the only other one the node takes.
-  ros::V_string arguments;
-  ros::removeROSArgs(argc, argv, arguments);
-  for (std::size_t i = 1; i < arguments.size(); ++i) {
-    if (arguments[i] == "-h" || arguments[i] == "--help") {
-      std::fputs(msf::NodeParameters::help().c_str(), stdout);
-      return 0;
-    }
+  if (msf::tool::wantsVersion(argc, argv)) {
+    std::printf("%s\n", msf::tool::versionLine("msf_ros_node").c_str());
+    return 0;
+  }
+  if (msf::tool::wantsHelp(argc, argv)) {
+    std::printf("%s%s\n", msf::NodeParameters::help().c_str(), msf::tool::versionLine("msf_ros_node").c_str());
+    return 0;
+  }
+  const std::string unexpected = firstArgumentNotRos(argc, argv);
+  if (!unexpected.empty()) {
     std::fprintf(stderr,
-                 "msf_ros_node: error: unexpected argument '%s': the node takes -h, remappings (topic:=name) "
-                 "and parameters (_name:=value)\n",
-                 arguments[i].c_str());
+                 "msf_ros_node: error: unexpected argument '%s': the node takes -h, --version, remappings "
+                 "(topic:=name) and parameters (_name:=value)\n",
+                 unexpected.c_str());
     return 1;
   }
   // SIGINT and SIGTERM stop the node while ROS still runs, so that it finishes the frames
