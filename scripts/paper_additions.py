@@ -72,6 +72,9 @@ def matches(section, key, patterns):
 
 
 def write_config(path, entries):
+    """`entries` as a config file at `path`; None for no entries: the tools' defaults (an empty file is refused)."""
+    if not entries:
+        return None
     by_section = {}
     for section, _, line in entries:
         by_section.setdefault(section, []).append(line)
@@ -79,6 +82,11 @@ def write_config(path, entries):
         f.write("%YAML:1.0\n")
         for section, lines in by_section.items():
             f.write(section + ":\n" + "\n".join(lines) + "\n")
+    return path
+
+
+def config_option(config):
+    return ["-config", config] if config else []
 
 
 def run(cmd):
@@ -91,8 +99,8 @@ def run(cmd):
 def depth_figures(bin_dir, dataset, frames, config, work):
     """Protocol 2 of `config`'s steps 1-4: (D1 % with missing = bad, MAE m); the street's all pixels."""
     table = os.path.join(work, "rows.csv")
-    run([os.path.join(bin_dir, "msf_holdout"), dataset, "-frames", frames, "-methods", "fused", "-config", config,
-         "-csv", table, "-overwrite"])
+    run([os.path.join(bin_dir, "msf_holdout"), dataset, "-frames", frames, "-methods", "fused", "-csv", table,
+         "-overwrite"] + config_option(config))
     for row in csv.DictReader(open(table)):
         if row.get("region", "all") == "all":
             return 100 * float(row["d1_all"]), float(row["mae_m"])
@@ -102,8 +110,8 @@ def depth_figures(bin_dir, dataset, frames, config, work):
 def map_figures(bin_dir, dataset, frames, config, work, synthetic):
     """Protocol 4 of `config`: the mesh's (coverage, D1 %) within range, or on the street (accuracy m, completeness %)."""
     out = os.path.join(work, "map")
-    cmd = [os.path.join(bin_dir, "msf_reconstruct"), dataset, "-o", out, "-frames", frames, "-config", config,
-           "-panels", "0"]
+    cmd = [os.path.join(bin_dir, "msf_reconstruct"), dataset, "-o", out, "-frames", frames, "-panels", "0"]
+    cmd += config_option(config)
     run(cmd + ([] if synthetic else ["-holdout"]))
     summary = json.load(open(os.path.join(out, "summary.json")))
     if synthetic:
@@ -127,9 +135,8 @@ def main():
     only = [o for o in args.only.split(",") if o]
     entries = paper_keys()
     with tempfile.TemporaryDirectory() as work:
-        paper, ours = os.path.join(work, "paper.yaml"), os.path.join(work, "ours.yaml")
-        write_config(paper, entries)
-        write_config(ours, [])
+        paper = write_config(os.path.join(work, "paper.yaml"), entries)
+        ours = write_config(os.path.join(work, "ours.yaml"), [])
         for stage in ("depth", "map"):
             if stage == "map" and not args.map:
                 continue
@@ -150,9 +157,10 @@ def main():
             for name, patterns, kind in ADDITIONS:
                 if kind != stage or (only and not any(name.startswith(o) for o in only)):
                     continue
-                plus, minus = os.path.join(work, "plus.yaml"), os.path.join(work, "minus.yaml")
-                write_config(plus, [e for e in entries if not matches(e[0], e[1], patterns)])
-                write_config(minus, [e for e in entries if matches(e[0], e[1], patterns)])
+                plus = write_config(os.path.join(work, "plus.yaml"),
+                                    [e for e in entries if not matches(e[0], e[1], patterns)])
+                minus = write_config(os.path.join(work, "minus.yaml"),
+                                     [e for e in entries if matches(e[0], e[1], patterns)])
                 cells = [figures(name, d[1], d[2], plus, d[3]) + " ; " + figures(name, d[1], d[2], minus, d[3])
                          for d in datasets]
                 print("| %s | %s |" % (name, " | ".join(cells)), flush=True)

@@ -709,7 +709,8 @@ private:
 void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::PipelineConfig& config) {
   cli.value("-o", "DIR", request.out,
             "output folder (default {default}): mesh.ply, volume.pcd, summary.json, frames.csv, runtime.png, "
-            "depth_NNNNNN.png, sky_NNNNNN.png, mesh_preview.png, report.md, config.yaml, poses.txt. Absent, empty, or an earlier "
+            "depth_<frame>.png, sky_<frame>.png, mesh_preview.png, report.md, config.yaml, poses.txt, poses_tum.txt, "
+            "trajectory.png (and the maps of -compare_sources and -compare_paper). Absent, empty, or an earlier "
             "run's output (replaced); anything else in it is refused")
       .value("-config", "FILE",
              [&](const std::string& path) {

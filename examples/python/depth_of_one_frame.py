@@ -1,6 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """The depth of one frame, each stage's and the fused one, as a picture:
-python3 depth_of_one_frame.py SEQUENCE_DIR FRAME_INDEX OUT.png"""
+PYTHONPATH=build/python /usr/bin/python3 examples/python/depth_of_one_frame.py SEQUENCE_DIR FRAME_INDEX OUT.png
+(from the repository, with the build tree's module; see docs/python.md)"""
 import sys
 
 import matplotlib

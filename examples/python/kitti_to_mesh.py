@@ -1,5 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-"""A KITTI drive to a coloured mesh: python3 kitti_to_mesh.py SEQUENCE_DIR MESH.ply [FRAMES]"""
+"""A KITTI drive to a coloured mesh:
+PYTHONPATH=build/python /usr/bin/python3 examples/python/kitti_to_mesh.py SEQUENCE_DIR MESH.ply [FRAMES]
+(from the repository, with the build tree's module; see docs/python.md)"""
 import itertools
 import sys
 

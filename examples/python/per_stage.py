@@ -1,6 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """A KITTI drive to a mesh stage by stage, each stage a call on numpy arrays:
-python3 per_stage.py SEQUENCE_DIR MESH.ply [FRAMES]
+PYTHONPATH=build/python /usr/bin/python3 examples/python/per_stage.py SEQUENCE_DIR MESH.ply [FRAMES]
+(from the repository, with the build tree's module; see docs/python.md)
 
 The pipeline (kitti_to_mesh.py) chains the same stages; it also integrates the interpolated
 LiDAR beyond the image's border and clears free space with the whole scan, so its mesh is a

@@ -31,6 +31,8 @@ fi
 
 BIN=$(cd "${1:?usage: bad_inputs.sh BIN_DIR KITTI_DIR}" && pwd)
 KITTI=${2:-}
+# Absolute, as BIN: the cases run in folders of their own.
+[ -z "$KITTI" ] || [ ! -d "$KITTI" ] || KITTI=$(cd "$KITTI" && pwd)
 MAX_SECONDS=5
 MAX_KB=$((500 * 1024))
 # Under AddressSanitizer (make test-sanitize sets ASAN_OPTIONS) a tool runs about twice as long
