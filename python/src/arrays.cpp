@@ -4,9 +4,11 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/limits.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -95,6 +97,32 @@ cv::Mat imageView(const py::handle& object, const char* name, int type, cv::Size
 
 cv::Mat optionalImageView(const py::handle& object, const char* name, int type, cv::Size expected) {
   return object.is_none() ? cv::Mat() : imageView(object, name, type, expected);
+}
+
+void requireValuesIn(const cv::Mat& image, const char* name, float lo, float hi, bool nan_allowed,
+                     const std::string& hint) {
+  for (int v = 0; v < image.rows; ++v) {
+    const float* row = image.ptr<float>(v);
+    for (int u = 0; u < image.cols; ++u) {
+      const float x = row[u];
+      if (std::isnan(x) ? nan_allowed : x >= lo && x <= hi)
+        continue;
+      std::ostringstream value;
+      value << x;
+      throw InvalidInputError(std::string(name) + " holds " + value.str() + " at row " + std::to_string(v) +
+                              ", column " + std::to_string(u) + ": " + hint);
+    }
+  }
+}
+
+void requireDepthValues(const cv::Mat& image, const char* name) {
+  constexpr float kMax = std::numeric_limits<float>::max();
+  requireValuesIn(image, name, -kMax, kMax, true, "give 0 or NaN where there is no depth");
+}
+
+void requireWeightValues(const cv::Mat& image, const char* name) {
+  requireValuesIn(image, name, 0.f, std::numeric_limits<float>::max(), false,
+                  "a weight is an inverse variance (m^-2), finite and not negative");
 }
 
 cv::Mat rowsView(const py::handle& object, const char* name, int depth, int min_columns, int max_columns) {

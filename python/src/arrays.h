@@ -26,6 +26,16 @@ cv::Mat imageView(const py::handle& array, const char* name, int type, cv::Size 
 /// The same for an optional argument: an empty cv::Mat for None.
 cv::Mat optionalImageView(const py::handle& array, const char* name, int type, cv::Size expected = {});
 
+/// Throws InvalidInputError naming `name` and the first pixel of a CV_32FC1 `image` (empty: none)
+/// outside lo..hi, or NaN unless `nan_allowed` (a depth image's NaN is no depth, as its 0);
+/// `hint` ends the message.
+void requireValuesIn(const cv::Mat& image, const char* name, float lo, float hi, bool nan_allowed,
+                     const std::string& hint);
+/// A depth image: anything but +-inf (0, a negative depth and NaN are no depth).
+void requireDepthValues(const cv::Mat& image, const char* name);
+/// A weight image (m^-2): finite and not negative.
+void requireWeightValues(const cv::Mat& image, const char* name);
+
 /// A one-channel cv::Mat of N rows over a C-contiguous array of shape (N, C), no copy, with
 /// min_columns <= C <= max_columns (points: x y z and maybe reflectance; triangles). `depth`:
 /// CV_32F, CV_32S, CV_8U... Throws InvalidInputError naming `name` as imageView.

@@ -60,6 +60,15 @@ FrameObject load(const FrameSource& source, long long i, bool with_color) {
   return object;
 }
 
+/// Camera 0's or 1's image: for a frame made from arrays the caller's own array (its flags, a
+/// read-only one included, stay its own), else a view of the frame's.
+py::object greyImage(const py::handle& self, int camera) {
+  const FrameObject& f = self.cast<const FrameObject&>();
+  if (py::isinstance<py::tuple>(f.arrays))
+    return py::reinterpret_borrow<py::tuple>(f.arrays)[static_cast<std::size_t>(camera)];
+  return viewOf(camera == 0 ? f.frame.left : f.frame.right, self);
+}
+
 /// for frame in source: loads frame after frame.
 struct FrameIterator {
   py::object source;  // keeps the FrameSource alive
@@ -92,12 +101,10 @@ void bindFrame(py::module_& m) {
       .def_property_readonly("name", [](const FrameObject& f) { return f.name; }, "File stem ('000042').")
       .def_property_readonly("timestamp", [](const FrameObject& f) { return f.frame.timestamp; },
                              "Seconds from the sequence's first frame.")
-      .def_property_readonly("left", [](const py::handle& self) {
-        return viewOf(self.cast<const FrameObject&>().frame.left, self);
-      }, "Camera 0's grey image, (H, W) uint8 (a view).")
-      .def_property_readonly("right", [](const py::handle& self) {
-        return viewOf(self.cast<const FrameObject&>().frame.right, self);
-      }, "Camera 1's grey image, (H, W) uint8 (a view).")
+      .def_property_readonly("left", [](const py::handle& self) { return greyImage(self, 0); },
+                             "Camera 0's grey image, (H, W) uint8 (a view; the array given, for a frame from arrays).")
+      .def_property_readonly("right", [](const py::handle& self) { return greyImage(self, 1); },
+                             "Camera 1's grey image, (H, W) uint8 (a view; the array given, for a frame from arrays).")
       .def_property_readonly("color", [](const FrameObject& f) -> py::object {
         if (f.frame.color.empty())
           return py::none();

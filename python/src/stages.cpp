@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
 
+#include <limits>
 #include <mutex>
 #include <string>
 
@@ -94,8 +95,16 @@ py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::hand
   // The sky's image: RGB (the library's order is BGR) or grey.
   const bool colour_sky = py::isinstance<py::array>(sky) && py::reinterpret_borrow<py::array>(sky).ndim() == 3;
   cv::Mat sky_image = optionalImageView(sky, "sky", colour_sky ? CV_8UC3 : CV_8UC1, size);
-  if (colour_sky)
-    cv::cvtColor(sky_image, sky_image, cv::COLOR_RGB2BGR);
+  if (colour_sky) { // into a new image: the caller's array stays as it was
+    cv::Mat bgr;
+    cv::cvtColor(sky_image, bgr, cv::COLOR_RGB2BGR);
+    sky_image = bgr;
+  }
+  requireDepthValues(ld, "lidar_depth");
+  requireDepthValues(sd, "stereo_depth");
+  requireValuesIn(dist, "lidar_distance", 0.f, std::numeric_limits<float>::max(), false,
+                  "a distance to the nearest real return, px, finite and not negative");
+  requireValuesIn(conf, "stereo_confidence", 0.f, 1.f, false, "a confidence is 0..1");
   cv::Mat depth, weight, free_weight;
   withoutGil(stage.mutex, [&] {
     stage.fusion.setInputImage(grey);

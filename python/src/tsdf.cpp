@@ -64,6 +64,9 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
   frame.free_space_weight = optionalImageView(free_space_weight, "free_space_weight", CV_32FC1, size);
   const cv::Mat rgb = optionalImageView(color, "color", CV_8UC3, size);
   const cv::Mat sky = optionalImageView(sky_depth, "sky_depth", CV_32FC1, size);
+  requireDepthValues(frame.depth, "depth");
+  requireWeightValues(frame.weight, "weight");
+  requireWeightValues(frame.free_space_weight, "free_space_weight");
   const Eigen::Isometry3d T_world_cam = poseFrom(pose, "pose");
   withoutGil(tsdf.mutex, [&] {
     if (!rgb.empty())

@@ -34,6 +34,21 @@ TEST(Calibration, OdometryCalibTxt) {
   EXPECT_TRUE(c.T_cam0_velo.linear().isUnitary(1e-5));
 }
 
+TEST(Calibration, ACameraIndexOutside0To3IsRefusedByEveryAccessor) {
+  msf::Calibration c;
+  for (auto& P : c.P)
+    P << 700, 0, 600, 0, 0, 700, 180, 0, 0, 0, 1, 0;
+  for (int camera : {-1, 4, 100000}) {
+    const std::string message = "camera index " + std::to_string(camera) + " is not 0..3";
+    EXPECT_THROW(c.K(camera), msf::InvalidInputError);
+    EXPECT_EQ(msf::test::errorOf([&] { c.K(camera); }), message);
+    EXPECT_EQ(msf::test::errorOf([&] { c.fx(camera); }), message);
+    EXPECT_EQ(msf::test::errorOf([&] { c.cameraCenter(camera); }), message);
+    EXPECT_EQ(msf::test::errorOf([&] { c.baseline(0, camera); }), message);
+  }
+  EXPECT_DOUBLE_EQ(c.K(3)(0, 0), 700.0);
+}
+
 TEST(Calibration, AFolderHoldingCalibTxtIsTheSame) {
   MSF_REQUIRE_KITTI();
   const msf::Calibration a = msf::loadCalibration(odometryCalib());

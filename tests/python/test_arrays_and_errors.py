@@ -266,3 +266,74 @@ def test_heavy_calls_release_the_gil(calibration, frame):
     spin(loop)
     assert not done.is_set(), "the Python loop waited for the stereo matches: the GIL was held"
     worker.join()
+
+
+def test_values_that_are_no_depth_weight_or_confidence_are_refused(calibration):
+    fusion = msfusion.DepthFusion(calibration)
+    depth = np.full((370, 1226), 10, np.float32)
+    inf_depth = depth.copy()
+    inf_depth[5, 7] = np.inf  # what focal_baseline / disparity gives where the disparity is 0
+    volume = msfusion.TsdfVolume()
+    cases = [
+        (lambda: fusion.fuse(depth, None, inf_depth, None),
+         "stereo_depth holds inf at row 5, column 7: give 0 or NaN where there is no depth"),
+        (lambda: fusion.fuse(inf_depth, None, depth, None), "lidar_depth holds inf at row 5, column 7"),
+        (lambda: fusion.fuse(depth, None, depth, np.full_like(depth, np.nan)),
+         "stereo_confidence holds nan at row 0, column 0: a confidence is 0..1"),
+        (lambda: fusion.fuse(depth, -depth, depth, None), "lidar_distance holds -10 at row 0, column 0"),
+        (lambda: volume.integrate(depth, np.eye(4), calibration, weight=np.full_like(depth, np.nan)),
+         r"weight holds nan at row 0, column 0: a weight is an inverse variance \(m\^-2\), finite and not negative"),
+        (lambda: volume.integrate(depth, np.eye(4), calibration, weight=-depth), "weight holds -10 at row 0"),
+    ]
+    for call, message in cases:
+        with pytest.raises(msfusion.InvalidInputError, match=message):
+            call()
+    assert volume.extract_mesh().vertices.shape[0] == 0  # nothing was integrated
+    # NaN is no depth, as 0 is: the stereo depth alone, finite weights.
+    fused, weight = fusion.fuse(np.full_like(depth, np.nan), None, depth, None)
+    assert np.all(np.isfinite(weight)) and np.count_nonzero(fused) > 0
+
+
+def test_inputs_are_never_written(calibration, frame):
+    stages = msfusion.LidarCompletion(calibration), msfusion.SgbmStereo(calibration), msfusion.DepthFusion(calibration)
+    depth, distance = stages[0].compute_depth(frame.scan)
+    stereo_depth, confidence = stages[1].compute_depth(frame.left, frame.right, prior=depth)
+    color = frame.color
+    before = color.copy()
+    first, _ = stages[2].fuse(depth, distance, stereo_depth, confidence, left=frame.left, sky=color)
+    np.testing.assert_array_equal(color, before)  # RGB still, not turned into the library's BGR
+    again, _ = stages[2].fuse(depth, distance, stereo_depth, confidence, left=frame.left, sky=color)
+    np.testing.assert_array_equal(again, first)
+    # A frame made from a read-only image gives that image back, read-only.
+    left = frame.left.copy()
+    left.flags.writeable = False
+    made = msfusion.Frame(left, frame.right.copy(), frame.scan)
+    assert made.left is left and not made.left.flags.writeable
+
+
+def test_a_camera_index_outside_0_to_3_is_refused(calibration):
+    for call in (lambda: calibration.K(4), lambda: calibration.K(-1), lambda: calibration.baseline(0, 100000)):
+        with pytest.raises(msfusion.InvalidInputError, match=r"camera index (4|-1|100000) is not 0\.\.3"):
+            call()
+    np.testing.assert_allclose(calibration.K(3)[2], [0, 0, 1])
+
+
+def test_a_mesh_without_colours_is_saved_without_them(tmp_path):
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    mesh = msfusion.Mesh(vertices, np.array([[0, 1, 2]], np.int32))
+    for extension in ("ply", "obj", "vtk"):
+        mesh.save(str(tmp_path / ("triangle." + extension)))
+    back = msfusion.read_mesh(str(tmp_path / "triangle.ply"))
+    np.testing.assert_array_equal(back.vertices, vertices)
+    np.testing.assert_array_equal(back.triangles, [[0, 1, 2]])
+
+
+def test_help_documents_every_public_name():
+    import pydoc
+
+    text = pydoc.render_doc(msfusion, renderer=pydoc.plaintext)
+    for name in msfusion.__all__:
+        assert hasattr(msfusion, name), name
+        assert name in text, name
+    for name in ("class Reconstructor", "class TsdfVolume", "class DepthFusion", "load_config(", "depth_to_points("):
+        assert name in text, name

@@ -349,6 +349,28 @@ TEST(MarchingCubes, SmoothingMovesWhatIsUncertainAndKeepsWhatIsKnown) {
   }
 }
 
+TEST(TriangleMesh, AMeshWithoutColoursIsSavedWithoutThemAndColoursNotOneAVertexAreRefused) {
+  TriangleMesh triangle;
+  triangle.vertices = {{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
+  triangle.triangles = {{0, 1, 2}};
+  pcl::PolygonMesh mesh;
+  triangle.toPolygonMesh(mesh);
+  ASSERT_EQ(mesh.cloud.fields.size(), 3u);
+  EXPECT_EQ(mesh.cloud.point_step, 12u);
+  test::TempDir dir;
+  for (const char* name : {"grey.ply", "grey.obj", "grey.vtk"}) {
+    saveMesh(dir.file(name), mesh);
+    pcl::PolygonMesh back;
+    loadMesh(dir.file(name), back);
+    EXPECT_EQ(back.cloud.width * back.cloud.height, 3u) << name;
+    EXPECT_EQ(back.polygons.size(), 1u) << name;
+  }
+  triangle.colors = {{255, 0, 0}};
+  EXPECT_THROW(triangle.toPolygonMesh(mesh), InvalidInputError);
+  EXPECT_EQ(test::errorOf([&] { triangle.toPolygonMesh(mesh); }),
+            "a mesh of 3 vertices has 1 colours: one a vertex, or none");
+}
+
 TEST(MarchingCubes, PolygonMeshSavesAsPlyObjAndVtk) {
   TsdfVolume volume(0.04, 0.12);
   integrateSphere(volume, 0, 2);

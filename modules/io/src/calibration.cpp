@@ -25,9 +25,13 @@ namespace fs = std::filesystem;
 
 namespace msf {
 
+void Calibration::throwNoSuchCamera(int camera) {
+  throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+}
+
 Eigen::Vector3d Calibration::cameraCenter(int camera) const {
   // P = K [R | t] with R = I for rectified cameras: centre = -K^-1 * P.col(3).
-  return -(K(camera).inverse() * P[camera].col(3));
+  return -(K(camera).inverse() * projection(camera).col(3));
 }
 
 double Calibration::baseline(int camera_a, int camera_b) const {

@@ -11,8 +11,7 @@
 namespace msf {
 
 PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int camera) {
-  if (camera < 0 || camera > 3)
-    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  Calibration::checkCamera(camera);
   const cv::Size size = calibration.requireImageSize();
   // Pixel indices (v * width + u, with a margin) are ints: the size is bounded first.
   limits::checkImageSize(size.width, size.height, "calibration '" + calibration.source + "'");

@@ -225,8 +225,7 @@ std::string Sequence::scanPath(std::size_t i) const {
 }
 
 std::string Sequence::imagePath(int camera, std::size_t i) const {
-  if (camera < 0 || camera > 3)
-    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  Calibration::checkCamera(camera);
   const fs::path p(dir_);
   if (layout_ == Layout::Odometry)
     return (p / ("image_" + std::to_string(camera)) / (frameName(i) + ".png")).string();

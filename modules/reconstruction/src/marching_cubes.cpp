@@ -611,10 +611,15 @@ void MarchingCubes::extract(const TsdfVolume& volume, pcl::PolygonMesh& mesh) {
 }
 
 void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
+  const bool coloured = !colors.empty();
+  if (coloured && colors.size() != vertices.size())
+    throw InvalidInputError("a mesh of " + std::to_string(vertices.size()) + " vertices has " +
+                            std::to_string(colors.size()) + " colours: one a vertex, or none");
   pcl::PCLPointCloud2& cloud = mesh.cloud;
   cloud = pcl::PCLPointCloud2();
   const char* names[4] = {"x", "y", "z", "rgb"};
-  for (int i = 0; i < 4; ++i) {
+  const int fields = coloured ? 4 : 3;
+  for (int i = 0; i < fields; ++i) {
     pcl::PCLPointField f;
     f.name = names[i];
     f.offset = static_cast<std::uint32_t>(4 * i);
@@ -622,7 +627,8 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
     f.count = 1;
     cloud.fields.push_back(f);
   }
-  cloud.point_step = 16;
+  const std::size_t step = 4 * static_cast<std::size_t>(fields);
+  cloud.point_step = static_cast<std::uint32_t>(step);
   cloud.width = static_cast<std::uint32_t>(vertices.size());
   cloud.height = 1;
   cloud.row_step = cloud.point_step * cloud.width;
@@ -630,8 +636,10 @@ void TriangleMesh::toPolygonMesh(pcl::PolygonMesh& mesh) const {
   cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
   parallelFor(cv::Range(0, static_cast<int>(vertices.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
-      std::uint8_t* p = cloud.data.data() + 16 * static_cast<std::size_t>(i);
+      std::uint8_t* p = cloud.data.data() + step * static_cast<std::size_t>(i);
       std::memcpy(p, vertices[i].data(), 12);
+      if (!coloured)
+        continue;
       const std::uint32_t rgb = (std::uint32_t(255) << 24) | (std::uint32_t(colors[i][0]) << 16) |
                                 (std::uint32_t(colors[i][1]) << 8) | std::uint32_t(colors[i][2]);
       std::memcpy(p + 12, &rgb, 4);

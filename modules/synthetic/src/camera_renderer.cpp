@@ -1,5 +1,4 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/exceptions.h>
 #include <msf/synthetic/camera_renderer.h>
 #include <msf/synthetic/counter_rng.h>
 #include <msf/synthetic/kitti_sky.h>
@@ -37,8 +36,7 @@ struct CameraModel {
 };
 
 CameraModel cameraModel(const Calibration& calibration, int camera, const Eigen::Isometry3d& T_world_cam0) {
-  if (camera < 0 || camera > 3)
-    throw InvalidInputError("camera index " + std::to_string(camera) + " is not 0..3");
+  Calibration::checkCamera(camera);
   CameraModel m;
   const Eigen::Vector3d c = T_world_cam0 * calibration.cameraCenter(camera);
   m.center = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};

@@ -33,12 +33,22 @@ struct Calibration {
     bool sweeping = true;                   ///< a spinning LiDAR: each scan swept over its period
   } lidar;
 
-  double fx(int camera = 0) const { return P[camera](0, 0); }
-  double fy(int camera = 0) const { return P[camera](1, 1); }
-  double cx(int camera = 0) const { return P[camera](0, 2); }
-  double cy(int camera = 0) const { return P[camera](1, 2); }
+  /// Throws InvalidInputError ("camera index N is not 0..3") unless `camera` is 0..3.
+  static void checkCamera(int camera) {
+    if (camera < 0 || camera > 3)
+      throwNoSuchCamera(camera);
+  }
+  /// The projection matrix of camera 0..3; throws as checkCamera.
+  const Projection& projection(int camera) const {
+    checkCamera(camera);
+    return P[static_cast<std::size_t>(camera)];
+  }
+  double fx(int camera = 0) const { return projection(camera)(0, 0); }
+  double fy(int camera = 0) const { return projection(camera)(1, 1); }
+  double cx(int camera = 0) const { return projection(camera)(0, 2); }
+  double cy(int camera = 0) const { return projection(camera)(1, 2); }
   /// Intrinsic matrix of a rectified camera.
-  Eigen::Matrix3d K(int camera = 0) const { return P[camera].leftCols<3>(); }
+  Eigen::Matrix3d K(int camera = 0) const { return projection(camera).leftCols<3>(); }
   /// Optical centre of a camera in the rectified frame of camera 0.
   Eigen::Vector3d cameraCenter(int camera) const;
   /// Distance between two optical centres in metres.
@@ -67,6 +77,9 @@ struct Calibration {
   /// size of 0x0 (unknown) or 1..limits::kMaxImageSide a side; T_cam0_velo (and
   /// T_velo_imu when read) rigid. loadCalibration calls it.
   void validate() const;
+
+private:
+  [[noreturn]] static void throwNoSuchCamera(int camera);
 };
 
 /// Reads a calibration, the format detected from `path`:

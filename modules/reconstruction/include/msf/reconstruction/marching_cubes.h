@@ -18,7 +18,7 @@ namespace msf {
 /// A welded triangle mesh: each vertex is stored once and shared by its triangles.
 struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;          ///< metres, world frame
-  std::vector<std::array<std::uint8_t, 3>> colors; ///< r, g, b per vertex
+  std::vector<std::array<std::uint8_t, 3>> colors; ///< r, g, b per vertex, or none
   /// Per vertex, the lesser weight (m^-2) of the two voxels whose zero crossing made it: how
   /// precisely the surface there is known; 0 where rays passed the one behind the surface since
   /// it last saw one (TsdfVoxel::passes): once, or MarchingCubes::Config::component_release_passes
@@ -27,7 +27,8 @@ struct TriangleMesh {
   std::vector<float> weights;
   std::vector<std::array<std::uint32_t, 3>> triangles; ///< counter-clockwise seen from outside (sdf > 0)
 
-  /// As a pcl::PolygonMesh whose cloud has fields x y z rgb (what saveMesh writes).
+  /// As a pcl::PolygonMesh whose cloud has fields x y z rgb (what saveMesh writes), x y z for a
+  /// mesh without colours; throws InvalidInputError when colours are given but not one a vertex.
   void toPolygonMesh(pcl::PolygonMesh& mesh) const;
 };
 
