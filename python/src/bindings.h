@@ -4,6 +4,8 @@
 // order by PYBIND11_MODULE (module.cpp); each file binds its classes with numpy in and out.
 #include "arrays.h"
 
+#include <pybind11/stl/filesystem.h> // a path argument takes str or os.PathLike (pathlib.Path)
+
 namespace msf::python {
 
 void bindErrors(py::module_& m);       // errors.cpp: msf::Error and its kinds

@@ -22,9 +22,9 @@ cv::Size sizeFrom(const std::optional<std::pair<int, int>>& image_size) {
   return image_size ? cv::Size(image_size->first, image_size->second) : cv::Size();
 }
 
-Calibration load(const std::string& path, const std::optional<std::pair<int, int>>& image_size) {
+Calibration load(const std::filesystem::path& path, const std::optional<std::pair<int, int>>& image_size) {
   py::gil_scoped_release release;
-  return loadCalibration(path, sizeFrom(image_size));
+  return loadCalibration(path.string(), sizeFrom(image_size));
 }
 
 py::array_t<double> projections(const Calibration& c) {
@@ -103,7 +103,9 @@ void bindCalibration(py::module_& m) {
                              "f * B of the grey pair: depth = focal_baseline / disparity.")
       .def("camera", &PinholeCamera::fromCalibration, py::arg("camera") = 0,
            "The PinholeCamera of a camera (0..3) of the rig.")
-      .def("save_yaml", &saveCalibrationYaml, py::arg("path"),
+      .def("save_yaml",
+           [](const Calibration& c, const std::filesystem::path& path) { saveCalibrationYaml(c, path.string()); },
+           py::arg("path"),
            "Writes the project's YAML rig file (read back by Calibration.load).")
       .def("__repr__", &describe);
   m.def("load_calibration", &load, py::arg("path"), py::arg("image_size") = py::none(),

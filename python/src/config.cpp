@@ -15,7 +15,8 @@ void bindConfig(py::module_& m) {
                              "Every stage's settings, one YAML section per stage (config/kitti.yaml lists every key). "
                              "Config() is the defaults; msfusion.load_config reads a file and overrides keys.")
       .def(py::init<>())
-      .def_static("load", &PipelineConfig::load, py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+      .def_static("load", [](const std::filesystem::path& path) { return PipelineConfig::load(path.string()); },
+                  py::arg("path"), py::call_guard<py::gil_scoped_release>(),
                   "The defaults overridden by the sections of a YAML file. Raises IOError for a missing file, "
                   "ConfigError naming a bad or unknown key.")
       .def_static("paper", &PipelineConfig::paper,

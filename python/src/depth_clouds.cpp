@@ -18,7 +18,8 @@ namespace msf::python {
 
 namespace {
 
-py::tuple readDepthCloud(const std::string& path, const std::optional<PinholeCamera>& camera) {
+py::tuple readDepthCloud(const std::filesystem::path& file, const std::optional<PinholeCamera>& camera) {
+  const std::string path = file.string();
   DepthFrame frame;
   cv::Mat sky_depth;
   {

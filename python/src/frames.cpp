@@ -158,7 +158,8 @@ void bindSources(py::module_& m) {
                                     "with poses/XX.txt), a KITTI raw drive (YYYY_MM_DD_drive_NNNN_sync, calibration "
                                     "in the date folder, poses from OXTS) or msf_synth's synthetic street. "
                                     "Indexing loads a Frame; iterating loads one after the other.")
-      .def(py::init<const std::string&>(), py::arg("path"), py::call_guard<py::gil_scoped_release>(),
+      .def(py::init([](const std::filesystem::path& path) { return std::make_unique<Sequence>(path.string()); }),
+           py::arg("path"), py::call_guard<py::gil_scoped_release>(),
            "Raises IOError naming the folder when it is no known layout.")
       .def_property_readonly("directory", &Sequence::directory)
       .def_property_readonly("layout", [](const Sequence& s) {
@@ -167,12 +168,12 @@ void bindSources(py::module_& m) {
       .def("__repr__", [](const Sequence& s) {
         return "Sequence('" + s.directory() + "', " + std::to_string(s.size()) + " frames)";
       });
-  m.def("open_dataset", [](const std::string& path, const std::string& rig) {
+  m.def("open_dataset", [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& rig) {
     py::gil_scoped_release release;
     DatasetOptions options;
-    options.rig = rig;
-    return openDataset(path, options);
-  }, py::arg("path"), py::arg("rig") = "",
+    options.rig = rig ? rig->string() : "";
+    return openDataset(path.string(), options);
+  }, py::arg("path"), py::arg("rig") = py::none(),
         "The FrameSource of a dataset folder, its layout detected (as msf_reconstruct reads it); rig: a "
         "calibration or rig file for layouts without one, or to override the dataset's.");
 }

@@ -71,7 +71,8 @@ TriangleMesh fromArrays(const py::handle& vertices, const py::handle& triangles,
   return mesh;
 }
 
-TriangleMesh readMesh(const std::string& path) {
+TriangleMesh readMesh(const std::filesystem::path& file) {
+  const std::string path = file.string();
   pcl::PolygonMesh polygons;
   {
     py::gil_scoped_release release;
@@ -79,12 +80,18 @@ TriangleMesh readMesh(const std::string& path) {
   }
   TriangleMesh mesh;
   const bool has_rgb = pcl::getFieldIndex(polygons.cloud, "rgb") >= 0 || pcl::getFieldIndex(polygons.cloud, "rgba") >= 0;
-  pcl::PointCloud<pcl::PointXYZRGB> points;
-  pcl::fromPCLPointCloud2(polygons.cloud, points);
-  for (const auto& p : points) {
-    mesh.vertices.emplace_back(p.x, p.y, p.z);
-    if (has_rgb)
+  if (has_rgb) {
+    pcl::PointCloud<pcl::PointXYZRGB> points;
+    pcl::fromPCLPointCloud2(polygons.cloud, points);
+    for (const auto& p : points) {
+      mesh.vertices.emplace_back(p.x, p.y, p.z);
       mesh.colors.push_back({p.r, p.g, p.b});
+    }
+  } else { // x y z only: PCL's conversion to a coloured point would warn of the missing field
+    pcl::PointCloud<pcl::PointXYZ> points;
+    pcl::fromPCLPointCloud2(polygons.cloud, points);
+    for (const auto& p : points)
+      mesh.vertices.emplace_back(p.x, p.y, p.z);
   }
   for (std::size_t i = 0; i < polygons.polygons.size(); ++i) {
     const auto& indices = polygons.polygons[i].vertices;
@@ -103,11 +110,11 @@ TriangleMesh readMesh(const std::string& path) {
   return mesh;
 }
 
-void saveTo(const TriangleMesh& mesh, const std::string& path) {
+void saveTo(const TriangleMesh& mesh, const std::filesystem::path& path) {
   py::gil_scoped_release release;
   pcl::PolygonMesh polygons;
   mesh.toPolygonMesh(polygons);
-  saveMesh(path, polygons);
+  saveMesh(path.string(), polygons);
 }
 
 } // namespace

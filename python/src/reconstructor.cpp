@@ -46,11 +46,11 @@ Reconstructor::PoseMode parsePoseMode(const std::string& text) {
 }
 
 std::unique_ptr<Engine> makeEngine(const Calibration& rig, const PipelineConfig& config, const std::string& poses,
-                                   int threads, const std::string& stream_directory) {
+                                   int threads, const std::optional<std::filesystem::path>& stream_directory) {
   Reconstructor::Options options;
   options.poses = parsePoseMode(poses);
   options.threads = threads;
-  options.stream_directory = stream_directory;
+  options.stream_directory = stream_directory ? stream_directory->string() : "";
   py::gil_scoped_release release;
   return std::make_unique<Engine>(rig, config, options);
 }
@@ -213,7 +213,7 @@ void bindReconstructor(py::module_& m) {
                      "LiDAR odometry's), the regularized TSDF volume and its mesh. The same classes and "
                      "settings as msf_reconstruct, so the same depth and mesh.")
       .def(py::init(&makeEngine), py::arg("calibration"), py::arg("config") = PipelineConfig(),
-           py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("stream_directory") = "",
+           py::arg("poses") = "auto", py::arg("threads") = 0, py::arg("stream_directory") = py::none(),
            "poses: auto (the frame's own pose; LiDAR odometry when the first frame has none), given (a frame "
            "without one is an error), odometry (always) or refine (the frames' own poses, a GPS/INS's, as the "
            "prior the LiDAR odometry refines). threads: of this engine's parallel loops, 0 = all "

@@ -138,8 +138,8 @@ void bindTsdf(py::module_& m) {
       .def("extract_mesh", &extractMesh,
            "The mesh of the volume (marching cubes, welded, coloured), meshing again only the blocks changed since "
            "the last call.")
-      .def("save", [](Tsdf& tsdf, const std::string& path) {
-        withoutGil(tsdf.mutex, [&] { tsdf.volume.save(path); });
+      .def("save", [](Tsdf& tsdf, const std::filesystem::path& path) {
+        withoutGil(tsdf.mutex, [&] { tsdf.volume.save(path.string()); });
       }, py::arg("path"), "The observed voxels as a .pcd of x y z sdf weight rgb (msf_mesh meshes it).")
       .def_property_readonly("voxel_size", [](const Tsdf& t) { return t.volume.voxelSize(); })
       .def_property_readonly("truncation", [](const Tsdf& t) { return t.volume.truncation(); })

@@ -337,3 +337,22 @@ def test_help_documents_every_public_name():
         assert name in text, name
     for name in ("class Reconstructor", "class TsdfVolume", "class DepthFusion", "load_config(", "depth_to_points("):
         assert name in text, name
+
+
+def test_a_path_may_be_a_pathlib_path(odometry04, tmp_path):
+    import pathlib
+
+    folder = pathlib.Path(odometry04)
+    assert len(msfusion.Sequence(folder)) == len(msfusion.open_dataset(folder)) > 0
+    calibration = msfusion.load_calibration(folder / "calib.txt")
+    calibration.save_yaml(tmp_path / "rig.yaml")
+    np.testing.assert_array_equal(msfusion.load_calibration(tmp_path / "rig.yaml").K(), calibration.K())
+    (tmp_path / "config.yaml").write_text("tsdf_volume:\n  voxel_size_m: 0.2\n")
+    assert "voxel_size_m: 0.2" in msfusion.load_config(tmp_path / "config.yaml").yaml()
+    mesh = msfusion.Mesh(np.eye(3, dtype=np.float32), np.array([[0, 1, 2]], np.int32))
+    mesh.save(tmp_path / "mesh.ply")
+    np.testing.assert_array_equal(msfusion.read_mesh(tmp_path / "mesh.ply").vertices, np.eye(3))
+    volume = msfusion.TsdfVolume()
+    volume.integrate_points(np.array([[5, 0, 0], [5, 0.5, 0]], np.float32), np.eye(4))
+    volume.save(tmp_path / "volume.pcd")
+    assert (tmp_path / "volume.pcd").stat().st_size > 0
