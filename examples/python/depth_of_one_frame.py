@@ -12,6 +12,9 @@ import numpy as np  # noqa: E402
 
 import msfusion  # noqa: E402
 
+if len(sys.argv) < 4:
+    sys.exit(__doc__)  # the usage
+
 sequence = msfusion.Sequence(sys.argv[1])
 frame = sequence[int(sys.argv[2])]
 result = msfusion.Reconstructor(sequence.calibration).compute_depth(frame)  # steps 1-4, each stage's depth

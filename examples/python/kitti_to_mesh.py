@@ -7,6 +7,9 @@ import sys
 
 import msfusion
 
+if len(sys.argv) < 3:
+    sys.exit(__doc__)  # the usage
+
 sequence = msfusion.Sequence(sys.argv[1])              # KITTI odometry sequence, raw drive or msf_synth's street
 engine = msfusion.Reconstructor(sequence.calibration)  # every stage with config/kitti.yaml's settings
 for frame in itertools.islice(sequence, int(sys.argv[3]) if len(sys.argv) > 3 else None):

@@ -11,6 +11,9 @@ import sys
 
 import msfusion
 
+if len(sys.argv) < 3:
+    sys.exit(__doc__)  # the usage
+
 sequence = msfusion.Sequence(sys.argv[1])
 calibration = sequence.calibration
 lidar = msfusion.LidarCompletion(calibration)   # steps 1-2: projection and compound interpolation

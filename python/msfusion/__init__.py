@@ -19,6 +19,7 @@ Mesh's arrays are views of it: copy one before editing it), and heavy calls rele
 Stage by stage: LidarCompletion, SgbmStereo, DepthFusion, colorize_depth, TsdfVolume; the
 configuration of every stage: Config and load_config; Open3D objects: msfusion.o3d.
 """
+from ._core import __commit__, __version__  # noqa: F401
 from ._core import (  # noqa: F401  (the package's API)
     Calibration,
     CalibrationError,

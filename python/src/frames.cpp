@@ -45,11 +45,16 @@ FrameObject fromArrays(const py::handle& left, const py::handle& right, const py
   return object;
 }
 
-FrameObject load(const FrameSource& source, long long i, bool with_color) {
+/// A Python index of a frame (negative: from the end) as the source's; IndexError outside it.
+std::size_t frameIndex(const FrameSource& source, long long i) {
   const auto size = static_cast<long long>(source.size());
   if (i < -size || i >= size)
     throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(size));
-  const auto index = static_cast<std::size_t>(i < 0 ? i + size : i);
+  return static_cast<std::size_t>(i < 0 ? i + size : i);
+}
+
+FrameObject load(const FrameSource& source, long long i, bool with_color) {
+  const std::size_t index = frameIndex(source, i);
   FrameObject object;
   {
     py::gil_scoped_release release;
@@ -143,13 +148,23 @@ void bindSources(py::module_& m) {
                           "the other, and its poses, if any.")
       .def("__len__", &FrameSource::size)
       .def("__getitem__", [](const FrameSource& s, long long i) { return load(s, i, true); }, py::arg("index"))
+      .def("__getitem__", [](const FrameSource& s, const py::slice& slice) {
+        std::size_t start = 0, stop = 0, step = 0, count = 0;
+        if (!slice.compute(s.size(), &start, &stop, &step, &count))
+          throw py::error_already_set();
+        py::list frames;
+        for (std::size_t k = 0; k < count; ++k)
+          frames.append(load(s, static_cast<long long>(start + k * step), true));
+        return frames;
+      }, py::arg("frames"), "A list of the frames of a slice, each loaded.")
       .def("load", &load, py::arg("index"), py::arg("with_color") = true,
            "Frame `index`; with_color=False skips reading the colour camera.")
       .def("__iter__", [](const py::object& self) { return FrameIterator{self, 0}; })
       .def_property_readonly("calibration", [](const FrameSource& s) { return s.calibration(); },
                              "A copy of the source's rig: changing it leaves the source as it is.")
       .def_property_readonly("poses", &posesOf, "(N, 4, 4) float64 T_world_cam0 per frame, or None.")
-      .def("frame_name", &FrameSource::frameName, py::arg("index"))
+      .def("frame_name", [](const FrameSource& s, long long i) { return s.frameName(frameIndex(s, i)); },
+           py::arg("index"), "The file stem of frame `index` ('000042').")
       .def("__repr__", [](const FrameSource& s) {
         return "FrameSource('" + s.description() + "', " + std::to_string(s.size()) + " frames)";
       });

@@ -2,12 +2,15 @@
 #include "bindings.h"
 
 #include <msf/common/huge_page_images.h>
+#include <msf/common/version.h>
 
 #include <opencv2/core/utility.hpp>
 
 PYBIND11_MODULE(_core, m) {
   m.doc() = "msfusion's library on numpy arrays (the package msfusion re-exports it; see help(msfusion))";
   using namespace msf::python;
+  m.attr("__version__") = msf::versionString();  // the C++ library's, "MAJOR.MINOR.PATCH"
+  m.attr("__commit__") = msf::gitCommit();       // what the tools' --version names
   bindErrors(m);
   bindCalibration(m);
   bindConfig(m);

@@ -356,3 +356,22 @@ def test_a_path_may_be_a_pathlib_path(odometry04, tmp_path):
     volume.integrate_points(np.array([[5, 0, 0], [5, 0.5, 0]], np.float32), np.eye(4))
     volume.save(tmp_path / "volume.pcd")
     assert (tmp_path / "volume.pcd").stat().st_size > 0
+
+
+def test_frames_are_indexed_and_sliced_as_a_python_sequence(sequence):
+    names = [sequence.frame_name(i) for i in range(len(sequence))]
+    assert sequence.frame_name(-1) == names[-1]
+    assert [f.name for f in sequence[1:6:2]] == names[1:6:2]
+    assert [f.name for f in sequence[::-3]] == names[::-3]
+    size = len(sequence)
+    with pytest.raises(IndexError, match="frame %d of a source of %d" % (size, size)):
+        sequence.frame_name(size)
+    with pytest.raises(IndexError, match="frame %d of a source of %d" % (-size - 1, size)):
+        sequence[-size - 1]
+
+
+def test_the_version_is_the_tools(run_tool):
+    import re
+
+    assert run_tool("msf_info", "--version").stdout.startswith("msf_info (msfusion) %s, commit " % msfusion.__version__)
+    assert re.fullmatch(r"[0-9a-f]{12}(-dirty)?|unknown", msfusion.__commit__)
