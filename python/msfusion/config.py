@@ -1,9 +1,10 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """The configuration of every stage from a YAML file of config/ and keys given in Python."""
 import os
+import re
 import tempfile
 
-from ._core import Config
+from ._core import Config, ConfigError
 
 
 def load_config(path=None, overrides=None):
@@ -69,4 +70,7 @@ def _load_text(text):
         path = os.path.join(folder, "config.yaml")
         with open(path, "w") as f:
             f.write(text)
-        return Config.load(path)
+        try:
+            return Config.load(path)
+        except ConfigError as error:  # name the overrides, not the file made of them
+            raise ConfigError(re.sub(r"^config '[^']*' line \d+: ", "overrides: ", str(error))) from None

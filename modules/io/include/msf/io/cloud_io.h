@@ -41,7 +41,7 @@ void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob,
                    const Eigen::Quaternionf& orientation = Eigen::Quaternionf::Identity());
 
 /// Saves a mesh by extension: .ply (binary), .obj or .vtk. Atomic and checked to the end,
-/// as saveCloud.
+/// as saveCloud; a mesh without vertices is an InvalidInputError, and no file.
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh);
 
 /// Loads a .ply/.obj/.vtk mesh; throws IOError naming the file.
