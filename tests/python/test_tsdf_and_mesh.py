@@ -98,3 +98,18 @@ def test_depth_to_points_puts_a_pixel_on_its_ray():
     points, colors = msfusion.depth_to_points(depth, CAMERA, color=color, pose=translation(0, 0, 10))
     np.testing.assert_allclose(points, [[1.0, 0.0, 12.0]])
     np.testing.assert_array_equal(colors, [WALL_COLOR])
+
+
+def test_depth_to_points_refuses_what_is_not_of_its_depth():
+    depth = np.zeros((CAMERA.height, CAMERA.width), np.float32)
+    cases = [
+        (lambda: msfusion.depth_to_points(depth, "camera"),
+         "camera must be a msfusion.PinholeCamera or a msfusion.Calibration, got str"),
+        (lambda: msfusion.depth_to_points(depth[:10], CAMERA), r"depth must have shape \(%d, %d\)" % depth.shape),
+        (lambda: msfusion.depth_to_points(depth, CAMERA, color=depth[:10]), "color must have shape"),
+        (lambda: msfusion.depth_to_points(depth, CAMERA, pose=np.eye(3)),
+         r"pose must have shape \(4, 4\), got \(3, 3\)"),
+    ]
+    for call, message in cases:
+        with pytest.raises(msfusion.InvalidInputError, match=message):
+            call()
