@@ -3,12 +3,15 @@
 // calib file or the project's YAML, the format detected) and the pinhole camera of one image.
 #include "bindings.h"
 
+#include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <utility>
@@ -48,7 +51,15 @@ void bindPinholeCamera(py::module_& m) {
                             "The intrinsics of one rectified camera: pixel (u, v) with depth z is the point "
                             "((u - cx) z / fx, (v - cy) z / fy, z).")
       .def(py::init([](float fx, float fy, float cx, float cy, int width, int height) {
-             return PinholeCamera{fx, fy, cx, cy, width, height};
+             const PinholeCamera camera{fx, fy, cx, cy, width, height};
+             if (!camera.valid() || !std::isfinite(fx) || !std::isfinite(fy) || !std::isfinite(cx) ||
+                 !std::isfinite(cy))
+               throw InvalidInputError("a PinholeCamera needs fx, fy > 0 and finite, cx, cy finite and a size of at "
+                                       "least 1x1, not fx " + std::to_string(fx) + ", fy " + std::to_string(fy) +
+                                       ", cx " + std::to_string(cx) + ", cy " + std::to_string(cy) + ", " +
+                                       std::to_string(width) + "x" + std::to_string(height));
+             limits::checkImageSize(width, height, "the PinholeCamera");
+             return camera;
            }),
            py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"), py::arg("height"))
       .def_readwrite("fx", &PinholeCamera::fx)

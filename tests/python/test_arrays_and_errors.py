@@ -316,6 +316,10 @@ def test_a_camera_index_outside_0_to_3_is_refused(calibration):
         with pytest.raises(msfusion.InvalidInputError, match=r"camera index (4|-1|100000) is not 0\.\.3"):
             call()
     np.testing.assert_allclose(calibration.K(3)[2], [0, 0, 1])
+    with pytest.raises(msfusion.InvalidInputError, match="a PinholeCamera needs fx, fy > 0 and finite"):
+        msfusion.PinholeCamera(0, 0, 0, 0, 0, 0)
+    with pytest.raises(msfusion.InvalidInputError, match="image size 100000x480 is outside"):
+        msfusion.PinholeCamera(500, 500, 320, 240, 100000, 480)
 
 
 def test_a_mesh_without_colours_is_saved_without_them(tmp_path):
