@@ -11,7 +11,6 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
-#include <cmath>
 #include <optional>
 #include <string>
 #include <utility>
@@ -52,8 +51,7 @@ void bindPinholeCamera(py::module_& m) {
                             "((u - cx) z / fx, (v - cy) z / fy, z).")
       .def(py::init([](float fx, float fy, float cx, float cy, int width, int height) {
              const PinholeCamera camera{fx, fy, cx, cy, width, height};
-             if (!camera.valid() || !std::isfinite(fx) || !std::isfinite(fy) || !std::isfinite(cx) ||
-                 !std::isfinite(cy))
+             if (!camera.valid())
                throw InvalidInputError("a PinholeCamera needs fx, fy > 0 and finite, cx, cy finite and a size of at "
                                        "least 1x1, not fx " + std::to_string(fx) + ", fy " + std::to_string(fy) +
                                        ", cx " + std::to_string(cx) + ", cy " + std::to_string(cy) + ", " +

@@ -1,11 +1,13 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
+#include <msf/io/pinhole_camera.h>
 #include <msf/io/velodyne_io.h>
 
 #include "test_support.h"
 
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace {
@@ -47,6 +49,17 @@ TEST(Calibration, ACameraIndexOutside0To3IsRefusedByEveryAccessor) {
     EXPECT_EQ(msf::test::errorOf([&] { c.baseline(0, camera); }), message);
   }
   EXPECT_DOUBLE_EQ(c.K(3)(0, 0), 700.0);
+}
+
+TEST(PinholeCamera, IsValidOnlyWithFinitePositiveFocalLengthsAFinitePrincipalPointAndASize) {
+  const msf::PinholeCamera good{500.f, 500.f, 320.f, 240.f, 640, 480};
+  EXPECT_TRUE(good.valid());
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (const msf::PinholeCamera& bad :
+       {msf::PinholeCamera{0.f, 500.f, 320.f, 240.f, 640, 480}, msf::PinholeCamera{inf, 500.f, 320.f, 240.f, 640, 480},
+        msf::PinholeCamera{500.f, nan, 320.f, 240.f, 640, 480}, msf::PinholeCamera{500.f, 500.f, nan, 240.f, 640, 480},
+        msf::PinholeCamera{500.f, 500.f, 320.f, inf, 640, 480}, msf::PinholeCamera{500.f, 500.f, 320.f, 240.f, 0, 480}})
+    EXPECT_FALSE(bad.valid()) << bad.fx << " " << bad.fy << " " << bad.cx << " " << bad.cy << " " << bad.width;
 }
 
 TEST(Calibration, AFolderHoldingCalibTxtIsTheSame) {

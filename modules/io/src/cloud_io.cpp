@@ -691,7 +691,7 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh) {
   const std::string ext = fileExtension(path);
   if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
     throw IOError("cannot write mesh '" + path + "': use .ply, .obj or .vtk");
-  if (mesh.cloud.width * mesh.cloud.height == 0) // PCL's writers refuse it, saying only why on the console
+  if (mesh.cloud.width == 0 || mesh.cloud.height == 0) // PCL's writers refuse it, saying why on the console only
     throw InvalidInputError("cannot write mesh '" + path + "': it has no vertices");
   writeThroughPipeAtomically(path, [&](const std::string& sink) {
     int result = -1;

@@ -24,10 +24,11 @@ struct DriveResources {
 
 /// The resources of `drive` reconstructed with `config` (its streaming settings included) over
 /// the frames of `frames` ("a:b"), by a process of `process_mb` before its run (the caller's
-/// resident memory before it predicted any drive: what a new msf_reconstruct starts from). Throws InvalidInputError naming the drive when its poses are
-/// not known before the run (a batch merges drives whose poses share a world: give a poses
-/// file), ConfigError when the streaming radius is below what the run needs (as the run would
-/// at its start), IOError / ConfigError as Sequence and Reconstructor do.
+/// resident memory before it predicted any drive: what a new msf_reconstruct starts from).
+/// Throws InvalidInputError naming the drive when its poses are not known before the run (a
+/// batch merges drives whose poses share a world: give a poses file), ConfigError when the
+/// streaming radius is below what the run needs (as the run would at its start), IOError /
+/// ConfigError as Sequence and Reconstructor do.
 DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames,
                                      double process_mb);
 

@@ -6,6 +6,7 @@
 #include <opencv2/core/types.hpp>
 #include <pcl/point_cloud.h>
 
+#include <cmath>
 #include <string>
 
 namespace msf {
@@ -16,7 +17,11 @@ struct PinholeCamera {
   float fx = 0.f, fy = 0.f, cx = 0.f, cy = 0.f;
   int width = 0, height = 0;
 
-  bool valid() const { return fx > 0.f && fy > 0.f && width > 0 && height > 0; }
+  /// fx, fy > 0 and finite, cx, cy finite, a size of at least 1x1.
+  bool valid() const {
+    return fx > 0.f && fy > 0.f && std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) &&
+           width > 0 && height > 0;
+  }
   /// The point the camera sees at pixel (u, v) with depth z, in its frame.
   Eigen::Vector3f point(float u, float v, float z) const { return {(u - cx) * z / fx, (v - cy) * z / fy, z}; }
   /// Camera `camera` (0..3) of a calibration; throws CalibrationError when the calibration
