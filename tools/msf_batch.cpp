@@ -167,7 +167,7 @@ int planAndRun(const Settings& s, const msf::tool::Arguments& paths, msf::BatchO
     print_highlight("Integrating %zu drives in one process into ", plan.drives().size());
     print_value("%s\n", s.out.c_str());
     const std::size_t triangles = msf::reconstructInOneProcess(plan, s.out);
-    msf::tool::printDone(tt.toc(), triangles);
+    msf::tool::printDone(tt.toc(), triangles, "triangles");
     return 0;
   }
   plan.requireRoot(); // a folder of someone else's is refused before the drives are read

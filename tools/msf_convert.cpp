@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     if (poses.size() == frames.size())
       msf::saveOdometryPoses((out / "poses.txt").string(), poses);
     output.commit();
-    msf::tool::printDone(tt.toc(), frames.size());
+    msf::tool::printDone(tt.toc(), frames.size(), "frames");
     return 0;
   });
 }

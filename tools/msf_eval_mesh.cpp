@@ -84,12 +84,12 @@ int main(int argc, char** argv) {
     pcl::PolygonMesh truth, mesh;
     msf::loadMesh(scene, truth);
     msf::loadMesh(args[0], mesh);
-    msf::tool::printDone(tt.toc(), seen.points.size());
+    msf::tool::printDone(tt.toc(), seen.points.size(), "points");
     print_highlight("Scoring ");
     print_value("%s ", args[0].c_str());
     tt.tic();
     const msf::MeshAccuracy a = msf::evaluateMesh(mesh, truth, seen.points, threshold_m);
-    msf::tool::printDone(tt.toc(), a.vertices);
+    msf::tool::printDone(tt.toc(), a.vertices, "vertices");
     print_info("accuracy %.4f m (median %.4f m), completeness %.2f %% and precision %.2f %% within %.2f m; %zu "
                "vertices, %zu samples of the seen surface\n",
                a.accuracy_mean_m, a.accuracy_median_m, 100 * a.completeness, 100 * a.precision, a.threshold_m,

@@ -118,7 +118,7 @@ Inputs loadInputs(const std::string& lidar_path, const std::string& stereo_path,
                                    std::to_string(inputs.left.rows) + ", the clouds are " +
                                    std::to_string(stereo.width) + "x" + std::to_string(stereo.height));
   }
-  msf::tool::printDone(tt.toc(), inputs.lidar->size() + inputs.stereo->size());
+  msf::tool::printDone(tt.toc(), inputs.lidar->size() + inputs.stereo->size(), "points");
   return inputs;
 }
 
@@ -140,7 +140,7 @@ void fuse(const Inputs& inputs, const msf::Calibration& calibration, const msf::
   std::size_t valid = 0;
   for (const auto& p : fused)
     valid += std::isfinite(p.z);
-  msf::tool::printDone(tt.toc(), valid);
+  msf::tool::printDone(tt.toc(), valid, "pixels with depth");
 }
 
 int run(const msf::tool::Arguments& files, Settings& settings) {
@@ -154,7 +154,7 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
   print_highlight("Saving ");
   print_value("%s ", files[2].c_str());
   msf::saveCloud(files[2], fused);
-  msf::tool::printDone(tt.toc(), fused.size());
+  msf::tool::printDone(tt.toc(), fused.size(), "points");
   return 0;
 }
 

@@ -404,7 +404,7 @@ void reportFullImage(const msf::Sequence& sequence, const std::vector<std::size_
   std::fflush(stdout);
   if (!settings.csv_path.empty())
     writeRegionCsv(settings.csv_path, results);
-  msf::tool::printDone(ms, results.empty() ? 0 : results.front().region[0].metrics.gt_pixels);
+  msf::tool::printDone(ms, results.empty() ? 0 : results.front().region[0].metrics.gt_pixels, "held-out pixels");
 }
 
 /// Ring hold-out: a row per method, and with -breakdown its rows by visibility and depth.
@@ -427,7 +427,7 @@ void reportHoldout(const msf::Sequence& sequence, const std::vector<std::size_t>
   std::fflush(stdout);
   if (!settings.csv_path.empty())
     msf::writeHoldoutCsv(settings.csv_path, results);
-  msf::tool::printDone(ms, results.empty() ? 0 : results.front().metrics.gt_pixels);
+  msf::tool::printDone(ms, results.empty() ? 0 : results.front().metrics.gt_pixels, "held-out pixels");
 }
 
 int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& positional, Settings& settings) {

@@ -176,7 +176,7 @@ double integrateFrames(const Frames& frames, const msf::PinholeCamera& camera, c
     integrator.integrateFrame(frame, T_world_cam, free);
     const msf::TsdfIntegrator::Stats& stats = integrator.lastStats();
     integrate_ms += stats.allocate_ms + stats.update_ms + stats.regularize_ms;
-    msf::tool::printDone(tt.toc(), stats.voxels_updated);
+    msf::tool::printDone(tt.toc(), stats.voxels_updated, "voxels");
   }
   return integrate_ms;
 }
@@ -227,7 +227,7 @@ int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& positiona
   print_value("%s ", settings.output.c_str());
   tt.tic();
   volume.save(settings.output);
-  msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
+  msf::tool::printDone(tt.toc(), volume.numObservedVoxels(), "voxels");
   return 0;
 }
 

@@ -83,7 +83,7 @@ pcl::PointCloud<pcl::PointXYZI>::Ptr loadInput(const std::string& path) {
     msf::loadVelodyneBin(path, *input);
   else
     msf::loadCloud(path, *input);
-  msf::tool::printDone(watch.getTime(), input->size());
+  msf::tool::printDone(watch.getTime(), input->size(), "points");
   return input;
 }
 
@@ -151,7 +151,7 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
     completeOrganized(*input, completion, settings, dense);
   }
   const std::size_t valid = countValid(dense);
-  msf::tool::printDone(watch.getTime(), valid);
+  msf::tool::printDone(watch.getTime(), valid, "pixels with depth");
   // As msf_project: an empty or all-NaN input (or a scan none of whose returns lands in
   // the camera) is an error, not an empty cloud written with exit code 0.
   if (valid == 0)
@@ -164,7 +164,7 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
   print_highlight("Saving ");
   print_value("%s ", out.c_str());
   msf::saveCloud(out, dense);
-  msf::tool::printDone(watch.getTime(), dense.size());
+  msf::tool::printDone(watch.getTime(), dense.size(), "points");
   return 0;
 }
 

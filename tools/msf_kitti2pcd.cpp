@@ -29,7 +29,7 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
   print_highlight("Loading ");
   print_value("%s ", in.c_str());
   const auto stats = msf::loadVelodyneBin(in, cloud);
-  msf::tool::printDone(tt.toc(), cloud.size());
+  msf::tool::printDone(tt.toc(), cloud.size(), "points");
   if (stats.dropped_nonfinite > 0)
     print_warn("dropped %zu of %zu records with non-finite values\n", stats.dropped_nonfinite, stats.records);
 
@@ -46,7 +46,7 @@ std::size_t convert(const std::string& in, const std::string& out, bool ascii) {
   } else {
     msf::saveCloud(out, cloud);
   }
-  msf::tool::printDone(tt.toc(), cloud.size());
+  msf::tool::printDone(tt.toc(), cloud.size(), "points");
   return cloud.size();
 }
 

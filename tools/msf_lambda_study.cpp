@@ -58,7 +58,7 @@ int run(const msf::LambdaStudy::Config& config, const std::string& out_dir) {
   print_value("%s", csv.c_str());
   print_info(" and ");
   print_value("%s ", png.c_str());
-  msf::tool::printDone(tt.toc(), cells.size());
+  msf::tool::printDone(tt.toc(), cells.size(), "cells");
   return 0;
 }
 

@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     print_highlight("Reading the indexes of %zu stores ", stores.size());
     tt.tic();
     const msf::StoreMerge merge(stores, merge_config);
-    msf::tool::printDone(tt.toc(), merge.tiles().size());
+    msf::tool::printDone(tt.toc(), merge.tiles().size(), "tiles");
 
     std::vector<std::string> inputs = stores;
     inputs.push_back(config_path);
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
     msf::StreamingMap::meshTiles(merged, config.mesher, merged.tiles(), tiles);
     const std::size_t triangles = msf::StreamingMap::unionOfTiles(merged, merged.tiles(), tiles, folder.dir() + "/mesh.ply");
     const double mesh_ms = tt.toc();
-    msf::tool::printDone(mesh_ms, triangles);
+    msf::tool::printDone(mesh_ms, triangles, "triangles");
     if (triangles == 0)
       throw msf::InvalidInputError("the merged map has no surface above weight " +
                                    std::to_string(config.mesher.min_weight) + ": nothing is written to '" + out + "'");

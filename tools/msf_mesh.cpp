@@ -72,7 +72,7 @@ int remeshStore(const std::string& store, const std::string& output, const Setti
   print_value("%s ", output.c_str());
   tt.tic();
   const std::size_t triangles = msf::StreamingMap::remesh(store, config, output, lo, hi);
-  msf::tool::printDone(tt.toc(), triangles);
+  msf::tool::printDone(tt.toc(), triangles, "triangles");
   if (triangles == 0)
     throw msf::InvalidInputError("store '" + store + "' has no surface above weight " +
                                  std::to_string(config.min_weight) + (region.empty() ? "" : " in the region") +
@@ -106,7 +106,7 @@ int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& files, co
   if (voxel < 0 || trunc < 0 || !std::isfinite(voxel) || !std::isfinite(trunc))
     throw msf::InvalidInputError("-voxel and -trunc must be > 0 m");
   const msf::TsdfVolume volume = msf::TsdfVolume::load(files[0], voxel, trunc);
-  msf::tool::printDone(tt.toc(), volume.numObservedVoxels());
+  msf::tool::printDone(tt.toc(), volume.numObservedVoxels(), "voxels");
 
   print_highlight("Meshing ");
   tt.tic();
@@ -140,7 +140,7 @@ int run(const msf::tool::CommandLine& cli, const msf::tool::Arguments& files, co
   print_value("%s ", files[1].c_str());
   tt.tic();
   msf::saveMesh(files[1], mesh);
-  msf::tool::printDone(tt.toc(), mesh.cloud.width);
+  msf::tool::printDone(tt.toc(), mesh.cloud.width, "vertices");
   return 0;
 }
 

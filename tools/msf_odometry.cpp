@@ -121,7 +121,7 @@ int run(const msf::tool::Arguments& positional, const Settings& settings) {
   print_highlight("Saving ");
   print_value("%s ", settings.output.c_str());
   msf::saveOdometryPoses(settings.output, tracked.T_world_cam0);
-  msf::tool::printDone(tt.toc(), tracked.T_world_cam0.size());
+  msf::tool::printDone(tt.toc(), tracked.T_world_cam0.size(), "poses");
 
   if (sequence.hasPoses()) {
     msf::PoseList reference;

@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     print_value("%s ", files[0].c_str());
     pcl::PointCloud<pcl::PointXYZ> cloud;
     msf::loadCloud(files[0], cloud);
-    msf::tool::printDone(tt.toc(), cloud.size());
+    msf::tool::printDone(tt.toc(), cloud.size(), "points");
     if (!cloud.isOrganized())
       throw msf::InvalidInputError("cloud '" + files[0] + "' is not organized (" + std::to_string(cloud.width) + "x" +
                                    std::to_string(cloud.height) + "): a depth image needs width x height pixels");
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
       warnSaturated(depth, "depth");
       msf::writeKittiDepthPng(files[1], depth);
     }
-    msf::tool::printDone(tt.toc(), static_cast<std::size_t>(cv::countNonZero(depth)));
+    msf::tool::printDone(tt.toc(), static_cast<std::size_t>(cv::countNonZero(depth)), "pixels with depth");
     return 0;
   });
 }

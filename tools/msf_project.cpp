@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
       msf::loadVelodyneBin(in, scan);
     else
       msf::loadCloud(in, scan);
-    msf::tool::printDone(watch.getTime(), scan.size());
+    msf::tool::printDone(watch.getTime(), scan.size(), "points");
 
     watch.reset();
     print_highlight("Projecting ");
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     std::size_t returns = 0;
     for (const auto& p : cloud)
       returns += std::isfinite(p.z);
-    msf::tool::printDone(watch.getTime(), returns);
+    msf::tool::printDone(watch.getTime(), returns, "returns");
     if (returns == 0)
       throw msf::InvalidInputError("no return of '" + in + "' lands in camera " + std::to_string(config.camera) +
                                    ": wrong calibration or scan?");
@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     print_highlight("Saving ");
     print_value("%s ", out.c_str());
     msf::saveCloud(out, cloud);
-    msf::tool::printDone(watch.getTime(), cloud.size());
+    msf::tool::printDone(watch.getTime(), cloud.size(), "points");
     return 0;
   });
 }

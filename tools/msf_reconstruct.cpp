@@ -483,7 +483,7 @@ private:
       if (evaluation_)
         evaluation_->scoreDepth("paper", p.index, p.fused.depth);
     });
-    msf::tool::printDone(tt.toc(), done.size());
+    msf::tool::printDone(tt.toc(), done.size(), "frames");
   }
 
   void meshMaps() {
@@ -499,7 +499,7 @@ private:
     const std::size_t streamed_triangles = streaming() ? engine_->finishStreaming(path(report_.mesh_file)) : 0;
     mesh_ = streaming() ? &streamed_ : &engine_->mesh();
     report_.mesh_ms = tt.toc();
-    msf::tool::printDone(report_.mesh_ms, streaming() ? streamed_triangles : mesh_->triangles.size());
+    msf::tool::printDone(report_.mesh_ms, streaming() ? streamed_triangles : mesh_->triangles.size(), "triangles");
     report_.vertices = mesh_->vertices.size();
     report_.triangles = streaming() ? streamed_triangles : mesh_->triangles.size();
     report_.pieces_removed = engine_->meshStats().components_removed;
@@ -515,7 +515,7 @@ private:
       tt.tic();
       print_highlight("Meshing the paper's map ");
       paper_mesh_ = &paper_->mesh();
-      msf::tool::printDone(tt.toc(), paper_mesh_->triangles.size());
+      msf::tool::printDone(tt.toc(), paper_mesh_->triangles.size(), "triangles");
     }
     if (source_maps_ && hurried()) { // stopped twice: the single-source maps are not meshed
       report_.skipped.push_back("compare_sources");
@@ -525,7 +525,7 @@ private:
       tt.tic();
       print_highlight("Meshing the map of each source alone ");
       source_maps_->mesh();
-      msf::tool::printDone(tt.toc(), source_maps_->maps().size());
+      msf::tool::printDone(tt.toc(), source_maps_->maps().size(), "maps");
     }
   }
 
@@ -559,7 +559,7 @@ private:
       if (!file)
         throw msf::IOError("cannot write '" + tmp + "'");
     });
-    msf::tool::printDone(tt.toc(), mesh_->vertices.size());
+    msf::tool::printDone(tt.toc(), mesh_->vertices.size(), "vertices");
     if (!mesh_->triangles.empty() && hurried())
       report_.skipped.push_back("mesh_preview");
     else if (!mesh_->triangles.empty())
@@ -609,7 +609,7 @@ private:
         report_.mesh_accuracy = scores["mesh"].accuracy;
         report_.has_mesh_accuracy = true;
       }
-      msf::tool::printDone(tt.toc(), scores.size());
+      msf::tool::printDone(tt.toc(), scores.size(), "meshes");
     }
     scoreViews(meshes, scores);
   }
@@ -652,7 +652,7 @@ private:
       if (protocol4)
         seen_through[name] = evaluation_->seenThroughPieces(*m.mesh);
     }
-    msf::tool::printDone(tt.toc(), views);
+    msf::tool::printDone(tt.toc(), views, "views");
     if (protocol4)
       summarizeProtocol4(scores, seen_through);
     if (protocol6) {

@@ -117,7 +117,7 @@ Inputs loadInputs(const std::string& left_path, const std::string& right_path, c
         inputs.guidance = inputs.guidance(image).clone();
     }
   }
-  msf::tool::printDone(tt.toc(), static_cast<std::size_t>(inputs.left.total()));
+  msf::tool::printDone(tt.toc(), static_cast<std::size_t>(inputs.left.total()), "pixels");
   return inputs;
 }
 
@@ -137,7 +137,7 @@ void match(const Inputs& inputs, const msf::Calibration& calibration, msf::SgbmS
   for (const auto& p : cloud)
     valid += std::isfinite(p.z);
   print_value("(%d disparities) ", stereo.getSearchedDisparities());
-  msf::tool::printDone(tt.toc(), valid);
+  msf::tool::printDone(tt.toc(), valid, "pixels with depth");
   if (valid == 0)
     print_warn("no pixel was matched: check the images (a rectified left/right pair?) and the disparity range\n");
 }
@@ -156,7 +156,7 @@ int run(const msf::tool::Arguments& files, Settings& settings) {
   if (!settings.disparity_path.empty())
     msf::writeKittiDisparityPng(settings.disparity_path, stereo.getDisparity());
   msf::saveCloud(files[2], cloud);
-  msf::tool::printDone(tt.toc(), cloud.size());
+  msf::tool::printDone(tt.toc(), cloud.size(), "points");
   return 0;
 }
 

@@ -71,7 +71,7 @@ void writeFrames(const msf::synthetic::SyntheticGenerator& generator, int frames
                                    output + "'");
     seconds.push_back(s);
     print_info("  frame %06zu ", frame);
-    msf::tool::printDone(1000.0 * s, points);
+    msf::tool::printDone(1000.0 * s, points, "points");
   });
   print_info("Wrote ");
   print_value("%s", output.c_str());

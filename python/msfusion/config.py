@@ -1,8 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """The configuration of every stage from a YAML file of config/ and keys given in Python."""
-import os
+import json
 import re
-import tempfile
 
 from ._core import Config, ConfigError
 
@@ -29,7 +28,10 @@ def load_config(path=None, overrides=None):
             if not dot or not name:
                 raise ValueError(f"override '{key}' must be 'section.key' or a section's dict of keys")
             sections.setdefault(section, {})[name] = _yaml_value(value)
-    return _load_text(_yaml_text(sections))
+    try:
+        return Config.from_yaml(_yaml_text(sections), "overrides")
+    except ConfigError as error:  # the overrides are not a file: no line to point at
+        raise ConfigError(re.sub(r"^config 'overrides' line \d+: ", "overrides: ", str(error))) from None
 
 
 def _sections(text):
@@ -54,6 +56,8 @@ def _yaml_value(value):
         return repr(value)
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_yaml_value(v) for v in value) + "]"
+    if isinstance(value, str):  # quoted, as YAML writes a string: "0.2" is not the number 0.2
+        return json.dumps(value)
     return str(value)
 
 
@@ -64,13 +68,3 @@ def _yaml_text(sections):
         lines.extend(f"  {name}: {value}" for name, value in keys.items())
     return "\n".join(lines) + "\n"
 
-
-def _load_text(text):
-    with tempfile.TemporaryDirectory(prefix="msfusion_config_") as folder:
-        path = os.path.join(folder, "config.yaml")
-        with open(path, "w") as f:
-            f.write(text)
-        try:
-            return Config.load(path)
-        except ConfigError as error:  # name the overrides, not the file made of them
-            raise ConfigError(re.sub(r"^config '[^']*' line \d+: ", "overrides: ", str(error))) from None

@@ -17,6 +17,29 @@ namespace msf::python {
 
 namespace py = pybind11;
 
+/// An argument of any Python object that the binding checks itself, with a message naming what
+/// is wrong (pybind11's own check would say only "incompatible function arguments"); its type
+/// name `Shown::name` is what signatures and help() show.
+template <typename Shown>
+class Checked : public py::object {
+public:
+  PYBIND11_OBJECT_DEFAULT(Checked, py::object, anyObject)
+
+private:
+  static bool anyObject(PyObject*) { return true; }
+};
+
+struct ShownAsArray {
+  static constexpr auto name = py::detail::const_name("numpy.ndarray");
+};
+struct ShownAsCamera {
+  static constexpr auto name = py::detail::const_name("PinholeCamera | Calibration");
+};
+/// A numpy array argument (imageView, rowsView and poseFrom check it); None where optional.
+using ArrayArg = Checked<ShownAsArray>;
+/// A camera argument: a PinholeCamera, or a Calibration for its camera 0.
+using CameraArg = Checked<ShownAsCamera>;
+
 /// A cv::Mat over `array`'s buffer, no copy: (H,W) for one channel, (H,W,C) for `channels`
 /// > 1. `type` is CV_8UC1, CV_8UC3, CV_32FC1... Throws InvalidInputError naming `name` when
 /// `array` is not a numpy array, has another dtype or shape, or is not C-contiguous. An
@@ -70,3 +93,10 @@ auto withoutGil(std::mutex& mutex, Work&& work) {
 }
 
 } // namespace msf::python
+
+namespace pybind11::detail {
+template <typename Shown>
+struct handle_type_name<msf::python::Checked<Shown>> {
+  static constexpr auto name = Shown::name;
+};
+} // namespace pybind11::detail

@@ -8,6 +8,15 @@
 
 namespace msf::python {
 
+/// copy.copy and copy.deepcopy of a class that holds all its data by value: a C++ copy.
+template <typename Class>
+Class& copyable(Class& cls) {
+  using T = typename Class::type;
+  cls.def("__copy__", [](const T& value) { return T(value); });
+  cls.def("__deepcopy__", [](const T& value, const py::dict&) { return T(value); }, py::arg("memo"));
+  return cls;
+}
+
 void bindErrors(py::module_& m);       // errors.cpp: msf::Error and its kinds
 void bindCalibration(py::module_& m);  // calibration.cpp: Calibration, PinholeCamera
 void bindConfig(py::module_& m);       // config.cpp: PipelineConfig as Config

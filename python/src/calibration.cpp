@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -45,21 +46,59 @@ std::string describe(const Calibration& c) {
          std::to_string(c.baselineGrey()) + " m" + (c.has_velodyne ? "" : ", cameras only") + ")";
 }
 
+PinholeCamera checkedCamera(float fx, float fy, float cx, float cy, int width, int height) {
+  const PinholeCamera camera{fx, fy, cx, cy, width, height};
+  if (!camera.valid())
+    throw InvalidInputError("a PinholeCamera needs fx, fy > 0 and finite, cx, cy finite and a size of at least 1x1, "
+                            "not fx " + std::to_string(fx) + ", fy " + std::to_string(fy) + ", cx " +
+                            std::to_string(cx) + ", cy " + std::to_string(cy) + ", " + std::to_string(width) + "x" +
+                            std::to_string(height));
+  limits::checkImageSize(width, height, "the PinholeCamera");
+  return camera;
+}
+
+/// Everything a Calibration holds, for pickle.
+py::tuple calibrationState(const Calibration& c) {
+  return py::make_tuple(projections(c), c.image_size.width, c.image_size.height, toArray(c.T_cam0_velo),
+                        toArray(c.T_velo_imu), c.has_imu, c.has_velodyne, c.source, c.lidar.rings,
+                        c.lidar.beam_elevations_deg, c.lidar.sweeping);
+}
+
+/// The Calibration of calibrationState, checked as a file's is.
+Calibration calibrationFromState(const py::tuple& state) {
+  if (state.size() != 11)
+    throw InvalidInputError("a pickled Calibration holds 11 values, not " + std::to_string(state.size()));
+  Calibration c;
+  const auto P = state[0].cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+  if (P.ndim() != 3 || P.shape(0) != 4 || P.shape(1) != 3 || P.shape(2) != 4)
+    throw InvalidInputError("a pickled Calibration's projections must have the shape (4, 3, 4)");
+  for (std::size_t i = 0; i < 4; ++i)
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 4; ++col)
+        c.P[i](r, col) = P.at(static_cast<py::ssize_t>(i), r, col);
+  c.image_size = cv::Size(state[1].cast<int>(), state[2].cast<int>());
+  c.T_cam0_velo = poseFrom(state[3], "a pickled Calibration's T_cam0_velo");
+  c.T_velo_imu = poseFrom(state[4], "a pickled Calibration's T_velo_imu");
+  c.has_imu = state[5].cast<bool>();
+  c.has_velodyne = state[6].cast<bool>();
+  c.source = state[7].cast<std::string>();
+  c.lidar.rings = state[8].cast<int>();
+  c.lidar.beam_elevations_deg = state[9].cast<std::vector<double>>();
+  c.lidar.sweeping = state[10].cast<bool>();
+  c.validate();
+  return c;
+}
+
 void bindPinholeCamera(py::module_& m) {
-  py::class_<PinholeCamera>(m, "PinholeCamera",
-                            "The intrinsics of one rectified camera: pixel (u, v) with depth z is the point "
-                            "((u - cx) z / fx, (v - cy) z / fy, z).")
-      .def(py::init([](float fx, float fy, float cx, float cy, int width, int height) {
-             const PinholeCamera camera{fx, fy, cx, cy, width, height};
-             if (!camera.valid())
-               throw InvalidInputError("a PinholeCamera needs fx, fy > 0 and finite, cx, cy finite and a size of at "
-                                       "least 1x1, not fx " + std::to_string(fx) + ", fy " + std::to_string(fy) +
-                                       ", cx " + std::to_string(cx) + ", cy " + std::to_string(cy) + ", " +
-                                       std::to_string(width) + "x" + std::to_string(height));
-             limits::checkImageSize(width, height, "the PinholeCamera");
-             return camera;
-           }),
-           py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"), py::arg("height"))
+  py::class_<PinholeCamera> camera(m, "PinholeCamera",
+                                   "The intrinsics of one rectified camera: pixel (u, v) with depth z is the point "
+                                   "((u - cx) z / fx, (v - cy) z / fy, z).");
+  copyable(camera)
+      .def(py::init(&checkedCamera), py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width"),
+           py::arg("height"))
+      .def(py::pickle(
+          [](const PinholeCamera& c) { return std::make_tuple(c.fx, c.fy, c.cx, c.cy, c.width, c.height); },
+          [](const std::tuple<float, float, float, float, int, int>& s) { return std::apply(checkedCamera, s); }))
       .def_readwrite("fx", &PinholeCamera::fx)
       .def_readwrite("fy", &PinholeCamera::fy)
       .def_readwrite("cx", &PinholeCamera::cx)
@@ -82,9 +121,12 @@ void bindPinholeCamera(py::module_& m) {
 
 void bindCalibration(py::module_& m) {
   bindPinholeCamera(m);
-  py::class_<Calibration>(m, "Calibration",
-                          "A rig: four rectified cameras (KITTI 0, 1 grey left/right; 2, 3 colour) sharing one image "
-                          "plane, and the LiDAR. Every projection maps points of camera 0's rectified frame to pixels.")
+  py::class_<Calibration> calibration(m, "Calibration",
+                                      "A rig: four rectified cameras (KITTI 0, 1 grey left/right; 2, 3 colour) sharing "
+                                      "one image plane, and the LiDAR. Every projection maps points of camera 0's "
+                                      "rectified frame to pixels.");
+  copyable(calibration)
+      .def(py::pickle(&calibrationState, &calibrationFromState))
       .def_static("load", &load, py::arg("path"), py::arg("image_size") = py::none(),
                   "Reads a KITTI odometry calib.txt (or its sequence folder), a KITTI raw date folder, a KITTI "
                   "object calib file or the project's YAML rig file, the format detected. image_size (width, "

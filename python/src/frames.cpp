@@ -19,8 +19,8 @@ namespace msf::python {
 
 namespace {
 
-FrameObject fromArrays(const py::handle& left, const py::handle& right, const py::handle& scan,
-                       const py::handle& color, const py::handle& pose, std::size_t index, double timestamp,
+FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayArg& scan,
+                       const ArrayArg& color, const ArrayArg& pose, std::size_t index, double timestamp,
                        const std::string& name) {
   FrameObject object;
   Frame& frame = object.frame;

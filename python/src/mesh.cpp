@@ -53,7 +53,7 @@ void readTriangles(const py::handle& triangles, std::size_t vertices, TriangleMe
     }
 }
 
-TriangleMesh fromArrays(const py::handle& vertices, const py::handle& triangles, const py::handle& colors) {
+TriangleMesh fromArrays(const ArrayArg& vertices, const ArrayArg& triangles, const ArrayArg& colors) {
   const cv::Mat v = rowsView(vertices, "vertices", CV_32F, 3, 3);
   TriangleMesh mesh;
   mesh.vertices.reserve(static_cast<std::size_t>(v.rows));
@@ -67,6 +67,31 @@ TriangleMesh fromArrays(const py::handle& vertices, const py::handle& triangles,
                               std::to_string(mesh.vertices.size()) + " vertices");
     mesh.colors.resize(mesh.vertices.size());
     std::memcpy(mesh.colors.data(), c.data, mesh.colors.size() * 3);
+  }
+  return mesh;
+}
+
+/// Everything a Mesh holds, as copies of its arrays (a view without an owner copies), for pickle.
+py::tuple meshState(const TriangleMesh& mesh) {
+  const py::handle copied;
+  const py::object colors = mesh.colors.empty()
+                                ? py::object(py::none())
+                                : view<std::uint8_t>(mesh.colors.data(), mesh.colors.size(), 3, copied);
+  return py::make_tuple(view<float>(mesh.vertices.data(), mesh.vertices.size(), 3, copied),
+                        view<std::int32_t>(mesh.triangles.data(), mesh.triangles.size(), 3, copied), colors,
+                        view<float>(mesh.weights.data(), mesh.weights.size(), 0, copied));
+}
+
+/// The Mesh of meshState, checked as fromArrays checks arrays.
+TriangleMesh meshFromState(const py::tuple& state) {
+  if (state.size() != 4)
+    throw InvalidInputError("a pickled Mesh holds 4 arrays, not " + std::to_string(state.size()));
+  TriangleMesh mesh = fromArrays(py::object(state[0]), py::object(state[1]), py::object(state[2]));
+  const auto weights = state[3].cast<py::array_t<float, py::array::c_style | py::array::forcecast>>();
+  if (weights.size() != 0) {
+    if (weights.ndim() != 1 || static_cast<std::size_t>(weights.size()) != mesh.vertices.size())
+      throw InvalidInputError("a pickled Mesh's weights must be one per vertex");
+    mesh.weights.assign(weights.data(), weights.data() + weights.size());
   }
   return mesh;
 }
@@ -120,13 +145,15 @@ void saveTo(const TriangleMesh& mesh, const std::filesystem::path& path) {
 } // namespace
 
 void bindMesh(py::module_& m) {
-  py::class_<TriangleMesh>(m, "Mesh",
-                           "A welded triangle mesh in metres, world frame: vertices (V, 3) float32, triangles (T, 3) "
-                           "int32 (counter-clockwise seen from outside), colors (V, 3) uint8 RGB and, from "
-                           "marching cubes, weights (V,) float32 (the lesser inverse variance of the two voxels "
-                           "that made each vertex; 0 where rays passed the one behind the surface since it last "
-                           "saw one: once, or component_release_passes frames in a row where a surface "
-                           "reappeared there after a pass). The arrays are views of the mesh: no copy.")
+  py::class_<TriangleMesh> mesh_class(
+      m, "Mesh",
+      "A welded triangle mesh in metres, world frame: vertices (V, 3) float32, triangles (T, 3) int32 "
+      "(counter-clockwise seen from outside), colors (V, 3) uint8 RGB and, from marching cubes, weights (V,) float32 "
+      "(the lesser inverse variance of the two voxels that made each vertex; 0 where rays passed the one behind the "
+      "surface since it last saw one: once, or component_release_passes frames in a row where a surface reappeared "
+      "there after a pass). The arrays are views of the mesh: no copy.");
+  copyable(mesh_class)
+      .def(py::pickle(&meshState, &meshFromState))
       .def(py::init(&fromArrays), py::arg("vertices"), py::arg("triangles"), py::arg("colors") = py::none(),
            "A mesh from arrays (copied): vertices (V, 3) float32, triangles (T, 3) int32, colors (V, 3) uint8.")
       .def_property_readonly("vertices", [](const py::handle& self) {

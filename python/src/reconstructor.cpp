@@ -160,7 +160,7 @@ void bindFrameResult(py::module_& m) {
       .def_property_readonly("name", [](const FrameResult& r) { return r.name; })
       .def_property("pose", [](const FrameResult& r) -> py::object {
         return r.has_pose ? py::object(toArray(r.T_world_cam0)) : py::none();
-      }, [](FrameResult& r, const py::handle& pose) {
+      }, [](FrameResult& r, const ArrayArg& pose) {
         r.has_pose = !pose.is_none();
         r.T_world_cam0 = r.has_pose ? poseFrom(pose, "pose") : Eigen::Isometry3d::Identity();
       }, "T_world_cam0 (4x4): the frame's, or the odometry's after add_frame; settable before integrate().")

@@ -32,7 +32,7 @@ struct LidarStage {
   std::mutex mutex;
 };
 
-py::tuple computeLidarDepth(LidarStage& stage, const py::handle& scan) {
+py::tuple computeLidarDepth(LidarStage& stage, const ArrayArg& scan) {
   const cv::Mat points = rowsView(scan, "scan", CV_32F, 3, 4);
   cv::Mat depth, distance;
   withoutGil(stage.mutex, [&] {
@@ -54,8 +54,8 @@ struct StereoStage {
   std::mutex mutex;
 };
 
-py::tuple computeStereoDepth(StereoStage& stage, const py::handle& left, const py::handle& right,
-                             const py::handle& prior, const py::handle& guidance) {
+py::tuple computeStereoDepth(StereoStage& stage, const ArrayArg& left, const ArrayArg& right,
+                             const ArrayArg& prior, const ArrayArg& guidance) {
   const cv::Mat l = imageView(left, "left", CV_8UC1, stage.size), r = imageView(right, "right", CV_8UC1, stage.size);
   const cv::Mat p = optionalImageView(prior, "prior", CV_32FC1, stage.size);
   const cv::Mat g = optionalImageView(guidance, "guidance", CV_32FC1, stage.size);
@@ -83,9 +83,9 @@ struct FusionStage {
   std::mutex mutex;
 };
 
-py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::handle& lidar_distance,
-               const py::handle& stereo_depth, const py::handle& stereo_confidence, const py::handle& left,
-               bool free_space, const py::handle& sky, bool fill_holes) {
+py::tuple fuse(FusionStage& stage, const ArrayArg& lidar_depth, const ArrayArg& lidar_distance,
+               const ArrayArg& stereo_depth, const ArrayArg& stereo_confidence, const ArrayArg& left,
+               bool free_space, const ArrayArg& sky, bool fill_holes) {
   const cv::Mat ld = imageView(lidar_depth, "lidar_depth", CV_32FC1);
   const cv::Size size = ld.size();
   const cv::Mat dist = optionalImageView(lidar_distance, "lidar_distance", CV_32FC1, size);
@@ -120,8 +120,8 @@ py::tuple fuse(FusionStage& stage, const py::handle& lidar_depth, const py::hand
   return py::make_tuple(toArray(depth), toArray(weight));
 }
 
-py::object colorize(const py::handle& depth, const Calibration& calibration, const py::handle& color,
-                    const py::handle& fallback, int color_camera) {
+py::object colorize(const ArrayArg& depth, const Calibration& calibration, const ArrayArg& color,
+                    const ArrayArg& fallback, int color_camera) {
   const cv::Mat d = imageView(depth, "depth", CV_32FC1, calibration.requireImageSize());
   const cv::Mat c = optionalImageView(color, "color", CV_8UC3);
   const bool rgb_fallback = py::isinstance<py::array>(fallback) && py::reinterpret_borrow<py::array>(fallback).ndim() == 3;
@@ -182,7 +182,7 @@ void bindStages(py::module_& m) {
            "fill_holes=True: the small holes (fusion.hole_fill_px) take the nearest depth at weight 0, as in "
            "the engine's depth and msf_fuse's.");
 
-  m.def("real_returns", [](const py::handle& depth, const py::handle& distance) {
+  m.def("real_returns", [](const ArrayArg& depth, const ArrayArg& distance) {
     const cv::Mat d = imageView(depth, "depth", CV_32FC1);
     return toArray(realReturns(d, imageView(distance, "distance", CV_32FC1, d.size())));
   }, py::arg("depth"), py::arg("distance"),

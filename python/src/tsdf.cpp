@@ -53,9 +53,9 @@ PinholeCamera cameraFrom(const py::handle& camera) {
                           py::str(camera.get_type().attr("__name__")).cast<std::string>());
 }
 
-void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose, const py::handle& camera,
-                    const py::handle& weight, const py::handle& color, const py::handle& free_space_weight,
-                    const py::handle& sky_depth) {
+void integrateDepth(Tsdf& tsdf, const ArrayArg& depth, const ArrayArg& pose, const CameraArg& camera,
+                    const ArrayArg& weight, const ArrayArg& color, const ArrayArg& free_space_weight,
+                    const ArrayArg& sky_depth) {
   DepthFrame frame;
   frame.camera = cameraFrom(camera);
   const cv::Size size(frame.camera.width, frame.camera.height);
@@ -81,7 +81,7 @@ void integrateDepth(Tsdf& tsdf, const py::handle& depth, const py::handle& pose,
   });
 }
 
-void integratePoints(Tsdf& tsdf, const py::handle& points, const py::handle& pose, const py::handle& colors) {
+void integratePoints(Tsdf& tsdf, const ArrayArg& points, const ArrayArg& pose, const ArrayArg& colors) {
   const cv::Mat p = rowsView(points, "points", CV_32F, 3, 4);
   const cv::Mat c = colors.is_none() ? cv::Mat() : rowsView(colors, "colors", CV_8U, 3, 3);
   if (!c.empty() && c.rows != p.rows)

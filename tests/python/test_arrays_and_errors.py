@@ -1,8 +1,10 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Shapes, dtypes and errors: what the binding takes and gives, and how it refuses."""
+import copy
 import gc
 import math
 import os
+import pickle
 import threading
 import time
 
@@ -232,6 +234,33 @@ def test_config_overrides_are_read_as_a_file_reads():
         msfusion.load_config(overrides={"fusion.no_such_key": 1})
     with pytest.raises(msfusion.IOError, match="/nonexistent.yaml"):
         msfusion.load_config("/nonexistent.yaml")
+
+
+def test_a_string_override_is_a_string_as_in_a_file():
+    assert "mode: sgbm" in msfusion.load_config(overrides={"stereo.mode": "sgbm"}).yaml()
+    with pytest.raises(msfusion.ConfigError, match=r"^overrides: .*voxel_size_m"):  # "0.2" is text, not 0.2
+        msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": "0.2"})
+    with pytest.raises(msfusion.ConfigError, match="^overrides: .*stereo.mode"):  # YAML's syntax stays text
+        msfusion.load_config(overrides={"stereo.mode": "sgbm\nfusion: {method: x}"})
+
+
+def test_a_calibration_copies_and_pickles_to_the_same_rig(calibration):
+    for twin in (copy.copy(calibration), copy.deepcopy(calibration), pickle.loads(pickle.dumps(calibration))):
+        np.testing.assert_array_equal(twin.P, calibration.P)
+        np.testing.assert_array_equal(twin.T_cam0_velo, calibration.T_cam0_velo)
+        assert repr(twin) == repr(calibration) and twin.image_size == calibration.image_size
+        twin.lidar_sweeping = not calibration.lidar_sweeping  # a copy, not the rig itself
+        assert twin.lidar_sweeping != calibration.lidar_sweeping
+
+
+def test_a_config_copies_and_pickles_to_the_same_keys():
+    config = msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": 0.2, "stereo.mode": "sgbm"})
+    for twin in (copy.copy(config), copy.deepcopy(config), pickle.loads(pickle.dumps(config))):
+        assert twin == config and twin.yaml() == config.yaml() and twin.voxel_size == 0.2
+    assert config != msfusion.Config()
+    assert msfusion.Config.from_yaml(config.yaml()) == config
+    with pytest.raises(msfusion.ConfigError, match="^config 'mine' line 2: .*voxel_size_m"):
+        msfusion.Config.from_yaml("tsdf_volume:\n  voxel_size_m: -1\n", "mine")
 
 
 def test_heavy_calls_release_the_gil(calibration, frame):

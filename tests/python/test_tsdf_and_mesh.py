@@ -2,6 +2,9 @@
 """The TSDF volume and the mesh on scenes with known answers (no data needed): a wall seen by a
 pinhole camera or by a sensor's rays lands where it is, in the colour it has, and meshes keep
 their arrays through a file."""
+import copy
+import pickle
+
 import numpy as np
 import pytest
 
@@ -65,6 +68,23 @@ def test_points_with_a_pose_mesh_where_they_are():
     assert (mesh.colors == WALL_COLOR).all()
     with pytest.raises(msfusion.InvalidInputError, match="colors has 3 rows for"):
         volume.integrate_points(points, np.eye(4), colors=colors[:3].copy())
+
+
+def test_a_mesh_and_a_camera_copy_and_pickle_whole():
+    volume = msfusion.TsdfVolume(voxel_size=0.1, truncation=0.3)
+    depth, weight, color = wall(5.0)
+    volume.integrate(depth, np.eye(4), CAMERA, weight=weight, color=color)
+    mesh = volume.extract_mesh()
+    for twin in (copy.copy(mesh), copy.deepcopy(mesh), pickle.loads(pickle.dumps(mesh))):
+        for name in ("vertices", "triangles", "colors", "weights"):
+            np.testing.assert_array_equal(getattr(twin, name), getattr(mesh, name))
+            assert not np.shares_memory(getattr(twin, name), getattr(mesh, name))
+    bare = pickle.loads(pickle.dumps(msfusion.Mesh(mesh.vertices, mesh.triangles)))
+    assert bare.colors.shape == (0, 3) and bare.weights.shape == (0,)
+    for twin in (copy.copy(CAMERA), copy.deepcopy(CAMERA), pickle.loads(pickle.dumps(CAMERA))):
+        assert repr(twin) == repr(CAMERA)
+        twin.fx = 1.0  # a copy, not the camera itself
+    assert CAMERA.fx == 200
 
 
 def test_a_mesh_keeps_its_arrays_through_a_file(tmp_path):

@@ -285,17 +285,17 @@ TEST(SkyCarving, OffEmptyOrRefused) {
   EXPECT_EQ(test::errorOf([&] {
               integrator.carveSky(cv::Mat(10, 10, CV_32FC1, cv::Scalar(5.f)), camera, drivePose(0), 1111.f);
             }),
-            "carveSky: the sky depth must be CV_32FC1 of the camera's 1241x376, not 10x10 of type 5");
+            "the sky depth must be CV_32FC1 of the camera's 1241x376, not 10x10 CV_32FC1");
   EXPECT_EQ(test::errorOf([&] {
               integrator.carveSky(cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(255)), camera, drivePose(0),
                                   1111.f);
             }),
-            "carveSky: the sky depth must be CV_32FC1 of the camera's 1241x376, not 1241x376 of type 0");
+            "the sky depth must be CV_32FC1 of the camera's 1241x376, not 1241x376 CV_8UC1");
   for (const float bound : {0.f, -2.f, -std::numeric_limits<float>::infinity()}) {
     cv::Mat sky_depth = everything.clone();
     sky_depth.at<float>(7, 30) = bound;
     const std::string error = test::errorOf([&] { integrator.carveSky(sky_depth, camera, drivePose(0), 1111.f); });
-    EXPECT_EQ(error.rfind("carveSky: the sky depth at pixel (30, 7) is ", 0), 0u) << error;
+    EXPECT_EQ(error.rfind("the sky depth at pixel (30, 7) is ", 0), 0u) << error;
     EXPECT_NE(error.find("a pixel's bound is NaN (not sky), a depth > 0 or +inf"), std::string::npos) << error;
   }
   EXPECT_THROW(integrator.carveSky(everything, camera, drivePose(0), 0.f), InvalidInputError);

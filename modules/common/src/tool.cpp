@@ -297,12 +297,12 @@ void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite) 
   }
 }
 
-void printDone(double milliseconds, std::size_t points) {
+void printDone(double milliseconds, std::size_t count, const char* counted) {
   pcl::console::print_info("[done, ");
   pcl::console::print_value("%g", milliseconds);
   pcl::console::print_info(" ms : ");
-  pcl::console::print_value("%zu", points);
-  pcl::console::print_info(" points]\n");
+  pcl::console::print_value("%zu", count);
+  pcl::console::print_info(" %s]\n", counted);
 }
 
 } // namespace msf::tool

@@ -149,10 +149,10 @@ void raysBeyondRange(const cv::Mat& depth, const cv::Mat& weight, float range, f
 
 void TsdfIntegrator::checkSkyDepth(const cv::Mat& sky_depth, const PinholeCamera& camera) {
   if (sky_depth.type() != CV_32FC1 || sky_depth.cols != camera.width || sky_depth.rows != camera.height)
-    throw InvalidInputError("carveSky: the sky depth must be CV_32FC1 of the camera's " + std::to_string(camera.width) +
-                            "x" + std::to_string(camera.height) + ", not " + std::to_string(sky_depth.cols) + "x" +
-                            std::to_string(sky_depth.rows) + " of type " + std::to_string(sky_depth.type()));
-  checkSkyDepthBounds(sky_depth, "carveSky: the sky depth");
+    throw InvalidInputError("the sky depth must be CV_32FC1 of the camera's " + std::to_string(camera.width) + "x" +
+                            std::to_string(camera.height) + ", not " + std::to_string(sky_depth.cols) + "x" +
+                            std::to_string(sky_depth.rows) + " " + cv::typeToString(sky_depth.type()));
+  checkSkyDepthBounds(sky_depth, "the sky depth");
 }
 
 void TsdfIntegrator::carveSky(const cv::Mat& sky_depth, const PinholeCamera& camera,

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     msf::writeKittiBag(*source, frames, output, options);
     if (tty)
       std::printf("\n");
-    msf::tool::printDone(tt.toc(), frames.size());
+    msf::tool::printDone(tt.toc(), frames.size(), "frames");
     return 0;
   });
 }

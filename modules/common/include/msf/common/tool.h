@@ -101,7 +101,7 @@ private:
 /// is written over), or whose folder is missing or not writable (requireWritableFolder).
 void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite);
 
-/// Prints PCL's done line: "[done, 12.3 ms : 465750 points]".
-void printDone(double milliseconds, std::size_t points);
+/// Prints PCL's done line with what was counted: "[done, 12.3 ms : 465750 points]".
+void printDone(double milliseconds, std::size_t count, const char* counted);
 
 } // namespace msf::tool
