@@ -33,9 +33,10 @@ ros_session_start "$build"
 "$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -o "$work/04.bag" >/dev/null
 ros_session_wait_master
 
-# No master at the URI: the node waits for one, says so, and a SIGTERM ends the wait (exit 130).
+# No master at the URI: the node waits for one, says so, and a SIGTERM ends the wait (exit 130),
+# also with a parameter to set on the master (ros::init would wait for it in silence).
 no_master=http://localhost:$(python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
-ROS_MASTER_URI=$no_master "$build/bin/msf_ros_node" __name:=waiting >"$work/waiting.log" 2>&1 &
+ROS_MASTER_URI=$no_master "$build/bin/msf_ros_node" __name:=waiting _queue_size:=2 >"$work/waiting.log" 2>&1 &
 waiting=$!
 for _ in $(seq 100); do
   grep -q "waiting for the ROS master at $no_master" "$work/waiting.log" && break

@@ -20,6 +20,12 @@
 #include <cstdlib>
 #include <string>
 
+namespace ros::master {
+// roscpp's own, exported but not in its headers: the master's URI from __master:= or
+// ROS_MASTER_URI, as ros::init sets it. ROS 1 is frozen, so the symbol stays.
+ROSCPP_DECL void init(const M_string& remappings);
+} // namespace ros::master
+
 namespace {
 std::atomic<bool> g_stop{false};
 
@@ -48,6 +54,17 @@ std::string firstArgumentNotRos(int argc, char** argv) {
   ros::V_string arguments;
   ros::removeROSArgs(argc, argv, arguments);
   return arguments.size() > 1 ? arguments[1] : "";
+}
+
+/// The arguments' remappings (name:=value), as ros::init reads them.
+ros::M_string remappingsOf(int argc, char** argv) {
+  ros::M_string remappings;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (const std::size_t at = argument.find(":="); at != std::string::npos)
+      remappings[argument.substr(0, at)] = argument.substr(at + 2);
+  }
+  return remappings;
 }
 
 /// Waits for the ROS master, as ROS's nodes do, until a stop signal: ROS's own retries would not
@@ -89,13 +106,16 @@ int main(int argc, char** argv) {
                  bad_uri.c_str());
     return 1;
   }
-  ros::init(argc, argv, "msf_ros_node", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { g_stop = true; });
   std::signal(SIGTERM, [](int) { g_stop = true; });
+  // Waited for before ros::init, which sets the _name:=value parameters on the master and would
+  // wait for it in silence, deaf to the stop signals.
+  ros::master::init(remappingsOf(argc, argv));
   if (!waitForMaster()) {
     std::fprintf(stderr, "msf_ros_node: stopped while waiting for the ROS master; nothing was done\n");
     return 130;
   }
+  ros::init(argc, argv, "msf_ros_node", ros::init_options::NoSigintHandler);
   msf::useHugePagesForLargeImages();
   ros::NodeHandle nh, private_nh("~");
   try {
