@@ -14,7 +14,8 @@ def load_config(path=None, overrides=None):
         msfusion.load_config(overrides={"tsdf_volume.voxel_size_m": 0.2, "tsdf_integrator": {"lambda": 5.0}})
 
     The library reads the result as it reads a file, so a key it does not know, a wrong type
-    or a value out of range is a ConfigError that names it."""
+    (a str is a YAML string: "0.2" is not the number 0.2) or a value out of range is a
+    ConfigError that names it."""
     config = Config.load(path) if path else Config()
     if not overrides:
         return config
