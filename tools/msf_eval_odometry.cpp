@@ -8,7 +8,7 @@
 #include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>
 #include <msf/io/poses.h>
-#include <msf/io/sequence.h>
+#include <msf/pipeline/open_dataset.h>
 
 #include <pcl/console/print.h>
 
@@ -24,10 +24,11 @@ namespace {
 msf::PoseList loadReference(const std::string& path, const std::string& frames_text) {
   msf::PoseList all;
   if (fs::is_directory(path)) {
-    const msf::Sequence sequence(path);
-    if (!sequence.hasPoses())
-      throw msf::InvalidInputError("dataset '" + path + "' has no poses (odometry poses/XX.txt, raw oxts/ or gt/) to compare with");
-    all = sequence.referencePoses(); // the truth, when the dataset's poses are a synthetic INS's
+    const auto dataset = msf::openDataset(path);
+    if (!dataset->hasPoses())
+      throw msf::InvalidInputError("dataset '" + path + "' has no poses (odometry poses/XX.txt, raw oxts/, gt/ or "
+                                   "your layout's poses.txt) to compare with");
+    all = dataset->referencePoses(); // the truth, when the dataset's poses are a synthetic INS's
   } else {
     all = msf::loadOdometryPoses(path);
   }
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
       "msf_eval_odometry", "est.txt REFERENCE [options]",
       "Scores an estimated trajectory (KITTI poses format: T_world_cam0, a 3x4 row-major matrix a line, one line per "
       "frame) against REFERENCE: a poses file of the same frames, or a dataset folder whose poses are the reference "
-      "(KITTI odometry poses, a raw drive's OXTS, a synthetic sequence's ground truth). Evaluation protocol 5:\n"
+      "(KITTI odometry poses, a raw drive's OXTS, a synthetic sequence's ground truth, your own layout's poses.txt). Evaluation protocol 5:\n"
       "  KITTI devkit translation error (%) and rotation error (deg/m) over segments of 100..800 m from every 10th "
       "frame, or, on a path shorter than 100 m, of k/8 of its length (k = 1..7) from every frame; absolute "
       "trajectory error (RMSE of the positions) and end-point drift (in m and in % of the path length), both after "

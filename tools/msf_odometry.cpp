@@ -7,8 +7,7 @@
 #include <msf/common/tool.h>
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/io/poses.h>
-#include <msf/io/sequence.h>
-#include <msf/io/velodyne_io.h>
+#include <msf/pipeline/open_dataset.h>
 #include <msf/registration/lidar_odometry.h>
 
 #include <pcl/console/print.h>
@@ -40,7 +39,7 @@ void printMetrics(const msf::OdometryMetrics& m) {
 
 /// What the command line sets.
 struct Settings {
-  std::string output, config_path, frames_text = "0:";
+  std::string output, config_path, rig, frames_text = "0:";
   bool print_config = false, overwrite = false;
 };
 
@@ -51,7 +50,7 @@ struct Track {
 };
 
 /// A frame's line: on a terminal the progress in place, else the registration's figures.
-void printProgress(const msf::Sequence& sequence, const std::vector<std::size_t>& frames, std::size_t k,
+void printProgress(const msf::FrameSource& sequence, const std::vector<std::size_t>& frames, std::size_t k,
                    double register_ms, const msf::LidarOdometry::Stats& s, double elapsed_s, bool tty) {
   const double fps = static_cast<double>(k + 1) / elapsed_s;
   if (tty)
@@ -66,7 +65,7 @@ void printProgress(const msf::Sequence& sequence, const std::vector<std::size_t>
 }
 
 /// Registers the scans of `frames` in turn; the first frame is at the dataset's pose.
-Track track(const msf::Sequence& sequence, const std::vector<std::size_t>& frames,
+Track track(const msf::FrameSource& sequence, const std::vector<std::size_t>& frames,
             const msf::LidarOdometry::Config& config) {
   const msf::Calibration& calibration = sequence.calibration();
   const Eigen::Isometry3d T_world_cam0_first =
@@ -74,18 +73,16 @@ Track track(const msf::Sequence& sequence, const std::vector<std::size_t>& frame
   print_highlight("Tracking ");
   print_value("%zu", frames.size());
   print_info(" frames of ");
-  print_value("%s\n", sequence.directory().c_str());
+  print_value("%s\n", sequence.description().c_str());
   msf::LidarOdometry odometry(msf::resolveDeskew(config, sequence));
   Track result;
   const bool tty = ::isatty(STDOUT_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  pcl::PointCloud<pcl::PointXYZI> scan;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const std::string path = sequence.scanPath(frames[k]);
-    msf::loadVelodyneBin(path, scan);
+    const auto scan = sequence.loadScan(frames[k]);
     TicToc tt;
     tt.tic();
-    const Eigen::Isometry3d T_velo0_velo = odometry.registerScan(scan, "scan '" + path + "'");
+    const Eigen::Isometry3d T_velo0_velo = odometry.registerScan(*scan, sequence.scanName(frames[k]));
     result.register_ms.push_back(tt.toc());
     result.T_world_cam0.push_back(msf::cameraPose(T_velo0_velo, calibration.T_cam0_velo, T_world_cam0_first));
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -112,7 +109,10 @@ int run(const msf::tool::Arguments& positional, const Settings& settings) {
   if (settings.print_config)
     msf::printConfig(std::cout, config);
 
-  const msf::Sequence sequence(positional.front());
+  msf::DatasetOptions options;
+  options.rig = settings.rig;
+  const auto source = msf::openDataset(positional.front(), options);
+  const msf::FrameSource& sequence = *source;
   const std::vector<std::size_t> frames = sequence.indices(msf::FrameRange::parse(settings.frames_text));
   const Track tracked = track(sequence, frames, config);
 
@@ -141,13 +141,14 @@ int main(int argc, char** argv) {
       "msf_odometry", "DATASET_DIR -o poses.txt [options]",
       "Estimates camera 0's pose of every frame from the LiDAR scans alone (LidarOdometry: each scan registered to a "
       "local map of the scans before it) and writes T_world_cam0 in KITTI's poses format, a 3x4 row-major matrix a "
-      "line, one line per frame run. DATASET_DIR: a KITTI odometry sequence, a KITTI raw drive or a synthetic "
-      "sequence (msf_synth). The first frame is at the dataset's pose when it has poses (the identity on KITTI), "
+      "line, one line per frame run. DATASET_DIR: what msf_reconstruct reads (a KITTI odometry sequence or raw "
+      "drive, a synthetic sequence of msf_synth, a folder of your own rig's layout, a ROS 1 bag). The first frame is at the dataset's pose when it has poses (the identity on KITTI), "
       "else at the identity; with poses, the estimate is also scored against them (evaluation protocol 5, "
       "msf_eval_odometry).");
   cli.value("-o", "FILE", settings.output, "output poses file (written whole or not at all)")
       .value("-frames", "a:b", settings.frames_text, "frame range, inclusive (default: all)")
       .value("-config", "FILE", settings.config_path, "YAML configuration; its `odometry` section (config/kitti.yaml)")
+      .value("-rig", "FILE", settings.rig, "a calibration or rig file instead of the dataset's own")
       .flag("-print_config", settings.print_config, "print the configuration in effect")
       .overwriteOption(settings.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) { return run(positional, settings); });

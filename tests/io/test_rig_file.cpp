@@ -1,6 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The rig file: a user's own sensors in plain YAML, read back exactly, each key refused by name
-// when it is missing or cannot be right.
+// when it is missing, misspelt or cannot be right.
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
 #include <msf/io/rig_file.h>
@@ -113,10 +113,21 @@ TEST(RigFile, EachFaultIsRefusedNamingTheKey) {
       {edited("baseline_m: 0.12", "baseline_m: 0.12\nbaseline_m: 0.5"),
        "baseline_m appears twice (lines 5 and 6)"},
       {edited("  rings: 4", "  rings: 4\n  rings: 8"), "lidar.rings appears twice (lines 11 and 12)"},
+      // Misspelt: each would leave its value at the default (a 16-beam LiDAR read as KITTI's).
+      {edited("baseline_m: 0.12", "baseline_m: 0.12\ncolour: {fx: 1, fy: 1, cx: 0, cy: 0}"),
+       "line 6: 'colour' is not a key of a rig file (image_width, image_height, left, right, baseline_m, color, "
+       "color_right, lidar)"},
+      {edited("beam_elevations_deg:", "beam_elevation_deg:"),
+       "line 12: 'beam_elevation_deg' is not a key of lidar (T_cam_lidar, rings, beam_elevations_deg, sweeping)"},
+      {edited("sweeping: false", "sweep: false"), "'sweep' is not a key of lidar"},
+      {edited("cy: 240.25", "cy: 240.25, k1: 0.1"), "'k1' is not a key of left (fx, fy, cx, cy, P)"},
+      // Still a rig file without its first keys: the missing one is named, not "not valid YAML".
+      {edited("left: {fx: 500.0, fy: 501.0, cx: 320.5, cy: 240.25}\n", ""), "left is missing"},
+      {edited("image_width: 640\nimage_height: 480\n", ""), "image_width is missing"},
   };
   for (const auto& c : cases) {
     const std::string path = write(dir, "bad.yaml", c.text);
-    const std::string error = msf::test::errorOf([&] { msf::loadRigFile(path); });
+    const std::string error = msf::test::errorOf([&] { msf::loadCalibration(path); }); // as the tools read it
     EXPECT_NE(error.find(c.message), std::string::npos) << "expected: " << c.message << "\ngot: " << error;
     EXPECT_NE(error.find(path), std::string::npos) << error;
   }

@@ -85,6 +85,26 @@ TEST(FolderSource, KittiConvertedToTheGenericLayoutGivesTheSameMesh) {
   EXPECT_TRUE(readFile(dir.file("kitti_run/volume.pcd")) == readFile(dir.file("generic_run/volume.pcd")));
 }
 
+TEST(FolderSource, TheOdometryToolsReadItAsTheyReadKitti) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string kitti = msf::test::kittiDir() + "/odometry/sequences/04";
+  const std::string generic = converted(kitti, "0:3", dir);
+  for (const auto& [name, input] : {std::pair<std::string, std::string>{"kitti.txt", kitti + " -frames 0:3"},
+                                    {"generic.txt", generic}}) {
+    const auto r = msf::test::runTool("msf_odometry", input + " -o " + dir.file(name));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  EXPECT_TRUE(readFile(dir.file("kitti.txt")) == readFile(dir.file("generic.txt")));
+  const auto scored = msf::test::runTool("msf_eval_odometry", dir.file("generic.txt") + " " + generic);
+  ASSERT_EQ(scored.exit_code, 0) << scored.err;
+  EXPECT_NE(scored.out.find("ATE"), std::string::npos) << scored.out;
+  // The KITTI reader names the layout and who reads it, rather than listing it as its own.
+  const std::string error = msf::test::errorOf([&] { msf::Sequence{generic}; });
+  EXPECT_NE(error.find("is a folder of your own rig's layout (left/, right/, lidar/): msf_reconstruct, msf_odometry"),
+            std::string::npos) << error;
+}
+
 TEST_F(PipelineTest, EveryScanAndImageFormatReadsTheSameFrame) {
   msf::test::TempDir dir;
   const std::string generic = converted(dataset(), "0:0", dir);

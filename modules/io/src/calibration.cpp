@@ -48,7 +48,8 @@ cv::Size Calibration::requireImageSize() const {
 void Calibration::requireVelodyne() const {
   if (!has_velodyne)
     throw CalibrationError("calibration '" + source +
-                           "' holds the cameras only (no 'Tr', 'Tr_velo_to_cam' or 'T_cam0_velo'): projecting a "
+                           "' holds the cameras only (no LiDAR extrinsic: a rig file's lidar.T_cam_lidar, KITTI's 'Tr' or "
+                           "'Tr_velo_to_cam', or 'T_cam0_velo'): projecting a "
                            "scan needs the LiDAR's extrinsics");
 }
 

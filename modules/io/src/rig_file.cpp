@@ -6,9 +6,11 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 
 namespace msf {
@@ -24,9 +26,28 @@ public:
     if (!root_.IsMap())
       throw CalibrationError("rig file '" + path + "' is not a map of keys (image_width, left, lidar, ...)");
     refuseRepeatedKeys(root_, "");
+    refuseUnknownKeys(root_, "a rig file",
+                      {"image_width", "image_height", "left", "right", "baseline_m", "color", "color_right", "lidar"});
   }
 
   const YAML::Node& root() const { return root_; }
+
+  /// Throws naming the first key of `map` (the file's `name`: "a rig file", "lidar") that is not
+  /// in `known`: a misspelt key would leave its value at the default, a 16-beam LiDAR read as
+  /// KITTI's.
+  void refuseUnknownKeys(const YAML::Node& map, const std::string& name,
+                         std::initializer_list<const char*> known) const {
+    for (const auto& entry : map) {
+      const std::string key = entry.first.Scalar();
+      if (std::any_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
+        continue;
+      std::string keys;
+      for (const char* k : known)
+        keys += (keys.empty() ? "" : ", ") + std::string(k);
+      throw CalibrationError(yamlWhere("rig file", path_, entry.first) + "'" + key + "' is not a key of " + name +
+                             " (" + keys + ")");
+    }
+  }
 
   [[noreturn]] void fail(const std::string& key, const std::string& why) const {
     throw CalibrationError("rig file '" + path_ + "': " + key + " " + why);
@@ -69,6 +90,7 @@ public:
   Calibration::Projection projection(const YAML::Node& camera, const std::string& key) const {
     if (!camera || !camera.IsMap())
       fail(key, camera ? "must be a map (fx, fy, cx, cy, or P)" : "is missing");
+    refuseUnknownKeys(camera, key, {"fx", "fy", "cx", "cy", "P"});
     Calibration::Projection P = Calibration::Projection::Zero();
     if (camera["P"]) {
       const std::vector<double> p = numbers(camera["P"], key + ".P", 12);
@@ -116,6 +138,7 @@ void readLidar(const RigReader& rig, Calibration& calibration) {
   }
   if (!lidar.IsMap())
     rig.fail("lidar", "must be a map (T_cam_lidar, rings, beam_elevations_deg, sweeping)");
+  rig.refuseUnknownKeys(lidar, "lidar", {"T_cam_lidar", "rings", "beam_elevations_deg", "sweeping"});
   const std::vector<double> T = rig.numbers(lidar["T_cam_lidar"], "lidar.T_cam_lidar", 16);
   Eigen::Matrix4d M;
   for (int k = 0; k < 16; ++k)
@@ -177,7 +200,12 @@ std::vector<double> rowMajor(const Calibration::Projection& P) {
 bool isRigFile(const std::string& path) {
   try {
     const YAML::Node root = loadYamlFile(path, "rig file");
-    return root.IsMap() && root["image_width"] && root["left"];
+    if (!root.IsMap() || root["P0"]) // the OpenCV camera file (saveCalibrationYaml) has P0..P3
+      return false;
+    for (const char* key : {"image_width", "image_height", "left", "right", "baseline_m", "lidar"})
+      if (root[key])
+        return true;
+    return false;
   } catch (const Error&) {
     return false;
   }

@@ -3,6 +3,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/message_text.h>
 #include <msf/io/image_io.h>
+#include <msf/io/folder_source.h>
 #include <msf/io/sequence.h>
 #include <msf/io/velodyne_io.h>
 
@@ -176,10 +177,14 @@ Sequence::Sequence(const std::string& dir, const std::string& calibration) {
     times = readTimestamps(p / "image_00" / "timestamps.txt", true);
     if (fs::is_directory(p / "oxts" / "data", ec) && calibration_.has_imu)
       poses_ = oxtsPosesOfFrames(p / "oxts" / "data", frame_names_, calibration_);
+  } else if (FolderSource::looksLikeOne(dir)) {
+    throw IOError("'" + dir + "' is a folder of your own rig's layout (left/, right/, lidar/): msf_reconstruct, "
+                  "msf_odometry, msf_eval_odometry and msfusion.open_dataset read it (openDataset); this reader "
+                  "takes KITTI's layouts and msf_synth's");
   } else {
     throw IOError("'" + dir +
                   "' is neither a KITTI odometry sequence (calib.txt, image_0/), a KITTI raw drive "
-                  "(image_00/data/ with calib_cam_to_cam.txt in the folder above) nor a folder of the generic "
+                  "(image_00/data/ with calib_cam_to_cam.txt in the folder above) nor a folder of your own rig's "
                   "layout (left/, right/, lidar/, rig.yaml)");
   }
   if (!calibration.empty())

@@ -22,11 +22,13 @@ namespace msf {
 ///     beam_elevations_deg: [-15.0, ..., 15.0]              # optional: one per ring
 ///     sweeping: true                                       # optional: a spinning LiDAR (deskewed; skew allowed)
 ///
-/// True when `path` is a YAML file with the rig's keys (image_width and left).
+/// True when `path` is a YAML map with a rig's key (image_width, left, baseline_m, lidar, ...)
+/// and not OpenCV's camera file (saveCalibrationYaml, whose keys are P0..P3): a rig file that
+/// misses a key is then refused naming it.
 bool isRigFile(const std::string& path);
 
 /// Reads a rig file. Throws CalibrationError naming the file and the key that is missing,
-/// malformed or cannot be right (a non-positive focal length or baseline, a right camera on
+/// unknown (a misspelling), malformed or cannot be right (a non-positive focal length or baseline, a right camera on
 /// the left, a non-rigid extrinsic), IOError when the file is not YAML.
 Calibration loadRigFile(const std::string& path);
 
