@@ -236,6 +236,18 @@ TEST(HostilePoses, NanAndTextAreNamedNotMiscounted) {
             std::string::npos);
 }
 
+TEST(HostilePoses, AHeaderCommentIsSkippedAndTheLinesKeepTheirNumbers) {
+  msf::test::TempDir dir;
+  write(dir.file("p.txt"), "# T_world_cam0, KITTI's 12 numbers\n1 0 0 0 0 1 0 0 0 0 1 0\n  # moved\n1 0 0 2 0 1 0 0 0 0 1 0\n"
+                           "1 0 0 x 0 1 0 0 0 0 1 0\n");
+  EXPECT_NE(errorOf([&] { msf::loadOdometryPoses(dir.file("p.txt")); }).find("line 5: value 4 'x' is not a number"),
+            std::string::npos);
+  write(dir.file("p.txt"), "# T_world_cam0\n1 0 0 0 0 1 0 0 0 0 1 0\n  # moved\n1 0 0 2 0 1 0 0 0 0 1 0\n");
+  const msf::PoseList poses = msf::loadOdometryPoses(dir.file("p.txt"));
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_DOUBLE_EQ(poses[1].translation().x(), 2.0);
+}
+
 TEST(HostilePoses, RotationThatIsNotARotation) {
   msf::test::TempDir dir;
   write(dir.file("p.txt"), "1000 0 0 0 0 1000 0 0 0 0 1000 0\n");

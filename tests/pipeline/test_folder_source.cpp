@@ -105,6 +105,24 @@ TEST(FolderSource, TheOdometryToolsReadItAsTheyReadKitti) {
             std::string::npos) << error;
 }
 
+TEST(FolderSource, ACalibrationWithoutAnImageSizeTakesTheImagesOwn) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string kitti = msf::test::kittiDir() + "/odometry/sequences/04";
+  const std::string generic = converted(kitti, "0:0", dir);
+  fs::create_directory(dir.file("calib"));
+  fs::copy_file(kitti + "/calib.txt", dir.file("calib/calib.txt")); // no image_0/ beside it: no size
+  EXPECT_EQ(msf::loadCalibration(dir.file("calib/calib.txt")).image_size, cv::Size(0, 0));
+  const msf::FolderSource folder(generic, dir.file("calib/calib.txt"));
+  EXPECT_EQ(folder.calibration().image_size, msf::Sequence(kitti).calibration().image_size);
+  // Names that are not frame numbers (a ROS export's nanoseconds): what names the reader takes.
+  for (const char* side : {"left", "right"})
+    fs::rename(generic + "/" + side + "/000000.png", generic + "/" + side + "/1700000000000000000.png");
+  const std::string error = msf::test::errorOf([&] { msf::FolderSource{generic}; });
+  EXPECT_NE(error.find("no PNG or JPEG image in left/ named by a frame number of up to 18 digits"), std::string::npos)
+      << error;
+}
+
 TEST_F(PipelineTest, EveryScanAndImageFormatReadsTheSameFrame) {
   msf::test::TempDir dir;
   const std::string generic = converted(dataset(), "0:0", dir);

@@ -117,6 +117,8 @@ FolderSource::FolderSource(const std::string& dir, const std::string& rig) {
   calibration_ = loadCalibration(rig_file);
   calibration_.requireVelodyne();
   findFrames();
+  if (calibration_.image_size.area() <= 0) // a calibration without a size (KITTI's calib.txt): the images give it
+    calibration_.image_size = readImage(frames_.front().left, cv::IMREAD_UNCHANGED).size();
   readTimes();
   readPoses();
 }
@@ -128,7 +130,8 @@ void FolderSource::findFrames() {
   const auto scans = numberedFiles(p / "lidar", kScanExtensions);
   const auto color = numberedFiles(p / "color", kImageExtensions);
   if (left.empty())
-    throw IOError("dataset '" + dir_ + "' has no frames: no numbered PNG or JPEG image in left/");
+    throw IOError("dataset '" + dir_ + "' has no frames: no PNG or JPEG image in left/ named by a frame number of up "
+                  "to 18 digits (000000.png, 000001.png, ...; timestamps.txt gives their times)");
   for (const auto& [name, path] : left) {
     FrameFiles f;
     f.name = name;

@@ -24,7 +24,8 @@ PoseList loadOdometryPoses(const std::string& path) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos)
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') // a blank line or a comment, as TUM files have
       continue;
     std::istringstream ss(line);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

@@ -11,7 +11,8 @@ namespace msf {
 
 using PoseList = std::vector<Eigen::Isometry3d, Eigen::aligned_allocator<Eigen::Isometry3d>>;
 
-/// KITTI odometry poses/XX.txt: one 3x4 row-major T_world_cam0 a line.
+/// KITTI odometry poses/XX.txt: one 3x4 row-major T_world_cam0 a line (blank lines and lines
+/// starting with # are skipped).
 /// Throws IOError naming file and line for a line that is not 12 finite numbers or not a
 /// rigid transform (limits::checkRigid: orthonormal rotation, translation within 1000 km).
 PoseList loadOdometryPoses(const std::string& path);
