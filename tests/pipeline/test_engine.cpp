@@ -69,6 +69,44 @@ TEST_F(PipelineTest, WithEarlierScansTheEngineFedFrameByFrameGivesTheToolsMap) {
   EXPECT_FALSE(savedMap(own_scans, other).second == volume) << "the earlier scans changed nothing";
 }
 
+TEST_F(PipelineTest, AFrameThatDoesNotFitIsRefusedBeforeTheEngineChanges) {
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor::Options odometry;
+  odometry.poses = msf::Reconstructor::PoseMode::Odometry;
+  msf::Reconstructor clean(sequence.calibration(), msf::PipelineConfig{}, odometry);
+  const msf::Frame first = sequence.load(0), second = sequence.load(1);
+  clean.addFrame(first);
+  const Eigen::Isometry3d pose = clean.addFrame(second).T_world_cam0;
+
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{}, odometry);
+  const auto refused = [&](msf::Frame frame, const std::string& message) {
+    const std::string error = msf::test::errorOf([&] { engine.addFrame(frame); });
+    EXPECT_NE(error.find(message), std::string::npos) << error;
+  };
+  msf::Frame broken = first;
+  broken.scan.reset();
+  refused(broken, "frame 0 has no scan: the engine needs the LiDAR's points each frame");
+  msf::Reconstructor given(sequence.calibration(), msf::PipelineConfig{}); // its pose used: no tracking
+  EXPECT_NE(msf::test::errorOf([&] { given.addFrame(broken); }).find("frame 0 has no scan"), std::string::npos);
+  EXPECT_NE(msf::test::errorOf([&] { given.computeDepth(broken); }).find("frame 0 has no scan"), std::string::npos);
+  broken = first;
+  broken.right = cv::Mat();
+  refused(broken, "frame 0's right image is missing or empty");
+  broken = first;
+  broken.color = cv::Mat(10, 10, CV_8UC3);
+  refused(broken, "frame 0's colour image is 10x10 but calibration");
+  broken = first;
+  broken.point_time_s.assign(3, 0.f);
+  refused(broken, "frame 0 has 3 point times for");
+  broken = first;
+  broken.T_world_cam0.linear() *= 2.0;
+  refused(broken, "frame 0's pose T_world_cam0");
+  engine.addFrame(first); // the refused frames left no trace: the same poses as a clean engine's
+  refused([&] { msf::Frame f = second; f.left = cv::Mat(); return f; }(), "frame 1's left image is missing");
+  EXPECT_TRUE(engine.addFrame(second).T_world_cam0.isApprox(pose, 1e-12));
+  EXPECT_EQ(engine.odometryMs().size(), 2u);
+}
+
 TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {
   // The street's scans are taken at one instant: its rig says so, and the engine takes it from
   // the rig whether fed frame by frame or run (the tests above give msf_reconstruct's map). A rig

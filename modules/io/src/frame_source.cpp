@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/limits.h>
 #include <msf/common/message_text.h>
 #include <msf/io/frame_source.h>
 
@@ -35,6 +36,44 @@ FrameRange FrameRange::parse(const std::string& text) {
   if (r.last >= 0 && r.last < r.first)
     throw InvalidInputError("frame range " + quoted(text) + " ends before it starts");
   return r;
+}
+
+namespace {
+
+std::string sizeText(const cv::Mat& image) { return std::to_string(image.cols) + "x" + std::to_string(image.rows); }
+
+void checkImage(const cv::Mat& image, const std::string& what, const Calibration& calibration, bool optional) {
+  if (image.empty()) {
+    if (optional)
+      return;
+    throw InvalidInputError(what + " is missing or empty");
+  }
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    throw InvalidInputError(what + " must be 8-bit grey or BGR, not OpenCV type " + std::to_string(image.type()));
+  const cv::Size expected = calibration.image_size;
+  if (expected.area() > 0 && image.size() != expected)
+    throw InvalidInputError(what + " is " + sizeText(image) + " but calibration '" + calibration.source + "' is " +
+                            std::to_string(expected.width) + "x" + std::to_string(expected.height));
+}
+
+} // namespace
+
+void checkFrame(const Frame& frame, const Calibration& calibration) {
+  const std::string name = "frame " + std::to_string(frame.index);
+  if (!frame.scan || frame.scan->empty())
+    throw InvalidInputError(name + " has no scan" + (frame.scan ? " point" : "") +
+                            ": the engine needs the LiDAR's points each frame");
+  const std::size_t points = frame.scan->size();
+  for (const auto& [count, what] : {std::pair<std::size_t, const char*>{frame.point_ring.size(), "rings"},
+                                    {frame.point_time_s.size(), "times"}})
+    if (count != 0 && count != points)
+      throw InvalidInputError(name + " has " + std::to_string(count) + " point " + what + " for " +
+                              std::to_string(points) + " scan points");
+  checkImage(frame.left, name + "'s left image", calibration, false);
+  checkImage(frame.right, name + "'s right image", calibration, false);
+  checkImage(frame.color, name + "'s colour image", calibration, true);
+  if (frame.has_pose)
+    limits::checkRigid(frame.T_world_cam0, name + "'s pose T_world_cam0");
 }
 
 const PoseList& FrameSource::poses() const {

@@ -157,6 +157,7 @@ bool Reconstructor::lidarBeforeStereo() const {
 }
 
 FrameResult Reconstructor::computeDepth(const Frame& frame) {
+  checkFrame(frame, calibration_);
   const ThreadBudget budget(options_.threads);
   FrameResult result = startFrame(frame);
   computeDepth(frame, result);
@@ -271,6 +272,12 @@ bool Reconstructor::tracks(const Frame& first) const {
 }
 
 Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& scan_name) {
+  // Refused before the odometry takes the frame in: a retry would find it changed.
+  if (!frame.scan)
+    throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan to track");
+  if (options_.poses == PoseMode::Refine && !frame.has_pose)
+    throw InvalidInputError("frame " + std::to_string(frame.index) +
+                            " has no pose to refine (PoseMode Refine refines each frame's own pose with its scan)");
   if (!odometry_) {
     LidarOdometry::Config odometry = config_.odometry;
     if (odometry.deskew == "auto")
@@ -278,8 +285,6 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
     odometry_ = std::make_unique<LidarOdometry>(odometry);
     T_world_cam0_first_ = frame.has_pose ? frame.T_world_cam0 : Eigen::Isometry3d::Identity();
   }
-  if (!frame.scan)
-    throw InvalidInputError("frame " + std::to_string(frame.index) + " has no scan to track");
   const auto start = Clock::now();
   const std::optional<Eigen::Isometry3d> measured = measuredMotion(frame);
   const Eigen::Isometry3d T_velo0_velo =
@@ -291,9 +296,6 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
 std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& frame) {
   if (options_.poses != PoseMode::Refine)
     return std::nullopt;
-  if (!frame.has_pose)
-    throw InvalidInputError("frame " + std::to_string(frame.index) +
-                            " has no pose to refine (PoseMode Refine refines each frame's own pose with its scan)");
   const Eigen::Isometry3d T_world_velo = frame.T_world_cam0 * calibration_.T_cam0_velo;
   if (odometry_->poses().empty()) // the first scan is the odometry's origin: any motion marks it as measured
     T_world_velo_measured_last_ = T_world_velo;
@@ -303,6 +305,7 @@ std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& fram
 }
 
 FrameResult Reconstructor::addFrame(const Frame& frame) {
+  checkFrame(frame, calibration_); // before the odometry or the earlier scans take it in
   const ThreadBudget budget(options_.threads);
   if (frames_added_ == 0)
     add_tracks_ = tracks(frame);

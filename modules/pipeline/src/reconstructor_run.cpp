@@ -82,6 +82,7 @@ struct Reconstructor::Run {
     Loaded item{source.load(i), FrameResult(), 0.0};
     if (engine.frame_filter_)
       engine.frame_filter_(item.frame);
+    checkFrame(item.frame, engine.calibration_);
     item.load_ms = msSince(start);
     if (i == frames.front())
       tracking = engine.tracks(item.frame);

@@ -38,6 +38,13 @@ struct Frame {
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
 };
 
+/// Throws InvalidInputError naming the frame and what does not fit the rig, so that the engine
+/// refuses a frame before it changes any state: no scan or one without a point, per-point rings
+/// or times of another count than the scan's points, a grey image missing, not 8-bit grey or
+/// BGR, or not of the calibration's size (when it has one), a colour image of another kind or
+/// size, a pose that is not rigid.
+void checkFrame(const Frame& frame, const Calibration& calibration);
+
 /// Where frames come from: a dataset folder, a bag, a program. Readers of every layout (KITTI
 /// odometry and raw, synthetic, a generic folder with a rig file, a ROS bag) give the engine
 /// the same Frame, so a new reader touches no stage.

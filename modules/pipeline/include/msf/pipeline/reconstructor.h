@@ -70,7 +70,7 @@ struct StageTimes {
 /// of the memory of organized clouds and no stage converts.
 struct FrameResult {
   std::size_t index = 0;                    ///< position in the sequence
-  std::string name;                         ///< file stem ("000042")
+  std::string name;                         ///< the source's frame name ("000042") under run(); addFrame's: empty
   bool has_pose = false;
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
   cv::Mat left;                             ///< camera 0 grey image
@@ -180,7 +180,8 @@ public:
   /// One frame, synchronously: its depth (steps 1-4), its pose (the frame's or the odometry's,
   /// as Options::poses says) and its integration into the map (step 5). Returns the frame's
   /// depth images, weight and the pose used. Throws InvalidInputError for images or a scan
-  /// that do not fit the rig, or a frame without a pose where one is needed.
+  /// that do not fit the rig (checkFrame), or a frame without a pose where one is needed,
+  /// before anything changes: the engine is as it was, and the frame can be given again.
   FrameResult addFrame(const Frame& frame);
 
   /// Depth of one frame, synchronously: steps 1-4, nothing added to the map. With
