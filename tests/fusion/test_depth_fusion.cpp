@@ -713,6 +713,22 @@ TEST(DepthFusion, BadInputNamesWhatIsWrong) {
   fusion.setInputStereo(b.stereo);
   EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("LiDAR cloud is 6x4 but the stereo cloud is 5x4"),
             std::string::npos);
+  // Both clouds of one size, which is not the rig's: fused, they would be at shifted pixels.
+  Inputs small(4, 2);
+  fusion.setInputLidar(small.lidar);
+  fusion.setInputStereo(small.stereo);
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("stereo cloud is 4x2 but calibration"), std::string::npos);
+  // A stereo depth whose confidence is NaN would weigh NaN.
+  Inputs nan_confidence(6, 4);
+  nan_confidence.setStereo(2, 1, 5.f, 0.5f);
+  nan_confidence.stereo->at(2, 1).confidence = std::numeric_limits<float>::quiet_NaN();
+  fusion.setInputLidar(nan_confidence.lidar);
+  fusion.setInputStereo(nan_confidence.stereo);
+  EXPECT_NE(errorOf([&] { fusion.fuse(out); }).find("stereo cloud's confidence at pixel (2, 1) is nan"),
+            std::string::npos);
+  nan_confidence.stereo->at(2, 1).confidence = 0.5f;
+  EXPECT_NO_THROW(fusion.fuse(out));
+  fusion.setInputLidar(a.lidar);
   // An unorganized cloud.
   StereoCloud::Ptr flat(new StereoCloud(*a.stereo));
   flat->width = 24;

@@ -19,17 +19,17 @@ namespace {
 
 constexpr int kW = 8, kH = 6;
 
-msf::Calibration calibration() {
+msf::Calibration calibration(int w = kW, int h = kH) {
   msf::Calibration c;
   Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();
   P(0, 0) = P(1, 1) = 500.0;
-  P(0, 2) = kW / 2.0;
-  P(1, 2) = kH / 2.0;
+  P(0, 2) = w / 2.0;
+  P(1, 2) = h / 2.0;
   P(2, 2) = 1.0;
   for (auto& p : c.P)
     p = P;
   c.P[1](0, 3) = -250.0;
-  c.image_size = cv::Size(kW, kH);
+  c.image_size = cv::Size(w, h);
   return c;
 }
 
@@ -145,6 +145,7 @@ TEST(FuseTool, TheLeftImageContinuesABlankWallUpward) {
   // without it, nothing above the LiDAR.
   constexpr int w = 40, h = 60;
   Files f;
+  msf::saveCalibrationYaml(calibration(w, h), f.calib); // the rig of these clouds
   auto lidar = cloudAt<msf::PointXYZID>(w, h, 10.f, 0);
   for (std::size_t i = 0; i < lidar.size(); ++i) {
     lidar[i].distance = 0.f;
@@ -166,8 +167,8 @@ TEST(FuseTool, TheLeftImageContinuesABlankWallUpward) {
     for (int u = 0; u < w; u += 13) {
       const auto& p = fused.at(u, v);
       ASSERT_NEAR(p.z, 10.f, 1e-4f) << u << "," << v;
-      EXPECT_NEAR(p.x, (u - kW / 2.f) * 10.f / 500.f, 1e-4f); // the calibration's principal point
-      EXPECT_NEAR(p.y, (v - kH / 2.f) * 10.f / 500.f, 1e-4f);
+      EXPECT_NEAR(p.x, (u - w / 2.f) * 10.f / 500.f, 1e-4f); // the calibration's principal point
+      EXPECT_NEAR(p.y, (v - h / 2.f) * 10.f / 500.f, 1e-4f);
       EXPECT_GT(p.weight, 0.f);
       EXPECT_LT(p.weight, fused.at(u, 45).weight); // less sure than the LiDAR
     }

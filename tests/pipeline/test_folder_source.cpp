@@ -76,6 +76,11 @@ TEST(FolderSource, KittiConvertedToTheGenericLayoutGivesTheSameMesh) {
   }
   EXPECT_THROW(folder.loadScan(3), msf::InvalidInputError);
   EXPECT_THROW(sequence.loadScan(10), msf::InvalidInputError);
+  for (const msf::FrameSource* source : std::initializer_list<const msf::FrameSource*>{&sequence, &folder}) {
+    EXPECT_THROW(source->frameName(10), msf::InvalidInputError); // a library error, not std::out_of_range
+    EXPECT_THROW(source->timestamp(10), msf::InvalidInputError);
+    EXPECT_THROW(source->scanName(10), msf::InvalidInputError);
+  }
   for (const auto& [name, input] : {std::pair<std::string, std::string>{"kitti_run", kitti + " -frames 0:2"},
                                     {"generic_run", generic}}) {
     const auto r = msf::test::runTool("msf_reconstruct", input + " -panels 0 -o " + dir.file(name));

@@ -94,7 +94,8 @@ public:
 
   /// Fuses the inputs into `output` (resized to the LiDAR cloud's width x height).
   /// Throws InvalidInputError naming the input that is missing, not organized, or of
-  /// another size than the other (or its canvas); CalibrationError when no calibration was set.
+  /// another size than the other (or its canvas) or the calibration's images, or a stereo
+  /// depth whose confidence is not 0..1 (NaN); CalibrationError when no calibration was set.
   void fuse(PointCloudOut& output);
 
 private:

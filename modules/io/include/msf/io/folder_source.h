@@ -35,14 +35,23 @@ public:
 
   const Calibration& calibration() const override { return calibration_; }
   std::size_t size() const override { return frames_.size(); }
-  std::string frameName(std::size_t i) const override { return frames_.at(i).name; }
+  std::string frameName(std::size_t i) const override {
+    checkIndex(i);
+    return frames_[i].name;
+  }
   Frame load(std::size_t i, bool with_color = true) const override;
   pcl::PointCloud<pcl::PointXYZI>::Ptr loadScan(std::size_t i) const override;
   const PoseList& poses() const override { return poses_; }
   std::string posesName() const override { return "poses file '" + poses_file_ + "'"; }
   std::string description() const override { return dir_; }
-  double timestamp(std::size_t i) const override { return timestamps_.at(i) - timestamps_.front(); }
-  std::string scanName(std::size_t i) const override { return "scan '" + frames_.at(i).scan + "'"; }
+  double timestamp(std::size_t i) const override {
+    checkIndex(i);
+    return timestamps_[i] - timestamps_.front();
+  }
+  std::string scanName(std::size_t i) const override {
+    checkIndex(i);
+    return "scan '" + frames_[i].scan + "'";
+  }
   bool hasColor() const override { return has_color_; }
 
 private:

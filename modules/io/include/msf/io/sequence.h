@@ -41,7 +41,10 @@ public:
   /// Folder of synthetic ground truth (`<root>/gt`), "" when there is none.
   std::string groundTruthDir() const override { return gt_dir_; }
   /// File stem of a frame ("000042" or "0000000042").
-  std::string frameName(std::size_t i) const override { return frame_names_.at(i); }
+  std::string frameName(std::size_t i) const override {
+    checkIndex(i);
+    return frame_names_[i];
+  }
   std::string description() const override { return dir_; }
   double timestamp(std::size_t i) const override;
   std::string scanName(std::size_t i) const override { return "scan '" + scanPath(i) + "'"; }

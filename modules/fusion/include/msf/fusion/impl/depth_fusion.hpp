@@ -59,6 +59,12 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() {
   }
   if (!has_calibration_)
     throw CalibrationError("DepthFusion: no calibration set (setCalibration)");
+  // A stereo cloud of another size than the rig's images would be fused at shifted pixels.
+  const cv::Size rig_size = calibration_.image_size;
+  if (rig_size.area() > 0 && image_size != rig_size)
+    throw InvalidInputError("DepthFusion: the stereo cloud is " + size(*stereo_) + " but calibration '" +
+                            calibration_.source + "' is " + std::to_string(rig_size.width) + "x" +
+                            std::to_string(rig_size.height));
   // A finite depth beyond any sensor's range (1e30 m) is a broken input: it would pass
   // through the fusion as a depth, so it is an error naming the cloud and the pixel.
   const auto checkRange = [](const auto& cloud, const char* what) {
@@ -71,6 +77,15 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() {
   };
   checkRange(*lidar_, "LiDAR");
   checkRange(*stereo_, "stereo");
+  // A NaN confidence would become a NaN weight, which the map takes as none.
+  if constexpr (detail::has_confidence_v<PointStereoT>)
+    for (std::size_t i = 0; i < stereo_->size(); ++i) {
+      const PointStereoT& p = (*stereo_)[i];
+      if (detail::validDepth(p.z) && !(p.confidence >= 0.f && p.confidence <= 1.f))
+        throw InvalidInputError("DepthFusion: the stereo cloud's confidence at pixel (" +
+                                std::to_string(i % stereo_->width) + ", " + std::to_string(i / stereo_->width) +
+                                ") is " + std::to_string(p.confidence) + "; a depth's confidence is 0..1");
+    }
 }
 
 template <typename PointLidarT, typename PointStereoT, typename PointOutT>
