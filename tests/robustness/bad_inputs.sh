@@ -152,6 +152,9 @@ pcd(f + "/dense.pcd", depth_rows(lambda u, v: 5.0 + 0.1 * u))
 sky_rows = [r + ["0" if i == 1 * W + 2 else "nan"] for i, r in enumerate(depth_rows(lambda u, v: 5.0 + 0.1 * u))]
 pcd(f + "/sky_zero.pcd", sky_rows, fields="x y z intensity sky_depth")
 pcd(f + "/far.pcd", depth_rows(lambda u, v: 1e30 if (u, v) == (2, 2) else 5.0))
+# A stereo cloud whose confidence at pixel (2, 1) is NaN.
+nan_confidence = [r[:3] + ["0", "nan" if i == 1 * W + 2 else r[3]] for i, r in enumerate(depth_rows(lambda u, v: 5.0))]
+pcd(f + "/nan_confidence.pcd", nan_confidence, fields="x y z rgb confidence")
 def volume_pcd(path, fields, sizes, types, rows):
     """A volume .pcd of 0.1 m voxels (ASCII) with the fields given, one row a voxel."""
     open(path, "w").write("# .PCD v0.7 - Point Cloud Data file format\n"
@@ -251,6 +254,7 @@ def yaml(path, fx=60.0, tx1=-30.0, w=8, h=6, nan=False):
                 "   data: [ 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1. ]\n")
 yaml(f + "/camera.yaml")
 yaml(f + "/swapped.yaml", tx1=30.0)
+yaml(f + "/camera_16x12.yaml", w=16, h=12)
 yaml(f + "/nano_baseline.yaml", tx1=-60e-9)
 yaml(f + "/far_baseline.yaml", tx1=-60 * 990e3)
 with open(f + "/camera.yaml") as i:
@@ -383,6 +387,12 @@ check "lambda_study -sweeps 1000000" 1 "lambda_study.sweeps must be in 0..100" -
 printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  rings: 32\n' >"$F/rings_only.yaml"
 check "synth -rig: rings without their elevations" 1 "rings_only.yaml': lidar.rings 32 without lidar.beam_elevations_deg" -- \
   msf_synth -o out -frames 1 -rig "$F/rings_only.yaml"
+printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  beam_elevation_deg: [-2, 2]\n' >"$F/rig_misspelt_key.yaml"
+check "synth -rig: a misspelt key" 1 "rig_misspelt_key.yaml' line 7: 'beam_elevation_deg' is not a key of lidar" -- \
+  msf_synth -o out -frames 1 -rig "$F/rig_misspelt_key.yaml"
+printf 'image_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\n' >"$F/rig_no_width.yaml"
+check "synth -rig: image_width missing" 1 "rig_no_width.yaml': image_width is missing" -- \
+  msf_synth -o out -frames 1 -rig "$F/rig_no_width.yaml"
 check "synth -lidar hdl16" 1 "synthetic.lidar_model must be hdl64e \| hdl32e \| beams, not 'hdl16'" -- \
   msf_synth -o out -frames 1 -lidar hdl16
 check "synth -lidar beams without beams" 1 "synthetic.lidar_beam_elevations_deg must hold 1..1024 elevations for lidar_model beams, not 0" -- \
@@ -465,6 +475,10 @@ check "interpolate: empty cloud, no calibration" 1 "too few valid points \(0\)" 
 check "info: '1 2 abc' in an ASCII .pcd" 1 "value 'abc' on data line 4 is not a number" -- msf_info "$F/abc.pcd"
 check "fuse: a LiDAR depth of 1e30 m" 1 "LiDAR cloud has a depth of 1000000015.*at pixel \(2, 2\)|LiDAR cloud has a depth of 1.*e\+30|LiDAR cloud has a depth of [0-9]{20,}" -- \
   msf_fuse "$F/far.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera.yaml"
+check "fuse: clouds of another size than the rig's images" 1 "stereo cloud is 8x6 but calibration '.*camera_16x12.yaml' is 16x12" -- \
+  msf_fuse "$F/dense.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera_16x12.yaml"
+check "fuse: a stereo confidence of NaN" 1 "stereo cloud's confidence at pixel \(2, 1\) is nan" -- \
+  msf_fuse "$F/dense.pcd" "$F/nan_confidence.pcd" o.pcd -calib "$F/camera.yaml"
 check "eval_disparity: ground truth with no valid pixel" 1 "gt_empty.png' has no valid pixel" -- \
   msf_eval_disparity "$F/gt_empty.png" "$F/est.png"
 
