@@ -89,6 +89,14 @@ TEST_F(PipelineTest, AFrameThatDoesNotFitIsRefusedBeforeTheEngineChanges) {
   msf::Reconstructor given(sequence.calibration(), msf::PipelineConfig{}); // its pose used: no tracking
   EXPECT_NE(msf::test::errorOf([&] { given.addFrame(broken); }).find("frame 0 has no scan"), std::string::npos);
   EXPECT_NE(msf::test::errorOf([&] { given.computeDepth(broken); }).find("frame 0 has no scan"), std::string::npos);
+  broken = first; // the scan in millimetres: no return within the LiDAR's range
+  broken.scan.reset(new pcl::PointCloud<pcl::PointXYZI>(*first.scan));
+  for (auto& p : *broken.scan)
+    p.getVector3fMap() *= 1000.f;
+  EXPECT_NE(msf::test::errorOf([&] { given.addFrame(broken); })
+                .find("frame 0: no return of its scan (" + std::to_string(first.scan->size()) +
+                      " points) lands in camera 0"),
+            std::string::npos);
   broken = first;
   broken.right = cv::Mat();
   refused(broken, "frame 0's right image is missing or empty");

@@ -106,6 +106,11 @@ void Reconstructor::computeLidar(const Frame& frame, FrameResult& result) {
   const Eigen::Isometry3d T_world_velo = result.T_world_cam0 * calibration_.T_cam0_velo;
   const auto& scan = stages_->history.withEarlierScans(*frame.scan, result.has_pose ? &T_world_velo : nullptr);
   stages_->lidar.computeDepth(scan, result.lidar_depth, &result.lidar_distance);
+  if (cv::countNonZero(result.lidar_depth) == 0) // with a right rig, a LiDAR always sees what is ahead
+    throw InvalidInputError("frame " + std::to_string(frame.index) + ": no return of its scan (" +
+                            std::to_string(frame.scan->size()) + " points) lands in camera 0 within " +
+                            "projection.max_range_m: is the rig's LiDAR extrinsic the LiDAR-to-camera transform "
+                            "(not its inverse), and are the scan's units metres?");
   stages_->lidar.canvasDepth().copyTo(result.lidar_canvas_depth); // its buffers serve the next scan
   stages_->lidar.canvasDistance().copyTo(result.lidar_canvas_distance);
   result.lidar_canvas_camera = stages_->lidar.projector().canvasCamera();
