@@ -174,6 +174,28 @@ TEST_F(PipelineTest, EveryScanAndImageFormatReadsTheSameFrame) {
   EXPECT_LT(cv::norm(frame.color, reference.color, cv::NORM_L1) / static_cast<double>(frame.color.total() * 3), 3.0);
 }
 
+TEST_F(PipelineTest, A16BitPairIsScaledAlikeSoItsImagesMatchAtOneGain) {
+  msf::test::TempDir dir;
+  const std::string generic = converted(dataset(), "0:0", dir);
+  const fs::path g(generic);
+  // One 12-bit picture for both cameras; the right one has a single pixel that needs 13 bits.
+  const cv::Mat picture = msf::FolderSource(generic).load(0).left;
+  cv::Mat left, right;
+  picture.convertTo(left, CV_16U, 4095.0 / 255.0);
+  right = left.clone();
+  right.at<std::uint16_t>(0, 0) = 5000;
+  cv::imwrite((g / "left" / "000000.png").string(), left);
+  cv::imwrite((g / "right" / "000000.png").string(), right);
+  const msf::Frame frame = msf::FolderSource(generic).load(0);
+  cv::Mat differs;
+  cv::compare(frame.left, frame.right, differs, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(differs), 1) << "the pair scaled at two gains"; // pixel (0, 0) alone
+  double brightest = 0, brightest_12_bit = 0;
+  cv::minMaxLoc(frame.left, nullptr, &brightest);
+  cv::minMaxLoc(left, nullptr, &brightest_12_bit);
+  EXPECT_NEAR(brightest, brightest_12_bit * 255.0 / 8191.0, 0.5); // 13 bits for both
+}
+
 TEST_F(PipelineTest, FramesTakeTheirLinesByNumberAndPosesInEitherFormat) {
   msf::test::TempDir dir;
   const std::string generic = converted(dataset(), "0:3", dir);
