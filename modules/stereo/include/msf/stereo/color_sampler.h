@@ -16,8 +16,8 @@ namespace msf {
 class ColorSampler {
 public:
   ColorSampler() = default;
-  /// `image`: CV_8UC3 (BGR) or CV_8UC1 (grey), of any size; `camera`: 0..3.
-  /// Throws InvalidInputError for another image type or camera index.
+  /// `image`: CV_8UC3 (BGR) or CV_8UC1 (grey), of the calibration's image size; `camera`: 0..3.
+  /// Throws InvalidInputError for another image type, size or camera index.
   ColorSampler(const cv::Mat& image, const Calibration& calibration, int camera);
 
   bool empty() const { return image_.empty(); }
