@@ -7,6 +7,7 @@
 #include <msf/common/limits.h>
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
+#include <msf/io/rig_file.h>
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
@@ -89,6 +90,18 @@ Calibration calibrationFromState(const py::tuple& state) {
   return c;
 }
 
+Calibration fromNumbers(int width, int height, double fx, double fy, double cx, double cy, double baseline,
+                        const ArrayArg& T_cam_lidar, const std::optional<std::vector<double>>& beam_elevations_deg,
+                        bool sweeping) {
+  Calibration::Lidar lidar;
+  lidar.beam_elevations_deg = beam_elevations_deg.value_or(std::vector<double>());
+  lidar.sweeping = sweeping;
+  if (T_cam_lidar.is_none())
+    return makeRig(cv::Size(width, height), fx, fy, cx, cy, baseline, nullptr, lidar);
+  const Eigen::Isometry3d T = poseFrom(T_cam_lidar, "T_cam_lidar");
+  return makeRig(cv::Size(width, height), fx, fy, cx, cy, baseline, &T, lidar);
+}
+
 void bindPinholeCamera(py::module_& m) {
   py::class_<PinholeCamera> camera(m, "PinholeCamera",
                                    "The intrinsics of one rectified camera: pixel (u, v) with depth z is the point "
@@ -126,6 +139,14 @@ void bindCalibration(py::module_& m) {
                                       "one image plane, and the LiDAR. Every projection maps points of camera 0's "
                                       "rectified frame to pixels.");
   copyable(calibration)
+      .def(py::init(&fromNumbers), py::arg("width"), py::arg("height"), py::arg("fx"), py::arg("fy"), py::arg("cx"),
+           py::arg("cy"), py::arg("baseline"), py::arg("T_cam_lidar") = py::none(),
+           py::arg("beam_elevations_deg") = py::none(), py::arg("sweeping") = true,
+           "Your rig from its numbers, as a rig file's required keys (docs/usage.md, \"Your own rig\"): a "
+           "rectified pair of width x height images, the left camera's fx, fy, cx, cy (it also colours), the right "
+           "one `baseline` metres to its right; the LiDAR at T_cam_lidar (4x4: its points into the left camera; "
+           "None: cameras only), its beams' elevations in degrees from the lowest (optional) and whether it sweeps. "
+           "Raises CalibrationError naming what cannot be right.")
       .def(py::pickle(&calibrationState, &calibrationFromState))
       .def_static("load", &load, py::arg("path"), py::arg("image_size") = py::none(),
                   "Reads a KITTI odometry calib.txt (or its sequence folder), a KITTI raw date folder, a KITTI "

@@ -100,8 +100,8 @@ void bindFrame(py::module_& m) {
       .def(py::init(&fromArrays), py::arg("left"), py::arg("right"), py::arg("scan"), py::arg("color") = py::none(),
            py::arg("pose") = py::none(), py::arg("index") = 0, py::arg("timestamp") = 0.0, py::arg("name") = "",
            "A frame from arrays: left, right (H, W) uint8 grey (viewed, not copied), scan (N, 4) float32 x y z "
-           "reflectance in the LiDAR's frame or (N, 3), color (H', W', 3) uint8 RGB of the colour camera, pose "
-           "4x4 T_world_cam0 (None: no pose).")
+           "reflectance in the LiDAR's frame or (N, 3), color (H, W, 3) uint8 RGB of the colour camera (the "
+           "rectified cameras share one image size), pose 4x4 T_world_cam0 (None: no pose).")
       .def_property_readonly("index", [](const FrameObject& f) { return f.frame.index; })
       .def_property_readonly("name", [](const FrameObject& f) { return f.name; }, "File stem ('000042').")
       .def_property_readonly("timestamp", [](const FrameObject& f) { return f.frame.timestamp; },

@@ -190,9 +190,9 @@ void bindStages(py::module_& m) {
         "guides SgbmStereo).");
   m.def("colorize_depth", &colorize, py::arg("depth"), py::arg("calibration"), py::arg("color"),
         py::arg("fallback") = py::none(), py::arg("color_camera") = 2,
-        "The colour of each pixel of a depth image of camera 0, read in the colour camera's (H', W', 3) uint8 "
-        "RGB image; pixels without depth or outside its view take `fallback` (camera 0's grey or RGB image; "
-        "None: black). Returns (H, W, 3) uint8 RGB, what TsdfVolume.integrate takes as colour.");
+        "The colour of each pixel of a depth image of camera 0, read in the colour camera's (H, W, 3) uint8 "
+        "RGB image (the rectified cameras share one image size); pixels without depth or outside its view take "
+        "`fallback` (camera 0's grey or RGB image; None: black). Returns (H, W, 3) uint8 RGB, what TsdfVolume.integrate takes as colour.");
 }
 
 } // namespace msf::python

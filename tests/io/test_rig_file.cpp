@@ -63,6 +63,28 @@ TEST(RigFile, ReadsTheCamerasTheBaselineAndTheLidar) {
   EXPECT_FALSE(c.lidar.sweeping);
 }
 
+TEST(RigFile, ARigMadeInCodeIsTheRigItsFileGives) {
+  msf::test::TempDir dir;
+  const msf::Calibration file = msf::loadRigFile(write(dir, "rig.yaml", kRig));
+  msf::Calibration::Lidar lidar;
+  lidar.beam_elevations_deg = {-15, -5, 5, 15};
+  lidar.sweeping = false;
+  const Eigen::Isometry3d T = file.T_cam0_velo;
+  const msf::Calibration code = msf::makeRig({640, 480}, 500.0, 501.0, 320.5, 240.25, 0.12, &T, lidar);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(code.P[i], file.P[i]) << "P" << i;
+  EXPECT_EQ(code.T_cam0_velo.matrix(), file.T_cam0_velo.matrix());
+  EXPECT_EQ(code.lidar.rings, 4);
+  EXPECT_FALSE(code.lidar.sweeping);
+  EXPECT_FALSE(msf::makeRig({640, 480}, 500.0, 500.0, 320.0, 240.0, 0.12, nullptr).has_velodyne);
+  EXPECT_NE(msf::test::errorOf([] { msf::makeRig({640, 480}, 500.0, 500.0, 320.0, 240.0, 0.0, nullptr); })
+                .find("the baseline must be > 0"),
+            std::string::npos);
+  EXPECT_NE(msf::test::errorOf([] { msf::makeRig({0, 0}, 500.0, 500.0, 320.0, 240.0, 0.12, nullptr); })
+                .find("the image size must be given"),
+            std::string::npos);
+}
+
 TEST(RigFile, AFileWithOpenCvsFirstLineReads) {
   msf::test::TempDir dir;
   const msf::Calibration c = msf::loadCalibration(write(dir, "rig.yaml", std::string("%YAML:1.0\n") + kRig));

@@ -244,6 +244,25 @@ def test_a_string_override_is_a_string_as_in_a_file():
         msfusion.load_config(overrides={"stereo.mode": "sgbm\nfusion: {method: x}"})
 
 
+def test_a_rig_from_its_numbers_is_the_rig_its_file_gives(calibration, frame):
+    K, (width, height) = calibration.K(0), calibration.image_size
+    mine = msfusion.Calibration(width=width, height=height, fx=K[0, 0], fy=K[1, 1], cx=K[0, 2], cy=K[1, 2],
+                                baseline=calibration.baseline(0, 1), T_cam_lidar=calibration.T_cam0_velo)
+    np.testing.assert_allclose(mine.P[:2], calibration.P[:2], rtol=1e-12, atol=1e-9)
+    np.testing.assert_array_equal(mine.T_cam0_velo, calibration.T_cam0_velo)
+    depth = [msfusion.Reconstructor(rig).compute_depth(frame).depth for rig in (calibration, mine)]
+    np.testing.assert_allclose(depth[1], depth[0], rtol=1e-5, atol=1e-5)
+    assert not msfusion.Calibration(640, 480, 500, 500, 320, 240, 0.12).has_velodyne  # cameras only
+    with pytest.raises(msfusion.CalibrationError, match="the baseline must be > 0"):
+        msfusion.Calibration(640, 480, 500, 500, 320, 240, -0.12)
+    with pytest.raises(msfusion.CalibrationError, match="focal lengths must be > 0"):
+        msfusion.Calibration(640, 480, 0, 500, 320, 240, 0.12)
+    with pytest.raises(msfusion.InvalidInputError, match="T_cam_lidar"):
+        msfusion.Calibration(640, 480, 500, 500, 320, 240, 0.12, T_cam_lidar=2 * np.eye(4))
+    with pytest.raises(msfusion.CalibrationError, match="must rise"):
+        msfusion.Calibration(640, 480, 500, 500, 320, 240, 0.12, np.eye(4), beam_elevations_deg=[2.0, -2.0])
+
+
 def test_a_calibration_copies_and_pickles_to_the_same_rig(calibration):
     for twin in (copy.copy(calibration), copy.deepcopy(calibration), pickle.loads(pickle.dumps(calibration))):
         np.testing.assert_array_equal(twin.P, calibration.P)

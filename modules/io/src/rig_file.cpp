@@ -246,6 +246,38 @@ Calibration loadRigFile(const std::string& path) {
   return calibration;
 }
 
+Calibration makeRig(cv::Size image_size, double fx, double fy, double cx, double cy, double baseline_m,
+                    const Eigen::Isometry3d* T_cam_lidar, const Calibration::Lidar& lidar) {
+  Calibration c;
+  c.source = "a rig made in code";
+  if (!(baseline_m > 0.0))
+    throw CalibrationError(c.source + ": the baseline must be > 0 (the right camera to the right of the left one), "
+                                      "not " + std::to_string(baseline_m) + " m");
+  c.image_size = image_size;
+  Calibration::Projection left = Calibration::Projection::Zero();
+  left(0, 0) = fx;
+  left(1, 1) = fy;
+  left(0, 2) = cx;
+  left(1, 2) = cy;
+  left(2, 2) = 1.0;
+  c.P = {left, rightOf(left, baseline_m), left, rightOf(left, baseline_m)};
+  c.has_velodyne = T_cam_lidar != nullptr;
+  if (T_cam_lidar)
+    c.T_cam0_velo = *T_cam_lidar;
+  c.lidar = lidar;
+  const std::vector<double>& e = lidar.beam_elevations_deg;
+  for (std::size_t i = 1; i < e.size(); ++i)
+    if (!(e[i] > e[i - 1]))
+      throw CalibrationError(c.source + ": the beam elevations must rise from the lowest beam to the highest");
+  if (!e.empty())
+    c.lidar.rings = static_cast<int>(e.size());
+  if (image_size.area() <= 0)
+    throw CalibrationError(c.source + ": the image size must be given, not " + std::to_string(image_size.width) +
+                           "x" + std::to_string(image_size.height));
+  c.validate();
+  return c;
+}
+
 void saveRigFile(const Calibration& c, const std::string& path) {
   YAML::Emitter out;
   out << YAML::BeginMap;

@@ -32,6 +32,13 @@ bool isRigFile(const std::string& path);
 /// the left, a non-rigid extrinsic), IOError when the file is not YAML.
 Calibration loadRigFile(const std::string& path);
 
+/// The rig a rig file with only the required keys describes, from its numbers: the left camera
+/// (camera 0, which also colours), the right one `baseline_m` to its right, and the LiDAR at
+/// `T_cam_lidar` (its points into the left camera; none: cameras only) with `lidar`'s beams.
+/// Throws CalibrationError naming what cannot be right, as loadRigFile.
+Calibration makeRig(cv::Size image_size, double fx, double fy, double cx, double cy, double baseline_m,
+                    const Eigen::Isometry3d* T_cam_lidar, const Calibration::Lidar& lidar = {});
+
 /// Writes `calibration` as a rig file (the right camera's P, the colour camera's when it is
 /// not the left one), atomically.
 void saveRigFile(const Calibration& calibration, const std::string& path);
