@@ -19,6 +19,7 @@
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/ring_holdout.h>
 #include <msf/pipeline/run_outputs.h>
+#include <msf/pipeline/rig_agreement.h>
 #include <msf/pipeline/run_report.h>
 #include <msf/pipeline/sky_scoring.h>
 #include <msf/pipeline/source_maps.h>
@@ -256,6 +257,9 @@ public:
     if (stats.interrupted)
       print_warn("Interrupted after %zu of %zu frames: writing what was integrated.\n", stats.frames_done,
                  frames_.size());
+    const std::string rig_warning = msf::rigDisagreementWarning(report_.lidarStereoDisagreements());
+    if (!rig_warning.empty())
+      print_warn("Warning: %s\n", rig_warning.c_str());
     return stats.interrupted;
   }
 
@@ -414,7 +418,7 @@ private:
   void onFrame(msf::FrameResult& r) {
     report_.frames.push_back({r.index, r.name, r.times,
                               r.times.load_ms + r.times.depth_ms + r.times.fusion_ms + r.times.integrate_ms,
-                              msf::residentMemoryMb()});
+                              msf::residentMemoryMb(), r.lidar_stereo_disagreement});
     used_poses_.push_back(r.T_world_cam0);
     if (sky_) {
       sky_->setPose(r.index, r.T_world_cam0);

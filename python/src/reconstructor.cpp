@@ -187,6 +187,10 @@ void bindFrameResult(py::module_& m) {
       .def_property_readonly("stereo_depth", &imageOf<&FrameResult::stereo_depth>, "SGBM's depth (step 3).")
       .def_property_readonly("stereo_confidence", &imageOf<&FrameResult::stereo_confidence>,
                              "SGBM's confidence in [0, 1].")
+      .def_readonly("lidar_stereo_disagreement", &FrameResult::lidar_stereo_disagreement,
+                    "Of the pixels with a real LiDAR return and a stereo depth, the share where the two differ by "
+                    "more than 10 %: a few percent with a right rig, a large share with a wrong extrinsic, baseline "
+                    "or unit; NaN where no pixel has both.")
       .def_property_readonly("times", [](const FrameResult& r) {
         const StageTimes& t = r.times;
         py::dict times;

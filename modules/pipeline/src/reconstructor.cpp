@@ -7,6 +7,7 @@
 #include <msf/fusion/hole_fill.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/reconstructor.h>
+#include <msf/pipeline/rig_agreement.h>
 #include <msf/pipeline/run_report.h>
 #include <msf/pipeline/source_depth_frame.h>
 #include <msf/range_image/lidar_completion.h>
@@ -150,6 +151,8 @@ void Reconstructor::computeFusion(const Frame& frame, FrameResult& result) {
                                    ? ColorSampler()
                                    : ColorSampler(frame.color, calibration_, config_.stereo.color_camera);
   colorizeDepth(fused.depth, camera_, sampler, frame.left, fused.color);
+  result.lidar_stereo_disagreement =
+      lidarStereoDisagreement(result.lidar_depth, result.lidar_distance, result.stereo_depth);
   result.times.fusion_ms = msSince(start);
 }
 

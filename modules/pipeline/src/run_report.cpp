@@ -8,6 +8,7 @@
 #include <msf/common/statistics.h>
 #include <msf/common/yaml_file.h>
 #include <msf/io/image_io.h>
+#include <msf/pipeline/rig_agreement.h>
 #include <msf/pipeline/run_report.h>
 
 #include <sys/resource.h>
@@ -529,17 +530,24 @@ double RunReport::framesPerSecondAfterFirst() const {
   return frames.size() > 1 && span > 0 ? static_cast<double>(frames.size() - 1) / span : 0.0;
 }
 
+std::vector<double> RunReport::lidarStereoDisagreements() const {
+  std::vector<double> shares;
+  for (const FrameRow& r : frames)
+    shares.push_back(r.lidar_stereo_disagreement);
+  return shares;
+}
+
 void RunReport::writeFramesCsv(const std::string& path) const {
   std::ostringstream s;
   s << "frame,name";
   for (const auto& c : stageColumns())
     s << "," << c.name << "_ms";
-  s << ",rss_mb\n";
+  s << ",rss_mb,lidar_stereo_disagreement\n";
   for (const auto& r : frames) {
     s << r.index << "," << r.name;
     for (const auto& c : stageColumns())
       s << "," << num(c.get(r), 3);
-    s << "," << num(r.rss_mb, 1) << "\n";
+    s << "," << num(r.rss_mb, 1) << "," << num(r.lidar_stereo_disagreement, 4) << "\n";
   }
   writeText(path, s.str());
 }
@@ -591,6 +599,7 @@ void RunReport::writeSpeedJson(std::ostream& s) const {
     << ",\n"
     << "  \"predicted_memory_mb\": " << (predicted_memory_mb >= 0 ? num(predicted_memory_mb, 1) : std::string("null"))
     << ",\n"
+    << "  \"lidar_stereo_disagreement\": " << num(medianDisagreement(lidarStereoDisagreements()), 4) << ",\n"
     << "  \"stage_ms\": {\n";
   const auto& columns = stageColumns();
   for (std::size_t k = 0; k < columns.size(); ++k) {

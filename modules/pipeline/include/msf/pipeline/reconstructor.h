@@ -99,6 +99,9 @@ struct FrameResult {
   /// map's depth where earlier frames saw a surface, and the small holes left the nearest depth at
   /// weight 0 (fusion.hole_fill_px); neither was integrated.
   DepthFrame fused;
+  /// Of the pixels with a real LiDAR return and a stereo depth, the share where the two differ
+  /// by more than 10 % (lidarStereoDisagreement): a few percent with a right rig; NaN: none.
+  double lidar_stereo_disagreement = 0;
   StageTimes times;
 };
 

@@ -29,6 +29,7 @@ public:
     StageTimes times;
     double latency_ms = 0;  ///< from the start of its loading to the end of its integration
     double rss_mb = 0;      ///< resident memory of the process after it (0: not measured)
+    double lidar_stereo_disagreement = 0; ///< FrameResult's (NaN: no pixel with both)
   };
 
   /// Depth errors of one method over all frames: every pixel with ground truth, and the
@@ -116,6 +117,8 @@ public:
   /// The rate once the pipeline is full: frames 2..N over the time after the first was done
   /// (0 with fewer than 2 frames). What keeping up with a sensor needs.
   double framesPerSecondAfterFirst() const;
+  /// The frames' disagreement between LiDAR and stereo, each frame's (NaN where none measured).
+  std::vector<double> lidarStereoDisagreements() const;
 
   void writeFramesCsv(const std::string& path) const;
   void writeSummaryJson(const std::string& path) const;
