@@ -250,8 +250,9 @@ def test_a_rig_from_its_numbers_is_the_rig_its_file_gives(calibration, frame):
                                 baseline=calibration.baseline(0, 1), T_cam_lidar=calibration.T_cam0_velo)
     np.testing.assert_allclose(mine.P[:2], calibration.P[:2], rtol=1e-12, atol=1e-9)
     np.testing.assert_array_equal(mine.T_cam0_velo, calibration.T_cam0_velo)
-    depth = [msfusion.Reconstructor(rig).compute_depth(frame).depth for rig in (calibration, mine)]
-    np.testing.assert_allclose(depth[1], depth[0], rtol=1e-5, atol=1e-5)
+    results = [msfusion.Reconstructor(rig).compute_depth(frame) for rig in (calibration, mine)]
+    np.testing.assert_allclose(results[1].depth, results[0].depth, rtol=1e-5, atol=1e-5)
+    assert 0 <= results[0].lidar_stereo_disagreement < 0.1  # the two sensors of a right rig agree
     assert not msfusion.Calibration(640, 480, 500, 500, 320, 240, 0.12).has_velodyne  # cameras only
     with pytest.raises(msfusion.CalibrationError, match="the baseline must be > 0"):
         msfusion.Calibration(640, 480, 500, 500, 320, 240, -0.12)
