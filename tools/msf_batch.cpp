@@ -63,7 +63,7 @@ std::vector<msf::Drive> collectDrives(const msf::tool::Arguments& paths, const s
     for (const msf::Drive& d : msf::readDriveList(list))
       drives.push_back(d);
   if (drives.empty())
-    throw msf::InvalidInputError("no drives: give dataset folders (a sequence, or a root holding several) or -list FILE");
+    throw msf::InvalidInputError("no drives: give datasets (a drive, or a root holding several) or -list FILE");
   msf::nameDrives(drives);
   return drives;
 }
@@ -189,8 +189,8 @@ int main(int argc, char** argv) {
   msf::BatchOptions options;
   msf::tool::CommandLine cli(
       "msf_batch", "-o OUT (-slurm | -local N | -one_process) [DATASET ...] [-list FILE] [options]",
-      "Reconstructs many drives into one map. Each drive (a KITTI odometry sequence, a KITTI raw drive or a synthetic "
-      "street; a dataset root gives all it holds) is a task of its own: msf_reconstruct DRIVE -stream R -o "
+      "Reconstructs many drives into one map. Each drive (a KITTI odometry sequence, a KITTI raw drive, a synthetic "
+      "street, a folder of the generic layout or a ROS bag, as msf_reconstruct reads them; a root gives all it holds) is a task of its own: msf_reconstruct DRIVE -stream R -o "
       "OUT/drives/NAME, with its log in OUT/logs/NAME.log; then the drives' TSDF stores are merged tile by tile (the "
       "TSDF's weighted mean per voxel) by merge_tasks tasks, meshed by as many, and OUT/map (mesh.ply, tsdf/, tiles/, "
       "summary.json) is committed. The drives' poses must share a world. Run again, it does only what is not done: a "

@@ -49,24 +49,23 @@ void writeTimes(const std::vector<double>& times, const fs::path& path) {
 } // namespace
 
 int main(int argc, char** argv) {
-  std::string rig, frames_text = "0:";
+  std::string frames_text = "0:";
   msf::tool::CommandLine cli(
       "msf_convert", "DATASET OUT_DIR [options]",
       "Writes a dataset the project reads (a KITTI odometry sequence or raw drive, a synthetic sequence, a folder of "
-      "the generic layout) into the generic layout, the one a user makes from their own recording:\n"
+      "the generic layout, a ROS 1 bag of kitti2bag's topics or those named below) into the generic layout, the one a user makes from their own recording:\n"
       "  OUT_DIR/rig.yaml, lidar/NNNNNN.bin, left/ right/ color/NNNNNN.png, timestamps.txt, poses.txt\n"
       "Frames are numbered from 000000 in the order converted; line i of the text files is frame i.");
-  cli.value("-rig", "FILE", rig, "a calibration or rig file instead of the dataset's own")
-      .value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)");
+  msf::DatasetOptions reader;
+  cli.value("-frames", "a:b", frames_text, "frame range, inclusive (default: all)");
+  msf::addDatasetOptions(cli, reader);
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 2)
       throw msf::InvalidInputError("expected DATASET OUT_DIR (see -h)");
-    msf::DatasetOptions reader;
-    reader.rig = rig;
     const auto source = msf::openDataset(positional[0], reader);
     const std::vector<std::size_t> frames = source->indices(msf::FrameRange::parse(frames_text));
     msf::tool::installStopSignals({"msf_convert: stopping after the frame under way; nothing is written"});
-    msf::OutputFolder output(positional[1], "msf_convert", {positional[0], rig});
+    msf::OutputFolder output(positional[1], "msf_convert", {positional[0], reader.rig});
     const fs::path out = output.dir();
     for (const char* sub : {"lidar", "left", "right"})
       fs::create_directory(out / sub);

@@ -39,7 +39,8 @@ void printMetrics(const msf::OdometryMetrics& m) {
 
 /// What the command line sets.
 struct Settings {
-  std::string output, config_path, rig, frames_text = "0:";
+  std::string output, config_path, frames_text = "0:";
+  msf::DatasetOptions reader;
   bool print_config = false, overwrite = false;
 };
 
@@ -109,9 +110,7 @@ int run(const msf::tool::Arguments& positional, const Settings& settings) {
   if (settings.print_config)
     msf::printConfig(std::cout, config);
 
-  msf::DatasetOptions options;
-  options.rig = settings.rig;
-  const auto source = msf::openDataset(positional.front(), options);
+  const auto source = msf::openDataset(positional.front(), settings.reader);
   const msf::FrameSource& sequence = *source;
   const std::vector<std::size_t> frames = sequence.indices(msf::FrameRange::parse(settings.frames_text));
   const Track tracked = track(sequence, frames, config);
@@ -148,8 +147,8 @@ int main(int argc, char** argv) {
   cli.value("-o", "FILE", settings.output, "output poses file (written whole or not at all)")
       .value("-frames", "a:b", settings.frames_text, "frame range, inclusive (default: all)")
       .value("-config", "FILE", settings.config_path, "YAML configuration; its `odometry` section (config/kitti.yaml)")
-      .value("-rig", "FILE", settings.rig, "a calibration or rig file instead of the dataset's own")
       .flag("-print_config", settings.print_config, "print the configuration in effect")
       .overwriteOption(settings.overwrite);
+  msf::addDatasetOptions(cli, settings.reader);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) { return run(positional, settings); });
 }

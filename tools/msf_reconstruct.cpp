@@ -722,9 +722,6 @@ void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::Pipeline
                request.config_path = path;
              },
              "YAML configuration (config/kitti.yaml); the options below override it")
-      .value("-rig", "FILE", request.reader.rig,
-             "a rig file (docs/usage.md, \"Your own rig\") or KITTI calibration: required by a folder of the generic layout "
-             "without rig.yaml, and used instead of a dataset's own (a bag's CameraInfo and LiDAR extrinsic too)")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
       .value("-world", "W", request.world,
              "camera: the outputs in camera 0 of the first frame (x right, y down, z forward; the default) | z_up: "
@@ -750,18 +747,6 @@ void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::Pipeline
              "memory budget of the run (tsdf_volume.max_memory_mb; 0: 3/4 of RAM): with the poses known before the "
              "run (the dataset's or a file's), a run whose predicted peak exceeds it is refused before it starts; "
              "the TSDF volume also stops the run at the first frame whose blocks would not fit")
-      .value("-lidar_topic", "T", request.reader.bag.lidar_topic, "a bag's LiDAR scans, PointCloud2 (default {default})")
-      .value("-left_topic", "T", request.reader.bag.left_topic,
-             "a bag's left rectified image (default {default}); each image's CameraInfo is its sibling camera_info")
-      .value("-right_topic", "T", request.reader.bag.right_topic, "a bag's right rectified image (default {default})")
-      .value("-color_topic", "T", request.reader.bag.color_topic,
-             "a bag's colour image (default {default}, when the bag has it; '' for none)")
-      .value("-world_frame", "F", request.reader.bag.world_frame,
-             "a bag's tf frame of the poses (default: camera_init, kitti2bag's, when the bag has it, else the root "
-             "of the left camera's tf tree)")
-      .value("-max_offset", "S", request.reader.bag.max_offset_s,
-             "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
-             "{default})")
       .flag("-save_depth", request.save_depth, "also write each frame's fused depth as OUT/depth/NNNNNN.pcd")
       .flag("-holdout", request.holdout,
             "evaluation protocol 4: the held-out rings (config section rings) are removed from every scan before the "
@@ -780,6 +765,7 @@ void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::Pipeline
       .note("Ctrl-C (or SIGTERM) stops after the frames under way and still writes the mesh and the summary (exit "
             "code 130); a second one also skips the mesh's scores and renderings (summary.json lists them under "
             "\"skipped\"); later ones are ignored until the mesh and the summary are written.");
+  msf::addDatasetOptions(cli, request.reader);
 }
 
 /// The DATASET_DIR argument ("" for the default street); refuses more than one.

@@ -75,7 +75,32 @@ TEST_F(BatchPlanTest, FindsDrivesUnderARootAndInAList) {
   EXPECT_NE(test::errorOf([&] { readDriveList(dir.file("bad.txt")); }).find("line 2"), std::string::npos);
   std::vector<Drive> twice = {found[0], found[0]};
   EXPECT_NE(test::errorOf([&] { nameDrives(twice); }).find("given twice"), std::string::npos);
-  EXPECT_NE(test::errorOf([&] { findDrives(dir.path()); }).find("holds no sequence"), std::string::npos);
+  EXPECT_NE(test::errorOf([&] { findDrives(dir.path()); }).find("holds no drive"), std::string::npos);
+}
+
+/// A user's own recordings: folders of the generic layout and ROS bags (known by their first
+/// bytes: nothing else is read before the plan), beside a KITTI sequence.
+TEST(DriveList, FindsFoldersOfTheGenericLayoutAndBags) {
+  test::TempDir dir;
+  for (const char* sub : {"left", "right", "lidar"})
+    fs::create_directories(dir.file("root/van_monday") + "/" + sub);
+  std::ofstream(dir.file("root/night_drive.bag")) << "#ROSBAG V2.0\n";
+  std::ofstream(dir.file("root/notes.bag")) << "not a bag\n";
+  std::vector<Drive> found = findDrives(dir.file("root"));
+  nameDrives(found);
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].name, "night_drive");
+  EXPECT_EQ(found[0].dataset, dir.file("root/night_drive.bag"));
+  EXPECT_EQ(found[1].name, "van_monday");
+  EXPECT_EQ(findDrives(dir.file("root/night_drive.bag")).size(), 1u);
+  EXPECT_EQ(findDrives(dir.file("root/van_monday")).front().dataset, dir.file("root/van_monday"));
+
+  std::ofstream(dir.file("root/drives.txt")) << "van_monday\nnight_drive.bag\nnotes.bag\n";
+  const std::string error = test::errorOf([&] { readDriveList(dir.file("root/drives.txt")); });
+  EXPECT_NE(error.find("line 3: 'notes.bag' is not a drive"), std::string::npos) << error;
+  EXPECT_NE(error.find("a ROS bag"), std::string::npos) << error;
+  std::ofstream(dir.file("root/drives.txt")) << "van_monday\nnight_drive.bag\n";
+  EXPECT_EQ(readDriveList(dir.file("root/drives.txt")).size(), 2u);
 }
 
 TEST_F(BatchPlanTest, SavesAndLoadsAndRefusesAFolderOfSomeoneElse) {
@@ -174,6 +199,31 @@ TEST_F(BatchPlanTest, LocalBatchMergesToTheOneProcessMapAndNeverRedoesADrive) {
   EXPECT_TRUE(done.driveDone(0));
   EXPECT_FALSE(BatchPlan(dir.file("batch"), drives, optionsFor(plainConfig(), "0:3")).driveDone(0));
   EXPECT_FALSE(BatchPlan(dir.file("batch"), drives, optionsFor(config())).driveDone(0));
+}
+
+/// A drive of the generic layout (the street's second drive, converted by msf_convert) is
+/// predicted, run and merged as its KITTI layout is: the map of the local batch is the one process
+/// map of the KITTI layouts.
+TEST_F(BatchPlanTest, ADriveOfTheGenericLayoutMergesAsItsKittiLayout) {
+  test::TempDir dir;
+  fs::create_directory(dir.file("own"));
+  const test::CommandResult convert = test::runCommand(test::binDir() + "/msf_convert '" + drives()[1] + "' " +
+                                                       dir.file("own/b_from_12m"));
+  ASSERT_EQ(convert.exit_code, 0) << convert.out << convert.err;
+  const std::string settings = " -config '" + plainConfig() + "' -stream " + kStream;
+  const test::CommandResult own = test::runCommand(batchTool() + " -o " + dir.file("batch") + " -local 2" + settings +
+                                                   " '" + drives()[0] + "' " + dir.file("own/b_from_12m"));
+  ASSERT_EQ(own.exit_code, 0) << own.out << own.err;
+  EXPECT_NE(own.out.find("b_from_12m"), std::string::npos) << own.out;
+  const test::CommandResult kitti = test::runCommand(batchTool() + " -o " + dir.file("one") + " -one_process" +
+                                                     settings + " '" + drives()[0] + "' '" + drives()[1] + "'");
+  ASSERT_EQ(kitti.exit_code, 0) << kitti.out << kitti.err;
+  const test::StoreDifference d =
+      test::compareStores(TsdfStore::open(dir.file("batch/map")), TsdfStore::open(dir.file("one")));
+  EXPECT_TRUE(d.same_blocks);
+  EXPECT_GT(d.observed, 50000u);
+  EXPECT_LT(d.sdf, 1e-4) << "metres";
+  EXPECT_LT(d.weight_relative, 1e-4);
 }
 
 TEST_F(BatchPlanTest, RefusesDrivesWithoutPosesAndForeignFolders) {

@@ -575,9 +575,11 @@ check "batch: no place to run the tasks" 1 "say where the tasks run, once: -slur
 check "batch -run before a plan" 1 "batch plan '.*out/plan.txt' does not exist" -- msf_batch -o out -run drive:0
 check "batch -run a task of no kind" 1 "task 'drives:1' is not drive:N, merge:N, mesh:N or finish" -- \
   msf_batch -o "$F" -run drives:1
-check "batch: a folder that holds no drive" 1 "dataset '.*' holds no sequence" -- msf_batch -o out -local 1 "$F"
+check "batch: a folder that holds no drive" 1 "dataset '.*' holds no drive" -- msf_batch -o out -local 1 "$F"
+check "batch: a file that is no bag" 1 "dataset '.*dense.pcd' is a file and not a ROS bag" -- \
+  msf_batch -o out -local 1 "$F/dense.pcd"
 printf '%s\n' "$F/dense.pcd" >"$F/drives.txt"
-check "batch -list with a line that is no drive" 1 "drive list '.*drives.txt' line 1: '.*dense.pcd' is not a sequence" -- \
+check "batch -list with a line that is no drive" 1 "drive list '.*drives.txt' line 1: '.*dense.pcd' is not a drive" -- \
   msf_batch -o out -local 1 -list "$F/drives.txt"
 check "merge: a folder without a store" 1 "TSDF store index '.*/tsdf/index.txt' does not exist" -- \
   msf_merge -o map "$F" "$F"

@@ -283,6 +283,40 @@ TEST(BagSource, OpenDatasetKnowsABagByItsFirstBytes) {
   EXPECT_TRUE(contains(errorOf([&] { msf::openDataset(dir.path(), options); }), "for a ROS bag"));
 }
 
+/// A rig's own bag, its topics named on msf_convert's command line as on msf_reconstruct's, into
+/// the generic layout (what msf_batch runs): the same rig, frames, images and scans.
+TEST(BagSource, ABagOfARigsOwnTopicsConvertsToTheGenericLayout) {
+  msf::test::TempDir dir;
+  TinyBag b;
+  b.poses = true;
+  writeTinyBag(dir.file("rig.bag"), b);
+  const std::string topics = " -lidar_topic /lidar/points -left_topic /cam/left/image_raw -right_topic "
+                             "/cam/right/image_raw -color_topic ''";
+  const msf::test::CommandResult r =
+      msf::test::runTool("msf_convert", "'" + dir.file("rig.bag") + "' '" + dir.file("rig") + "'" + topics);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const msf::BagSource bag(dir.file("rig.bag"), tinyTopics());
+  const auto folder = msf::openDataset(dir.file("rig"));
+  ASSERT_EQ(folder->size(), bag.size());
+  EXPECT_EQ(folder->calibration().image_size, bag.calibration().image_size);
+  EXPECT_TRUE(folder->calibration().P[1].isApprox(bag.calibration().P[1], 1e-12));
+  EXPECT_TRUE(folder->calibration().T_cam0_velo.isApprox(bag.calibration().T_cam0_velo, 1e-9));
+  for (std::size_t i = 0; i < bag.size(); ++i) {
+    const msf::Frame a = bag.load(i), c = folder->load(i);
+    EXPECT_EQ(cv::norm(a.left, c.left, cv::NORM_INF), 0.0) << i;
+    EXPECT_EQ(cv::norm(a.right, c.right, cv::NORM_INF), 0.0) << i;
+    ASSERT_EQ(a.scan->size(), c.scan->size()) << i;
+    EXPECT_EQ(a.scan->back().getVector3fMap(), c.scan->back().getVector3fMap()) << i;
+    EXPECT_NEAR(a.timestamp, c.timestamp, 1e-9) << i;
+    ASSERT_TRUE(c.has_pose) << i;
+    EXPECT_TRUE(a.T_world_cam0.isApprox(c.T_world_cam0, 1e-6)) << i;
+  }
+  const msf::test::CommandResult default_topics =
+      msf::test::runTool("msf_convert", "'" + dir.file("rig.bag") + "' '" + dir.file("other") + "'");
+  EXPECT_TRUE(contains(default_topics.err, "-lidar_topic")) << default_topics.err;
+  EXPECT_FALSE(msf::test::fileExists(dir.file("other")));
+}
+
 // ---------------------------------------------------------------------------------------
 // KITTI odometry 04 through writeKittiBag and back.
 

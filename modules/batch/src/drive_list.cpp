@@ -2,6 +2,8 @@
 #include <msf/batch/drive_list.h>
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/io/folder_source.h>
+#include <msf/pipeline/open_dataset.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -24,15 +26,22 @@ bool isFile(const fs::path& p) {
   return fs::is_regular_file(p, e);
 }
 
-/// The layouts msf::Sequence reads, by their files alone (no calibration or poses read here).
+/// The layouts openDataset reads, by their files alone (no calibration or poses read here).
 bool isOdometrySequence(const fs::path& p) { return isFile(p / "calib.txt") && isDir(p / "image_0"); }
 bool isRawDrive(const fs::path& p) {
   return isDir(p / "image_00" / "data") && isFile(p.parent_path() / "calib_cam_to_cam.txt");
 }
+bool isOwnFolder(const fs::path& p) { return FolderSource::looksLikeOne(p.string()); }
+bool isBag(const fs::path& p) { return isFile(p) && isRosBag(p.string()); }
 
-/// The sequence folder of `p`: itself, or the one sequence of a root holding sequences/NN.
+/// What the drives' errors say a drive may be.
+const char* const kDriveLayouts = "a KITTI odometry sequence, a KITTI raw drive, a folder of the generic layout "
+                                  "(left/, right/, lidar/, rig.yaml), a ROS bag or a synthetic street";
+
+/// The drive `p` is: itself (a sequence, a folder of the generic layout or a bag), or the one
+/// sequence of a root holding sequences/NN; empty when it is none.
 fs::path sequenceOf(const fs::path& p) {
-  if (isOdometrySequence(p) || isRawDrive(p))
+  if (isOdometrySequence(p) || isRawDrive(p) || isOwnFolder(p) || isBag(p))
     return p;
   std::vector<fs::path> found;
   if (isDir(p / "sequences"))
@@ -45,6 +54,17 @@ fs::path sequenceOf(const fs::path& p) {
 fs::path normal(const std::string& path) {
   fs::path p = fs::absolute(path).lexically_normal();
   return p.filename().empty() ? p.parent_path() : p;
+}
+
+/// The ROS bags directly in `p`, by their first bytes, sorted.
+std::vector<fs::path> bagsIn(const fs::path& p) {
+  std::vector<fs::path> out;
+  if (isDir(p))
+    for (const auto& e : fs::directory_iterator(p))
+      if (isBag(e.path()))
+        out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 std::vector<fs::path> subfolders(const fs::path& p) {
@@ -60,8 +80,12 @@ std::vector<fs::path> subfolders(const fs::path& p) {
 } // namespace
 
 std::vector<Drive> findDrives(const std::string& path) {
-  requireDirectory(path, "dataset");
   const fs::path root = normal(path);
+  if (isFile(root) && !isBag(root))
+    throw IOError("dataset '" + path + "' is a file and not a ROS bag (whose first bytes are '#ROSBAG V'): " +
+                  "a drive is " + kDriveLayouts);
+  if (!isBag(root))
+    requireDirectory(path, "dataset");
   std::vector<fs::path> found;
   if (const fs::path one = sequenceOf(root); !one.empty()) {
     found.push_back(one);
@@ -69,6 +93,8 @@ std::vector<Drive> findDrives(const std::string& path) {
     for (const fs::path& p : subfolders(root / "sequences"))
       if (isOdometrySequence(p))
         found.push_back(p);
+    for (const fs::path& bag : bagsIn(root))
+      found.push_back(bag);
     for (const fs::path& level1 : subfolders(root)) {
       if (const fs::path inside = sequenceOf(level1); !inside.empty())
         found.push_back(inside);
@@ -82,9 +108,10 @@ std::vector<Drive> findDrives(const std::string& path) {
   found.erase(std::unique(found.begin(), found.end()), found.end());
   if (found.empty())
     throw IOError("dataset '" + path +
-                  "' holds no sequence: neither a KITTI odometry sequence (calib.txt, image_0/), a KITTI raw drive "
-                  "(image_00/data/ below a date folder with calib_cam_to_cam.txt), nor folders of them (sequences/NN, "
-                  "DATE/DATE_drive_NNNN_sync, STREET/sequences/00)");
+                  "' holds no drive: neither a KITTI odometry sequence (calib.txt, image_0/), a KITTI raw drive "
+                  "(image_00/data/ below a date folder with calib_cam_to_cam.txt), a folder of the generic layout "
+                  "(left/, right/, lidar/, rig.yaml), a ROS bag, nor a folder of them (sequences/NN, "
+                  "DATE/DATE_drive_NNNN_sync, STREET/sequences/00, NAME/left/..., NAME.bag)");
   std::vector<Drive> drives;
   for (const fs::path& p : found)
     drives.push_back({"", p.string(), ""});
@@ -119,10 +146,9 @@ std::vector<Drive> readDriveList(const std::string& path) {
     if (fields.empty() || fields.size() > 2)
       throw IOError(where + ": expected 'DATASET [POSES]', got '" + line + "'");
     const fs::path dataset = fs::path(fields[0]).is_absolute() ? fs::path(fields[0]) : base / fields[0];
-    const fs::path sequence = isDir(dataset) ? sequenceOf(normal(dataset.string())) : fs::path();
+    const fs::path sequence = sequenceOf(normal(dataset.string()));
     if (sequence.empty())
-      throw IOError(where + ": '" + fields[0] + "' is not a sequence (a KITTI odometry sequence, a KITTI raw drive or " +
-                    "a synthetic street with one sequence)");
+      throw IOError(where + ": '" + fields[0] + "' is not a drive (" + kDriveLayouts + " with one sequence)");
     Drive drive{"", sequence.string(), ""};
     if (fields.size() == 2) {
       const fs::path poses = fs::path(fields[1]).is_absolute() ? fs::path(fields[1]) : base / fields[1];
@@ -145,7 +171,8 @@ void nameDrives(std::vector<Drive>& drives) {
     const fs::path root = p.parent_path().parent_path();
     d.name = isOdometrySequence(p) && p.parent_path().filename() == "sequences" && isDir(root / "gt")
                  ? root.filename().string()
-                 : p.filename().string();
+             : isBag(p) ? p.stem().string() // drive_07.bag: drive_07
+                        : p.filename().string();
     if (const auto it = seen_datasets.find(d.dataset); it != seen_datasets.end())
       throw InvalidInputError("dataset '" + d.dataset + "' is given twice");
     if (const auto it = seen_names.find(d.name); it != seen_names.end())

@@ -3,8 +3,8 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
-#include <msf/io/sequence.h>
 #include <msf/pipeline/reconstructor.h>
+#include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/pose_source.h>
 
 #include <chrono>
@@ -35,22 +35,22 @@ std::size_t reconstructInOneProcess(const BatchPlan& plan, const std::string& ou
   inputs.push_back(plan.options().config);
   OutputFolder folder(out, "msf_batch", inputs);
   const PipelineConfig& config = plan.pipelineConfig();
-  const Sequence first(plan.drives().front().dataset);
+  const std::unique_ptr<FrameSource> first = openDataset(plan.drives().front().dataset);
   Reconstructor::Options options;
   options.poses = Reconstructor::PoseMode::Given;
   options.stream_directory = folder.dir();
-  Reconstructor engine(first.calibration(), config, options);
+  Reconstructor engine(first->calibration(), config, options);
   const auto start = std::chrono::steady_clock::now();
   std::size_t frames = 0;
   for (const Drive& d : plan.drives()) {
-    const Sequence sequence(d.dataset);
-    requireSameRig(first.calibration(), sequence.calibration(), d.name);
-    const std::vector<std::size_t> indices = sequence.indices(FrameRange::parse(plan.options().frames));
-    const PoseSource poses(d.poses.empty() ? "dataset" : d.poses, sequence, indices);
+    const std::unique_ptr<FrameSource> source = openDataset(d.dataset);
+    requireSameRig(first->calibration(), source->calibration(), d.name);
+    const std::vector<std::size_t> indices = source->indices(FrameRange::parse(plan.options().frames));
+    const PoseSource poses(d.poses.empty() ? "dataset" : d.poses, *source, indices);
     if (poses.kind() == PoseSource::Kind::Estimated)
       throw InvalidInputError("drive '" + d.name + "' has no poses: one map needs poses in one world");
     engine.setFrameFilter([&poses](Frame& frame) { poses.apply(frame); });
-    frames += engine.run(sequence, indices, nullptr).frames_done;
+    frames += engine.run(*source, indices, nullptr).frames_done;
   }
   const std::size_t triangles = engine.finishStreaming(folder.dir() + "/mesh.ply");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

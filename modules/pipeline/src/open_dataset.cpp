@@ -11,6 +11,25 @@
 
 namespace msf {
 
+void addDatasetOptions(tool::CommandLine& cli, DatasetOptions& options) {
+  BagOptions& bag = options.bag;
+  cli.value("-rig", "FILE", options.rig,
+            "a rig file (docs/usage.md, \"Your own rig\") or KITTI calibration: required by a folder of the generic "
+            "layout without rig.yaml, and used instead of a dataset's own (a bag's CameraInfo and LiDAR extrinsic too)")
+      .value("-lidar_topic", "T", bag.lidar_topic, "a bag's LiDAR scans, PointCloud2 (default {default})")
+      .value("-left_topic", "T", bag.left_topic,
+             "a bag's left rectified image (default {default}); each image's CameraInfo is its sibling camera_info")
+      .value("-right_topic", "T", bag.right_topic, "a bag's right rectified image (default {default})")
+      .value("-color_topic", "T", bag.color_topic,
+             "a bag's colour image (default {default}, when the bag has it; '' for none)")
+      .value("-world_frame", "F", bag.world_frame,
+             "a bag's tf frame of the poses (default: camera_init, kitti2bag's, when the bag has it, else the root "
+             "of the left camera's tf tree)")
+      .value("-max_offset", "S", bag.max_offset_s,
+             "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
+             "{default})");
+}
+
 bool isRosBag(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   char magic[9] = {};

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/common/tool.h>
 #include <msf/io/bag_options.h>
 #include <msf/io/frame_source.h>
 
@@ -24,6 +25,10 @@ struct DatasetOptions {
 /// does: msf::BagSource, in builds with the ros module). Throws IOError naming the path and the
 /// layouts it knows when it is none of them.
 std::unique_ptr<FrameSource> openDataset(const std::string& path, const DatasetOptions& options = {});
+
+/// The options every tool that opens a dataset takes: -rig, and a bag's topics, world frame and
+/// stamps' offset (-lidar_topic, -left_topic, -right_topic, -color_topic, -world_frame, -max_offset).
+void addDatasetOptions(tool::CommandLine& cli, DatasetOptions& options);
 
 /// Whether `path` is a ROS 1 bag file (its first bytes are "#ROSBAG V").
 bool isRosBag(const std::string& path);
