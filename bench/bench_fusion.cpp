@@ -2,7 +2,7 @@
 // Per-pixel depth fusion per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370):
 // the cloud class DepthFusion<PointXYZID, PointXYZRGBConfidence, PointXYZRGBWeight> and the
 // image-level DepthImageFusion, for both methods, and the facade extension after it
-// (extendFacades on the fused depth, its copy not timed). Inputs (interpolated LiDAR with distances,
+// (extendFacades on the fused depth, its copy not timed), and the rig's check beside them. Inputs (interpolated LiDAR with distances,
 // SGBM with confidence) are made once before timing; cpu_ms_all_threads is the process CPU
 // time per frame (all threads).
 //
@@ -16,6 +16,7 @@
 #include <msf/fusion/sky_mask.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/io/sequence.h>
+#include <msf/pipeline/rig_agreement.h>
 #include <msf/range_image/compound_interpolation.h>
 #include <msf/range_image/depth_interpolator.h>
 #include <msf/range_image/distance_transform.h>
@@ -181,6 +182,19 @@ void BM_SkyMask(benchmark::State& state) {
   }
 }
 
+/// The rig's check the engine runs after the fusion: the share of pixels where the LiDAR's real
+/// return and the stereo depth differ (msf::lidarStereoDisagreement), beside the fusion's cost.
+void BM_LidarStereoDisagreement(benchmark::State& state) {
+  const Data& d = data();
+  std::size_t i = 0;
+  double share = 0;
+  for (auto _ : state) {
+    const std::size_t f = i++ % d.lidar.size();
+    share += msf::lidarStereoDisagreement(d.lidar_depth[f], d.lidar_distance[f], d.stereo_depth[f]);
+  }
+  state.counters["share"] = share / static_cast<double>(state.iterations());
+}
+
 void BM_FusionCloudPaper(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Paper); }
 void BM_FusionCloudUncertainty(benchmark::State& s) { cloudFusion(s, msf::FusionMethod::Uncertainty); }
 void BM_FusionImagePaper(benchmark::State& s) { imageFusion(s, msf::FusionMethod::Paper); }
@@ -199,6 +213,7 @@ BENCHMARK(BM_FusionImageUncertainty)->Unit(benchmark::kMillisecond)->UseRealTime
 BENCHMARK(BM_FusionImageUncertaintyNoEdgeSupport)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_FacadeExtension)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
 BENCHMARK(BM_SkyMask)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
+BENCHMARK(BM_LidarStereoDisagreement)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(50);
 BENCHMARK(BM_SilhouetteThickness)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()->Iterations(50);
 
 BENCHMARK_MAIN();

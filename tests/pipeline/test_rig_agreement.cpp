@@ -3,6 +3,7 @@
 #include <msf/io/sequence.h>
 #include <msf/pipeline/reconstructor.h>
 #include <msf/pipeline/rig_agreement.h>
+#include <msf/pipeline/run_report.h>
 
 #include "pipeline_fixture.h"
 #include "test_support.h"
@@ -27,6 +28,14 @@ TEST(RigAgreement, TheShareCountsPixelsWithARealReturnAndAStereoDepth) {
       << warning;
   EXPECT_NE(warning.find("not its inverse"), std::string::npos) << warning;
   EXPECT_EQ(msf::rigDisagreementWarning({nan}), "");
+  // A row longer than a vector register, with a tail: every 3rd pixel 20 % off.
+  cv::Mat wide_lidar(1, 37, CV_32FC1, cv::Scalar(8.f)), wide_stereo = wide_lidar.clone();
+  for (int u = 0; u < 37; u += 3)
+    wide_stereo.at<float>(0, u) = 9.6f;
+  EXPECT_DOUBLE_EQ(msf::lidarStereoDisagreement(wide_lidar, cv::Mat::zeros(1, 37, CV_32FC1), wide_stereo), 13.0 / 37);
+  // A result no fusion ran on measured nothing: NaN, which the median skips, not a share of 0.
+  EXPECT_TRUE(std::isnan(msf::FrameResult().lidar_stereo_disagreement));
+  EXPECT_TRUE(std::isnan(msf::RunReport::FrameRow().lidar_stereo_disagreement));
 }
 
 TEST_F(PipelineTest, ARightRigAgreesAndAnInvertedExtrinsicIsWarnedOf) {

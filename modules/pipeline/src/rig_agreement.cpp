@@ -10,15 +10,16 @@ namespace msf {
 double lidarStereoDisagreement(const cv::Mat& lidar_depth, const cv::Mat& lidar_distance,
                                const cv::Mat& stereo_depth) {
   std::size_t both = 0, differ = 0;
+  const float relative = static_cast<float>(kDisagreementRelative);
   for (int v = 0; v < lidar_depth.rows; ++v) {
     const float* lidar = lidar_depth.ptr<float>(v);
     const float* distance = lidar_distance.ptr<float>(v);
     const float* stereo = stereo_depth.ptr<float>(v);
+    // Without a branch, so that the compiler vectorizes the row.
     for (int u = 0; u < lidar_depth.cols; ++u) {
-      if (!(lidar[u] > 0.f && distance[u] == 0.f && stereo[u] > 0.f))
-        continue;
-      ++both;
-      differ += std::abs(stereo[u] - lidar[u]) > kDisagreementRelative * lidar[u];
+      const bool measured = (lidar[u] > 0.f) & (distance[u] == 0.f) & (stereo[u] > 0.f);
+      both += measured;
+      differ += measured & (std::abs(stereo[u] - lidar[u]) > relative * lidar[u]);
     }
   }
   return both ? static_cast<double>(differ) / static_cast<double>(both) : std::nan("");

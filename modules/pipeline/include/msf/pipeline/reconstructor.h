@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -101,7 +102,7 @@ struct FrameResult {
   DepthFrame fused;
   /// Of the pixels with a real LiDAR return and a stereo depth, the share where the two differ
   /// by more than 10 % (lidarStereoDisagreement): a few percent with a right rig; NaN: none.
-  double lidar_stereo_disagreement = 0;
+  double lidar_stereo_disagreement = std::numeric_limits<double>::quiet_NaN();
   StageTimes times;
 };
 

@@ -11,6 +11,7 @@
 #include <msf/pipeline/reconstructor.h>
 
 #include <iosfwd>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -29,7 +30,8 @@ public:
     StageTimes times;
     double latency_ms = 0;  ///< from the start of its loading to the end of its integration
     double rss_mb = 0;      ///< resident memory of the process after it (0: not measured)
-    double lidar_stereo_disagreement = 0; ///< FrameResult's (NaN: no pixel with both)
+    /// FrameResult's (NaN: no pixel with both)
+    double lidar_stereo_disagreement = std::numeric_limits<double>::quiet_NaN();
   };
 
   /// Depth errors of one method over all frames: every pixel with ground truth, and the
