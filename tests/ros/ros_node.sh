@@ -111,20 +111,31 @@ refuse bad_poses "parameter /bad_poses/poses must be auto, tf, odometry or refin
 refuse bad_config "parameter /bad_config/config: config '$work/none.yaml' does not exist" _config:="$work/none.yaml"
 refuse bad_sweep "parameter /bad_sweep/sweeping_scans must be true or false" _sweeping_scans:=maybe
 refuse bad_overwrite "parameter /bad_overwrite/overwrite must be true or false" _overwrite:=sometimes
+refuse bad_ext "parameter /bad_ext/mesh_path: cannot write mesh '$work/m.txt': use .ply, .obj or .vtk" \
+  _mesh_path:="$work/m.txt"
+refuse bad_rig "parameter /bad_rig/rig: calibration '$work/none.yaml' does not exist" _rig:="$work/none.yaml"
 refuse bad_folder \
   "parameter /bad_folder/mesh_path: cannot write '$work/none/m.ply': output folder '$work/none' does not exist" \
   _mesh_path:="$work/none/m.ply"
 
 # Plays the bag to the node started by launch/kitti_bag.launch with ARGS...; returns when it has
 # published a depth image per frame (rostopic echo -n exits then) and has been stopped.
-play_to_node() { # NAME ARGS...
+play_to_node() { # NAME ARGS... (the bag: $bag, else 04.bag; $during: a command run while the node runs)
   local name=$1 counter launcher seen
   local log="$work/${name}_depth_seen.log"
   shift
   background "${name}_depth_seen" rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
   counter=$started
-  background "$name" roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 queue_size:=$frames "$@"
+  background "$name" roslaunch --wait msfusion kitti_bag.launch bag:="${bag:-$work/04.bag}" rate:=0.5 \
+    queue_size:=$frames "$@"
   launcher=$started
+  if [ -n "${during:-}" ]; then # once the engine has started
+    for ((k = 0; k < 300; ++k)); do
+      grep -aq "reconstructing" "$work/$name.log" && break
+      sleep 0.1
+    done
+    eval "$during"
+  fi
   for ((k = 0; ; ++k)); do
     kill -0 "$counter" 2>/dev/null || break
     ((k < 600)) || fail "the node published $(grep -c '^---' "$log") depth images of $frames in 60 s"
@@ -169,6 +180,41 @@ play_to_node snapshots params:="$work/snapshots.yaml" mesh_path:="$work/mine.ply
 ! cmp -s "$work/node_mesh.ply" "$work/mine.ply" ||
   fail "sweeping_scans false made the same mesh as the sweeping rig: the parameter did not reach the engine"
 echo "ok: sweeping_scans false makes another map, written over mine.ply with overwrite true"
+
+# A file put at ~mesh_path while the node runs is the user's: left as it is, the mesh beside it.
+during="echo mine >'$work/late.ply'" play_to_node late mesh_path:="$work/late.ply"
+[ "$(cat "$work/late.ply")" = mine ] || fail "the node wrote over late.ply, which appeared while it ran"
+cmp "$work/late_1.ply" "$work/node_mesh.ply" || fail "the node did not save its mesh as late_1.ply"
+node_lines "$work/late.log" | grep -aq "'$work/late.ply' appeared while the node ran and is left as it is" ||
+  fail "the node did not say it left late.ply: $(node_lines "$work/late.log" | tr '\n' ' ')"
+echo "ok: a file that appeared at ~mesh_path while the node ran is left as it is; the mesh is late_1.ply"
+
+# A rig's own bag: no colour camera though ~color_topic names one (a grey mesh, every frame), and
+# tf's world not kitti2bag's camera_init (the root of the left camera's tree, which a moving
+# transform leads to: msf_kitti2bag's 'world' above it): the poses from tf, the mesh
+# msf_reconstruct's of the same bag.
+/usr/bin/python3 - "$work/04.bag" "$work/own.bag" <<'PY' || fail "could not write own.bag"
+import rosbag, sys
+# Raw messages: "camera_init" renamed in the serialized bytes to a name of the same length.
+with rosbag.Bag(sys.argv[1]) as bag_in, rosbag.Bag(sys.argv[2], "w") as bag_out:
+    for topic, raw, t in bag_in.read_messages(raw=True):
+        if "camera_color_left" in topic:
+            continue
+        if topic in ("/tf", "/tf_static"):
+            raw = (raw[0], raw[1].replace(b"camera_init", b"vehicle_map")) + tuple(raw[2:])
+        bag_out.write(topic, raw, t, raw=True)
+PY
+bag=$work/own.bag play_to_node own mesh_path:="$work/own_mesh.ply"
+account=$(node_lines "$work/own.log" | grep -a "scans received")
+[[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||
+  fail "the node on a bag without colour: '$account'"
+node_lines "$work/own.log" | grep -aq "world frame 'world' (the root of the left camera's tf tree)" ||
+  fail "the node did not take the root of the tf tree as its world: $(node_lines "$work/own.log" | tr '\n' ' ')"
+"$build/bin/msf_reconstruct" "$work/own.bag" -panels 0 -o "$work/own_reconstruct" >"$work/own_reconstruct.log" 2>&1 ||
+  fail "msf_reconstruct of own.bag: $(tail -5 "$work/own_reconstruct.log")"
+cmp "$work/own_mesh.ply" "$work/own_reconstruct/mesh.ply" ||
+  fail "the node's mesh of a bag without colour and camera_init differs from msf_reconstruct's"
+echo "ok: a bag without the colour camera nor camera_init: every frame, poses from tf's root, msf_reconstruct's mesh"
 
 ros_session_stop
 echo "ok: roscore, the node, the player and the recorder stopped; no process left"

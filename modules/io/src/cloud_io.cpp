@@ -687,10 +687,15 @@ void detail::saveCloudData(const std::string& path, const pcl::PCLPointCloud2& l
   });
 }
 
-void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh) {
+void requireMeshExtension(const std::string& path) {
   const std::string ext = fileExtension(path);
   if (ext != ".ply" && ext != ".obj" && ext != ".vtk")
     throw IOError("cannot write mesh '" + path + "': use .ply, .obj or .vtk");
+}
+
+void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh) {
+  requireMeshExtension(path);
+  const std::string ext = fileExtension(path);
   if (mesh.cloud.width == 0 || mesh.cloud.height == 0) // PCL's writers refuse it, saying why on the console only
     throw InvalidInputError("cannot write mesh '" + path + "': it has no vertices");
   writeThroughPipeAtomically(path, [&](const std::string& sink) {

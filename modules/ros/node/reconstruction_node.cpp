@@ -63,6 +63,17 @@ struct ParamDoc {
 
 std::string quoted(const std::string& text) { return "\"" + text + "\""; }
 
+/// `path`, or the first of path's stem + "_1", "_2", ... beside it that does not exist.
+std::string freeNameBeside(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p(path);
+  fs::path free = p;
+  for (int k = 1; fs::exists(free, ec); ++k)
+    free = p.parent_path() / (p.stem().string() + "_" + std::to_string(k) + p.extension().string());
+  return free.string();
+}
+
 std::string numberText(double value) {
   std::ostringstream text;
   text << value;
@@ -74,9 +85,12 @@ std::vector<ParamDoc> paramDocs(const NodeParameters& d) {
       {"lidar_topic", quoted(d.lidar_topic), "sensor_msgs/PointCloud2: x y z (intensity, ring, time)"},
       {"left_topic", quoted(d.left_topic), "rectified Image (its CameraInfo: camera_info beside it); the depth's"},
       {"right_topic", quoted(d.right_topic), "rectified Image of the pair's right camera"},
-      {"color_topic", quoted(d.color_topic), "the mesh's colour (\"\" = a grey mesh)"},
+      {"color_topic", quoted(d.color_topic),
+       "the mesh's colour, when the topic has a publisher (\"\" or none = a grey mesh)"},
       {"sync_slop_s", numberText(d.sync_slop_s), "the largest spread of stamps within one frame's messages"},
-      {"world_frame", quoted(d.world_frame), "tf frame of the poses and of the mesh"},
+      {"world_frame", quoted(d.world_frame),
+       "tf frame of the poses and of the mesh (\"\" = camera_init when tf has it, else the root of the left "
+       "camera's tf tree)"},
       {"poses", quoted(d.poses), "auto, tf, odometry or refine (tf's poses refined by the LiDAR)"},
       {"tf_timeout_s", numberText(d.tf_timeout_s), "how long a frame waits for its pose (the first, its extrinsic)"},
       {"sweeping_scans", "the rig's, else true", "a spinning LiDAR's swept scans (false: taken at one instant)"},
@@ -147,8 +161,20 @@ NodeParameters NodeParameters::read(const ros::NodeHandle& nh) {
   check(p.mesh_rate_hz >= 0, "mesh_rate_hz", ">= 0", p.mesh_rate_hz);
   if (p.lidar_topic.empty() || p.left_topic.empty() || p.right_topic.empty())
     throw ConfigError("parameters " + nh.resolveName("lidar_topic") + ", left_topic and right_topic must be set");
+  if (!p.rig.empty()) {
+    try { // read at start, not at the first frame
+      loadCalibration(p.rig);
+    } catch (const Error& e) {
+      throw ConfigError("parameter " + nh.resolveName("rig") + ": " + e.what());
+    }
+  }
   if (!p.mesh_path.empty()) {
     p.mesh_path = std::filesystem::absolute(p.mesh_path).string(); // the node's folder is ROS_HOME
+    try {
+      requireMeshExtension(p.mesh_path);
+    } catch (const IOError& e) {
+      throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": " + e.what());
+    }
     std::error_code ec;
     if (!p.overwrite && std::filesystem::exists(p.mesh_path, ec))
       throw ConfigError("parameter " + nh.resolveName("mesh_path") + ": '" + p.mesh_path + "' exists; set " +
@@ -178,10 +204,11 @@ ReconstructionNode::ReconstructionNode(ros::NodeHandle& nh, ros::NodeHandle& pri
   subscribe(nh); // the callbacks run in ros::spin, after this
   last_mesh_ = Clock::now();
   worker_ = std::thread(&ReconstructionNode::work, this);
-  ROS_INFO("msf_ros_node: %s + %s + %s%s%s, poses: %s (world frame '%s'), %d frame%s waiting at most", params_.lidar_topic.c_str(),
-           params_.left_topic.c_str(), params_.right_topic.c_str(), params_.color_topic.empty() ? "" : " + ",
-           params_.color_topic.c_str(), params_.poses.c_str(), params_.world_frame.c_str(), params_.queue_size,
-           params_.queue_size == 1 ? "" : "s");
+  const std::string world = params_.world_frame.empty() ? "from tf" : "'" + params_.world_frame + "'";
+  ROS_INFO("msf_ros_node: %s + %s + %s%s%s, poses: %s (world frame %s), %d frame%s waiting at most",
+           params_.lidar_topic.c_str(), params_.left_topic.c_str(), params_.right_topic.c_str(),
+           params_.color_topic.empty() ? "" : " + (when published) ", params_.color_topic.c_str(),
+           params_.poses.c_str(), world.c_str(), params_.queue_size, params_.queue_size == 1 ? "" : "s");
 }
 
 void ReconstructionNode::subscribe(ros::NodeHandle& nh) {
@@ -189,31 +216,77 @@ void ReconstructionNode::subscribe(ros::NodeHandle& nh) {
   // callback only queues, so these never fill.
   constexpr std::uint32_t kQueue = 5, kSyncQueue = 10;
   cloud_sub_.subscribe(nh, params_.lidar_topic, kQueue);
-  cloud_sub_.registerCallback([this](const Cloud::ConstPtr&) { ++scans_; });
   left_sub_.subscribe(nh, params_.left_topic, kQueue);
   left_info_sub_.subscribe(nh, cameraInfoTopic(params_.left_topic), kQueue);
   right_sub_.subscribe(nh, params_.right_topic, kQueue);
   right_info_sub_.subscribe(nh, cameraInfoTopic(params_.right_topic), kQueue);
   const ros::Duration slop(params_.sync_slop_s);
-  if (params_.color_topic.empty()) {
-    stereo_sync_ = std::make_unique<message_filters::Synchronizer<StereoPolicy>>(
-        StereoPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_);
-    stereo_sync_->getPolicy()->setMaxIntervalDuration(slop);
-    stereo_sync_->registerCallback(&ReconstructionNode::onStereo, this);
-    return;
+  // Frames without colour, and with it when the colour camera publishes (colorPublished).
+  stereo_sync_ = std::make_unique<message_filters::Synchronizer<StereoPolicy>>(
+      StereoPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_);
+  stereo_sync_->getPolicy()->setMaxIntervalDuration(slop);
+  stereo_sync_->registerCallback(&ReconstructionNode::onStereo, this);
+  if (!params_.color_topic.empty()) {
+    color_sub_.subscribe(nh, params_.color_topic, kQueue);
+    color_info_sub_.subscribe(nh, cameraInfoTopic(params_.color_topic), kQueue);
+    color_sync_ = std::make_unique<message_filters::Synchronizer<ColorPolicy>>(
+        ColorPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_, color_sub_,
+        color_info_sub_);
+    color_sync_->getPolicy()->setMaxIntervalDuration(slop);
+    color_sync_->registerCallback(&ReconstructionNode::onColor, this);
   }
-  color_sub_.subscribe(nh, params_.color_topic, kQueue);
-  color_info_sub_.subscribe(nh, cameraInfoTopic(params_.color_topic), kQueue);
-  color_sync_ = std::make_unique<message_filters::Synchronizer<ColorPolicy>>(
-      ColorPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_, color_sub_,
-      color_info_sub_);
-  color_sync_->getPolicy()->setMaxIntervalDuration(slop);
-  color_sync_->registerCallback(&ReconstructionNode::onColor, this);
+  countMessages();
+}
+
+void ReconstructionNode::countMessages() {
+  const auto count = [this](const std::string& topic) {
+    std::lock_guard<std::mutex> lock(drops_mutex_);
+    ++messages_[topic];
+  };
+  for (const std::string& topic : {params_.left_topic, params_.right_topic, cameraInfoTopic(params_.left_topic),
+                                   cameraInfoTopic(params_.right_topic)})
+    messages_[topic] = 0;
+  cloud_sub_.registerCallback([this](const Cloud::ConstPtr&) { onScan(); });
+  left_sub_.registerCallback([=, topic = params_.left_topic](const Image::ConstPtr&) { count(topic); });
+  right_sub_.registerCallback([=, topic = params_.right_topic](const Image::ConstPtr&) { count(topic); });
+  left_info_sub_.registerCallback(
+      [=, topic = cameraInfoTopic(params_.left_topic)](const Info::ConstPtr&) { count(topic); });
+  right_info_sub_.registerCallback(
+      [=, topic = cameraInfoTopic(params_.right_topic)](const Info::ConstPtr&) { count(topic); });
+}
+
+bool ReconstructionNode::colorPublished() const {
+  return color_sync_ && color_sub_.getSubscriber().getNumPublishers() > 0;
+}
+
+std::string ReconstructionNode::silentInputs() const {
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  std::string silent;
+  for (const auto& [topic, n] : messages_)
+    if (n == 0)
+      silent += (silent.empty() ? "'" : ", '") + topic + "'";
+  return silent;
+}
+
+void ReconstructionNode::onScan() {
+  ++scans_;
+  // A few scans with no frame: say which input they wait for, while it waits.
+  constexpr std::size_t kScansBeforeWarning = 5;
+  if (++scans_since_frame_ < kScansBeforeWarning)
+    return;
+  const std::string silent = silentInputs();
+  const std::string why = silent.empty() ? "their images and CameraInfo are not within sync_slop_s (" +
+                                               numberText(params_.sync_slop_s) + " s) of them"
+                                         : "nothing yet on " + silent;
+  ROS_WARN_THROTTLE(5.0, "msf_ros_node: %zu scans on '%s' and no frame: %s", scans_since_frame_.load(),
+                    params_.lidar_topic.c_str(), why.c_str());
 }
 
 void ReconstructionNode::onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left,
                                   const Info::ConstPtr& left_info, const Image::ConstPtr& right,
                                   const Info::ConstPtr& right_info) {
+  if (colorPublished())
+    return; // the colour sync gives this frame, with its colour
   enqueue({cloud, left, right, nullptr, left_info, right_info, nullptr});
 }
 
@@ -225,6 +298,12 @@ void ReconstructionNode::onColor(const Cloud::ConstPtr& cloud, const Image::Cons
 }
 
 void ReconstructionNode::enqueue(Pending pending) {
+  // A colour camera that starts publishing later: its frames follow the grey ones, none twice.
+  const std::int64_t scan_ns = stampNs(pending.cloud->header.stamp);
+  if (scan_ns <= last_queued_scan_ns_)
+    return;
+  last_queued_scan_ns_ = scan_ns;
+  scans_since_frame_ = 0;
   if (frames_++ == 0)
     first_arrival_ = Clock::now();
   last_arrival_ = Clock::now();
@@ -314,15 +393,45 @@ Frame ReconstructionNode::frameFromMessages(const Pending& pending) const {
 bool ReconstructionNode::placeFrame(Frame& frame, const std_msgs::Header& camera_header) {
   if (tracking_)
     return true;
-  std::string error;
-  frame.has_pose = lookUp(params_.world_frame, camera_header.frame_id, camera_header.stamp, frame.T_world_cam0, error);
-  // Without a pose, only the first frame of PoseMode::Auto goes on: the odometry tracks from it.
-  if (frame.has_pose || (params_.poses == "auto" && reconstructed_ == 0))
+  const std::string world = worldFrame(camera_header.frame_id);
+  std::string error = "no frame above it in tf reached through a moving transform: set ~world_frame";
+  frame.has_pose = !world.empty() &&
+                   lookUp(world, camera_header.frame_id, camera_header.stamp, frame.T_world_cam0, error);
+  if (frame.has_pose)
     return true;
-  ROS_WARN_THROTTLE(5.0, "msf_ros_node: no tf from '%s' to '%s' at %.3f s: %s", params_.world_frame.c_str(),
+  // Without a pose, only the first frame of PoseMode::Auto goes on: the odometry tracks from it.
+  if (params_.poses == "auto" && reconstructed_ == 0) {
+    ROS_WARN("msf_ros_node: the first frame has no pose from tf (%s): the LiDAR odometry gives the poses, the mesh "
+             "in the first left camera's frame; set ~world_frame to the tf frame of your poses, or ~poses tf",
+             error.c_str());
+    return true;
+  }
+  ROS_WARN_THROTTLE(5.0, "msf_ros_node: no tf from '%s' to '%s' at %.3f s: %s", world.c_str(),
                     camera_header.frame_id.c_str(), camera_header.stamp.toSec(), error.c_str());
   drop("no pose (tf from the world frame to the left camera at the frame's stamp)");
   return false;
+}
+
+std::string ReconstructionNode::worldFrame(const std::string& camera_frame) {
+  if (!world_frame_.empty())
+    return world_frame_;
+  if (!params_.world_frame.empty() || tf_buffer_.canTransform("camera_init", camera_frame, ros::Time(0))) {
+    world_frame_ = params_.world_frame.empty() ? "camera_init" : params_.world_frame;
+    return world_frame_;
+  }
+  std::string root = camera_frame, parent;
+  while (tf_buffer_._getParent(root, ros::Time(0), parent) && parent != root)
+    root = parent;
+  // Only static transforms up to the root (the rig's own frames): no pose; tf may not have the moving one yet.
+  try {
+    if (root == camera_frame || tf_buffer_.lookupTransform(root, camera_frame, ros::Time(0)).header.stamp.isZero())
+      return "";
+  } catch (const tf2::TransformException&) {
+    return "";
+  }
+  world_frame_ = root;
+  ROS_INFO("msf_ros_node: world frame '%s' (the root of the left camera's tf tree)", root.c_str());
+  return world_frame_;
 }
 
 bool ReconstructionNode::lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
@@ -367,7 +476,7 @@ void ReconstructionNode::publishMesh() {
     return; // meshing costs: only for a listener (the file at shutdown meshes anyway)
   meshed_frames_ = reconstructed_;
   std_msgs::Header header = last_header_;
-  header.frame_id = params_.world_frame;
+  header.frame_id = world_frame_.empty() ? "camera_init" : world_frame_; // the odometry's world: kitti2bag's name
   mesh_pub_.publish(meshToMarker(engine_->mesh(), header));
 }
 
@@ -388,11 +497,15 @@ void ReconstructionNode::saveMesh() {
   const TriangleMesh& mesh = engine_->mesh();
   pcl::PolygonMesh polygons;
   mesh.toPolygonMesh(polygons);
-  msf::saveMesh(params_.mesh_path, polygons);
-  ROS_INFO("msf_ros_node: mesh of %zu triangles saved to '%s'", mesh.triangles.size(), params_.mesh_path.c_str());
+  const std::string path = params_.overwrite ? params_.mesh_path : freeNameBeside(params_.mesh_path);
+  if (path != params_.mesh_path)
+    ROS_WARN("msf_ros_node: '%s' appeared while the node ran and is left as it is", params_.mesh_path.c_str());
+  msf::saveMesh(path, polygons);
+  ROS_INFO("msf_ros_node: mesh of %zu triangles saved to '%s'", mesh.triangles.size(), path.c_str());
 }
 
 std::string ReconstructionNode::summary() const {
+  const std::string silent = silentInputs();
   std::lock_guard<std::mutex> lock(drops_mutex_);
   std::size_t dropped = 0;
   std::string reasons;
@@ -403,7 +516,8 @@ std::string ReconstructionNode::summary() const {
   const std::size_t unmatched = scans_ - frames_;
   if (unmatched > 0)
     reasons += "\n  " + std::to_string(unmatched) + " scans had no stereo pair (and CameraInfo) within " +
-               std::to_string(params_.sync_slop_s) + " s of their stamp: not frames";
+               numberText(params_.sync_slop_s) + " s of their stamp: not frames" +
+               (silent.empty() ? "" : " (nothing came on " + silent + ")");
   char times[160] = "";
   if (reconstructed_ > 1 && frames_ > 1)
     std::snprintf(times, sizeof times, "\n  the engine: %.0f ms a frame (the first %.0f ms); the frames came every %.0f ms",

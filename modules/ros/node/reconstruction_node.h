@@ -34,7 +34,9 @@ struct NodeParameters {
   std::string left_topic;    ///< rectified grey or colour Image; its CameraInfo is the sibling camera_info
   std::string right_topic;
   std::string color_topic;   ///< "" = no colour camera
-  std::string world_frame = "camera_init"; ///< tf frame of the poses and of the mesh
+  /// tf frame of the poses and of the mesh; "" = camera_init (kitti2bag's) when tf has it, else
+  /// the root of the left camera's tf tree when a moving transform leads there.
+  std::string world_frame;
   std::string poses = "auto";              ///< auto | tf | odometry | refine (Reconstructor::PoseMode)
   std::string config;        ///< the engine's YAML configuration ("" = its defaults)
   std::string rig;           ///< a calibration file instead of CameraInfo and the tf extrinsic
@@ -51,8 +53,9 @@ struct NodeParameters {
 
   NodeParameters();
   /// Reads the private parameters; throws ConfigError naming the parameter for an unknown
-  /// name, a wrong type or a value out of range, for a mesh_path that exists unless overwrite,
-  /// and for one whose folder is missing or not writable.
+  /// name, a wrong type or a value out of range, for a rig file that does not load, for a
+  /// mesh_path that exists unless overwrite, is not .ply/.obj/.vtk or whose folder is missing
+  /// or not writable.
   static NodeParameters read(const ros::NodeHandle& private_nh);
   /// The node's usage: its topics and every parameter with its meaning and default (-h).
   static std::string help();
@@ -79,6 +82,13 @@ private:
   using ColorPolicy = message_filters::sync_policies::ApproximateTime<Cloud, Image, Info, Image, Info, Image, Info>;
 
   void subscribe(ros::NodeHandle& nh);
+  /// Counts each input's messages, for saying which one a scan waits for.
+  void countMessages();
+  /// Whether the colour camera is there (its topic has a publisher): frames then wait for it.
+  bool colorPublished() const;
+  /// The inputs that have sent nothing yet, as "'topic', 'topic'" ("" = none).
+  std::string silentInputs() const;
+  void onScan();
   void onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
                 const Image::ConstPtr& right, const Info::ConstPtr& right_info);
   void onColor(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
@@ -95,6 +105,8 @@ private:
   Frame frameFromMessages(const Pending& pending) const;
   /// The frame's pose from tf, unless the engine tracks it; false when it needs one and tf has none.
   bool placeFrame(Frame& frame, const std_msgs::Header& camera_header);
+  /// The world frame of the poses (NodeParameters::world_frame), "" while tf shows none.
+  std::string worldFrame(const std::string& camera_frame);
   bool lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
               Eigen::Isometry3d& T, std::string& error) const;
   void publish(const FrameResult& result, const std_msgs::Header& camera_header);
@@ -117,6 +129,9 @@ private:
 
   BoundedQueue<Pending> queue_;
   std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
+  std::atomic<std::size_t> scans_since_frame_ = 0;
+  std::map<std::string, std::size_t> messages_; // per input topic (the spin thread's)
+  std::int64_t last_queued_scan_ns_ = -1;        // frames are queued in the scans' order
   Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;
   std::map<std::string, std::size_t> dropped_; // reason -> frames
@@ -125,6 +140,7 @@ private:
   std::unique_ptr<Reconstructor> engine_;
   bool tracking_ = false; // the engine's odometry gives the poses
   std::int64_t first_scan_ns_ = 0;
+  std::string world_frame_; // resolved (worldFrame)
   std_msgs::Header last_header_;
   Clock::time_point last_mesh_;
   std::size_t meshed_frames_ = 0;

@@ -40,6 +40,10 @@ void saveCloudBlob(const std::string& path, const pcl::PCLPointCloud2& blob,
                    const Eigen::Vector4f& origin = Eigen::Vector4f::Zero(),
                    const Eigen::Quaternionf& orientation = Eigen::Quaternionf::Identity());
 
+/// Throws IOError naming `path` unless it ends in a mesh's extension saveMesh writes: .ply, .obj
+/// or .vtk (checked before a long run, not at its end).
+void requireMeshExtension(const std::string& path);
+
 /// Saves a mesh by extension: .ply (binary), .obj or .vtk. Atomic and checked to the end,
 /// as saveCloud; a mesh without vertices is an InvalidInputError, and no file.
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh);
