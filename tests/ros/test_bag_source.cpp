@@ -12,6 +12,7 @@
 
 #include "test_support.h"
 
+#include <cv_bridge/cv_bridge.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_msgs/TFMessage.h>
@@ -46,6 +47,7 @@ struct TinyBag {
   bool poses = false;
   std::int64_t right_lag_ns = 0; // the right camera's stamps after the scan's
   int frames = 3;
+  int image_bits = 8; // 12: mono16 of a 12-bit camera, the 8-bit values x 16
 };
 
 sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag& b, int frame) {
@@ -131,9 +133,18 @@ void writeTinyBag(const std::string& path, const TinyBag& b) {
     }
     const cv::Mat image(kHeight, kWidth, CV_8UC1, cv::Scalar(10 * f + 1));
     const std::int64_t right_ns = ns + b.right_lag_ns;
-    bag.write("/cam/left/" + b.image_name, msf::stampFromNs(ns), msf::imageToMessage(image, header("cam_left", ns)));
+    const auto message = [&](const cv::Mat& grey, const std_msgs::Header& h) {
+      if (b.image_bits == 8)
+        return msf::imageToMessage(grey, h);
+      cv::Mat wide;
+      grey.convertTo(wide, CV_16U, 1 << (b.image_bits - 8));
+      sensor_msgs::Image m;
+      cv_bridge::CvImage(h, "mono16", wide).toImageMsg(m);
+      return m;
+    };
+    bag.write("/cam/left/" + b.image_name, msf::stampFromNs(ns), message(image, header("cam_left", ns)));
     bag.write("/cam/right/" + b.image_name, msf::stampFromNs(right_ns),
-              msf::imageToMessage(image + 1, header("cam_right", right_ns)));
+              message(image + 1, header("cam_right", right_ns)));
     if (b.camera_info) {
       bag.write("/cam/left/camera_info", msf::stampFromNs(ns), tinyInfo(header("cam_left", ns), 0.0));
       bag.write("/cam/right/camera_info", msf::stampFromNs(right_ns), tinyInfo(header("cam_right", right_ns), -50.0));
@@ -185,6 +196,20 @@ TEST(BagSource, ReadsScansImagesCameraInfoAndTheExtrinsicOfARigsBag) {
   EXPECT_FALSE(f.has_pose);
   // A scan's place in the scans' stamp order, and a right image 7 ms late still its frame's.
   EXPECT_EQ(source.scanStampNs(1), kStart + 100 * kMs);
+}
+
+/// A 12-bit camera's mono16 pair: scaled by the bits the brighter image needs, one gain for both,
+/// not by 256 (which left it black).
+TEST(BagSource, AMono16PairOfA12BitCameraIsScaledByOneGain) {
+  msf::test::TempDir dir;
+  TinyBag b;
+  b.image_bits = 12;
+  writeTinyBag(dir.file("wide.bag"), b);
+  const msf::Frame f = msf::BagSource(dir.file("wide.bag"), tinyTopics()).load(2);
+  // Frame 2: left 21 x 16 = 336, right 22 x 16 = 352, which needs 9 bits: x 255 / 511.
+  EXPECT_EQ(f.left.type(), CV_8UC1);
+  EXPECT_EQ(f.left.at<std::uint8_t>(0, 0), 168);
+  EXPECT_EQ(f.right.at<std::uint8_t>(0, 0), 176);
 }
 
 TEST(BagSource, ReadsKitti2bagsOtherNamesRingsTimesAndPosesFromTf) {

@@ -49,34 +49,8 @@ std::map<std::string, std::string> numberedFiles(const fs::path& dir, const std:
   return files;
 }
 
-/// The bits a channel of `image` holds: 8 for 8-bit images; for 16-bit ones, those its brightest
-/// pixel needs (12-bit sensors store 0..4095), so that neither a 12- nor a 16-bit camera comes
-/// out dark.
-int bitsOf(const cv::Mat& image) {
-  if (image.depth() == CV_8U)
-    return 8;
-  if (image.depth() != CV_16U)
-    throw InvalidInputError("an image of 8 or 16 bits a channel is needed, not OpenCV depth " +
-                            std::to_string(image.depth()));
-  double max_value = 0;
-  cv::minMaxLoc(image.reshape(1), nullptr, &max_value);
-  int bits = 8;
-  while (bits < 16 && max_value > (1 << bits) - 1)
-    ++bits;
-  return bits;
-}
-
-/// 8 bits a channel, `bits` of the image scaled to them.
-cv::Mat eightBit(const cv::Mat& image, int bits) {
-  if (image.depth() == CV_8U)
-    return image;
-  cv::Mat out;
-  image.convertTo(out, CV_8U, 255.0 / ((1 << bits) - 1));
-  return out;
-}
-
 cv::Mat grey(const cv::Mat& image, int bits) {
-  const cv::Mat bytes = eightBit(image, bits);
+  const cv::Mat bytes = toEightBit(image, bits);
   if (bytes.channels() == 1)
     return bytes;
   cv::Mat out;
@@ -85,7 +59,7 @@ cv::Mat grey(const cv::Mat& image, int bits) {
 }
 
 cv::Mat colour(const cv::Mat& image, int bits) {
-  const cv::Mat bytes = eightBit(image, bits);
+  const cv::Mat bytes = toEightBit(image, bits);
   if (bytes.channels() == 3)
     return bytes;
   cv::Mat out;
@@ -264,12 +238,12 @@ Frame FolderSource::load(std::size_t i, bool with_color) const {
   const cv::Mat left_image = left.get(), right_image = right.get();
   // One scale for the pair: scaled each by its own brightest pixel, the two would match at
   // different gains.
-  const int pair_bits = std::max(bitsOf(left_image), bitsOf(right_image));
+  const int pair_bits = std::max(significantBits(left_image), significantBits(right_image));
   f.left = grey(left_image, pair_bits);
   f.right = grey(right_image, pair_bits);
   if (color.valid()) {
     const cv::Mat color_image = color.get();
-    f.color = colour(color_image, bitsOf(color_image));
+    f.color = colour(color_image, significantBits(color_image));
   } else if (with_color && left_image.channels() >= 3) {
     f.color = colour(left_image, pair_bits);
   }

@@ -103,6 +103,28 @@ void writeScaled16(const std::string& path, const cv::Mat& values, const char* w
 
 } // namespace
 
+int significantBits(const cv::Mat& image) {
+  if (image.depth() == CV_8U)
+    return 8;
+  if (image.depth() != CV_16U)
+    throw InvalidInputError("an image of 8 or 16 bits a channel is needed, not OpenCV depth " +
+                            std::to_string(image.depth()));
+  double max_value = 0;
+  cv::minMaxLoc(image.reshape(1), nullptr, &max_value);
+  int bits = 8;
+  while (bits < 16 && max_value > (1 << bits) - 1)
+    ++bits;
+  return bits;
+}
+
+cv::Mat toEightBit(const cv::Mat& image, int bits) {
+  if (image.depth() == CV_8U)
+    return image;
+  cv::Mat out;
+  image.convertTo(out, CV_8U, 255.0 / ((1 << bits) - 1));
+  return out;
+}
+
 cv::Mat readKittiDepthPng(const std::string& path) { return readScaled16(path, "depth PNG"); }
 cv::Mat readKittiDisparityPng(const std::string& path) { return readScaled16(path, "disparity PNG"); }
 void writeKittiDepthPng(const std::string& path, const cv::Mat& depth) { writeScaled16(path, depth, "depth PNG"); }

@@ -383,8 +383,8 @@ Frame ReconstructionNode::frameFromMessages(const Pending& pending) const {
   scanFromMessage(*pending.cloud, frame, "the scan on '" + params_.lidar_topic + "'");
   stampFrame(frame, reconstructed_, stampNs(pending.cloud->header.stamp), first_scan_ns_,
              pending.cloud->header.frame_id);
-  frame.left = greyFromMessage(*pending.left, "the image on '" + params_.left_topic + "'");
-  frame.right = greyFromMessage(*pending.right, "the image on '" + params_.right_topic + "'");
+  greyPairFromMessages(*pending.left, *pending.right, frame.left, frame.right,
+                       "the image on '" + params_.left_topic + "'", "the image on '" + params_.right_topic + "'");
   if (pending.color)
     frame.color = colorFromMessage(*pending.color, "the image on '" + params_.color_topic + "'");
   return frame;

@@ -360,8 +360,8 @@ Frame BagSource::load(std::size_t i, bool with_color) const {
   if (f.scan->empty())
     throw InvalidInputError(what + ": " + scanName(i) + " has no finite point");
   stampFrame(f, i, scanStampNs(i), scanStampNs(0), scan->header.frame_id);
-  f.left = greyFromMessage(*left, what + ", topic '" + options_.left_topic + "'");
-  f.right = greyFromMessage(*right, what + ", topic '" + options_.right_topic + "'");
+  greyPairFromMessages(*left, *right, f.left, f.right, what + ", topic '" + options_.left_topic + "'",
+                       what + ", topic '" + options_.right_topic + "'");
   if (color)
     f.color = colorFromMessage(*color, what + ", topic '" + options_.color_topic + "'");
   const std::pair<const cv::Mat*, const std::string*> images[] = {

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/io/image_io.h>
 #include <msf/ros/message_conversions.h>
 
 #include <cv_bridge/cv_bridge.h>
@@ -80,6 +81,18 @@ cv::Mat convertImage(const sensor_msgs::Image& message, const std::string& encod
     throw InvalidInputError(what + ": image of encoding '" + message.encoding + "' cannot be read as " + encoding +
                             ": " + e.what());
   }
+}
+
+/// The Image as grey or BGR at its own bits a channel: 16-bit ones kept 16-bit.
+cv::Mat convertKeepingBits(const sensor_msgs::Image& message, bool grey, const std::string& what) {
+  namespace enc = sensor_msgs::image_encodings;
+  bool sixteen = false;
+  try {
+    sixteen = enc::bitDepth(message.encoding) == 16;
+  } catch (const std::exception&) { // an encoding it does not know: convertImage names it
+  }
+  return convertImage(message, grey ? (sixteen ? enc::MONO16 : enc::MONO8) : (sixteen ? enc::BGR16 : enc::BGR8),
+                      what);
 }
 
 } // namespace
@@ -170,12 +183,17 @@ sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Heade
   return message;
 }
 
-cv::Mat greyFromMessage(const sensor_msgs::Image& message, const std::string& what) {
-  return convertImage(message, sensor_msgs::image_encodings::MONO8, what);
+void greyPairFromMessages(const sensor_msgs::Image& left, const sensor_msgs::Image& right, cv::Mat& left_grey,
+                          cv::Mat& right_grey, const std::string& what_left, const std::string& what_right) {
+  const cv::Mat l = convertKeepingBits(left, true, what_left), r = convertKeepingBits(right, true, what_right);
+  const int bits = std::max(significantBits(l), significantBits(r));
+  left_grey = toEightBit(l, bits);
+  right_grey = toEightBit(r, bits);
 }
 
 cv::Mat colorFromMessage(const sensor_msgs::Image& message, const std::string& what) {
-  return convertImage(message, sensor_msgs::image_encodings::BGR8, what);
+  const cv::Mat image = convertKeepingBits(message, false, what);
+  return toEightBit(image, significantBits(image));
 }
 
 sensor_msgs::Image imageToMessage(const cv::Mat& image, const std_msgs::Header& header) {

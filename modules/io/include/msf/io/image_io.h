@@ -16,6 +16,15 @@ cv::Mat readImage(const std::string& path, int flags = -1);
 /// (msf/common/checked_write.h); throws IOError naming the file and the reason on failure.
 void writeImage(const std::string& path, const cv::Mat& image);
 
+/// The bits a channel of `image` holds: 8 for an 8-bit image; for a 16-bit one, those its
+/// brightest pixel needs (a 12-bit sensor stores 0..4095), so that neither a 12- nor a 16-bit
+/// camera comes out dark. Throws InvalidInputError for other depths.
+int significantBits(const cv::Mat& image);
+
+/// 8 bits a channel: `bits` of a 16-bit image scaled to them; an 8-bit image as it is. A stereo
+/// pair is scaled with the bits of the brighter image, one gain for both.
+cv::Mat toEightBit(const cv::Mat& image, int bits);
+
 /// KITTI 16-bit PNG (value = metres or pixels x 256, 0 = none) to CV_32F (0 = none).
 /// Throws IOError when the file is not a single-channel 16-bit image.
 cv::Mat readKittiDepthPng(const std::string& path);

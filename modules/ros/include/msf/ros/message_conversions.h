@@ -36,9 +36,13 @@ void scanFromMessage(const sensor_msgs::PointCloud2& message, Frame& frame, cons
 /// (uint16) and `time` (float32) when the frame has them.
 sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Header& header);
 
-/// An Image as grey (CV_8UC1) or BGR (CV_8UC3), converted by cv_bridge from the encodings it
-/// knows (mono8, mono16, bgr8, rgb8, ...). Throws InvalidInputError naming `what` otherwise.
-cv::Mat greyFromMessage(const sensor_msgs::Image& message, const std::string& what);
+/// A stereo pair's Images as grey (CV_8UC1), converted by cv_bridge from the encodings it knows
+/// (mono8, mono16, bgr8, rgb8, ...); 16-bit ones scaled to 8 bits by the bits the brighter image
+/// needs (significantBits), one gain for both, so that a 10- or 12-bit camera is not dark.
+/// Throws InvalidInputError naming `what_left` or `what_right` for an encoding it cannot read.
+void greyPairFromMessages(const sensor_msgs::Image& left, const sensor_msgs::Image& right, cv::Mat& left_grey,
+                          cv::Mat& right_grey, const std::string& what_left, const std::string& what_right);
+/// An Image as BGR (CV_8UC3), a 16-bit one scaled by the bits it needs. Throws as above.
 cv::Mat colorFromMessage(const sensor_msgs::Image& message, const std::string& what);
 /// A grey (mono8), BGR (bgr8) or float (32FC1) image as a message.
 sensor_msgs::Image imageToMessage(const cv::Mat& image, const std_msgs::Header& header);
