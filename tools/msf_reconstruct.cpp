@@ -207,11 +207,14 @@ public:
         poses_(request.poses, source, frames_),
         holdout_(source, msf::HoldoutConfig{config.rings, config.projection, {}}),
         panel_frames_(spread(frames_, request.panels)),
-        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world))),
+        T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world), firstPose())),
         on_rig_(msf::adaptToRig(config, source.calibration())) {
     if (!source.hasColor())
       print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
                  source.description().c_str());
+    if (msf::parseWorldFrame(request.world) == msf::WorldFrame::ZUp && msf::worldIsZUp(firstPose()))
+      print_info("The poses' world is already z-up (%s): -world z_up leaves it as it is\n",
+                 poses_.description().c_str());
     if (request.holdout) { // the first frame's split, before any work: a scan without rings is a clear error at once
       msf::Frame first = source.load(frames_.front(), false);
       holdout_.split(first);
@@ -290,6 +293,11 @@ public:
 
 private:
   bool streaming() const { return config_.streaming.enabled(); }
+  /// The first frame's pose when known before the run (the identity for the odometry's).
+  Eigen::Isometry3d firstPose() const {
+    const msf::PoseList known = poses_.knownPoses({frames_.front()});
+    return known.empty() ? Eigen::Isometry3d::Identity() : known.front();
+  }
   /// Whether the run may stream its map: every evaluation it was asked for works on a streamed one.
   bool mayStream() const {
     return !streaming() && !request_.holdout && !request_.compare_sources && !request_.compare_paper;
@@ -724,9 +732,11 @@ void declareOptions(msf::tool::CommandLine& cli, Request& request, msf::Pipeline
              "YAML configuration (config/kitti.yaml); the options below override it")
       .value("-frames", "a:b", request.frames, "frame range, inclusive (default: all)")
       .value("-world", "W", request.world,
-             "camera: the outputs in camera 0 of the first frame (x right, y down, z forward; the default) | z_up: "
-             "x forward, y left, z up (ROS): mesh*.ply, poses.txt, poses_tum.txt (volume.pcd and a streamed map's "
-             "tiles/ and tsdf/ stay the map's own store, in camera 0)")
+             "camera: the outputs in the poses' world (the default): KITTI's and the odometry's is camera 0 of the "
+             "first frame (x right, y down, z forward), a bag's tf world or a poses file's as they are | z_up: such "
+             "a camera's world turned to x forward, y left, z up (ROS), a world already z-up left as it is: "
+             "mesh*.ply, poses.txt, poses_tum.txt (volume.pcd and a streamed map's tiles/ and tsdf/ stay the map's "
+             "own store, in the poses' world)")
       .value("-poses", "P", request.poses,
              "dataset: the dataset's poses as they are (the default for ground truth: KITTI odometry, synthetic) | "
              "refine: the dataset's GPS/INS poses refined by LiDAR odometry, their motion the prediction and a soft "

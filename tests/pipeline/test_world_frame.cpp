@@ -11,6 +11,10 @@
 #include "test_support.h"
 
 #include <pcl/conversions.h>
+#include <pcl/kdtree/kdtree_flann.h>
+
+#include <algorithm>
+#include <cmath>
 
 namespace {
 
@@ -56,6 +60,36 @@ TEST_F(PipelineTest, AZUpWorldIsTheCameraWorldRotated) {
   EXPECT_NE(msf::test::runTool("msf_reconstruct", dataset() + " -world up -o " + dir.file("x")).err.find(
                 "world frame must be camera"),
             std::string::npos);
+
+  // Poses in a world that is already z-up (a map frame's): -world z_up leaves it, and the outputs
+  // are those of the camera world turned (the mesh to the voxel grid's turn: the map's grid is
+  // the world's).
+  EXPECT_TRUE(msf::worldIsZUp(T * a[0]));
+  EXPECT_FALSE(msf::worldIsZUp(a[0]));
+  EXPECT_TRUE(msf::outputTransform(msf::WorldFrame::ZUp, T * a[0]).matrix().isIdentity());
+  msf::saveOdometryPoses(dir.file("map_poses.txt"), msf::transformPoses(a, T));
+  const auto r = msf::test::runTool("msf_reconstruct", dataset() + " -frames 0:1 -panels 0 -world z_up -poses " +
+                                                           dir.file("map_poses.txt") + " -o " + dir.file("map"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("already z-up"), std::string::npos) << r.out;
+  const msf::PoseList map_poses = msf::loadOdometryPoses(dir.file("map/poses.txt"));
+  ASSERT_EQ(map_poses.size(), b.size());
+  for (std::size_t i = 0; i < b.size(); ++i)
+    EXPECT_TRUE(map_poses[i].isApprox(b[i], 1e-8)) << i;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr turned(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& v : z_up)
+    turned->push_back(pcl::PointXYZ(v.x(), v.y(), v.z()));
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(turned);
+  std::vector<float> distances;
+  for (const auto& v : verticesOf(dir.file("map/mesh.ply"))) {
+    std::vector<int> index(1);
+    std::vector<float> squared(1);
+    tree.nearestKSearch(pcl::PointXYZ(v.x(), v.y(), v.z()), 1, index, squared);
+    distances.push_back(std::sqrt(squared[0]));
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  EXPECT_LT(distances[distances.size() / 2], 0.05) << "metres: the median distance to the turned mesh";
 }
 
 TEST_F(PipelineTest, TumPosesOutAreTheKittiPosesAndComeBackIn) {

@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/world_frame.h>
 
+#include <cmath>
 #include <cstring>
 
 namespace msf {
@@ -11,15 +12,20 @@ WorldFrame parseWorldFrame(const std::string& text) {
     return WorldFrame::Camera;
   if (text == "z_up")
     return WorldFrame::ZUp;
-  throw InvalidInputError("world frame must be camera (camera 0 of the first frame: x right, y down, z forward) or "
+  throw InvalidInputError("world frame must be camera (the poses' world: KITTI's is camera 0 of the first frame) or "
                           "z_up (x forward, y left, z up), not '" + text + "'");
 }
 
 const char* toString(WorldFrame frame) { return frame == WorldFrame::ZUp ? "z_up" : "camera"; }
 
-Eigen::Isometry3d outputTransform(WorldFrame frame) {
+bool worldIsZUp(const Eigen::Isometry3d& T_world_cam0) {
+  const Eigen::Vector3d camera_up = T_world_cam0.linear() * Eigen::Vector3d(0, -1, 0);
+  return camera_up.z() > std::cos(M_PI / 4);
+}
+
+Eigen::Isometry3d outputTransform(WorldFrame frame, const Eigen::Isometry3d& T_world_cam0) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  if (frame == WorldFrame::ZUp)
+  if (frame == WorldFrame::ZUp && !worldIsZUp(T_world_cam0))
     T.linear() << 0, 0, 1, // x: forward, the camera's z
         -1, 0, 0,          // y: left, the camera's -x
         0, -1, 0;          // z: up, the camera's -y
