@@ -239,6 +239,33 @@ TEST(BagSource, ReadsKitti2bagsOtherNamesRingsTimesAndPosesFromTf) {
   EXPECT_FLOAT_EQ(f.point_time_s[2], 0.04f);
 }
 
+/// A driver's cloud of float64 coordinates (and an int intensity): read as their values; one
+/// without z: refused naming the fields it has.
+TEST(MessageConversions, AScanOfFloat64CoordinatesIsReadAndOneWithoutZIsNamed) {
+  sensor_msgs::PointCloud2 m;
+  sensor_msgs::PointCloud2Modifier modifier(m);
+  using F = sensor_msgs::PointField;
+  modifier.setPointCloud2Fields(4, "x", 1, F::FLOAT64, "y", 1, F::FLOAT64, "z", 1, F::FLOAT64, "intensity", 1,
+                                F::UINT16);
+  modifier.resize(2);
+  const double xyz[2][3] = {{10.5, -2.25, 1.0}, {20.0, 0.5, -1.5}};
+  for (std::size_t k = 0; k < 2; ++k) {
+    std::memcpy(&m.data[k * m.point_step], xyz[k], sizeof xyz[k]);
+    const std::uint16_t intensity = static_cast<std::uint16_t>(100 * (k + 1));
+    std::memcpy(&m.data[k * m.point_step + m.fields[3].offset], &intensity, sizeof intensity);
+  }
+  msf::Frame frame;
+  msf::scanFromMessage(m, frame, "the scan");
+  ASSERT_EQ(frame.scan->size(), 2u);
+  EXPECT_EQ((*frame.scan)[0].y, -2.25f);
+  EXPECT_EQ((*frame.scan)[1].z, -1.5f);
+  EXPECT_EQ((*frame.scan)[1].intensity, 200.f);
+
+  modifier.setPointCloud2Fields(3, "x", 1, F::FLOAT64, "y", 1, F::FLOAT64, "intensity", 1, F::FLOAT32);
+  EXPECT_EQ(errorOf([&] { msf::scanFromMessage(m, frame, "the scan"); }),
+            "the scan: PointCloud2 has no field 'z' (fields: x y intensity)");
+}
+
 TEST(BagSource, RefusesWhatItCannotReadNamingWhatToGive) {
   msf::test::TempDir dir;
   TinyBag no_extrinsic;

@@ -50,27 +50,49 @@ void putField(sensor_msgs::PointCloud2& message, const sensor_msgs::PointField& 
   std::memcpy(&message.data[i * message.point_step + field.offset], &value, sizeof value);
 }
 
-void requireLayout(const sensor_msgs::PointCloud2& message, const std::string& what) {
-  for (const char* name : {"x", "y", "z"}) {
-    const auto* field = findField(message, name);
-    if (!field || field->datatype != sensor_msgs::PointField::FLOAT32 || field->count != 1)
-      throw InvalidInputError(what + ": PointCloud2 has no float32 field '" + name + "' (fields: " +
-                              [&] {
-                                std::string names;
-                                for (const auto& f : message.fields)
-                                  names += (names.empty() ? "" : " ") + f.name;
-                                return names.empty() ? std::string("none") : names;
-                              }() +
-                              ")");
+/// The bytes of a PointField's datatype (0 for one PointField does not define).
+std::size_t datatypeBytes(std::uint8_t datatype) {
+  using F = sensor_msgs::PointField;
+  switch (datatype) {
+  case F::INT8: case F::UINT8: return 1;
+  case F::INT16: case F::UINT16: return 2;
+  case F::INT32: case F::UINT32: case F::FLOAT32: return 4;
+  case F::FLOAT64: return 8;
+  default: return 0;
   }
+}
+
+/// x, y and z of one number each (float32, float64 or an integer), and the fields read (those and
+/// intensity, ring, time) within a point.
+void requireLayout(const sensor_msgs::PointCloud2& message, const std::string& what) {
+  for (const char* name : {"x", "y", "z"})
+    if (!findField(message, name)) {
+      std::string names;
+      for (const auto& f : message.fields)
+        names += (names.empty() ? "" : " ") + f.name;
+      throw InvalidInputError(what + ": PointCloud2 has no field '" + name + "' (fields: " +
+                              (names.empty() ? std::string("none") : names) + ")");
+    }
   const std::size_t points = static_cast<std::size_t>(message.width) * message.height;
   if (message.point_step == 0 || message.data.size() < points * message.point_step)
     throw InvalidInputError(what + ": PointCloud2 holds " + std::to_string(message.data.size()) + " bytes, not the " +
                             std::to_string(points) + " points of " + std::to_string(message.point_step) +
                             " bytes its header says");
-  for (const auto& field : message.fields)
-    if (field.offset >= message.point_step)
+  for (const auto& field : message.fields) {
+    if (!(field.name == "x" || field.name == "y" || field.name == "z" || field.name == "intensity" ||
+          field.name == "i" || field.name == "ring" || field.name == "time"))
+      continue;
+    const std::size_t bytes = datatypeBytes(field.datatype);
+    if (bytes == 0)
+      throw InvalidInputError(what + ": PointCloud2 field '" + field.name + "' has datatype " +
+                              std::to_string(field.datatype) + ", which sensor_msgs/PointField does not define");
+    if (field.offset + bytes * std::max<std::uint32_t>(field.count, 1) > message.point_step)
       throw InvalidInputError(what + ": PointCloud2 field '" + field.name + "' lies beyond its point step");
+  }
+  for (const char* name : {"x", "y", "z"})
+    if (findField(message, name)->count != 1)
+      throw InvalidInputError(what + ": PointCloud2 field '" + std::string(name) + "' holds " +
+                              std::to_string(findField(message, name)->count) + " numbers, not one");
 }
 
 /// cv_bridge's conversion to `encoding`, its exception as ours.

@@ -29,8 +29,9 @@ ros::Time stampFromNs(std::int64_t ns);
 /// sweep) into frame.scan (the points in the sensor's frame, in the order sent), and
 /// frame.point_ring and frame.point_time_s when the fields are there (times from the sweep's
 /// start: a driver that stamps the sweep's end sends negative offsets). Non-finite points are
-/// dropped, as loadVelodyneBin does. Throws InvalidInputError naming `what` and the field
-/// when x, y or z is missing or not float32.
+/// dropped, as loadVelodyneBin does. x, y and z may be float32, float64 or integers. Throws
+/// InvalidInputError naming `what` and the field when x, y or z is missing or a field does not
+/// fit in a point.
 void scanFromMessage(const sensor_msgs::PointCloud2& message, Frame& frame, const std::string& what);
 /// frame.scan as a PointCloud2 of float32 x y z intensity (kitti2bag's fields), with `ring`
 /// (uint16) and `time` (float32) when the frame has them.
