@@ -210,7 +210,8 @@ public:
         T_out_world_(msf::outputTransform(msf::parseWorldFrame(request.world), firstPose())),
         on_rig_(msf::adaptToRig(config, source.calibration())) {
     if (!source.hasColor())
-      print_warn("'%s' has no colour camera (image_2): the mesh is coloured from the grey left image\n",
+      print_warn("'%s' has no colour camera (a KITTI folder's image_2, a folder's color/, a bag's -color_topic): "
+                 "the mesh is coloured from the grey left image\n",
                  source.description().c_str());
     if (msf::parseWorldFrame(request.world) == msf::WorldFrame::ZUp && msf::worldIsZUp(firstPose()))
       print_info("The poses' world is already z-up (%s): -world z_up leaves it as it is\n",

@@ -27,6 +27,21 @@ TEST(FrameMatcher, EachScanTakesTheNearestImagesWithinTheTolerance) {
   EXPECT_EQ(m.notes[2], "1 right image in no frame");
 }
 
+TEST(FrameMatcher, APairWhoseImagesLieApartIsNoted) {
+  // The right camera 30 ms after the left (not triggered together): matched, and said.
+  const std::vector<std::int64_t> scans{0, 100 * kMs, 200 * kMs};
+  const std::vector<std::int64_t> left{0, 100 * kMs, 200 * kMs};
+  const std::vector<std::int64_t> right{30 * kMs, 130 * kMs, 230 * kMs};
+  msf::FrameMatches m = msf::matchFrames(scans, left, right, {}, 50 * kMs);
+  ASSERT_EQ(m.frames.size(), 3u);
+  ASSERT_EQ(m.notes.size(), 1u);
+  EXPECT_EQ(m.notes[0], "the stereo pair's images lie a median of 30 ms apart: a pair must be taken at one instant "
+                        "(its cameras triggered together), else a moving rig's depth is wrong");
+  // 4 ms apart: no note.
+  m = msf::matchFrames(scans, left, {4 * kMs, 104 * kMs, 204 * kMs}, {}, 50 * kMs);
+  EXPECT_TRUE(m.notes.empty());
+}
+
 TEST(FrameMatcher, AnImageServesOnlyItsNearestScan) {
   // A LiDAR at 20 Hz and cameras at 10 Hz: every other scan has no image of its own.
   const std::vector<std::int64_t> scans{0, 50 * kMs, 100 * kMs, 150 * kMs};

@@ -60,6 +60,26 @@ std::string listed(const std::string& head, const std::vector<std::int64_t>& tim
   return text + (times.size() > kShown ? ", ...)" : ")");
 }
 
+/// A note when the pairs' images lie apart in time (a median above kPairApart): their cameras
+/// not triggered together, so a moving rig's depth is wrong, and past half a frame's period
+/// the left image meets the right of another frame.
+std::string pairApart(const std::vector<FrameMatch>& frames, const std::vector<std::int64_t>& left,
+                      const std::vector<std::int64_t>& right) {
+  constexpr std::int64_t kPairApart = 10 * 1000000;
+  std::vector<std::int64_t> apart;
+  for (const FrameMatch& m : frames)
+    apart.push_back(std::llabs(left[m.left] - right[m.right]));
+  if (apart.empty())
+    return "";
+  std::nth_element(apart.begin(), apart.begin() + static_cast<std::ptrdiff_t>(apart.size() / 2), apart.end());
+  const std::int64_t median = apart[apart.size() / 2];
+  if (median <= kPairApart)
+    return "";
+  return "the stereo pair's images lie a median of " + std::to_string(median / 1000000) +
+         " ms apart: a pair must be taken at one instant (its cameras triggered together), else a moving rig's "
+         "depth is wrong";
+}
+
 std::string plural(std::size_t n, const std::string& noun) {
   return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
@@ -101,6 +121,8 @@ FrameMatches matchFrames(const std::vector<std::int64_t>& scans, const std::vect
   }
   for (const auto& [reason, times] : skipped)
     result.notes.push_back(listed(plural(times.size(), "scan") + " skipped: " + reason, times));
+  if (const std::string apart = pairApart(result.frames, left, right); !apart.empty())
+    result.notes.push_back(apart);
   if (!uncoloured.empty())
     result.notes.push_back(listed(plural(uncoloured.size(), "frame") + " without a colour image " + within +
                                       ": coloured from the left grey image",
