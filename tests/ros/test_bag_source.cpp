@@ -48,6 +48,7 @@ struct TinyBag {
   std::int64_t right_lag_ns = 0; // the right camera's stamps after the scan's
   int frames = 3;
   int image_bits = 8; // 12: mono16 of a 12-bit camera, the 8-bit values x 16
+  int beam_points = 0; // with ring_and_time: returns of three beams (+2, -4, -10 degrees, numbered from the top)
 };
 
 sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag& b, int frame) {
@@ -61,7 +62,7 @@ sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag&
   else
     modifier.setPointCloud2Fields(4, "x", 1, F::FLOAT32, "y", 1, F::FLOAT32, "z", 1, F::FLOAT32, b.intensity.c_str(),
                                   1, F::FLOAT32);
-  modifier.resize(4);
+  modifier.resize(4 + 3 * static_cast<std::size_t>(b.beam_points));
   // The ring and time layout is packed (22 bytes a point): its fields are copied, not referenced.
   const auto put = [&m](const std::string& name, int k, auto value) {
     for (const auto& field : m.fields)
@@ -78,6 +79,18 @@ sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag&
       put("time", k, -0.1f + 0.02f * static_cast<float>(k)); // a driver that stamps the sweep's end
     }
   }
+  const double beams_deg[] = {2.0, -4.0, -10.0};
+  for (int beam = 0; beam < 3; ++beam)
+    for (int j = 0; j < b.beam_points; ++j) {
+      const int k = 4 + beam * b.beam_points + j;
+      const double e = beams_deg[beam] * M_PI / 180.0, azimuth = 0.01 * j;
+      put("x", k, static_cast<float>(10.0 * std::cos(e) * std::cos(azimuth)));
+      put("y", k, static_cast<float>(10.0 * std::cos(e) * std::sin(azimuth)));
+      put("z", k, static_cast<float>(10.0 * std::sin(e)));
+      put(b.intensity, k, 0.5f);
+      put("ring", k, static_cast<std::uint16_t>(beam));
+      put("time", k, 0.f);
+    }
   return m;
 }
 
@@ -210,6 +223,27 @@ TEST(BagSource, AMono16PairOfA12BitCameraIsScaledByOneGain) {
   EXPECT_EQ(f.left.type(), CV_8UC1);
   EXPECT_EQ(f.left.at<std::uint8_t>(0, 0), 168);
   EXPECT_EQ(f.right.at<std::uint8_t>(0, 0), 176);
+}
+
+/// A bag's CameraInfo and tf say nothing of the LiDAR's beams: its scans' rings do.
+TEST(BagSource, TheBeamsOfARigsBagComeFromItsFirstScansRings) {
+  msf::test::TempDir dir;
+  TinyBag b;
+  b.ring_and_time = true;
+  b.beam_points = 50;
+  writeTinyBag(dir.file("beams.bag"), b);
+  const msf::BagSource source(dir.file("beams.bag"), tinyTopics());
+  const std::vector<double>& beams = source.calibration().lidar.beam_elevations_deg;
+  ASSERT_EQ(beams.size(), 3u);
+  EXPECT_NEAR(beams[0], -10.0, 1e-4);
+  EXPECT_NEAR(beams[2], 2.0, 1e-4);
+  EXPECT_EQ(source.calibration().lidar.rings, 3);
+  ASSERT_FALSE(source.notes().empty());
+  EXPECT_TRUE(contains(source.notes().back(), "3 beams from the first scan's rings, -10.0 to 2.0 degrees"))
+      << source.notes().back();
+  // Without rings, none: KITTI's sizes, as for a rig file that lists no beams.
+  writeTinyBag(dir.file("plain.bag"), TinyBag{});
+  EXPECT_TRUE(msf::BagSource(dir.file("plain.bag"), tinyTopics()).calibration().lidar.beam_elevations_deg.empty());
 }
 
 TEST(BagSource, ReadsKitti2bagsOtherNamesRingsTimesAndPosesFromTf) {

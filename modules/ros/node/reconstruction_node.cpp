@@ -4,6 +4,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/io/bag_options.h>
+#include <msf/io/beam_elevations.h>
 #include <msf/io/cloud_io.h>
 #include <msf/pipeline/fused_cloud.h>
 #include <msf/ros/message_conversions.h>
@@ -367,6 +368,15 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
   }
   if (params_.sweeping_scans)
     rig.lidar.sweeping = *params_.sweeping_scans;
+  if (rig.lidar.beam_elevations_deg.empty()) { // the beams, from the first scan's rings when it has them
+    Frame first;
+    scanFromMessage(*pending.cloud, first, "the scan on '" + params_.lidar_topic + "'");
+    rig.lidar.beam_elevations_deg = beamElevationsFromRings(*first.scan, first.point_ring);
+    rig.lidar.rings = static_cast<int>(rig.lidar.beam_elevations_deg.size());
+    if (rig.lidar.rings > 0)
+      ROS_INFO("msf_ros_node: %d beams from the first scan's rings, %.1f to %.1f degrees", rig.lidar.rings,
+               rig.lidar.beam_elevations_deg.front(), rig.lidar.beam_elevations_deg.back());
+  }
   Reconstructor::Options options;
   options.poses = kPoseModes.at(params_.poses);
   options.threads = params_.threads;

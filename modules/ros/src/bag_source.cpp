@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/io/beam_elevations.h>
 #include <msf/ros/bag_source.h>
 #include <msf/ros/frame_matcher.h>
 #include <msf/ros/message_conversions.h>
@@ -233,6 +234,7 @@ void BagSource::readCalibration(const std::string& rig) {
   if (!rig.empty()) {
     calibration_ = loadCalibration(rig, size);
     notes_.push_back("calibration from '" + rig + "'; the bag's CameraInfo and LiDAR extrinsic are not read");
+    beamsFromFirstScan();
     return;
   }
   const auto right = info(options_.right_topic);
@@ -258,6 +260,24 @@ void BagSource::readCalibration(const std::string& rig) {
     }
   }
   calibration_ = rigFromCameraInfo(*left, *right, color.get(), T_cam0_velo, size, path_);
+  beamsFromFirstScan();
+}
+
+void BagSource::beamsFromFirstScan() {
+  if (!calibration_.lidar.beam_elevations_deg.empty())
+    return;
+  Frame first;
+  scanFromMessage(*bag_->read<sensor_msgs::PointCloud2>(bag_->scans, 0), first,
+                  "the first scan of '" + path_ + "', topic '" + options_.lidar_topic + "'");
+  const std::vector<double> beams = beamElevationsFromRings(*first.scan, first.point_ring);
+  if (beams.empty())
+    return;
+  calibration_.lidar.beam_elevations_deg = beams;
+  calibration_.lidar.rings = static_cast<int>(beams.size());
+  char text[200];
+  std::snprintf(text, sizeof text, "%zu beams from the first scan's rings, %.1f to %.1f degrees (a rig file's "
+                "lidar.beam_elevations_deg sets them)", beams.size(), beams.front(), beams.back());
+  notes_.push_back(text);
 }
 
 void BagSource::matchAndPose() {

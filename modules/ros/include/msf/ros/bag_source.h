@@ -66,6 +66,8 @@ private:
 
   void resolveTopics();
   void readCalibration(const std::string& rig);
+  /// The LiDAR's beams from the first scan's rings, when the rig lists none (beamElevationsFromRings).
+  void beamsFromFirstScan();
   void matchAndPose();
 
   std::string path_;

@@ -1,0 +1,45 @@
+// Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+// A LiDAR's beams from a scan's per-point rings, for a rig that lists none (a ROS bag's).
+#include <msf/io/beam_elevations.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace {
+
+/// `count` returns of one beam at `elevation_deg`, spread in azimuth, 10 m away.
+void addBeam(pcl::PointCloud<pcl::PointXYZI>& scan, std::vector<std::uint16_t>& rings, std::uint16_t ring,
+             double elevation_deg, int count) {
+  const double e = elevation_deg * M_PI / 180.0;
+  for (int k = 0; k < count; ++k) {
+    const double azimuth = 2.0 * M_PI * k / count;
+    pcl::PointXYZI p;
+    p.x = static_cast<float>(10.0 * std::cos(e) * std::cos(azimuth));
+    p.y = static_cast<float>(10.0 * std::cos(e) * std::sin(azimuth));
+    p.z = static_cast<float>(10.0 * std::sin(e));
+    scan.push_back(p);
+    rings.push_back(ring);
+  }
+}
+
+TEST(BeamElevations, EachRingsMedianElevationLowestFirst) {
+  // A 16-beam LiDAR from +15 to -15 degrees, its rings numbered from the top (as some drivers do).
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  std::vector<std::uint16_t> rings;
+  for (std::uint16_t ring = 0; ring < 16; ++ring)
+    addBeam(scan, rings, ring, 15.0 - 2.0 * ring, 100);
+  addBeam(scan, rings, 40, 30.0, 5); // a ring of a few returns: not a beam to count on
+  const std::vector<double> beams = msf::beamElevationsFromRings(scan, rings);
+  ASSERT_EQ(beams.size(), 16u);
+  for (std::size_t b = 0; b < 16; ++b)
+    EXPECT_NEAR(beams[b], -15.0 + 2.0 * static_cast<double>(b), 1e-4) << b;
+
+  EXPECT_TRUE(msf::beamElevationsFromRings(scan, {}).empty()) << "a scan without rings lists no beams";
+  pcl::PointCloud<pcl::PointXYZI> one;
+  std::vector<std::uint16_t> one_ring;
+  addBeam(one, one_ring, 3, -5.0, 100);
+  EXPECT_TRUE(msf::beamElevationsFromRings(one, one_ring).empty()) << "one beam gives no spacing";
+}
+
+} // namespace
