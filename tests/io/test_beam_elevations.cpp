@@ -40,6 +40,12 @@ TEST(BeamElevations, EachRingsMedianElevationLowestFirst) {
   std::vector<std::uint16_t> one_ring;
   addBeam(one, one_ring, 3, -5.0, 100);
   EXPECT_TRUE(msf::beamElevationsFromRings(one, one_ring).empty()) << "one beam gives no spacing";
+
+  // A field named ring that numbers points round-robin, not beams: no beams.
+  std::vector<std::uint16_t> round_robin(scan.size());
+  for (std::size_t k = 0; k < scan.size(); ++k)
+    round_robin[k] = static_cast<std::uint16_t>(k % 32);
+  EXPECT_TRUE(msf::beamElevationsFromRings(scan, round_robin).empty());
 }
 
 } // namespace

@@ -18,6 +18,7 @@
 #include <opencv2/imgproc.hpp>
 #include <pcl/io/pcd_io.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -172,6 +173,45 @@ TEST_F(PipelineTest, EveryScanAndImageFormatReadsTheSameFrame) {
   EXPECT_EQ(cv::norm(frame.left, reference.left, cv::NORM_INF), 0.0);  // 16 bits scaled back exactly
   EXPECT_EQ(cv::norm(frame.right, reference.right, cv::NORM_INF), 0.0); // colour to grey
   EXPECT_LT(cv::norm(frame.color, reference.color, cv::NORM_L1) / static_cast<double>(frame.color.total() * 3), 3.0);
+}
+
+/// A rig file without the LiDAR's beams, and scans with a ring field: the beams are the rings'.
+TEST_F(PipelineTest, ARigWithoutBeamsTakesThemFromTheScansRings) {
+  msf::test::TempDir dir;
+  const std::string generic = converted(dataset(), "0:0", dir);
+  const fs::path g(generic);
+  { // the rig file without its beams
+    std::ifstream in(g / "rig.yaml");
+    std::string text, line;
+    while (std::getline(in, line))
+      if (line.find("beam_elevations_deg") == std::string::npos && line.find("rings:") == std::string::npos)
+        text += line + "\n";
+    in.close();
+    std::ofstream(g / "rig.yaml") << text;
+  }
+  EXPECT_TRUE(msf::FolderSource(generic).calibration().lidar.beam_elevations_deg.empty())
+      << "KITTI's .bin scans have no rings";
+  // The street's HDL-64E: 64 beams from -24.9 to +2.0 degrees; each return's ring is its beam's.
+  const msf::Frame frame = msf::FolderSource(generic).load(0);
+  const double lowest = -24.9, spacing = 26.9 / 63;
+  std::ofstream pcd(g / "lidar" / "000000.pcd");
+  pcd << "VERSION 0.7\nFIELDS x y z intensity ring\nSIZE 4 4 4 4 2\nTYPE F F F F U\nCOUNT 1 1 1 1 1\nWIDTH "
+      << frame.scan->size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << frame.scan->size() << "\nDATA ascii\n";
+  pcd.precision(9);
+  for (const auto& p : *frame.scan) {
+    const double elevation = std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI;
+    pcd << p.x << ' ' << p.y << ' ' << p.z << ' ' << p.intensity << ' ' << std::lround((elevation - lowest) / spacing)
+        << '\n';
+  }
+  pcd.close();
+  fs::remove(g / "lidar" / "000000.bin");
+  const msf::FolderSource source(generic);
+  const std::vector<double>& beams = source.calibration().lidar.beam_elevations_deg;
+  ASSERT_GT(beams.size(), 50u) << "the rings with returns";
+  EXPECT_NEAR(beams.front(), lowest, 0.1);
+  EXPECT_NEAR(beams.back(), 2.0, 0.5);
+  ASSERT_EQ(source.notes().size(), 1u);
+  EXPECT_NE(source.notes()[0].find("beams from the first scan's rings"), std::string::npos) << source.notes()[0];
 }
 
 TEST_F(PipelineTest, A16BitPairIsScaledAlikeSoItsImagesMatchAtOneGain) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 namespace msf {
@@ -16,17 +17,30 @@ std::vector<double> beamElevationsFromRings(const pcl::PointCloud<pcl::PointXYZI
     const pcl::PointXYZI& p = scan[i];
     by_ring[rings[i]].push_back(std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI);
   }
+  // A beam's returns lie at one elevation: rings whose returns spread wider are not beams.
+  constexpr double kBeamSpreadDeg = 1.0;
   std::vector<double> elevations;
   for (auto& [ring, values] : by_ring) {
     if (values.size() < min_points)
       continue;
-    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+    std::sort(values.begin(), values.end());
+    if (values[values.size() * 3 / 4] - values[values.size() / 4] > kBeamSpreadDeg)
+      return {};
     elevations.push_back(values[values.size() / 2]);
   }
   if (elevations.size() < 2)
     return {};
   std::sort(elevations.begin(), elevations.end()); // drivers number rings top first or bottom first
   return elevations;
+}
+
+std::string beamsFromRingsNote(const std::vector<double>& beams) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "%zu beams from the first scan's rings, %.1f to %.1f degrees (a rig file's lidar.beam_elevations_deg "
+                "sets them)",
+                beams.size(), beams.empty() ? 0.0 : beams.front(), beams.empty() ? 0.0 : beams.back());
+  return text;
 }
 
 } // namespace msf

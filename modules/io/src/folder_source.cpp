@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/io/beam_elevations.h>
 #include <msf/io/folder_source.h>
 #include <msf/io/image_io.h>
 #include <msf/io/scan_file.h>
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -103,6 +105,19 @@ FolderSource::FolderSource(const std::string& dir, const std::string& rig) {
     calibration_.image_size = readImage(frames_.front().left, cv::IMREAD_UNCHANGED).size();
   readTimes();
   readPoses();
+  beamsFromFirstScan();
+}
+
+void FolderSource::beamsFromFirstScan() {
+  if (!calibration_.lidar.beam_elevations_deg.empty())
+    return;
+  const ScanFile first = loadScanFile(frames_.front().scan);
+  const std::vector<double> beams = beamElevationsFromRings(first.points, first.ring);
+  if (beams.empty())
+    return;
+  calibration_.lidar.beam_elevations_deg = beams;
+  calibration_.lidar.rings = static_cast<int>(beams.size());
+  notes_.push_back(beamsFromRingsNote(beams));
 }
 
 void FolderSource::findFrames() {

@@ -374,8 +374,7 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
     rig.lidar.beam_elevations_deg = beamElevationsFromRings(*first.scan, first.point_ring);
     rig.lidar.rings = static_cast<int>(rig.lidar.beam_elevations_deg.size());
     if (rig.lidar.rings > 0)
-      ROS_INFO("msf_ros_node: %d beams from the first scan's rings, %.1f to %.1f degrees", rig.lidar.rings,
-               rig.lidar.beam_elevations_deg.front(), rig.lidar.beam_elevations_deg.back());
+      ROS_INFO("msf_ros_node: %s", beamsFromRingsNote(rig.lidar.beam_elevations_deg).c_str());
   }
   Reconstructor::Options options;
   options.poses = kPoseModes.at(params_.poses);

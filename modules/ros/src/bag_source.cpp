@@ -274,10 +274,7 @@ void BagSource::beamsFromFirstScan() {
     return;
   calibration_.lidar.beam_elevations_deg = beams;
   calibration_.lidar.rings = static_cast<int>(beams.size());
-  char text[200];
-  std::snprintf(text, sizeof text, "%zu beams from the first scan's rings, %.1f to %.1f degrees (a rig file's "
-                "lidar.beam_elevations_deg sets them)", beams.size(), beams.front(), beams.back());
-  notes_.push_back(text);
+  notes_.push_back(beamsFromRingsNote(beams));
 }
 
 void BagSource::matchAndPose() {

@@ -53,6 +53,7 @@ public:
     return "scan '" + frames_[i].scan + "'";
   }
   bool hasColor() const override { return has_color_; }
+  std::vector<std::string> notes() const override { return notes_; }
 
 private:
   struct FrameFiles {
@@ -66,6 +67,8 @@ private:
   pcl::PointCloud<pcl::PointXYZI>::Ptr frameScan(pcl::PointCloud<pcl::PointXYZI>&& points, std::size_t i) const;
   void readTimes();
   void readPoses();
+  /// The LiDAR's beams from the first scan's rings, when the rig lists none (beamElevationsFromRings).
+  void beamsFromFirstScan();
 
   std::string dir_, poses_file_;
   Calibration calibration_;
@@ -73,6 +76,7 @@ private:
   std::vector<double> timestamps_;
   PoseList poses_;
   bool has_color_ = false;
+  std::vector<std::string> notes_;
 };
 
 } // namespace msf
