@@ -7,6 +7,7 @@
 
 #include <msf/common/exceptions.h>
 #include <msf/io/sequence.h>
+#include <msf/io/bag_options.h>
 #include <msf/pipeline/open_dataset.h>
 
 #include <opencv2/imgproc.hpp>
@@ -163,6 +164,10 @@ void bindSources(py::module_& m) {
       .def_property_readonly("calibration", [](const FrameSource& s) { return s.calibration(); },
                              "A copy of the source's rig: changing it leaves the source as it is.")
       .def_property_readonly("poses", &posesOf, "(N, 4, 4) float64 T_world_cam0 per frame, or None.")
+      .def_property_readonly("has_color", &FrameSource::hasColor, "Whether its frames have a colour camera's image.")
+      .def_property_readonly("notes", &FrameSource::notes,
+                             "What reading it left out or took from the data, a line each (a bag's skipped scans, "
+                             "the beams a rig without them took from the scans' rings).")
       .def("frame_name", [](const FrameSource& s, long long i) { return s.frameName(frameIndex(s, i)); },
            py::arg("index"), "The file stem of frame `index` ('000042').")
       .def("__repr__", [](const FrameSource& s) {
@@ -183,14 +188,26 @@ void bindSources(py::module_& m) {
       .def("__repr__", [](const Sequence& s) {
         return "Sequence('" + s.directory() + "', " + std::to_string(s.size()) + " frames)";
       });
-  m.def("open_dataset", [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& rig) {
-    py::gil_scoped_release release;
-    DatasetOptions options;
-    options.rig = rig ? rig->string() : "";
-    return openDataset(path.string(), options);
-  }, py::arg("path"), py::arg("rig") = py::none(),
-        "The FrameSource of a dataset folder, its layout detected (as msf_reconstruct reads it); rig: a "
-        "calibration or rig file for layouts without one, or to override the dataset's.");
+  const BagOptions kitti2bag;
+  m.def(
+      "open_dataset",
+      [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& rig,
+         const std::string& lidar_topic, const std::string& left_topic, const std::string& right_topic,
+         const std::string& color_topic, const std::string& world_frame, double max_offset) {
+        py::gil_scoped_release release;
+        DatasetOptions options;
+        options.rig = rig ? rig->string() : "";
+        options.bag = {lidar_topic, left_topic, right_topic, color_topic, world_frame, max_offset};
+        return openDataset(path.string(), options);
+      },
+      py::arg("path"), py::arg("rig") = py::none(), py::kw_only(), py::arg("lidar_topic") = kitti2bag.lidar_topic,
+      py::arg("left_topic") = kitti2bag.left_topic, py::arg("right_topic") = kitti2bag.right_topic,
+      py::arg("color_topic") = kitti2bag.color_topic, py::arg("world_frame") = kitti2bag.world_frame,
+      py::arg("max_offset") = kitti2bag.max_offset_s,
+      "The FrameSource of a dataset, its layout detected (as msf_reconstruct reads it): a folder, or a ROS 1 bag "
+      "read by its topics (kitti2bag's by default; color_topic '' for none), tf's world_frame ('' = camera_init, "
+      "else the root of the left camera's tree) and the largest offset in seconds between a scan and its images; "
+      "rig: a calibration or rig file for layouts without one, or to override the dataset's.");
 }
 
 } // namespace

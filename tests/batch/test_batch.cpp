@@ -101,6 +101,12 @@ TEST(DriveList, FindsFoldersOfTheGenericLayoutAndBags) {
   EXPECT_NE(error.find("a ROS bag"), std::string::npos) << error;
   std::ofstream(dir.file("root/drives.txt")) << "van_monday\nnight_drive.bag\n";
   EXPECT_EQ(readDriveList(dir.file("root/drives.txt")).size(), 2u);
+
+  // A folder without its rig file: the batch, which takes no -rig, says how to make one it reads.
+  const std::string no_rig = test::errorOf([&] { openDrive(found[1]); });
+  EXPECT_NE(no_rig.find("drive 'van_monday': dataset '"), std::string::npos) << no_rig;
+  EXPECT_NE(no_rig.find("has no rig.yaml"), std::string::npos) << no_rig;
+  EXPECT_NE(no_rig.find("msf_convert DATASET DIR, with -rig FILE"), std::string::npos) << no_rig;
 }
 
 TEST_F(BatchPlanTest, SavesAndLoadsAndRefusesAFolderOfSomeoneElse) {

@@ -41,6 +41,21 @@ TEST(BeamElevations, EachRingsMedianElevationLowestFirst) {
   addBeam(one, one_ring, 3, -5.0, 100);
   EXPECT_TRUE(msf::beamElevationsFromRings(one, one_ring).empty()) << "one beam gives no spacing";
 
+  // A beam missing between two others (ring 7 without returns): no beams, not a wider spacing.
+  pcl::PointCloud<pcl::PointXYZI> gap;
+  std::vector<std::uint16_t> gap_rings;
+  for (std::uint16_t ring = 0; ring < 16; ++ring)
+    addBeam(gap, gap_rings, ring, 15.0 - 2.0 * ring, ring == 7 ? 3 : 100);
+  EXPECT_TRUE(msf::beamElevationsFromRings(gap, gap_rings).empty());
+  // The top beam seeing only sky: the others, their spacing the same.
+  pcl::PointCloud<pcl::PointXYZI> sky;
+  std::vector<std::uint16_t> sky_rings;
+  for (std::uint16_t ring = 0; ring < 16; ++ring)
+    addBeam(sky, sky_rings, ring, 15.0 - 2.0 * ring, ring == 0 ? 2 : 100);
+  const std::vector<double> below = msf::beamElevationsFromRings(sky, sky_rings);
+  ASSERT_EQ(below.size(), 15u);
+  EXPECT_NEAR(below.back(), 13.0, 1e-4);
+
   // A field named ring that numbers points round-robin, not beams: no beams.
   std::vector<std::uint16_t> round_robin(scan.size());
   for (std::size_t k = 0; k < scan.size(); ++k)

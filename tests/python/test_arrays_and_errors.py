@@ -104,6 +104,22 @@ def test_a_sequence_is_an_iterable_of_frames(kitti_dir, odometry04):
         msfusion.open_dataset("/nonexistent/drive")
 
 
+def test_a_bag_opens_by_its_topics(odometry04, bin_dir, run_tool, tmp_path):
+    if not os.path.exists(os.path.join(bin_dir, "msf_kitti2bag")):
+        pytest.skip("a build without the ROS module")
+    bag = tmp_path / "04.bag"
+    run_tool("msf_kitti2bag", odometry04, "-frames", "0:1", "-o", bag)
+    opened = msfusion.open_dataset(bag)  # kitti2bag's topics, as msf_reconstruct reads them
+    assert len(opened) == 2 and opened.has_color
+    grey = msfusion.open_dataset(bag, color_topic="")
+    assert len(grey) == 2 and not grey.has_color and isinstance(grey.notes, list)
+    np.testing.assert_array_equal(grey[1].left, opened[1].left)
+    with pytest.raises(msfusion.InvalidInputError, match="has no topic '/velodyne_points' where the LiDAR's scans"):
+        msfusion.open_dataset(bag, lidar_topic="/velodyne_points")
+    with pytest.raises(msfusion.InvalidInputError, match="bag topics and frames are for a ROS bag"):
+        msfusion.open_dataset(odometry04, lidar_topic="/velodyne_points")
+
+
 def test_stage_outputs_are_owned_contiguous_arrays(calibration, frame):
     lidar = msfusion.LidarCompletion(calibration)
     depth, distance = lidar.compute_depth(frame.scan)

@@ -183,4 +183,14 @@ void nameDrives(std::vector<Drive>& drives) {
   }
 }
 
+std::unique_ptr<FrameSource> openDrive(const Drive& drive) {
+  try {
+    return openDataset(drive.dataset);
+  } catch (const Error& e) {
+    throw InvalidInputError("drive '" + drive.name + "': " + e.what() +
+                            ". msf_batch reads a folder with its rig.yaml and a bag by kitti2bag's topics: "
+                            "msf_convert DATASET DIR, with -rig FILE or the bag's topic options, writes one it reads");
+  }
+}
+
 } // namespace msf

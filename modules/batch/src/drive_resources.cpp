@@ -1,7 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/batch/drive_resources.h>
+#include <msf/batch/drive_list.h>
 #include <msf/common/exceptions.h>
-#include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/pose_source.h>
 #include <msf/range_image/lidar_projector.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -12,7 +12,7 @@ namespace msf {
 
 DriveResources predictDriveResources(const Drive& drive, const PipelineConfig& config, const std::string& frames,
                                      double process_mb) {
-  const std::unique_ptr<FrameSource> source = openDataset(drive.dataset);
+  const std::unique_ptr<FrameSource> source = openDrive(drive);
   const std::vector<std::size_t> indices = source->indices(FrameRange::parse(frames));
   if (drive.poses.empty() && !source->hasPoses())
     throw InvalidInputError("drive '" + drive.name + "' ('" + drive.dataset +

@@ -1,10 +1,10 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
+#include <msf/batch/drive_list.h>
 #include <msf/batch/one_process_map.h>
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/output_folder.h>
 #include <msf/pipeline/reconstructor.h>
-#include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/pose_source.h>
 
 #include <chrono>
@@ -35,7 +35,7 @@ std::size_t reconstructInOneProcess(const BatchPlan& plan, const std::string& ou
   inputs.push_back(plan.options().config);
   OutputFolder folder(out, "msf_batch", inputs);
   const PipelineConfig& config = plan.pipelineConfig();
-  const std::unique_ptr<FrameSource> first = openDataset(plan.drives().front().dataset);
+  const std::unique_ptr<FrameSource> first = openDrive(plan.drives().front());
   Reconstructor::Options options;
   options.poses = Reconstructor::PoseMode::Given;
   options.stream_directory = folder.dir();
@@ -43,7 +43,7 @@ std::size_t reconstructInOneProcess(const BatchPlan& plan, const std::string& ou
   const auto start = std::chrono::steady_clock::now();
   std::size_t frames = 0;
   for (const Drive& d : plan.drives()) {
-    const std::unique_ptr<FrameSource> source = openDataset(d.dataset);
+    const std::unique_ptr<FrameSource> source = openDrive(d);
     requireSameRig(first->calibration(), source->calibration(), d.name);
     const std::vector<std::size_t> indices = source->indices(FrameRange::parse(plan.options().frames));
     const PoseSource poses(d.poses.empty() ? "dataset" : d.poses, *source, indices);

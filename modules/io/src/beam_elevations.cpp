@@ -20,6 +20,7 @@ std::vector<double> beamElevationsFromRings(const pcl::PointCloud<pcl::PointXYZI
   // A beam's returns lie at one elevation: rings whose returns spread wider are not beams.
   constexpr double kBeamSpreadDeg = 1.0;
   std::vector<double> elevations;
+  std::vector<std::uint16_t> kept;
   for (auto& [ring, values] : by_ring) {
     if (values.size() < min_points)
       continue;
@@ -27,8 +28,10 @@ std::vector<double> beamElevationsFromRings(const pcl::PointCloud<pcl::PointXYZI
     if (values[values.size() * 3 / 4] - values[values.size() / 4] > kBeamSpreadDeg)
       return {};
     elevations.push_back(values[values.size() / 2]);
+    kept.push_back(ring);
   }
-  if (elevations.size() < 2)
+  // A beam missing between two others would widen the spacing the stages take from the list.
+  if (elevations.size() < 2 || kept.back() - kept.front() + 1u != kept.size())
     return {};
   std::sort(elevations.begin(), elevations.end()); // drivers number rings top first or bottom first
   return elevations;

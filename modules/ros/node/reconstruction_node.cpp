@@ -12,6 +12,7 @@
 #include <pcl_conversions/pcl_conversions.h>
 #include <visualization_msgs/Marker.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -247,6 +248,13 @@ void ReconstructionNode::countMessages() {
   for (const std::string& topic : {params_.left_topic, params_.right_topic, cameraInfoTopic(params_.left_topic),
                                    cameraInfoTopic(params_.right_topic)})
     messages_[topic] = 0;
+  if (color_sync_) {
+    messages_[params_.color_topic] = 0;
+    messages_[cameraInfoTopic(params_.color_topic)] = 0;
+    color_sub_.registerCallback([=, topic = params_.color_topic](const Image::ConstPtr&) { count(topic); });
+    color_info_sub_.registerCallback(
+        [=, topic = cameraInfoTopic(params_.color_topic)](const Info::ConstPtr&) { count(topic); });
+  }
   cloud_sub_.registerCallback([this](const Cloud::ConstPtr&) { onScan(); });
   left_sub_.registerCallback([=, topic = params_.left_topic](const Image::ConstPtr&) { count(topic); });
   right_sub_.registerCallback([=, topic = params_.right_topic](const Image::ConstPtr&) { count(topic); });
@@ -257,14 +265,16 @@ void ReconstructionNode::countMessages() {
 }
 
 bool ReconstructionNode::colorPublished() const {
-  return color_sync_ && color_sub_.getSubscriber().getNumPublishers() > 0;
+  return color_sync_ && color_sub_.getSubscriber().getNumPublishers() > 0 &&
+         color_info_sub_.getSubscriber().getNumPublishers() > 0;
 }
 
 std::string ReconstructionNode::silentInputs() const {
+  const bool color = colorPublished(); // else frames do not wait for the colour camera
   std::lock_guard<std::mutex> lock(drops_mutex_);
   std::string silent;
   for (const auto& [topic, n] : messages_)
-    if (n == 0)
+    if (n == 0 && (color || (topic != params_.color_topic && topic != cameraInfoTopic(params_.color_topic))))
       silent += (silent.empty() ? "'" : ", '") + topic + "'";
   return silent;
 }
@@ -299,11 +309,14 @@ void ReconstructionNode::onColor(const Cloud::ConstPtr& cloud, const Image::Cons
 }
 
 void ReconstructionNode::enqueue(Pending pending) {
-  // A colour camera that starts publishing later: its frames follow the grey ones, none twice.
+  // A colour camera that starts publishing later: both syncs may give its first frames, queued once.
+  constexpr std::size_t kRemembered = 8;
   const std::int64_t scan_ns = stampNs(pending.cloud->header.stamp);
-  if (scan_ns <= last_queued_scan_ns_)
+  if (std::find(queued_scans_ns_.begin(), queued_scans_ns_.end(), scan_ns) != queued_scans_ns_.end())
     return;
-  last_queued_scan_ns_ = scan_ns;
+  queued_scans_ns_.push_back(scan_ns);
+  if (queued_scans_ns_.size() > kRemembered)
+    queued_scans_ns_.pop_front();
   scans_since_frame_ = 0;
   if (frames_++ == 0)
     first_arrival_ = Clock::now();
@@ -371,10 +384,12 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
   if (rig.lidar.beam_elevations_deg.empty()) { // the beams, from the first scan's rings when it has them
     Frame first;
     scanFromMessage(*pending.cloud, first, "the scan on '" + params_.lidar_topic + "'");
-    rig.lidar.beam_elevations_deg = beamElevationsFromRings(*first.scan, first.point_ring);
-    rig.lidar.rings = static_cast<int>(rig.lidar.beam_elevations_deg.size());
-    if (rig.lidar.rings > 0)
-      ROS_INFO("msf_ros_node: %s", beamsFromRingsNote(rig.lidar.beam_elevations_deg).c_str());
+    const std::vector<double> beams = beamElevationsFromRings(*first.scan, first.point_ring);
+    if (!beams.empty()) {
+      rig.lidar.beam_elevations_deg = beams;
+      rig.lidar.rings = static_cast<int>(beams.size());
+      ROS_INFO("msf_ros_node: %s", beamsFromRingsNote(beams).c_str());
+    }
   }
   Reconstructor::Options options;
   options.poses = kPoseModes.at(params_.poses);
@@ -424,23 +439,28 @@ bool ReconstructionNode::placeFrame(Frame& frame, const std_msgs::Header& camera
 std::string ReconstructionNode::worldFrame(const std::string& camera_frame) {
   if (!world_frame_.empty())
     return world_frame_;
-  if (!params_.world_frame.empty() || tf_buffer_.canTransform("camera_init", camera_frame, ros::Time(0))) {
-    world_frame_ = params_.world_frame.empty() ? "camera_init" : params_.world_frame;
-    return world_frame_;
-  }
-  std::string root = camera_frame, parent;
-  while (tf_buffer_._getParent(root, ros::Time(0), parent) && parent != root)
-    root = parent;
-  // Only static transforms up to the root (the rig's own frames): no pose; tf may not have the moving one yet.
-  try {
-    if (root == camera_frame || tf_buffer_.lookupTransform(root, camera_frame, ros::Time(0)).header.stamp.isZero())
-      return "";
-  } catch (const tf2::TransformException&) {
-    return "";
-  }
-  world_frame_ = root;
-  ROS_INFO("msf_ros_node: world frame '%s' (the root of the left camera's tf tree)", root.c_str());
-  return world_frame_;
+  if (!params_.world_frame.empty())
+    return world_frame_ = params_.world_frame;
+  // tf's moving transform may come after the frame's messages: looked for up to tf_timeout_s.
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(params_.tf_timeout_s));
+  do {
+    if (tf_buffer_.canTransform("camera_init", camera_frame, ros::Time(0)))
+      return world_frame_ = "camera_init";
+    std::string root = camera_frame, parent;
+    while (tf_buffer_._getParent(root, ros::Time(0), parent) && parent != root)
+      root = parent;
+    // Only static transforms up to the root (the rig's own frames) give no pose.
+    try {
+      if (root != camera_frame && !tf_buffer_.lookupTransform(root, camera_frame, ros::Time(0)).header.stamp.isZero()) {
+        ROS_INFO("msf_ros_node: world frame '%s' (the root of the left camera's tf tree)", root.c_str());
+        return world_frame_ = root;
+      }
+    } catch (const tf2::TransformException&) {
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  } while (Clock::now() < deadline);
+  return "";
 }
 
 bool ReconstructionNode::lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
@@ -485,7 +505,8 @@ void ReconstructionNode::publishMesh() {
     return; // meshing costs: only for a listener (the file at shutdown meshes anyway)
   meshed_frames_ = reconstructed_;
   std_msgs::Header header = last_header_;
-  header.frame_id = world_frame_.empty() ? "camera_init" : world_frame_; // the odometry's world: kitti2bag's name
+  // The odometry's world is the first left camera's pose: kitti2bag's camera_init.
+  header.frame_id = tracking_ || world_frame_.empty() ? "camera_init" : world_frame_;
   mesh_pub_.publish(meshToMarker(engine_->mesh(), header));
 }
 

@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -84,7 +85,8 @@ private:
   void subscribe(ros::NodeHandle& nh);
   /// Counts each input's messages, for saying which one a scan waits for.
   void countMessages();
-  /// Whether the colour camera is there (its topic has a publisher): frames then wait for it.
+  /// Whether the colour camera is there (its image and CameraInfo topics have publishers):
+  /// frames then wait for it.
   bool colorPublished() const;
   /// The inputs that have sent nothing yet, as "'topic', 'topic'" ("" = none).
   std::string silentInputs() const;
@@ -131,7 +133,7 @@ private:
   std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
   std::atomic<std::size_t> scans_since_frame_ = 0;
   std::map<std::string, std::size_t> messages_; // per input topic (the spin thread's)
-  std::int64_t last_queued_scan_ns_ = -1;        // frames are queued in the scans' order
+  std::deque<std::int64_t> queued_scans_ns_;    // the last frames' scans: none queued twice
   Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;
   std::map<std::string, std::size_t> dropped_; // reason -> frames

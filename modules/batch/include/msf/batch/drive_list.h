@@ -1,5 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <msf/io/frame_source.h>
+
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,5 +34,10 @@ std::vector<Drive> readDriveList(const std::string& path);
 /// a raw drive's or a generic layout's folder) or a bag's file name without its extension.
 /// Throws InvalidInputError naming two drives of one name, or one dataset given twice.
 void nameDrives(std::vector<Drive>& drives);
+
+/// The drive's dataset, opened as msf_reconstruct opens it without options (openDataset). Throws
+/// InvalidInputError naming the drive when it cannot, and saying how to make it one msf_batch
+/// reads (msf_convert with -rig or a bag's topic options).
+std::unique_ptr<FrameSource> openDrive(const Drive& drive);
 
 } // namespace msf

@@ -11,9 +11,11 @@ namespace msf {
 
 /// The beams' elevations a scan shows through its per-point rings (a ROS driver's `ring` field):
 /// each ring's median elevation in the LiDAR's frame (z up), in degrees, lowest first, over the
-/// rings with at least `min_points` returns. Empty when `rings` is empty, names fewer than two
-/// such rings, or a ring's returns spread over more than a degree (not a beam's: a field named
-/// ring that numbers something else); a rig that lists no beams then keeps KITTI's sizes.
+/// rings with at least `min_points` returns (a top beam that sees only sky drops out). Empty when
+/// `rings` is empty, names fewer than two such rings, such rings are not numbered one after the
+/// other (a beam missing between two), or a ring's returns spread over more than a degree (not a
+/// beam's: a field named ring that numbers something else); a rig that lists no beams then keeps
+/// KITTI's sizes.
 std::vector<double> beamElevationsFromRings(const pcl::PointCloud<pcl::PointXYZI>& scan,
                                             const std::vector<std::uint16_t>& rings, std::size_t min_points = 20);
 
