@@ -181,6 +181,26 @@ play_to_node snapshots params:="$work/snapshots.yaml" mesh_path:="$work/mine.ply
   fail "sweeping_scans false made the same mesh as the sweeping rig: the parameter did not reach the engine"
 echo "ok: sweeping_scans false makes another map, written over mine.ply with overwrite true"
 
+# A rig of another image size than the bag's: every frame refused, the error logged once.
+printf '%s\n' "image_width: 640" "image_height: 480" "left:" "  P: [500, 0, 320, 0, 0, 500, 240, 0, 0, 0, 1, 0]" \
+  "right:" "  P: [500, 0, 320, -250, 0, 500, 240, 0, 0, 0, 1, 0]" >"$work/small_rig.yaml"
+sed "s|^rig: \"\" |rig: \"$work/small_rig.yaml\"|" "$node_params" >"$work/refused.yaml"
+grep -q "^rig: \"$work/small_rig.yaml\"" "$work/refused.yaml" || fail "kitti_bag.yaml has no 'rig: \"\" ' line"
+background refused roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" rate:=0.5 params:="$work/refused.yaml"
+refused=$started
+for ((k = 0; k < 600; ++k)); do
+  grep -aq "player-2.*finished" "$work/refused.log" && break
+  sleep 0.1
+done
+sleep 2 # the frames still queued
+stop_group "$refused" 30
+account=$(node_lines "$work/refused.log" | grep -a "scans received")
+[[ "$account" == *"$frames scans received, $frames frames, 0 reconstructed, $frames dropped"* ]] ||
+  fail "the node with a rig of another size: '$account'"
+errors=$(node_lines "$work/refused.log" | grep -ac "each error is logged once" || true)
+[ "$errors" = 1 ] || fail "the node logged the refusal $errors times: $(node_lines "$work/refused.log" | tr '\n' ' ')"
+echo "ok: a rig of another image size: every frame refused, the error logged once"
+
 # A file put at ~mesh_path while the node runs is the user's: left as it is, the mesh beside it.
 during="echo mine >'$work/late.ply'" play_to_node late mesh_path:="$work/late.ply"
 [ "$(cat "$work/late.ply")" = mine ] || fail "the node wrote over late.ply, which appeared while it ran"

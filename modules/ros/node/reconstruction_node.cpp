@@ -332,7 +332,10 @@ void ReconstructionNode::work() {
       try {
         process(*pending);
       } catch (const std::exception& e) {
-        ROS_ERROR("msf_ros_node: the frame of the scan at %.3f s: %s", pending->cloud->header.stamp.toSec(), e.what());
+        // Each error once: a rig that does not fit would repeat it at every frame.
+        if (refusals_logged_.insert(e.what()).second)
+          ROS_ERROR("msf_ros_node: the frame of the scan at %.3f s: %s (each error is logged once)",
+                    pending->cloud->header.stamp.toSec(), e.what());
         drop("the engine refused it (the error is logged)");
       }
     }

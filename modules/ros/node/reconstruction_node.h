@@ -23,6 +23,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -143,6 +144,7 @@ private:
   bool tracking_ = false; // the engine's odometry gives the poses
   std::int64_t first_scan_ns_ = 0;
   std::string world_frame_; // resolved (worldFrame)
+  std::set<std::string> refusals_logged_; // the engine's errors, each logged once
   std_msgs::Header last_header_;
   Clock::time_point last_mesh_;
   std::size_t meshed_frames_ = 0;
