@@ -193,21 +193,23 @@ void bindSources(py::module_& m) {
       "open_dataset",
       [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& rig,
          const std::string& lidar_topic, const std::string& left_topic, const std::string& right_topic,
-         const std::string& color_topic, const std::string& world_frame, double max_offset) {
+         const std::string& color_topic, const std::string& world_frame, double max_offset,
+         std::optional<bool> sweeping_scans) {
         py::gil_scoped_release release;
         DatasetOptions options;
         options.rig = rig ? rig->string() : "";
-        options.bag = {lidar_topic, left_topic, right_topic, color_topic, world_frame, max_offset};
+        options.bag = {lidar_topic, left_topic, right_topic, color_topic, world_frame, max_offset, sweeping_scans};
         return openDataset(path.string(), options);
       },
       py::arg("path"), py::arg("rig") = py::none(), py::kw_only(), py::arg("lidar_topic") = kitti2bag.lidar_topic,
       py::arg("left_topic") = kitti2bag.left_topic, py::arg("right_topic") = kitti2bag.right_topic,
       py::arg("color_topic") = kitti2bag.color_topic, py::arg("world_frame") = kitti2bag.world_frame,
-      py::arg("max_offset") = kitti2bag.max_offset_s,
+      py::arg("max_offset") = kitti2bag.max_offset_s, py::arg("sweeping_scans") = py::none(),
       "The FrameSource of a dataset, its layout detected (as msf_reconstruct reads it): a folder, or a ROS 1 bag "
       "read by its topics (kitti2bag's by default; color_topic '' for none), tf's world_frame ('' = camera_init, "
-      "else the root of the left camera's tree) and the largest offset in seconds between a scan and its images; "
-      "rig: a calibration or rig file for layouts without one, or to override the dataset's.");
+      "else the root of the left camera's tree), the largest offset in seconds between a scan and its images, and "
+      "whether its LiDAR sweeps its scans (None: it does); rig: a calibration or rig file for layouts without one, "
+      "or to override the dataset's.");
 }
 
 } // namespace

@@ -114,6 +114,8 @@ def test_a_bag_opens_by_its_topics(odometry04, bin_dir, run_tool, tmp_path):
     grey = msfusion.open_dataset(bag, color_topic="")
     assert len(grey) == 2 and not grey.has_color and isinstance(grey.notes, list)
     np.testing.assert_array_equal(grey[1].left, opened[1].left)
+    assert opened.calibration.lidar_sweeping  # a bag does not say: swept, unless told
+    assert not msfusion.open_dataset(bag, sweeping_scans=False).calibration.lidar_sweeping
     with pytest.raises(msfusion.InvalidInputError, match="has no topic '/velodyne_points' where the LiDAR's scans"):
         msfusion.open_dataset(bag, lidar_topic="/velodyne_points")
     with pytest.raises(msfusion.InvalidInputError, match="bag topics and frames are for a ROS bag"):

@@ -631,6 +631,10 @@ if [ $have_kitti = 1 ]; then
   check "reconstruct -frames 0:100000" 1 "frame range 0:100000 goes beyond the last frame" -- \
     msf_reconstruct "$SEQ" -frames 0:100000 -panels 0 -o out
   check "reconstruct -panels -1" 1 "-panels must be 0..100, not -1" -- msf_reconstruct "$SEQ" -panels -1 -o out
+  check "reconstruct -sweeping_scans maybe" 1 "-sweeping_scans must be true or false, not 'maybe'" -- \
+    msf_reconstruct "$SEQ" -sweeping_scans maybe -o out
+  check "reconstruct: a bag's option for a folder" 1 "bag topics and frames are for a ROS bag" -- \
+    msf_reconstruct "$SEQ" -sweeping_scans false -o out
   check "reconstruct -voxel 1e6" 1 "voxel_size_m \(-voxel, the voxel size\) must be 0.001 .. 10 m, got 1000000" -- \
     msf_reconstruct "$SEQ" -voxel 1e6 -o out
   check "reconstruct -max_memory 1" 1 "the run is predicted to need up to [0-9]+ MiB at its peak in memory and [0-9]+ MiB streamed .* over the memory budget of 1 MiB" -- \

@@ -241,6 +241,11 @@ TEST(BagSource, TheBeamsOfARigsBagComeFromItsFirstScansRings) {
   ASSERT_FALSE(source.notes().empty());
   EXPECT_TRUE(contains(source.notes().back(), "3 beams from the first scan's rings, -10.0 to 2.0 degrees"))
       << source.notes().back();
+  // A bag does not say how its LiDAR takes scans: swept, unless told (-sweeping_scans false).
+  EXPECT_TRUE(source.calibration().lidar.sweeping);
+  msf::BagOptions snapshots = tinyTopics();
+  snapshots.sweeping_scans = false;
+  EXPECT_FALSE(msf::BagSource(dir.file("beams.bag"), snapshots).calibration().lidar.sweeping);
   // Without rings, none: KITTI's sizes, as for a rig file that lists no beams.
   writeTinyBag(dir.file("plain.bag"), TinyBag{});
   EXPECT_TRUE(msf::BagSource(dir.file("plain.bag"), tinyTopics()).calibration().lidar.beam_elevations_deg.empty());

@@ -27,7 +27,16 @@ void addDatasetOptions(tool::CommandLine& cli, DatasetOptions& options) {
              "of the left camera's tf tree)")
       .value("-max_offset", "S", bag.max_offset_s,
              "a bag's scan and images are one frame when their stamps are at most S seconds apart (default "
-             "{default})");
+             "{default})")
+      .value(
+          "-sweeping_scans", "B",
+          [&bag](const std::string& text) {
+            if (text != "true" && text != "false")
+              throw InvalidInputError("-sweeping_scans must be true or false, not '" + text + "'");
+            bag.sweeping_scans = text == "true";
+          },
+          "a bag's LiDAR sweeps each scan over its period (true, a spinning LiDAR's: the default) or takes it at "
+          "one instant (false); as msf_ros_node's ~sweeping_scans");
 }
 
 bool isRosBag(const std::string& path) {

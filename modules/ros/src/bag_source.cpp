@@ -235,6 +235,7 @@ void BagSource::readCalibration(const std::string& rig) {
     calibration_ = loadCalibration(rig, size);
     notes_.push_back("calibration from '" + rig + "'; the bag's CameraInfo and LiDAR extrinsic are not read");
     beamsFromFirstScan();
+    applySweeping();
     return;
   }
   const auto right = info(options_.right_topic);
@@ -261,6 +262,12 @@ void BagSource::readCalibration(const std::string& rig) {
   }
   calibration_ = rigFromCameraInfo(*left, *right, color.get(), T_cam0_velo, size, path_);
   beamsFromFirstScan();
+  applySweeping();
+}
+
+void BagSource::applySweeping() {
+  if (options_.sweeping_scans)
+    calibration_.lidar.sweeping = *options_.sweeping_scans;
 }
 
 void BagSource::beamsFromFirstScan() {

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <optional>
 #include <string>
 
 namespace msf {
@@ -17,12 +18,16 @@ struct BagOptions {
   std::string world_frame;
   /// A scan and an image are one frame when their stamps are at most this far apart.
   double max_offset_s = 0.05;
+  /// How the LiDAR takes its scans, which a bag does not say: swept over their period (a
+  /// spinning LiDAR's, the default) or at one instant (false). Unset: swept, or a -rig file's.
+  std::optional<bool> sweeping_scans;
 
   /// Whether every field is its default (options for a bag given with another dataset are an error).
   bool isDefault() const {
     const BagOptions d;
     return lidar_topic == d.lidar_topic && left_topic == d.left_topic && right_topic == d.right_topic &&
-           color_topic == d.color_topic && world_frame == d.world_frame && max_offset_s == d.max_offset_s;
+           color_topic == d.color_topic && world_frame == d.world_frame && max_offset_s == d.max_offset_s &&
+           !sweeping_scans;
   }
 };
 

@@ -68,6 +68,8 @@ private:
   void readCalibration(const std::string& rig);
   /// The LiDAR's beams from the first scan's rings, when the rig lists none (beamElevationsFromRings).
   void beamsFromFirstScan();
+  /// BagOptions::sweeping_scans, when given, on the rig.
+  void applySweeping();
   void matchAndPose();
 
   std::string path_;
