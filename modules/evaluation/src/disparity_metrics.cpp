@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/evaluation/disparity_metrics.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@ namespace msf {
 
 namespace {
 inline bool has(float d) { return d > 0.f && std::isfinite(d); }
-
-std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
 } // namespace
 
 DisparityRegionErrors& DisparityRegionErrors::operator+=(const DisparityRegionErrors& other) {

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/evaluation/open_sky_coverage.h>
 
 #include <opencv2/imgproc.hpp>
@@ -7,12 +8,6 @@
 #include <algorithm>
 
 namespace msf {
-
-namespace {
-
-std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
-
-} // namespace
 
 OpenSkyCoverage::OpenSkyCoverage(const PinholeCamera& camera) : camera_(camera) {
   if (!camera.valid())

@@ -1,5 +1,6 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
 #include <msf/fusion/sky_mask.h>
 
 #include <opencv2/imgproc.hpp>
@@ -20,8 +21,6 @@ constexpr double kBlueHueMin = 85.0, kBlueHueMax = 135.0;
 constexpr int kTextureWindow = 5;
 /// Rows within which returns lie on one ring (KITTI's rings lie 5-6 pixels apart up there).
 constexpr int kOneRingRows = 3;
-
-std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
 
 void checkImage(const cv::Mat& image) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))

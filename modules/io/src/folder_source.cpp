@@ -109,7 +109,8 @@ FolderSource::FolderSource(const std::string& dir, const std::string& rig) {
 }
 
 void FolderSource::beamsFromFirstScan() {
-  if (!calibration_.lidar.beam_elevations_deg.empty())
+  // A KITTI .bin holds no rings: its scan is not read for them.
+  if (!calibration_.lidar.beam_elevations_deg.empty() || fs::path(frames_.front().scan).extension() == ".bin")
     return;
   const ScanFile first = loadScanFile(frames_.front().scan);
   const std::vector<double> beams = beamElevationsFromRings(first.points, first.ring);

@@ -40,7 +40,6 @@ FrameRange FrameRange::parse(const std::string& text) {
 
 namespace {
 
-std::string sizeText(const cv::Mat& image) { return std::to_string(image.cols) + "x" + std::to_string(image.rows); }
 
 void checkImage(const cv::Mat& image, const std::string& what, const Calibration& calibration, bool optional) {
   if (image.empty()) {
@@ -53,7 +52,7 @@ void checkImage(const cv::Mat& image, const std::string& what, const Calibration
   const cv::Size expected = calibration.image_size;
   if (expected.area() > 0 && image.size() != expected)
     throw InvalidInputError(what + " is " + sizeText(image) + " but calibration '" + calibration.source + "' is " +
-                            std::to_string(expected.width) + "x" + std::to_string(expected.height));
+                            sizeText(expected));
 }
 
 } // namespace

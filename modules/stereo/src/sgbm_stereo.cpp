@@ -1,6 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-#include <msf/common/parallel.h>
 #include <msf/common/exceptions.h>
+#include <msf/common/message_text.h>
+#include <msf/common/parallel.h>
 #include <msf/io/organized_conversion.h>
 #include <msf/stereo/disparity_search_range.h>
 #include <msf/stereo/guidance_hints.h>
@@ -20,7 +21,6 @@
 namespace msf {
 
 namespace {
-std::string sizeText(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
 
 cv::Mat toGrey(const cv::Mat& image) {
   if (image.channels() == 1)

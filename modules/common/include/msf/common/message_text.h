@@ -1,5 +1,7 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #pragma once
+#include <opencv2/core/mat.hpp>
+
 #include <cstddef>
 #include <sstream>
 #include <string>
@@ -22,5 +24,11 @@ inline std::string number(double value) {
   s << value;
   return s.str();
 }
+
+/// An image's size as a message shows it: "1242x375" (width x height).
+inline std::string sizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+inline std::string sizeText(const cv::Mat& image) { return sizeText(image.size()); }
 
 } // namespace msf
