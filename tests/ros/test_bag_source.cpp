@@ -300,6 +300,9 @@ TEST(MessageConversions, AScanOfFloat64CoordinatesIsReadAndOneWithoutZIsNamed) {
   EXPECT_EQ((*frame.scan)[1].z, -1.5f);
   EXPECT_EQ((*frame.scan)[1].intensity, 200.f);
 
+  m.fields[2].datatype = 42;
+  EXPECT_EQ(errorOf([&] { msf::scanFromMessage(m, frame, "the scan"); }),
+            "the scan: PointCloud2 field 'z' has datatype 42, which sensor_msgs/PointField does not define");
   modifier.setPointCloud2Fields(3, "x", 1, F::FLOAT64, "y", 1, F::FLOAT64, "intensity", 1, F::FLOAT32);
   EXPECT_EQ(errorOf([&] { msf::scanFromMessage(m, frame, "the scan"); }),
             "the scan: PointCloud2 has no field 'z' (fields: x y intensity)");

@@ -50,18 +50,6 @@ void putField(sensor_msgs::PointCloud2& message, const sensor_msgs::PointField& 
   std::memcpy(&message.data[i * message.point_step + field.offset], &value, sizeof value);
 }
 
-/// The bytes of a PointField's datatype (0 for one PointField does not define).
-std::size_t datatypeBytes(std::uint8_t datatype) {
-  using F = sensor_msgs::PointField;
-  switch (datatype) {
-  case F::INT8: case F::UINT8: return 1;
-  case F::INT16: case F::UINT16: return 2;
-  case F::INT32: case F::UINT32: case F::FLOAT32: return 4;
-  case F::FLOAT64: return 8;
-  default: return 0;
-  }
-}
-
 /// x, y and z of one number each (float32, float64 or an integer), and the fields read (those and
 /// intensity, ring, time) within a point.
 void requireLayout(const sensor_msgs::PointCloud2& message, const std::string& what) {
@@ -82,10 +70,13 @@ void requireLayout(const sensor_msgs::PointCloud2& message, const std::string& w
     if (!(field.name == "x" || field.name == "y" || field.name == "z" || field.name == "intensity" ||
           field.name == "i" || field.name == "ring" || field.name == "time"))
       continue;
-    const std::size_t bytes = datatypeBytes(field.datatype);
-    if (bytes == 0)
+    std::size_t bytes = 0;
+    try { // PointField's own sizes (sensor_msgs/impl/point_cloud2_iterator.h)
+      bytes = static_cast<std::size_t>(::sizeOfPointField(field.datatype));
+    } catch (const std::runtime_error&) {
       throw InvalidInputError(what + ": PointCloud2 field '" + field.name + "' has datatype " +
                               std::to_string(field.datatype) + ", which sensor_msgs/PointField does not define");
+    }
     if (field.offset + bytes * std::max<std::uint32_t>(field.count, 1) > message.point_step)
       throw InvalidInputError(what + ": PointCloud2 field '" + field.name + "' lies beyond its point step");
   }
