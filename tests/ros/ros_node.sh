@@ -120,8 +120,9 @@ refuse bad_folder \
 
 # Plays the bag to the node started by launch/kitti_bag.launch with ARGS...; returns when it has
 # published a depth image per frame (rostopic echo -n exits then) and has been stopped.
+# $frames_made: the frames it makes, else every scan's.
 play_to_node() { # NAME ARGS... (the bag: $bag, else 04.bag; $during: a command run while the node runs)
-  local name=$1 counter launcher seen
+  local name=$1 counter launcher seen frames=${frames_made:-$frames}
   local log="$work/${name}_depth_seen.log"
   shift
   background "${name}_depth_seen" rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
@@ -235,6 +236,69 @@ node_lines "$work/own.log" | grep -aq "world frame 'world' (the root of the left
 cmp "$work/own_mesh.ply" "$work/own_reconstruct/mesh.ply" ||
   fail "the node's mesh of a bag without colour and camera_init differs from msf_reconstruct's"
 echo "ok: a bag without the colour camera nor camera_init: every frame, poses from tf's root, msf_reconstruct's mesh"
+
+# The same rig tracked by the odometry (~poses odometry), its right camera 30 ms late: the node
+# says the pair lies apart (the last scan makes no frame: the approximate-time sync holds a pair
+# not stamped as its scan until a later message shows it is the nearest), and puts its poses in tf as camera_init above the root of the left
+# camera's tree, so that the mesh marker's frame meets the rig's; composed with the bag's tf,
+# each is the left camera's motion since the first frame.
+/usr/bin/python3 - "$work/own.bag" "$work/late_right.bag" <<'PY' || fail "could not write late_right.bag"
+import rosbag, rospy, sys
+with rosbag.Bag(sys.argv[1]) as bag_in, rosbag.Bag(sys.argv[2], "w") as bag_out:
+    for topic, msg, t in bag_in.read_messages():
+        if topic.startswith("/kitti/camera_gray_right/"):
+            msg.header.stamp += rospy.Duration(0.030)
+            t += rospy.Duration(0.030)
+        bag_out.write(topic, msg, t)
+PY
+sed 's/^poses: auto$/poses: odometry/' "$node_params" >"$work/odometry.yaml"
+grep -q "^poses: odometry" "$work/odometry.yaml" || fail "kitti_bag.yaml has no 'poses: auto' line"
+background record_tf rosbag record -q -O "$work/odometry_tf.bag" /tf
+recorder=$started
+frames_made=$last bag=$work/late_right.bag play_to_node odometry params:="$work/odometry.yaml"
+stop_group "$recorder" 10
+node_lines "$work/odometry.log" | grep -aq "the stereo pair's images lie a median of 30 ms apart" ||
+  fail "the node did not say the pair lies 30 ms apart: $(node_lines "$work/odometry.log" | tr '\n' ' ')"
+node_lines "$work/odometry.log" | grep -aq "the odometry's poses go to tf as 'camera_init' -> 'world'" ||
+  fail "the node did not say where its poses go in tf: $(node_lines "$work/odometry.log" | tr '\n' ' ')"
+/usr/bin/python3 - "$work/own.bag" "$work/odometry_tf.bag" "$last" <<'PY' || fail "the odometry's tf is not the rig's motion"
+import numpy as np, rosbag, sys
+
+def matrix(transform):
+    q, p = transform.rotation, transform.translation
+    x, y, z, w = q.x, q.y, q.z, q.w
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = [p.x, p.y, p.z]
+    return T
+
+def transforms(path):  # (parent, child, stamp in ns) -> 4x4
+    found = {}
+    with rosbag.Bag(path) as bag:
+        for _, msg, _ in bag.read_messages(topics=["/tf", "/tf_static"]):
+            for t in msg.transforms:
+                found[(t.header.frame_id, t.child_frame_id, t.header.stamp.to_nsec())] = matrix(t.transform)
+    return found
+
+rig = transforms(sys.argv[1])
+static = next(T for (p, c, _), T in rig.items() if (p, c) == ("world", "vehicle_map"))
+world_cam = {s: static @ T for (p, c, s), T in rig.items() if (p, c) == ("vehicle_map", "camera_gray_left")}
+odometry = {s: T for (p, c, s), T in transforms(sys.argv[2]).items() if (p, c) == ("camera_init", "world")}
+assert len(odometry) == int(sys.argv[3]), f"{len(odometry)} odometry transforms for {sys.argv[3]} frames"
+first = min(odometry)
+for stamp, T_init_world in sorted(odometry.items()):
+    tracked = T_init_world @ world_cam[stamp]
+    truth = np.linalg.inv(world_cam[first]) @ world_cam[stamp]
+    error = np.linalg.inv(truth) @ tracked
+    metres = np.linalg.norm(error[:3, 3])
+    degrees = np.degrees(np.arccos(np.clip((np.trace(error[:3, :3]) - 1) / 2, -1, 1)))
+    assert metres < 0.1 and degrees < 1, f"at {stamp}: {metres:.3f} m, {degrees:.2f} degrees off the rig's motion"
+    print(f"  frame at {stamp * 1e-9:.3f} s: {np.linalg.norm(truth[:3, 3]):.2f} m from the first, "
+          f"the odometry {metres:.3f} m and {degrees:.2f} degrees off")
+PY
+echo "ok: the odometry's poses in tf as camera_init above the rig's tree; a right camera 30 ms late is said"
 
 ros_session_stop
 echo "ok: roscore, the node, the player and the recorder stopped; no process left"

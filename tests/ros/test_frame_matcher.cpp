@@ -42,6 +42,15 @@ TEST(FrameMatcher, APairWhoseImagesLieApartIsNoted) {
   EXPECT_TRUE(m.notes.empty());
 }
 
+TEST(FrameMatcher, ThePairsGapIsJudgedByItsMedian) {
+  // The node's live pairs: one late pair among on-time ones is no note, most pairs late are.
+  EXPECT_EQ(msf::stereoPairApartNote({0, 0, 40 * kMs}), "");
+  EXPECT_EQ(msf::stereoPairApartNote({10 * kMs, 10 * kMs}), ""); // at the limit: together
+  EXPECT_EQ(msf::stereoPairApartNote({12 * kMs, 0, 12 * kMs}).rfind("the stereo pair's images lie a median of 12 ms", 0),
+            0u);
+  EXPECT_EQ(msf::stereoPairApartNote({}), "");
+}
+
 TEST(FrameMatcher, AnImageServesOnlyItsNearestScan) {
   // A LiDAR at 20 Hz and cameras at 10 Hz: every other scan has no image of its own.
   const std::vector<std::int64_t> scans{0, 50 * kMs, 100 * kMs, 150 * kMs};

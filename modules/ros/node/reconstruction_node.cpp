@@ -7,6 +7,7 @@
 #include <msf/io/beam_elevations.h>
 #include <msf/io/cloud_io.h>
 #include <msf/pipeline/fused_cloud.h>
+#include <msf/ros/frame_matcher.h>
 #include <msf/ros/message_conversions.h>
 
 #include <pcl_conversions/pcl_conversions.h>
@@ -24,6 +25,9 @@
 namespace msf {
 
 namespace {
+
+/// The odometry's world, the first left camera's pose: kitti2bag's name for it.
+constexpr char kOdometryWorld[] = "camera_init";
 
 std::string cameraInfoTopic(const std::string& image_topic) {
   const std::size_t slash = image_topic.rfind('/');
@@ -112,7 +116,7 @@ std::string NodeParameters::help() {
   text << "msf_ros_node: the msfusion engine as a ROS 1 node (docs/ros.md).\n"
           "usage: rosrun or roslaunch (launch/kitti_bag.launch), or msf_ros_node [_param:=value] [topic:=remap]\n"
           "  in:  ~lidar_topic, ~left_topic, ~right_topic (and their camera_info), ~color_topic, /tf, /tf_static\n"
-          "  out: ~depth, ~weight (Image 32FC1), ~points (PointCloud2), ~mesh (Marker)\n"
+          "  out: ~depth, ~weight (Image 32FC1), ~points (PointCloud2), ~mesh (Marker), /tf (the odometry's poses)\n"
           "parameters (private: _name:=value, or a launch file's rosparam), with their defaults:\n";
   for (const ParamDoc& doc : paramDocs(NodeParameters()))
     text << "  " << doc.name << " = " << doc.default_value << "\n      " << doc.meaning << "\n";
@@ -318,12 +322,25 @@ void ReconstructionNode::enqueue(Pending pending) {
   if (queued_scans_ns_.size() > kRemembered)
     queued_scans_ns_.pop_front();
   scans_since_frame_ = 0;
+  judgePairStamps(pending);
   if (frames_++ == 0)
     first_arrival_ = Clock::now();
   last_arrival_ = Clock::now();
   if (queue_.pushNewest(std::move(pending)))
     drop("the engine was busy: the oldest of " + std::to_string(params_.queue_size) +
          " waiting frames made room for the newest");
+}
+
+void ReconstructionNode::judgePairStamps(const Pending& pending) {
+  constexpr std::size_t kPairsJudged = 10;
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  if (pair_apart_ns_.size() == kPairsJudged)
+    return;
+  pair_apart_ns_.push_back(std::llabs(stampNs(pending.left->header.stamp) - stampNs(pending.right->header.stamp)));
+  if (pair_apart_ns_.size() == kPairsJudged)
+    if (const std::string note = stereoPairApartNote(pair_apart_ns_); !note.empty())
+      ROS_WARN("msf_ros_node: on '%s' and '%s', %s", params_.left_topic.c_str(), params_.right_topic.c_str(),
+               note.c_str());
 }
 
 void ReconstructionNode::work() {
@@ -361,6 +378,8 @@ void ReconstructionNode::process(const Pending& pending) {
   ROS_DEBUG("msf_ros_node: frame %zu (scan at %.3f s) in %.0f ms", frame.index, pending.cloud->header.stamp.toSec(), ms);
   last_header_ = pending.left->header;
   publish(result, pending.left->header);
+  if (tracking_)
+    publishOdometryTf(result, pending.left->header);
 }
 
 bool ReconstructionNode::startEngine(const Pending& pending) {
@@ -448,11 +467,9 @@ std::string ReconstructionNode::worldFrame(const std::string& camera_frame) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(params_.tf_timeout_s));
   do {
-    if (tf_buffer_.canTransform("camera_init", camera_frame, ros::Time(0)))
-      return world_frame_ = "camera_init";
-    std::string root = camera_frame, parent;
-    while (tf_buffer_._getParent(root, ros::Time(0), parent) && parent != root)
-      root = parent;
+    if (tf_buffer_.canTransform(kOdometryWorld, camera_frame, ros::Time(0)))
+      return world_frame_ = kOdometryWorld;
+    const std::string root = treeRoot(camera_frame);
     // Only static transforms up to the root (the rig's own frames) give no pose.
     try {
       if (root != camera_frame && !tf_buffer_.lookupTransform(root, camera_frame, ros::Time(0)).header.stamp.isZero()) {
@@ -464,6 +481,41 @@ std::string ReconstructionNode::worldFrame(const std::string& camera_frame) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   } while (Clock::now() < deadline);
   return "";
+}
+
+std::string ReconstructionNode::treeRoot(const std::string& frame) const {
+  std::string root = frame, parent;
+  while (tf_buffer_._getParent(root, ros::Time(0), parent) && parent != root)
+    root = parent;
+  return root;
+}
+
+void ReconstructionNode::publishOdometryTf(const FrameResult& result, const std_msgs::Header& camera_header) {
+  const std::string& camera = camera_header.frame_id;
+  if (!odometry_tf_child_) { // decided at the first frame, before tf holds this node's own transforms
+    const ros::Duration wait(params_.tf_timeout_s);
+    const bool known = tf_buffer_.canTransform(kOdometryWorld, camera, ros::Time(0), wait);
+    odometry_tf_child_ = known ? "" : treeRoot(camera);
+    if (!known)
+      ROS_INFO("msf_ros_node: the odometry's poses go to tf as '%s' -> '%s', the root of the left camera's tree",
+               kOdometryWorld, odometry_tf_child_->c_str());
+  }
+  if (odometry_tf_child_->empty())
+    return;
+  Eigen::Isometry3d T_camera_child = Eigen::Isometry3d::Identity();
+  std::string error;
+  const std::string& child = *odometry_tf_child_;
+  if (child != camera && !lookUp(camera, child, camera_header.stamp, T_camera_child, error)) {
+    ROS_WARN_THROTTLE(5.0, "msf_ros_node: the odometry's pose at %.3f s is not in tf: no tf from '%s' to '%s' (%s)",
+                      camera_header.stamp.toSec(), child.c_str(), camera.c_str(), error.c_str());
+    return;
+  }
+  geometry_msgs::TransformStamped message;
+  message.header.stamp = camera_header.stamp;
+  message.header.frame_id = kOdometryWorld;
+  message.child_frame_id = child;
+  message.transform = transformFromIsometry(result.T_world_cam0 * T_camera_child);
+  tf_broadcaster_.sendTransform(message);
 }
 
 bool ReconstructionNode::lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
@@ -508,8 +560,7 @@ void ReconstructionNode::publishMesh() {
     return; // meshing costs: only for a listener (the file at shutdown meshes anyway)
   meshed_frames_ = reconstructed_;
   std_msgs::Header header = last_header_;
-  // The odometry's world is the first left camera's pose: kitti2bag's camera_init.
-  header.frame_id = tracking_ || world_frame_.empty() ? "camera_init" : world_frame_;
+  header.frame_id = tracking_ || world_frame_.empty() ? kOdometryWorld : world_frame_;
   mesh_pub_.publish(meshToMarker(engine_->mesh(), header));
 }
 
@@ -546,11 +597,13 @@ std::string ReconstructionNode::summary() const {
     dropped += n;
     reasons += "\n  " + std::to_string(n) + ": " + reason;
   }
+  if (const std::string apart = stereoPairApartNote(pair_apart_ns_); !apart.empty())
+    reasons += "\n  " + apart;
   const std::size_t unmatched = scans_ - frames_;
   if (unmatched > 0)
-    reasons += "\n  " + std::to_string(unmatched) + " scans had no stereo pair (and CameraInfo) within " +
-               numberText(params_.sync_slop_s) + " s of their stamp: not frames" +
-               (silent.empty() ? "" : " (nothing came on " + silent + ")");
+    reasons += "\n  " + std::to_string(unmatched) + " scans made no frame: no stereo pair (and CameraInfo) within " +
+               numberText(params_.sync_slop_s) + " s of their stamp, or, the last ones, no messages after them " +
+               "to show which pair is nearest" + (silent.empty() ? "" : " (nothing came on " + silent + ")");
   char times[160] = "";
   if (reconstructed_ > 1 && frames_ > 1)
     std::snprintf(times, sizeof times, "\n  the engine: %.0f ms a frame (the first %.0f ms); the frames came every %.0f ms",

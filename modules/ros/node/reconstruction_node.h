@@ -14,6 +14,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
@@ -26,6 +27,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace msf {
 
@@ -110,6 +112,15 @@ private:
   bool placeFrame(Frame& frame, const std_msgs::Header& camera_header);
   /// The world frame of the poses (NodeParameters::world_frame), "" while tf shows none.
   std::string worldFrame(const std::string& camera_frame);
+  /// The root of the tf tree that holds `frame` (the frame itself when tf has no parent for it).
+  std::string treeRoot(const std::string& frame) const;
+  /// The odometry's pose of the frame to tf, as camera_init (the odometry's world) above the root
+  /// of the left camera's tree, so that the mesh and the rig's frames meet in one tree; nothing
+  /// when tf has camera_init already (kitti2bag's bags).
+  void publishOdometryTf(const FrameResult& result, const std_msgs::Header& camera_header);
+  /// Keeps the first frames' gap between the left and right images' stamps, and says once when
+  /// their median is too large (stereoPairApartNote).
+  void judgePairStamps(const Pending& pending);
   bool lookUp(const std::string& target, const std::string& source, const ros::Time& stamp,
               Eigen::Isometry3d& T, std::string& error) const;
   void publish(const FrameResult& result, const std_msgs::Header& camera_header);
@@ -129,6 +140,7 @@ private:
   std::unique_ptr<message_filters::Synchronizer<StereoPolicy>> stereo_sync_;
   std::unique_ptr<message_filters::Synchronizer<ColorPolicy>> color_sync_;
   ros::Publisher depth_pub_, weight_pub_, points_pub_, mesh_pub_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
 
   BoundedQueue<Pending> queue_;
   std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
@@ -138,12 +150,14 @@ private:
   Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;
   std::map<std::string, std::size_t> dropped_; // reason -> frames
+  std::vector<std::int64_t> pair_apart_ns_;    // the first frames' |left - right| stamps
 
   // The worker thread's own.
   std::unique_ptr<Reconstructor> engine_;
   bool tracking_ = false; // the engine's odometry gives the poses
   std::int64_t first_scan_ns_ = 0;
   std::string world_frame_; // resolved (worldFrame)
+  std::optional<std::string> odometry_tf_child_; // under camera_init (publishOdometryTf); "" = none
   std::set<std::string> refusals_logged_; // the engine's errors, each logged once
   std_msgs::Header last_header_;
   Clock::time_point last_mesh_;

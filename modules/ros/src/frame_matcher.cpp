@@ -60,24 +60,14 @@ std::string listed(const std::string& head, const std::vector<std::int64_t>& tim
   return text + (times.size() > kShown ? ", ...)" : ")");
 }
 
-/// A note when the pairs' images lie apart in time (a median above kPairApart): their cameras
-/// not triggered together, so a moving rig's depth is wrong, and past half a frame's period
-/// the left image meets the right of another frame.
+/// The note of stereoPairApartNote over the matched pairs. Past half a frame's period the left
+/// image meets the right of another frame, so the median read is at most half the period.
 std::string pairApart(const std::vector<FrameMatch>& frames, const std::vector<std::int64_t>& left,
                       const std::vector<std::int64_t>& right) {
-  constexpr std::int64_t kPairApart = 10 * 1000000;
   std::vector<std::int64_t> apart;
   for (const FrameMatch& m : frames)
     apart.push_back(std::llabs(left[m.left] - right[m.right]));
-  if (apart.empty())
-    return "";
-  std::nth_element(apart.begin(), apart.begin() + static_cast<std::ptrdiff_t>(apart.size() / 2), apart.end());
-  const std::int64_t median = apart[apart.size() / 2];
-  if (median <= kPairApart)
-    return "";
-  return "the stereo pair's images lie a median of " + std::to_string(median / 1000000) +
-         " ms apart: a pair must be taken at one instant (its cameras triggered together), else a moving rig's "
-         "depth is wrong";
+  return stereoPairApartNote(std::move(apart));
 }
 
 std::string plural(std::size_t n, const std::string& noun) {
@@ -85,6 +75,19 @@ std::string plural(std::size_t n, const std::string& noun) {
 }
 
 } // namespace
+
+std::string stereoPairApartNote(std::vector<std::int64_t> apart_ns) {
+  constexpr std::int64_t kPairApart = 10 * 1000000;
+  if (apart_ns.empty())
+    return "";
+  const auto middle = apart_ns.begin() + static_cast<std::ptrdiff_t>(apart_ns.size() / 2);
+  std::nth_element(apart_ns.begin(), middle, apart_ns.end());
+  if (*middle <= kPairApart)
+    return "";
+  return "the stereo pair's images lie a median of " + std::to_string(*middle / 1000000) +
+         " ms apart: a pair must be taken at one instant (its cameras triggered together), else a moving rig's "
+         "depth is wrong";
+}
 
 FrameMatches matchFrames(const std::vector<std::int64_t>& scans, const std::vector<std::int64_t>& left,
                          const std::vector<std::int64_t>& right, const std::vector<std::int64_t>& color,

@@ -27,4 +27,9 @@ FrameMatches matchFrames(const std::vector<std::int64_t>& scans, const std::vect
                          const std::vector<std::int64_t>& right, const std::vector<std::int64_t>& color,
                          std::int64_t max_offset_ns);
 
+/// A note when a stereo pair's images lie apart in time: the median of |left - right| over the
+/// pairs' stamps (nanoseconds) above 10 ms, their cameras not triggered together, so a moving
+/// rig's depth is wrong. "" when they lie together or there are none.
+std::string stereoPairApartNote(std::vector<std::int64_t> apart_ns);
+
 } // namespace msf
