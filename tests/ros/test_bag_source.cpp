@@ -42,6 +42,7 @@ struct TinyBag {
   std::string image_name = "image_raw";  // kitti2bag's newer versions write "image"
   std::string intensity = "intensity";   // and its older ones "i"
   bool ring_and_time = false;
+  bool instant_scans = false; // with ring_and_time: every point's time 0 (a LiDAR of one instant)
   bool camera_info = true;
   bool extrinsic = true;
   bool poses = false;
@@ -76,7 +77,8 @@ sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag&
     put(b.intensity, k, 0.25f * static_cast<float>(k));
     if (b.ring_and_time) {
       put("ring", k, static_cast<std::uint16_t>(5 + k));
-      put("time", k, -0.1f + 0.02f * static_cast<float>(k)); // a driver that stamps the sweep's end
+      // A driver that stamps the sweep's end, or a LiDAR of one instant.
+      put("time", k, b.instant_scans ? 0.f : -0.1f + 0.02f * static_cast<float>(k));
     }
   }
   const double beams_deg[] = {2.0, -4.0, -10.0};
@@ -249,6 +251,34 @@ TEST(BagSource, TheBeamsOfARigsBagComeFromItsFirstScansRings) {
   // Without rings, none: KITTI's sizes, as for a rig file that lists no beams.
   writeTinyBag(dir.file("plain.bag"), TinyBag{});
   EXPECT_TRUE(msf::BagSource(dir.file("plain.bag"), tinyTopics()).calibration().lidar.beam_elevations_deg.empty());
+}
+
+/// Scans whose points all have one time may come from a LiDAR of one instant, or from a driver
+/// that leaves the field unset: still taken as swept, and the run says how to tell it otherwise.
+TEST(BagSource, ScansOfOneInstantAreSaidWhileTheRigIsTakenAsSweeping) {
+  msf::test::TempDir dir;
+  TinyBag b;
+  b.ring_and_time = true;
+  b.instant_scans = true;
+  writeTinyBag(dir.file("instant.bag"), b);
+  const auto said = [](const msf::BagSource& source) {
+    for (const std::string& note : source.notes())
+      if (contains(note, "the first scan's points all have the same time: if the LiDAR takes each scan at one "
+                         "instant, say so with -sweeping_scans false"))
+        return true;
+    return false;
+  };
+  const msf::BagSource source(dir.file("instant.bag"), tinyTopics());
+  EXPECT_TRUE(source.calibration().lidar.sweeping);
+  EXPECT_TRUE(said(source));
+  msf::BagOptions snapshots = tinyTopics();
+  snapshots.sweeping_scans = false; // told: nothing to say
+  EXPECT_FALSE(said(msf::BagSource(dir.file("instant.bag"), snapshots)));
+  b.instant_scans = false; // the times of a sweep
+  writeTinyBag(dir.file("swept.bag"), b);
+  EXPECT_FALSE(said(msf::BagSource(dir.file("swept.bag"), tinyTopics())));
+  writeTinyBag(dir.file("plain.bag"), TinyBag{}); // no time field: nothing to go by
+  EXPECT_FALSE(said(msf::BagSource(dir.file("plain.bag"), tinyTopics())));
 }
 
 TEST(BagSource, ReadsKitti2bagsOtherNamesRingsTimesAndPosesFromTf) {

@@ -403,9 +403,12 @@ bool ReconstructionNode::startEngine(const Pending& pending) {
   }
   if (params_.sweeping_scans)
     rig.lidar.sweeping = *params_.sweeping_scans;
+  Frame first;
+  scanFromMessage(*pending.cloud, first, "the scan on '" + params_.lidar_topic + "'");
+  if (rig.lidar.sweeping && !params_.sweeping_scans && scanTimesAreOneInstant(first))
+    ROS_WARN("msf_ros_node: the first scan's points all have the same time: if the LiDAR takes each scan at one "
+             "instant, set ~sweeping_scans false (else its scans are taken as swept over their period)");
   if (rig.lidar.beam_elevations_deg.empty()) { // the beams, from the first scan's rings when it has them
-    Frame first;
-    scanFromMessage(*pending.cloud, first, "the scan on '" + params_.lidar_topic + "'");
     const std::vector<double> beams = beamElevationsFromRings(*first.scan, first.point_ring);
     if (!beams.empty()) {
       rig.lidar.beam_elevations_deg = beams;

@@ -234,8 +234,8 @@ void BagSource::readCalibration(const std::string& rig) {
   if (!rig.empty()) {
     calibration_ = loadCalibration(rig, size);
     notes_.push_back("calibration from '" + rig + "'; the bag's CameraInfo and LiDAR extrinsic are not read");
-    beamsFromFirstScan();
     applySweeping();
+    learnFromFirstScan();
     return;
   }
   const auto right = info(options_.right_topic);
@@ -261,8 +261,8 @@ void BagSource::readCalibration(const std::string& rig) {
     }
   }
   calibration_ = rigFromCameraInfo(*left, *right, color.get(), T_cam0_velo, size, path_);
-  beamsFromFirstScan();
   applySweeping();
+  learnFromFirstScan();
 }
 
 void BagSource::applySweeping() {
@@ -270,12 +270,15 @@ void BagSource::applySweeping() {
     calibration_.lidar.sweeping = *options_.sweeping_scans;
 }
 
-void BagSource::beamsFromFirstScan() {
-  if (!calibration_.lidar.beam_elevations_deg.empty())
-    return;
+void BagSource::learnFromFirstScan() {
   Frame first;
   scanFromMessage(*bag_->read<sensor_msgs::PointCloud2>(bag_->scans, 0), first,
                   "the first scan of '" + path_ + "', topic '" + options_.lidar_topic + "'");
+  if (calibration_.lidar.sweeping && !options_.sweeping_scans && scanTimesAreOneInstant(first))
+    notes_.push_back("the first scan's points all have the same time: if the LiDAR takes each scan at one instant, "
+                     "say so with -sweeping_scans false (else its scans are taken as swept over their period)");
+  if (!calibration_.lidar.beam_elevations_deg.empty())
+    return;
   const std::vector<double> beams = beamElevationsFromRings(*first.scan, first.point_ring);
   if (beams.empty())
     return;

@@ -157,6 +157,12 @@ void scanFromMessage(const sensor_msgs::PointCloud2& message, Frame& frame, cons
   frame.scan->is_dense = true;
 }
 
+bool scanTimesAreOneInstant(const Frame& frame) {
+  // scanFromMessage counts the times from the earliest: one instant is all zeros.
+  return !frame.point_time_s.empty() &&
+         std::all_of(frame.point_time_s.begin(), frame.point_time_s.end(), [](float t) { return t == 0.f; });
+}
+
 sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Header& header) {
   sensor_msgs::PointCloud2 message;
   message.header = header;

@@ -66,10 +66,12 @@ private:
 
   void resolveTopics();
   void readCalibration(const std::string& rig);
-  /// The LiDAR's beams from the first scan's rings, when the rig lists none (beamElevationsFromRings).
-  void beamsFromFirstScan();
   /// BagOptions::sweeping_scans, when given, on the rig.
   void applySweeping();
+  /// What the first scan tells of the LiDAR: its beams from the rings, when the rig lists none
+  /// (beamElevationsFromRings), and a note when its points' times say one instant while the rig
+  /// is taken as sweeping.
+  void learnFromFirstScan();
   void matchAndPose();
 
   std::string path_;

@@ -33,6 +33,11 @@ ros::Time stampFromNs(std::int64_t ns);
 /// InvalidInputError naming `what` and the field when x, y or z is missing or a field does not
 /// fit in a point.
 void scanFromMessage(const sensor_msgs::PointCloud2& message, Frame& frame, const std::string& what);
+
+/// Whether a scan read by scanFromMessage has one time at every point (a `time` field of one
+/// value): a LiDAR that takes each scan at once, or a driver that leaves the field unset, which
+/// only the rig can tell apart. False for a scan without times.
+bool scanTimesAreOneInstant(const Frame& frame);
 /// frame.scan as a PointCloud2 of float32 x y z intensity (kitti2bag's fields), with `ring`
 /// (uint16) and `time` (float32) when the frame has them.
 sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Header& header);
