@@ -2,7 +2,7 @@
 """Depth images to points, in numpy: what a notebook plots or hands to another library."""
 import numpy as np
 
-from ._core import Calibration, InvalidInputError, PinholeCamera
+from ._core import Calibration, InvalidInputError, PinholeCamera, _rigid_pose
 
 
 def depth_to_points(depth, camera, color=None, pose=None):
@@ -26,9 +26,7 @@ def depth_to_points(depth, camera, color=None, pose=None):
             raise InvalidInputError(f"color must have shape {depth.shape} or {depth.shape + (3,)} of the depth, "
                                     f"got {color.shape}")
     if pose is not None:
-        pose = np.asarray(pose, dtype=np.float64)
-        if pose.shape != (4, 4):
-            raise InvalidInputError(f"pose must have shape (4, 4), got {pose.shape}")
+        pose = _rigid_pose(np.asarray(pose, dtype=np.float64), "pose")
     v, u = np.nonzero(np.isfinite(depth) & (depth > 0))
     z = depth[v, u].astype(np.float32)
     points = np.stack([(u - camera.cx) * z / camera.fx, (v - camera.cy) * z / camera.fy, z], axis=1).astype(np.float32)

@@ -49,12 +49,20 @@ py::array requireArray(const py::handle& object, const char* name) {
   return py::reinterpret_borrow<py::array>(object);
 }
 
+// EquivTypes, not the type number alone: a byte-swapped float32 is not float32 in memory.
+bool equivalent(const py::dtype& a, const py::dtype& b) {
+  return py::detail::npy_api::get().PyArray_EquivTypes_(a.ptr(), b.ptr());
+}
+
 void requireDtype(const py::array& array, const char* name, int depth) {
   const py::dtype wanted = dtypeOf(depth);
-  // EquivTypes, not the type number alone: a byte-swapped float32 is not float32 in memory.
-  if (!py::detail::npy_api::get().PyArray_EquivTypes_(array.dtype().ptr(), wanted.ptr()))
-    throw InvalidInputError(std::string(name) + " must be " + text(wanted) + ", got " + text(array.dtype()) +
-                            " (convert it with .astype(numpy." + text(wanted) + "))");
+  if (equivalent(array.dtype(), wanted))
+    return;
+  // .astype(uint8) of wider values keeps their low byte, and of a float image in 0..1 zeros and ones.
+  const std::string how = depth == CV_8U ? "scale it to 0..255 first, then .astype(numpy.uint8)"
+                                         : "convert it with .astype(numpy." + text(wanted) + ")";
+  throw InvalidInputError(std::string(name) + " must be " + text(wanted) + ", got " + text(array.dtype()) + " (" +
+                          how + ")");
 }
 
 void requireContiguous(const py::array& array, const char* name) {
@@ -93,6 +101,11 @@ cv::Mat imageView(const py::handle& object, const char* name, int type, cv::Size
                             " (W x H), expected " + std::to_string(expected.width) + "x" +
                             std::to_string(expected.height));
   return cv::Mat(static_cast<int>(rows), static_cast<int>(cols), type, const_cast<void*>(array.data()));
+}
+
+bool hasDepth(const py::handle& object, int depth) {
+  return py::isinstance<py::array>(object) &&
+         equivalent(py::reinterpret_borrow<py::array>(object).dtype(), dtypeOf(depth));
 }
 
 cv::Mat optionalImageView(const py::handle& object, const char* name, int type, cv::Size expected) {
@@ -140,7 +153,14 @@ cv::Mat rowsView(const py::handle& object, const char* name, int depth, int min_
                  const_cast<void*>(array.data()));
 }
 
-pcl::PointCloud<pcl::PointXYZI>::Ptr scanFromPoints(const cv::Mat& points) {
+cv::Mat scanView(const py::handle& array) {
+  return rowsView(array, "scan", hasDepth(array, CV_64F) ? CV_64F : CV_32F, 3, 4);
+}
+
+pcl::PointCloud<pcl::PointXYZI>::Ptr scanFromPoints(const cv::Mat& given) {
+  cv::Mat points = given;
+  if (points.depth() == CV_64F) // Open3D's and most numpy code's points: to PCL's floats
+    given.convertTo(points, CV_32F);
   pcl::PointCloud<pcl::PointXYZI>::Ptr scan(new pcl::PointCloud<pcl::PointXYZI>);
   scan->resize(static_cast<std::size_t>(points.rows));
   const bool has_reflectance = points.cols == 4;

@@ -49,6 +49,9 @@ cv::Mat imageView(const py::handle& array, const char* name, int type, cv::Size 
 /// The same for an optional argument: an empty cv::Mat for None.
 cv::Mat optionalImageView(const py::handle& array, const char* name, int type, cv::Size expected = {});
 
+/// Whether `array` is a numpy array of OpenCV depth `depth`'s dtype (CV_16U: uint16).
+bool hasDepth(const py::handle& array, int depth);
+
 /// Throws InvalidInputError naming `name` and the first pixel of a CV_32FC1 `image` (empty: none)
 /// outside lo..hi, or NaN unless `nan_allowed` (a depth image's NaN is no depth, as its 0);
 /// `hint` ends the message.
@@ -64,8 +67,10 @@ void requireWeightValues(const cv::Mat& image, const char* name);
 /// CV_32F, CV_32S, CV_8U... Throws InvalidInputError naming `name` as imageView.
 cv::Mat rowsView(const py::handle& array, const char* name, int depth, int min_columns, int max_columns);
 
-/// A LiDAR scan from rowsView's (N, 3) or (N, 4) x y z [reflectance]: a copy, as PCL's
-/// points are 32 bytes (reflectance 0 for (N, 3)).
+/// rowsView of a scan argument: (N, 3) or (N, 4) x y z [reflectance], float32 or float64.
+cv::Mat scanView(const py::handle& array);
+/// A LiDAR scan from scanView's rows: a copy, as PCL's points are 32 bytes (reflectance 0 for
+/// (N, 3)).
 pcl::PointCloud<pcl::PointXYZI>::Ptr scanFromPoints(const cv::Mat& points);
 /// A scan as an (N, 4) float32 array of x y z reflectance (a copy).
 py::object toArray(const pcl::PointCloud<pcl::PointXYZI>& scan);
@@ -85,10 +90,10 @@ py::array_t<double> toArray(const Eigen::Isometry3d& pose);
 
 /// Runs `work` with the GIL released and `mutex` held: heavy calls let other Python threads
 /// run, and calls on one object from several threads take turns (the stages keep buffers).
-template <typename Work>
-auto withoutGil(std::mutex& mutex, Work&& work) {
+template <typename Mutex, typename Work>
+auto withoutGil(Mutex& mutex, Work&& work) {
   py::gil_scoped_release release;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<Mutex> lock(mutex);
   return std::forward<Work>(work)();
 }
 

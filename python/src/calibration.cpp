@@ -168,6 +168,10 @@ void bindCalibration(py::module_& m) {
           "True for a spinning LiDAR, each scan swept over its period (the odometry deskews it, the scan's "
           "carving allows for its skew); False for scans taken at one instant. A rig file's lidar.sweeping; "
           "False for a synthetic sequence's.")
+      .def_property_readonly("lidar_rings", [](const Calibration& c) { return c.lidar.rings; },
+                             "The LiDAR's beams (0: unknown, the stages take them from the scans).")
+      .def_property_readonly("beam_elevations_deg", [](const Calibration& c) { return c.lidar.beam_elevations_deg; },
+                             "The LiDAR's beam elevations in degrees, lowest first ([]: unknown).")
       .def("K", &Calibration::K, py::arg("camera") = 0, "The 3x3 intrinsic matrix of a camera (0..3).")
       .def("baseline", &Calibration::baseline, py::arg("camera_a") = 0, py::arg("camera_b") = 1,
            "Distance between two optical centres in metres.")
@@ -178,7 +182,8 @@ void bindCalibration(py::module_& m) {
       .def("save_yaml",
            [](const Calibration& c, const std::filesystem::path& path) { saveCalibrationYaml(c, path.string()); },
            py::arg("path"),
-           "Writes the project's YAML rig file (read back by Calibration.load).")
+           "Writes the project's YAML camera file: P0..P3, the image size, the LiDAR's extrinsic and its "
+           "description (sweeping, rings, beam elevations); load_calibration reads it back the same.")
       .def("__repr__", &describe);
   m.def("load_calibration", &load, py::arg("path"), py::arg("image_size") = py::none(),
         "Calibration.load: a KITTI calib.txt, raw date folder, object calib file or the project's YAML rig.");

@@ -6,6 +6,7 @@
 #include "frame_object.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
 #include <msf/io/bag_options.h>
 #include <msf/pipeline/open_dataset.h>
@@ -13,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -27,10 +29,14 @@ FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayA
   Frame& frame = object.frame;
   frame.index = index;
   frame.timestamp = timestamp;
-  frame.left = imageView(left, "left", CV_8UC1);
-  frame.right = imageView(right, "right", CV_8UC1, frame.left.size());
-  const cv::Mat points = rowsView(scan, "scan", CV_32F, 3, 4);
-  const cv::Mat rgb = optionalImageView(color, "color", CV_8UC3);
+  // A 10- to 16-bit camera's uint16 images are scaled to 8 bits as the folder and bag readers
+  // scale them: by the bits the brighter image of the pair needs, one gain for both.
+  const int depth = hasDepth(left, CV_16U) ? CV_16U : CV_8U;
+  frame.left = imageView(left, "left", CV_MAKETYPE(depth, 1));
+  frame.right = imageView(right, "right", CV_MAKETYPE(depth, 1), frame.left.size());
+  const cv::Mat points = scanView(scan);
+  const int color_depth = hasDepth(color, CV_16U) ? CV_16U : CV_8U;
+  cv::Mat rgb = optionalImageView(color, "color", CV_MAKETYPE(color_depth, 3));
   if (!pose.is_none()) {
     frame.T_world_cam0 = poseFrom(pose, "pose");
     frame.has_pose = true;
@@ -38,11 +44,19 @@ FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayA
   {
     py::gil_scoped_release release;
     frame.scan = scanFromPoints(points);
+    if (depth == CV_16U) {
+      const int bits = std::max(significantBits(frame.left), significantBits(frame.right));
+      frame.left = toEightBit(frame.left, bits);
+      frame.right = toEightBit(frame.right, bits);
+    }
+    if (color_depth == CV_16U)
+      rgb = toEightBit(rgb, significantBits(rgb));
     if (!rgb.empty())
       cv::cvtColor(rgb, frame.color, cv::COLOR_RGB2BGR); // the library's order
   }
   object.name = name.empty() ? std::to_string(index) : name;
-  object.arrays = py::make_tuple(left, right);
+  // The frame views the caller's arrays, unless they were scaled to 8 bits into its own images.
+  object.arrays = depth == CV_8U ? py::object(py::make_tuple(left, right)) : py::object(py::none());
   return object;
 }
 
@@ -100,9 +114,11 @@ void bindFrame(py::module_& m) {
                           "image and the pose of camera 0 (T_world_cam0), if any.")
       .def(py::init(&fromArrays), py::arg("left"), py::arg("right"), py::arg("scan"), py::arg("color") = py::none(),
            py::arg("pose") = py::none(), py::arg("index") = 0, py::arg("timestamp") = 0.0, py::arg("name") = "",
-           "A frame from arrays: left, right (H, W) uint8 grey (viewed, not copied), scan (N, 4) float32 x y z "
-           "reflectance in the LiDAR's frame or (N, 3), color (H, W, 3) uint8 RGB of the colour camera (the "
-           "rectified cameras share one image size), pose 4x4 T_world_cam0 (None: no pose).")
+           "A frame from arrays: left, right (H, W) uint8 grey (viewed, not copied), or uint16 of a 10- to 16-bit "
+           "camera (scaled to 8 bits by the bits the brighter image needs, one gain for both, as the dataset "
+           "readers scale them), scan (N, 4) float32 (or float64) x y z reflectance in the LiDAR's frame or "
+           "(N, 3), color (H, W, 3) uint8 (or uint16) RGB of the colour camera (the rectified cameras share one "
+           "image size), pose 4x4 T_world_cam0 (None: no pose).")
       .def_property_readonly("index", [](const FrameObject& f) { return f.frame.index; })
       .def_property_readonly("name", [](const FrameObject& f) { return f.name; }, "File stem ('000042').")
       .def_property_readonly("timestamp", [](const FrameObject& f) { return f.frame.timestamp; },

@@ -24,6 +24,12 @@ PYBIND11_MODULE(_core, m) {
         "Threads of the library's parallel loops (OpenCV's pool, shared by every object): n, 1 or 0 = "
         "the calling thread only, negative = all the cores (the default).");
   m.def("get_num_threads", &cv::getNumThreads, "Threads of the library's parallel loops.");
+  m.def(
+      "_rigid_pose",
+      [](const py::handle& pose, const std::string& name) { return toArray(poseFrom(pose, name.c_str())); },
+      py::arg("pose"), py::arg("name"),
+      "A 4x4 float64 copy of `pose`; InvalidInputError naming `name` when it is not a rigid transform, as every "
+      "function that takes a pose checks it.");
   m.def("use_huge_pages_for_large_images", &msf::useHugePagesForLargeImages,
         "Images of 1 MiB or more on transparent huge pages, for the rest of the process, as the tools have them: "
         "fewer page faults for the images each frame allocates. The same values; it changes OpenCV's allocator "

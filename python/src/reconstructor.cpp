@@ -30,7 +30,9 @@ struct Engine {
   Engine(const Calibration& rig, const PipelineConfig& config, const Reconstructor::Options& options)
       : engine(rig, config, options) {}
   Reconstructor engine;
-  std::mutex mutex;
+  /// Calls from several Python threads take turns; run() holds it on its own thread, where its
+  /// on_frame callback may call mesh() or num_blocks (the engine refuses the others there).
+  std::recursive_mutex mutex;
 };
 
 Reconstructor::PoseMode parsePoseMode(const std::string& text) {
@@ -83,7 +85,7 @@ TriangleMesh mesh(Engine& e) {
 /// Reconstructor::run on a thread of its own while this one, the caller's, waits without the GIL
 /// and looks for signals every 0.1 s: Ctrl-C stops the run after the frame being integrated (as
 /// msf_reconstruct does) and is raised once the run has ended. `on_frame` gets each FrameResult
-/// on the engine's integration thread, with the GIL.
+/// on the engine's integration thread, with the GIL; it may call mesh() and num_blocks.
 py::dict run(Engine& e, const FrameSource& source, std::optional<std::vector<std::size_t>> frames,
              const py::object& on_frame) {
   std::vector<std::size_t> indices(source.size());
@@ -105,12 +107,12 @@ py::dict run(Engine& e, const FrameSource& source, std::optional<std::vector<std
   std::exception_ptr failure;
   {
     py::gil_scoped_release release;
-    std::lock_guard<std::mutex> engine_lock(e.mutex);
     std::mutex done_mutex;
     std::condition_variable done_signal;
     bool done = false;
     std::thread runner([&] {
       try {
+        std::lock_guard<std::recursive_mutex> engine_lock(e.mutex);
         stats = e.engine.run(source, indices, callback, &stop);
       } catch (...) {
         failure = std::current_exception();
@@ -236,8 +238,10 @@ void bindReconstructor(py::module_& m) {
       .def("run", &run, py::arg("source"), py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
            "The frames of a source (a Sequence; all, or the indices given) overlapped on the engine's "
            "threads: the same map as add_frame frame by frame, faster. on_frame(result) is called after each "
-           "frame is integrated, in order. Ctrl-C stops after the frame being integrated. Returns frames_done, "
-           "wall_s, first_frame_s and interrupted.")
+           "frame is integrated, in order; it may call mesh() and num_blocks (another call of the engine raises "
+           "msfusion.Error). Ctrl-C stops after the frame being integrated and raises KeyboardInterrupt, the map "
+           "holding the frames done. Returns frames_done, wall_s, first_frame_s and interrupted (a stop that was "
+           "not Ctrl-C's).")
       .def_property_readonly("calibration", [](Engine& e) { return e.engine.calibration(); })
       .def_property_readonly("config", [](Engine& e) { return e.engine.config(); })
       .def_property_readonly("num_blocks", [](Engine& e) {

@@ -7,6 +7,7 @@
 #include <msf/fusion/depth_image_fusion.h>
 #include <msf/io/pinhole_camera.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/real_returns.h>
 #include <msf/stereo/color_sampler.h>
@@ -24,16 +25,18 @@ namespace msf::python {
 namespace {
 
 /// Steps 1-2: LidarCompletion, the scan projected onto the image grown by projection.margin_px
-/// and completed (compound interpolation by default).
+/// and completed (compound interpolation by default). Each stage takes `config` adapted to the
+/// rig (adaptToRig), as the engine and the tools that run one stage do.
 struct LidarStage {
   LidarStage(const Calibration& calibration, const PipelineConfig& config, const std::string& method)
-      : completion(calibration, parseCompletionMethod(method), config.projection, config.interpolation) {}
+      : completion(calibration, parseCompletionMethod(method), adaptToRig(config, calibration).projection,
+                   adaptToRig(config, calibration).interpolation) {}
   LidarCompletion completion;
   std::mutex mutex;
 };
 
 py::tuple computeLidarDepth(LidarStage& stage, const ArrayArg& scan) {
-  const cv::Mat points = rowsView(scan, "scan", CV_32F, 3, 4);
+  const cv::Mat points = scanView(scan);
   cv::Mat depth, distance;
   withoutGil(stage.mutex, [&] {
     const auto cloud = scanFromPoints(points);
@@ -46,7 +49,7 @@ py::tuple computeLidarDepth(LidarStage& stage, const ArrayArg& scan) {
 struct StereoStage {
   StereoStage(const Calibration& calibration, const PipelineConfig& config)
       : size(calibration.requireImageSize()) {
-    matcher.setConfig(config.stereo);
+    matcher.setConfig(adaptToRig(config, calibration).stereo);
     matcher.setCalibration(calibration);
   }
   SgbmStereo matcher;
@@ -76,7 +79,8 @@ py::tuple computeStereoDepth(StereoStage& stage, const ArrayArg& left, const Arr
 
 /// Step 4: DepthImageFusion, the per-pixel fusion of the two depth images.
 struct FusionStage {
-  FusionStage(const Calibration& calibration, const PipelineConfig& config) : fusion(config.fusion) {
+  FusionStage(const Calibration& calibration, const PipelineConfig& config)
+      : fusion(adaptToRig(config, calibration).fusion) {
     fusion.setCalibration(calibration);
   }
   DepthImageFusion fusion;
@@ -144,19 +148,19 @@ void bindStages(py::module_& m) {
   py::class_<LidarStage>(m, "LidarCompletion",
                          "Steps 1-2: a LiDAR scan projected into camera 0 (onto the image grown by "
                          "projection.margin_px) and completed to dense depth. Takes the sections projection and "
-                         "interpolation of `config`.")
+                         "interpolation of `config`, adapted to the rig as the engine adapts them.")
       .def(py::init<const Calibration&, const PipelineConfig&, const std::string&>(), py::arg("calibration"),
            py::arg("config") = defaults, py::arg("method") = "compound",
            "method: compound (the paper's), linear, cubic, ipbasic or ipbasic_multiscale.")
       .def("compute_depth", &computeLidarDepth, py::arg("scan"),
-           "scan: (N, 4) float32 x y z reflectance in the LiDAR's frame (a KITTI .bin), or (N, 3). Returns "
-           "(depth, distance): (H, W) float32 metres (0 = none) and pixels to the nearest real return.")
+           "scan: (N, 4) float32 (or float64) x y z reflectance in the LiDAR's frame (a KITTI .bin), or (N, 3). "
+           "Returns (depth, distance): (H, W) float32 metres (0 = none) and pixels to the nearest real return.")
       .def_property_readonly("camera", [](const LidarStage& s) { return s.completion.camera(); },
                              "The camera of the depth image.");
 
   py::class_<StereoStage>(m, "SgbmStereo",
                           "Step 3: semi-global matching on the rectified grey pair of cameras 0 and 1. Takes the "
-                          "section stereo of `config`.")
+                          "section stereo of `config`, adapted to the rig as the engine adapts it.")
       .def(py::init<const Calibration&, const PipelineConfig&>(), py::arg("calibration"), py::arg("config") = defaults)
       .def("compute_depth", &computeStereoDepth, py::arg("left"), py::arg("right"), py::arg("prior") = py::none(),
            py::arg("guidance") = py::none(),
@@ -166,7 +170,7 @@ void bindStages(py::module_& m) {
 
   py::class_<FusionStage>(m, "DepthFusion",
                           "Step 4: the per-pixel fusion of the LiDAR's and the stereo depth. Takes the section "
-                          "fusion of `config`.")
+                          "fusion of `config`, adapted to the rig as the engine adapts it.")
       .def(py::init<const Calibration&, const PipelineConfig&>(), py::arg("calibration"), py::arg("config") = defaults)
       .def("fuse", &fuse, py::arg("lidar_depth"), py::arg("lidar_distance"), py::arg("stereo_depth"),
            py::arg("stereo_confidence"), py::arg("left") = py::none(), py::arg("free_space") = false,

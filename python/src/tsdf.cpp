@@ -7,6 +7,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
 #include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/reconstruction/depth_frame.h>
 #include <msf/reconstruction/marching_cubes.h>
 #include <msf/reconstruction/tsdf_integrator.h>
@@ -37,8 +38,9 @@ struct Tsdf {
   std::mutex mutex;
 };
 
-std::unique_ptr<Tsdf> makeTsdf(const PipelineConfig& config, std::optional<double> voxel_size,
-                               std::optional<double> truncation) {
+std::unique_ptr<Tsdf> makeTsdf(const PipelineConfig& given, std::optional<double> voxel_size,
+                               std::optional<double> truncation, const std::optional<Calibration>& calibration) {
+  const PipelineConfig config = calibration ? adaptToRig(given, *calibration) : given;
   return std::make_unique<Tsdf>(config, voxel_size.value_or(config.volume.voxel_size_m),
                                 truncation.value_or(config.volume.truncation_m));
 }
@@ -118,9 +120,10 @@ void bindTsdf(py::module_& m) {
   py::class_<Tsdf>(m, "TsdfVolume",
                    "A sparse, boundless TSDF volume with its integrator and incremental mesher (step 5). Takes the "
                    "sections tsdf_volume, tsdf_integrator and marching_cubes of `config`; voxel_size and "
-                   "truncation (metres) override the first.")
+                   "truncation (metres) override the first; with the rig's `calibration`, the keys are adapted to "
+                   "it as the engine adapts them (adaptToRig: tsdf_integrator.max_depth_m, by its stereo's range).")
       .def(py::init(&makeTsdf), py::arg("config") = defaults, py::arg("voxel_size") = py::none(),
-           py::arg("truncation") = py::none())
+           py::arg("truncation") = py::none(), py::arg("calibration") = py::none())
       .def("integrate", &integrateDepth, py::arg("depth"), py::arg("pose"), py::arg("camera"),
            py::arg("weight") = py::none(), py::arg("color") = py::none(), py::arg("free_space_weight") = py::none(),
            py::arg("sky_depth") = py::none(),

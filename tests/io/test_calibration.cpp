@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/calibration.h>
 #include <msf/io/pinhole_camera.h>
+#include <msf/io/rig_file.h>
 #include <msf/io/velodyne_io.h>
 
 #include "test_support.h"
@@ -131,11 +132,36 @@ TEST(Calibration, YamlRoundTrip) {
     EXPECT_TRUE(c.P[i].isApprox(y.P[i], 1e-12));
   EXPECT_TRUE(c.T_cam0_velo.isApprox(y.T_cam0_velo, 1e-12));
   EXPECT_EQ(y.image_size, c.image_size);
+  EXPECT_TRUE(y.lidar.sweeping);
+  EXPECT_TRUE(y.lidar.beam_elevations_deg.empty());
+  // A rig's LiDAR description is kept: a snapshot LiDAR of three beams reads back as one.
+  msf::Calibration rig = c;
+  rig.lidar = {3, {-10.0, -4.0, 2.0}, false};
+  msf::saveCalibrationYaml(rig, dir.file("rig.yaml"));
+  const msf::Calibration r = msf::loadCalibration(dir.file("rig.yaml"));
+  EXPECT_FALSE(r.lidar.sweeping);
+  EXPECT_EQ(r.lidar.rings, 3);
+  EXPECT_EQ(r.lidar.beam_elevations_deg, rig.lidar.beam_elevations_deg);
   // And as an odometry calib.txt.
   msf::saveOdometryCalibration(c, dir.file("calib.txt"));
   const msf::Calibration o = msf::loadCalibration(dir.file("calib.txt"));
   EXPECT_TRUE(c.P[2].isApprox(o.P[2], 1e-9));
   EXPECT_TRUE(c.T_cam0_velo.isApprox(o.T_cam0_velo, 1e-9));
+}
+
+TEST(Calibration, ValidateChecksTheLidarsBeams) {
+  const Eigen::Isometry3d lidar = Eigen::Isometry3d::Identity();
+  msf::Calibration c = msf::makeRig(cv::Size(64, 48), 50, 50, 32, 24, 0.5, &lidar, {3, {-10.0, -4.0, 2.0}, true});
+  c.validate();
+  c.lidar.rings = 32; // as a program may set it by hand
+  EXPECT_NE(msf::test::errorOf([&] { c.validate(); })
+                .find("lidar.rings is 32 but lidar.beam_elevations_deg holds 3: one elevation per ring"),
+            std::string::npos);
+  c.lidar.rings = 3;
+  c.lidar.beam_elevations_deg = {-10.0, 2.0, -4.0};
+  EXPECT_NE(msf::test::errorOf([&] { c.validate(); })
+                .find("lidar.beam_elevations_deg must rise from the lowest beam to the highest"),
+            std::string::npos);
 }
 
 class CalibrationErrors : public ::testing::Test {

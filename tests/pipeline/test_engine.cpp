@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 namespace {
 
@@ -103,6 +104,12 @@ TEST_F(PipelineTest, AFrameThatDoesNotFitIsRefusedBeforeTheEngineChanges) {
   broken = first;
   broken.color = cv::Mat(10, 10, CV_8UC3);
   refused(broken, "frame 0's colour image is 10x10 but calibration");
+  broken = first; // a BGR pair: the stages need grey
+  cv::cvtColor(first.left, broken.left, cv::COLOR_GRAY2BGR);
+  refused(broken, "frame 0's left image must be 8-bit grey (CV_8UC1), not CV_8UC3: convert it with cv::cvtColor");
+  broken = first;
+  broken.color = first.left.clone();
+  refused(broken, "frame 0's colour image must be 8-bit BGR (CV_8UC3), not CV_8UC1");
   broken = first;
   broken.point_time_s.assign(3, 0.f);
   refused(broken, "frame 0 has 3 point times for");
@@ -113,6 +120,61 @@ TEST_F(PipelineTest, AFrameThatDoesNotFitIsRefusedBeforeTheEngineChanges) {
   refused([&] { msf::Frame f = second; f.left = cv::Mat(); return f; }(), "frame 1's left image is missing");
   EXPECT_TRUE(engine.addFrame(second).T_world_cam0.isApprox(pose, 1e-12));
   EXPECT_EQ(engine.odometryMs().size(), 2u);
+}
+
+TEST_F(PipelineTest, ARigThatIsNotPhysicalIsRefusedWhenTheEngineIsMade) {
+  const msf::Sequence sequence(dataset());
+  msf::Calibration rig = sequence.calibration();
+  rig.T_cam0_velo.linear() *= 1000.0; // millimetres where metres are due
+  EXPECT_NE(msf::test::errorOf([&] { msf::Reconstructor(rig, msf::PipelineConfig{}); })
+                .find("the LiDAR-to-camera transform is not a rigid transform"),
+            std::string::npos);
+  rig = sequence.calibration();
+  rig.P[2](0, 0) = -5.0;
+  EXPECT_NE(msf::test::errorOf([&] { msf::Reconstructor(rig, msf::PipelineConfig{}); })
+                .find("P2 has fx -5"),
+            std::string::npos);
+}
+
+TEST_F(PipelineTest, TheEngineTakesOneCallAtATime) {
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  std::string other_thread, nested;
+  std::size_t meshed = 0;
+  engine.run(sequence, {0, 1}, [&](msf::FrameResult&) {
+    // While run() holds the engine, another thread's call is refused, not interleaved with it.
+    std::thread([&] { other_thread = msf::test::errorOf([&] { engine.mesh(); }); }).join();
+    nested = msf::test::errorOf([&] { engine.addFrame(sequence.load(2)); });
+    meshed = engine.mesh().triangles.size(); // the callback's own thread may mesh
+  });
+  for (const auto& [error, expected] :
+       {std::pair<std::string, const char*>{other_thread, "msf::Reconstructor::mesh was called while another thread "
+                                                          "is in a call of the same engine: it takes one call at a time"},
+        {nested, "msf::Reconstructor::addFrame was called within another call of the same engine (run()'s callback): "
+                 "only mesh() may be"}})
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  EXPECT_GT(meshed, 0u);
+  // Once run() returned, any thread may call it.
+  std::size_t after = 0;
+  std::thread([&] { after = engine.addFrame(sequence.load(2)).index; }).join();
+  EXPECT_EQ(after, 2u);
+}
+
+TEST_F(PipelineTest, AnImageThatIsAViewIntoALargerOneGivesItsCopysDepth) {
+  // OpenCV's filters read past a view's edge into the image it was cut from.
+  const msf::Sequence sequence(dataset());
+  const msf::Frame frame = sequence.load(1);
+  msf::Frame viewed = frame;
+  for (cv::Mat* image : {&viewed.left, &viewed.right, &viewed.color}) {
+    cv::Mat larger(image->rows + 40, image->cols + 40, image->type(), cv::Scalar::all(255));
+    image->copyTo(larger(cv::Rect(20, 20, image->cols, image->rows)));
+    *image = larger(cv::Rect(20, 20, image->cols, image->rows));
+  }
+  ASSERT_TRUE(viewed.left.isSubmatrix());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  const msf::FrameResult copied = engine.computeDepth(frame), from_views = engine.computeDepth(viewed);
+  EXPECT_EQ(cv::countNonZero(copied.fused.depth != from_views.fused.depth), 0);
+  EXPECT_EQ(cv::countNonZero(copied.stereo_depth != from_views.stereo_depth), 0);
 }
 
 TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {

@@ -288,6 +288,28 @@ Calibration fromYaml(const std::string& path) {
   }
 }
 
+/// The LiDAR's description (Calibration::Lidar) as saveCalibrationYaml writes it: keys
+/// lidar_sweeping (0 or 1), lidar_rings and lidar_beam_elevations_deg (1xN), each optional.
+void readLidarYaml(const cv::FileStorage& in, const std::string& path, Calibration::Lidar& lidar) {
+  const auto integer = [&](const char* key, int lowest, int highest) {
+    const cv::FileNode node = in[key];
+    if (!node.isInt() || static_cast<int>(node) < lowest || static_cast<int>(node) > highest)
+      throw CalibrationError("calibration '" + path + "': key '" + key + "' must be an integer " +
+                             std::to_string(lowest) + ".." + std::to_string(highest));
+    return static_cast<int>(node);
+  };
+  if (!in["lidar_sweeping"].empty())
+    lidar.sweeping = integer("lidar_sweeping", 0, 1) == 1;
+  if (!in["lidar_rings"].empty())
+    lidar.rings = integer("lidar_rings", 1, 1024);
+  const cv::FileNode beams = in["lidar_beam_elevations_deg"];
+  if (beams.empty())
+    return;
+  const int count = beams.isMap() && beams["cols"].isInt() ? static_cast<int>(beams["cols"]) : 0;
+  const cv::Mat e = readMatrixYaml(in, "lidar_beam_elevations_deg", 1, std::max(count, 1), path);
+  lidar.beam_elevations_deg.assign(e.begin<double>(), e.end<double>());
+}
+
 Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path) {
   Calibration c;
   c.source = path;
@@ -310,6 +332,7 @@ Calibration fromYamlNodes(const cv::FileStorage& in, const std::string& path) {
   for (int r = 0; r < 4; ++r)
     for (int col = 0; col < 4; ++col)
       c.T_cam0_velo.matrix()(r, col) = T.at<double>(r, col);
+  readLidarYaml(in, path, c.lidar);
   return c;
 }
 
@@ -369,6 +392,15 @@ void Calibration::validate() const {
   }
   if (image_size.width != 0 || image_size.height != 0)
     limits::checkImageSize(image_size.width, image_size.height, where);
+  const std::vector<double>& beams = lidar.beam_elevations_deg;
+  if (!beams.empty() && lidar.rings != 0 && lidar.rings != static_cast<int>(beams.size()))
+    throw CalibrationError(where + ": lidar.rings is " + std::to_string(lidar.rings) + " but " +
+                           "lidar.beam_elevations_deg holds " + std::to_string(beams.size()) +
+                           ": one elevation per ring");
+  for (std::size_t i = 0; i < beams.size(); ++i)
+    if (!(std::abs(beams[i]) < 90.0) || (i > 0 && !(beams[i] > beams[i - 1])))
+      throw CalibrationError(where + ": lidar.beam_elevations_deg must rise from the lowest beam to the highest, "
+                                     "within -90 .. 90 degrees");
   try {
     limits::checkRigid(T_cam0_velo, where + ": the LiDAR-to-camera transform");
     if (has_imu)
@@ -473,6 +505,14 @@ void saveCalibrationYaml(const Calibration& calibration, const std::string& path
       for (int c = 0; c < 4; ++c)
         T.at<double>(r, c) = calibration.T_cam0_velo.matrix()(r, c);
     out << "T_cam0_velo" << T;
+    const Calibration::Lidar& lidar = calibration.lidar;
+    out << "lidar_sweeping" << (lidar.sweeping ? 1 : 0);
+    if (lidar.rings > 0)
+      out << "lidar_rings" << lidar.rings;
+    if (!lidar.beam_elevations_deg.empty())
+      out << "lidar_beam_elevations_deg"
+          << cv::Mat(1, static_cast<int>(lidar.beam_elevations_deg.size()), CV_64F,
+                     const_cast<double*>(lidar.beam_elevations_deg.data()));
   }
   const std::string text = out.releaseAndGetString();
   writeStreamAtomically(path, [&](std::ostream& stream) { stream << text; });

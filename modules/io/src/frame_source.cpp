@@ -41,14 +41,18 @@ FrameRange FrameRange::parse(const std::string& text) {
 namespace {
 
 
-void checkImage(const cv::Mat& image, const std::string& what, const Calibration& calibration, bool optional) {
+/// An image of `channels` 8-bit channels (1: grey, 3: BGR) and the calibration's size.
+void checkImage(const cv::Mat& image, const std::string& what, const Calibration& calibration, int channels,
+                bool optional) {
   if (image.empty()) {
     if (optional)
       return;
     throw InvalidInputError(what + " is missing or empty");
   }
-  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    throw InvalidInputError(what + " must be 8-bit grey or BGR, not OpenCV type " + std::to_string(image.type()));
+  if (image.type() != CV_MAKETYPE(CV_8U, channels))
+    throw InvalidInputError(what + " must be " + (channels == 1 ? "8-bit grey (CV_8UC1)" : "8-bit BGR (CV_8UC3)") +
+                            ", not " + cv::typeToString(image.type()) +
+                            (channels == 1 && image.depth() == CV_8U ? ": convert it with cv::cvtColor" : ""));
   const cv::Size expected = calibration.image_size;
   if (expected.area() > 0 && image.size() != expected)
     throw InvalidInputError(what + " is " + sizeText(image) + " but calibration '" + calibration.source + "' is " +
@@ -68,11 +72,21 @@ void checkFrame(const Frame& frame, const Calibration& calibration) {
     if (count != 0 && count != points)
       throw InvalidInputError(name + " has " + std::to_string(count) + " point " + what + " for " +
                               std::to_string(points) + " scan points");
-  checkImage(frame.left, name + "'s left image", calibration, false);
-  checkImage(frame.right, name + "'s right image", calibration, false);
-  checkImage(frame.color, name + "'s colour image", calibration, true);
+  checkImage(frame.left, name + "'s left image", calibration, 1, false);
+  checkImage(frame.right, name + "'s right image", calibration, 1, false);
+  checkImage(frame.color, name + "'s colour image", calibration, 3, true);
   if (frame.has_pose)
     limits::checkRigid(frame.T_world_cam0, name + "'s pose T_world_cam0");
+}
+
+const Frame& withWholeImages(const Frame& frame, Frame& copy) {
+  if (!frame.left.isSubmatrix() && !frame.right.isSubmatrix() && !frame.color.isSubmatrix())
+    return frame;
+  copy = frame;
+  for (cv::Mat* image : {&copy.left, &copy.right, &copy.color})
+    if (image->isSubmatrix())
+      *image = image->clone();
+  return copy;
 }
 
 const PoseList& FrameSource::poses() const {

@@ -265,12 +265,8 @@ Calibration makeRig(cv::Size image_size, double fx, double fy, double cx, double
   if (T_cam_lidar)
     c.T_cam0_velo = *T_cam_lidar;
   c.lidar = lidar;
-  const std::vector<double>& e = lidar.beam_elevations_deg;
-  for (std::size_t i = 1; i < e.size(); ++i)
-    if (!(e[i] > e[i - 1]))
-      throw CalibrationError(c.source + ": the beam elevations must rise from the lowest beam to the highest");
-  if (!e.empty())
-    c.lidar.rings = static_cast<int>(e.size());
+  if (!lidar.beam_elevations_deg.empty()) // validate() checks that they rise
+    c.lidar.rings = static_cast<int>(lidar.beam_elevations_deg.size());
   if (image_size.area() <= 0)
     throw CalibrationError(c.source + ": the image size must be given, not " + std::to_string(image_size.width) +
                            "x" + std::to_string(image_size.height));

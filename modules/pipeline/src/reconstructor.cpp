@@ -18,6 +18,8 @@
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/sgbm_stereo.h>
 
+#include "one_caller.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -72,6 +74,7 @@ Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& confi
 Reconstructor::Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options)
     : calibration_(rig), config_(adaptToRig(config, rig)), options_(options), mesher_(config.mesher) {
   config_.validate();
+  calibration_.validate();
   calibration_.requireImageSize();
   if (options_.threads < 0)
     throw ConfigError("Reconstructor: threads must be >= 0 (0: all cores), got " + std::to_string(options_.threads));
@@ -164,7 +167,14 @@ bool Reconstructor::lidarBeforeStereo() const {
   return config_.scheduling.stereo_prior || config_.stereo.lidarGuidance();
 }
 
-FrameResult Reconstructor::computeDepth(const Frame& frame) {
+FrameResult Reconstructor::computeDepth(const Frame& given) {
+  const OneCaller call(caller_, "computeDepth");
+  return depthOf(given);
+}
+
+FrameResult Reconstructor::depthOf(const Frame& given) {
+  Frame copy;
+  const Frame& frame = withWholeImages(given, copy);
   checkFrame(frame, calibration_);
   const ThreadBudget budget(options_.threads);
   FrameResult result = startFrame(frame);
@@ -208,6 +218,11 @@ TsdfIntegrator::FreeSpace freeSpaceOf(const FrameResult& result, const PinholeCa
 }
 
 void Reconstructor::integrate(FrameResult& result) {
+  const OneCaller call(caller_, "integrate");
+  integrateResult(result);
+}
+
+void Reconstructor::integrateResult(FrameResult& result) {
   if (!result.has_pose)
     throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
                             " has no pose: integration needs one (the frame's, or PoseMode Odometry)");
@@ -312,7 +327,10 @@ std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& fram
   return motion;
 }
 
-FrameResult Reconstructor::addFrame(const Frame& frame) {
+FrameResult Reconstructor::addFrame(const Frame& given) {
+  const OneCaller call(caller_, "addFrame");
+  Frame copy;
+  const Frame& frame = withWholeImages(given, copy);
   checkFrame(frame, calibration_); // before the odometry or the earlier scans take it in
   const ThreadBudget budget(options_.threads);
   if (frames_added_ == 0)
@@ -323,11 +341,11 @@ FrameResult Reconstructor::addFrame(const Frame& frame) {
     result.has_pose = true;
   }
   computeDepth(frame, result);
-  integrate(result);
+  integrateResult(result);
   ++frames_added_;
   if (config_.scheduling.mesh_every_n_frames > 0 &&
       frames_added_ % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)
-    mesh();
+    remesh();
   return result;
 }
 
@@ -356,6 +374,7 @@ double Reconstructor::minimumStreamingRadius() const {
 }
 
 std::size_t Reconstructor::finishStreaming(const std::string& mesh_path) {
+  const OneCaller call(caller_, "finishStreaming");
   if (!streaming_)
     throw ConfigError("finishStreaming: the map is not streamed (Options::stream_directory)");
   const ThreadBudget budget(options_.threads);
@@ -423,7 +442,7 @@ double Reconstructor::blocksPerBandBlock(const FrameSource& source, const std::v
     // The depth from this engine's own stages, whose buffers the run then reuses; its blocks are
     // those its bands allocate in an empty volume (the carvings update only blocks that exist).
     stages_->history.clear(); // frames far apart: none is another's earlier scan
-    FrameResult result = computeDepth(frame);
+    FrameResult result = depthOf(frame);
     stages_->history.clear();
     TsdfVolume empty(config_.volume);
     const std::size_t blocks = TsdfIntegrator(empty, config_.integrator)
@@ -477,6 +496,7 @@ std::size_t Reconstructor::blocksInWindow(const MemoryEvidence& evidence) const 
 
 MemoryEvidence Reconstructor::measureMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
                                             const PoseList& T_world_cam0) {
+  const OneCaller call(caller_, "measureMemory");
   const auto start = Clock::now();
   if (frames.size() != T_world_cam0.size())
     throw InvalidInputError("predictMemory: " + std::to_string(frames.size()) + " frames but " +
@@ -540,6 +560,11 @@ MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const s
 }
 
 const TriangleMesh& Reconstructor::mesh() {
+  const OneCaller call(caller_, "mesh", true);
+  return remesh();
+}
+
+const TriangleMesh& Reconstructor::remesh() {
   const ThreadBudget budget(options_.threads);
   mesher_.extract(*volume_, mesh_);
   return mesh_;

@@ -5,6 +5,8 @@
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/reconstructor.h>
 
+#include "one_caller.h"
+
 #include <chrono>
 #include <exception>
 #include <mutex>
@@ -80,6 +82,8 @@ struct Reconstructor::Run {
   Loaded load(std::size_t i) {
     const auto start = Clock::now();
     Loaded item{source.load(i), FrameResult(), 0.0};
+    if (Frame whole; &withWholeImages(item.frame, whole) == &whole)
+      item.frame = std::move(whole);
     if (engine.frame_filter_)
       engine.frame_filter_(item.frame);
     checkFrame(item.frame, engine.calibration_);
@@ -149,10 +153,10 @@ struct Reconstructor::Run {
         result->T_world_cam0 = *pose;
         result->has_pose = true;
       }
-      engine.integrate(*result);
+      engine.integrateResult(*result);
       const int mesh_every = engine.config_.scheduling.mesh_every_n_frames;
       if (mesh_every > 0 && (stats.frames_done + 1) % static_cast<std::size_t>(mesh_every) == 0)
-        engine.mesh();
+        engine.remesh();
       ++stats.frames_done;
       if (on_frame)
         on_frame(*result);
@@ -187,6 +191,7 @@ struct Reconstructor::Run {
 
 Reconstructor::RunStats Reconstructor::run(const FrameSource& source, const std::vector<std::size_t>& frames,
                                            const FrameCallback& on_frame, const std::atomic<bool>* stop) {
+  const OneCaller call(caller_, "run");
   Run r(*this, source, frames, stop);
   std::thread loader([&] {
     r.guarded([&] { r.loadFrames(); });

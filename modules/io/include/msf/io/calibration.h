@@ -75,7 +75,8 @@ struct Calibration {
   /// Throws CalibrationError naming `source` and the key unless the calibration is
   /// physical: P0..P3 finite, fx, fy > 0, third row 0 0 1 (rectified), no skew; an image
   /// size of 0x0 (unknown) or 1..limits::kMaxImageSide a side; T_cam0_velo (and
-  /// T_velo_imu when read) rigid. loadCalibration calls it.
+  /// T_velo_imu when read) rigid; the LiDAR's beam elevations, when listed, one per ring, rising
+  /// within -90 .. 90 degrees. loadCalibration and the Reconstructor call it.
   void validate() const;
 
 private:
@@ -109,7 +110,9 @@ inline constexpr const char* kVelodyneFrameId = "velodyne";
 cv::Size parseImageSize(const std::string& text);
 
 /// Writes the project's YAML camera file (keys P0..P3 as 3x4, image_width, image_height,
-/// T_cam0_velo as 4x4 unless the calibration is camera-only). Atomic: nothing is left behind on failure.
+/// T_cam0_velo as 4x4 and the LiDAR's description, lidar_sweeping, lidar_rings and
+/// lidar_beam_elevations_deg, unless the calibration is camera-only). Atomic: nothing is left
+/// behind on failure.
 void saveCalibrationYaml(const Calibration& calibration, const std::string& path);
 
 /// Writes a KITTI odometry calib.txt (P0..P3, and Tr unless camera-only). Atomic.

@@ -40,10 +40,15 @@ struct Frame {
 
 /// Throws InvalidInputError naming the frame and what does not fit the rig, so that the engine
 /// refuses a frame before it changes any state: no scan or one without a point, per-point rings
-/// or times of another count than the scan's points, a grey image missing, not 8-bit grey or
-/// BGR, or not of the calibration's size (when it has one), a colour image of another kind or
-/// size, a pose that is not rigid.
+/// or times of another count than the scan's points, a grey image missing, not 8-bit grey
+/// (CV_8UC1) or not of the calibration's size (when it has one), a colour image not 8-bit BGR
+/// (CV_8UC3) or of another size, a pose that is not rigid.
 void checkFrame(const Frame& frame, const Calibration& calibration);
+
+/// `frame`, or `copy` made of it with each image that is a view into a larger one (a cv::Mat
+/// ROI) copied whole: OpenCV's filters read past a view's edge into the image it was cut from,
+/// so a view would not give its copy's depth. The engine takes every frame through it.
+const Frame& withWholeImages(const Frame& frame, Frame& copy);
 
 /// Where frames come from: a dataset folder, a bag, a program. Readers of every layout (KITTI
 /// odometry and raw, synthetic, a generic folder with a rig file, a ROS bag) give the engine

@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace msf {
@@ -134,7 +135,10 @@ cv::Mat mapPriorHoles(const FrameResult& result);
 ///  - run(source, frames, ...), which overlaps frames: loading (with steps 1-2 when they feed
 ///    SGBM), stereo + fusion, integration, and the odometry each have a thread, joined by
 ///    bounded queues, so memory is bounded by the map, not by the number of frames.
-/// Both give the same map for the same frames.
+/// Both give the same map for the same frames. One call at a time, as PCL's classes: a call
+/// made while another thread is in one of this engine's calls throws Error rather than corrupt
+/// the map (guard it with a mutex, or give each thread its own engine); run()'s callback may
+/// call mesh() only.
 ///
 /// With `pipeline.stereo_prior` (the default) SGBM searches only the disparities that the
 /// interpolated LiDAR allows, and with `stereo.guidance: lidar` (the default) the LiDAR's real
@@ -174,7 +178,8 @@ public:
   /// The rig's LiDAR decides how its scans are taken (rig.lidar.sweeping): swept over their
   /// period, the odometry deskews them (odometry.deskew auto) and the scan's carving allows for
   /// their skew (ScanFreeSpace::skew). Throws ConfigError for an invalid config or streaming
-  /// options, CalibrationError when the rig has no image size.
+  /// options, CalibrationError for a rig that is not physical (Calibration::validate) or has no
+  /// image size.
   Reconstructor(const Calibration& rig, const PipelineConfig& config, const Options& options);
   Reconstructor(const Calibration& rig, const PipelineConfig& config);
   ~Reconstructor();
@@ -279,6 +284,11 @@ private:
   bool lidarBeforeStereo() const;
   /// Steps 1-4 into a started result, at its pose (the earlier scans are placed by it).
   void computeDepth(const Frame& frame, FrameResult& result);
+  /// computeDepth(), integrate() and mesh() within a call that holds the engine (addFrame, run,
+  /// measureMemory).
+  FrameResult depthOf(const Frame& frame);
+  void integrateResult(FrameResult& result);
+  const TriangleMesh& remesh();
   /// The fused depth's holes filled before the frame is integrated, in new images (the
   /// integration frame shares the old): first from the map (section map_prior, fillFromMap),
   /// then the small holes left (fusion.hole_fill_px, msf::fillSmallHoles).
@@ -328,6 +338,8 @@ private:
   Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_velo_measured_last_ = Eigen::Isometry3d::Identity();  // PoseMode::Refine's prior
   std::vector<double> odometry_ms_;
+  /// The thread in a public call that changes the engine (OneCaller; the class comment).
+  std::atomic<std::thread::id> caller_{};
   std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
   bool add_tracks_ = false;
 };

@@ -2,6 +2,7 @@
 #pragma once
 #include <msf/range_image/depth_completion_filter.h>
 #include <msf/range_image/depth_interpolator.h>
+#include <msf/range_image/point_types.h>
 
 namespace msf {
 

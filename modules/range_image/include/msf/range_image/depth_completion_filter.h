@@ -25,7 +25,9 @@ public:
   using PointCloud = typename pcl::Filter<PointT>::PointCloud;
 
   /// Intrinsics of the camera the cloud is organized by. When unset (the default), they
-  /// are recovered from the input's points (estimatePinholeCamera) at every call.
+  /// are estimated from the input's points (estimatePinholeCamera) at every call, to the
+  /// points' float precision: the new points' x and y then differ from the exact camera's by
+  /// a fraction of a millimetre. Set it for exact rays (LidarCompletion does).
   void setCamera(const PinholeCamera& camera) { camera_ = camera; }
   const PinholeCamera& getCamera() const { return camera_; }
 
