@@ -17,4 +17,8 @@ struct FrameObject {
   py::object arrays;
 };
 
+/// A Python index of a frame of `source` (negative: from the end) as the source's; IndexError
+/// outside it.
+std::size_t frameIndex(const FrameSource& source, long long i);
+
 } // namespace msf::python

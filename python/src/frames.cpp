@@ -60,13 +60,6 @@ FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayA
   return object;
 }
 
-/// A Python index of a frame (negative: from the end) as the source's; IndexError outside it.
-std::size_t frameIndex(const FrameSource& source, long long i) {
-  const auto size = static_cast<long long>(source.size());
-  if (i < -size || i >= size)
-    throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(size));
-  return static_cast<std::size_t>(i < 0 ? i + size : i);
-}
 
 FrameObject load(const FrameSource& source, long long i, bool with_color) {
   const std::size_t index = frameIndex(source, i);
@@ -229,6 +222,13 @@ void bindSources(py::module_& m) {
 }
 
 } // namespace
+
+std::size_t frameIndex(const FrameSource& source, long long i) {
+  const auto size = static_cast<long long>(source.size());
+  if (i < -size || i >= size)
+    throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(size));
+  return static_cast<std::size_t>(i < 0 ? i + size : i);
+}
 
 void bindFrames(py::module_& m) {
   bindFrame(m);

@@ -86,15 +86,15 @@ TriangleMesh mesh(Engine& e) {
 /// and looks for signals every 0.1 s: Ctrl-C stops the run after the frame being integrated (as
 /// msf_reconstruct does) and is raised once the run has ended. `on_frame` gets each FrameResult
 /// on the engine's integration thread, with the GIL; it may call mesh() and num_blocks.
-py::dict run(Engine& e, const FrameSource& source, std::optional<std::vector<std::size_t>> frames,
+py::dict run(Engine& e, const FrameSource& source, const std::optional<std::vector<long long>>& frames,
              const py::object& on_frame) {
   std::vector<std::size_t> indices(source.size());
   std::iota(indices.begin(), indices.end(), std::size_t(0));
-  if (frames)
-    indices = *frames;
-  for (const std::size_t i : indices)
-    if (i >= source.size())
-      throw py::index_error("frame " + std::to_string(i) + " of a source of " + std::to_string(source.size()));
+  if (frames) { // indices as a Python sequence's: negative from the end
+    indices.clear();
+    for (const long long i : *frames)
+      indices.push_back(frameIndex(source, i));
+  }
   Reconstructor::FrameCallback callback;
   if (!on_frame.is_none())
     callback = [&](FrameResult& result) {
@@ -236,8 +236,9 @@ void bindReconstructor(py::module_& m) {
            "Step 5: a compute_depth result at its pose into the map. Raises InvalidInputError without a pose.")
       .def("mesh", &mesh, "The map's Mesh, meshing again only the blocks changed since the last call.")
       .def("run", &run, py::arg("source"), py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
-           "The frames of a source (a Sequence; all, or the indices given) overlapped on the engine's "
-           "threads: the same map as add_frame frame by frame, faster. on_frame(result) is called after each "
+           "The frames of a source (a Sequence; all, or the indices given, negative from the end) overlapped on "
+           "the engine's threads: the same map as add_frame frame by frame, faster. on_frame(result) is called "
+           "after each "
            "frame is integrated, in order; it may call mesh() and num_blocks (another call of the engine raises "
            "msfusion.Error). Ctrl-C stops after the frame being integrated and raises KeyboardInterrupt, the map "
            "holding the frames done. Returns frames_done, wall_s, first_frame_s and interrupted (a stop that was "

@@ -105,3 +105,12 @@ def test_points_of_a_pose_that_is_not_rigid_are_refused(own_rig):
     depth = np.ones((camera.height, camera.width), np.float32)
     with pytest.raises(msfusion.InvalidInputError, match="pose is not a rigid transform"):
         msfusion.depth_to_points(depth, camera, pose=np.eye(4) * 3)
+
+
+def test_run_indexes_frames_as_a_python_sequence(own_rig):
+    seen = []
+    engine = msfusion.Reconstructor(own_rig.calibration)
+    stats = engine.run(own_rig, frames=[-1], on_frame=lambda r: seen.append(r.index))
+    assert seen == [1] and stats["frames_done"] == 1
+    with pytest.raises(IndexError, match="frame -3 of a source of 2"):
+        msfusion.Reconstructor(own_rig.calibration).run(own_rig, frames=[-3])
