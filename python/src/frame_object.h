@@ -15,6 +15,9 @@ struct FrameObject {
   Frame frame;
   std::string name;
   py::object arrays;
+  /// False for a frame made of arrays without an index: an engine's add_frame numbers it by its
+  /// place among the frames it was given, so that its messages and result name it.
+  bool numbered = true;
 };
 
 /// A Python index of a frame of `source` (negative: from the end) as the source's; IndexError

@@ -15,6 +15,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,11 +24,12 @@ namespace msf::python {
 namespace {
 
 FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayArg& scan,
-                       const ArrayArg& color, const ArrayArg& pose, std::size_t index, double timestamp,
-                       const std::string& name) {
+                       const ArrayArg& color, const ArrayArg& pose, std::optional<std::size_t> index,
+                       double timestamp, const std::string& name) {
   FrameObject object;
   Frame& frame = object.frame;
-  frame.index = index;
+  frame.index = index.value_or(0);
+  object.numbered = index.has_value();
   frame.timestamp = timestamp;
   // A 10- to 16-bit camera's uint16 images are scaled to 8 bits as the folder and bag readers
   // scale them: by the bits the brighter image of the pair needs, one gain for both.
@@ -54,7 +56,7 @@ FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayA
     if (!rgb.empty())
       cv::cvtColor(rgb, frame.color, cv::COLOR_RGB2BGR); // the library's order
   }
-  object.name = name.empty() ? std::to_string(index) : name;
+  object.name = name.empty() ? std::to_string(frame.index) : name;
   // The frame views the caller's arrays, unless they were scaled to 8 bits into its own images.
   object.arrays = depth == CV_8U ? py::object(py::make_tuple(left, right)) : py::object(py::none());
   return object;
@@ -106,12 +108,13 @@ void bindFrame(py::module_& m) {
                           "One frame: the rectified grey pair of cameras 0 and 1, the LiDAR scan, the colour camera's "
                           "image and the pose of camera 0 (T_world_cam0), if any.")
       .def(py::init(&fromArrays), py::arg("left"), py::arg("right"), py::arg("scan"), py::arg("color") = py::none(),
-           py::arg("pose") = py::none(), py::arg("index") = 0, py::arg("timestamp") = 0.0, py::arg("name") = "",
+           py::arg("pose") = py::none(), py::arg("index") = py::none(), py::arg("timestamp") = 0.0, py::arg("name") = "",
            "A frame from arrays: left, right (H, W) uint8 grey (viewed, not copied), or uint16 of a 10- to 16-bit "
            "camera (scaled to 8 bits by the bits the brighter image needs, one gain for both, as the dataset "
            "readers scale them), scan (N, 4) float32 (or float64) x y z reflectance in the LiDAR's frame or "
            "(N, 3), color (H, W, 3) uint8 (or uint16) RGB of the colour camera (the rectified cameras share one "
-           "image size), pose 4x4 T_world_cam0 (None: no pose).")
+           "image size), pose 4x4 T_world_cam0 (None: no pose); index None: an engine's add_frame numbers it by "
+           "its place among the frames it was given.")
       .def_property_readonly("index", [](const FrameObject& f) { return f.frame.index; })
       .def_property_readonly("name", [](const FrameObject& f) { return f.name; }, "File stem ('000042').")
       .def_property_readonly("timestamp", [](const FrameObject& f) { return f.frame.timestamp; },

@@ -30,6 +30,7 @@ struct Engine {
   Engine(const Calibration& rig, const PipelineConfig& config, const Reconstructor::Options& options)
       : engine(rig, config, options) {}
   Reconstructor engine;
+  std::size_t frames_added = 0; // by add_frame: the index of a frame made of arrays without one
   /// Calls from several Python threads take turns; run() holds it on its own thread, where its
   /// on_frame callback may call mesh() or num_blocks (the engine refuses the others there).
   std::recursive_mutex mutex;
@@ -62,12 +63,22 @@ std::unique_ptr<Engine> makeEngine(const Calibration& rig, const PipelineConfig&
 FrameResult keepable(FrameResult result, const FrameObject& frame) {
   if (!frame.arrays.is_none())
     result.left = result.left.clone();
-  result.name = frame.name;
+  result.name = frame.numbered ? frame.name : std::to_string(result.index);
   return result;
 }
 
-FrameResult addFrame(Engine& e, const FrameObject& frame) {
-  return keepable(withoutGil(e.mutex, [&] { return e.engine.addFrame(frame.frame); }), frame);
+FrameResult addFrame(Engine& e, const FrameObject& object) {
+  return keepable(withoutGil(e.mutex, [&] {
+                    Frame numbered;
+                    if (!object.numbered) {
+                      numbered = object.frame; // shares its images and scan
+                      numbered.index = e.frames_added;
+                    }
+                    FrameResult result = e.engine.addFrame(object.numbered ? object.frame : numbered);
+                    ++e.frames_added;
+                    return result;
+                  }),
+                  object);
 }
 
 FrameResult computeDepth(Engine& e, const FrameObject& frame) {

@@ -114,3 +114,15 @@ def test_run_indexes_frames_as_a_python_sequence(own_rig):
     assert seen == [1] and stats["frames_done"] == 1
     with pytest.raises(IndexError, match="frame -3 of a source of 2"):
         msfusion.Reconstructor(own_rig.calibration).run(own_rig, frames=[-3])
+
+
+def test_frames_of_arrays_are_numbered_by_the_engine(own_rig):
+    """A frame made of arrays without an index is named by its place among the frames given."""
+    engine = msfusion.Reconstructor(own_rig.calibration, poses="given")
+    first, second = own_rig[0], own_rig[1]
+    result = engine.add_frame(msfusion.Frame(first.left, first.right, first.scan, pose=first.pose))
+    assert (result.index, result.name) == (0, "0")
+    with pytest.raises(msfusion.InvalidInputError, match="frame 1 has no pose"):
+        engine.add_frame(msfusion.Frame(second.left, second.right, second.scan))
+    given = engine.add_frame(msfusion.Frame(second.left, second.right, second.scan, pose=second.pose, index=7))
+    assert (given.index, given.name) == (7, "7")
