@@ -7,6 +7,8 @@
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/sequence.h>
+#include <msf/pipeline/pipeline_config.h>
+#include <msf/pipeline/rig_adaptation.h>
 #include <msf/synthetic/ground_truth.h>
 #include <msf/synthetic/seen_surface.h>
 
@@ -46,7 +48,7 @@ void writeJson(const std::string& path, const msf::MeshAccuracy& a, std::size_t 
 
 int main(int argc, char** argv) {
   std::string frames = "0:", json;
-  double max_depth_m = 40.0, threshold_m = 0.2;
+  double max_depth_m = 0.0, threshold_m = 0.2; // 0: each sequence's rig's range
   bool overwrite = false;
   msf::tool::CommandLine cli(
       "msf_eval_mesh", "<mesh.ply> <synthetic sequence>... [options]",
@@ -56,12 +58,14 @@ int main(int argc, char** argv) {
       "-max_depth) within -threshold of the mesh. Scored against the same sequences, the meshes of single drives "
       "and of their merge compare.");
   cli.value("-frames", "a:b", frames, "the frames of each sequence that saw the surface (default {default})")
-      .value("-max_depth", "M", max_depth_m, "the depth up to which a frame saw the surface (default {default} m)")
+      .value("-max_depth", "M", max_depth_m,
+             "the depth up to which a frame saw the surface (default: the range msf_reconstruct scores its map to on "
+             "the sequence's rig, tsdf_integrator.max_depth_m adapted to it; 40 m on KITTI's)")
       .value("-threshold", "T", threshold_m, "completeness and precision distance (default {default} m)")
       .value("-o", "FILE", json, "also write the scores as JSON")
       .overwriteOption(overwrite);
   return cli.run(argc, argv, 2, [&](const msf::tool::Arguments& args) {
-    if (!(max_depth_m > 0) || !(threshold_m > 0))
+    if ((cli.given("-max_depth") && !(max_depth_m > 0)) || !(threshold_m > 0))
       throw msf::InvalidInputError("-max_depth and -threshold must be > 0");
     msf::tool::requireNewOutputs({json}, overwrite);
     pcl::console::TicToc tt;
@@ -79,7 +83,11 @@ int main(int argc, char** argv) {
       else if (!sameBytes(scene, this_scene))
         throw msf::InvalidInputError("'" + args[k] + "' is not of the world of '" + args[1] +
                                      "': their gt/scene.ply differ (msf_synth: the same -seed and -street_m)");
-      seen.add(sequence, sequence.indices(msf::FrameRange::parse(frames)), max_depth_m);
+      // One yardstick: the range msf_reconstruct scores to on this rig (adaptToRig), unless given.
+      const double depth_m = cli.given("-max_depth")
+                                 ? max_depth_m
+                                 : msf::adaptToRig(msf::PipelineConfig(), sequence.calibration()).integrator.max_depth_m;
+      seen.add(sequence, sequence.indices(msf::FrameRange::parse(frames)), depth_m);
     }
     pcl::PolygonMesh truth, mesh;
     msf::loadMesh(scene, truth);

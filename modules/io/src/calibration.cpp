@@ -349,10 +349,15 @@ Calibration readCalibration(const std::string& path) {
       return fromRawDateFolder(p);
     if (fs::exists(p.parent_path() / "calib_cam_to_cam.txt")) // a drive folder
       return fromRawDateFolder(p.parent_path());
+    // A rig file beside calib.txt (msf_synth writes both) also says what the LiDAR's beams are,
+    // and a folder of the generic layout has it alone: read first, as the dataset readers read it.
+    if (fs::is_regular_file(p / "rig.yaml", ec))
+      return readCalibration((p / "rig.yaml").string());
     if (fs::exists(p / "calib.txt"))
       return fromOdometry(KeyValueFile((p / "calib.txt").string()));
     throw IOError("calibration folder '" + path +
-                  "' has neither calib_cam_to_cam.txt (KITTI raw) nor calib.txt (KITTI odometry)");
+                  "' has neither calib_cam_to_cam.txt (KITTI raw), rig.yaml (a rig file) nor calib.txt (KITTI "
+                  "odometry)");
   }
   const std::string ext = fileExtension(path);
   if ((ext == ".yaml" || ext == ".yml") && isRigFile(path))

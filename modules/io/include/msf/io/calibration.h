@@ -90,6 +90,8 @@ private:
 ///    plus calib_velo_to_cam.txt and, when present, calib_imu_to_velo.txt), a drive folder
 ///    inside it, or calib_cam_to_cam.txt itself;
 ///  - a KITTI object `calib/NNNNNN.txt` (P0..P3, R0_rect, Tr_velo_to_cam);
+///  - a rig file (rig_file.h), or a folder holding one as rig.yaml, which is read before a
+///    calib.txt beside it, as the dataset readers read it;
 ///  - the project's OpenCV YAML camera file (.yaml/.yml, see saveCalibrationYaml).
 /// For odometry and object files, the image size is read from the first image beside the
 /// calibration when there is one. A missing key or a matrix with the wrong number of values
