@@ -84,9 +84,8 @@ int main(int argc, char** argv) {
         throw msf::InvalidInputError("'" + args[k] + "' is not of the world of '" + args[1] +
                                      "': their gt/scene.ply differ (msf_synth: the same -seed and -street_m)");
       // One yardstick: the range msf_reconstruct scores to on this rig (adaptToRig), unless given.
-      const double depth_m = cli.given("-max_depth")
-                                 ? max_depth_m
-                                 : msf::adaptToRig(msf::PipelineConfig(), sequence.calibration()).integrator.max_depth_m;
+      const msf::PipelineConfig on_rig = msf::adaptToRig(msf::PipelineConfig(), sequence.calibration());
+      const double depth_m = cli.given("-max_depth") ? max_depth_m : on_rig.integrator.max_depth_m;
       seen.add(sequence, sequence.indices(msf::FrameRange::parse(frames)), depth_m);
     }
     pcl::PolygonMesh truth, mesh;
