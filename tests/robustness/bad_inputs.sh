@@ -490,6 +490,11 @@ check "integrate -sweeps of 100000 digits" 1 "-sweeps must be a whole number in 
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -sweeps "$(printf '9%.0s' $(seq 100000))"
 check "integrate -voxel 1e999" 1 "-voxel needs a finite number within the range of a double, not '1e999'" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 1e999
+# An option given twice, or two names of one setting, with two values: neither is guessed.
+check "integrate -voxel given twice" 1 "option '-voxel' is given twice, '0.1' and '0.2': give it once" -- \
+  msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -voxel 0.1 -voxel 0.2
+check "fuse -calib and -rig of two files" 1 "options '-calib' and '-rig' set one thing, given '.*camera.yaml' and 'rig.yaml': give one of them" -- \
+  msf_fuse "$F/dense.pcd" "$F/dense.pcd" o.pcd -calib "$F/camera.yaml" -rig rig.yaml
 check "integrate -lambda 1e300" 1 "tsdf_integrator.lambda \(-lambda\) must be 0 .. 1e6 \(beyond, eq. 7 flattens" -- \
   msf_integrate "$F/dense.pcd" -poses "$F/pose.txt" -o v.pcd -lambda 1e300
 check "info: x y z as int32" 0 "valid: +48 \(100.0 %\)" -- msf_info "$F/int32.pcd"

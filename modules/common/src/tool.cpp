@@ -157,29 +157,29 @@ CommandLine::CommandLine(std::string name, std::string usage, std::string about)
 
 CommandLine& CommandLine::add(const std::string& option, const std::string& metavar,
                               std::function<void(const std::string&)> apply, const std::string& help,
-                              const std::string& default_text) {
+                              const std::string& default_text, const void* target) {
   std::string text = help;
   for (std::size_t at; (at = text.find("{default}")) != std::string::npos;)
     text.replace(at, 9, default_text);
-  options_.push_back({option, metavar, text, std::move(apply)});
+  options_.push_back({option, metavar, text, std::move(apply), target});
   return *this;
 }
 
 CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, std::string& target,
                                 const std::string& help) {
-  return add(option, metavar, [&target](const std::string& text) { target = text; }, help, target);
+  return add(option, metavar, [&target](const std::string& text) { target = text; }, help, target, &target);
 }
 CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, int& target,
                                 const std::string& help) {
-  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+  return add(option, metavar, numberInto(option, target), help, defaultText(target), &target);
 }
 CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, float& target,
                                 const std::string& help) {
-  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+  return add(option, metavar, numberInto(option, target), help, defaultText(target), &target);
 }
 CommandLine& CommandLine::value(const std::string& option, const std::string& metavar, double& target,
                                 const std::string& help) {
-  return add(option, metavar, numberInto(option, target), help, defaultText(target));
+  return add(option, metavar, numberInto(option, target), help, defaultText(target), &target);
 }
 CommandLine& CommandLine::value(const std::string& option, const std::string& metavar,
                                 std::function<void(const std::string&)> apply, const std::string& help) {
@@ -246,8 +246,12 @@ Arguments CommandLine::parse(int argc, char** argv) {
         throw InvalidInputError(std::string("option '") + argv[i] + "' needs a value");
       text = argv[++i];
     }
-    values.emplace(o->name, text); // the first one stays
+    const auto [given, first] = values.emplace(o->name, text);
+    if (!first && given->second != text)
+      throw InvalidInputError("option '" + o->name + "' is given twice, '" + given->second + "' and '" +
+                              text + "': give it once");
   }
+  requireOneValuePerSetting(values);
   for (const Option& o : options_) {
     const auto v = values.find(o.name);
     if (v == values.end())
@@ -256,6 +260,19 @@ Arguments CommandLine::parse(int argc, char** argv) {
     o.apply(v->second);
   }
   return positional;
+}
+
+void CommandLine::requireOneValuePerSetting(const std::map<std::string, std::string>& values) const {
+  std::map<const void*, std::pair<std::string, std::string>> by_setting; // target -> option, value
+  for (const Option& o : options_) {
+    const auto v = values.find(o.name);
+    if (!o.target || v == values.end())
+      continue;
+    const auto [other, first] = by_setting.emplace(o.target, std::pair(o.name, v->second));
+    if (!first && other->second.second != v->second)
+      throw InvalidInputError("options '" + other->second.first + "' and '" + o.name + "' set one thing, given '" +
+                              other->second.second + "' and '" + v->second + "': give one of them");
+  }
 }
 
 bool CommandLine::given(const std::string& option) const {

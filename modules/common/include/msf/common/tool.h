@@ -2,6 +2,7 @@
 #pragma once
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,9 @@ std::string versionLine(const std::string& name);
 /// not wholly a number (a whole one for int) throws InvalidInputError naming the option and
 /// the value. Options are applied in the order they are declared, not in the order given, so
 /// that a -config declared first (a callback that reads the file) is overridden by the options
-/// declared after it; an option given twice keeps its first value, as PCL's parser does.
+/// declared after it. An option given twice with two values is an error (PCL's parser keeps
+/// the first, a shell's habit is the last: either would surprise someone), and so are two
+/// names of one setting (-calib and -rig) given different values.
 /// Unknown options are errors: PCL's parser ignores them, and a typo should not silently do
 /// the default. "-5" or "-0.3" are values, not options.
 using Arguments = std::vector<std::string>;
@@ -86,9 +89,12 @@ private:
   struct Option {
     std::string name, metavar, help; // no metavar: a flag
     std::function<void(const std::string&)> apply;
+    const void* target = nullptr; // the setting it writes, when known: two names of one setting share it
   };
+  /// Throws InvalidInputError when two options of one target were given different values.
+  void requireOneValuePerSetting(const std::map<std::string, std::string>& values) const;
   CommandLine& add(const std::string& option, const std::string& metavar, std::function<void(const std::string&)> apply,
-                   const std::string& help, const std::string& default_text);
+                   const std::string& help, const std::string& default_text, const void* target = nullptr);
 
   std::string name_, usage_, about_;
   std::vector<Option> options_;
