@@ -47,7 +47,7 @@ FrameObject fromArrays(const ArrayArg& left, const ArrayArg& right, const ArrayA
     py::gil_scoped_release release;
     frame.scan = scanFromPoints(points);
     if (depth == CV_16U) {
-      const int bits = std::max(significantBits(frame.left), significantBits(frame.right));
+      const int bits = pairBits(frame.left, frame.right);
       frame.left = toEightBit(frame.left, bits);
       frame.right = toEightBit(frame.right, bits);
     }

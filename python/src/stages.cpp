@@ -29,8 +29,9 @@ namespace {
 /// rig (adaptToRig), as the engine and the tools that run one stage do.
 struct LidarStage {
   LidarStage(const Calibration& calibration, const PipelineConfig& config, const std::string& method)
-      : completion(calibration, parseCompletionMethod(method), adaptToRig(config, calibration).projection,
-                   adaptToRig(config, calibration).interpolation) {}
+      : LidarStage(calibration, adaptToRig(config, calibration), parseCompletionMethod(method)) {}
+  LidarStage(const Calibration& calibration, const PipelineConfig& on_rig, CompletionMethod method)
+      : completion(calibration, method, on_rig.projection, on_rig.interpolation) {}
   LidarCompletion completion;
   std::mutex mutex;
 };

@@ -252,9 +252,7 @@ Frame FolderSource::load(std::size_t i, bool with_color) const {
   f.point_ring = std::move(scan.ring);
   f.point_time_s = std::move(scan.time_s);
   const cv::Mat left_image = left.get(), right_image = right.get();
-  // One scale for the pair: scaled each by its own brightest pixel, the two would match at
-  // different gains.
-  const int pair_bits = std::max(significantBits(left_image), significantBits(right_image));
+  const int pair_bits = pairBits(left_image, right_image);
   f.left = grey(left_image, pair_bits);
   f.right = grey(right_image, pair_bits);
   if (color.valid()) {

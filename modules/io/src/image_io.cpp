@@ -117,6 +117,10 @@ int significantBits(const cv::Mat& image) {
   return bits;
 }
 
+int pairBits(const cv::Mat& left, const cv::Mat& right) {
+  return std::max(significantBits(left), significantBits(right));
+}
+
 cv::Mat toEightBit(const cv::Mat& image, int bits) {
   if (image.depth() == CV_8U)
     return image;

@@ -205,7 +205,7 @@ sensor_msgs::PointCloud2 scanToMessage(const Frame& frame, const std_msgs::Heade
 void greyPairFromMessages(const sensor_msgs::Image& left, const sensor_msgs::Image& right, cv::Mat& left_grey,
                           cv::Mat& right_grey, const std::string& what_left, const std::string& what_right) {
   const cv::Mat l = convertKeepingBits(left, true, what_left), r = convertKeepingBits(right, true, what_right);
-  const int bits = std::max(significantBits(l), significantBits(r));
+  const int bits = pairBits(l, r);
   left_grey = toEightBit(l, bits);
   right_grey = toEightBit(r, bits);
 }

@@ -22,8 +22,11 @@ void writeImage(const std::string& path, const cv::Mat& image);
 int significantBits(const cv::Mat& image);
 
 /// 8 bits a channel: `bits` of a 16-bit image scaled to them; an 8-bit image as it is. A stereo
-/// pair is scaled with the bits of the brighter image, one gain for both.
+/// pair is scaled with pairBits, one gain for both.
 cv::Mat toEightBit(const cv::Mat& image, int bits);
+/// The bits of a stereo pair: its brighter image's (significantBits). Scaled each by its own
+/// brightest pixel, the two images would be matched at different gains.
+int pairBits(const cv::Mat& left, const cv::Mat& right);
 
 /// KITTI 16-bit PNG (value = metres or pixels x 256, 0 = none) to CV_32F (0 = none).
 /// Throws IOError when the file is not a single-channel 16-bit image.
