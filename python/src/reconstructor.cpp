@@ -244,7 +244,8 @@ void bindReconstructor(py::module_& m) {
            "Steps 1-4 of a Frame, nothing added to the map. Raises InvalidInputError for images or a scan that "
            "do not fit the rig.")
       .def("integrate", &integrate, py::arg("result"),
-           "Step 5: a compute_depth result at its pose into the map. Raises InvalidInputError without a pose.")
+           "Step 5: a compute_depth result at its pose into the map. Raises InvalidInputError without a pose, and "
+           "for a result this map took already (add_frame's and run's too), which would weigh double.")
       .def("mesh", &mesh, "The map's Mesh, meshing again only the blocks changed since the last call.")
       .def("run", &run, py::arg("source"), py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
            "The frames of a source (a Sequence; all, or the indices given, negative from the end) overlapped on "

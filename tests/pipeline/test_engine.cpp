@@ -177,6 +177,37 @@ TEST_F(PipelineTest, AnImageThatIsAViewIntoALargerOneGivesItsCopysDepth) {
   EXPECT_EQ(cv::countNonZero(copied.stereo_depth != from_views.stereo_depth), 0);
 }
 
+TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapTakesItToo) {
+  // A result integrated twice would weigh double: refused, the map unchanged.
+  const msf::Sequence sequence(dataset());
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  msf::FrameResult depth = engine.computeDepth(sequence.load(0));
+  engine.integrate(depth);
+  msf::test::TempDir once, after;
+  const auto map_once = savedMap(engine, once);
+  const std::string again = msf::test::errorOf([&] { engine.integrate(depth); });
+  msf::FrameResult copy = depth;
+  const std::string copied = msf::test::errorOf([&] { engine.integrate(copy); });
+  msf::FrameResult added = engine.addFrame(sequence.load(1));
+  const std::string from_add = msf::test::errorOf([&] { engine.integrate(added); });
+  for (const std::string& error : {again, copied})
+    EXPECT_NE(error.find("frame 0's result is in the map already (addFrame and run integrate theirs): a second "
+                         "time would double its weight"),
+              std::string::npos)
+        << error;
+  EXPECT_NE(from_add.find("frame 1's result is in the map already"), std::string::npos) << from_add;
+  // The map holds frames 0 and 1 once each: as an engine fed them by addFrame.
+  msf::Reconstructor fed(sequence.calibration(), msf::PipelineConfig{});
+  fed.addFrame(sequence.load(0));
+  fed.addFrame(sequence.load(1));
+  msf::test::TempDir a, b;
+  EXPECT_TRUE(savedMap(engine, a).second == savedMap(fed, b).second) << "a refused result changed the map";
+  EXPECT_FALSE(map_once.second == savedMap(engine, after).second);
+  // Another map takes the same result.
+  msf::Reconstructor other(sequence.calibration(), msf::PipelineConfig{});
+  EXPECT_NO_THROW(other.integrate(depth));
+}
+
 TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {
   // The street's scans are taken at one instant: its rig says so, and the engine takes it from
   // the rig whether fed frame by frame or run (the tests above give msf_reconstruct's map). A rig

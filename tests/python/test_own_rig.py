@@ -126,3 +126,19 @@ def test_frames_of_arrays_are_numbered_by_the_engine(own_rig):
         engine.add_frame(msfusion.Frame(second.left, second.right, second.scan))
     given = engine.add_frame(msfusion.Frame(second.left, second.right, second.scan, pose=second.pose, index=7))
     assert (given.index, given.name) == (7, "7")
+
+
+def test_a_map_takes_a_result_once(own_rig):
+    """A result integrated twice would weigh double: the map refuses it, and another map takes it."""
+    engine = msfusion.Reconstructor(own_rig.calibration)
+    result = engine.compute_depth(own_rig[0])
+    engine.integrate(result)
+    once = engine.mesh().vertices.copy()
+    with pytest.raises(msfusion.InvalidInputError, match="frame 000000's result is in the map already"):
+        engine.integrate(result)
+    np.testing.assert_array_equal(engine.mesh().vertices, once)
+    with pytest.raises(msfusion.InvalidInputError, match="frame 000001's result is in the map already"):
+        engine.integrate(engine.add_frame(own_rig[1]))
+    other = msfusion.Reconstructor(own_rig.calibration)
+    other.integrate(result)
+    np.testing.assert_array_equal(other.mesh().vertices, once)

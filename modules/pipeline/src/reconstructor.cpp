@@ -96,8 +96,16 @@ Reconstructor::~Reconstructor() = default;
 
 const ScanHistory& Reconstructor::scanHistory() const { return stages_->history; }
 
+namespace {
+std::uint64_t newSerial() {
+  static std::atomic<std::uint64_t> last{0};
+  return ++last;
+}
+} // namespace
+
 FrameResult Reconstructor::startFrame(const Frame& frame) const {
   FrameResult result;
+  result.serial = newSerial();
   result.index = frame.index;
   result.has_pose = frame.has_pose;
   result.T_world_cam0 = frame.T_world_cam0;
@@ -223,9 +231,15 @@ void Reconstructor::integrate(FrameResult& result) {
 }
 
 void Reconstructor::integrateResult(FrameResult& result) {
+  const std::string frame_name = result.name.empty() ? std::to_string(result.index) : result.name;
   if (!result.has_pose)
-    throw InvalidInputError("frame " + (result.name.empty() ? std::to_string(result.index) : result.name) +
-                            " has no pose: integration needs one (the frame's, or PoseMode Odometry)");
+    throw InvalidInputError("frame " + frame_name + " has no pose: integration needs one (the frame's, or PoseMode "
+                            "Odometry)");
+  if (result.serial == 0)
+    result.serial = newSerial();
+  if (integrated_.count(result.serial) != 0)
+    throw InvalidInputError("frame " + frame_name + "'s result is in the map already (addFrame and run integrate "
+                            "theirs): a second time would double its weight");
   if (config_.streaming.enabled() && !streaming_)
     throw ConfigError("streaming.active_radius_m > 0 needs a folder for the tiles (Options::stream_directory)");
   const ThreadBudget budget(options_.threads);
@@ -241,6 +255,7 @@ void Reconstructor::integrateResult(FrameResult& result) {
     if (streaming_->stats().blocks_freed != freed)
       mesher_.reset(); // its cache holds the freed blocks' meshes
   }
+  integrated_.insert(result.serial);
   result.times.integrate_ms = msSince(start);
 }
 

@@ -13,12 +13,14 @@
 #include <msf/registration/lidar_odometry.h>
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <thread>
+#include <unordered_set>
 #include <vector>
 
 namespace msf {
@@ -75,6 +77,9 @@ struct FrameResult {
   std::string name;                         ///< the source's frame name ("000042") under run(); addFrame's: empty
   bool has_pose = false;
   Eigen::Isometry3d T_world_cam0 = Eigen::Isometry3d::Identity();
+  /// What an engine knows the result by, unique in the process (0: not yet known to one): a map
+  /// takes a result once, since a second time would double its weight.
+  std::uint64_t serial = 0;
   cv::Mat left;                             ///< camera 0 grey image
   cv::Mat lidar_sparse;       ///< projected scan (step 1), if kept (setKeepSparse)
   cv::Mat lidar_depth;        ///< interpolated LiDAR (step 2)
@@ -199,7 +204,8 @@ public:
   FrameResult computeDepth(const Frame& frame);
   /// Integrates the fused depth of `result` at its pose (step 5), grown by the interpolated
   /// LiDAR of the canvas's margin (fusedDepthFrame). Throws InvalidInputError when the frame
-  /// has no pose.
+  /// has no pose, or when this map took the result already (addFrame's and run()'s results
+  /// included): a second time would double its weight.
   void integrate(FrameResult& result);
 
   struct RunStats {
@@ -340,6 +346,7 @@ private:
   std::vector<double> odometry_ms_;
   /// The thread in a public call that changes the engine (OneCaller; the class comment).
   std::atomic<std::thread::id> caller_{};
+  std::unordered_set<std::uint64_t> integrated_;  // the results' serials this map took
   std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
   bool add_tracks_ = false;
 };
