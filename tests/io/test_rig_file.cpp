@@ -146,6 +146,9 @@ TEST(RigFile, EachFaultIsRefusedNamingTheKey) {
       // Still a rig file without its first keys: the missing one is named, not "not valid YAML".
       {edited("left: {fx: 500.0, fy: 501.0, cx: 320.5, cy: 240.25}\n", ""), "left is missing"},
       {edited("image_width: 640\nimage_height: 480\n", ""), "image_width is missing"},
+      // Every key misspelt is still a rig file (OpenCV's files start with %YAML), its first key named.
+      {"imagewidth: 640\nleftcam: {fx: 500, fy: 500, cx: 320, cy: 240}\n",
+       "line 1: 'imagewidth' is not a key of a rig file"},
   };
   for (const auto& c : cases) {
     const std::string path = write(dir, "bad.yaml", c.text);

@@ -16,11 +16,13 @@
 #include "pipeline_fixture.h"
 #include "test_support.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace {
 
+namespace fs = std::filesystem;
 using msf::synthetic::SyntheticConfig;
 
 SyntheticConfig compactRig() {
@@ -28,6 +30,14 @@ SyntheticConfig compactRig() {
   c.camera = "pinhole";
   c.lidar_model = "hdl32e";
   return c;
+}
+
+/// The compact rig's street of `frames` frames, written into `dir`'s street/.
+msf::Sequence compactStreet(const msf::test::TempDir& dir, int frames) {
+  SyntheticConfig config = compactRig();
+  config.frames = frames;
+  msf::synthetic::SyntheticGenerator(config).writeDataset(dir.file("street"));
+  return msf::Sequence(dir.file("street"));
 }
 
 std::string printed(const msf::PipelineConfig& config) {
@@ -171,10 +181,7 @@ TEST(AnyRig, TheToolsOfOneStageFollowTheRigAsTheEngineDoes) {
   // The compact rig's frame through the tools, each given the rig file: the engine's fused depth,
   // pixel for pixel. With the keys as written (KITTI's rows between rings) it is another depth.
   msf::test::TempDir dir;
-  SyntheticConfig config = compactRig();
-  config.frames = 2;
-  msf::synthetic::SyntheticGenerator(config).writeDataset(dir.file("street"));
-  const msf::Sequence sequence(dir.file("street"));
+  const msf::Sequence sequence = compactStreet(dir, 2);
   const std::string rig = sequence.directory() + "/rig.yaml";
   msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
   const cv::Mat expected = engine.addFrame(sequence.load(1)).fused.depth; // holes filled, as msf_fuse's
@@ -194,13 +201,48 @@ TEST(AnyRig, TheToolsOfOneStageFollowTheRigAsTheEngineDoes) {
   EXPECT_GT(cv::norm(expected, as_written, cv::NORM_INF), 0.0);
 }
 
+TEST(AnyRig, ACloudOfAnotherRigOfTheSameSizeIsRefused) {
+  // The compact rig's clouds given with a rig of the same image size but a 4 % longer focal length:
+  // fused or integrated at other rays without a word before; refused, naming both cameras.
+  msf::test::TempDir dir;
+  const msf::Sequence sequence = compactStreet(dir, 1);
+  const std::string rig = sequence.directory() + "/rig.yaml";
+  msf::Calibration other = sequence.calibration();
+  for (int camera = 0; camera < 4; ++camera)
+    other.P[camera](0, 0) *= 1.04;
+  msf::saveRigFile(other, dir.file("other.yaml"));
+  const auto run = [&](const std::string& tool, const std::string& arguments) {
+    return msf::test::runTool(tool, arguments);
+  };
+  ASSERT_EQ(run("msf_interpolate", sequence.scanPath(0) + " " + dir.file("lidar.pcd") + " -rig " + rig).exit_code, 0);
+  ASSERT_EQ(run("msf_stereo", sequence.imagePath(0, 0) + " " + sequence.imagePath(1, 0) + " " + dir.file("stereo.pcd") +
+                                  " -rig " + rig + " -prior " + dir.file("lidar.pcd"))
+                .exit_code,
+            0);
+  const std::string fuse = dir.file("lidar.pcd") + " " + dir.file("stereo.pcd") + " ";
+  const auto refused = run("msf_fuse", fuse + dir.file("other.pcd") + " -rig " + dir.file("other.yaml"));
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("DepthFusion: the stereo cloud was made by a camera of fx 500.00, fy 500.00, cx 320.00, "
+                             "cy 240.00, not by the left camera of calibration '" +
+                             dir.file("other.yaml") + "' (fx 520.00"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(dir.file("other.pcd")));
+  ASSERT_EQ(run("msf_fuse", fuse + dir.file("fused.pcd") + " -rig " + rig).exit_code, 0);
+  std::ofstream(dir.file("poses.txt")) << "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const std::string integrate = dir.file("fused.pcd") + " -poses " + dir.file("poses.txt") + " -o ";
+  const auto integrated =
+      run("msf_integrate", integrate + dir.file("other_volume.pcd") + " -rig " + dir.file("other.yaml"));
+  EXPECT_EQ(integrated.exit_code, 1);
+  EXPECT_NE(integrated.err.find("fused.pcd' was made by a camera of fx 500.00"), std::string::npos) << integrated.err;
+  EXPECT_EQ(run("msf_integrate", integrate + dir.file("volume.pcd") + " -rig " + rig).exit_code, 0);
+}
+
 TEST(AnyRig, MsfEvalMeshScoresTheRigsRangeAsMsfReconstructDoes) {
   // One yardstick: the compact rig's map scored by msf_eval_mesh within the range msf_reconstruct
   // scores it to (f·B / 8 px = 7.5 m), not KITTI's 40 m, where the rig's frames see little.
   msf::test::TempDir dir;
-  SyntheticConfig config = compactRig();
-  config.frames = 3;
-  msf::synthetic::SyntheticGenerator(config).writeDataset(dir.file("street"));
+  compactStreet(dir, 3);
   auto r = msf::test::runTool("msf_reconstruct", dir.file("street") + " -panels 0 -o " + dir.file("out"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = msf::test::runTool("msf_eval_mesh", dir.file("out/mesh.ply") + " " + dir.file("street") + " -o " +

@@ -390,6 +390,9 @@ check "synth -rig: rings without their elevations" 1 "rings_only.yaml': lidar.ri
 printf 'image_width: 640\nimage_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\nlidar:\n  T_cam_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n  beam_elevation_deg: [-2, 2]\n' >"$F/rig_misspelt_key.yaml"
 check "synth -rig: a misspelt key" 1 "rig_misspelt_key.yaml' line 7: 'beam_elevation_deg' is not a key of lidar" -- \
   msf_synth -o out -frames 1 -rig "$F/rig_misspelt_key.yaml"
+printf 'imagewidth: 640\nimageheight: 480\nleftcam: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\n' >"$F/rig_all_misspelt.yaml"
+check "synth -rig: every key misspelt" 1 "rig_all_misspelt.yaml' line 1: 'imagewidth' is not a key of a rig file" -- \
+  msf_synth -o out -frames 1 -rig "$F/rig_all_misspelt.yaml"
 printf 'image_height: 480\nleft: {fx: 500.0, fy: 500.0, cx: 320.0, cy: 240.0}\nbaseline_m: 0.12\n' >"$F/rig_no_width.yaml"
 check "synth -rig: image_width missing" 1 "rig_no_width.yaml': image_width is missing" -- \
   msf_synth -o out -frames 1 -rig "$F/rig_no_width.yaml"

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace msf {
 
@@ -87,7 +88,36 @@ PinholeCamera PinholeFit::solve(int width, int height, const std::string& what, 
   return c;
 }
 
-#define MSF_INSTANTIATE_PINHOLE_CAMERA(T) \
+void requireCameraOfPoints(const PinholeFit& fit, const PinholeCamera& camera, const std::string& what,
+                           const std::string& source) {
+  PinholeCamera points;
+  try {
+    points = fit.solve(camera.width, camera.height, what);
+  } catch (const InvalidInputError&) {
+    return;
+  }
+  constexpr double kMostApartPx = 2.0;
+  double apart = 0;
+  for (const double u : {0.0, camera.width - 1.0})
+    apart = std::max(apart, std::abs((u - points.cx) / points.fx * camera.fx + camera.cx - u));
+  for (const double v : {0.0, camera.height - 1.0})
+    apart = std::max(apart, std::abs((v - points.cy) / points.fy * camera.fy + camera.cy - v));
+  if (apart <= kMostApartPx)
+    return;
+  const auto intrinsics = [](const PinholeCamera& c) {
+    char text[96];
+    std::snprintf(text, sizeof text, "fx %.2f, fy %.2f, cx %.2f, cy %.2f", c.fx, c.fy, c.cx, c.cy);
+    return std::string(text);
+  };
+  char px[32];
+  std::snprintf(px, sizeof px, "%.1f", apart);
+  throw InvalidInputError(what + " was made by a camera of " + intrinsics(points) + ", not by " + source + " (" +
+                          intrinsics(camera) + "; a ray lands " + px +
+                          " px apart): a cloud of another rig? Give the rig it was made with");
+}
+
+#define MSF_INSTANTIATE_PINHOLE_CAMERA(T)                                            \
+  template PinholeFit fitPinhole<T>(const pcl::PointCloud<T>&);                        \
   template PinholeCamera estimatePinholeCamera<T>(const pcl::PointCloud<T>&, double);
 MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZ)
 MSF_INSTANTIATE_PINHOLE_CAMERA(pcl::PointXYZI)

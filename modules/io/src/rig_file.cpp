@@ -205,7 +205,12 @@ bool isRigFile(const std::string& path) {
     for (const char* key : {"image_width", "image_height", "left", "right", "baseline_m", "lidar"})
       if (root[key])
         return true;
-    return false;
+    // OpenCV reads no YAML without its "%YAML" line: a map without one is a rig file whose keys are
+    // all misspelt, and its reader names them.
+    std::ifstream file(path);
+    std::string first_line;
+    std::getline(file, first_line);
+    return first_line.rfind("%YAML", 0) != 0;
   } catch (const Error&) {
     return false;
   }

@@ -97,7 +97,7 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
       const float x = readFloat(p + fx->offset), y = readFloat(p + fy->offset), z = readFloat(p + fz->offset);
       const bool valid = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) && z > 0.f;
       depth[u] = valid ? z : 0.f;
-      if (valid && !camera)
+      if (valid)
         fit.add(u, v, x, y, z);
       if (frgb) {
         std::uint32_t rgb;
@@ -117,6 +117,8 @@ DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* c
       }
     }
   }
+  if (camera)
+    requireCameraOfPoints(fit, *camera, what, "the camera given");
   frame.camera = camera ? *camera : fit.solve(cols, rows, what);
   frame.validate();
   return frame;

@@ -55,6 +55,17 @@ private:
   double sb_ = 0, sbb_ = 0, sv_ = 0, sbv_ = 0, svv_ = 0;          // b = y / z against v
 };
 
+/// Throws InvalidInputError naming `what` when its points, fitted as `fit`, were made by another
+/// camera than `camera` (named by `source`): a ray through a corner of the image lands
+/// more than 2 pixels apart in the two, as in a .pcd of another rig of the same image size. A fit
+/// that recovers no camera (too few points, points off their rays) says nothing.
+void requireCameraOfPoints(const PinholeFit& fit, const PinholeCamera& camera, const std::string& what,
+                           const std::string& source);
+
+/// The fit of an organized cloud's valid points (finite, z > 0) against their pixels.
+template <typename PointT>
+PinholeFit fitPinhole(const pcl::PointCloud<PointT>& cloud);
+
 /// The intrinsics of an organized cloud made by a pinhole camera, fitted over its valid
 /// points. Throws InvalidInputError when the cloud is not organized, has too few valid
 /// points, or its points are not on their pixels' rays (see PinholeFit::solve).

@@ -22,9 +22,9 @@ namespace msf {
 ///     beam_elevations_deg: [-15.0, ..., 15.0]              # optional: one per ring
 ///     sweeping: true                                       # optional: a spinning LiDAR (deskewed; skew allowed)
 ///
-/// True when `path` is a YAML map with a rig's key (image_width, left, baseline_m, lidar, ...)
-/// and not OpenCV's camera file (saveCalibrationYaml, whose keys are P0..P3): a rig file that
-/// misses a key is then refused naming it.
+/// True when `path` is a YAML map with a rig's key (image_width, left, baseline_m, lidar, ...),
+/// or without OpenCV's "%YAML" first line, and not OpenCV's camera file (saveCalibrationYaml,
+/// whose keys are P0..P3): a rig file that misses a key or misspells one is then refused naming it.
 bool isRigFile(const std::string& path);
 
 /// Reads a rig file. Throws CalibrationError naming the file and the key that is missing,

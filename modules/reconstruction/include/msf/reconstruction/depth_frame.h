@@ -42,7 +42,8 @@ DepthFrame toDepthFrame(const pcl::PointCloud<PointT>& cloud, const PinholeCamer
 
 /// Same from a cloud of any point type as read from a file (fields x y z, optional rgb or
 /// rgba, optional weight and free_space_weight), so tools accept every organized cloud the other stages write.
-/// `what` names the cloud in messages.
+/// `what` names the cloud in messages. Also throws InvalidInputError when its points were made by
+/// another camera than `camera` (requireCameraOfPoints): a .pcd of another rig of the same size.
 DepthFrame toDepthFrame(const pcl::PCLPointCloud2& cloud, const PinholeCamera* camera = nullptr,
                         const std::string& what = "cloud");
 

@@ -8,7 +8,7 @@
 #include <msf/fusion/clear_sky.h>
 #include <msf/fusion/fused_canvas.h>
 #include <msf/fusion/sky_mask.h>
-#include <msf/io/pinhole_camera.h>
+#include <msf/io/impl/pinhole_camera.hpp>
 #include <msf/stereo/color_sampler.h>
 #include <msf/stereo/point_field_traits.h>
 
@@ -77,6 +77,15 @@ void DepthFusion<PointLidarT, PointStereoT, PointOutT>::checkInputs() {
   };
   checkRange(*lidar_, "LiDAR");
   checkRange(*stereo_, "stereo");
+  // Clouds of another rig of the same size would be fused, and integrated, at other rays.
+  if (rig_size.area() > 0) {
+    const PinholeCamera image = PinholeCamera::fromCalibration(calibration_);
+    const std::string rig = "the left camera of calibration '" + calibration_.source + "'";
+    requireCameraOfPoints(fitPinhole(*stereo_), image, "DepthFusion: the stereo cloud", rig);
+    requireCameraOfPoints(fitPinhole(*lidar_),
+                          image_in_canvas_.empty() ? image : image.onCanvas(image_in_canvas_, lidar_size),
+                          "DepthFusion: the LiDAR cloud", rig);
+  }
   // A NaN confidence would become a NaN weight, which the map takes as none.
   if constexpr (detail::has_confidence_v<PointStereoT>)
     for (std::size_t i = 0; i < stereo_->size(); ++i) {
