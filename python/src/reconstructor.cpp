@@ -3,6 +3,7 @@
 // caller's thread (add_frame: depth, pose, integration; mesh()), or a source's frames overlapped
 // on the engine's threads (run), each frame's depth images given back as a FrameResult.
 #include "bindings.h"
+#include "frame_list.h"
 #include "frame_object.h"
 
 #include <msf/common/exceptions.h>
@@ -93,12 +94,26 @@ TriangleMesh mesh(Engine& e) {
   return withoutGil(e.mutex, [&] { return e.engine.mesh(); }); // a copy: the engine keeps its own
 }
 
+/// The FrameSource `source` is, or a FrameList of the engine's rig made in `list` over a Python
+/// sequence of Frame.
+const FrameSource& sourceOf(const py::object& source, const Engine& e, std::optional<FrameList>& list) {
+  if (py::isinstance<FrameSource>(source))
+    return source.cast<const FrameSource&>();
+  if (!py::hasattr(source, "__len__") || !py::hasattr(source, "__getitem__"))
+    throw InvalidInputError("source must be a FrameSource (a Sequence, open_dataset's) or a sequence of Frame (a "
+                            "list), not a " +
+                            py::str(source.get_type().attr("__name__")).cast<std::string>());
+  return list.emplace(source, e.engine.calibration());
+}
+
 /// Reconstructor::run on a thread of its own while this one, the caller's, waits without the GIL
 /// and looks for signals every 0.1 s: Ctrl-C stops the run after the frame being integrated (as
 /// msf_reconstruct does) and is raised once the run has ended. `on_frame` gets each FrameResult
 /// on the engine's integration thread, with the GIL; it may call mesh() and num_blocks.
-py::dict run(Engine& e, const FrameSource& source, const std::optional<std::vector<long long>>& frames,
+py::dict run(Engine& e, const py::object& frame_source, const std::optional<std::vector<long long>>& frames,
              const py::object& on_frame) {
+  std::optional<FrameList> list;
+  const FrameSource& source = sourceOf(frame_source, e, list);
   std::vector<std::size_t> indices(source.size());
   std::iota(indices.begin(), indices.end(), std::size_t(0));
   if (frames) { // indices as a Python sequence's: negative from the end
@@ -248,10 +263,10 @@ void bindReconstructor(py::module_& m) {
            "for a result this map took already (add_frame's and run's too), which would weigh double.")
       .def("mesh", &mesh, "The map's Mesh, meshing again only the blocks changed since the last call.")
       .def("run", &run, py::arg("source"), py::arg("frames") = py::none(), py::arg("on_frame") = py::none(),
-           "The frames of a source (a Sequence; all, or the indices given, negative from the end) overlapped on "
-           "the engine's threads: the same map as add_frame frame by frame, faster. on_frame(result) is called "
-           "after each "
-           "frame is integrated, in order; it may call mesh() and num_blocks (another call of the engine raises "
+           "The frames of a source (a Sequence, open_dataset's, or a list of Frame made of your own arrays; "
+           "all, or the indices given, negative from the end) overlapped on the engine's threads: the same map "
+           "as add_frame frame by frame, faster. A list's Frame without an index is numbered by its place. "
+           "on_frame(result) is called after each frame is integrated, in order; it may call mesh() and num_blocks (another call of the engine raises "
            "msfusion.Error). Ctrl-C stops after the frame being integrated and raises KeyboardInterrupt, the map "
            "holding the frames done. Returns frames_done, wall_s, first_frame_s and interrupted (a stop that was "
            "not Ctrl-C's).")

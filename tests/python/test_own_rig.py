@@ -142,3 +142,38 @@ def test_a_map_takes_a_result_once(own_rig):
     other = msfusion.Reconstructor(own_rig.calibration)
     other.integrate(result)
     np.testing.assert_array_equal(other.mesh().vertices, once)
+
+
+class MadeOnRead:
+    """A program's frames made when asked for, from arrays that go with them."""
+
+    def __init__(self, sequence):
+        self.sequence = sequence
+
+    def __len__(self):
+        return len(self.sequence)
+
+    def __getitem__(self, i):
+        f = self.sequence[i]
+        return msfusion.Frame(f.left.copy(), f.right.copy(), f.scan, color=f.color, pose=f.pose)
+
+
+def test_run_takes_a_list_of_frames_made_of_arrays(own_rig):
+    """run() over frames of arrays, a list or any sequence, gives add_frame's map, their results
+    numbered by place; an item that is not a Frame is named."""
+    frames = [msfusion.Frame(f.left, f.right, f.scan, color=f.color, pose=f.pose) for f in own_rig]
+    fed = msfusion.Reconstructor(own_rig.calibration)
+    for frame in frames:
+        fed.add_frame(frame)
+    expected = fed.mesh().vertices
+    for source in (frames, MadeOnRead(own_rig)):
+        engine, names = msfusion.Reconstructor(own_rig.calibration), []
+        stats = engine.run(source, on_frame=lambda result: names.append((result.index, result.name)))
+        assert stats["frames_done"] == 2 and names == [(0, "0"), (1, "1")]
+        np.testing.assert_array_equal(engine.mesh().vertices, expected)
+    engine = msfusion.Reconstructor(own_rig.calibration)
+    assert engine.run(frames, frames=[-1])["frames_done"] == 1
+    with pytest.raises(msfusion.InvalidInputError, match="item 1 of the frames is a str, not a msfusion.Frame"):
+        msfusion.Reconstructor(own_rig.calibration).run([frames[0], "000001.png"])
+    with pytest.raises(msfusion.InvalidInputError, match="or a sequence of Frame .a list., not a int"):
+        msfusion.Reconstructor(own_rig.calibration).run(7)
