@@ -35,7 +35,16 @@ struct Engine {
   /// Calls from several Python threads take turns; run() holds it on its own thread, where its
   /// on_frame callback may call mesh() or num_blocks (the engine refuses the others there).
   std::recursive_mutex mutex;
+  std::size_t notes_said = 0; // the engine's notes raised as warnings so far
 };
+
+/// The engine's new notes as Python warnings (UserWarning), each once; with the GIL.
+void warnOfNewNotes(Engine& e) {
+  const std::vector<std::string> notes = withoutGil(e.mutex, [&] { return e.engine.notes(); });
+  for (; e.notes_said < notes.size(); ++e.notes_said)
+    if (PyErr_WarnEx(PyExc_UserWarning, ("msfusion.Reconstructor: " + notes[e.notes_said]).c_str(), 1) != 0)
+      throw py::error_already_set(); // a filter that turns warnings into errors
+}
 
 Reconstructor::PoseMode parsePoseMode(const std::string& text) {
   if (text == "auto")
@@ -69,17 +78,19 @@ FrameResult keepable(FrameResult result, const FrameObject& frame) {
 }
 
 FrameResult addFrame(Engine& e, const FrameObject& object) {
-  return keepable(withoutGil(e.mutex, [&] {
-                    Frame numbered;
-                    if (!object.numbered) {
-                      numbered = object.frame; // shares its images and scan
-                      numbered.index = e.frames_added;
-                    }
-                    FrameResult result = e.engine.addFrame(object.numbered ? object.frame : numbered);
-                    ++e.frames_added;
-                    return result;
-                  }),
-                  object);
+  FrameResult added = keepable(withoutGil(e.mutex, [&] {
+                                 Frame numbered;
+                                 if (!object.numbered) {
+                                   numbered = object.frame; // shares its images and scan
+                                   numbered.index = e.frames_added;
+                                 }
+                                 FrameResult result = e.engine.addFrame(object.numbered ? object.frame : numbered);
+                                 ++e.frames_added;
+                                 return result;
+                               }),
+                               object);
+  warnOfNewNotes(e);
+  return added;
 }
 
 FrameResult computeDepth(Engine& e, const FrameObject& frame) {
@@ -166,6 +177,7 @@ py::dict run(Engine& e, const py::object& frame_source, const std::optional<std:
     throw *interrupt;
   if (failure)
     std::rethrow_exception(failure);
+  warnOfNewNotes(e);
   py::dict out;
   out["frames_done"] = stats.frames_done;
   out["wall_s"] = stats.wall_s;
@@ -275,6 +287,10 @@ void bindReconstructor(py::module_& m) {
       .def_property_readonly("num_blocks", [](Engine& e) {
         return withoutGil(e.mutex, [&] { return e.engine.volume().numBlocks(); });
       }, "Blocks of 8^3 voxels the map holds.")
+      .def_property_readonly("notes", [](Engine& e) { return e.engine.notes(); },
+                             "What the engine did that you may not expect, a line each (each also raised once as a "
+                             "UserWarning): poses='auto' tracking frames that have their own pose, since the first "
+                             "had none.")
       .def_property_readonly("odometry_ms", [](Engine& e) { return e.engine.odometryMs(); },
                              "Milliseconds the odometry took for each frame it tracked.");
 }

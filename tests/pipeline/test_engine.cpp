@@ -208,6 +208,33 @@ TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapTakesItToo) {
   EXPECT_NO_THROW(other.integrate(depth));
 }
 
+TEST_F(PipelineTest, PosesThatAutoModeTrackedInsteadAreSaid) {
+  // The first frame has no pose, so every frame is tracked: the later frames' own poses go unused.
+  const msf::Sequence sequence(dataset());
+  msf::Frame first = sequence.load(0);
+  first.has_pose = false;
+  msf::Reconstructor automatic(sequence.calibration(), msf::PipelineConfig{});
+  automatic.addFrame(first);
+  EXPECT_TRUE(automatic.notes().empty());
+  automatic.addFrame(sequence.load(1));
+  automatic.addFrame(sequence.load(2));
+  ASSERT_EQ(automatic.notes().size(), 1u);
+  EXPECT_EQ(automatic.notes()[0], "frames with their own pose, from frame 1 on, were tracked by LiDAR odometry "
+                                  "instead: the first frame had none, so PoseMode Auto tracks every frame; give the "
+                                  "first frame its pose, or use PoseMode Refine to refine the poses with the scans");
+  // Asked for, the odometry's poses are no surprise; given, the frames' are used.
+  msf::Reconstructor::Options odometry;
+  odometry.poses = msf::Reconstructor::PoseMode::Odometry;
+  msf::Reconstructor tracked(sequence.calibration(), msf::PipelineConfig{}, odometry);
+  msf::Reconstructor given(sequence.calibration(), msf::PipelineConfig{});
+  for (std::size_t i = 0; i < 2; ++i) {
+    tracked.addFrame(sequence.load(i));
+    given.addFrame(sequence.load(i));
+  }
+  EXPECT_TRUE(tracked.notes().empty());
+  EXPECT_TRUE(given.notes().empty());
+}
+
 TEST_F(PipelineTest, TheRigSaysHowItsScansAreTakenToEveryDoor) {
   // The street's scans are taken at one instant: its rig says so, and the engine takes it from
   // the rig whether fed frame by frame or run (the tests above give msf_reconstruct's map). A rig

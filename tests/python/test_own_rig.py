@@ -3,6 +3,7 @@
 it), whose stages follow the rig as the engine's do, whose calibration saves and loads whole, and
 whose camera may give 16-bit images; and the engine's rules for callbacks and threads."""
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -177,3 +178,16 @@ def test_run_takes_a_list_of_frames_made_of_arrays(own_rig):
         msfusion.Reconstructor(own_rig.calibration).run([frames[0], "000001.png"])
     with pytest.raises(msfusion.InvalidInputError, match="or a sequence of Frame .a list., not a int"):
         msfusion.Reconstructor(own_rig.calibration).run(7)
+
+
+def test_poses_that_auto_mode_tracked_instead_are_a_warning(own_rig):
+    first, second = own_rig[0], own_rig[1]
+    engine = msfusion.Reconstructor(own_rig.calibration)  # poses="auto"
+    engine.add_frame(msfusion.Frame(first.left, first.right, first.scan, color=first.color))
+    with pytest.warns(UserWarning, match="frames with their own pose, from frame 1 on, were tracked by LiDAR "
+                                         "odometry instead"):
+        engine.add_frame(second)
+    assert len(engine.notes) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # said once
+        engine.add_frame(second)

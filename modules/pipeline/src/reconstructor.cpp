@@ -323,12 +323,24 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
     odometry_ = std::make_unique<LidarOdometry>(odometry);
     T_world_cam0_first_ = frame.has_pose ? frame.T_world_cam0 : Eigen::Isometry3d::Identity();
   }
+  if (options_.poses == PoseMode::Auto && frame.has_pose && !poses_not_used_) {
+    poses_not_used_ = true;
+    first_pose_not_used_ = frame.index;
+  }
   const auto start = Clock::now();
   const std::optional<Eigen::Isometry3d> measured = measuredMotion(frame);
   const Eigen::Isometry3d T_velo0_velo =
       odometry_->registerScan(*frame.scan, scan_name, measured ? &*measured : nullptr);
   odometry_ms_.push_back(msSince(start));
   return cameraPose(T_velo0_velo, calibration_.T_cam0_velo, T_world_cam0_first_);
+}
+
+std::vector<std::string> Reconstructor::notes() const {
+  if (!poses_not_used_)
+    return {};
+  return {"frames with their own pose, from frame " + std::to_string(first_pose_not_used_) +
+          " on, were tracked by LiDAR odometry instead: the first frame had none, so PoseMode Auto tracks every "
+          "frame; give the first frame its pose, or use PoseMode Refine to refine the poses with the scans"};
 }
 
 std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& frame) {

@@ -269,6 +269,10 @@ public:
   const StreamingMap* streaming() const { return streaming_.get(); }
   /// Milliseconds the odometry took for each frame it tracked (empty when it did not run).
   const std::vector<double>& odometryMs() const { return odometry_ms_; }
+  /// What the engine did that its caller may not expect, a line each, for the door to say: in
+  /// PoseMode Auto, the own poses of later frames, which the odometry replaced because the first
+  /// frame had none.
+  std::vector<std::string> notes() const;
 
   /// The configuration the stages run with: the one given, adapted to the rig (adaptToRig).
   const PipelineConfig& config() const { return config_; }
@@ -344,6 +348,8 @@ private:
   Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_velo_measured_last_ = Eigen::Isometry3d::Identity();  // PoseMode::Refine's prior
   std::vector<double> odometry_ms_;
+  bool poses_not_used_ = false;          // PoseMode Auto: a frame tracked though it had a pose
+  std::size_t first_pose_not_used_ = 0;  // the first of them
   /// The thread in a public call that changes the engine (OneCaller; the class comment).
   std::atomic<std::thread::id> caller_{};
   std::unordered_set<std::uint64_t> integrated_;  // the results' serials this map took
