@@ -177,7 +177,7 @@ TEST_F(PipelineTest, AnImageThatIsAViewIntoALargerOneGivesItsCopysDepth) {
   EXPECT_EQ(cv::countNonZero(copied.stereo_depth != from_views.stereo_depth), 0);
 }
 
-TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapTakesItToo) {
+TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapOfItsRigTakesItToo) {
   // A result integrated twice would weigh double: refused, the map unchanged.
   const msf::Sequence sequence(dataset());
   msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
@@ -203,9 +203,19 @@ TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapTakesItToo) {
   msf::test::TempDir a, b;
   EXPECT_TRUE(savedMap(engine, a).second == savedMap(fed, b).second) << "a refused result changed the map";
   EXPECT_FALSE(map_once.second == savedMap(engine, after).second);
-  // Another map takes the same result.
+  // Another map takes the same result; a map of another rig of the same image size does not.
   msf::Reconstructor other(sequence.calibration(), msf::PipelineConfig{});
   EXPECT_NO_THROW(other.integrate(depth));
+  msf::Calibration longer = sequence.calibration();
+  for (int camera = 0; camera < 4; ++camera)
+    longer.P[camera](0, 0) *= 1.04;
+  msf::Reconstructor of_another_rig(longer, msf::PipelineConfig{});
+  msf::FrameResult next = engine.computeDepth(sequence.load(2));
+  EXPECT_NE(msf::test::errorOf([&] { of_another_rig.integrate(next); })
+                .find("frame 2's result was computed for a camera of fx 721.54, fy 721.54, cx 609.56, cy 172.85, "
+                      "1242x375, not this map's rig (fx 750.40"),
+            std::string::npos);
+  EXPECT_EQ(of_another_rig.volume().numBlocks(), 0u);
 }
 
 TEST_F(PipelineTest, PosesThatAutoModeTrackedInsteadAreSaid) {

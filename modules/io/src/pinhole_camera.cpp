@@ -30,6 +30,12 @@ PinholeCamera PinholeCamera::fromCalibration(const Calibration& calibration, int
   return c;
 }
 
+std::string PinholeCamera::intrinsicsText() const {
+  char text[96];
+  std::snprintf(text, sizeof text, "fx %.2f, fy %.2f, cx %.2f, cy %.2f", fx, fy, cx, cy);
+  return text;
+}
+
 PinholeCamera PinholeCamera::onCanvas(const cv::Rect& image_in_canvas, const cv::Size& canvas) const {
   PinholeCamera c = *this;
   c.cx += static_cast<float>(image_in_canvas.x);
@@ -104,15 +110,10 @@ void requireCameraOfPoints(const PinholeFit& fit, const PinholeCamera& camera, c
     apart = std::max(apart, std::abs((v - points.cy) / points.fy * camera.fy + camera.cy - v));
   if (apart <= kMostApartPx)
     return;
-  const auto intrinsics = [](const PinholeCamera& c) {
-    char text[96];
-    std::snprintf(text, sizeof text, "fx %.2f, fy %.2f, cx %.2f, cy %.2f", c.fx, c.fy, c.cx, c.cy);
-    return std::string(text);
-  };
   char px[32];
   std::snprintf(px, sizeof px, "%.1f", apart);
-  throw InvalidInputError(what + " was made by a camera of " + intrinsics(points) + ", not by " + source + " (" +
-                          intrinsics(camera) + "; a ray lands " + px +
+  throw InvalidInputError(what + " was made by a camera of " + points.intrinsicsText() + ", not by " + source + " (" +
+                          camera.intrinsicsText() + "; a ray lands " + px +
                           " px apart): a cloud of another rig? Give the rig it was made with");
 }
 

@@ -235,6 +235,12 @@ void Reconstructor::integrateResult(FrameResult& result) {
   if (!result.has_pose)
     throw InvalidInputError("frame " + frame_name + " has no pose: integration needs one (the frame's, or PoseMode "
                             "Odometry)");
+  const PinholeCamera& made_by = result.fused.camera;
+  if (made_by.valid() && made_by != camera_)
+    throw InvalidInputError("frame " + frame_name + "'s result was computed for a camera of " +
+                            made_by.intrinsicsText() + ", " + std::to_string(made_by.width) + "x" +
+                            std::to_string(made_by.height) + ", not this map's rig (" + camera_.intrinsicsText() +
+                            "): integrate it into an engine of its own rig");
   if (result.serial == 0)
     result.serial = newSerial();
   if (integrated_.count(result.serial) != 0)

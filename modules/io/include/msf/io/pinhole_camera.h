@@ -22,6 +22,13 @@ struct PinholeCamera {
     return fx > 0.f && fy > 0.f && std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) &&
            width > 0 && height > 0;
   }
+  /// "fx 500.00, fy 500.00, cx 320.00, cy 240.00", for messages.
+  std::string intrinsicsText() const;
+  /// The same intrinsics and size.
+  bool operator==(const PinholeCamera& o) const {
+    return fx == o.fx && fy == o.fy && cx == o.cx && cy == o.cy && width == o.width && height == o.height;
+  }
+  bool operator!=(const PinholeCamera& o) const { return !(*this == o); }
   /// The point the camera sees at pixel (u, v) with depth z, in its frame.
   Eigen::Vector3f point(float u, float v, float z) const { return {(u - cx) * z / fx, (v - cy) * z / fy, z}; }
   /// Camera `camera` (0..3) of a calibration; throws CalibrationError when the calibration

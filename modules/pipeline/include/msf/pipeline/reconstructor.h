@@ -204,8 +204,9 @@ public:
   FrameResult computeDepth(const Frame& frame);
   /// Integrates the fused depth of `result` at its pose (step 5), grown by the interpolated
   /// LiDAR of the canvas's margin (fusedDepthFrame). Throws InvalidInputError when the frame
-  /// has no pose, or when this map took the result already (addFrame's and run()'s results
-  /// included): a second time would double its weight.
+  /// has no pose, was computed for another rig (its camera differs from this engine's), or when
+  /// this map took the result already (addFrame's and run()'s results included): a second time
+  /// would double its weight.
   void integrate(FrameResult& result);
 
   struct RunStats {
