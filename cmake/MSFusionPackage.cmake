@@ -1,5 +1,6 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
-# Installs and exports the CMake package: find_package(MSFusion) gives MSFusion::<module>.
+# Installs and exports the CMake package: find_package(MSFusion), or find_package(msfusion),
+# gives MSFusion::<module>.
 include(CMakePackageConfigHelpers)
 get_property(MSF_EXPORTED_MODULES GLOBAL PROPERTY MSF_MODULE_TARGETS)
 string(REPLACE "msf_" "" MSF_EXPORTED_MODULES "${MSF_EXPORTED_MODULES}")
@@ -11,4 +12,8 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/MSFusionConfigVersion.cma
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/MSFusionConfig.cmake
   ${PROJECT_BINARY_DIR}/MSFusionConfigVersion.cmake DESTINATION lib/cmake/MSFusion)
+# find_package(msfusion) too: CMake matches the folder's name in any case, the file's exactly.
+install(FILES ${PROJECT_SOURCE_DIR}/cmake/msfusion-config.cmake DESTINATION lib/cmake/MSFusion)
+install(FILES ${PROJECT_BINARY_DIR}/MSFusionConfigVersion.cmake DESTINATION lib/cmake/MSFusion
+  RENAME msfusion-config-version.cmake)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION share/msfusion/config)

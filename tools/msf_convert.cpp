@@ -6,11 +6,11 @@
 #include <msf/common/output_folder.h>
 #include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/io/image_io.h>
 #include <msf/io/poses.h>
 #include <msf/io/rig_file.h>
 #include <msf/io/velodyne_io.h>
-#include <msf/pipeline/open_dataset.h>
 
 #include <pcl/console/print.h>
 #include <pcl/console/time.h>

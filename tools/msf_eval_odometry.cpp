@@ -4,11 +4,11 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/common/tool.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/evaluation/trajectory_plot.h>
 #include <msf/io/image_io.h>
 #include <msf/io/poses.h>
-#include <msf/pipeline/open_dataset.h>
 
 #include <pcl/console/print.h>
 

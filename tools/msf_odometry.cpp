@@ -5,9 +5,9 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/statistics.h>
 #include <msf/common/tool.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/evaluation/odometry_metrics.h>
 #include <msf/io/poses.h>
-#include <msf/pipeline/open_dataset.h>
 #include <msf/registration/lidar_odometry.h>
 
 #include <pcl/console/print.h>

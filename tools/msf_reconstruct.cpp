@@ -7,13 +7,13 @@
 #include <msf/common/output_folder.h>
 #include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/evaluation/reconstruction_evaluation.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
 #include <msf/io/world_frame.h>
 #include <msf/pipeline/frame_panel.h>
-#include <msf/pipeline/open_dataset.h>
 #include <msf/pipeline/fused_cloud.h>
 #include <msf/pipeline/pose_source.h>
 #include <msf/pipeline/reconstructor.h>

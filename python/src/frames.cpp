@@ -6,10 +6,10 @@
 #include "frame_object.h"
 
 #include <msf/common/exceptions.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/io/image_io.h>
 #include <msf/io/sequence.h>
 #include <msf/io/bag_options.h>
-#include <msf/pipeline/open_dataset.h>
 
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>

@@ -3,12 +3,12 @@
 // reads the same frames, in every scan and image format, with frames matched to their lines
 // by number.
 #include <msf/common/exceptions.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/io/folder_source.h>
 #include <msf/io/image_io.h>
 #include <msf/io/scan_file.h>
 #include <msf/io/sequence.h>
 #include <msf/io/tum_poses.h>
-#include <msf/pipeline/open_dataset.h>
 
 #include "pipeline_fixture.h"
 #include "test_support.h"

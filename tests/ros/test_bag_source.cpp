@@ -2,10 +2,10 @@
 // ROS 1 bags as datasets: bags written with the rosbag API (by the test itself, and by
 // writeKittiBag from the KITTI sample) read back by BagSource, and what it refuses.
 #include <msf/common/exceptions.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/evaluation/mesh_accuracy.h>
 #include <msf/io/cloud_io.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/open_dataset.h>
 #include <msf/ros/bag_source.h>
 #include <msf/ros/bag_writer.h>
 #include <msf/ros/message_conversions.h>

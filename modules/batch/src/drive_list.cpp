@@ -2,8 +2,8 @@
 #include <msf/batch/drive_list.h>
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/io/folder_source.h>
-#include <msf/pipeline/open_dataset.h>
 
 #include <algorithm>
 #include <filesystem>

@@ -5,7 +5,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/common/stop_signals.h>
 #include <msf/common/tool.h>
-#include <msf/pipeline/open_dataset.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/ros/bag_writer.h>
 
 #include <pcl/console/print.h>

@@ -1,8 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 #include <msf/common/exceptions.h>
+#include <msf/datasets/open_dataset.h>
 #include <msf/io/folder_source.h>
 #include <msf/io/sequence.h>
-#include <msf/pipeline/open_dataset.h>
 #ifdef MSF_WITH_ROS
 #include <msf/ros/bag_source.h>
 #endif
