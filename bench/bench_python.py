@@ -8,11 +8,13 @@ a shared machine disturbs less.
 
     PYTHONPATH=build/python python3 bench/bench_python.py build/bin ../shared/data/kitti [ROUNDS]
 
-Three Python paths, each against its C++ counterpart:
+Four Python paths, each against its C++ counterpart:
   load + add_frame   Sequence[i] read in the loop          vs BM_LoadAndAddFrame
   add_frame          the frames read before the timing     vs BM_AddFrame
   arrays + add_frame a Frame made of numpy arrays per frame vs BM_AddFrame
                      (the grey pair viewed, the scan and the colour image copied)
+  run(list)          a list of those Frames through run(), overlapped on the engine's threads
+                     vs BM_Run (the sequence read by run())
 """
 import json
 import os
@@ -27,12 +29,12 @@ FRAMES = 10
 
 
 def cpp_round(bin_dir, kitti_dir):
-    """(wall, CPU) ms per frame of BM_LoadAndAddFrame and of BM_AddFrame, one process."""
+    """(wall, CPU) ms per frame of BM_LoadAndAddFrame, BM_AddFrame and BM_Run, one process."""
     r = subprocess.run([os.path.join(bin_dir, "bench_frame_loop"), "--benchmark_format=json"], capture_output=True,
                        text=True, check=True, env=dict(os.environ, MSF_KITTI_DIR=kitti_dir))
     times = {b["name"].split("/")[0]: (b["real_time"] / FRAMES, b["cpu_time"] / FRAMES)
              for b in json.loads(r.stdout)["benchmarks"]}
-    return times["BM_LoadAndAddFrame"], times["BM_AddFrame"]
+    return times["BM_LoadAndAddFrame"], times["BM_AddFrame"], times["BM_Run"]
 
 
 def timed(calibration, frames):
@@ -45,10 +47,18 @@ def timed(calibration, frames):
     return (time.perf_counter() - wall) * 1000 / FRAMES, (time.process_time() - cpu) * 1000 / FRAMES
 
 
+def timed_run(calibration, frames):
+    """(wall, CPU) ms per frame of run() over the list `frames` in a fresh engine."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    msfusion.Reconstructor(calibration).run(frames)
+    return (time.perf_counter() - wall) * 1000 / FRAMES, (time.process_time() - cpu) * 1000 / FRAMES
+
+
 def python_round(sequence, loaded, arrays):
     return (timed(sequence.calibration, lambda i: sequence[i]),
             timed(sequence.calibration, lambda i: loaded[i]),
-            timed(sequence.calibration, lambda i: msfusion.Frame(**arrays[i])))
+            timed(sequence.calibration, lambda i: msfusion.Frame(**arrays[i])),
+            timed_run(sequence.calibration, [msfusion.Frame(**a) for a in arrays]))
 
 
 def cpu_model():
@@ -75,7 +85,8 @@ def main():
     print(f"\nKITTI odometry 04 frames 0-{FRAMES - 1}, ms per frame, median of {rounds} alternating rounds; "
           f"{os.cpu_count()} cores, {cpu_model()}")
     print(f"{'path':<20} {'C++ wall':>9} {'Python':>8} {'ratio':>6}   {'C++ CPU':>8} {'Python':>8} {'ratio':>6}")
-    for name, c, p in (("load + add_frame", 0, 0), ("add_frame", 1, 1), ("arrays + add_frame", 1, 2)):
+    for name, c, p in (("load + add_frame", 0, 0), ("add_frame", 1, 1), ("arrays + add_frame", 1, 2),
+                       ("run(list)", 2, 3)):
         row = f"{name:<20}"
         for clock in (0, 1):
             a = statistics.median(r[c][clock] for r in cpp)
