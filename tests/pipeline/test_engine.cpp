@@ -188,7 +188,8 @@ TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapOfItsRigTakesItToo) {
   const std::string again = msf::test::errorOf([&] { engine.integrate(depth); });
   msf::FrameResult copy = depth;
   const std::string copied = msf::test::errorOf([&] { engine.integrate(copy); });
-  msf::FrameResult added = engine.addFrame(sequence.load(1));
+  const msf::Frame second = sequence.load(1);
+  msf::FrameResult added = engine.addFrame(second);
   const std::string from_add = msf::test::errorOf([&] { engine.integrate(added); });
   for (const std::string& error : {again, copied})
     EXPECT_NE(error.find("frame 0's result is in the map already (addFrame and run integrate theirs): a second "
@@ -196,6 +197,11 @@ TEST_F(PipelineTest, AMapTakesAResultOnceAndAnotherMapOfItsRigTakesItToo) {
               std::string::npos)
         << error;
   EXPECT_NE(from_add.find("frame 1's result is in the map already"), std::string::npos) << from_add;
+  // The same frame given again in a row, as a loop that feeds one frame twice does.
+  const std::string twice = msf::test::errorOf([&] { engine.addFrame(second); });
+  EXPECT_NE(twice.find("frame 1 is the frame given last (the same scan): given twice, the map would take it twice"),
+            std::string::npos)
+      << twice;
   // The map holds frames 0 and 1 once each: as an engine fed them by addFrame.
   msf::Reconstructor fed(sequence.calibration(), msf::PipelineConfig{});
   fed.addFrame(sequence.load(0));

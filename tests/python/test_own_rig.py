@@ -188,6 +188,9 @@ def test_poses_that_auto_mode_tracked_instead_are_a_warning(own_rig):
                                          "odometry instead"):
         engine.add_frame(second)
     assert len(engine.notes) == 1
+    again = own_rig[1]
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # said once
-        engine.add_frame(second)
+        engine.add_frame(again)
+    with pytest.raises(msfusion.InvalidInputError, match="frame 1 is the frame given last .the same scan."):
+        engine.add_frame(again)  # given twice in a row

@@ -365,6 +365,9 @@ FrameResult Reconstructor::addFrame(const Frame& given) {
   Frame copy;
   const Frame& frame = withWholeImages(given, copy);
   checkFrame(frame, calibration_); // before the odometry or the earlier scans take it in
+  if (frame.scan && last_scan_.lock() == frame.scan)
+    throw InvalidInputError("frame " + std::to_string(frame.index) +
+                            " is the frame given last (the same scan): given twice, the map would take it twice");
   const ThreadBudget budget(options_.threads);
   if (frames_added_ == 0)
     add_tracks_ = tracks(frame);
@@ -375,6 +378,7 @@ FrameResult Reconstructor::addFrame(const Frame& given) {
   }
   computeDepth(frame, result);
   integrateResult(result);
+  last_scan_ = frame.scan;
   ++frames_added_;
   if (config_.scheduling.mesh_every_n_frames > 0 &&
       frames_added_ % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)

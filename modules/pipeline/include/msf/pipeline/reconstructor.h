@@ -195,7 +195,9 @@ public:
   /// as Options::poses says) and its integration into the map (step 5). Returns the frame's
   /// depth images, weight and the pose used. Throws InvalidInputError for images or a scan
   /// that do not fit the rig (checkFrame), or a frame without a pose where one is needed,
-  /// before anything changes: the engine is as it was, and the frame can be given again.
+  /// before anything changes: the engine is as it was, and the frame can be given again. A frame
+  /// given twice in a row (the same scan object as the frame it took last) is refused too: the
+  /// map would take it twice.
   FrameResult addFrame(const Frame& frame);
 
   /// Depth of one frame, synchronously: steps 1-4, nothing added to the map. With
@@ -356,6 +358,7 @@ private:
   std::unordered_set<std::uint64_t> integrated_;  // the results' serials this map took
   std::size_t frames_added_ = 0;  // by addFrame: its first frame decides PoseMode::Auto
   bool add_tracks_ = false;
+  std::weak_ptr<const pcl::PointCloud<pcl::PointXYZI>> last_scan_;  // of the last frame addFrame took
 };
 
 } // namespace msf
