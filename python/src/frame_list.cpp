@@ -21,7 +21,10 @@ const FrameObject& frameAt(const py::object& frames, std::size_t i, py::object& 
 } // namespace
 
 FrameList::FrameList(py::object frames, const Calibration& rig)
-    : frames_(std::move(frames)), rig_(rig), size_(py::len(frames_)) {}
+    : frames_(std::move(frames)), rig_(rig), size_(py::len(frames_)) {
+  py::object first;
+  has_color_ = size_ > 0 && !frameAt(frames_, 0, first).frame.color.empty();
+}
 
 std::string FrameList::frameName(std::size_t i) const {
   const std::lock_guard<std::mutex> lock(names_mutex_);

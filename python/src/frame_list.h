@@ -26,12 +26,14 @@ public:
   Frame load(std::size_t i, bool with_color = true) const override;
   double timestamp(std::size_t i) const override;
   std::string description() const override;
-  bool hasColor() const override { return true; }
+  /// Whether its first Frame has a colour image.
+  bool hasColor() const override { return has_color_; }
 
 private:
   py::object frames_;
   Calibration rig_;
   std::size_t size_ = 0;
+  bool has_color_ = false;
   mutable std::mutex names_mutex_;
   mutable std::unordered_map<std::size_t, std::string> names_;  // by Frame::index, as the engine asks
 };

@@ -235,6 +235,7 @@ TEST(AnyRig, ACloudOfAnotherRigOfTheSameSizeIsRefused) {
       run("msf_integrate", integrate + dir.file("other_volume.pcd") + " -rig " + dir.file("other.yaml"));
   EXPECT_EQ(integrated.exit_code, 1);
   EXPECT_NE(integrated.err.find("fused.pcd' was made by a camera of fx 500.00"), std::string::npos) << integrated.err;
+  EXPECT_FALSE(fs::exists(dir.file("other_volume.pcd")));
   EXPECT_EQ(run("msf_integrate", integrate + dir.file("volume.pcd") + " -rig " + rig).exit_code, 0);
 }
 
