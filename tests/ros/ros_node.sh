@@ -210,6 +210,32 @@ node_lines "$work/late.log" | grep -aq "'$work/late.ply' appeared while the node
   fail "the node did not say it left late.ply: $(node_lines "$work/late.log" | tr '\n' ' ')"
 echo "ok: a file that appeared at ~mesh_path while the node ran is left as it is; the mesh is late_1.ply"
 
+# The bag played twice to one node: time goes back at the second play. Its scans make no frame
+# (the map takes frames in time order), the node says why, and the map is the first play's.
+background replay roslaunch --wait msfusion kitti_bag.launch bag:="$work/04.bag" play:=false queue_size:=$frames \
+  mesh_path:="$work/replay_mesh.ply"
+replay=$started
+background replay_depth_seen rostopic echo -n "$frames" /msf_ros_node/depth/header/seq
+counter=$started
+rosbag play -q --wait-for-subscribers --rate 0.5 "$work/04.bag" >"$work/replay_play1.log" 2>&1 ||
+  fail "rosbag play: $(tail -3 "$work/replay_play1.log")"
+for ((k = 0; k < 600; ++k)); do
+  kill -0 "$counter" 2>/dev/null || break
+  sleep 0.1
+done
+rosbag play -q --rate 0.5 "$work/04.bag" >"$work/replay_play2.log" 2>&1 ||
+  fail "rosbag play again: $(tail -3 "$work/replay_play2.log")"
+sleep 2 # the last messages reach the node
+stop_group "$replay" 30
+account=$(node_lines "$work/replay.log" | grep -a -A3 "scans received")
+[[ "$account" == *"$((2 * frames)) scans received, $frames frames, $frames reconstructed, 0 dropped"* &&
+  "$account" == *"$frames scans made no frame: time went back, by up to "*" (a bag played again, or a clock reset)"* &&
+  "$account" != *"no stereo pair"* ]] || fail "the node's account of a bag played twice: '$account'"
+node_lines "$work/replay.log" | grep -aq "time went back on '/kitti/velo/pointcloud'.*restart the node for a new map" ||
+  fail "the node did not warn that time went back: $(node_lines "$work/replay.log" | tr '\n' ' ')"
+cmp "$work/replay_mesh.ply" "$work/node_mesh.ply" || fail "the map of a bag played twice is not the first play's"
+echo "ok: a bag played twice: the second play's $frames scans make no frame, the node says time went back"
+
 # A rig's own bag: no colour camera though ~color_topic names one (a grey mesh, every frame), and
 # tf's world not kitti2bag's camera_init (the root of the left camera's tree, which a moving
 # transform leads to: msf_kitti2bag's 'world' above it): the poses from tf, the mesh

@@ -259,7 +259,7 @@ void ReconstructionNode::countMessages() {
     color_info_sub_.registerCallback(
         [=, topic = cameraInfoTopic(params_.color_topic)](const Info::ConstPtr&) { count(topic); });
   }
-  cloud_sub_.registerCallback([this](const Cloud::ConstPtr&) { onScan(); });
+  cloud_sub_.registerCallback([this](const Cloud::ConstPtr& cloud) { onScan(cloud->header.stamp); });
   left_sub_.registerCallback([=, topic = params_.left_topic](const Image::ConstPtr&) { count(topic); });
   right_sub_.registerCallback([=, topic = params_.right_topic](const Image::ConstPtr&) { count(topic); });
   left_info_sub_.registerCallback(
@@ -283,8 +283,26 @@ std::string ReconstructionNode::silentInputs() const {
   return silent;
 }
 
-void ReconstructionNode::onScan() {
+void ReconstructionNode::onScan(const ros::Time& stamp) {
   ++scans_;
+  const std::int64_t ns = stampNs(stamp);
+  if (scans_ > 1 && ns <= newest_scan_ns_) {
+    // The map takes its frames in time order: a frame of this scan would come after newer ones.
+    ++scans_back_in_time_;
+    {
+      std::lock_guard<std::mutex> lock(drops_mutex_);
+      largest_step_back_ns_ = std::max(largest_step_back_ns_, newest_scan_ns_ - ns);
+    }
+    if (!stepping_back_)
+      ROS_WARN("msf_ros_node: time went back on '%s' (a scan at %.3f s after one at %.3f s: a bag played again, or a "
+               "clock reset): scans up to %.3f s make no frame, since the map takes its frames in time order; "
+               "restart the node for a new map",
+               params_.lidar_topic.c_str(), stamp.toSec(), newest_scan_ns_ * 1e-9, newest_scan_ns_ * 1e-9);
+    stepping_back_ = true;
+    return;
+  }
+  newest_scan_ns_ = ns;
+  stepping_back_ = false;
   // A few scans with no frame: say which input they wait for, while it waits.
   constexpr std::size_t kScansBeforeWarning = 5;
   if (++scans_since_frame_ < kScansBeforeWarning)
@@ -314,13 +332,11 @@ void ReconstructionNode::onColor(const Cloud::ConstPtr& cloud, const Image::Cons
 
 void ReconstructionNode::enqueue(Pending pending) {
   // A colour camera that starts publishing later: both syncs may give its first frames, queued once.
-  constexpr std::size_t kRemembered = 8;
+  // A scan from before the last frame's (time went back) is counted by onScan.
   const std::int64_t scan_ns = stampNs(pending.cloud->header.stamp);
-  if (std::find(queued_scans_ns_.begin(), queued_scans_ns_.end(), scan_ns) != queued_scans_ns_.end())
+  if (frames_ > 0 && scan_ns <= newest_queued_scan_ns_)
     return;
-  queued_scans_ns_.push_back(scan_ns);
-  if (queued_scans_ns_.size() > kRemembered)
-    queued_scans_ns_.pop_front();
+  newest_queued_scan_ns_ = scan_ns;
   scans_since_frame_ = 0;
   judgePairStamps(pending);
   if (frames_++ == 0)
@@ -602,7 +618,13 @@ std::string ReconstructionNode::summary() const {
   }
   if (const std::string apart = stereoPairApartNote(pair_apart_ns_); !apart.empty())
     reasons += "\n  " + apart;
-  const std::size_t unmatched = scans_ - frames_;
+  if (scans_back_in_time_ > 0) {
+    char back[64];
+    std::snprintf(back, sizeof back, "%.3f s", static_cast<double>(largest_step_back_ns_) * 1e-9);
+    reasons += "\n  " + std::to_string(scans_back_in_time_) + " scans made no frame: time went back, by up to " +
+               back + " (a bag played again, or a clock reset), and the map takes its frames in time order";
+  }
+  const std::size_t unmatched = scans_ - frames_ - scans_back_in_time_;
   if (unmatched > 0)
     reasons += "\n  " + std::to_string(unmatched) + " scans made no frame: no stereo pair (and CameraInfo) within " +
                numberText(params_.sync_slop_s) + " s of their stamp, or, the last ones, no messages after them " +

@@ -19,7 +19,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -93,13 +92,15 @@ private:
   bool colorPublished() const;
   /// The inputs that have sent nothing yet, as "'topic', 'topic'" ("" = none).
   std::string silentInputs() const;
-  void onScan();
+  /// Counts the scan, and its going back in time (a bag played again): such scans make no frame.
+  void onScan(const ros::Time& stamp);
   void onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
                 const Image::ConstPtr& right, const Info::ConstPtr& right_info);
   void onColor(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
                const Image::ConstPtr& right, const Info::ConstPtr& right_info, const Image::ConstPtr& color,
                const Info::ConstPtr& color_info);
-  /// The sync's callback: queues the frame; when the queue is full its oldest frame is dropped.
+  /// The sync's callback: queues the frame, unless its scan is not newer than the last queued
+  /// (both syncs gave it, or time went back); when the queue is full its oldest frame is dropped.
   void enqueue(Pending pending);
   /// The worker thread: one frame at a time through the engine, the mesh marker when due.
   void work();
@@ -146,7 +147,11 @@ private:
   std::atomic<std::size_t> scans_ = 0, frames_ = 0, reconstructed_ = 0;
   std::atomic<std::size_t> scans_since_frame_ = 0;
   std::map<std::string, std::size_t> messages_; // per input topic (the spin thread's)
-  std::deque<std::int64_t> queued_scans_ns_;    // the last frames' scans: none queued twice
+  std::int64_t newest_queued_scan_ns_ = 0;      // the frames go to the engine in time order
+  // Scans not newer than one before them (the spin thread's): time went back, by up to the largest.
+  std::int64_t newest_scan_ns_ = 0, largest_step_back_ns_ = 0;
+  bool stepping_back_ = false; // the last scan was such a scan
+  std::atomic<std::size_t> scans_back_in_time_ = 0;
   Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;
   std::map<std::string, std::size_t> dropped_; // reason -> frames
