@@ -236,6 +236,38 @@ node_lines "$work/replay.log" | grep -aq "time went back on '/kitti/velo/pointcl
 cmp "$work/replay_mesh.ply" "$work/node_mesh.ply" || fail "the map of a bag played twice is not the first play's"
 echo "ok: a bag played twice: the second play's $frames scans make no frame, the node says time went back"
 
+# A rig that records its images compressed (CompressedImage on image_raw/compressed; PNG keeps
+# every grey level): the node, told the compressed topics, decodes them and makes the raw bag's map.
+"$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -images png -o "$work/png.bag" >/dev/null
+sed -E 's|^((left\|right\|color)_topic: +/kitti/[a-z_]+/image_raw)|\1/compressed|' "$node_params" >"$work/png.yaml"
+[ "$(grep -c "image_raw/compressed" "$work/png.yaml")" = 3 ] || fail "kitti_bag.yaml has not three image topics"
+bag=$work/png.bag play_to_node compressed params:="$work/png.yaml" mesh_path:="$work/png_mesh.ply"
+account=$(node_lines "$work/compressed.log" | grep -a "scans received")
+[[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||
+  fail "the node on compressed images: '$account'"
+cmp "$work/png_mesh.ply" "$work/node_mesh.ply" || fail "the node's map of PNG-compressed images is not the raw bag's"
+echo "ok: images compressed as PNG on image_raw/compressed: every frame, the raw bag's mesh byte for byte"
+
+# The same rig with the node told the raw topics: while its scans wait, it names the compressed
+# topics that are published instead, and the parameter to set.
+"$build/bin/msf_kitti2bag" "$sequence" -frames 0:5 -images png -o "$work/png6.bag" >/dev/null
+# The player cannot wait for subscribers to every topic: the node subscribes to none of the images.
+background hint roslaunch --wait msfusion kitti_bag.launch bag:="$work/png6.bag" play:=false
+hint=$started
+for ((k = 0; k < 300; ++k)); do
+  rostopic info /kitti/velo/pointcloud 2>/dev/null | grep -q "/msf_ros_node" && break
+  sleep 0.1
+done
+rosbag play -q --rate 0.5 "$work/png6.bag" >"$work/hint_play.log" 2>&1 ||
+  fail "rosbag play: $(tail -3 "$work/hint_play.log")"
+stop_group "$hint" 30
+expected="nothing yet on '/kitti/camera_gray_left/image_raw', '/kitti/camera_gray_right/image_raw'; "
+expected+="'/kitti/camera_gray_left/image_raw/compressed' is published (sensor_msgs/CompressedImage): name it in "
+expected+="~left_topic; '/kitti/camera_gray_right/image_raw/compressed' is published"
+node_lines "$work/hint.log" | grep -aqF "$expected" ||
+  fail "the node did not name the compressed topics: $(node_lines "$work/hint.log" | tr '\n' ' ')"
+echo "ok: told the raw topics of a compressed rig, the node names the compressed ones and their parameters"
+
 # A rig's own bag: no colour camera though ~color_topic names one (a grey mesh, every frame), and
 # tf's world not kitti2bag's camera_init (the root of the left camera's tree, which a moving
 # transform leads to: msf_kitti2bag's 'world' above it): the poses from tf, the mesh

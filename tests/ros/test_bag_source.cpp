@@ -8,6 +8,7 @@
 #include <msf/io/sequence.h>
 #include <msf/ros/bag_source.h>
 #include <msf/ros/bag_writer.h>
+#include <msf/ros/compressed_image.h>
 #include <msf/ros/message_conversions.h>
 
 #include "test_support.h"
@@ -50,6 +51,9 @@ struct TinyBag {
   int frames = 3;
   int image_bits = 8; // 12: mono16 of a 12-bit camera, the 8-bit values x 16
   int beam_points = 0; // with ring_and_time: returns of three beams (+2, -4, -10 degrees, numbered from the top)
+  // The images as CompressedImage on <image_name>/compressed: "png", or what no camera sends
+  // ("depth": a compressedDepth map, "garbage": bytes that do not decode); "" = Image.
+  std::string compressed;
 };
 
 sensor_msgs::PointCloud2 tinyScan(const std_msgs::Header& header, const TinyBag& b, int frame) {
@@ -157,9 +161,24 @@ void writeTinyBag(const std::string& path, const TinyBag& b) {
       cv_bridge::CvImage(h, "mono16", wide).toImageMsg(m);
       return m;
     };
-    bag.write("/cam/left/" + b.image_name, msf::stampFromNs(ns), message(image, header("cam_left", ns)));
-    bag.write("/cam/right/" + b.image_name, msf::stampFromNs(right_ns),
-              message(image + 1, header("cam_right", right_ns)));
+    const auto compressed = [&](const cv::Mat& grey, const std_msgs::Header& h) {
+      sensor_msgs::CompressedImage m = msf::compressImage(grey, h, "png");
+      if (b.compressed == "depth")
+        m.format = "16UC1; compressedDepth png";
+      if (b.compressed == "garbage")
+        m.data.assign(m.data.size(), 7);
+      return m;
+    };
+    if (b.compressed.empty()) {
+      bag.write("/cam/left/" + b.image_name, msf::stampFromNs(ns), message(image, header("cam_left", ns)));
+      bag.write("/cam/right/" + b.image_name, msf::stampFromNs(right_ns),
+                message(image + 1, header("cam_right", right_ns)));
+    } else {
+      bag.write("/cam/left/" + b.image_name + "/compressed", msf::stampFromNs(ns),
+                compressed(image, header("cam_left", ns)));
+      bag.write("/cam/right/" + b.image_name + "/compressed", msf::stampFromNs(right_ns),
+                compressed(image + 1, header("cam_right", right_ns)));
+    }
     if (b.camera_info) {
       bag.write("/cam/left/camera_info", msf::stampFromNs(ns), tinyInfo(header("cam_left", ns), 0.0));
       bag.write("/cam/right/camera_info", msf::stampFromNs(right_ns), tinyInfo(header("cam_right", right_ns), -50.0));
@@ -211,6 +230,64 @@ TEST(BagSource, ReadsScansImagesCameraInfoAndTheExtrinsicOfARigsBag) {
   EXPECT_FALSE(f.has_pose);
   // A scan's place in the scans' stamp order, and a right image 7 ms late still its frame's.
   EXPECT_EQ(source.scanStampNs(1), kStart + 100 * kMs);
+}
+
+/// A rig that records its images compressed (image_transport's <image>/compressed): read where
+/// the image topic is named, decoded, beside the image topic's CameraInfo; what is no camera's
+/// image is refused naming the frame and the topic.
+TEST(BagSource, ReadsCompressedImagesAndRefusesWhatIsNoCamerasImage) {
+  msf::test::TempDir dir;
+  TinyBag b;
+  b.compressed = "png";
+  writeTinyBag(dir.file("png.bag"), b);
+  const msf::BagSource source(dir.file("png.bag"), tinyTopics());
+  ASSERT_EQ(source.size(), 3u);
+  ASSERT_EQ(source.notes().size(), 2u);
+  EXPECT_EQ(source.notes()[0], "topic '/cam/left/image_raw' is absent: the left rectified image read from "
+                               "'/cam/left/image_raw/compressed'");
+  EXPECT_DOUBLE_EQ(source.calibration().baselineGrey(), 0.5); // /cam/*/camera_info
+  const msf::Frame f = source.load(1);
+  EXPECT_EQ(f.left.type(), CV_8UC1);
+  EXPECT_EQ(cv::norm(f.left, cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(11)), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(f.right, cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(12)), cv::NORM_INF), 0.0);
+
+  b.compressed = "depth";
+  writeTinyBag(dir.file("depth.bag"), b);
+  EXPECT_EQ(errorOf([&] { msf::BagSource(dir.file("depth.bag"), tinyTopics()); }),
+            "the first image of '" + dir.file("depth.bag") + "', topic '/cam/left/image_raw/compressed': a "
+            "compressedDepth image (format '16UC1; compressedDepth png') is a depth map, not a camera's");
+  b.compressed = "garbage";
+  writeTinyBag(dir.file("garbage.bag"), b);
+  EXPECT_TRUE(contains(errorOf([&] { msf::BagSource(dir.file("garbage.bag"), tinyTopics()); }),
+                       "topic '/cam/left/image_raw/compressed': the compressed image (format 'mono8; png compressed "
+                       "mono8', "))
+      << errorOf([&] { msf::BagSource(dir.file("garbage.bag"), tinyTopics()); });
+}
+
+TEST(CompressedImage, TopicsAndCodecs) {
+  EXPECT_TRUE(msf::isCompressedTopic("/cam/left/image_raw/compressed"));
+  EXPECT_FALSE(msf::isCompressedTopic("/cam/left/image_raw"));
+  EXPECT_FALSE(msf::isCompressedTopic("/compressed"));
+  EXPECT_EQ(msf::cameraInfoTopic("/cam/left/image_raw/compressed"), "/cam/left/camera_info");
+  EXPECT_EQ(msf::cameraInfoTopic("/cam/left/image_raw"), "/cam/left/camera_info");
+  EXPECT_EQ(msf::cameraInfoTopic("image"), "camera_info");
+  // 12 bits of a mono16 camera, kept by PNG; JPEG holds 8 bits and says so.
+  cv::Mat wide(4, 6, CV_16UC1);
+  cv::randu(wide, 0, 4096);
+  const auto png = msf::compressImage(wide, std_msgs::Header(), "png");
+  EXPECT_EQ(png.format, "mono16; png compressed mono16");
+  const sensor_msgs::ImageConstPtr back = msf::decodeCompressedImage(png, "test");
+  EXPECT_EQ(back->encoding, "mono16");
+  EXPECT_EQ(cv::norm(cv_bridge::toCvShare(back)->image, wide, cv::NORM_INF), 0.0);
+  EXPECT_EQ(errorOf([&] { msf::compressImage(wide, std_msgs::Header(), "jpeg"); }),
+            "JPEG holds 8 bits a channel: a mono16 image is compressed as png");
+  EXPECT_EQ(errorOf([&] { msf::compressImage(wide, std_msgs::Header(), "webp"); }),
+            "images are compressed as png or jpeg, not 'webp'");
+  sensor_msgs::CompressedImage bayer = png;
+  bayer.format = "bayer_rggb8; png compressed bayer_rggb8";
+  EXPECT_EQ(errorOf([&] { msf::decodeCompressedImage(bayer, "the image on '/cam'"); }),
+            "the image on '/cam': a Bayer mosaic (format 'bayer_rggb8; png compressed bayer_rggb8') is not a "
+            "rectified camera's image");
 }
 
 /// A 12-bit camera's mono16 pair: scaled by the bits the brighter image needs, one gain for both,
@@ -481,6 +558,44 @@ TEST(KittiBag, ReadBackEqualsTheKittiReader) {
     EXPECT_TRUE(k.T_world_cam0.isApprox(r.T_world_cam0, 1e-6)) << "frame " << i;
     EXPECT_LT((k.T_world_cam0.translation() - r.T_world_cam0.translation()).norm(), 1e-9);
   }
+}
+
+/// The sequence written with compressed images: PNG reads back as the folder's images, byte for
+/// byte; JPEG close to them. An unknown codec is refused before a bag is written.
+TEST(KittiBag, CompressedImagesReadBackLosslessAsPngAndCloseAsJpeg) {
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const msf::Sequence sequence(msf::test::kittiDir() + "/odometry/sequences/04");
+  const std::vector<std::size_t> frames{0, 1};
+  msf::KittiBagOptions options;
+  for (const std::string codec : {"png", "jpeg"}) {
+    options.images = codec;
+    msf::writeKittiBag(sequence, frames, dir.file(codec + ".bag"), options);
+    const msf::BagSource bag(dir.file(codec + ".bag"));
+    ASSERT_EQ(bag.size(), frames.size());
+    ASSERT_EQ(bag.notes().size(), 3u) << codec;
+    EXPECT_EQ(bag.notes()[2], "topic '/kitti/camera_color_left/image_raw' is absent: the colour image read from "
+                              "'/kitti/camera_color_left/image_raw/compressed'");
+    EXPECT_EQ(sequence.calibration().P[1], bag.calibration().P[1]);
+    for (std::size_t i : frames) {
+      const msf::Frame k = sequence.load(i), r = bag.load(i);
+      for (const auto& [a, b] : {std::pair{&k.left, &r.left}, {&k.right, &r.right}, {&k.color, &r.color}}) {
+        ASSERT_EQ(a->type(), b->type()) << codec;
+        if (codec == "png") {
+          EXPECT_EQ(cv::norm(*a, *b, cv::NORM_INF), 0.0) << "frame " << i;
+        } else {
+          // Within 2 grey levels on average; colour more, its chroma halved each way (4:2:0).
+          EXPECT_LT(cv::norm(*a, *b, cv::NORM_L1) / static_cast<double>(a->total() * a->channels()),
+                    a->channels() == 1 ? 2.0 : 5.0);
+          EXPECT_GT(cv::norm(*a, *b, cv::NORM_INF), 0.0); // lossy: not the raw bag again
+        }
+      }
+    }
+  }
+  options.images = "webp";
+  EXPECT_EQ(errorOf([&] { msf::writeKittiBag(sequence, frames, dir.file("webp.bag"), options); }),
+            "the bag's images must be raw, png or jpeg, not 'webp'");
+  EXPECT_FALSE(msf::test::fileExists(dir.file("webp.bag")));
 }
 
 std::string readBytes(const std::string& path) {

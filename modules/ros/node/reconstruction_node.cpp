@@ -7,6 +7,7 @@
 #include <msf/io/beam_elevations.h>
 #include <msf/io/cloud_io.h>
 #include <msf/pipeline/fused_cloud.h>
+#include <msf/ros/compressed_image.h>
 #include <msf/ros/frame_matcher.h>
 #include <msf/ros/message_conversions.h>
 
@@ -28,11 +29,6 @@ namespace {
 
 /// The odometry's world, the first left camera's pose: kitti2bag's name for it.
 constexpr char kOdometryWorld[] = "camera_init";
-
-std::string cameraInfoTopic(const std::string& image_topic) {
-  const std::size_t slash = image_topic.rfind('/');
-  return (slash == std::string::npos ? std::string() : image_topic.substr(0, slash + 1)) + "camera_info";
-}
 
 const std::map<std::string, Reconstructor::PoseMode> kPoseModes{
     {"auto", Reconstructor::PoseMode::Auto}, {"tf", Reconstructor::PoseMode::Given},
@@ -89,7 +85,8 @@ std::string numberText(double value) {
 std::vector<ParamDoc> paramDocs(const NodeParameters& d) {
   return {
       {"lidar_topic", quoted(d.lidar_topic), "sensor_msgs/PointCloud2: x y z (intensity, ring, time)"},
-      {"left_topic", quoted(d.left_topic), "rectified Image (its CameraInfo: camera_info beside it); the depth's"},
+      {"left_topic", quoted(d.left_topic),
+       "rectified Image, or CompressedImage on .../compressed (its CameraInfo: camera_info beside it); the depth's"},
       {"right_topic", quoted(d.right_topic), "rectified Image of the pair's right camera"},
       {"color_topic", quoted(d.color_topic),
        "the mesh's colour, when the topic has a publisher (\"\" or none = a grey mesh)"},
@@ -221,10 +218,13 @@ void ReconstructionNode::subscribe(ros::NodeHandle& nh) {
   // Deep enough for a frame's messages to meet however the transport orders them; the sync's
   // callback only queues, so these never fill.
   constexpr std::uint32_t kQueue = 5, kSyncQueue = 10;
+  const auto refused = [](const std::string& why) {
+    ROS_ERROR_THROTTLE(5.0, "msf_ros_node: %s: its frame is not made", why.c_str());
+  };
   cloud_sub_.subscribe(nh, params_.lidar_topic, kQueue);
-  left_sub_.subscribe(nh, params_.left_topic, kQueue);
+  left_sub_.subscribe(nh, params_.left_topic, kQueue, refused);
   left_info_sub_.subscribe(nh, cameraInfoTopic(params_.left_topic), kQueue);
-  right_sub_.subscribe(nh, params_.right_topic, kQueue);
+  right_sub_.subscribe(nh, params_.right_topic, kQueue, refused);
   right_info_sub_.subscribe(nh, cameraInfoTopic(params_.right_topic), kQueue);
   const ros::Duration slop(params_.sync_slop_s);
   // Frames without colour, and with it when the colour camera publishes (colorPublished).
@@ -233,7 +233,7 @@ void ReconstructionNode::subscribe(ros::NodeHandle& nh) {
   stereo_sync_->getPolicy()->setMaxIntervalDuration(slop);
   stereo_sync_->registerCallback(&ReconstructionNode::onStereo, this);
   if (!params_.color_topic.empty()) {
-    color_sub_.subscribe(nh, params_.color_topic, kQueue);
+    color_sub_.subscribe(nh, params_.color_topic, kQueue, refused);
     color_info_sub_.subscribe(nh, cameraInfoTopic(params_.color_topic), kQueue);
     color_sync_ = std::make_unique<message_filters::Synchronizer<ColorPolicy>>(
         ColorPolicy(kSyncQueue), cloud_sub_, left_sub_, left_info_sub_, right_sub_, right_info_sub_, color_sub_,
@@ -269,7 +269,7 @@ void ReconstructionNode::countMessages() {
 }
 
 bool ReconstructionNode::colorPublished() const {
-  return color_sync_ && color_sub_.getSubscriber().getNumPublishers() > 0 &&
+  return color_sync_ && color_sub_.publishers() > 0 &&
          color_info_sub_.getSubscriber().getNumPublishers() > 0;
 }
 
@@ -281,6 +281,25 @@ std::string ReconstructionNode::silentInputs() const {
     if (n == 0 && (color || (topic != params_.color_topic && topic != cameraInfoTopic(params_.color_topic))))
       silent += (silent.empty() ? "'" : ", '") + topic + "'";
   return silent;
+}
+
+std::string ReconstructionNode::compressedInstead() const {
+  ros::master::V_TopicInfo published;
+  if (!ros::master::getTopics(published))
+    return "";
+  std::string hint;
+  const std::pair<const char*, std::string> inputs[] = {
+      {"left_topic", params_.left_topic}, {"right_topic", params_.right_topic}, {"color_topic", params_.color_topic}};
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  for (const auto& [parameter, topic] : inputs) {
+    const auto counted = messages_.find(topic);
+    if (topic.empty() || isCompressedTopic(topic) || counted == messages_.end() || counted->second > 0)
+      continue;
+    for (const ros::master::TopicInfo& info : published)
+      if (info.name == topic + "/compressed")
+        hint += "; '" + info.name + "' is published (" + info.datatype + "): name it in ~" + parameter;
+  }
+  return hint;
 }
 
 void ReconstructionNode::onScan(const ros::Time& stamp) {
@@ -303,16 +322,18 @@ void ReconstructionNode::onScan(const ros::Time& stamp) {
   }
   newest_scan_ns_ = ns;
   stepping_back_ = false;
-  // A few scans with no frame: say which input they wait for, while it waits.
+  // A few scans with no frame: say which input they wait for, every few seconds while it waits.
   constexpr std::size_t kScansBeforeWarning = 5;
-  if (++scans_since_frame_ < kScansBeforeWarning)
+  constexpr std::chrono::seconds kWarningEvery(5);
+  if (++scans_since_frame_ < kScansBeforeWarning || Clock::now() < next_input_warning_)
     return;
+  next_input_warning_ = Clock::now() + kWarningEvery;
   const std::string silent = silentInputs();
   const std::string why = silent.empty() ? "their images and CameraInfo are not within sync_slop_s (" +
                                                numberText(params_.sync_slop_s) + " s) of them"
-                                         : "nothing yet on " + silent;
-  ROS_WARN_THROTTLE(5.0, "msf_ros_node: %zu scans on '%s' and no frame: %s", scans_since_frame_.load(),
-                    params_.lidar_topic.c_str(), why.c_str());
+                                         : "nothing yet on " + silent + compressedInstead();
+  ROS_WARN("msf_ros_node: %zu scans on '%s' and no frame: %s", scans_since_frame_.load(), params_.lidar_topic.c_str(),
+           why.c_str());
 }
 
 void ReconstructionNode::onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left,

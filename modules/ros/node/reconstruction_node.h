@@ -2,6 +2,8 @@
 #pragma once
 // The reconstruction engine (msf::Reconstructor) as a ROS 1 node: messages in, the engine's
 // depth, points and mesh out. All the method lives in the library; this converts and schedules.
+#include "image_input.h"
+
 #include <msf/pipeline/bounded_queue.h>
 #include <msf/pipeline/pipeline_config.h>
 #include <msf/pipeline/reconstructor.h>
@@ -92,6 +94,9 @@ private:
   bool colorPublished() const;
   /// The inputs that have sent nothing yet, as "'topic', 'topic'" ("" = none).
   std::string silentInputs() const;
+  /// For each image topic that has sent nothing while its "<topic>/compressed" is published (the
+  /// master says), "; '<topic>/compressed' is published (<type>): name it in ~<parameter>".
+  std::string compressedInstead() const;
   /// Counts the scan, and its going back in time (a bag played again): such scans make no frame.
   void onScan(const ros::Time& stamp);
   void onStereo(const Cloud::ConstPtr& cloud, const Image::ConstPtr& left, const Info::ConstPtr& left_info,
@@ -136,7 +141,7 @@ private:
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   message_filters::Subscriber<Cloud> cloud_sub_;
-  message_filters::Subscriber<Image> left_sub_, right_sub_, color_sub_;
+  ImageInput left_sub_, right_sub_, color_sub_;
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_, color_info_sub_;
   std::unique_ptr<message_filters::Synchronizer<StereoPolicy>> stereo_sync_;
   std::unique_ptr<message_filters::Synchronizer<ColorPolicy>> color_sync_;
@@ -151,6 +156,7 @@ private:
   // Scans not newer than one before them (the spin thread's): time went back, by up to the largest.
   std::int64_t newest_scan_ns_ = 0, largest_step_back_ns_ = 0;
   bool stepping_back_ = false; // the last scan was such a scan
+  Clock::time_point next_input_warning_; // when scans without a frame may be warned of again
   std::atomic<std::size_t> scans_back_in_time_ = 0;
   Clock::time_point first_arrival_, last_arrival_; // of the frames (the spin thread's)
   mutable std::mutex drops_mutex_;

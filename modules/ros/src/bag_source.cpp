@@ -2,6 +2,7 @@
 #include <msf/common/exceptions.h>
 #include <msf/io/beam_elevations.h>
 #include <msf/ros/bag_source.h>
+#include <msf/ros/compressed_image.h>
 #include <msf/ros/frame_matcher.h>
 #include <msf/ros/message_conversions.h>
 
@@ -57,6 +58,7 @@ namespace {
 
 constexpr const char* kPointCloud2 = "sensor_msgs/PointCloud2";
 constexpr const char* kImage = "sensor_msgs/Image";
+constexpr const char* kCompressedImage = "sensor_msgs/CompressedImage";
 constexpr const char* kCameraInfo = "sensor_msgs/CameraInfo";
 constexpr const char* kKittiOdometryWorld = "camera_init";
 
@@ -140,6 +142,13 @@ struct BagSource::Bag {
                               ros::message_traits::DataType<Message>::value() + " expected");
     return message;
   }
+
+  /// Message k of an image topic, decoded when the topic holds CompressedImage.
+  sensor_msgs::ImageConstPtr readImage(const Topic& topic, std::size_t k, const std::string& what) const {
+    if (types.at(topic.name) != kCompressedImage)
+      return read<sensor_msgs::Image>(topic, k);
+    return decodeCompressedImage(*read<sensor_msgs::CompressedImage>(topic, k), what);
+  }
 };
 
 BagSource::BagSource(const std::string& path, const BagOptions& options, const std::string& rig)
@@ -175,18 +184,23 @@ void BagSource::resolveTopics() {
   for (const rosbag::ConnectionInfo* c : all.getConnections())
     bag_->types[c->topic] = c->datatype;
   // The topic, or for an image kitti2bag's other name for it (image_raw or image, as its
-  // version goes); "" when the bag has neither.
+  // version goes), each also compressed ("<image>/compressed"); "" when the bag has none.
   const auto find = [&](const std::string& topic, const char* type) -> std::string {
+    const bool image = type == std::string(kImage);
     const auto has = [&](const std::string& name) {
       const auto it = bag_->types.find(name);
-      return it != bag_->types.end() && it->second == type;
+      return it != bag_->types.end() && (it->second == type || (image && it->second == kCompressedImage));
     };
-    if (has(topic))
-      return topic;
-    if (type == std::string(kImage))
+    std::vector<std::string> names{topic};
+    if (image)
       for (const char* name : {"image_raw", "image"})
-        if (has(sibling(topic, name)))
-          return sibling(topic, name);
+        names.push_back(sibling(topic, name));
+    for (const std::string& name : names) {
+      if (has(name))
+        return name;
+      if (image && !isCompressedTopic(name) && has(name + "/compressed"))
+        return name + "/compressed";
+    }
     return {};
   };
   const auto resolve = [&](std::string& topic, const char* type, const std::string& role, const char* option) {
@@ -221,7 +235,7 @@ void BagSource::resolveTopics() {
 
 void BagSource::readCalibration(const std::string& rig) {
   const auto info = [&](const std::string& image_topic) -> boost::shared_ptr<sensor_msgs::CameraInfo> {
-    const std::string topic = sibling(image_topic, "camera_info");
+    const std::string topic = cameraInfoTopic(image_topic);
     rosbag::View view(bag_->bag, rosbag::TopicQuery(topic));
     for (const rosbag::MessageInstance& m : view)
       if (auto message = m.instantiate<sensor_msgs::CameraInfo>())
@@ -229,7 +243,8 @@ void BagSource::readCalibration(const std::string& rig) {
     return nullptr;
   };
   const auto left = info(options_.left_topic);
-  const auto first_left = bag_->read<sensor_msgs::Image>(bag_->left, 0);
+  const auto first_left = bag_->readImage(bag_->left, 0, "the first image of '" + path_ + "', topic '" +
+                                                               options_.left_topic + "'");
   const cv::Size size(static_cast<int>(first_left->width), static_cast<int>(first_left->height));
   if (!rig.empty()) {
     calibration_ = loadCalibration(rig, size);
@@ -242,11 +257,11 @@ void BagSource::readCalibration(const std::string& rig) {
   const auto color = has_color_ ? info(options_.color_topic) : nullptr;
   for (const auto& [message, topic] : {std::pair{left, options_.left_topic}, {right, options_.right_topic}})
     if (!message)
-      throw CalibrationError("ROS bag '" + path_ + "' has no " + kCameraInfo + " on '" + sibling(topic, "camera_info") +
+      throw CalibrationError("ROS bag '" + path_ + "' has no " + kCameraInfo + " on '" + cameraInfoTopic(topic) +
                              "': give the rig's calibration with -rig FILE (a KITTI calib.txt or a rig YAML)");
   if (has_color_ && !color)
     throw CalibrationError("ROS bag '" + path_ + "' has no " + kCameraInfo + " on '" +
-                           sibling(options_.color_topic, "camera_info") + "' for its colour camera: give -color_topic " +
+                           cameraInfoTopic(options_.color_topic) + "' for its colour camera: give -color_topic " +
                            "'' to leave colour out, or the rig's calibration with -rig FILE");
   const std::string& lidar_frame = bag_->scans.frame_id;
   const std::string& camera_frame = bag_->left.frame_id;
@@ -375,14 +390,15 @@ Frame BagSource::load(std::size_t i, bool with_color) const {
                             std::to_string(size()) + " frames");
   const FrameMessages& m = frames_[i];
   const auto scan = bag_->read<sensor_msgs::PointCloud2>(bag_->scans, m.scan);
-  const auto left = bag_->read<sensor_msgs::Image>(bag_->left, m.left);
-  const auto right = bag_->read<sensor_msgs::Image>(bag_->right, m.right);
+  const std::string what = "frame " + frameName(i) + " of '" + path_ + "'";
+  const auto left = bag_->readImage(bag_->left, m.left, what + ", topic '" + options_.left_topic + "'");
+  const auto right = bag_->readImage(bag_->right, m.right, what + ", topic '" + options_.right_topic + "'");
   const auto color = with_color && m.color >= 0
-                         ? bag_->read<sensor_msgs::Image>(bag_->color, static_cast<std::size_t>(m.color))
+                         ? bag_->readImage(bag_->color, static_cast<std::size_t>(m.color),
+                                           what + ", topic '" + options_.color_topic + "'")
                          : nullptr;
 
   Frame f;
-  const std::string what = "frame " + frameName(i) + " of '" + path_ + "'";
   scanFromMessage(*scan, f, what + ", topic '" + options_.lidar_topic + "'");
   if (f.scan->empty())
     throw InvalidInputError(what + ": " + scanName(i) + " has no finite point");

@@ -2,6 +2,7 @@
 #include <msf/common/atomic_file.h>
 #include <msf/common/exceptions.h>
 #include <msf/ros/bag_writer.h>
+#include <msf/ros/compressed_image.h>
 #include <msf/ros/message_conversions.h>
 
 #include <rosbag/bag.h>
@@ -77,8 +78,13 @@ template <typename Message> boost::shared_ptr<ros::M_string> latched(const Messa
   return h;
 }
 
-void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source, std::size_t seq,
-                const ros::Time& stamp) {
+void requireImageCodec(const std::string& images) {
+  if (images != "raw" && images != "png" && images != "jpeg")
+    throw InvalidInputError("the bag's images must be raw, png or jpeg, not '" + images + "'");
+}
+
+void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source, const std::string& codec,
+                std::size_t seq, const ros::Time& stamp) {
   const Calibration& calibration = source.calibration();
   const tf2_msgs::TFMessage fixed = staticTransforms(calibration, source.hasColor(), stamp);
   bag.write("/tf_static", stamp, fixed, latched(fixed));
@@ -92,7 +98,11 @@ void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source,
     if (images[camera]->empty())
       continue;
     const std_msgs::Header h = header(stamp, kCameras[camera].frame, seq);
-    bag.write(std::string(kCameras[camera].namespace_) + "image_raw", stamp, imageToMessage(*images[camera], h));
+    const std::string topic = std::string(kCameras[camera].namespace_) + "image_raw";
+    if (codec == "raw")
+      bag.write(topic, stamp, imageToMessage(*images[camera], h));
+    else
+      bag.write(topic + "/compressed", stamp, compressImage(*images[camera], h, codec));
     bag.write(std::string(kCameras[camera].namespace_) + "camera_info", stamp,
               cameraInfoFromCalibration(calibration, camera, h));
   }
@@ -108,6 +118,7 @@ void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& fr
     throw IOError("'" + path + "' exists: a bag is not written over a file unless told to (overwrite)");
   source.calibration().requireVelodyne();
   const rosbag::compression::CompressionType compression = compressionOf(options.compression);
+  requireImageCodec(options.images);
   if (!(options.start_time_s > 0.0) || !(options.start_time_s < 4.0e9))
     throw InvalidInputError("the bag's start time must be in (0, 4e9) s since the epoch, not " +
                             std::to_string(options.start_time_s));
@@ -118,7 +129,8 @@ void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& fr
       bag.setCompression(compression);
       for (std::size_t k = 0; k < frames.size(); ++k) {
         const Frame frame = source.load(frames[k], true);
-        writeFrame(bag, frame, source, frames[k], stampFromNs(start_ns + std::llround(frame.timestamp * 1e9)));
+        const ros::Time stamp = stampFromNs(start_ns + std::llround(frame.timestamp * 1e9));
+        writeFrame(bag, frame, source, options.images, frames[k], stamp);
         if (options.progress)
           options.progress(k + 1, frames.size());
       }

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
              "stamp of the dataset's time 0, in seconds since the epoch (default {default}; kitti2bag takes the "
              "time of conversion)")
       .value("-compression", "C", options.compression, "none (default, kitti2bag's), lz4 or bz2")
+      .value("-images", "CODEC", options.images,
+             "raw (default, kitti2bag's Image on image_raw), or png (lossless) or jpeg: CompressedImage on "
+             "image_raw/compressed, as a rig that records compressed images writes them")
       .overwriteOption(options.overwrite);
   return cli.run(argc, argv, 1, [&](const msf::tool::Arguments& positional) {
     if (positional.size() != 1)
