@@ -6,7 +6,9 @@
 
 #include "test_support.h"
 
+#include <cerrno>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 
 namespace {
@@ -278,6 +280,8 @@ TEST(Tool, AnOutputFileThatExistsIsRefusedUnlessOverwriteIsGiven) {
     FAIL() << "expected IOError";
   } catch (const msf::IOError& e) {
     EXPECT_EQ(std::string(e.what()), "output '" + dir.file("mine.pcd") + "' exists; give -overwrite to replace it");
+    EXPECT_EQ(e.path(), dir.file("mine.pcd"));
+    EXPECT_EQ(e.code(), EEXIST);
   }
   cli.parse(forced.argc(), forced.argv());
   ASSERT_TRUE(overwrite);
@@ -289,11 +293,37 @@ TEST(Tool, AnOutputFileThatExistsIsRefusedUnlessOverwriteIsGiven) {
   } catch (const msf::IOError& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("output folder '" + dir.file("missing") + "' does not exist"), std::string::npos) << message;
+    EXPECT_EQ(e.path(), dir.file("missing"));
+    EXPECT_EQ(e.code(), ENOENT);
   }
   std::ifstream in(dir.file("mine.pcd"));
   std::string first;
   in >> first;
   EXPECT_EQ(first, "the");
+}
+
+/// A missing file, a folder where a file should be, a file where a folder should be: each an
+/// IOError that names the path and gives the errno a caller (the Python door) can tell apart.
+TEST(Files, AMissingOrMisplacedPathGivesItsErrno) {
+  msf::test::TempDir dir;
+  writeText(dir.file("file.txt"), "text");
+  const auto codeOf = [](const std::function<void()>& f, const std::string& path) {
+    try {
+      f();
+    } catch (const msf::IOError& e) {
+      EXPECT_EQ(e.path(), path) << e.what();
+      return e.code();
+    }
+    return -1;
+  };
+  EXPECT_EQ(codeOf([&] { msf::requireFile(dir.file("none.txt"), "scan"); }, dir.file("none.txt")), ENOENT);
+  EXPECT_EQ(codeOf([&] { msf::requireFile(dir.path(), "scan"); }, dir.path()), EISDIR);
+  EXPECT_EQ(codeOf([&] { msf::requireDirectory(dir.file("none"), "sequence"); }, dir.file("none")), ENOENT);
+  EXPECT_EQ(codeOf([&] { msf::requireDirectory(dir.file("file.txt"), "sequence"); }, dir.file("file.txt")), ENOTDIR);
+  msf::requireFile(dir.file("file.txt"), "scan");
+  msf::requireDirectory(dir.path(), "sequence");
+  // An error of a file's content carries no errno.
+  EXPECT_EQ(msf::IOError("cloud 'a.pcd' has no points").code(), 0);
 }
 
 } // namespace

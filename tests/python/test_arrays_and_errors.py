@@ -1,6 +1,7 @@
 # Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 """Shapes, dtypes and errors: what the binding takes and gives, and how it refuses."""
 import copy
+import errno
 import gc
 import math
 import os
@@ -38,6 +39,31 @@ def test_errors_are_library_kinds_and_python_builtins():
         msfusion.load_calibration("/nonexistent/calib.txt")
     with pytest.raises(OSError):
         msfusion.Sequence("/nonexistent/sequence")
+
+
+def test_a_missing_or_misplaced_file_is_the_builtin_oserror_with_errno_and_filename(odometry04, tmp_path):
+    missing = str(tmp_path / "none")
+    calls = [
+        (lambda: msfusion.load_calibration(missing), FileNotFoundError, missing, f"calibration '{missing}' does not"),
+        (lambda: msfusion.open_dataset(missing), FileNotFoundError, missing, f"sequence '{missing}' does not exist"),
+        (lambda: msfusion.load_config(missing), FileNotFoundError, missing, f"config '{missing}' does not exist"),
+        (lambda: msfusion.read_mesh(missing + ".ply"), FileNotFoundError, missing + ".ply", "mesh '"),
+        (lambda: msfusion.Sequence(os.path.join(odometry04, "calib.txt")), NotADirectoryError,
+         os.path.join(odometry04, "calib.txt"), "sequence '"),
+    ]
+    for call, builtin, path, message in calls:
+        with pytest.raises(builtin) as raised:
+            call()
+        error = raised.value
+        assert isinstance(error, msfusion.IOError) and isinstance(error, msfusion.Error)
+        assert error.errno == {FileNotFoundError: errno.ENOENT, NotADirectoryError: errno.ENOTDIR}[builtin]
+        assert error.filename == path and error.strerror == os.strerror(error.errno)
+        assert str(error).startswith(message), str(error)  # the library's message, not "[Errno 2] ..."
+    # A file whose content is wrong has no errno: an IOError, and no built-in's subclass.
+    (tmp_path / "bad.ply").write_text("not a mesh\n")
+    with pytest.raises(msfusion.IOError) as raised:
+        msfusion.read_mesh(str(tmp_path / "bad.ply"))
+    assert raised.value.errno is None and not isinstance(raised.value, FileNotFoundError)
 
 
 def test_a_calibration_missing_a_key_names_it(odometry04, tmp_path):

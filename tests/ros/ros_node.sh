@@ -240,7 +240,8 @@ echo "ok: a bag played twice: the second play's $frames scans make no frame, the
 # every grey level): the node, told the compressed topics, decodes them and makes the raw bag's map.
 "$build/bin/msf_kitti2bag" "$sequence" -frames "0:$last" -images png -o "$work/png.bag" >/dev/null
 sed -E 's|^((left\|right\|color)_topic: +/kitti/[a-z_]+/image_raw)|\1/compressed|' "$node_params" >"$work/png.yaml"
-[ "$(grep -c "image_raw/compressed" "$work/png.yaml")" = 3 ] || fail "kitti_bag.yaml has not three image topics"
+[ "$(grep -cE "^(left|right|color)_topic: +\S+/image_raw/compressed" "$work/png.yaml")" = 3 ] ||
+  fail "kitti_bag.yaml has not three image topics"
 bag=$work/png.bag play_to_node compressed params:="$work/png.yaml" mesh_path:="$work/png_mesh.ply"
 account=$(node_lines "$work/compressed.log" | grep -a "scans received")
 [[ "$account" == *"$frames scans received, $frames frames, $frames reconstructed, 0 dropped"* ]] ||

@@ -3,6 +3,7 @@
 #include <msf/common/exceptions.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <atomic>
 #include <filesystem>
 #include <system_error>
@@ -21,15 +22,16 @@ std::string fileExtension(const std::string& path) {
 void requireFile(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!fs::exists(path, ec))
-    throw IOError(what + " '" + path + "' does not exist");
+    throw IOError(what + " '" + path + "' does not exist", path, ENOENT);
   if (!fs::is_regular_file(path, ec))
-    throw IOError(what + " '" + path + "' is not a regular file");
+    throw IOError(what + " '" + path + "' is not a regular file", path, fs::is_directory(path, ec) ? EISDIR : EINVAL);
 }
 
 void requireDirectory(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!fs::is_directory(path, ec))
-    throw IOError(what + " '" + path + "' does not exist or is not a directory");
+    throw IOError(what + " '" + path + "' does not exist or is not a directory", path,
+                  fs::exists(path, ec) ? ENOTDIR : ENOENT);
 }
 
 std::vector<std::string> filesIn(const std::string& dir, const std::vector<std::string>& extensions,
@@ -55,12 +57,13 @@ void ensureOutputDirectory(const std::string& path) {
   if (fs::is_directory(path, ec))
     return;
   if (fs::exists(path, ec))
-    throw IOError("output folder '" + path + "' exists and is not a directory");
+    throw IOError("output folder '" + path + "' exists and is not a directory", path, ENOTDIR);
   const fs::path parent = fs::absolute(path).lexically_normal().parent_path();
   if (!fs::is_directory(parent, ec))
-    throw IOError("output folder '" + path + "': its parent '" + parent.string() + "' does not exist");
+    throw IOError("output folder '" + path + "': its parent '" + parent.string() + "' does not exist", parent.string(),
+                  ENOENT);
   if (!fs::create_directory(path, ec) && !fs::is_directory(path))
-    throw IOError("cannot create output folder '" + path + "': " + ec.message());
+    throw IOError("cannot create output folder '" + path + "': " + ec.message(), path, ec.value());
 }
 
 namespace {
@@ -74,9 +77,11 @@ void requireWritableFolder(const std::string& path) {
   const fs::path dir = folderOf(path);
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
-    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' does not exist");
+    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' does not exist", dir.string(),
+                  ENOENT);
   if (::access(dir.c_str(), W_OK) != 0)
-    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' is not writable");
+    throw IOError("cannot write '" + path + "': output folder '" + dir.string() + "' is not writable", dir.string(),
+                  EACCES);
 }
 
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write) {

@@ -76,7 +76,7 @@ void OutputFolder::requireOwnOutput(const std::string& folder, const std::string
   if (!fs::exists(fs::symlink_status(root, ec)))
     return;
   if (fs::is_symlink(fs::symlink_status(root, ec)) || !fs::is_directory(root, ec))
-    throw IOError("output folder '" + folder + "' exists and is not a folder");
+    throw IOError("output folder '" + folder + "' exists and is not a folder", folder, ENOTDIR);
   const std::vector<std::string> entries = entriesUnder(root);
   if (entries.empty())
     return;
@@ -101,10 +101,12 @@ OutputFolder::OutputFolder(const std::string& path, const std::string& tool, con
   const fs::path parent = target.parent_path();
   std::error_code ec;
   if (!fs::is_directory(parent, ec))
-    throw IOError("output folder '" + path + "': its parent folder '" + parent.string() + "' does not exist");
+    throw IOError("output folder '" + path + "': its parent folder '" + parent.string() + "' does not exist",
+                  parent.string(), ENOENT);
   if (::access(parent.c_str(), W_OK) != 0)
     throw IOError("output folder '" + path + "': its parent folder '" + parent.string() + "' is not writable: " +
-                  errnoText(errno));
+                      errnoText(errno),
+                  parent.string(), errno);
   const fs::path real_target = fs::weakly_canonical(target, ec);
   for (const std::string& input : inputs) {
     if (input.empty())

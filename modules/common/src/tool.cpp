@@ -309,7 +309,7 @@ void requireNewOutputs(const std::vector<std::string>& outputs, bool overwrite) 
     if (std::filesystem::is_directory(path, ec))
       throw IOError("output '" + path + "' is a folder, not a file");
     if (!overwrite && std::filesystem::exists(std::filesystem::symlink_status(path, ec)))
-      throw IOError("output '" + path + "' exists; give -overwrite to replace it");
+      throw IOError("output '" + path + "' exists; give -overwrite to replace it", path, EEXIST);
     requireWritableFolder(path);
   }
 }

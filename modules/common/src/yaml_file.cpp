@@ -6,6 +6,7 @@
 #include <yaml-cpp/depthguard.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -36,7 +37,7 @@ std::string readWholeFile(const std::string& path, const std::string& what) {
   requireFile(path, what);
   std::ifstream in(path, std::ios::binary);
   if (!in)
-    throw IOError(what + " '" + path + "' cannot be opened: " + std::strerror(errno));
+    throw IOError(what + " '" + path + "' cannot be opened: " + std::strerror(errno), path, errno);
   std::string text;
   char buffer[1 << 16];
   while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {

@@ -12,6 +12,7 @@
 
 #include <opencv2/core/persistence.hpp>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -343,7 +344,7 @@ Calibration readCalibration(const std::string& path) {
   std::error_code ec;
   const fs::path p(path);
   if (!fs::exists(p, ec))
-    throw IOError("calibration '" + path + "' does not exist");
+    throw IOError("calibration '" + path + "' does not exist", path, ENOENT);
   if (fs::is_directory(p, ec)) {
     if (fs::exists(p / "calib_cam_to_cam.txt"))
       return fromRawDateFolder(p);

@@ -8,6 +8,7 @@
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 
@@ -115,7 +116,7 @@ void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& fr
                    const KittiBagOptions& options) {
   std::error_code ec;
   if (!options.overwrite && std::filesystem::exists(path, ec))
-    throw IOError("'" + path + "' exists: a bag is not written over a file unless told to (overwrite)");
+    throw IOError("'" + path + "' exists: a bag is not written over a file unless told to (overwrite)", path, EEXIST);
   source.calibration().requireVelodyne();
   const rosbag::compression::CompressionType compression = compressionOf(options.compression);
   requireImageCodec(options.images);

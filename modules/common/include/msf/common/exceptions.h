@@ -2,6 +2,7 @@
 #pragma once
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace msf {
 
@@ -11,10 +12,22 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-/// A file that cannot be read or written, or whose content is malformed.
+/// A file that cannot be read or written, or whose content is malformed. When the system says
+/// why (a missing file, one that exists), path() names the file and code() is the errno value
+/// (ENOENT, EEXIST, ...); the Python door raises it as the matching built-in OSError subclass.
 class IOError : public Error {
 public:
   using Error::Error;
+  IOError(const std::string& message, std::string path, int code)
+      : Error(message), path_(std::move(path)), code_(code) {}
+  /// The file at fault, "" when the error is not one file's.
+  const std::string& path() const { return path_; }
+  /// The errno value of the condition, 0 when there is none (malformed content, say).
+  int code() const { return code_; }
+
+private:
+  std::string path_;
+  int code_ = 0;
 };
 
 /// A calibration that is missing a key or has a matrix of the wrong size.
