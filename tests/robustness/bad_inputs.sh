@@ -695,6 +695,14 @@ if [ $have_kitti = 1 ]; then
     msf_holdout "$SEQ" -frames 0:0 -methods fused,fussed
   check "holdout -csv into a missing folder" 1 "cannot write '/nonexistent/h.csv': output folder '/nonexistent' does not exist" -- \
     msf_holdout "$SEQ" -frames 0:0 -methods interpolated -csv /nonexistent/h.csv
+  if [ -x "$BIN/msf_kitti2bag" ]; then # a build with the ROS module
+    check "kitti2bag -images webp, before any frame" 1 "msf_kitti2bag: error: the bag's images must be raw, png or jpeg, not 'webp'" -- \
+      msf_kitti2bag "$SEQ" -frames 0:0 -images webp -o b.bag
+    if grep -q Writing "$T/out"; then
+      failures=$((failures + 1))
+      echo "FAIL  kitti2bag -images webp began writing before it refused the codec"
+    fi
+  fi
   check "odometry -o into a missing folder, before tracking" 1 \
     "cannot write '/nonexistent/p.txt': output folder '/nonexistent' does not exist" -- \
     msf_odometry "$SEQ" -frames 0:1 -o /nonexistent/p.txt

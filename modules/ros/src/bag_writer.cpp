@@ -79,11 +79,6 @@ template <typename Message> boost::shared_ptr<ros::M_string> latched(const Messa
   return h;
 }
 
-void requireImageCodec(const std::string& images) {
-  if (images != "raw" && images != "png" && images != "jpeg")
-    throw InvalidInputError("the bag's images must be raw, png or jpeg, not '" + images + "'");
-}
-
 void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source, const std::string& codec,
                 std::size_t seq, const ros::Time& stamp) {
   const Calibration& calibration = source.calibration();
@@ -112,17 +107,23 @@ void writeFrame(rosbag::Bag& bag, const Frame& frame, const FrameSource& source,
 
 } // namespace
 
+void requireKittiBagOptions(const KittiBagOptions& options) {
+  compressionOf(options.compression);
+  if (options.images != "raw" && options.images != "png" && options.images != "jpeg")
+    throw InvalidInputError("the bag's images must be raw, png or jpeg, not '" + options.images + "'");
+  if (!(options.start_time_s > 0.0) || !(options.start_time_s < 4.0e9))
+    throw InvalidInputError("the bag's start time must be in (0, 4e9) s since the epoch, not " +
+                            std::to_string(options.start_time_s));
+}
+
 void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& frames, const std::string& path,
                    const KittiBagOptions& options) {
   std::error_code ec;
   if (!options.overwrite && std::filesystem::exists(path, ec))
     throw IOError("'" + path + "' exists: a bag is not written over a file unless told to (overwrite)", path, EEXIST);
   source.calibration().requireVelodyne();
+  requireKittiBagOptions(options);
   const rosbag::compression::CompressionType compression = compressionOf(options.compression);
-  requireImageCodec(options.images);
-  if (!(options.start_time_s > 0.0) || !(options.start_time_s < 4.0e9))
-    throw InvalidInputError("the bag's start time must be in (0, 4e9) s since the epoch, not " +
-                            std::to_string(options.start_time_s));
   const std::int64_t start_ns = std::llround(options.start_time_s * 1e9);
   writeAtomically(path, [&](const std::string& tmp) {
     try {

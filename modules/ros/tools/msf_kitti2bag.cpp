@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
                                    " positional arguments (see -h)");
     if (output.empty())
       throw msf::InvalidInputError("no output bag: give -o file.bag");
+    msf::requireKittiBagOptions(options);
     msf::tool::requireNewOutputs({output}, options.overwrite);
     msf::tool::installStopSignals({"msf_kitti2bag: stopping; the bag is not written"});
     const auto source = msf::openDataset(positional.front());

@@ -26,6 +26,10 @@ struct KittiBagOptions {
   std::function<void(std::size_t, std::size_t)> progress;
 };
 
+/// Throws InvalidInputError naming the option when `options` asks for an unknown compression or
+/// image codec, or a start time out of (0, 4e9) s; writeKittiBag checks them first too.
+void requireKittiBagOptions(const KittiBagOptions& options);
+
 /// Writes frames of a dataset (a KITTI odometry sequence, a raw drive, a synthetic sequence)
 /// into a ROS 1 bag in kitti2bag's layout, what BagSource reads by default:
 ///  - /kitti/velo/pointcloud: the scan, PointCloud2 of float32 x y z intensity (ring and time
@@ -41,7 +45,7 @@ struct KittiBagOptions {
 ///  - /tf, when the dataset has poses: camera_init -> camera_gray_left, T_world_cam0.
 /// All messages of frame i carry one stamp. Written through a temporary file and a rename;
 /// an existing `path` is refused (IOError) unless options.overwrite, as is a source without a
-/// LiDAR extrinsic; an unknown compression or image codec (InvalidInputError) before anything is written.
+/// LiDAR extrinsic, and options requireKittiBagOptions refuses, before anything is written.
 void writeKittiBag(const FrameSource& source, const std::vector<std::size_t>& frames, const std::string& path,
                    const KittiBagOptions& options = {});
 
