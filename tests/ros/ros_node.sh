@@ -223,7 +223,7 @@ for ((k = 0; k < 600; ++k)); do
   kill -0 "$counter" 2>/dev/null || break
   sleep 0.1
 done
-rosbag play -q --rate 0.5 "$work/04.bag" >"$work/replay_play2.log" 2>&1 ||
+rosbag play -q --wait-for-subscribers --rate 0.5 "$work/04.bag" >"$work/replay_play2.log" 2>&1 ||
   fail "rosbag play again: $(tail -3 "$work/replay_play2.log")"
 sleep 2 # the last messages reach the node
 stop_group "$replay" 30
@@ -251,15 +251,16 @@ echo "ok: images compressed as PNG on image_raw/compressed: every frame, the raw
 
 # The same rig with the node told the raw topics: while its scans wait, it names the compressed
 # topics that are published instead, and the parameter to set.
-"$build/bin/msf_kitti2bag" "$sequence" -frames 0:5 -images png -o "$work/png6.bag" >/dev/null
-# The player cannot wait for subscribers to every topic: the node subscribes to none of the images.
-background hint roslaunch --wait msfusion kitti_bag.launch bag:="$work/png6.bag" play:=false
+"$build/bin/msf_kitti2bag" "$sequence" -frames 0:9 -images png -o "$work/png10.bag" >/dev/null
+# The player cannot wait for subscribers to every topic (the node subscribes to none of the
+# images): it waits 2 s after advertising for the node to connect, and sends 10 scans.
+background hint roslaunch --wait msfusion kitti_bag.launch bag:="$work/png10.bag" play:=false
 hint=$started
 for ((k = 0; k < 300; ++k)); do
   rostopic info /kitti/velo/pointcloud 2>/dev/null | grep -q "/msf_ros_node" && break
   sleep 0.1
 done
-rosbag play -q --rate 0.5 "$work/png6.bag" >"$work/hint_play.log" 2>&1 ||
+rosbag play -q -d 2 --rate 0.5 "$work/png10.bag" >"$work/hint_play.log" 2>&1 ||
   fail "rosbag play: $(tail -3 "$work/hint_play.log")"
 stop_group "$hint" 30
 expected="nothing yet on '/kitti/camera_gray_left/image_raw', '/kitti/camera_gray_right/image_raw'; "
