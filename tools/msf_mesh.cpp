@@ -167,6 +167,8 @@ int main(int argc, char** argv) {
              "remove connected pieces of fewer than N triangles (default {default}; 0 keeps all)")
       .value("-component_keep_weight", "W", config.component_keep_weight,
              "... but keep a piece with a vertex of weight >= W (m^-2; default {default}; 0: none is kept for it)")
+      .value("-min_component_extent_voxels", "N", config.min_component_extent_voxels,
+             "... unless it is closed and fits in a box of N voxels a side (default {default}; 0: off)")
       .value("-component_release_passes", "N", config.component_release_passes,
              "... unless rays passed the voxel behind that vertex N frames in a row since it saw a surface, as where "
              "a car stood (0..3; default {default}, 0 = never)")

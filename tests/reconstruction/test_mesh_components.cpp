@@ -115,6 +115,37 @@ TEST(MeshComponents, ZeroOrOneKeepsEverything) {
   EXPECT_EQ(removeSmallComponents(empty, 20).components, 0u);
 }
 
+TEST(MeshComponents, AClosedBubbleWithinTheExtentGoesWhateverItsWeightAndAnOpenFragmentStays) {
+  // Heavy (the LiDAR's weight) and small: a tetrahedron of 5 cm, closed; a 5 cm square of two
+  // triangles, open; a 1 m strip of 2 triangles, open, too long for the extent.
+  TriangleMesh mesh;
+  const auto add = [&mesh](std::initializer_list<Eigen::Vector3f> points) {
+    for (const Eigen::Vector3f& p : points) {
+      mesh.vertices.push_back(p);
+      mesh.colors.push_back({1, 2, 3});
+      mesh.weights.push_back(1000.f);
+    }
+  };
+  add({{0, 0, 0}, {0.05f, 0, 0}, {0, 0.05f, 0}, {0, 0, 0.05f}});
+  mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  add({{5, 0, 0}, {5.05f, 0, 0}, {5, 0.05f, 0}, {5.05f, 0.05f, 0}});
+  mesh.triangles.push_back({4, 5, 6});
+  mesh.triangles.push_back({5, 7, 6});
+  add({{9, 0, 0}, {10, 0, 0}, {9, 0.05f, 0}});
+  mesh.triangles.push_back({8, 9, 10});
+
+  TriangleMesh kept = mesh;
+  EXPECT_EQ(removeSmallComponents(kept, 2000, 300.f).components_removed, 0u); // the weight keeps all
+  const ComponentFilterStats stats = removeSmallComponents(mesh, 2000, 300.f, 0.3f);
+  EXPECT_EQ(stats.components, 3u);
+  EXPECT_EQ(stats.components_removed, 1u);
+  EXPECT_EQ(stats.triangles_removed, 4u);
+  ASSERT_EQ(mesh.triangles.size(), 3u);
+  ASSERT_EQ(mesh.vertices.size(), 7u);
+  EXPECT_EQ(mesh.vertices.front().x(), 5.f); // the tetrahedron went, the square and the strip stay
+  EXPECT_EQ(mesh.weights.size(), 7u);
+}
+
 TEST(MeshComponents, RejectsAMeshThatIsNotConsistent) {
   TriangleMesh mesh;
   addStrip(mesh, 1, 0.f, 1);
@@ -171,22 +202,46 @@ TEST(MeshComponents, MarchingCubesRemovesSpecksAndReportsThem) {
   for (const float w : clean.weights)
     EXPECT_EQ(w, 100.f); // the lesser weight of the crossing's two voxels
 
-  // Known precisely (a pole the LiDAR saw, 1000 m^-2: sigma 3 cm), the same speck is kept by the
-  // default component_keep_weight (300); with 0, no piece is kept for its weight.
+  // Known precisely (1000 m^-2: sigma 3 cm), the speck is still one voxel of flipped sign, within
+  // the default min_component_extent_voxels (3): removed whatever its weight; kept for its weight
+  // (the default component_keep_weight, 300) with the extent rule off.
   ASSERT_EQ(config.component_keep_weight, 300.f);
+  ASSERT_EQ(config.min_component_extent_voxels, 3.f);
   TsdfBlock& speck = *volume.findBlock(GridIndex(5, 5, 5));
-  for (int z = 3; z <= 5; ++z)
-    for (int y = 3; y <= 5; ++y)
-      for (int x = 3; x <= 5; ++x)
-        speck.at(x, y, z).weight = 1000.f;
-  speck.stamp = volume.beginGeneration();
+  const auto setPrecise = [&](int x0, int x1, int y0, int y1, int z0, int z1) {
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+          speck.at(x, y, z).weight = 1000.f;
+    speck.stamp = volume.beginGeneration();
+  };
+  setPrecise(3, 5, 3, 5, 3, 5);
   TriangleMesh precise;
   mesher.extract(volume, precise);
+  EXPECT_EQ(precise.triangles.size(), 450u);
+  EXPECT_EQ(mesher.lastStats().components_removed, 1u);
+  MarchingCubes::Config extent_off = config;
+  extent_off.min_component_extent_voxels = 0.f;
+  MarchingCubes(extent_off).extract(volume, precise);
   EXPECT_EQ(precise.triangles.size(), 450u + 8u);
-  EXPECT_EQ(mesher.lastStats().components_removed, 0u);
   config.component_keep_weight = 0.f;
+  config.min_component_extent_voxels = 0.f;
   MarchingCubes(config).extract(volume, precise);
   EXPECT_EQ(precise.triangles.size(), 450u);
+
+  // A pole the LiDAR saw: the voxel column x = y = 4, z = 1..6, 0.5 m tall, a small piece that
+  // its weight keeps at the default extent rule.
+  for (int z = 1; z <= 6; ++z)
+    speck.at(4, 4, z).sdf = -0.05f;
+  setPrecise(3, 5, 3, 5, 0, 7);
+  speck.updateSigns();
+  MarchingCubes::Config defaults;
+  defaults.min_component_triangles = 20;
+  MarchingCubes pole_mesher(defaults);
+  pole_mesher.extract(volume, precise);
+  EXPECT_EQ(pole_mesher.lastStats().components_removed, 0u);
+  EXPECT_GT(precise.triangles.size(), 450u + 20u);
+  EXPECT_LT(precise.triangles.size(), 450u + 2000u);
 }
 
 TEST(MeshComponents, ConfigRejectsANegativeSize) {

@@ -698,7 +698,8 @@ void RunReport::writeMapSize(std::ostream& s) const {
     << volume_file << "`](" << volume_file << ").";
   if (pieces_removed > 0)
     s << " " << pieces_removed << " pieces of fewer than `marching_cubes.min_component_triangles` triangles that no "
-      << "vertex of `marching_cubes.component_keep_weight` holds (" << triangles_removed << " triangles) were removed.";
+      << "vertex of `marching_cubes.component_keep_weight` holds, or closed within "
+      << "`marching_cubes.min_component_extent_voxels` (" << triangles_removed << " triangles), were removed.";
   s << "\n\n";
   if (!preview_file.empty())
     s << "![mesh from above and from the first camera](" << preview_file << ")\n\n";

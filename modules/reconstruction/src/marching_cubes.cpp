@@ -576,7 +576,8 @@ void MarchingCubes::extract(const TsdfVolume& volume, TriangleMesh& mesh) {
     const auto t2 = Clock::now();
     const ComponentFilterStats removed =
         removeSmallComponents(mesh, static_cast<std::size_t>(config_.min_component_triangles),
-                              config_.component_keep_weight);
+                              config_.component_keep_weight,
+                              config_.min_component_extent_voxels * static_cast<float>(volume.voxelSize()));
     stats_.components_removed = removed.components_removed;
     stats_.triangles_removed = removed.triangles_removed;
     stats_.filter_ms = msSince(t2);

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace msf {
@@ -54,7 +56,45 @@ std::vector<std::uint32_t> componentLabels(const TriangleMesh& mesh) {
   return label;
 }
 
-ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight) {
+namespace {
+
+/// Whether each piece (at its label) fits in a box of `extent` a side.
+std::vector<char> piecesWithin(const TriangleMesh& mesh, const std::vector<std::uint32_t>& piece, float extent) {
+  const std::size_t n = mesh.vertices.size();
+  std::vector<char> within(n, 0);
+  if (!(extent > 0.f))
+    return within;
+  std::vector<Eigen::Vector3f> low(n, Eigen::Vector3f::Constant(std::numeric_limits<float>::max()));
+  std::vector<Eigen::Vector3f> high(n, Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest()));
+  for (std::size_t v = 0; v < n; ++v) {
+    low[piece[v]] = low[piece[v]].cwiseMin(mesh.vertices[v]);
+    high[piece[v]] = high[piece[v]].cwiseMax(mesh.vertices[v]);
+  }
+  for (std::size_t v = 0; v < n; ++v)
+    within[v] = piece[v] == v && (high[v] - low[v]).maxCoeff() < extent;
+  return within;
+}
+
+/// Of the pieces `marked` (at their labels), unmarks those that are not closed: an edge not
+/// shared by exactly two of the piece's triangles. A closed piece that small is a bubble of a
+/// voxel or two of flipped sign; an open one is a fragment of a surface that holes cut off.
+void unmarkOpenPieces(const TriangleMesh& mesh, const std::vector<std::uint32_t>& piece, std::vector<char>& marked) {
+  std::unordered_map<std::uint64_t, int> edges; // (smaller vertex, larger) -> triangles
+  for (const auto& t : mesh.triangles)
+    if (marked[piece[t[0]]])
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+        ++edges[static_cast<std::uint64_t>(std::min(a, b)) << 32 | std::max(a, b)];
+      }
+  for (const auto& [edge, triangles] : edges)
+    if (triangles != 2)
+      marked[piece[static_cast<std::uint32_t>(edge >> 32)]] = 0;
+}
+
+} // namespace
+
+ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight,
+                                           float min_extent) {
   const std::size_t n = mesh.vertices.size();
   if (mesh.colors.size() != n)
     throw InvalidInputError("mesh has " + std::to_string(n) + " vertices but " + std::to_string(mesh.colors.size()) +
@@ -70,12 +110,15 @@ ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_t
   std::vector<std::uint32_t> size(n, 0);
   for (const auto& t : mesh.triangles)
     ++size[piece[t[0]]];
-  if (weighted && keep_weight > 0.f)
+  if (weighted && keep_weight > 0.f) {
+    std::vector<char> tiny = piecesWithin(mesh, piece, min_extent);
+    unmarkOpenPieces(mesh, piece, tiny);
     for (std::size_t v = 0; v < n; ++v)
-      if (mesh.weights[v] >= keep_weight) {
+      if (mesh.weights[v] >= keep_weight && !tiny[piece[v]]) {
         std::uint32_t& s = size[piece[v]];
         s = s > 0 ? std::max<std::uint32_t>(s, static_cast<std::uint32_t>(min_triangles)) : 0;
       }
+  }
 
   ComponentFilterStats stats;
   for (std::size_t v = 0; v < n; ++v)

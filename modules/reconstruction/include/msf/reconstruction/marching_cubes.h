@@ -68,6 +68,11 @@ public:
     /// applied to a streamed map, whose tiles are meshed apart.
     int min_component_triangles = 2000;
     float component_keep_weight = 300.f;
+    /// A closed piece within a box of this many voxels a side is removed whatever its weight: a
+    /// bubble of a voxel or two whose sign the frames flipped against all their neighbours', which
+    /// the weight of a much-seen place would keep; a pole or a sign spans tens of voxels, and an
+    /// open fragment of a surface that holes cut off stays.
+    float min_component_extent_voxels = 3.f;
     /// A vertex whose voxel behind the surface rays passed since it last saw a surface holds no
     /// piece: where a car stood. Once is enough where no ray had passed the voxel before (a car's
     /// back, whose inside no ray reached); where a surface reappeared after a pass, this many
@@ -87,6 +92,8 @@ public:
         "connected pieces of fewer triangles that no precise depth holds are removed (0: keep all)");
       k("component_keep_weight", component_keep_weight, atLeast(0),
         "a piece with a vertex of at least this weight is kept whatever its size, m^-2 (300: sigma 6 cm)");
+      k("min_component_extent_voxels", min_component_extent_voxels, atLeast(0),
+        "a closed piece within a box of this many voxels a side is removed whatever its weight (0: off)");
       k("component_release_passes", component_release_passes, between(0, TsdfVoxel::kMaxPasses),
         "a vertex holds no piece once rays passed the voxel behind it this many frames in a row, or once where "
         "no surface reappeared there after a pass (0: never)");

@@ -28,9 +28,12 @@ std::vector<std::uint32_t> componentLabels(const TriangleMesh& mesh);
 /// `keep_weight` holds when the LiDAR saw them.
 /// With `keep_weight` > 0 and the mesh's per-vertex weights, a small piece with a vertex of at
 /// least that weight is kept: it is known precisely (a pole or a sign the LiDAR saw), whatever
-/// its size. The kept vertices and triangles stay in their order. Throws InvalidInputError when a
-/// triangle names a vertex the mesh does not have, or when colors (or weights, when there are
-/// any) and vertices differ in number.
-ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight = 0.f);
+/// its size, unless it is closed and fits in a box of `min_extent` metres a side: a bubble of a
+/// voxel or two whose sign the frames flipped against their neighbours', smaller than anything a
+/// sensor resolves there; an open fragment of a surface is kept. The kept vertices and triangles
+/// stay in their order. Throws InvalidInputError when a triangle names a vertex the mesh does not
+/// have, or when colors (or weights, when there are any) and vertices differ in number.
+ComponentFilterStats removeSmallComponents(TriangleMesh& mesh, std::size_t min_triangles, float keep_weight = 0.f,
+                                           float min_extent = 0.f);
 
 } // namespace msf
