@@ -290,7 +290,9 @@ TEST(Tools, MeshRejectsBadInput) {
       {"-min_component_triangles -1", "marching_cubes.min_component_triangles must be >= 0"},
       {"-min_component_triangles 2O", "-min_component_triangles needs a whole number, not '2O'"},
       {"-component_keep_weight -1", "marching_cubes.component_keep_weight must be >= 0"},
-      {"-component_keep_weight nan", "-component_keep_weight needs a number, not 'nan'"}};
+      {"-component_keep_weight nan", "-component_keep_weight needs a number, not 'nan'"},
+      {"-min_component_extent_voxels -1", "marching_cubes.min_component_extent_voxels must be >= 0, not -1"},
+      {"-min_component_extent_voxels nan", "-min_component_extent_voxels needs a number, not 'nan'"}};
   for (const auto& [flags, message] : bad_flags)
     expectToolError(test::runTool("msf_mesh", dir.file("plain.pcd") + " " + dir.file("mesh.ply") + " " + flags),
                     "msf_mesh", message);

@@ -83,7 +83,9 @@ sensor_msgs::CompressedImage compressImage(const cv::Mat& image, const std_msgs:
   sensor_msgs::CompressedImage message;
   message.header = header;
   message.format = encoding + "; " + codec + " compressed " + encoding;
-  cv::imencode("." + codec, image, message.data, params);
+  if (!cv::imencode("." + codec, image, message.data, params) || message.data.empty())
+    throw InvalidInputError("a " + encoding + " image of " + std::to_string(image.cols) + "x" +
+                            std::to_string(image.rows) + " could not be compressed as " + codec);
   return message;
 }
 
