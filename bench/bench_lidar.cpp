@@ -1,7 +1,8 @@
 // Copyright the msfusion authors. SPDX-License-Identifier: BSD-3-Clause
 // The LiDAR branch per KITTI frame (odometry 04, frames 0-9 in turn, 1226 x 370): paper
 // steps 1 + 2 (projection and compound interpolation) beside the IP-Basic baseline on the
-// same projection, in the same run. Each benchmark is 20 repetitions of the 10 frames;
+// same projection, in the same run, and the scan's free space all around (ScanFreeSpace, its
+// ground plane included). Each benchmark is 20 repetitions of the 10 frames;
 // the median and the minimum over repetitions are reported (the minimum is the least
 // disturbed by other processes on a shared machine). Wall-clock time, all the threads of OpenCV's pool.
 //
@@ -15,6 +16,7 @@
 #include <msf/range_image/distance_transform.h>
 #include <msf/range_image/lidar_completion.h>
 #include <msf/range_image/lidar_projector.h>
+#include <msf/reconstruction/scan_free_space.h>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
@@ -112,6 +114,16 @@ void BM_ProjectAndFilterCloud(benchmark::State& state) {
   }
 }
 
+/// What a scan says is free all around the sensor (one thread, as the pipeline's depth stage builds it).
+void BM_ScanFreeSpace(benchmark::State& state) {
+  const Data& d = data();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const msf::ScanFreeSpace free_space(d.scans[i++ % d.scans.size()]);
+    benchmark::DoNotOptimize(free_space.belowGround());
+  }
+}
+
 double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
 } // namespace
@@ -133,5 +145,6 @@ MSF_LIDAR_BENCH(BM_CompoundCloud);
 MSF_LIDAR_BENCH(BM_ProjectAndFilterCloud);
 MSF_LIDAR_BENCH(BM_IpBasicFastDepth);
 MSF_LIDAR_BENCH(BM_IpBasicMultiscaleDepth);
+MSF_LIDAR_BENCH(BM_ScanFreeSpace);
 
 BENCHMARK_MAIN();

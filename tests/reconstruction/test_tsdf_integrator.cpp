@@ -1183,6 +1183,58 @@ TEST(ScanFreeSpace, TheNearestReturnAroundADirection) {
   EXPECT_EQ(ScanFreeSpace().nearestAround(Eigen::Vector3f(1, 0, 0)), 0.f);
 }
 
+TEST(ScanFreeSpace, AReturnUnderTheGroundClearsNothing) {
+  // A level road 1.73 m under the sensor, rings from -24 to -8 degrees. Ahead and to the right a
+  // wet patch mirrors the two lowest rings on to a van 20.7 m on and sends the rings above them
+  // nowhere (as on KITTI odometry 04, frames 10-16): the mirrored returns lie 6.6 m under the
+  // road, and taken for straight beams they would clear the road from underneath. A kerb
+  // 0.5 m under the road to the left (a ditch's edge) is a straight beam's and stays.
+  constexpr double kHeight = 1.73;
+  const auto at = [](double range, double el_deg, double az_deg) {
+    const double e = el_deg * M_PI / 180, a = az_deg * M_PI / 180;
+    pcl::PointXYZI p;
+    p.x = static_cast<float>(range * std::cos(e) * std::cos(a));
+    p.y = static_cast<float>(range * std::cos(e) * std::sin(a));
+    p.z = static_cast<float>(range * std::sin(e));
+    return p;
+  };
+  const auto mirrored = [](double el_deg, double az_deg) { return el_deg < -23.4 && std::abs(az_deg + 15) < 1; };
+  const auto ditch = [](double az_deg) { return std::abs(az_deg - 90) < 2; };
+  pcl::PointCloud<pcl::PointXYZI> scan;
+  std::size_t mirrored_returns = 0, ditch_returns = 0;
+  for (double el = -24.15; el <= -8; el += 0.5)
+    for (double az = -180; az < 180; az += 0.2) {
+      const double down = std::sin(-el * M_PI / 180);
+      if (mirrored(el, az)) {
+        scan.push_back(at(20.7, el, az));
+        ++mirrored_returns;
+      } else if (std::abs(az + 15) < 1 && el < -17) {
+        continue; // the beams the patch sent away
+      } else if (ditch(az) && el < -14) {
+        scan.push_back(at((kHeight + 0.5) / down, el, az));
+        ++ditch_returns;
+      } else {
+        scan.push_back(at(kHeight / down, el, az));
+      }
+    }
+  ASSERT_GT(ditch_returns, 0u);
+  const ScanFreeSpace free_space(scan);
+  EXPECT_EQ(free_space.belowGround(), mirrored_returns);
+  // Just under the road where the mirrored beams point, 4.3 m on: no return says it is free.
+  const pcl::PointXYZI under_road = at(kHeight / std::sin(23.9 * M_PI / 180) + 0.2, -23.9, -15);
+  EXPECT_EQ(free_space.nearestAround(under_road.getVector3fMap()), 0.f);
+  // The kerb's returns are kept: its bins hold them.
+  const pcl::PointXYZI kerb = at(4.0, -20.15, 90);
+  EXPECT_NEAR(free_space.nearestAround(kerb.getVector3fMap()), (kHeight + 0.5) / std::sin(20.65 * M_PI / 180), 0.05);
+
+  // Nothing lies under a scan without ground in sight (a sphere's lower half is no plane).
+  pcl::PointCloud<pcl::PointXYZI> sphere;
+  for (double el = -20; el <= 10; el += 0.25)
+    for (double az = -180; az < 180; az += 0.2)
+      sphere.push_back(at(10, el, az));
+  EXPECT_EQ(ScanFreeSpace(sphere).belowGround(), 0u);
+}
+
 TEST(TsdfIntegrator, ScanCarvingClearsWhatDroveAwayOutOfViewAndKeepsTheStreet) {
   // An oncoming car 8 m ahead in the other lane at frame 0; it has passed by frame 1, when the
   // camera is 12 m on and never sees its place again. The camera's own free space cannot clear

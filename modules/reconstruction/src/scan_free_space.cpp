@@ -2,9 +2,13 @@
 #include <msf/reconstruction/scan_free_space.h>
 
 #include <opencv2/imgproc.hpp>
+#include <pcl/sample_consensus/ransac.h>
+#include <pcl/sample_consensus/sac_model_perpendicular_plane.h>
 
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 
 namespace msf {
 
@@ -39,17 +43,59 @@ inline bool binOf(float x, float y, float z, int& row, int& column) {
   return elevation >= ScanFreeSpace::kMinElevationDeg && row < kRows;
 }
 
+/// The ground the scan stands on, as (n, d) with n the unit normal pointing up and n.p + d a
+/// point's height over it: the largest plane within 20 degrees of level, 0.3 m or more under
+/// the sensor, among every 16th return 2-20 m away across the ground (a plane needs no more).
+/// None where it holds fewer than 100 of them (no ground in sight, or too little to tell).
+std::optional<Eigen::Vector4f> groundPlane(const pcl::PointCloud<pcl::PointXYZI>& scan) {
+  constexpr float kMinHeightM = 0.3f, kNearM = 2.f, kFarM = 20.f, kInlierM = 0.1f;
+  constexpr std::size_t kStride = 16, kMinInliers = 100;
+  auto near = std::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
+  for (std::size_t i = 0; i < scan.size(); i += kStride) {
+    const auto& p = scan[i];
+    const float across = std::hypot(p.x, p.y);
+    if (p.z < -kMinHeightM && across >= kNearM && across <= kFarM)
+      near->push_back(p);
+  }
+  if (near->size() < kMinInliers)
+    return std::nullopt;
+  // Not random: PCL seeds the model's sampler with a constant, so a scan has one ground.
+  auto model = std::make_shared<pcl::SampleConsensusModelPerpendicularPlane<pcl::PointXYZI>>(near);
+  model->setAxis(Eigen::Vector3f::UnitZ());
+  model->setEpsAngle(20.0 * M_PI / 180.0);
+  pcl::RandomSampleConsensus<pcl::PointXYZI> ransac(model, kInlierM);
+  pcl::Indices inliers;
+  Eigen::VectorXf plane;
+  if (!ransac.computeModel())
+    return std::nullopt;
+  ransac.getInliers(inliers);
+  if (inliers.size() < kMinInliers)
+    return std::nullopt;
+  ransac.getModelCoefficients(plane);
+  Eigen::Vector4f up = plane.head<4>() / plane.head<3>().norm();
+  if (up.z() < 0.f)
+    up = -up;
+  if (!(up.w() >= kMinHeightM)) // the sensor's own height over the plane
+    return std::nullopt;
+  return up;
+}
+
 } // namespace
 
 ScanFreeSpace::ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan, bool swept)
     : skew_m_(swept ? kSweepSkewM : 0.f) {
   constexpr float kNone = std::numeric_limits<float>::infinity();
   cv::Mat nearest(kRows, kColumns, CV_32FC1, cv::Scalar(kNone));
+  const std::optional<Eigen::Vector4f> ground = groundPlane(scan);
   for (const auto& p : scan) {
     const float range = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
     int row, column;
     if (!(range > 1e-3f) || !std::isfinite(range) || !binOf(p.x, p.y, p.z, row, column))
       continue;
+    if (ground && ground->dot(Eigen::Vector4f(p.x, p.y, p.z, 1.f)) < -kBelowGroundM) {
+      ++below_ground_;
+      continue;
+    }
     float& bin = nearest.at<float>(row, column);
     bin = std::min(bin, range);
   }
