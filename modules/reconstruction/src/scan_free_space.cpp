@@ -46,7 +46,8 @@ inline bool binOf(float x, float y, float z, int& row, int& column) {
 /// The ground the scan stands on, as (n, d) with n the unit normal pointing up and n.p + d a
 /// point's height over it: the largest plane within 20 degrees of level, 0.3 m or more under
 /// the sensor, among every 16th return 2-20 m away across the ground (a plane needs no more).
-/// None where it holds fewer than 100 of them (no ground in sight, or too little to tell).
+/// None where it holds fewer than 100 of them or under a quarter: no ground in sight, or too
+/// little to tell it from a plane that only cuts through what the sensor sees.
 std::optional<Eigen::Vector4f> groundPlane(const pcl::PointCloud<pcl::PointXYZI>& scan) {
   constexpr float kMinHeightM = 0.3f, kNearM = 2.f, kFarM = 20.f, kInlierM = 0.1f;
   constexpr std::size_t kStride = 16, kMinInliers = 100;
@@ -69,7 +70,7 @@ std::optional<Eigen::Vector4f> groundPlane(const pcl::PointCloud<pcl::PointXYZI>
   if (!ransac.computeModel())
     return std::nullopt;
   ransac.getInliers(inliers);
-  if (inliers.size() < kMinInliers)
+  if (inliers.size() < kMinInliers || inliers.size() < near->size() / 4)
     return std::nullopt;
   ransac.getModelCoefficients(plane);
   Eigen::Vector4f up = plane.head<4>() / plane.head<3>().norm();
