@@ -1187,8 +1187,8 @@ TEST(ScanFreeSpace, AReturnUnderTheGroundClearsNothing) {
   // A level road 1.73 m under the sensor, rings from -24 to -8 degrees. Ahead and to the right a
   // wet patch mirrors the two lowest rings on to a van 20.7 m on and sends the rings above them
   // nowhere (as on KITTI odometry 04, frames 10-16): the mirrored returns lie 6.6 m under the
-  // road, and taken for straight beams they would clear the road from underneath. A kerb
-  // 0.5 m under the road to the left (a ditch's edge) is a straight beam's and stays.
+  // road, and taken whole they would clear the road from underneath. Their beams end at the
+  // road. A kerb 0.5 m under the road to the left (a ditch's edge) is taken whole.
   constexpr double kHeight = 1.73;
   const auto at = [](double range, double el_deg, double az_deg) {
     const double e = el_deg * M_PI / 180, a = az_deg * M_PI / 180;
@@ -1220,9 +1220,17 @@ TEST(ScanFreeSpace, AReturnUnderTheGroundClearsNothing) {
   ASSERT_GT(ditch_returns, 0u);
   const ScanFreeSpace free_space(scan);
   EXPECT_EQ(free_space.belowGround(), mirrored_returns);
-  // Just under the road where the mirrored beams point, 4.3 m on: no return says it is free.
-  const pcl::PointXYZI under_road = at(kHeight / std::sin(23.9 * M_PI / 180) + 0.2, -23.9, -15);
-  EXPECT_EQ(free_space.nearestAround(under_road.getVector3fMap()), 0.f);
+  // Where the mirrored beams point, free space ends at the road, 4.2-4.3 m on: not under it.
+  const float to_road = static_cast<float>(kHeight / std::sin(24.15 * M_PI / 180));
+  const pcl::PointXYZI under_road = at(to_road + 0.2, -23.9, -15);
+  EXPECT_NEAR(free_space.nearestAround(under_road.getVector3fMap()), to_road, 0.01f);
+  // A road falling away far off frees its beams as far as they meet the plane: a return 1.5 m
+  // under the road 50 m on frees its beam to 26.8 m, beyond the carving's reach (20 m and a metre).
+  pcl::PointCloud<pcl::PointXYZI> falling = scan;
+  const pcl::PointXYZI far_road = at(50, -std::asin((kHeight + 1.5) / 50) * 180 / M_PI, 45);
+  falling.push_back(far_road);
+  const pcl::PointXYZI on_the_way = at(20, -std::asin((kHeight + 1.5) / 50) * 180 / M_PI, 45);
+  EXPECT_NEAR(ScanFreeSpace(falling).nearestAround(on_the_way.getVector3fMap()), 50 * kHeight / (kHeight + 1.5), 0.01);
   // The kerb's returns are kept: its bins hold them.
   const pcl::PointXYZI kerb = at(4.0, -20.15, 90);
   EXPECT_NEAR(free_space.nearestAround(kerb.getVector3fMap()), (kHeight + 0.5) / std::sin(20.65 * M_PI / 180), 0.05);

@@ -93,12 +93,15 @@ ScanFreeSpace::ScanFreeSpace(const pcl::PointCloud<pcl::PointXYZI>& scan, bool s
     int row, column;
     if (!(range > 1e-3f) || !std::isfinite(range) || !binOf(p.x, p.y, p.z, row, column))
       continue;
-    if (ground && ground->dot(Eigen::Vector4f(p.x, p.y, p.z, 1.f)) < -kBelowGroundM) {
+    float free_range = range;
+    const float height = ground ? ground->dot(Eigen::Vector4f(p.x, p.y, p.z, 1.f)) : 0.f;
+    if (height < -kBelowGroundM) { // the beam's free space ends where it met the ground
+      const float sensor_height = ground->w();
+      free_range = range * sensor_height / (sensor_height - height);
       ++below_ground_;
-      continue;
     }
     float& bin = nearest.at<float>(row, column);
-    bin = std::min(bin, range);
+    bin = std::min(bin, free_range);
   }
   // The minimum over each bin's 3 x 3 neighbourhood, azimuth wrapping round; empty bins hold
   // infinity, so they do not lower it, and give 0 where the bin itself is empty.

@@ -13,11 +13,12 @@ namespace msf {
 /// degrees of azimuth by 0.5 of elevation, about the spacing of a 64-ring scanner's rings),
 /// the nearest return in the bin and its 8 neighbours. A point nearer than that, in a bin that
 /// holds a return, lies in front of every return around its direction: the laser passed
-/// through it. A bin without a return (sky, glass, black paint) says nothing, and neither does a
-/// return that lies more than kBelowGroundM under the ground the scan stands on (the largest
-/// plane below the sensor, near level): a beam a wet road or a car's body mirrored on to
-/// something else, whose range is the length of its bent path. Taken for a straight beam, it
-/// would clear the road it never went through.
+/// through it. A bin without a return (sky, glass, black paint) says nothing. A return that lies
+/// more than kBelowGroundM under the ground the scan stands on (the largest plane below the
+/// sensor, near level) frees its beam only down to the ground: it may be a beam a wet road or a
+/// car's body mirrored on to something else, whose range is the length of its bent path, and
+/// taken whole it would clear the road from underneath. A road falling away in the distance
+/// loses nothing within the carving's reach.
 ///
 /// The camera sees a quarter of what the LiDAR sees; TsdfIntegrator::carveWithScan uses the
 /// rest, and the pixels where the camera has no depth, to clear what moved away (an oncoming car
@@ -32,8 +33,8 @@ public:
   /// How far a swept scan's returns may lie from where its one pose puts them: a spinning LiDAR's
   /// sweep is not motion-compensated (KITTI's are not), and at 13 m/s it skews by up to 0.65 m.
   static constexpr float kSweepSkewM = 0.6f;
-  /// How far under the ground plane a return may lie and still be a straight beam's: a road that
-  /// falls away by a 5 % grade over the carving's reach, a kerb, a ditch's edge.
+  /// How far under the ground plane a return may lie and still be taken whole: a road that falls
+  /// away by a 5 % grade over the carving's reach, a kerb, a ditch's edge.
   static constexpr float kBelowGroundM = 1.0f;
 
   ScanFreeSpace() = default;
@@ -46,7 +47,8 @@ public:
   /// How far a return may lie from where the scan's pose puts it: kSweepSkewM for a swept scan,
   /// 0 for one taken at one instant.
   float skew() const { return skew_m_; }
-  /// The returns left out for lying under the ground plane (0 where the scan shows no ground).
+  /// The returns more than kBelowGroundM under the ground plane, whose beams end at it (0 where
+  /// the scan shows no ground).
   std::size_t belowGround() const { return below_ground_; }
   /// The nearest return around the direction of `p` (sensor frame), or 0 where the direction's
   /// own bin holds no return or lies outside the elevations kept.
