@@ -54,8 +54,8 @@ std::optional<Eigen::Vector4f> groundPlane(const pcl::PointCloud<pcl::PointXYZI>
   auto near = std::make_shared<pcl::PointCloud<pcl::PointXYZI>>();
   for (std::size_t i = 0; i < scan.size(); i += kStride) {
     const auto& p = scan[i];
-    const float across = std::hypot(p.x, p.y);
-    if (p.z < -kMinHeightM && across >= kNearM && across <= kFarM)
+    const float across2 = p.x * p.x + p.y * p.y;
+    if (p.z < -kMinHeightM && across2 >= kNearM * kNearM && across2 <= kFarM * kFarM)
       near->push_back(p);
   }
   if (near->size() < kMinInliers)
@@ -65,13 +65,13 @@ std::optional<Eigen::Vector4f> groundPlane(const pcl::PointCloud<pcl::PointXYZI>
   model->setAxis(Eigen::Vector3f::UnitZ());
   model->setEpsAngle(20.0 * M_PI / 180.0);
   pcl::RandomSampleConsensus<pcl::PointXYZI> ransac(model, kInlierM);
-  pcl::Indices inliers;
-  Eigen::VectorXf plane;
   if (!ransac.computeModel())
     return std::nullopt;
+  pcl::Indices inliers;
   ransac.getInliers(inliers);
   if (inliers.size() < kMinInliers || inliers.size() < near->size() / 4)
     return std::nullopt;
+  Eigen::VectorXf plane;
   ransac.getModelCoefficients(plane);
   Eigen::Vector4f up = plane.head<4>() / plane.head<3>().norm();
   if (up.z() < 0.f)

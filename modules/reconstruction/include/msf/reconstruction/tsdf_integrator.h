@@ -278,8 +278,9 @@ public:
   /// it has no depth; CV_32FC1 of the camera's size), only where all four pixels around a voxel's
   /// projection carved at least the scan's weight. A crumb at a car's edge, where the fusion's
   /// depth is uncertain and carves a little a frame, is cleared by the LiDAR that made it.
-  /// Conservative: only where the scan has returns, and only voxels behind a surface (the ones that
-  /// make it), so that a road seen at a grazing angle, whose returns lie around it, is left alone.
+  /// Conservative: only where the scan has returns, a return under the ground only down to the
+  /// ground, and only voxels behind a surface (the ones that make it), so that a road seen at a
+  /// grazing angle, whose returns lie around it, is left alone.
   void carveWithScan(const ScanFreeSpace& free_space, const Eigen::Isometry3d& T_world_lidar, float weight,
                      const PinholeCamera& camera, const Eigen::Isometry3d& T_world_cam,
                      const cv::Mat& camera_carved = cv::Mat());
