@@ -82,6 +82,7 @@ def test_a_callback_may_mesh_but_not_feed_the_engine(own_rig):
     assert len(seen) == 2 and seen[0][0] > 0 and seen[1][1] > 0
 
 
+@pytest.mark.filterwarnings("ignore:.*the frames are not in time order")  # the threads' frames come in either order
 def test_calls_from_two_threads_take_turns(own_rig):
     """The Python engine holds a lock: two threads' frames are both integrated, one after the other."""
     engine = msfusion.Reconstructor(own_rig.calibration)
@@ -194,3 +195,13 @@ def test_poses_that_auto_mode_tracked_instead_are_a_warning(own_rig):
         engine.add_frame(again)
     with pytest.raises(msfusion.InvalidInputError, match="frame 1 is the frame given last .the same scan."):
         engine.add_frame(again)  # given twice in a row
+
+
+def test_frames_out_of_time_order_are_a_warning(own_rig):
+    """A frame before the one given just before it is taken, and said once."""
+    engine = msfusion.Reconstructor(own_rig.calibration)
+    engine.add_frame(own_rig[1])
+    with pytest.warns(UserWarning, match=r"frame 0 \(at 0 s\) came after a frame at 0.1 s: the frames are not in "
+                                         r"time order"):
+        engine.add_frame(own_rig[0])
+    assert len(engine.notes) == 1 and engine.num_blocks > 0

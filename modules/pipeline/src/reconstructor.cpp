@@ -26,6 +26,7 @@
 #include <exception>
 #include <future>
 #include <optional>
+#include <sstream>
 
 namespace msf {
 
@@ -331,7 +332,9 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
   }
   if (options_.poses == PoseMode::Auto && frame.has_pose && !poses_not_used_) {
     poses_not_used_ = true;
-    first_pose_not_used_ = frame.index;
+    say("frames with their own pose, from frame " + std::to_string(frame.index) +
+        " on, were tracked by LiDAR odometry instead: the first frame had none, so PoseMode Auto tracks every frame; "
+        "give the first frame its pose, or use PoseMode Refine to refine the poses with the scans");
   }
   const auto start = Clock::now();
   const std::optional<Eigen::Isometry3d> measured = measuredMotion(frame);
@@ -341,12 +344,26 @@ Eigen::Isometry3d Reconstructor::track(const Frame& frame, const std::string& sc
   return cameraPose(T_velo0_velo, calibration_.T_cam0_velo, T_world_cam0_first_);
 }
 
+void Reconstructor::checkTimeOrder(const Frame& frame) {
+  if (last_time_s_ && frame.timestamp < *last_time_s_ && !time_went_back_) {
+    time_went_back_ = true;
+    std::ostringstream note;
+    note << "frame " << frame.index << " (at " << frame.timestamp << " s) came after a frame at " << *last_time_s_
+         << " s: the frames are not in time order, which the odometry's prediction of each scan's motion and the "
+            "earlier scans (accumulation) assume; give them in the order of Frame::timestamp";
+    say(note.str());
+  }
+  last_time_s_ = frame.timestamp;
+}
+
+void Reconstructor::say(std::string note) {
+  const std::lock_guard<std::mutex> lock(notes_mutex_);
+  notes_.push_back(std::move(note));
+}
+
 std::vector<std::string> Reconstructor::notes() const {
-  if (!poses_not_used_)
-    return {};
-  return {"frames with their own pose, from frame " + std::to_string(first_pose_not_used_) +
-          " on, were tracked by LiDAR odometry instead: the first frame had none, so PoseMode Auto tracks every "
-          "frame; give the first frame its pose, or use PoseMode Refine to refine the poses with the scans"};
+  const std::lock_guard<std::mutex> lock(notes_mutex_);
+  return notes_;
 }
 
 std::optional<Eigen::Isometry3d> Reconstructor::measuredMotion(const Frame& frame) {
@@ -379,6 +396,7 @@ FrameResult Reconstructor::addFrame(const Frame& given) {
   computeDepth(frame, result);
   integrateResult(result);
   last_scan_ = frame.scan;
+  checkTimeOrder(frame); // once taken: a refused frame can be given again
   ++frames_added_;
   if (config_.scheduling.mesh_every_n_frames > 0 &&
       frames_added_ % static_cast<std::size_t>(config_.scheduling.mesh_every_n_frames) == 0)

@@ -87,6 +87,7 @@ struct Reconstructor::Run {
     if (engine.frame_filter_)
       engine.frame_filter_(item.frame);
     checkFrame(item.frame, engine.calibration_);
+    engine.checkTimeOrder(item.frame);
     item.load_ms = msSince(start);
     if (i == frames.front())
       tracking = engine.tracks(item.frame);

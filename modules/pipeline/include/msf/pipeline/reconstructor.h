@@ -17,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -272,9 +273,10 @@ public:
   const StreamingMap* streaming() const { return streaming_.get(); }
   /// Milliseconds the odometry took for each frame it tracked (empty when it did not run).
   const std::vector<double>& odometryMs() const { return odometry_ms_; }
-  /// What the engine did that its caller may not expect, a line each, for the door to say: in
-  /// PoseMode Auto, the own poses of later frames, which the odometry replaced because the first
-  /// frame had none.
+  /// What the engine did that its caller may not expect, a line each in the order they arose, for
+  /// the door to say: in PoseMode Auto, the own poses of later frames, which the odometry replaced
+  /// because the first frame had none; a frame whose time (Frame::timestamp) is before the one
+  /// taken just before it.
   std::vector<std::string> notes() const;
 
   /// The configuration the stages run with: the one given, adapted to the rig (adaptToRig).
@@ -319,6 +321,12 @@ private:
   bool tracks(const Frame& first) const;
   /// The odometry's pose of the frame's scan; frames in order.
   Eigen::Isometry3d track(const Frame& frame, const std::string& scan_name);
+  /// Says (notes()) the first frame whose time is before the one taken just before it: taken
+  /// still, since a drive given backwards with its poses makes a good map, but the odometry
+  /// predicts each scan's motion from the scans before it and the earlier scans (accumulation)
+  /// are the frames taken last.
+  void checkTimeOrder(const Frame& frame);
+  void say(std::string note);
   /// PoseMode::Refine: the LiDAR's motion since the previous frame by the frames' own poses
   /// (the identity for the first); nullopt in the other modes.
   std::optional<Eigen::Isometry3d> measuredMotion(const Frame& frame);
@@ -351,8 +359,11 @@ private:
   Eigen::Isometry3d T_world_cam0_first_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_velo_measured_last_ = Eigen::Isometry3d::Identity();  // PoseMode::Refine's prior
   std::vector<double> odometry_ms_;
-  bool poses_not_used_ = false;          // PoseMode Auto: a frame tracked though it had a pose
-  std::size_t first_pose_not_used_ = 0;  // the first of them
+  bool poses_not_used_ = false;        // PoseMode Auto: a frame tracked though it had a pose
+  std::optional<double> last_time_s_;  // the time of the frame taken last (run(): loaded last)
+  bool time_went_back_ = false;        // said once
+  mutable std::mutex notes_mutex_;     // run() says notes from its loading and its odometry threads
+  std::vector<std::string> notes_;
   /// The thread in a public call that changes the engine (OneCaller; the class comment).
   std::atomic<std::thread::id> caller_{};
   std::unordered_set<std::uint64_t> integrated_;  // the results' serials this map took
