@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <thread>
 
 namespace {
@@ -113,6 +114,9 @@ TEST_F(PipelineTest, AFrameThatDoesNotFitIsRefusedBeforeTheEngineChanges) {
   broken = first;
   broken.point_time_s.assign(3, 0.f);
   refused(broken, "frame 0 has 3 point times for");
+  broken = first; // a time the order of frames cannot be told by
+  broken.timestamp = std::numeric_limits<double>::quiet_NaN();
+  refused(broken, "frame 0's timestamp is nan: seconds from the first frame, or 0 when not known");
   broken = first;
   broken.T_world_cam0.linear() *= 2.0;
   refused(broken, "frame 0's pose T_world_cam0");

@@ -205,3 +205,6 @@ def test_frames_out_of_time_order_are_a_warning(own_rig):
                                          r"time order"):
         engine.add_frame(own_rig[0])
     assert len(engine.notes) == 1 and engine.num_blocks > 0
+    f = own_rig[1]
+    with pytest.raises(msfusion.InvalidInputError, match="frame 1's timestamp is nan: seconds from the first frame"):
+        engine.add_frame(msfusion.Frame(f.left, f.right, f.scan, index=1, timestamp=float("nan")))

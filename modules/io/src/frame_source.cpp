@@ -4,6 +4,7 @@
 #include <msf/common/message_text.h>
 #include <msf/io/frame_source.h>
 
+#include <cmath>
 #include <string>
 
 namespace msf {
@@ -75,6 +76,9 @@ void checkFrame(const Frame& frame, const Calibration& calibration) {
   checkImage(frame.left, name + "'s left image", calibration, 1, false);
   checkImage(frame.right, name + "'s right image", calibration, 1, false);
   checkImage(frame.color, name + "'s colour image", calibration, 3, true);
+  if (!std::isfinite(frame.timestamp))
+    throw InvalidInputError(name + "'s timestamp is " + std::to_string(frame.timestamp) +
+                            ": seconds from the first frame, or 0 when not known");
   if (frame.has_pose)
     limits::checkRigid(frame.T_world_cam0, name + "'s pose T_world_cam0");
 }

@@ -42,7 +42,7 @@ struct Frame {
 /// refuses a frame before it changes any state: no scan or one without a point, per-point rings
 /// or times of another count than the scan's points, a grey image missing, not 8-bit grey
 /// (CV_8UC1) or not of the calibration's size (when it has one), a colour image not 8-bit BGR
-/// (CV_8UC3) or of another size, a pose that is not rigid.
+/// (CV_8UC3) or of another size, a time that is not finite, a pose that is not rigid.
 void checkFrame(const Frame& frame, const Calibration& calibration);
 
 /// `frame`, or `copy` made of it with each image that is a view into a larger one (a cv::Mat
