@@ -21,9 +21,15 @@ const FrameObject& frameAt(const py::object& frames, std::size_t i, py::object& 
 } // namespace
 
 FrameList::FrameList(py::object frames, const Calibration& rig)
-    : frames_(std::move(frames)), rig_(rig), size_(py::len(frames_)) {
-  py::object first;
-  has_color_ = size_ > 0 && !frameAt(frames_, 0, first).frame.color.empty();
+    : frames_(std::move(frames)), rig_(rig), size_(py::len(frames_)) {}
+
+bool FrameList::hasColor() const {
+  const py::gil_scoped_acquire gil;
+  if (!has_color_) {
+    py::object first;
+    has_color_ = size_ > 0 && !frameAt(frames_, 0, first).frame.color.empty();
+  }
+  return *has_color_;
 }
 
 std::string FrameList::frameName(std::size_t i) const {

@@ -151,28 +151,32 @@ class MadeOnRead:
 
     def __init__(self, sequence):
         self.sequence = sequence
+        self.reads = []
 
     def __len__(self):
         return len(self.sequence)
 
     def __getitem__(self, i):
+        self.reads.append(i)
         f = self.sequence[i]
         return msfusion.Frame(f.left.copy(), f.right.copy(), f.scan, color=f.color, pose=f.pose)
 
 
 def test_run_takes_a_list_of_frames_made_of_arrays(own_rig):
     """run() over frames of arrays, a list or any sequence, gives add_frame's map, their results
-    numbered by place; an item that is not a Frame is named."""
+    numbered by place, each item read once; an item that is not a Frame is named."""
     frames = [msfusion.Frame(f.left, f.right, f.scan, color=f.color, pose=f.pose) for f in own_rig]
     fed = msfusion.Reconstructor(own_rig.calibration)
     for frame in frames:
         fed.add_frame(frame)
     expected = fed.mesh().vertices
-    for source in (frames, MadeOnRead(own_rig)):
+    made_on_read = MadeOnRead(own_rig)
+    for source in (frames, made_on_read):
         engine, names = msfusion.Reconstructor(own_rig.calibration), []
         stats = engine.run(source, on_frame=lambda result: names.append((result.index, result.name)))
         assert stats["frames_done"] == 2 and names == [(0, "0"), (1, "1")]
         np.testing.assert_array_equal(engine.mesh().vertices, expected)
+    assert sorted(made_on_read.reads) == [0, 1]  # each frame made once
     engine = msfusion.Reconstructor(own_rig.calibration)
     assert engine.run(frames, frames=[-1])["frames_done"] == 1
     with pytest.raises(msfusion.InvalidInputError, match="item 1 of the frames is a str, not a msfusion.Frame"):
