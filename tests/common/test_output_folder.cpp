@@ -141,7 +141,12 @@ TEST(OutputFolder, APlainFileOrASymbolicLinkIsNotAnOutputFolder) {
   EXPECT_NE(errorOf([&] { OutputFolder(dir.file("file"), "msf_test"); }).find("not a folder"), std::string::npos);
   fs::create_directory(dir.file("real"));
   fs::create_directory_symlink(dir.file("real"), dir.file("link"));
-  EXPECT_NE(errorOf([&] { OutputFolder(dir.file("link"), "msf_test"); }).find("not a folder"), std::string::npos);
+  const std::string link = errorOf([&] { OutputFolder(dir.file("link"), "msf_test"); });
+  EXPECT_NE(link.find("output folder '" + dir.file("link") + "' is a symbolic link (to '" + dir.file("real") +
+                      "'), which the run's folder would replace: give the folder it points to"),
+            std::string::npos)
+      << link;
+  EXPECT_TRUE(fs::is_symlink(dir.file("link")));
   EXPECT_NE(errorOf([&] { OutputFolder(dir.file("missing/out"), "msf_test"); }).find("does not exist"),
             std::string::npos);
 }

@@ -768,6 +768,13 @@ if [ $have_kitti = 1 ]; then
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -config "$D/home/my.yaml" -o "$D/home"
   check "reconstruct -o the dataset itself" 1 "input '.*/seq' lies inside the output folder" -- \
     msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/seq"
+  ln -s "$D/home" "$D/homelink"
+  check "reconstruct -o a symbolic link to a user's folder" 1 "output folder '.*/homelink' is a symbolic link \(to '.*/home'\), which the run's folder would replace: give the folder it points to" -- \
+    msf_reconstruct "$D/seq" -frames 0:0 -panels 0 -o "$D/homelink"
+  if [ ! -L "$D/homelink" ]; then
+    failures=$((failures + 1))
+    echo "FAIL  reconstruct -o a symbolic link: the link went"
+  fi
   check "synth -o over a user's folder" 1 "holds 'data.csv' and is not an output of msfusion" -- \
     msf_synth -frames 1 -o "$D/home"
   check "batch -o over a user's folder" 1 "holds '(data.csv|notes.txt|my.yaml|photo.png)', which is not a batch's" -- \
@@ -820,7 +827,7 @@ if [ $have_kitti = 1 ]; then
     failures=$((failures + 1))
     echo "FAIL  project -overwrite left the file as it was"
   fi
-  if [ "$before" != "$after" ] || [ -n "$(ls -A "$D" | grep -v -x -e seq -e poses -e home -e mine)" ]; then
+  if [ "$before" != "$after" ] || [ -n "$(ls -A "$D" | grep -v -x -e seq -e poses -e home -e homelink -e mine)" ]; then
     failures=$((failures + 1))
     echo "FAIL  data loss: a user's folder changed"
     diff <(echo "$before") <(echo "$after") | head

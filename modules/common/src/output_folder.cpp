@@ -75,7 +75,12 @@ void OutputFolder::requireOwnOutput(const std::string& folder, const std::string
   const fs::path root(folder);
   if (!fs::exists(fs::symlink_status(root, ec)))
     return;
-  if (fs::is_symlink(fs::symlink_status(root, ec)) || !fs::is_directory(root, ec))
+  // A run puts its folder in the link's place: the link would be replaced, not followed.
+  if (fs::is_symlink(fs::symlink_status(root, ec)))
+    throw IOError("output folder '" + folder + "' is a symbolic link (to '" + fs::read_symlink(root, ec).string() +
+                      "'), which the run's folder would replace: give the folder it points to",
+                  folder, ENOTDIR);
+  if (!fs::is_directory(root, ec))
     throw IOError("output folder '" + folder + "' exists and is not a folder", folder, ENOTDIR);
   const std::vector<std::string> entries = entriesUnder(root);
   if (entries.empty())
