@@ -164,11 +164,15 @@ void printMapEvaluation(const msf::RunReport::MapEvaluation& e) {
 /// The console's protocol 6 lines: the open sky each mesh covers, by the image's sky mask and,
 /// on a synthetic sequence, by its true sky (where the mask also takes bright blank façades).
 void printOpenSky(const std::map<std::string, msf::SkyCoverage>& open_sky, const msf::RunReport::MapEvaluation& e) {
-  for (const auto& [name, c] : open_sky)
+  for (const auto& [name, c] : open_sky) {
+    char depth[64] = ", no surface over it";
+    if (c.covered_pixels > 0)
+      std::snprintf(depth, sizeof depth, ", at a median depth of %.1f m", c.covered_depth_median_m);
     print_info("  open sky covered by %-11s %.2f %% of %zu pixels in %zu frames (mean per frame %.2f %%, worst "
-               "%.2f %% at frame %zu), at a median depth of %.1f m\n",
+               "%.2f %% at frame %zu)%s\n",
                name.c_str(), 100 * c.share, c.sky_pixels, c.frames, 100 * c.mean_frame_share, 100 * c.worst_share,
-               c.worst_frame, c.covered_depth_median_m);
+               c.worst_frame, depth);
+  }
   for (const auto& r : e.rows)
     if (r.true_sky.sky_pixels > 0)
       print_info("  true sky covered by %-11s %.2f %% of %zu pixels (worst %.2f %% at frame %zu), by sheets off the "

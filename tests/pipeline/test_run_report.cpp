@@ -45,3 +45,22 @@ TEST(RunReport, IntegersEndingInZeroKeepTheirDigits) {
   EXPECT_NE(text.find("mesh extraction 10 ms"), std::string::npos) << text;
   EXPECT_NE(text.find("2 frames per second"), std::string::npos) << text;
 }
+
+TEST(RunReport, TheSkysCoverHasADepthOnlyWhereTheMeshCoversIt) {
+  RunReport report = reportOf(2, 1.0, 0.5);
+  msf::SkyCoverage& empty = report.open_sky["mesh"];
+  empty.frames = 2;
+  empty.sky_pixels = 93148;
+  msf::SkyCoverage& covered = report.open_sky["mesh_lidar"];
+  covered.frames = 2;
+  covered.sky_pixels = 93148;
+  covered.covered_pixels = 120;
+  covered.share = 120.0 / 93148;
+  covered.covered_depth_median_m = 32.4;
+  const std::string path = ::testing::TempDir() + "run_report_sky.md";
+  report.writeMarkdown(path);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("| mesh | 2 | 93148 | 0 % | 0 % | 0 % (frame 0) | none |"), std::string::npos) << text;
+  EXPECT_NE(text.find("(frame 0) | 32.4 m |"), std::string::npos) << text;
+}

@@ -767,7 +767,7 @@ void RunReport::writeOpenSky(std::ostream& s) const {
   for (const auto& [name, c] : open_sky)
     s << "| " << name << " | " << c.frames << " | " << c.sky_pixels << " | " << num(100 * c.share, 2) << " % | "
       << num(100 * c.mean_frame_share, 2) << " % | " << num(100 * c.worst_share, 2) << " % (frame " << c.worst_frame
-      << ") | " << num(c.covered_depth_median_m, 1) << " m |\n";
+      << ") | " << (c.covered_pixels > 0 ? num(c.covered_depth_median_m, 1) + " m" : std::string("none")) << " |\n";
   s << "\n";
   if (!sky_pictures.empty())
     s << "The sky in cyan, where the mesh covers it in red:\n\n";
