@@ -16,6 +16,14 @@ RunReport reportOf(std::size_t frames, double wall_s, double first_frame_s) {
   report.first_frame_s = first_frame_s;
   return report;
 }
+
+/// The report.md `report` writes.
+std::string markdownOf(const RunReport& report, const std::string& name) {
+  const std::string path = ::testing::TempDir() + name;
+  report.writeMarkdown(path);
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
 } // namespace
 
 TEST(RunReport, RateAfterTheFirstFrameLeavesOutTheFillingOfThePipeline) {
@@ -37,10 +45,7 @@ TEST(RunReport, IntegersEndingInZeroKeepTheirDigits) {
   report.peak_memory_mb = 7200;  // above this test process's own peak, which the report takes if larger
   report.observed_voxels = 100;
   report.mesh_ms = 10;
-  const std::string path = ::testing::TempDir() + "run_report_integers.md";
-  report.writeMarkdown(path);
-  std::ifstream in(path);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = markdownOf(report, "run_report_integers.md");
   EXPECT_NE(text.find("peak memory 7200 MiB"), std::string::npos) << text;
   EXPECT_NE(text.find("mesh extraction 10 ms"), std::string::npos) << text;
   EXPECT_NE(text.find("2 frames per second"), std::string::npos) << text;
@@ -57,10 +62,7 @@ TEST(RunReport, TheSkysCoverHasADepthOnlyWhereTheMeshCoversIt) {
   covered.covered_pixels = 120;
   covered.share = 120.0 / 93148;
   covered.covered_depth_median_m = 32.4;
-  const std::string path = ::testing::TempDir() + "run_report_sky.md";
-  report.writeMarkdown(path);
-  std::ifstream in(path);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = markdownOf(report, "run_report_sky.md");
   EXPECT_NE(text.find("| mesh | 2 | 93148 | 0 % | 0 % | 0 % (frame 0) | none |"), std::string::npos) << text;
   EXPECT_NE(text.find("(frame 0) | 32.4 m |"), std::string::npos) << text;
 }
