@@ -307,8 +307,16 @@ private:
   bool mayStream() const {
     return !streaming() && !request_.holdout && !request_.compare_sources && !request_.compare_paper;
   }
-  /// Whether the run keeps each frame's ground truth to score the whole mesh at the end (makeEvaluations).
-  bool keepsEveryFrame() const { return !streaming() && (request_.holdout || !source_.groundTruthDir().empty()); }
+  /// The pixels of each frame whose ground truth the run keeps to score the whole mesh at the end
+  /// (makeEvaluations): a synthetic drive's every pixel; under -holdout the held-out rings' returns,
+  /// a ring in rings.modulo of the scan's (those in the camera's view are fewer still).
+  double scoredPixelsPerFrame(const msf::MemoryEvidence& evidence) const {
+    if (streaming())
+      return 0.0;
+    if (!source_.groundTruthDir().empty())
+      return static_cast<double>(source_.calibration().requireImageSize().area());
+    return request_.holdout ? static_cast<double>(evidence.most_scan_returns) / config_.rings.modulo : 0.0;
+  }
   int maps() const { return 1 + (request_.compare_sources ? 2 : 0) + (request_.compare_paper ? 1 : 0); }
 
   std::unique_ptr<msf::Reconstructor> makeEngine() const {
@@ -334,7 +342,7 @@ private:
       return;
     }
     const msf::MemoryEvidence evidence = engine_->measureMemory(source_, frames_, poses);
-    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), scoredPixelsPerFrame(evidence));
     report_.predicted_memory_mb = p.total_mb;
     print_info("Memory: predicted peak %.0f MiB (%s), budget %.0f MiB%s (predicted in %.0f ms)\n", p.total_mb,
                p.describe().c_str(), budget_mb, explicitBudget() ? "" : " (three quarters of RAM)", p.ms);
@@ -363,7 +371,7 @@ private:
     const double radius = std::ceil(engine_->minimumStreamingRadius());
     config_.streaming.active_radius_m = radius;
     engine_ = makeEngine();
-    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), keepsEveryFrame());
+    const msf::MemoryPrediction p = engine_->predictMemory(evidence, maps(), scoredPixelsPerFrame(evidence));
     report_.predicted_memory_mb = p.total_mb;
     if (explicitBudget() && p.total_mb > budget_mb)
       throw msf::InvalidInputError(

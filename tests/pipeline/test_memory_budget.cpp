@@ -9,6 +9,7 @@
 #include "pipeline_fixture.h"
 #include "test_support.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -36,8 +37,7 @@ void expectPredictionHolds(const std::string& out, const char* what) {
   const double said = jsonNumber(json, "predicted_memory_mb"), peak = jsonNumber(json, "peak_memory_mb");
   EXPECT_GE(said, peak) << "a budget the prediction lets through holds the run: " << json;
   EXPECT_LE(said, kMaxOverPrediction * peak) << json;
-  std::printf("synthetic street, 1 frame, %s: predicted %.0f MiB, measured peak %.0f MiB (%.2fx)\n", what, said, peak,
-              said / peak);
+  std::printf("%s: predicted %.0f MiB, measured peak %.0f MiB (%.2fx)\n", what, said, peak, said / peak);
 }
 
 TEST_F(PipelineTest, ThePredictedPeakHoldsTheMeasuredOneAndABudgetBelowItStreamsOrRefuses) {
@@ -82,7 +82,7 @@ TEST_F(PipelineTest, ThePredictedPeakHoldsTheMeasuredOneAndABudgetBelowItStreams
   ASSERT_EQ(yes.exit_code, 0) << yes.err;
   EXPECT_NE(yes.out.find("Memory: predicted peak"), std::string::npos) << yes.out;
   EXPECT_EQ(yes.out.find("streaming the map"), std::string::npos) << yes.out;
-  expectPredictionHolds(above, "in memory");
+  expectPredictionHolds(above, "synthetic street, 1 frame, in memory");
 
   // The streamed prediction, as a run with a budget just below the in-memory one prints it,
   // streaming or refused.
@@ -108,7 +108,7 @@ TEST_F(PipelineTest, ThePredictedPeakHoldsTheMeasuredOneAndABudgetBelowItStreams
   EXPECT_NE(streams.out.find("(tiles in " + between + "/tiles)"), std::string::npos) << streams.out;
   EXPECT_TRUE(std::filesystem::is_directory(between + "/tiles"));
   EXPECT_LE(jsonNumber(readFile(between + "/summary.json"), "peak_memory_mb"), static_cast<double>(budget));
-  expectPredictionHolds(between, "streamed on its own");
+  expectPredictionHolds(between, "synthetic street, 1 frame, streamed on its own");
 
   // The same budget for a run that needs the whole map in memory: refused.
   const auto whole = msf::test::runTool("msf_reconstruct", dataset() + " -o " + refused + frames +
@@ -159,6 +159,50 @@ TEST_F(PipelineTest, AStreamedMapIsPredictedWithinItsWindow) {
   EXPECT_LT(narrow.blocks_in_memory, whole.blocks_in_memory);
   EXPECT_LT(narrow.volume_mb, whole.volume_mb);
   EXPECT_NE(narrow.describe().find("in memory at once"), std::string::npos) << narrow.describe();
+}
+
+TEST_F(PipelineTest, TheGroundTruthKeptIsPredictedByItsPixels) {
+  // What a run keeps to score the mesh at the end is counted by the pixels kept a frame: a
+  // synthetic drive's every pixel, or under -holdout its held-out returns, which the scans bound.
+  const msf::Sequence sequence(dataset());
+  const auto frames = sequence.indices(msf::FrameRange::parse("0:"));
+  msf::PoseList poses;
+  std::size_t most_returns = 0;
+  for (std::size_t i : frames) {
+    poses.push_back(sequence.poses()[i]);
+    most_returns = std::max(most_returns, sequence.loadScan(i)->size());
+  }
+  msf::Reconstructor engine(sequence.calibration(), msf::PipelineConfig{});
+  const msf::MemoryEvidence evidence = engine.measureMemory(sequence, frames, poses);
+  EXPECT_EQ(evidence.most_scan_returns, most_returns);
+  const msf::MemoryPrediction none = engine.predictMemory(evidence);
+  const msf::MemoryPrediction every = engine.predictMemory(evidence, 1, 1000.0 * 1000.0);
+  const double mib = 1024.0 * 1024.0, kept_mb = 12.0 * 1000.0 * 1000.0 * static_cast<double>(frames.size()) / mib;
+  EXPECT_NEAR(every.frames_mb - none.frames_mb, kept_mb, 1e-6) << "12 bytes a pixel a frame";
+  EXPECT_NEAR(every.total_mb - none.total_mb, kept_mb, 1e-6);
+  EXPECT_EQ(every.volume_mb, none.volume_mb);
+}
+
+TEST(MemoryPrediction, HeldOutRingsAddTheirReturnsNotAnImageAFrame) {
+  // KITTI under -holdout keeps a few thousand held-out pixels a frame, not an image: the frames'
+  // term of its prediction is the run's without -holdout and a MiB or two (the returns of a ring in
+  // four, 12 bytes each, five frames), and its peak is below the prediction.
+  MSF_REQUIRE_KITTI();
+  msf::test::TempDir dir;
+  const std::string drive = msf::test::kittiDir() + "/odometry/sequences/04 -frames 0:4 -panels 0";
+  long frames_mb[2] = {0, 0};
+  for (const bool holdout : {false, true}) {
+    const std::string out = dir.file(holdout ? "holdout" : "plain");
+    const auto r = msf::test::runTool("msf_reconstruct", drive + (holdout ? " -holdout" : "") + " -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.out, m, std::regex("frames and stage buffers ([0-9]+) MiB"))) << r.out;
+    frames_mb[holdout] = std::stol(m[1]);
+    if (holdout)
+      expectPredictionHolds(out, "odometry 04, 5 frames, under -holdout");
+  }
+  EXPECT_GE(frames_mb[1] - frames_mb[0], 1) << "the held-out returns are counted";
+  EXPECT_LE(frames_mb[1] - frames_mb[0], 3) << "an image a frame would be 40 MiB";
 }
 
 } // namespace

@@ -41,8 +41,9 @@ using Clock = std::chrono::steady_clock;
 constexpr double kStageBytesPerPixel = 370;
 // A frame in flight (images, scan, depth images).
 constexpr double kFrameBytesPerPixel = 24;
-// A frame whose ground truth the run keeps to score the mesh at the end (protocol 4).
-constexpr double kScoredFrameBytesPerPixel = 12;
+// A pixel whose ground truth the run keeps to score the mesh at the end (protocol 4): its index
+// and depth, and an estimate while later scans may still mark it.
+constexpr double kScoredBytesPerPixel = 12;
 // What the end of an in-memory run adds (the mesh, its per-block cache, the copy written and
 // volume.pcd's compressed pieces), in units of the predicted volume's bytes: above the most
 // measured in units of the real volume's, since the predicted volume can be as little as the real one.
@@ -462,7 +463,7 @@ ScanBandBlocks Reconstructor::scanBands() const {
 }
 
 ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                          const PoseList& T_world_cam0) const {
+                                          const PoseList& T_world_cam0, std::size_t& most_returns) const {
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   ScanBandBlocks bands = scanBands();
   // The next scan is read while this one's bands are found (one read at a time, off this thread).
@@ -477,6 +478,7 @@ ScanBandBlocks Reconstructor::scanBandsOf(const FrameSource& source, const std::
     if (k + 1 < frames.size())
       next = read(k + 1);
     bands.addScan(*scan, calibration_.T_cam0_velo, canvas, T_world_cam0[k]);
+    most_returns = std::max(most_returns, scan->size());
   }
   return bands;
 }
@@ -568,7 +570,10 @@ MemoryEvidence Reconstructor::measureMemory(const FrameSource& source, const std
   BlockFootprint footprint(config_.volume.voxel_size_m);
   for (const Eigen::Isometry3d& T : T_world_cam0)
     footprint.addView(canvas, T, config_.integrator.min_depth_m, far_m);
-  MemoryEvidence evidence{T_world_cam0, std::move(footprint), scanBandsOf(source, frames, T_world_cam0)};
+  std::size_t most_scan_returns = 0;
+  MemoryEvidence evidence{T_world_cam0, std::move(footprint),
+                          scanBandsOf(source, frames, T_world_cam0, most_scan_returns)};
+  evidence.most_scan_returns = most_scan_returns;
   evidence.blocks_per_band_block = blocksPerBandBlock(source, frames, T_world_cam0);
   evidence.process_mb = process_mb;
   evidence.ms = msSince(start);
@@ -576,7 +581,7 @@ MemoryEvidence Reconstructor::measureMemory(const FrameSource& source, const std
 }
 
 MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, int maps,
-                                              bool scores_every_frame) const {
+                                              double scored_pixels_per_frame) const {
   const auto start = Clock::now();
   MemoryPrediction p;
   p.frames = evidence.T_world_cam0.size();
@@ -599,9 +604,8 @@ MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, in
   const double in_flight =
       std::min(static_cast<double>(p.frames), 3.0 + 2.0 * config_.scheduling.queue_capacity);
   p.frames_mb = pixels *
-                (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel +
-                 (scores_every_frame ? kScoredFrameBytesPerPixel * static_cast<double>(p.frames) : 0.0)) /
-                kMiB;
+                    (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel) / kMiB +
+                scored_pixels_per_frame * kScoredBytesPerPixel * static_cast<double>(p.frames) / kMiB;
   // The end of the run: an in-memory map is meshed and written whole, a streamed one tile by
   // tile as the camera moves on, within the window's volume.
   p.mesh_mb = (config_.streaming.enabled() ? kStreamedEndShare : kEndOfRunShare) * map_mb;
@@ -611,8 +615,9 @@ MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, in
 }
 
 MemoryPrediction Reconstructor::predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                              const PoseList& T_world_cam0, int maps, bool scores_every_frame) {
-  return predictMemory(measureMemory(source, frames, T_world_cam0), maps, scores_every_frame);
+                                              const PoseList& T_world_cam0, int maps,
+                                              double scored_pixels_per_frame) {
+  return predictMemory(measureMemory(source, frames, T_world_cam0), maps, scored_pixels_per_frame);
 }
 
 const TriangleMesh& Reconstructor::mesh() {

@@ -39,6 +39,7 @@ struct MemoryPrediction {
   std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all: the bound
   std::size_t band_blocks = 0;       ///< blocks within the band of the scans' returns in view, in all
   double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
+  std::size_t most_scan_returns = 0; ///< the most returns a scan of the run holds
   std::size_t blocks = 0;            ///< blocks the run is predicted to allocate, in all
   std::size_t blocks_in_memory = 0;  ///< at once: all of them, or with -stream the most within the window
   double process_mb = 0;  ///< the process when predicting (libraries, calibration, config)
@@ -60,6 +61,7 @@ struct MemoryEvidence {
   BlockFootprint footprint;          ///< the blocks every frame's view meets: the bound
   ScanBandBlocks bands;              ///< the blocks within the band of the scans' returns in view
   double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
+  std::size_t most_scan_returns = 0; ///< the most returns a scan of the run holds
   double process_mb = 0;             ///< the process before the calibration frames
   double ms = 0;                     ///< time the measure took
 };
@@ -258,12 +260,14 @@ public:
   /// integrator and projection configuration, streamed or not): see MemoryPrediction. With
   /// streaming, the volume term is the most blocks within the active radius (grown by a tile) of
   /// any frame's camera. `maps` is the number of volumes the caller fills from the same frames
-  /// (msf_reconstruct -compare_sources: 3); `scores_every_frame`: the caller keeps each frame's
-  /// ground truth to the end (protocol 4).
-  MemoryPrediction predictMemory(const MemoryEvidence& evidence, int maps = 1, bool scores_every_frame = false) const;
+  /// (msf_reconstruct -compare_sources: 3); `scored_pixels_per_frame`: the pixels of each frame
+  /// whose ground truth the caller keeps to the end (protocol 4): a synthetic drive's every pixel,
+  /// the held-out rings' returns under -holdout; 0: none.
+  MemoryPrediction predictMemory(const MemoryEvidence& evidence, int maps = 1,
+                                 double scored_pixels_per_frame = 0) const;
   /// Both: measureMemory, then predictMemory from it.
   MemoryPrediction predictMemory(const FrameSource& source, const std::vector<std::size_t>& frames,
-                                 const PoseList& T_world_cam0, int maps = 1, bool scores_every_frame = false);
+                                 const PoseList& T_world_cam0, int maps = 1, double scored_pixels_per_frame = 0);
 
   /// The least streaming.active_radius_m a streamed map of this run accepts: the integrator's
   /// reach over the LiDAR's canvas plus a tile (StreamingMap::minimumRadius).
@@ -333,8 +337,9 @@ private:
   void startStreaming();
   // The memory prediction's steps (predictMemory).
   ScanBandBlocks scanBands() const;
+  /// The scans' bands, and in `most_returns` the most returns a scan holds.
   ScanBandBlocks scanBandsOf(const FrameSource& source, const std::vector<std::size_t>& frames,
-                             const PoseList& T_world_cam0) const;
+                             const PoseList& T_world_cam0, std::size_t& most_returns) const;
   /// The blocks a frame's fused depth allocates per block of its scan's band, the most over a few
   /// frames spread over the run; 0 when none could be measured.
   double blocksPerBandBlock(const FrameSource& source, const std::vector<std::size_t>& frames,
