@@ -598,14 +598,14 @@ MemoryPrediction Reconstructor::predictMemory(const MemoryEvidence& evidence, in
   p.volume_mb = map_mb * (1.0 + kOtherMapShare * (maps - 1));
   // The frames in flight: one in each of the three stages (loading, depth, integration) and
   // queue_capacity in each of the two queues between them (no more than the run's frames), over
-  // the stages' own buffers; and the frames whose ground truth the caller keeps.
+  // the stages' own buffers; and the pixels of ground truth the caller keeps, each frame's.
   const PinholeCamera canvas = stages_->lidar.projector().canvasCamera();
   const double pixels = static_cast<double>(canvas.width) * canvas.height;
   const double in_flight =
       std::min(static_cast<double>(p.frames), 3.0 + 2.0 * config_.scheduling.queue_capacity);
-  p.frames_mb = pixels *
-                    (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel) / kMiB +
-                scored_pixels_per_frame * kScoredBytesPerPixel * static_cast<double>(p.frames) / kMiB;
+  const double stage_bytes = pixels * (kStageBytesPerPixel + in_flight * kFrameBytesPerPixel);
+  const double kept_bytes = scored_pixels_per_frame * kScoredBytesPerPixel * static_cast<double>(p.frames);
+  p.frames_mb = (stage_bytes + kept_bytes) / kMiB;
   // The end of the run: an in-memory map is meshed and written whole, a streamed one tile by
   // tile as the camera moves on, within the window's volume.
   p.mesh_mb = (config_.streaming.enabled() ? kStreamedEndShare : kEndOfRunShare) * map_mb;
