@@ -42,8 +42,8 @@ constexpr double kStageBytesPerPixel = 370;
 // A frame in flight (images, scan, depth images).
 constexpr double kFrameBytesPerPixel = 24;
 // A pixel whose ground truth the run keeps to score the mesh at the end (protocol 4): its index
-// and depth, and an estimate while later scans may still mark it.
-constexpr double kScoredBytesPerPixel = 12;
+// and its depth (the estimates waiting for later scans to mark them are a few frames' only).
+constexpr double kScoredBytesPerPixel = 8;
 // What the end of an in-memory run adds (the mesh, its per-block cache, the copy written and
 // volume.pcd's compressed pieces), in units of the predicted volume's bytes: above the most
 // measured in units of the real volume's, since the predicted volume can be as little as the real one.
