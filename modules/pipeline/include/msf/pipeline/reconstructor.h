@@ -39,7 +39,6 @@ struct MemoryPrediction {
   std::size_t footprint_blocks = 0;  ///< blocks the frames' views can allocate, in all: the bound
   std::size_t band_blocks = 0;       ///< blocks within the band of the scans' returns in view, in all
   double blocks_per_band_block = 0;  ///< measured on the calibration frames; 0 when not measured
-  std::size_t most_scan_returns = 0; ///< the most returns a scan of the run holds
   std::size_t blocks = 0;            ///< blocks the run is predicted to allocate, in all
   std::size_t blocks_in_memory = 0;  ///< at once: all of them, or with -stream the most within the window
   double process_mb = 0;  ///< the process when predicting (libraries, calibration, config)
